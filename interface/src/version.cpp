@@ -1,0 +1,5 @@
+#include "partita/interface/version.hpp"
+
+namespace partita {
+const char* version() { return PARTITA_VERSION; }
+}  // namespace partita
