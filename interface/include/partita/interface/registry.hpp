@@ -1,0 +1,76 @@
+#pragma once
+// A registry of named factories. Registration is explicit: a module offers a function
+// `register_builtin(...)` with one add() line per entry; no static self-registration.
+// An unknown name is an error in every build type, listing the known names and the nearest.
+
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "partita/interface/config.hpp"
+#include "partita/interface/error.hpp"
+
+namespace partita {
+
+template <class Factory>
+class Registry {
+ public:
+  struct Entry {
+    std::string name;
+    std::string doc;                     ///< one line
+    Factory factory;
+    std::shared_ptr<const config::Spec> spec;  ///< its parameters (may be null)
+  };
+
+  /// `kind` names what is registered ("solver", "mapper", ...) for messages.
+  explicit Registry(std::string kind) : kind_(std::move(kind)) {}
+
+  /// Add an entry; a duplicate name is an error.
+  void add(std::string name, std::string doc, Factory factory,
+           std::shared_ptr<const config::Spec> spec = nullptr) {
+    if (contains(name)) throw Error(kind_ + " '" + name + "' is registered twice");
+    entries_.push_back(Entry{std::move(name), std::move(doc), std::move(factory), std::move(spec)});
+  }
+
+  bool contains(std::string_view name) const { return find(name) != nullptr; }
+
+  const Entry* find(std::string_view name) const {
+    for (const auto& e : entries_)
+      if (e.name == name) return &e;
+    return nullptr;
+  }
+
+  /// The entry, or partita::Error "unknown <kind> 'x'; known: a, b, c; did you mean 'a'?".
+  const Entry& get(std::string_view name) const {
+    if (const Entry* e = find(name)) return *e;
+    throw Error(unknown_message(name));
+  }
+
+  /// Same, but the error points at a YAML node.
+  const Entry& get(const config::Node& where) const {
+    const std::string name = where.as_string();
+    if (const Entry* e = find(name)) return *e;
+    where.fail(unknown_message(name));
+  }
+
+  std::vector<std::string> names() const {
+    std::vector<std::string> n;
+    for (const auto& e : entries_) n.push_back(e.name);
+    return n;
+  }
+  const std::vector<Entry>& entries() const { return entries_; }
+  const std::string& kind() const { return kind_; }
+
+  std::string unknown_message(std::string_view name) const {
+    return "unknown " + kind_ + " '" + std::string(name) + "'; known " + kind_ + "s: " +
+           join_names(names()) + did_you_mean(name, names());
+  }
+
+ private:
+  std::string kind_;
+  std::vector<Entry> entries_;
+};
+
+}  // namespace partita

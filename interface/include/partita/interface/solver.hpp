@@ -1,0 +1,131 @@
+#pragma once
+// The Solver contract: what an adapter implements so that the coupling core can drive a solver
+// without knowing what it computes.
+//
+// Call order (the coupling core guarantees it):
+//
+//   1. The factory builds the solver from its YAML section (SolverContext); the solver reads
+//      its own inputs and sets up its initial state (time 0).
+//   2. meshes() — called once after construction; the list and the reference coordinates of
+//      its meshes stay fixed for the whole run.
+//   3. Once before the first window: write_output(frame 0) and monitors() for t = 0, and the
+//      core asks write() for the initial values of every exchanged field.
+//   4. For every time window [t_n, t_n + Δt]:
+//        (implicit schemes) save_checkpoint()            — state at t_n
+//        for every substep k of the window:
+//          read(mesh, data, values)  for each field it receives (values already mapped to its
+//                                    mesh and interpolated in time to the substep's end)
+//          advance(dt_k)             — one step of its own physics, dt_k <= stable_time_step()
+//          write(mesh, data, values) for each field it sends (the core combines substeps)
+//        (implicit schemes, not converged) restore_checkpoint() and repeat the window
+//      after an accepted window: monitors(); write_output() when an output time is reached.
+//   5. finalize() — once, after the last window (close files, print summaries).
+//
+// read() may be called several times before one advance(); the last call for a field wins.
+// A field's values are N x C matrices: N = the mesh's number of points, C = its components.
+
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "partita/interface/config.hpp"
+#include "partita/interface/mesh.hpp"
+
+namespace partita {
+
+/// How a field behaves under mapping between non-matching meshes.
+enum class DataKind {
+  intensive,  ///< a density or a point value (displacement, traction): mapped consistently
+  extensive,  ///< an amount that adds up (force): mapped conservatively, sums preserved
+};
+
+/// A field a solver sends or receives on one of its meshes.
+struct DataSpec {
+  std::string name;     ///< "displacement", "traction", "force", "pressure", ...
+  int components = 3;   ///< columns of the values matrix
+  std::string unit;     ///< SI unit, e.g. "m", "Pa", "N"
+  DataKind kind = DataKind::intensive;
+};
+
+/// A mesh a solver exposes to the coupling, with what it can receive and send on it.
+struct InterfaceMesh {
+  Mesh mesh;
+  std::vector<DataSpec> reads;   ///< fields the solver accepts through read()
+  std::vector<DataSpec> writes;  ///< fields the solver provides through write()
+};
+
+/// A scalar the solver reports after each accepted window (for monitors / CSV).
+struct MonitorValue {
+  std::string name;  ///< e.g. "kinetic_energy", "plate.force_z"
+  std::string unit;  ///< SI unit, e.g. "J", "N"
+  double value = 0.0;
+};
+
+/// Where and when write_output() writes.
+struct OutputFrame {
+  std::filesystem::path vtk_directory;  ///< DIR/vtk of the run (exists)
+  std::string prefix;                   ///< participant name: files start with it
+  int index = 0;                        ///< frame number, 0, 1, 2, ...
+  double time = 0.0;                    ///< simulated time [s]
+};
+
+/// The abstract solver a coupling participant wraps. See the call order above.
+class Solver {
+ public:
+  virtual ~Solver() = default;
+
+  /// The coupling meshes in the reference configuration, with their readable/writable fields.
+  virtual const std::vector<InterfaceMesh>& meshes() const = 0;
+
+  /// Give the solver the values of a field it receives (N x C on that mesh's points).
+  virtual void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) = 0;
+
+  /// Ask the solver for the values of a field it sends (resized to N x C by the solver).
+  virtual void write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) = 0;
+
+  /// The largest step the solver can take now [s]; +infinity when unconditionally stable.
+  virtual double stable_time_step() const { return std::numeric_limits<double>::infinity(); }
+
+  /// One step of the solver's own physics, of length dt [s].
+  virtual void advance(double dt) = 0;
+
+  /// The solver's current time [s].
+  virtual double time() const = 0;
+
+  /// Keep the complete state (one slot); restore_checkpoint() returns to it bit for bit.
+  virtual void save_checkpoint() = 0;
+  virtual void restore_checkpoint() = 0;
+
+  /// Write VTK files for this frame under frame.vtk_directory (the core keeps the .pvd series
+  /// from what add_output_file() was told).
+  virtual void write_output(const OutputFrame& frame) {}
+
+  /// Files written by the last write_output() call, relative to vtk_directory, with a series
+  /// name each (e.g. {"particles", "granules_particles_000012.vtp"}).
+  virtual std::vector<std::pair<std::string, std::string>> output_files() const { return {}; }
+
+  /// Scalar quantities after the last accepted window.
+  virtual std::vector<MonitorValue> monitors() const { return {}; }
+
+  /// Once after the last window.
+  virtual void finalize() {}
+};
+
+/// What a solver factory receives.
+struct SolverContext {
+  std::string name;                    ///< participant name in the case
+  config::Node config;                 ///< the participant's YAML section
+  std::filesystem::path case_dir;      ///< folder of the case file (relative inputs)
+  std::filesystem::path output_dir;    ///< the run's output folder
+  int threads = 1;                     ///< threads the solver may use
+};
+
+using SolverFactory = std::function<std::unique_ptr<Solver>(const SolverContext&)>;
+
+}  // namespace partita

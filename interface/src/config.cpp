@@ -1,0 +1,608 @@
+#include "partita/interface/config.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace partita::config {
+
+// ---------------------------------------------------------------------------------------------
+// Types and parameters
+
+const char* type_name(Type t) {
+  switch (t) {
+    case Type::real: return "real";
+    case Type::integer: return "integer";
+    case Type::boolean: return "boolean";
+    case Type::string: return "string";
+    case Type::choice: return "choice";
+    case Type::reals: return "list of reals";
+    case Type::integers: return "list of integers";
+    case Type::strings: return "list of strings";
+    case Type::section: return "section";
+    case Type::list: return "list of sections";
+    case Type::any: return "any";
+  }
+  return "?";
+}
+
+Param::Param(std::string key, Type type, std::string doc)
+    : key_(std::move(key)), type_(type), doc_(std::move(doc)) {}
+
+Param& Param::required(bool r) {
+  required_ = r;
+  return *this;
+}
+Param& Param::def(double v) {
+  default_ = YAML::Node(v);
+  return *this;
+}
+Param& Param::def(long v) {
+  default_ = YAML::Node(v);
+  return *this;
+}
+Param& Param::def(bool v) {
+  default_ = YAML::Node(v);
+  return *this;
+}
+Param& Param::def(const char* v) { return def(std::string(v)); }
+Param& Param::def(std::string v) {
+  default_ = YAML::Node(v);
+  return *this;
+}
+Param& Param::def(std::vector<double> v) {
+  YAML::Node n(YAML::NodeType::Sequence);
+  for (double x : v) n.push_back(x);
+  default_ = n;
+  return *this;
+}
+Param& Param::unit(std::string u) {
+  unit_ = std::move(u);
+  return *this;
+}
+Param& Param::min(double v, bool exclusive) {
+  min_ = {v, exclusive};
+  return *this;
+}
+Param& Param::max(double v, bool exclusive) {
+  max_ = {v, exclusive};
+  return *this;
+}
+Param& Param::range(double lo, double hi, bool open) {
+  min(lo, open);
+  return max(hi, open);
+}
+Param& Param::choices(std::vector<std::string> names) {
+  choices_ = std::move(names);
+  return *this;
+}
+Param& Param::size(int n) {
+  size_ = n;
+  return *this;
+}
+Param& Param::spec(std::shared_ptr<const Spec> s) {
+  spec_ = std::move(s);
+  return *this;
+}
+
+namespace {
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(12);
+  s << v;
+  return s.str();
+}
+}  // namespace
+
+std::string Param::bounds_text() const {
+  if (!min_ && !max_) return "";
+  std::string s;
+  if (min_) s += num(min_->first) + (min_->second ? " < " : " <= ");
+  s += "value";
+  if (max_) s += (max_->second ? " < " : " <= ") + num(max_->first);
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Spec
+
+Spec::Spec(std::string name, std::string doc) : name_(std::move(name)), doc_(std::move(doc)) {}
+
+Param& Spec::add(std::string key, Type type, std::string doc) {
+  for (const auto& p : params_)
+    if (p.key() == key) throw Error("spec '" + name_ + "' declares key '" + key + "' twice");
+  params_.emplace_back(std::move(key), type, std::move(doc));
+  return params_.back();
+}
+
+Spec& Spec::one_of(std::vector<std::string> keys, bool required) {
+  one_of_.emplace_back(std::move(keys), required);
+  return *this;
+}
+
+const Param* Spec::find(std::string_view key) const {
+  for (const auto& p : params_)
+    if (p.key() == key) return &p;
+  return nullptr;
+}
+
+std::vector<std::string> Spec::keys() const {
+  std::vector<std::string> k;
+  for (const auto& p : params_) k.push_back(p.key());
+  return k;
+}
+
+namespace {
+
+std::string default_text(const YAML::Node& n) {
+  if (n.IsScalar()) return n.Scalar();
+  if (n.IsSequence()) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < n.size(); ++i) s += (i ? ", " : "") + default_text(n[i]);
+    return s + "]";
+  }
+  return "";
+}
+
+// Checks of one value against its parameter declaration (shared by validate() and getters).
+void check_value(const Node& c, const Param& p);
+
+bool is_number_text(const std::string& s) {
+  double v;
+  auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  return r.ec == std::errc() && r.ptr == s.data() + s.size();
+}
+
+void check_bounds(const Node& c, const Param& p, double v) {
+  bool ok = true;
+  if (p.min_bound()) ok = ok && (p.min_bound()->second ? v > p.min_bound()->first : v >= p.min_bound()->first);
+  if (p.max_bound()) ok = ok && (p.max_bound()->second ? v < p.max_bound()->first : v <= p.max_bound()->first);
+  if (!ok)
+    c.fail("value " + num(v) + (p.unit_name().empty() ? "" : " " + p.unit_name()) +
+           " is out of range; allowed: " + p.bounds_text() +
+           (p.unit_name().empty() ? "" : " (" + p.unit_name() + ")"));
+}
+
+void check_choice(const Node& c, const Param& p, const std::string& v) {
+  if (p.allowed().empty()) return;
+  for (const auto& a : p.allowed())
+    if (a == v) return;
+  c.fail("unknown value '" + v + "'; allowed: " + join_names(p.allowed()) + did_you_mean(v, p.allowed()));
+}
+
+void check_value(const Node& c, const Param& p) {
+  switch (p.type()) {
+    case Type::real: check_bounds(c, p, c.as_real(p.unit_name())); break;
+    case Type::integer: check_bounds(c, p, static_cast<double>(c.as_integer())); break;
+    case Type::boolean: c.as_boolean(); break;
+    case Type::string: c.as_string(); break;
+    case Type::choice: check_choice(c, p, c.as_string()); break;
+    case Type::reals:
+    case Type::integers:
+    case Type::strings: {
+      if (!c.is_sequence())
+        c.fail(std::string("expected a ") + type_name(p.type()) + " such as [1, 2, 3], found " + c.describe());
+      if (p.length() >= 0 && static_cast<int>(c.size()) != p.length())
+        c.fail("expected " + std::to_string(p.length()) + " values, found " + std::to_string(c.size()));
+      for (const Node& e : c.items()) {
+        if (p.type() == Type::reals) check_bounds(e, p, e.as_real(p.unit_name()));
+        else if (p.type() == Type::integers) check_bounds(e, p, static_cast<double>(e.as_integer()));
+        else check_choice(e, p, e.as_string());
+      }
+      break;
+    }
+    case Type::section:
+      if (p.sub_spec()) p.sub_spec()->validate(c);
+      else if (!c.is_map()) c.fail("expected a map, found " + c.describe());
+      break;
+    case Type::list:
+      if (!c.is_sequence()) c.fail("expected a list (a YAML sequence '- ...'), found " + c.describe());
+      if (p.sub_spec())
+        for (const Node& e : c.items()) p.sub_spec()->validate(e);
+      break;
+    case Type::any: break;
+  }
+}
+
+}  // namespace
+
+void Spec::validate(const Node& node) const {
+  if (!node.defined()) {
+    // An absent or empty section: only its required keys can be wrong.
+    for (const auto& p : params_)
+      if (p.is_required())
+        node.fail("missing required key '" + p.key() + "' (" + type_name(p.type()) +
+                  (p.unit_name().empty() ? "" : ", " + p.unit_name()) + ": " + p.doc() + ")");
+    return;
+  }
+  if (!node.is_map()) node.fail("expected a map for " + name_ + " (" + doc_ + "), found " + node.describe());
+  std::set<std::string> seen;
+  const std::vector<std::string> allowed = keys();
+  for (auto it = node.yaml().begin(); it != node.yaml().end(); ++it) {
+    const std::string key = it->first.as<std::string>();
+    Node key_node(it->first, nullptr, node.path().empty() ? key : node.path() + "." + key);
+    SourceLocation where{node.file(), it->first.Mark().line + 1, it->first.Mark().column + 1};
+    if (!seen.insert(key).second)
+      throw Error(where, key_node.path(), "duplicate key '" + key + "' (each key may appear once)");
+    if (!find(key))
+      throw Error(where, key_node.path(),
+                  "unknown key '" + key + "' in " + name_ + "; allowed keys: " + join_names(allowed) +
+                      did_you_mean(key, allowed));
+  }
+  for (const auto& p : params_) {
+    if (node.has(p.key()) && node[p.key()].defined()) {
+      check_value(node[p.key()], p);
+    } else if (p.is_required()) {
+      node.fail("missing required key '" + p.key() + "' (" + type_name(p.type()) +
+                (p.unit_name().empty() ? "" : ", " + p.unit_name()) + ": " + p.doc() + ")");
+    }
+  }
+  for (const auto& [group, required] : one_of_) {
+    std::vector<std::string> present;
+    for (const auto& k : group)
+      if (node.has(k)) present.push_back(k);
+    if (present.size() > 1)
+      node.fail("keys " + join_names(present) + " exclude each other; give only one of: " + join_names(group));
+    if (required && present.empty()) node.fail("give exactly one of: " + join_names(group));
+  }
+}
+
+std::string Spec::docs(int indent) const {
+  const std::string pad(static_cast<std::size_t>(indent), ' ');
+  std::string s = pad + name_ + ": " + doc_ + "\n";
+  for (const auto& p : params_) {
+    s += pad + "  " + p.key() + " (" + type_name(p.type());
+    if (!p.unit_name().empty()) s += ", " + p.unit_name();
+    if (p.is_required()) s += ", required";
+    if (p.default_value()) s += ", default " + default_text(*p.default_value());
+    s += ")";
+    if (!p.allowed().empty()) s += " one of: " + join_names(p.allowed()) + ";";
+    if (!p.bounds_text().empty()) s += " " + p.bounds_text() + ";";
+    s += " " + p.doc() + "\n";
+    if (p.sub_spec()) s += p.sub_spec()->docs(indent + 4);
+  }
+  for (const auto& [group, required] : one_of_)
+    s += pad + "  (" + (required ? "exactly" : "at most") + " one of: " + join_names(group) + ")\n";
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Quantities with units
+
+std::optional<double> parse_quantity(std::string_view text, std::string_view unit, std::string* why) {
+  auto trim = [](std::string_view s) {
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+    while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+    return s;
+  };
+  text = trim(text);
+  double value = 0;
+  const char* begin = text.data();
+  const char* end = text.data() + text.size();
+  if (!text.empty() && text.front() == '+') ++begin;
+  auto r = std::from_chars(begin, end, value);
+  if (r.ec != std::errc()) {
+    if (why) *why = "not a number";
+    return std::nullopt;
+  }
+  if (!std::isfinite(value)) {
+    if (why) *why = "not a finite number";
+    return std::nullopt;
+  }
+  const std::string_view token = trim(std::string_view(r.ptr, static_cast<std::size_t>(end - r.ptr)));
+  if (token.empty()) return value;
+  if (unit.empty()) {
+    if (why) *why = "'" + std::string(token) + "' follows the number, but this value takes no unit";
+    return std::nullopt;
+  }
+  if (token == unit) return value;
+  static const std::vector<std::pair<std::string, double>> prefixes = {
+      {"G", 1e9}, {"M", 1e6}, {"k", 1e3}, {"c", 1e-2}, {"m", 1e-3}, {"u", 1e-6}, {"\xC2\xB5", 1e-6}, {"n", 1e-9}};
+  // The base symbol: a declared unit that itself carries a prefix (kg) is rebased (g).
+  std::string base(unit);
+  double base_factor = 1.0;
+  if (base.size() > 1 && base[0] == 'k' && base.substr(1, 1) == "g") {
+    base = base.substr(1);
+    base_factor = 1e-3;
+  }
+  // Power of the first symbol (m^2, m^3): the prefix is raised to it.
+  int power = 1;
+  const auto slash = base.find('/');
+  const auto caret = base.find('^');
+  if (caret != std::string::npos && (slash == std::string::npos || caret < slash) && caret + 1 < base.size())
+    power = base[caret + 1] - '0';
+  for (const auto& [p, f] : prefixes) {
+    if (token == p + base) return value * std::pow(f, power) * base_factor;
+  }
+  if (base_factor != 1.0 && token == base) return value * base_factor;
+  if (why)
+    *why = "unit '" + std::string(token) + "' is not allowed here; the unit is " + std::string(unit) +
+           " (SI prefixes G, M, k, m, u, n may precede it)";
+  return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Node
+
+namespace {
+const std::string& empty_string() {
+  static const std::string s;
+  return s;
+}
+}  // namespace
+
+Node::Node(YAML::Node node, std::shared_ptr<const std::string> file, std::string path,
+           std::shared_ptr<const Spec> spec)
+    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)), spec_(std::move(spec)) {}
+
+Node Node::load_string(const std::string& text, const std::string& name) {
+  auto file = std::make_shared<const std::string>(name);
+  try {
+    YAML::Node root = YAML::Load(text);
+    Node n(root, file, "");
+    n.fallback_ = SourceLocation{name, 1, 1};
+    return n;
+  } catch (const YAML::Exception& e) {
+    throw Error(SourceLocation{name, e.mark.line + 1, e.mark.column + 1}, "",
+                "YAML syntax error: " + e.msg + " (check indentation, colons and brackets)");
+  }
+}
+
+Node Node::load_file(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec))
+    throw Error("cannot open '" + file.string() + "': no such file");
+  if (std::filesystem::is_directory(file, ec))
+    throw Error("cannot read '" + file.string() + "': it is a directory, a YAML file is expected");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error("cannot open '" + file.string() + "' for reading");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return load_string(ss.str(), file.string());
+}
+
+const std::string& Node::file() const { return file_ ? *file_ : empty_string(); }
+
+SourceLocation Node::location() const {
+  if (node_.IsDefined()) {
+    const YAML::Mark m = node_.Mark();
+    if (m.line >= 0) return SourceLocation{file(), m.line + 1, m.column + 1};
+  }
+  SourceLocation f = fallback_;
+  if (f.file.empty()) f.file = file();
+  return f;
+}
+
+std::string Node::describe() const {
+  if (!node_.IsDefined() || node_.IsNull()) return "nothing";
+  if (node_.IsScalar()) return "'" + node_.Scalar() + "'";
+  if (node_.IsMap()) return "a map";
+  if (node_.IsSequence()) return "a sequence";
+  return "?";
+}
+
+void Node::fail(const std::string& message) const { throw Error(location(), path_, message); }
+
+const Param* Node::param(std::string_view key) const { return spec_ ? spec_->find(key) : nullptr; }
+
+Node Node::child(std::string_view key, const YAML::Node& n, bool from_default) const {
+  std::string p = path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  std::shared_ptr<const Spec> s;
+  if (const Param* pr = param(key); pr && pr->type() == Type::section) s = pr->sub_spec();
+  Node c(n, file_, std::move(p), s);
+  c.fallback_ = location();
+  if (const Param* pr = param(key); pr && pr->type() == Type::list && pr->sub_spec()) {
+    // Items of a declared list get the item spec: remember it through a one-param wrapper.
+    auto w = std::make_shared<Spec>(pr->key(), pr->doc());
+    w->list("[]", pr->doc(), pr->sub_spec());
+    c.spec_ = w;
+  }
+  (void)from_default;
+  return c;
+}
+
+bool Node::has(std::string_view key) const {
+  if (!node_.IsDefined() || !node_.IsMap()) return false;
+  for (auto it = node_.begin(); it != node_.end(); ++it)
+    if (it->first.Scalar() == key) return true;
+  return false;
+}
+
+Node Node::operator[](std::string_view key) const {
+  if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap())
+    fail("expected a map containing '" + std::string(key) + "', found " + describe());
+  if (node_.IsDefined() && node_.IsMap()) {
+    for (auto it = node_.begin(); it != node_.end(); ++it)
+      if (it->first.Scalar() == key) return child(key, it->second, false);
+  }
+  if (const Param* p = param(key); p && p->default_value()) return child(key, *p->default_value(), true);
+  return child(key, YAML::Node(YAML::NodeType::Undefined), false);
+}
+
+Node Node::operator[](std::size_t i) const {
+  if (!node_.IsDefined() || !node_.IsSequence()) fail("expected a sequence, found " + describe());
+  if (i >= node_.size())
+    fail("index " + std::to_string(i) + " is past the end of a sequence of " + std::to_string(node_.size()));
+  std::shared_ptr<const Spec> s;
+  if (spec_ && spec_->params().size() == 1 && spec_->params().front().key() == "[]")
+    s = spec_->params().front().sub_spec();
+  Node c(node_[i], file_, path_ + "[" + std::to_string(i) + "]", s);
+  c.fallback_ = location();
+  return c;
+}
+
+std::vector<Node> Node::items() const {
+  std::vector<Node> v;
+  if (!defined()) return v;
+  if (!node_.IsSequence()) fail("expected a sequence ('- ...' items or [a, b]), found " + describe());
+  for (std::size_t i = 0; i < node_.size(); ++i) v.push_back((*this)[i]);
+  return v;
+}
+
+std::vector<std::string> Node::keys() const {
+  std::vector<std::string> k;
+  if (!defined()) return k;
+  if (!node_.IsMap()) fail("expected a map, found " + describe());
+  for (auto it = node_.begin(); it != node_.end(); ++it) k.push_back(it->first.Scalar());
+  return k;
+}
+
+Node Node::validated(std::shared_ptr<const Spec> spec) const {
+  spec->validate(*this);
+  Node n = *this;
+  n.spec_ = std::move(spec);
+  return n;
+}
+
+Node Node::validated(const Spec& spec) const { return validated(std::make_shared<const Spec>(spec)); }
+
+// --- typed values of this node ---------------------------------------------------------------
+
+double Node::as_real(std::string_view unit) const {
+  if (!defined()) fail("missing value; expected a real number" + (unit.empty() ? std::string() : " [" + std::string(unit) + "]"));
+  if (!node_.IsScalar()) fail("expected a real number, found " + describe());
+  std::string why;
+  auto v = parse_quantity(node_.Scalar(), unit, &why);
+  if (!v)
+    fail("expected a real number" + (unit.empty() ? std::string() : " in " + std::string(unit)) + ", found " +
+         describe() + " (" + why + ")");
+  return *v;
+}
+
+long Node::as_integer() const {
+  if (!defined()) fail("missing value; expected an integer");
+  if (!node_.IsScalar()) fail("expected an integer, found " + describe());
+  const std::string& s = node_.Scalar();
+  long v = 0;
+  const char* b = s.data();
+  if (!s.empty() && s[0] == '+') ++b;
+  auto r = std::from_chars(b, s.data() + s.size(), v);
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size())
+    fail("expected an integer, found " + describe() + (is_number_text(s) ? " (a whole number is required)" : ""));
+  return v;
+}
+
+bool Node::as_boolean() const {
+  if (!defined()) fail("missing value; expected true or false");
+  if (!node_.IsScalar()) fail("expected true or false, found " + describe());
+  std::string s = node_.Scalar();
+  for (auto& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (s == "true" || s == "yes" || s == "on") return true;
+  if (s == "false" || s == "no" || s == "off") return false;
+  fail("expected true or false, found " + describe());
+}
+
+std::string Node::as_string() const {
+  if (!defined()) fail("missing value; expected a string");
+  if (!node_.IsScalar()) fail("expected a string, found " + describe());
+  return node_.Scalar();
+}
+
+std::vector<double> Node::as_reals(std::string_view unit) const {
+  if (!defined()) fail("missing value; expected a list of reals");
+  if (!node_.IsSequence()) fail("expected a list of reals such as [0, 0, 1], found " + describe());
+  std::vector<double> v;
+  for (const Node& e : items()) v.push_back(e.as_real(unit));
+  return v;
+}
+
+Eigen::Vector3d Node::as_vec3(std::string_view unit) const {
+  const std::vector<double> v = as_reals(unit);
+  if (v.size() != 3) fail("expected 3 values [x, y, z], found " + std::to_string(v.size()));
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+// --- typed values of children ----------------------------------------------------------------
+
+void Node::check_param(const Param& p) const { check_value(*this, p); }
+
+namespace {
+[[noreturn]] void missing(const Node& parent, std::string_view key, const Param* p) {
+  std::string what = "missing required key '" + std::string(key) + "'";
+  if (p) what += " (" + std::string(type_name(p->type())) + (p->unit_name().empty() ? "" : ", " + p->unit_name()) + ": " + p->doc() + ")";
+  parent.fail(what);
+}
+}  // namespace
+
+double Node::real(std::string_view key) const {
+  Node c = (*this)[key];
+  const Param* p = param(key);
+  if (!c.defined()) missing(*this, key, p);
+  if (p) c.check_param(*p);
+  return c.as_real(p ? std::string_view(p->unit_name()) : std::string_view());
+}
+
+long Node::integer(std::string_view key) const {
+  Node c = (*this)[key];
+  const Param* p = param(key);
+  if (!c.defined()) missing(*this, key, p);
+  if (p) c.check_param(*p);
+  return c.as_integer();
+}
+
+bool Node::boolean(std::string_view key) const {
+  Node c = (*this)[key];
+  if (!c.defined()) missing(*this, key, param(key));
+  return c.as_boolean();
+}
+
+std::string Node::string(std::string_view key) const {
+  Node c = (*this)[key];
+  const Param* p = param(key);
+  if (!c.defined()) missing(*this, key, p);
+  if (p) c.check_param(*p);
+  return c.as_string();
+}
+
+std::vector<double> Node::reals(std::string_view key) const {
+  Node c = (*this)[key];
+  const Param* p = param(key);
+  if (!c.defined()) missing(*this, key, p);
+  if (p) c.check_param(*p);
+  return c.as_reals(p ? std::string_view(p->unit_name()) : std::string_view());
+}
+
+std::vector<long> Node::integers(std::string_view key) const {
+  Node c = (*this)[key];
+  const Param* p = param(key);
+  if (!c.defined()) missing(*this, key, p);
+  if (p) c.check_param(*p);
+  std::vector<long> v;
+  for (const Node& e : c.items()) v.push_back(e.as_integer());
+  return v;
+}
+
+std::vector<std::string> Node::strings(std::string_view key) const {
+  Node c = (*this)[key];
+  const Param* p = param(key);
+  if (!c.defined()) missing(*this, key, p);
+  if (p) c.check_param(*p);
+  if (c.is_scalar()) return {c.as_string()};
+  std::vector<std::string> v;
+  for (const Node& e : c.items()) v.push_back(e.as_string());
+  return v;
+}
+
+Eigen::Vector3d Node::vec3(std::string_view key) const {
+  Node c = (*this)[key];
+  const Param* p = param(key);
+  if (!c.defined()) missing(*this, key, p);
+  if (p) c.check_param(*p);
+  return c.as_vec3(p ? std::string_view(p->unit_name()) : std::string_view());
+}
+
+std::optional<double> Node::real_opt(std::string_view key) const {
+  Node c = (*this)[key];
+  if (!c.defined()) return std::nullopt;
+  return real(key);
+}
+
+std::optional<std::string> Node::string_opt(std::string_view key) const {
+  Node c = (*this)[key];
+  if (!c.defined()) return std::nullopt;
+  return string(key);
+}
+
+}  // namespace partita::config

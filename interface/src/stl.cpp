@@ -1,0 +1,241 @@
+#include "partita/interface/stl.hpp"
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "partita/interface/error.hpp"
+#include "partita/interface/output.hpp"
+
+namespace partita {
+
+namespace {
+
+struct Soup {
+  std::vector<std::array<double, 9>> tris;  // three vertices per triangle
+  std::vector<int> lines;                   // source line of each facet (ASCII) or 0
+};
+
+[[noreturn]] void stl_error(const std::string& source, int line, const std::string& what) {
+  throw Error(SourceLocation{source, line, 0}, "", what);
+}
+
+// Binary STL: 80-byte header, uint32 count, then per triangle: normal (3 float), 3 vertices
+// (9 float), uint16 attribute = 50 bytes. Detected by size == 84 + 50 n.
+bool looks_binary(const std::string& b) {
+  if (b.size() < 84) return false;
+  std::uint32_t n = 0;
+  std::memcpy(&n, b.data() + 80, 4);
+  return b.size() == 84 + 50ull * n;
+}
+
+Soup parse_binary(const std::string& b, const std::string& source) {
+  std::uint32_t n = 0;
+  std::memcpy(&n, b.data() + 80, 4);
+  Soup s;
+  s.tris.resize(n);
+  s.lines.assign(n, 0);
+  for (std::uint32_t t = 0; t < n; ++t) {
+    const char* p = b.data() + 84 + 50ull * t + 12;  // skip the normal
+    for (int k = 0; k < 9; ++k) {
+      float f;
+      std::memcpy(&f, p + 4 * k, 4);
+      s.tris[t][static_cast<std::size_t>(k)] = f;
+    }
+  }
+  (void)source;
+  return s;
+}
+
+Soup parse_ascii(const std::string& b, const std::string& source) {
+  // solid name / facet normal nx ny nz / outer loop / vertex x y z (x3) / endloop / endfacet / endsolid
+  Soup s;
+  std::istringstream in(b);
+  std::string line;
+  int lineno = 0;
+  enum class St { start, solid, facet, loop, endloop, done } st = St::start;
+  std::array<double, 9> tri{};
+  int nv = 0;
+  int facet_line = 0;
+  while (std::getline(in, line)) {
+    ++lineno;
+    std::istringstream ls(line);
+    std::string word;
+    if (!(ls >> word)) continue;
+    auto expect = [&](const char* what) {
+      stl_error(source, lineno, "STL syntax error: expected " + std::string(what) + ", found '" + word + "'");
+    };
+    switch (st) {
+      case St::start:
+        if (word != "solid") expect("'solid'");
+        st = St::solid;
+        break;
+      case St::solid:
+        if (word == "endsolid") {
+          st = St::done;
+          break;
+        }
+        if (word != "facet") expect("'facet' or 'endsolid'");
+        facet_line = lineno;
+        st = St::facet;
+        break;
+      case St::facet:
+        if (word != "outer") expect("'outer loop'");
+        st = St::loop;
+        nv = 0;
+        break;
+      case St::loop: {
+        if (word == "endloop") {
+          if (nv != 3)
+            stl_error(source, lineno, "STL facet has " + std::to_string(nv) + " vertices; exactly 3 are required");
+          st = St::endloop;
+          break;
+        }
+        if (word != "vertex") expect("'vertex' or 'endloop'");
+        if (nv >= 3) stl_error(source, lineno, "STL facet has more than 3 vertices; exactly 3 are required");
+        for (int k = 0; k < 3; ++k) {
+          std::string tok;
+          if (!(ls >> tok)) stl_error(source, lineno, "STL vertex needs 3 coordinates");
+          char* end = nullptr;
+          const double v = std::strtod(tok.c_str(), &end);
+          if (end == tok.c_str() || *end != '\0')
+            stl_error(source, lineno, "STL vertex coordinate '" + tok + "' is not a number");
+          tri[static_cast<std::size_t>(3 * nv + k)] = v;
+        }
+        ++nv;
+        break;
+      }
+      case St::endloop:
+        if (word != "endfacet") expect("'endfacet'");
+        s.tris.push_back(tri);
+        s.lines.push_back(facet_line);
+        st = St::solid;
+        break;
+      case St::done:
+        if (word == "solid") {  // several solids in one file
+          st = St::solid;
+          break;
+        }
+        expect("end of file");
+    }
+  }
+  if (st != St::done)
+    stl_error(source, lineno, "STL file ends early (truncated?): 'endsolid' is missing");
+  return s;
+}
+
+}  // namespace
+
+Mesh parse_stl(const std::string& bytes, const std::string& source, const std::string& name, double scale) {
+  if (bytes.empty()) throw Error(source + ": the STL file is empty");
+  if (!(scale > 0) || !std::isfinite(scale))
+    throw Error(source + ": STL scale must be a positive number, got " + std::to_string(scale));
+  Soup soup;
+  const bool ascii_start = bytes.compare(0, 5, "solid") == 0 && bytes.find("facet") != std::string::npos;
+  if (looks_binary(bytes)) {
+    soup = parse_binary(bytes, source);
+  } else if (ascii_start || bytes.compare(0, 5, "solid") == 0) {
+    soup = parse_ascii(bytes, source);
+  } else if (bytes.size() >= 84) {
+    std::uint32_t n = 0;
+    std::memcpy(&n, bytes.data() + 80, 4);
+    throw Error(source + ": not a valid STL file: as binary STL its header announces " + std::to_string(n) +
+                " triangles (" + std::to_string(84 + 50ull * n) + " bytes) but the file has " +
+                std::to_string(bytes.size()) + " bytes (truncated?), and it does not start with 'solid' as ASCII STL does");
+  } else {
+    throw Error(source + ": not a valid STL file (" + std::to_string(bytes.size()) +
+                " bytes: too short for binary STL and not ASCII STL starting with 'solid')");
+  }
+  if (soup.tris.empty()) throw Error(source + ": the STL file contains no triangles");
+
+  // Merge vertices with identical coordinates; check each triangle.
+  std::map<std::array<double, 3>, int> index;
+  std::vector<std::array<double, 3>> pts;
+  Mesh::Triangles tris(static_cast<Eigen::Index>(soup.tris.size()), 3);
+  double extent = 0;
+  for (const auto& t : soup.tris)
+    for (double v : t) extent = std::max(extent, std::abs(v));
+  for (std::size_t t = 0; t < soup.tris.size(); ++t) {
+    const auto& tri = soup.tris[t];
+    const std::string where =
+        soup.lines[t] ? "facet at line " + std::to_string(soup.lines[t]) : "triangle " + std::to_string(t);
+    for (double v : tri)
+      if (!std::isfinite(v)) stl_error(source, soup.lines[t], where + " has a NaN or infinite coordinate");
+    Eigen::Vector3d a(tri[0], tri[1], tri[2]), b(tri[3], tri[4], tri[5]), c(tri[6], tri[7], tri[8]);
+    const double area2 = (b - a).cross(c - a).norm();
+    if (!(area2 > 1e-12 * extent * extent))
+      stl_error(source, soup.lines[t], where + " has zero area (degenerate triangle); remove it or fix its vertices");
+    for (int k = 0; k < 3; ++k) {
+      std::array<double, 3> p{tri[3 * k] * scale, tri[3 * k + 1] * scale, tri[3 * k + 2] * scale};
+      auto [it, inserted] = index.emplace(p, static_cast<int>(pts.size()));
+      if (inserted) pts.push_back(p);
+      tris(static_cast<Eigen::Index>(t), k) = it->second;
+    }
+  }
+  Mesh::Points P(static_cast<Eigen::Index>(pts.size()), 3);
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    P.row(static_cast<Eigen::Index>(i)) << pts[i][0], pts[i][1], pts[i][2];
+  return Mesh(name, std::move(P), std::move(tris));
+}
+
+Mesh read_stl(const std::filesystem::path& file, const std::string& name, double scale) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw Error("cannot open STL file '" + file.string() + "': no such file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error("cannot open STL file '" + file.string() + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_stl(ss.str(), file.string(), name, scale);
+}
+
+void write_stl_binary(const std::filesystem::path& file, const Mesh& mesh) {
+  AtomicFile f(file, true);
+  char header[80] = {};
+  const std::string h = "partita binary STL: " + mesh.name();
+  std::memcpy(header, h.data(), std::min<std::size_t>(h.size(), 79));
+  auto& out = f.stream();
+  out.write(header, 80);
+  const auto n = static_cast<std::uint32_t>(mesh.num_triangles());
+  out.write(reinterpret_cast<const char*>(&n), 4);
+  const Mesh::Points normals = mesh.triangle_normals();
+  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
+    float buf[12];
+    for (int k = 0; k < 3; ++k) buf[k] = static_cast<float>(normals(t, k));
+    for (int v = 0; v < 3; ++v)
+      for (int k = 0; k < 3; ++k) buf[3 + 3 * v + k] = static_cast<float>(mesh.points()(mesh.triangles()(t, v), k));
+    out.write(reinterpret_cast<const char*>(buf), sizeof buf);
+    const std::uint16_t attr = 0;
+    out.write(reinterpret_cast<const char*>(&attr), 2);
+  }
+  f.commit();
+}
+
+void write_stl_ascii(const std::filesystem::path& file, const Mesh& mesh) {
+  AtomicFile f(file);
+  auto& out = f.stream();
+  out << std::setprecision(9);
+  const std::string solid = mesh.name().empty() ? "partita" : mesh.name();
+  out << "solid " << solid << "\n";
+  const Mesh::Points normals = mesh.triangle_normals();
+  for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
+    out << "  facet normal " << normals(t, 0) << " " << normals(t, 1) << " " << normals(t, 2) << "\n    outer loop\n";
+    for (int v = 0; v < 3; ++v) {
+      const auto p = mesh.points().row(mesh.triangles()(t, v));
+      out << "      vertex " << static_cast<float>(p(0)) << " " << static_cast<float>(p(1)) << " "
+          << static_cast<float>(p(2)) << "\n";
+    }
+    out << "    endloop\n  endfacet\n";
+  }
+  out << "endsolid " << solid << "\n";
+  f.commit();
+}
+
+}  // namespace partita
