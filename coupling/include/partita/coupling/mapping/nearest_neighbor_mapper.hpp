@@ -1,0 +1,26 @@
+#pragma once
+// nearest-neighbor: each target point takes the value of the nearest source point (consistent);
+// each source value goes whole to the nearest target point (conservative). First order; the
+// search is a k-d tree over the source points, O(n log n).
+
+#include <memory>
+
+#include "partita/coupling/mapping/sparse_mapper.hpp"
+
+namespace partita::coupling {
+
+class NearestNeighborMapper final : public SparseMapper {
+ public:
+  explicit NearestNeighborMapper(Constraint constraint) : SparseMapper(constraint) {}
+
+  std::string name() const override { return "nearest-neighbor"; }
+
+  /// Its options (only `type`).
+  static std::shared_ptr<const config::Spec> spec();
+  static std::unique_ptr<Mapper> create(const MapperContext& context);
+
+ protected:
+  Matrix interpolation(const Mesh& source, const Mesh& target) const override;
+};
+
+}  // namespace partita::coupling
