@@ -221,7 +221,7 @@ void write_stl_binary(const std::filesystem::path& file, const Mesh& mesh) {
 void write_stl_ascii(const std::filesystem::path& file, const Mesh& mesh) {
   AtomicFile f(file);
   auto& out = f.stream();
-  out << std::setprecision(9);
+  out << std::setprecision(17);  // round-trips every double exactly
   const std::string solid = mesh.name().empty() ? "partita" : mesh.name();
   out << "solid " << solid << "\n";
   const Mesh::Points normals = mesh.triangle_normals();
@@ -229,8 +229,7 @@ void write_stl_ascii(const std::filesystem::path& file, const Mesh& mesh) {
     out << "  facet normal " << normals(t, 0) << " " << normals(t, 1) << " " << normals(t, 2) << "\n    outer loop\n";
     for (int v = 0; v < 3; ++v) {
       const auto p = mesh.points().row(mesh.triangles()(t, v));
-      out << "      vertex " << static_cast<float>(p(0)) << " " << static_cast<float>(p(1)) << " "
-          << static_cast<float>(p(2)) << "\n";
+      out << "      vertex " << p(0) << " " << p(1) << " " << p(2) << "\n";
     }
     out << "    endloop\n  endfacet\n";
   }

@@ -23,7 +23,7 @@ Mesh parse_stl(const std::string& bytes, const std::string& source, const std::s
 /// 32-bit floats, as the format requires.
 void write_stl_binary(const std::filesystem::path& file, const Mesh& mesh);
 
-/// Write an ASCII STL (atomically), coordinates with 9 significant digits (exact for floats).
+/// Write an ASCII STL (atomically), coordinates with 17 significant digits (exact for doubles).
 void write_stl_ascii(const std::filesystem::path& file, const Mesh& mesh);
 
 }  // namespace partita
