@@ -1,0 +1,122 @@
+// The bad-input corpus: every file in tests/inputs/bad/ goes through `partita check`; each must
+// end with a non-zero exit status, no signal (no crash), and one message that names the problem.
+
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int status = 0;
+  bool signalled = false;
+  std::string output;
+};
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+Result run_partita(const std::string& args) {
+  const std::string cmd = quote(PARTITA_EXECUTABLE) + " " + args + " 2>&1";
+  Result r;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) r.output += buf.data();
+  const int st = pclose(p);
+  r.signalled = WIFSIGNALED(st);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::map<std::string, std::string> manifest(const fs::path& dir) {
+  std::map<std::string, std::string> m;
+  std::ifstream in(dir / "expected.txt");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    const auto colon = line.find(": ");
+    if (colon != std::string::npos) m[line.substr(0, colon)] = line.substr(colon + 2);
+  }
+  return m;
+}
+
+std::string first_line_expectation(const fs::path& f) {
+  std::ifstream in(f);
+  std::string line;
+  std::getline(in, line);
+  const std::string tag = "# expect: ";
+  return line.rfind(tag, 0) == 0 ? line.substr(tag.size()) : std::string();
+}
+
+}  // namespace
+
+TEST_CASE("bad inputs: partita check exits non-zero with one clear message", "[app][bad-inputs]") {
+  const fs::path dir = fs::path(PARTITA_SOURCE_DIR) / "tests" / "inputs" / "bad";
+  const auto expected = manifest(dir);
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const fs::path f = entry.path();
+    if (f.filename() == "expected.txt" || fs::is_directory(f)) continue;
+    if (f.extension() != ".yaml" && f.extension() != ".yml" && f.extension() != ".stl") continue;
+    ++count;
+    std::string want = first_line_expectation(f);
+    if (auto it = expected.find(f.filename().string()); it != expected.end()) want = it->second;
+    const Result r = run_partita("check " + quote(f.string()));
+    INFO("input: " << f.filename().string() << "\noutput:\n" << r.output);
+    CHECK_FALSE(r.signalled);
+    CHECK(r.status != 0);
+    CHECK(r.status != -1);
+    CHECK(r.output.find("partita: error: ") != std::string::npos);
+    // The message names the file it is about.
+    CHECK(r.output.find(f.filename().string()) != std::string::npos);
+    if (!want.empty()) CHECK(r.output.find(want) != std::string::npos);
+    // One message: a single error line (plus nothing that looks like a stack dump).
+    CHECK(r.output.find("AddressSanitizer") == std::string::npos);
+    CHECK(r.output.find("runtime error") == std::string::npos);
+  }
+  CHECK(count >= 25);
+}
+
+TEST_CASE("cli: version, help, usage errors", "[app][cli]") {
+  const Result v = run_partita("--version");
+  CHECK(v.status == 0);
+  CHECK(v.output.find("partita 0.") != std::string::npos);
+  const Result h = run_partita("--help");
+  CHECK(h.status == 0);
+  CHECK(h.output.find("run") != std::string::npos);
+  CHECK(h.output.find("check") != std::string::npos);
+  const Result none = run_partita("");
+  CHECK(none.status != 0);
+  CHECK_FALSE(none.signalled);
+  const Result bad = run_partita("frobnicate");
+  CHECK(bad.status != 0);
+  const Result missing = run_partita("check /nonexistent/case.yaml");
+  CHECK(missing.status == 1);
+  CHECK(missing.output.find("no such file") != std::string::npos);
+  const Result lvl = run_partita("list --log-level chatty");
+  CHECK(lvl.status != 0);
+}
+
+TEST_CASE("cli: list shows every registry", "[app][cli]") {
+  const Result l = run_partita("list");
+  REQUIRE(l.status == 0);
+  for (const char* heading : {"solvers:", "mappers:", "schemes:", "accelerations:", "convergence measures:"})
+    CHECK(l.output.find(heading) != std::string::npos);
+  CHECK(l.output.find("nearest-neighbor") != std::string::npos);
+  const Result d = run_partita("docs nearest-neighbr");
+  CHECK(d.status == 1);
+  CHECK(d.output.find("did you mean 'nearest-neighbor'") != std::string::npos);
+}
