@@ -62,6 +62,27 @@ bool is_stl(const std::string& file) {
   return ext == ".stl";
 }
 
+// PNG plots of the run's CSV time series, drawn by the bundled matplotlib script. A missing
+// python3/matplotlib costs the plots only, never the run.
+void plot_csv_files(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> csvs;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".csv") csvs.push_back(e.path().string());
+  if (csvs.empty()) return;
+  fs::path script = PARTITA_PLOT_SCRIPT;
+  if (!fs::exists(script)) script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_monitors.py";
+  if (!fs::exists(script)) return;
+  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  std::string cmd = python + " '" + script.string() + "'";
+  for (const auto& c : csvs) cmd += " '" + c + "'";
+  cmd += " >/dev/null";
+  if (std::system(cmd.c_str()) != 0)
+    partita::log::get("app")->warn("plotting the CSV files failed (is python3-matplotlib installed?)");
+  else
+    partita::log::get("app")->info("plots: {}/*.png", dir.string());
+}
+
 int list(const Registries& r) {
   for_each_registry(r, [](const char* heading, const auto& reg) {
     std::cout << heading << ":\n";
@@ -150,6 +171,7 @@ int main(int argc, char** argv) {
     }
     partita::coupling::CaseRun c(case_file, registries, options);
     c.run();
+    plot_csv_files(c.output_dir());
     std::cout << "partita run: finished; output in " << c.output_dir().string() << "/\n";
     return 0;
   } catch (const partita::Error& e) {
