@@ -1,0 +1,54 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include "partita/fem/dirichlet_condition.hpp"
+#include "partita/fem/hex8_formulation.hpp"
+#include "partita/fem/load.hpp"
+#include "partita/fem/material.hpp"
+#include "partita/fem/mesh.hpp"
+
+namespace partita::fem {
+
+// What is computed: mesh + material(s) + Dirichlet conditions + model loads. A Solver takes a
+// copy, so change a Model before building its Solver. Names are checked when they are given
+// (Error listing the known sets / faces / regions).
+class Model {
+ public:
+  explicit Model(Mesh mesh, const Material& material = {});
+
+  const Mesh& mesh() const { return mesh_; }
+
+  // --- material ---
+  void set_material(const Material& material);  // every region
+  void set_material(const std::string& region, const Material& material);
+  const Material& material(int region) const { return materials_.at(static_cast<std::size_t>(region)); }
+  void set_hex8_formulation(Hex8Formulation f) { hex8_ = f; }
+  Hex8Formulation hex8_formulation() const { return hex8_; }
+
+  // --- Dirichlet conditions (components 0 = x, 1 = y, 2 = z) ---
+  void fix(const std::string& node_set, const std::vector<int>& components = {0, 1, 2});
+  // u_c(t) = value(t) on every node of the set.
+  void prescribe(const std::string& node_set, int component, TimeFunction value);
+  // u_c(X, t) = value(X, t), X the node's reference position.
+  void prescribe_field(const std::string& node_set, int component, SpaceTimeFunction value);
+  const std::vector<DirichletCondition>& dirichlet_conditions() const { return dirichlet_; }
+
+  // --- model loads, each times amplitude(t) (1 when empty) ---
+  void add_pressure(const std::string& face, double pressure, TimeFunction amplitude = {});
+  void add_traction(const std::string& face, const Vec3& traction, TimeFunction amplitude = {});
+  void add_nodal_force(const std::string& node_set, const Vec3& force_per_node,
+                       TimeFunction amplitude = {});
+  void add_gravity(const Vec3& acceleration, TimeFunction amplitude = {});
+  const std::vector<Load>& loads() const { return loads_; }
+
+ private:
+  void check_component(int component) const;
+  Mesh mesh_;
+  std::vector<Material> materials_;
+  Hex8Formulation hex8_ = Hex8Formulation::IncompatibleModes;
+  std::vector<DirichletCondition> dirichlet_;
+  std::vector<Load> loads_;
+};
+
+}  // namespace partita::fem

@@ -1,0 +1,29 @@
+#pragma once
+#include <vector>
+
+#include "partita/fem/element_type.hpp"
+#include "partita/fem/face_type.hpp"
+#include "partita/fem/types.hpp"
+
+namespace partita::fem {
+
+struct VolumeRulePoint {
+  Vec3 xi;
+  double weight;
+};
+struct FaceRulePoint {
+  Eigen::Vector2d xi;
+  double weight;
+};
+
+// What a volume rule integrates: stiffness (grad N . D . grad N) or mass (N N).
+enum class QuadratureUse { Stiffness, Mass };
+
+// Gauss rules (weights sum to the reference volume / area):
+//   Hex8 2x2x2 (both), Hex20 3x3x3 (both); Tet4 1 point (stiffness), 4 points degree 2 (mass);
+//   Tet10 4 points degree 2 (stiffness), collapsed 4x4x4 Gauss-Legendre, exact to degree 7
+//   (mass); Quad4 2x2, Quad8 3x3, Tri3 3 points degree 2, Tri6 6 points degree 4 (Dunavant).
+const std::vector<VolumeRulePoint>& volume_rule(ElementType type, QuadratureUse use);
+const std::vector<FaceRulePoint>& face_rule(FaceType type);
+
+}  // namespace partita::fem

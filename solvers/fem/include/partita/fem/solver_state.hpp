@@ -1,0 +1,27 @@
+#pragma once
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "partita/fem/types.hpp"
+
+namespace partita::fem {
+
+// Everything that evolves in a Solver: kinematics, time, the coupling loads that are set, the
+// energy bookkeeping. Solver::restore_state(save_state()) then continuing gives bit-identical
+// results.
+struct SolverState {
+  double time = 0.0;
+  std::size_t steps = 0;
+  Eigen::VectorXd displacement, velocity, acceleration;
+  Eigen::VectorXd external_force;  // F(time) used by the last solve
+  bool acceleration_valid = false;
+  double external_work = 0.0;
+  Eigen::VectorXd coupling_force;
+  std::map<std::string, MatrixX3> face_tractions;
+  std::vector<std::size_t> nodal_force_nodes;
+  MatrixX3 nodal_forces;
+};
+
+}  // namespace partita::fem

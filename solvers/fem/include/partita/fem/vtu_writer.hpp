@@ -1,0 +1,14 @@
+#pragma once
+#include <string>
+
+#include "partita/fem/solver.hpp"
+
+namespace partita::fem {
+
+// Writes the solver's mesh and point data (displacement, velocity, stress as a 6-component
+// symmetric tensor XX YY ZZ XY YZ XZ, von_mises) as a VTK XML UnstructuredGrid (.vtu, ASCII)
+// to path. Writes path + ".tmp" first and renames it, so a reader never sees a partial file.
+// Throws Error when the file cannot be written.
+void write_vtu(const std::string& path, const Solver& solver);
+
+}  // namespace partita::fem

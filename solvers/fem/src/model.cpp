@@ -1,0 +1,74 @@
+#include "partita/fem/model.hpp"
+
+#include <algorithm>
+
+#include "partita/fem/error.hpp"
+
+namespace partita::fem {
+
+Model::Model(Mesh mesh, const Material& material) : mesh_(std::move(mesh)) {
+  mesh_.validate();
+  material.validate();
+  materials_.assign(std::max<std::size_t>(1, mesh_.region_names().size()), material);
+}
+
+void Model::set_material(const Material& material) {
+  material.validate();
+  std::fill(materials_.begin(), materials_.end(), material);
+}
+
+void Model::set_material(const std::string& region, const Material& material) {
+  material.validate();
+  materials_.at(static_cast<std::size_t>(mesh_.region(region))) = material;
+}
+
+void Model::check_component(int component) const {
+  if (component < 0 || component > 2) {
+    throw Error("displacement component " + std::to_string(component) +
+                " does not exist; allowed: 0 (x), 1 (y), 2 (z)");
+  }
+}
+
+void Model::fix(const std::string& node_set, const std::vector<int>& components) {
+  mesh_.node_set(node_set);  // throws for unknown names
+  for (int c : components) {
+    check_component(c);
+    dirichlet_.push_back({node_set, c, {}});
+  }
+}
+
+void Model::prescribe(const std::string& node_set, int component, TimeFunction value) {
+  mesh_.node_set(node_set);
+  check_component(component);
+  if (!value) throw Error("prescribe('" + node_set + "'): empty function");
+  dirichlet_.push_back({node_set, component, [value](const Vec3&, double t) { return value(t); }});
+}
+
+void Model::prescribe_field(const std::string& node_set, int component, SpaceTimeFunction value) {
+  mesh_.node_set(node_set);
+  check_component(component);
+  if (!value) throw Error("prescribe_field('" + node_set + "'): empty function");
+  dirichlet_.push_back({node_set, component, std::move(value)});
+}
+
+void Model::add_pressure(const std::string& face, double pressure, TimeFunction amplitude) {
+  mesh_.face(face);
+  loads_.push_back({LoadKind::Pressure, face, pressure, Vec3::Zero(), std::move(amplitude)});
+}
+
+void Model::add_traction(const std::string& face, const Vec3& traction, TimeFunction amplitude) {
+  mesh_.face(face);
+  loads_.push_back({LoadKind::Traction, face, 0.0, traction, std::move(amplitude)});
+}
+
+void Model::add_nodal_force(const std::string& node_set, const Vec3& force_per_node,
+                            TimeFunction amplitude) {
+  mesh_.node_set(node_set);
+  loads_.push_back({LoadKind::NodalForce, node_set, 0.0, force_per_node, std::move(amplitude)});
+}
+
+void Model::add_gravity(const Vec3& acceleration, TimeFunction amplitude) {
+  loads_.push_back({LoadKind::Gravity, "", 0.0, acceleration, std::move(amplitude)});
+}
+
+}  // namespace partita::fem

@@ -1,0 +1,604 @@
+#include "partita/fem/solver.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <unordered_map>
+
+#include "block_assembler.hpp"
+#include "partita/fem/error.hpp"
+#include "partita/fem/quadrature.hpp"
+#include "partita/fem/shape_functions.hpp"
+
+namespace partita::fem {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+ElementCoordinates coordinates(const Mesh& mesh, const Element& e) {
+  const int n = node_count(e.type);
+  ElementCoordinates x(n, 3);
+  for (int a = 0; a < n; ++a) x.row(a) = mesh.node(e.nodes[a]).transpose();
+  return x;
+}
+
+double amplitude_at(const TimeFunction& f, double t) { return f ? f(t) : 1.0; }
+
+}  // namespace
+
+Solver::Solver(Model model, SolverOptions options)
+    : model_(std::move(model)), options_(options), integrator_(model_.hex8_formulation()) {
+  if (!(options_.newmark_beta > 0.0) || !(options_.newmark_gamma > 0.0)) {
+    throw Error("Newmark parameters must be > 0 (beta = 1/4, gamma = 1/2 is the default)");
+  }
+  if (options_.rayleigh_alpha < 0.0 || options_.rayleigh_beta < 0.0) {
+    throw Error("Rayleigh damping coefficients must be >= 0");
+  }
+  ndof_ = 3 * mesh().num_nodes();
+  const auto n = static_cast<Eigen::Index>(ndof_);
+  u_ = Eigen::VectorXd::Zero(n);
+  v_ = Eigen::VectorXd::Zero(n);
+  a_ = Eigen::VectorXd::Zero(n);
+  f_ = Eigen::VectorXd::Zero(n);
+  coupling_force_ = Eigen::VectorXd::Zero(n);
+  setup_dofs();
+  assemble_stiffness();
+  assemble_loads();
+  // Start from rest with the prescribed values of t = 0.
+  Eigen::VectorXd uc;
+  prescribed_values(0.0, uc);
+  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k) u_[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
+  evaluate_external_force(0.0, f_);
+}
+
+Solver::~Solver() = default;
+
+// ---------------------------------------------------------------- setup and assembly
+
+void Solver::setup_dofs() {
+  std::vector<char> constrained(ndof_, 0);
+  std::vector<SpaceTimeFunction> value(ndof_);
+  for (const auto& bc : model_.dirichlet_conditions()) {
+    for (auto node : mesh().node_set(bc.node_set)) {
+      const std::size_t dof = 3 * node + static_cast<std::size_t>(bc.component);
+      constrained[dof] = 1;
+      value[dof] = bc.value;
+    }
+  }
+  free_index_.assign(ndof_, -1);
+  for (std::size_t d = 0; d < ndof_; ++d) {
+    if (constrained[d]) {
+      constrained_dofs_.push_back(static_cast<Eigen::Index>(d));
+      constrained_value_.push_back(value[d]);
+    } else {
+      free_index_[d] = static_cast<Eigen::Index>(free_dofs_.size());
+      free_dofs_.push_back(static_cast<Eigen::Index>(d));
+    }
+  }
+}
+
+void Solver::partition(const SparseMatrix& a, SparseMatrix& aff, SparseMatrix& afc) const {
+  // Free dofs keep their relative order, so columns and rows stay sorted.
+  const auto nf = static_cast<Eigen::Index>(free_dofs_.size());
+  const auto nc = static_cast<Eigen::Index>(constrained_dofs_.size());
+  auto extract = [&](const std::vector<Eigen::Index>& cols, Eigen::Index ncols, SparseMatrix& out) {
+    std::vector<int> outer(static_cast<std::size_t>(ncols) + 1, 0), inner;
+    std::vector<double> values;
+    for (std::size_t k = 0; k < cols.size(); ++k) {
+      for (SparseMatrix::InnerIterator it(a, cols[k]); it; ++it) {
+        const Eigen::Index r = free_index_[static_cast<std::size_t>(it.row())];
+        if (r >= 0) {
+          inner.push_back(static_cast<int>(r));
+          values.push_back(it.value());
+        }
+      }
+      outer[k + 1] = static_cast<int>(inner.size());
+    }
+    out = Eigen::Map<SparseMatrix>(nf, ncols, static_cast<Eigen::Index>(inner.size()), outer.data(),
+                                   inner.data(), values.data());
+  };
+  extract(free_dofs_, nf, aff);
+  extract(constrained_dofs_, nc, afc);
+}
+
+void Solver::assemble_stiffness() {
+  const auto t0 = Clock::now();
+  const BlockAssembler assembler(mesh());
+  k_ = assembler.make_matrix();
+  ElementMatrix ke;
+  std::vector<Matrix6> d;
+  for (std::size_t r = 0; r < std::max<std::size_t>(1, mesh().region_names().size()); ++r) {
+    d.push_back(model_.material(static_cast<int>(r)).elasticity_matrix());
+  }
+  // K = sum_e A_e^T K_e A_e
+  for (const auto& e : mesh().elements()) {
+    integrator_.stiffness(e.type, coordinates(mesh(), e), d[static_cast<std::size_t>(e.region)], ke);
+    assembler.add(k_, e.node_span(), ke);
+  }
+  partition(k_, k_ff_, k_fc_);
+  timings_.assembly += seconds_since(t0);
+}
+
+void Solver::assemble_mass() {
+  if (mass_ready_) return;
+  const auto t0 = Clock::now();
+  if (options_.mass == MassType::Consistent) {
+    const BlockAssembler assembler(mesh());
+    m_ = assembler.make_matrix();
+    ElementMatrix me;
+    // M = sum_e A_e^T M_e A_e
+    for (const auto& e : mesh().elements()) {
+      integrator_.consistent_mass(e.type, coordinates(mesh(), e), model_.material(e.region).density, me);
+      assembler.add(m_, e.node_span(), me);
+    }
+  } else {
+    Eigen::VectorXd diag = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ndof_));
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
+    for (const auto& e : mesh().elements()) {
+      integrator_.lumped_mass(e.type, coordinates(mesh(), e), model_.material(e.region).density, m);
+      for (int a = 0; a < node_count(e.type); ++a) {
+        diag.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a])).array() += m[a];
+      }
+    }
+    m_.resize(diag.size(), diag.size());
+    m_.reserve(Eigen::VectorXi::Ones(diag.size()));
+    for (Eigen::Index i = 0; i < diag.size(); ++i) m_.insert(i, i) = diag[i];
+    m_.makeCompressed();
+  }
+  partition(m_, m_ff_, m_fc_);
+  mass_ready_ = true;
+  timings_.assembly += seconds_since(t0);
+}
+
+void Solver::assemble_loads() {
+  const auto t0 = Clock::now();
+  const auto n = static_cast<Eigen::Index>(ndof_);
+  for (const auto& load : model_.loads()) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+    switch (load.kind) {
+      case LoadKind::Pressure:
+      case LoadKind::Traction: {
+        // f_a = sum_q N_a(x_q) t_q w_q with t = -p n (pressure) or the given traction
+        const auto qps = face_quadrature_points(load.target);
+        const auto& op = face_operator(load.target);
+        for (std::size_t k = 0; k < op.node.size(); ++k) {
+          const auto& qp = qps[op.qp[k]];
+          const Vec3 t = load.kind == LoadKind::Pressure ? Vec3(-load.pressure * qp.normal) : load.vector;
+          f.segment<3>(3 * static_cast<Eigen::Index>(op.node[k])) += op.coefficient[k] * t;
+        }
+        break;
+      }
+      case LoadKind::NodalForce:
+        for (auto node : mesh().node_set(load.target)) {
+          f.segment<3>(3 * static_cast<Eigen::Index>(node)) += load.vector;
+        }
+        break;
+      case LoadKind::Gravity: {
+        ElementVector fe;
+        for (const auto& e : mesh().elements()) {
+          integrator_.body_force(e.type, coordinates(mesh(), e),
+                                 model_.material(e.region).density * load.vector, fe);
+          for (int a = 0; a < node_count(e.type); ++a) {
+            f.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a])) += fe.segment<3>(3 * a);
+          }
+        }
+        break;
+      }
+    }
+    load_vectors_.push_back(std::move(f));
+  }
+  timings_.assembly += seconds_since(t0);
+}
+
+// ---------------------------------------------------------------- faces and coupling loads
+
+std::vector<FaceQuadraturePoint> Solver::face_quadrature_points(const std::string& face) const {
+  std::vector<FaceQuadraturePoint> out;
+  const auto& elements = mesh().face(face);
+  FaceShapeVector n;
+  FaceShapeGradient dn;
+  for (std::size_t s = 0; s < elements.size(); ++s) {
+    const auto& se = elements[s];
+    const int nn = node_count(se.type);
+    Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxFaceNodes, 3> x(nn, 3);
+    for (int a = 0; a < nn; ++a) x.row(a) = mesh().node(se.nodes[a]).transpose();
+    for (const auto& q : face_rule(se.type)) {
+      shape_functions(se.type, q.xi, n, dn);
+      // dA = |dx/dxi x dx/deta| dxi deta, outward normal along dx/dxi x dx/deta
+      const Vec3 t1 = x.transpose() * dn.col(0);
+      const Vec3 t2 = x.transpose() * dn.col(1);
+      const Vec3 nv = t1.cross(t2);
+      const double area = nv.norm();
+      if (!(area > 0.0)) throw Error("face '" + face + "': degenerate surface element " + std::to_string(s));
+      out.push_back({x.transpose() * n, nv / area, q.weight * area, s});
+    }
+  }
+  return out;
+}
+
+const Solver::FaceOperator& Solver::face_operator(const std::string& face) const {
+  auto it = face_operators_.find(face);
+  if (it != face_operators_.end()) return it->second;
+  FaceOperator op;
+  const auto qps = face_quadrature_points(face);
+  const auto& elements = mesh().face(face);
+  FaceShapeVector n;
+  FaceShapeGradient dn;
+  std::size_t q_index = 0;
+  for (const auto& se : elements) {
+    for (const auto& q : face_rule(se.type)) {
+      shape_functions(se.type, q.xi, n, dn);
+      for (int a = 0; a < node_count(se.type); ++a) {
+        op.node.push_back(se.nodes[a]);
+        op.qp.push_back(q_index);
+        op.coefficient.push_back(n[a] * qps[q_index].weight);
+      }
+      ++q_index;
+    }
+  }
+  op.num_qp = q_index;
+  return face_operators_.emplace(face, std::move(op)).first->second;
+}
+
+FaceMesh Solver::face_mesh(const std::string& face) const {
+  FaceMesh fm;
+  fm.nodes = mesh().face_nodes(face);
+  std::unordered_map<std::size_t, int> local;
+  fm.positions.resize(static_cast<Eigen::Index>(fm.nodes.size()), 3);
+  for (std::size_t i = 0; i < fm.nodes.size(); ++i) {
+    local[fm.nodes[i]] = static_cast<int>(i);
+    fm.positions.row(static_cast<Eigen::Index>(i)) = mesh().node(fm.nodes[i]).transpose();
+  }
+  for (const auto& se : mesh().face(face)) {
+    FaceMesh::Cell c{se.type, {}};
+    for (int a = 0; a < node_count(se.type); ++a) c.nodes[a] = local.at(se.nodes[a]);
+    fm.cells.push_back(c);
+    const auto& v = c.nodes;
+    switch (se.type) {
+      case FaceType::Tri3: fm.triangles.push_back({v[0], v[1], v[2]}); break;
+      case FaceType::Quad4:
+        fm.triangles.push_back({v[0], v[1], v[2]});
+        fm.triangles.push_back({v[0], v[2], v[3]});
+        break;
+      case FaceType::Tri6:
+        fm.triangles.push_back({v[0], v[3], v[5]});
+        fm.triangles.push_back({v[3], v[1], v[4]});
+        fm.triangles.push_back({v[5], v[4], v[2]});
+        fm.triangles.push_back({v[3], v[4], v[5]});
+        break;
+      case FaceType::Quad8:
+        fm.triangles.push_back({v[0], v[4], v[7]});
+        fm.triangles.push_back({v[4], v[1], v[5]});
+        fm.triangles.push_back({v[5], v[2], v[6]});
+        fm.triangles.push_back({v[7], v[6], v[3]});
+        fm.triangles.push_back({v[4], v[5], v[6]});
+        fm.triangles.push_back({v[4], v[6], v[7]});
+        break;
+    }
+  }
+  return fm;
+}
+
+void Solver::set_face_tractions_at_quadrature_points(const std::string& face,
+                                                     const MatrixX3& tractions) {
+  const auto& op = face_operator(face);
+  if (static_cast<std::size_t>(tractions.rows()) != op.num_qp) {
+    throw Error("set_face_tractions_at_quadrature_points('" + face + "'): the face has " +
+                std::to_string(op.num_qp) + " quadrature points, got " +
+                std::to_string(tractions.rows()) + " tractions (one row per point, see face_quadrature_points())");
+  }
+  if (!tractions.allFinite()) throw Error("set_face_tractions_at_quadrature_points('" + face + "'): non-finite traction");
+  face_tractions_[face] = tractions;
+  update_coupling_force();
+}
+
+void Solver::set_nodal_forces(const std::vector<std::size_t>& nodes, const MatrixX3& forces) {
+  if (static_cast<std::size_t>(forces.rows()) != nodes.size()) {
+    throw Error("set_nodal_forces: " + std::to_string(nodes.size()) + " nodes but " +
+                std::to_string(forces.rows()) + " force rows");
+  }
+  for (auto n : nodes) {
+    if (n >= mesh().num_nodes()) {
+      throw Error("set_nodal_forces: node " + std::to_string(n) + " does not exist (the mesh has " +
+                  std::to_string(mesh().num_nodes()) + " nodes)");
+    }
+  }
+  if (!forces.allFinite()) throw Error("set_nodal_forces: non-finite force");
+  nodal_force_nodes_ = nodes;
+  nodal_forces_ = forces;
+  update_coupling_force();
+}
+
+void Solver::clear_coupling_loads() {
+  face_tractions_.clear();
+  nodal_force_nodes_.clear();
+  nodal_forces_.resize(0, 3);
+  update_coupling_force();
+}
+
+void Solver::update_coupling_force() {
+  coupling_force_.setZero();
+  // f_a = sum_q N_a(x_q) t_q w_q over every face with tractions
+  for (const auto& [face, t] : face_tractions_) {
+    const auto& op = face_operator(face);
+    for (std::size_t k = 0; k < op.node.size(); ++k) {
+      coupling_force_.segment<3>(3 * static_cast<Eigen::Index>(op.node[k])) +=
+          op.coefficient[k] * t.row(static_cast<Eigen::Index>(op.qp[k])).transpose();
+    }
+  }
+  for (std::size_t k = 0; k < nodal_force_nodes_.size(); ++k) {
+    coupling_force_.segment<3>(3 * static_cast<Eigen::Index>(nodal_force_nodes_[k])) +=
+        nodal_forces_.row(static_cast<Eigen::Index>(k)).transpose();
+  }
+}
+
+void Solver::evaluate_external_force(double t, Eigen::VectorXd& f) const {
+  // F(t) = sum_l amplitude_l(t) F_l + F_coupling
+  f = coupling_force_;
+  for (std::size_t l = 0; l < load_vectors_.size(); ++l) {
+    const double s = amplitude_at(model_.loads()[l].amplitude, t);
+    if (s != 0.0) f += s * load_vectors_[l];
+  }
+}
+
+void Solver::prescribed_values(double t, Eigen::VectorXd& uc) const {
+  uc.resize(static_cast<Eigen::Index>(constrained_dofs_.size()));
+  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k) {
+    const auto& g = constrained_value_[k];
+    const auto dof = static_cast<std::size_t>(constrained_dofs_[k]);
+    uc[static_cast<Eigen::Index>(k)] = g ? g(mesh().node(dof / 3), t) : 0.0;
+  }
+}
+
+// ---------------------------------------------------------------- analyses
+
+namespace {
+void check_factorisation(const Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>& f,
+                         const char* what) {
+  if (f.info() != Eigen::Success) {
+    throw Error(std::string(what) + ": factorisation failed (singular matrix)");
+  }
+  const auto d = f.vectorD();
+  if (d.size() > 0 && !(d.minCoeff() > 1e-14 * d.cwiseAbs().maxCoeff())) {
+    throw Error(std::string(what) +
+                " is singular or indefinite: the Dirichlet conditions do not prevent rigid-body "
+                "motion (fix more components) or an element is inverted");
+  }
+}
+}  // namespace
+
+void Solver::solve_static() {
+  const auto t0 = Clock::now();
+  if (!static_factor_) {
+    static_factor_ = std::make_unique<Factorisation>();
+    static_factor_->compute(k_ff_);
+    check_factorisation(*static_factor_, "static stiffness matrix K_ff");
+    ++timings_.factorisations;
+    timings_.factorisation += seconds_since(t0);
+  }
+  const auto t1 = Clock::now();
+  evaluate_external_force(time_, f_);
+  Eigen::VectorXd uc;
+  prescribed_values(time_, uc);
+  // K_ff u_f = F_f - K_fc u_c
+  Eigen::VectorXd rhs(static_cast<Eigen::Index>(free_dofs_.size()));
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k) rhs[static_cast<Eigen::Index>(k)] = f_[free_dofs_[k]];
+  if (uc.size() > 0 && uc.cwiseAbs().maxCoeff() > 0.0) rhs -= k_fc_ * uc;
+  const Eigen::VectorXd uf = static_factor_->solve(rhs);
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k) u_[free_dofs_[k]] = uf[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k) u_[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
+  v_.setZero();
+  a_.setZero();
+  acceleration_valid_ = true;
+  ++timings_.solves;
+  timings_.solve += seconds_since(t1);
+}
+
+void Solver::initialise_acceleration() {
+  // M_ff a_f = F_f - (K u + C v)_f   (prescribed accelerations taken as zero)
+  evaluate_external_force(time_, f_);
+  Eigen::VectorXd r = f_ - k_ * u_;
+  if (options_.rayleigh_alpha != 0.0) r -= options_.rayleigh_alpha * (m_ * v_);
+  if (options_.rayleigh_beta != 0.0) r -= options_.rayleigh_beta * (k_ * v_);
+  Eigen::VectorXd rf(static_cast<Eigen::Index>(free_dofs_.size()));
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k) rf[static_cast<Eigen::Index>(k)] = r[free_dofs_[k]];
+  Eigen::VectorXd af;
+  if (options_.mass == MassType::Lumped) {
+    af = rf.cwiseQuotient(Eigen::VectorXd(m_ff_.diagonal()));
+  } else {
+    const auto t0 = Clock::now();
+    mass_factor_ = std::make_unique<Factorisation>();
+    mass_factor_->compute(m_ff_);
+    check_factorisation(*mass_factor_, "mass matrix M_ff");
+    ++timings_.factorisations;
+    timings_.factorisation += seconds_since(t0);
+    af = mass_factor_->solve(rf);
+    mass_factor_.reset();
+  }
+  a_.setZero();
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k) a_[free_dofs_[k]] = af[static_cast<Eigen::Index>(k)];
+  acceleration_valid_ = true;
+}
+
+void Solver::factorise_dynamic(double dt) {
+  const auto t0 = Clock::now();
+  const double beta = options_.newmark_beta, gamma = options_.newmark_gamma;
+  const double c0 = 1.0 / (beta * dt * dt), c1 = gamma / (beta * dt);
+  // K_eff = K + gamma/(beta dt) C + 1/(beta dt^2) M with C = alpha M + beta_R K
+  const double sk = 1.0 + c1 * options_.rayleigh_beta;
+  const double sm = c0 + c1 * options_.rayleigh_alpha;
+  const SparseMatrix keff_ff = sk * k_ff_ + sm * m_ff_;
+  keff_fc_ = sk * k_fc_ + sm * m_fc_;
+  if (!dynamic_factor_) {
+    dynamic_factor_ = std::make_unique<Factorisation>();
+    dynamic_factor_->analyzePattern(keff_ff);
+  }
+  dynamic_factor_->factorize(keff_ff);
+  check_factorisation(*dynamic_factor_, "effective matrix K_eff");
+  factor_dt_ = dt;
+  ++timings_.factorisations;
+  timings_.factorisation += seconds_since(t0);
+}
+
+void Solver::step(double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw Error("step(dt): dt must be > 0, got " + std::to_string(dt));
+  assemble_mass();
+  if (!acceleration_valid_) initialise_acceleration();
+  if (dt != factor_dt_) factorise_dynamic(dt);
+  const auto t0 = Clock::now();
+  const double beta = options_.newmark_beta, gamma = options_.newmark_gamma;
+  const double c0 = 1.0 / (beta * dt * dt), c1 = gamma / (beta * dt), c2 = 1.0 / (beta * dt);
+  const double c3 = 0.5 / beta - 1.0, c4 = gamma / beta - 1.0, c5 = dt * (0.5 * gamma / beta - 1.0);
+  const double t1 = time_ + dt;
+
+  Eigen::VectorXd f1;
+  evaluate_external_force(t1, f1);
+  // K_eff u1 = F1 + M (c0 u + c2 v + c3 a) + C (c1 u + c4 v + c5 a)
+  const Eigen::VectorXd pm = c0 * u_ + c2 * v_ + c3 * a_;
+  Eigen::VectorXd rhs = f1;
+  if (options_.rayleigh_alpha != 0.0 || options_.rayleigh_beta != 0.0) {
+    const Eigen::VectorXd pc = c1 * u_ + c4 * v_ + c5 * a_;
+    rhs += m_ * (pm + options_.rayleigh_alpha * pc);
+    if (options_.rayleigh_beta != 0.0) rhs += options_.rayleigh_beta * (k_ * pc);
+  } else {
+    rhs += m_ * pm;
+  }
+  Eigen::VectorXd uc;
+  prescribed_values(t1, uc);
+  Eigen::VectorXd rf(static_cast<Eigen::Index>(free_dofs_.size()));
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k) rf[static_cast<Eigen::Index>(k)] = rhs[free_dofs_[k]];
+  if (uc.size() > 0 && uc.cwiseAbs().maxCoeff() > 0.0) rf -= keff_fc_ * uc;
+  const Eigen::VectorXd uf = dynamic_factor_->solve(rf);
+
+  Eigen::VectorXd u1(u_.size());
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k) u1[free_dofs_[k]] = uf[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k) u1[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
+  // a1 = c0 (u1 - u) - c2 v - c3 a;  v1 = v + dt ((1 - gamma) a + gamma a1)
+  Eigen::VectorXd a1 = c0 * (u1 - u_) - c2 * v_ - c3 * a_;
+  v_ += dt * ((1.0 - gamma) * a_ + gamma * a1);
+  external_work_ += 0.5 * (f_ + f1).dot(u1 - u_);
+  u_ = std::move(u1);
+  a_ = std::move(a1);
+  f_ = std::move(f1);
+  time_ = t1;
+  ++steps_;
+  ++timings_.solves;
+  timings_.solve += seconds_since(t0);
+}
+
+// ---------------------------------------------------------------- results
+
+MatrixX3 Solver::displacements(const std::vector<std::size_t>& nodes) const {
+  MatrixX3 d(static_cast<Eigen::Index>(nodes.size()), 3);
+  for (std::size_t k = 0; k < nodes.size(); ++k) d.row(static_cast<Eigen::Index>(k)) = displacement(nodes.at(k)).transpose();
+  return d;
+}
+
+Vec3 Solver::reaction(const std::string& node_set) const {
+  const auto& nodes = mesh().node_set(node_set);
+  // r = K u + C v + M a - F
+  Eigen::VectorXd r = k_ * u_ - f_;
+  if (mass_ready_) {
+    r += m_ * a_;
+    if (options_.rayleigh_alpha != 0.0) r += options_.rayleigh_alpha * (m_ * v_);
+    if (options_.rayleigh_beta != 0.0) r += options_.rayleigh_beta * (k_ * v_);
+  }
+  Vec3 sum = Vec3::Zero();
+  for (auto n : nodes) sum += r.segment<3>(3 * static_cast<Eigen::Index>(n));
+  return sum;
+}
+
+MatrixX6 Solver::nodal_stress() const {
+  MatrixX6 s = MatrixX6::Zero(static_cast<Eigen::Index>(mesh().num_nodes()), 6);
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(s.rows());
+  ElementStresses se;
+  ElementVector ue;
+  for (const auto& e : mesh().elements()) {
+    const int n = node_count(e.type);
+    ue.resize(3 * n);
+    for (int a = 0; a < n; ++a) ue.segment<3>(3 * a) = u_.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a]));
+    integrator_.stresses_at_nodes(e.type, coordinates(mesh(), e),
+                                  model_.material(e.region).elasticity_matrix(), ue, se);
+    for (int a = 0; a < n; ++a) {
+      const auto i = static_cast<Eigen::Index>(e.nodes[a]);
+      s.row(i) += se.row(a);
+      count[i] += 1.0;
+    }
+  }
+  for (Eigen::Index i = 0; i < s.rows(); ++i) {
+    if (count[i] > 0) s.row(i) /= count[i];
+  }
+  return s;
+}
+
+Eigen::VectorXd Solver::von_mises(const MatrixX6& s) {
+  Eigen::VectorXd vm(s.rows());
+  // sigma_vm = sqrt(1/2 ((sx-sy)^2 + (sy-sz)^2 + (sz-sx)^2) + 3 (txy^2 + tyz^2 + tzx^2))
+  for (Eigen::Index i = 0; i < s.rows(); ++i) {
+    const double a = s(i, 0) - s(i, 1), b = s(i, 1) - s(i, 2), c = s(i, 2) - s(i, 0);
+    vm[i] = std::sqrt(0.5 * (a * a + b * b + c * c) +
+                      3.0 * (s(i, 3) * s(i, 3) + s(i, 4) * s(i, 4) + s(i, 5) * s(i, 5)));
+  }
+  return vm;
+}
+
+double Solver::kinetic_energy() const { return mass_ready_ ? 0.5 * v_.dot(m_ * v_) : 0.0; }
+double Solver::strain_energy() const { return 0.5 * u_.dot(k_ * u_); }
+
+double Solver::max_displacement() const {
+  double m = 0.0;
+  for (Eigen::Index i = 0; i + 2 < u_.size(); i += 3) m = std::max(m, u_.segment<3>(i).norm());
+  return m;
+}
+
+Vec3 Solver::total_coupling_force() const {
+  return coupling_force_.reshaped(3, coupling_force_.size() / 3).rowwise().sum();
+}
+
+Vec3 Solver::total_external_force() const { return f_.reshaped(3, f_.size() / 3).rowwise().sum(); }
+
+// ---------------------------------------------------------------- state
+
+SolverState Solver::save_state() const {
+  SolverState s;
+  s.time = time_;
+  s.steps = steps_;
+  s.displacement = u_;
+  s.velocity = v_;
+  s.acceleration = a_;
+  s.external_force = f_;
+  s.acceleration_valid = acceleration_valid_;
+  s.external_work = external_work_;
+  s.coupling_force = coupling_force_;
+  s.face_tractions = face_tractions_;
+  s.nodal_force_nodes = nodal_force_nodes_;
+  s.nodal_forces = nodal_forces_;
+  return s;
+}
+
+void Solver::restore_state(const SolverState& s) {
+  const auto n = static_cast<Eigen::Index>(ndof_);
+  if (s.displacement.size() != n || s.velocity.size() != n || s.acceleration.size() != n ||
+      s.external_force.size() != n || s.coupling_force.size() != n) {
+    throw Error("restore_state: the state has " + std::to_string(s.displacement.size()) +
+                " dofs but this solver has " + std::to_string(ndof_) + " (state of another model?)");
+  }
+  time_ = s.time;
+  steps_ = s.steps;
+  u_ = s.displacement;
+  v_ = s.velocity;
+  a_ = s.acceleration;
+  f_ = s.external_force;
+  acceleration_valid_ = s.acceleration_valid;
+  external_work_ = s.external_work;
+  coupling_force_ = s.coupling_force;
+  face_tractions_ = s.face_tractions;
+  nodal_force_nodes_ = s.nodal_force_nodes;
+  nodal_forces_ = s.nodal_forces;
+}
+
+}  // namespace partita::fem

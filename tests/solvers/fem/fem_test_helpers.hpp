@@ -1,0 +1,60 @@
+#pragma once
+// Shared helpers of the partita::fem tests (not a test file itself).
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "partita/fem/box_mesher.hpp"
+#include "partita/fem/element_topology.hpp"
+#include "partita/fem/mesh.hpp"
+
+namespace partita::fem::test {
+
+// Deterministic pseudo-random numbers in [-1, 1].
+class Lcg {
+ public:
+  explicit Lcg(unsigned long long seed) : s_(seed) {}
+  double next() {
+    s_ = s_ * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(s_ >> 11) / static_cast<double>(1ull << 53) * 2.0 - 1.0;
+  }
+
+ private:
+  unsigned long long s_;
+};
+
+// Union of node sets.
+inline void add_union_set(Mesh& mesh, const std::string& name, const std::vector<std::string>& sets) {
+  std::vector<std::size_t> ids;
+  for (const auto& s : sets) ids.insert(ids.end(), mesh.node_set(s).begin(), mesh.node_set(s).end());
+  mesh.add_node_set(name, ids);
+}
+
+// Places the edge nodes of quadratic elements at the midpoints of their corners.
+inline void straighten_edges(Mesh& mesh) {
+  for (const auto& e : mesh.elements()) {
+    const int nc = corner_count(e.type);
+    const auto edges = quadratic_edges(e.type);
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+      mesh.set_node(e.nodes[nc + k], 0.5 * (mesh.node(e.nodes[edges[k][0]]) + mesh.node(e.nodes[edges[k][1]])));
+    }
+  }
+}
+
+// Moves every node not on the box boundary by up to `amount` (fraction of the cell size h) in
+// each direction, then straightens the edges of quadratic elements.
+inline void distort_interior(Mesh& mesh, const BoxSpec& spec, double amount, unsigned long long seed) {
+  Lcg rng(seed);
+  const Vec3 lo = spec.origin, hi = spec.origin + spec.size;
+  for (std::size_t i = 0; i < mesh.num_nodes(); ++i) {
+    Vec3 x = mesh.node(i);
+    bool boundary = false;
+    for (int d = 0; d < 3; ++d) boundary = boundary || std::abs(x[d] - lo[d]) < 1e-12 || std::abs(x[d] - hi[d]) < 1e-12;
+    if (boundary) continue;
+    for (int d = 0; d < 3; ++d) x[d] += amount * spec.size[d] / spec.cells[d] * rng.next();
+    mesh.set_node(i, x);
+  }
+  straighten_edges(mesh);
+}
+
+}  // namespace partita::fem::test
