@@ -40,7 +40,7 @@ std::string mapper_type(const config::Node& node) {
 
 std::unique_ptr<Mapper> create_mapper(const Registry<MapperFactory>& registry, const MapperContext& context) {
   const config::Node& node = context.config;
-  if (!node.is_scalar() && !node.is_map()) mapper_type(node);  // throws with the expected forms
+  mapper_type(node);  // throws unless a name or a map with `type`
   const auto& entry = registry.get(node.is_scalar() ? node : node["type"]);
   return entry.factory(context);
 }

@@ -19,6 +19,10 @@ std::unique_ptr<Mapper> NearestNeighborMapper::create(const MapperContext& conte
 }
 
 SparseMapper::Matrix NearestNeighborMapper::interpolation(const Mesh& source, const Mesh& target) const {
+  return weights(source, target);
+}
+
+SparseMapper::Matrix NearestNeighborMapper::weights(const Mesh& source, const Mesh& target) {
   const PointTree tree(source.points());
   const Eigen::Index n = target.size();
   // W_ij = 1 if j is the source point nearest to target point i, else 0

@@ -19,6 +19,9 @@ class NearestNeighborMapper final : public SparseMapper {
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Mapper> create(const MapperContext& context);
 
+  /// W_ij = 1 if source point j is the nearest to target point i (target x source).
+  static Matrix weights(const Mesh& source, const Mesh& target);
+
  protected:
   Matrix interpolation(const Mesh& source, const Mesh& target) const override;
 };
