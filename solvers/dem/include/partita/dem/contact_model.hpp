@@ -1,0 +1,146 @@
+#pragma once
+// Hertz-Mindlin contact law for spheres against spheres, planes and triangles, and the table of
+// per-material-pair parameters it reads.
+//
+// Effective quantities (REFERENCES.md): 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2,
+// 1/G* = 2(2-nu1)(1+nu1)/E1 + 2(2-nu2)(1+nu2)/E2, R* = R1 R2/(R1+R2) (wall: R1),
+// m* = m1 m2/(m1+m2) (wall: m1).
+
+#include "partita/dem/damping_model.hpp"
+#include "partita/dem/interaction.hpp"
+#include "partita/dem/material.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace partita::dem {
+
+/// Everything the force law needs about one pair of materials, precomputed.
+struct PairParameters {
+  double e_star = 0.0;            ///< E* [Pa]
+  double g_star = 0.0;            ///< G* [Pa]
+  double zeta = 0.0;              ///< damping ratio: gamma = 2 zeta sqrt(S m*)
+  double friction = 0.0;          ///< mu
+  double rolling_friction = 0.0;  ///< mu_r
+  bool no_tension = true;  ///< clamp F_n >= 0
+  /// Cap spring + damping tangential force at mu F_n (calibrated model); false: LIGGGHTS, which
+  /// caps the spring only and adds the damping force while sticking.
+  bool cap_total_tangential = true;
+  bool defined = false;           ///< an interaction was given for this pair
+};
+
+/// Materials, interactions and the damping model; turns them into a PairParameters table.
+class ContactModel {
+ public:
+  /// Adds a material and returns its id (0, 1, ...). Throws Error on non-physical values.
+  int add_material(const Material& material);
+  /// Sets the interaction of materials a and b (symmetric). Throws Error on unknown ids or
+  /// values out of range.
+  void set_interaction(int a, int b, const Interaction& interaction);
+  void set_damping_model(DampingModel model);
+  DampingModel damping_model() const { return damping_model_; }
+
+  int material_count() const { return static_cast<int>(materials_.size()); }
+  const Material& material(int id) const;
+  /// Throws Error naming `what` if id is not a material id.
+  void check_material(int id, const std::string& what) const;
+  bool has_interaction(int a, int b) const;
+
+  /// Recomputes the pair table (restitution calibration) after changes; cheap when unchanged.
+  void update();
+  /// Parameters of the pair (a, b); valid after update().
+  const PairParameters& pair(int a, int b) const { return table_[a * n_ + b]; }
+
+ private:
+  std::vector<Material> materials_;
+  std::vector<Interaction> interactions_;  // n x n
+  std::vector<bool> interaction_set_;      // n x n
+  std::vector<PairParameters> table_;      // n_ x n_
+  int n_ = 0;
+  DampingModel damping_model_ = DampingModel::calibrated;
+  bool dirty_ = true;
+};
+
+/// Hertz-Mindlin force on body i from body j (or a wall) for one contact with overlap delta > 0.
+///   n      unit normal pointing from j (or the wall) to i
+///   v_rel  v_i - v_j at the centres (wall: v_i - velocity of the wall at the contact point)
+///   w_arm  cr_i omega_i + cr_j omega_j with cr = R - delta/2 (wall: cr_i omega_i)
+///   shear  tangential displacement history, updated in place when update_history
+/// Returns the normal force magnitude F_n; writes the total force on i and its tangential part.
+inline double hertz_mindlin(const PairParameters& p, double delta, double r_eff, double m_eff,
+                            const Eigen::Vector3d& n, const Eigen::Vector3d& v_rel,
+                            const Eigen::Vector3d& w_arm, Eigen::Vector3d& shear, double dt,
+                            bool update_history, Eigen::Vector3d& force,
+                            Eigen::Vector3d& f_tangential) {
+  // Normal: F_n = 4/3 E* sqrt(R*) delta^(3/2) - gamma_n v_n, S_n = 2 E* sqrt(R* delta),
+  // gamma_n = 2 zeta sqrt(S_n m*) (v_n < 0 while approaching).
+  const double a = std::sqrt(r_eff * delta);  // contact radius
+  const double s_n = 2.0 * p.e_star * a;
+  const double v_n = v_rel.dot(n);
+  double f_n = (2.0 / 3.0) * s_n * delta;
+  if (p.zeta > 0.0) f_n -= 2.0 * p.zeta * std::sqrt(s_n * m_eff) * v_n;
+  if (p.no_tension && f_n < 0.0) f_n = 0.0;
+  force = f_n * n;
+  if (p.friction <= 0.0) {
+    f_tangential.setZero();
+    shear.setZero();
+    return f_n;
+  }
+  // Tangential (Mindlin, no-slip stiffness): S_t = 8 G* sqrt(R* delta); history xi integrates
+  // the tangential velocity at the contact point and is kept in the current tangent plane:
+  //   v_t = v_rel - v_n n + n x w_arm,  xi += v_t dt,  xi -= (xi.n) n,
+  //   F_t = -S_t xi - gamma_t v_t,  gamma_t = 2 zeta sqrt(S_t m*),
+  //   |F_t| <= mu |F_n|: when above, F_t is scaled to the cap and the spring takes all of it,
+  //   xi = -F_t/S_t. LIGGGHTS variant: the test is on the spring force alone and the damping is
+  //   added unchecked while sticking (which lets F_t exceed the cap at the start of a contact).
+  const Eigen::Vector3d v_t = v_rel - v_n * n + n.cross(w_arm);
+  if (update_history) {
+    shear += v_t * dt;
+    shear -= shear.dot(n) * n;
+  }
+  const double k_t = 8.0 * p.g_star * a;
+  if (p.cap_total_tangential) {
+    f_tangential = -k_t * shear;
+    if (p.zeta > 0.0) f_tangential -= (2.0 * p.zeta * std::sqrt(k_t * m_eff)) * v_t;
+    const double ft2 = f_tangential.squaredNorm();
+    const double cap = p.friction * f_n;
+    if (ft2 > cap * cap) {
+      f_tangential *= cap / std::sqrt(ft2);
+      if (update_history) shear = f_tangential / (-k_t);
+    }
+    force += f_tangential;
+    return f_n;
+  }
+  const double shear_norm = shear.norm();
+  const double ft_spring = k_t * shear_norm;
+  const double ft_cap = p.friction * std::abs(f_n);
+  if (ft_spring > ft_cap) {
+    if (shear_norm > 0.0) {
+      const double ratio = ft_cap / ft_spring;
+      f_tangential = (-k_t * ratio) * shear;
+      if (update_history) shear *= ratio;
+    } else {
+      f_tangential.setZero();
+    }
+  } else {
+    f_tangential = -k_t * shear;
+    if (p.zeta > 0.0) f_tangential -= (2.0 * p.zeta * std::sqrt(k_t * m_eff)) * v_t;
+  }
+  force += f_tangential;
+  return f_n;
+}
+
+/// Elastic energy stored in a Hertz contact: integral of 4/3 E* sqrt(R*) d^(3/2) from 0 to delta
+/// = 8/15 E* sqrt(R*) delta^(5/2), plus the tangential spring 1/2 S_t |xi|^2.
+inline double hertz_elastic_energy(const PairParameters& p, double delta, double r_eff,
+                                   const Eigen::Vector3d& shear) {
+  const double a = std::sqrt(r_eff * delta);
+  return 8.0 / 15.0 * p.e_star * a * delta * delta +
+         0.5 * 8.0 * p.g_star * a * shear.squaredNorm();
+}
+
+}  // namespace partita::dem

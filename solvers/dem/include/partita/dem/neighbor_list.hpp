@@ -1,0 +1,90 @@
+#pragma once
+// Neighbour search: linked cells + Verlet lists with a skin.
+//
+// Particle pairs: a half list in compressed rows (pairs (i, j) with j > i, j ascending), cut-off
+// R_i + R_j + skin, so that it stays valid until some particle has moved more than skin/2 since
+// the build. Each pair slot carries its tangential history (moved to the new slot at a rebuild)
+// and a force buffer; a reverse index (for each j, the slots (i, j)) lets every particle gather
+// its forces in a fixed order, which makes the results independent of the thread count.
+// Particle-triangle candidates: triangles are binned into the same cells (box grown by
+// R_max + skin), each particle keeps the triangles within R + skin; valid until a particle or a
+// mesh vertex has moved more than skin/2.
+// Cells are 2 R_max + skin wide (correct for any size distribution; with very wide ones the
+// cells hold many small particles). Vectors are reused: no allocation between rebuilds.
+
+#include "partita/dem/particles.hpp"
+#include "partita/dem/triangle_mesh.hpp"
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace partita::dem {
+
+/// Force of one pair on i and torques on i and j (force on j is -force).
+struct PairForce {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque_i = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque_j = Eigen::Vector3d::Zero();
+};
+
+struct MeshCandidate {
+  int mesh = 0;
+  int triangle = 0;
+};
+
+class NeighborList {
+ public:
+  void set_skin(double skin) { skin_ = skin; }
+  double skin() const { return skin_; }
+  /// Forgets the lists (next needs_rebuild() is true); histories are dropped.
+  void clear();
+  /// True when a particle or mesh vertex moved more than skin/2 since the last build.
+  bool needs_rebuild(const Particles& particles, const std::vector<TriangleMesh>& meshes) const;
+  /// Rebuilds cells and lists, carrying the tangential histories of surviving pairs over.
+  void build(const Particles& particles, std::vector<TriangleMesh>& meshes);
+
+  std::size_t pair_count() const { return neighbors_.size(); }
+  long build_count() const { return builds_; }
+
+ private:
+  friend class System;
+
+  struct Grid {
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    double inv_cell = 1.0;
+    int nx = 1, ny = 1, nz = 1;
+    int coord(double x, double o, int n) const;
+    std::array<int, 3> coords(const Eigen::Vector3d& x) const;
+    int index(int ix, int iy, int iz) const { return (iz * ny + iy) * nx + ix; }
+    int cells() const { return nx * ny * nz; }
+  };
+
+  template <class Visit>
+  void visit_pairs(const Particles& p, int i, Visit&& visit) const;
+  void build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes,
+                             double r_max);
+
+  double skin_ = 0.0;
+  long builds_ = 0;
+  bool valid_ = false;
+  Grid grid_;
+  std::vector<int> cell_start_, cell_items_, particle_cell_;
+  // half list (compressed rows) with per-pair history and force buffers
+  std::vector<int> offsets_, neighbors_;
+  std::vector<Eigen::Vector3d> shear_;
+  std::vector<PairForce> pair_force_;
+  std::vector<int> reverse_offsets_, reverse_pairs_;
+  std::vector<Eigen::Vector3d> position_at_build_;
+  // scratch reused between builds
+  std::vector<int> new_offsets_, new_neighbors_, counts_;
+  std::vector<Eigen::Vector3d> new_shear_;
+  // particle-triangle candidates
+  std::vector<int> tri_cell_start_;
+  std::vector<MeshCandidate> tri_cell_items_;
+  std::vector<int> mesh_offsets_;
+  std::vector<MeshCandidate> mesh_candidates_;
+};
+
+}  // namespace partita::dem

@@ -1,0 +1,28 @@
+#pragma once
+// The damping ratio that makes a damped Hertz contact rebound with a given restitution.
+//
+// Normal contact with viscous damping gamma = 2 zeta sqrt(S_n m*), S_n = 2 E* sqrt(R* delta):
+//   m* delta'' = -4/3 E* sqrt(R*) delta^(3/2) - gamma delta'
+// Scaling delta = D x and t = T tau with T^2 = m*/(4/3 E* sqrt(R*) D^(1/2)) and D = v0 T turns it
+// into the parameter-free equation
+//   x'' = -x^(3/2) - 2 sqrt(3/2) zeta x^(1/4) x',   x(0) = 0, x'(0) = 1,
+// so the realised restitution e = -x'(end) depends on zeta only, not on the impact speed, the
+// masses or the stiffness (Antypov & Elliott, EPL 94 (2011) 50004; Thornton, Cummins & Cleary,
+// Powder Technol. 233 (2013) 30-46). The linear-spring expression zeta = -ln(e)/sqrt(ln(e)^2+pi^2)
+// (times sqrt(5/6) in LIGGGHTS) is therefore not exact for Hertz contacts: we integrate the scaled
+// equation numerically (RK4) and invert e(zeta) by bisection, once per interaction.
+
+namespace partita::dem {
+
+class RestitutionCalibration {
+ public:
+  /// Realised restitution of the damped Hertz contact with damping ratio zeta >= 0.
+  /// no_tension: the normal force is clamped at zero (no attraction at the end of the contact).
+  static double restitution(double zeta, bool no_tension);
+  /// The damping ratio zeta whose realised restitution is e (0 < e <= 1). Throws Error outside.
+  static double damping_ratio(double e, bool no_tension = true);
+  /// LIGGGHTS/EDEM damping ratio: zeta = -sqrt(5/6) ln(e)/sqrt(ln(e)^2 + pi^2).
+  static double liggghts_damping_ratio(double e);
+};
+
+}  // namespace partita::dem

@@ -1,0 +1,67 @@
+#pragma once
+// A triangle mesh wall whose vertices a caller may move at every step (the coupling interface).
+// Holds vertex positions and velocities, edge topology (to count a contact on a shared edge or
+// vertex once), and the contact forces of the last step per triangle and per vertex.
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace partita::dem {
+
+/// Closest point of a triangle to a point, with the feature it lies on.
+struct TriangleClosestPoint {
+  enum Feature { face = 0, edge = 1, vertex = 2 };
+  Eigen::Vector3d point;
+  std::array<double, 3> barycentric;  ///< weights of the triangle's vertices 0, 1, 2
+  Feature feature = face;
+  int local_index = 0;  ///< edge 0 (v0v1), 1 (v1v2), 2 (v2v0) or vertex 0..2
+};
+
+class TriangleMesh {
+ public:
+  using Triangles = Eigen::Matrix<int, Eigen::Dynamic, 3>;
+
+  /// Throws Error if an index is out of range, a triangle is degenerate or a coordinate is not
+  /// finite.
+  TriangleMesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices, const Triangles& triangles,
+               int material);
+
+  int vertex_count() const { return static_cast<int>(position_.size()); }
+  int triangle_count() const { return static_cast<int>(triangles_.size()); }
+  int material() const { return material_; }
+  const std::vector<Eigen::Vector3d>& positions() const { return position_; }
+  const std::vector<Eigen::Vector3d>& velocities() const { return velocity_; }
+  const std::array<int, 3>& triangle(int t) const { return triangles_[t]; }
+  /// Edge ids of triangle t: edges (v0,v1), (v1,v2), (v2,v0).
+  const std::array<int, 3>& triangle_edges(int t) const { return triangle_edges_[t]; }
+  const std::array<int, 2>& edge(int e) const { return edges_[e]; }
+
+  /// Closest point of triangle t to p (Ericson, Real-Time Collision Detection, 5.1.5).
+  TriangleClosestPoint closest_point(int t, const Eigen::Vector3d& p) const;
+
+  /// Force exerted by the particles on each triangle / vertex in the last step [N].
+  const Eigen::MatrixX3d& triangle_forces() const { return triangle_force_; }
+  const Eigen::MatrixX3d& vertex_forces() const { return vertex_force_; }
+  Eigen::Vector3d total_force() const { return triangle_force_.colwise().sum().transpose(); }
+
+ private:
+  friend class System;
+  friend class NeighborList;
+
+  std::vector<Eigen::Vector3d> position_;
+  std::vector<Eigen::Vector3d> velocity_;
+  std::vector<Eigen::Vector3d> position_last_step_;  // for velocities from the motion
+  std::vector<Eigen::Vector3d> position_at_build_;   // for the neighbour-list criterion
+  std::vector<std::array<int, 3>> triangles_;
+  std::vector<std::array<int, 3>> triangle_edges_;
+  std::vector<std::array<int, 2>> edges_;
+  Eigen::MatrixX3d triangle_force_;
+  Eigen::MatrixX3d vertex_force_;
+  int material_ = 0;
+  bool velocity_from_motion_ = false;  // next step derives velocities from the displacement
+};
+
+}  // namespace partita::dem

@@ -1,0 +1,226 @@
+#include "partita/dem/neighbor_list.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace partita::dem {
+
+int NeighborList::Grid::coord(double x, double o, int n) const {
+  const double c = std::floor((x - o) * inv_cell);
+  if (!(c >= 0.0)) return 0;  // also NaN
+  return c >= n - 1 ? n - 1 : static_cast<int>(c);
+}
+
+std::array<int, 3> NeighborList::Grid::coords(const Eigen::Vector3d& x) const {
+  return {coord(x.x(), origin.x(), nx), coord(x.y(), origin.y(), ny),
+          coord(x.z(), origin.z(), nz)};
+}
+
+void NeighborList::clear() {
+  valid_ = false;
+  offsets_.assign(1, 0);
+  neighbors_.clear();
+  shear_.clear();
+  pair_force_.clear();
+  reverse_offsets_.assign(1, 0);
+  reverse_pairs_.clear();
+  mesh_offsets_.assign(1, 0);
+  mesh_candidates_.clear();
+}
+
+bool NeighborList::needs_rebuild(const Particles& p, const std::vector<TriangleMesh>& meshes) const {
+  if (!valid_ || position_at_build_.size() != p.size()) return true;
+  const double limit2 = 0.25 * skin_ * skin_;
+  const long n = static_cast<long>(p.size());
+  double max2 = 0.0;
+#pragma omp parallel for reduction(max : max2) schedule(static)
+  for (long i = 0; i < n; ++i) max2 = std::max(max2, (p.position[i] - position_at_build_[i]).squaredNorm());
+  if (max2 > limit2) return true;
+  for (const TriangleMesh& m : meshes)
+    for (int v = 0; v < m.vertex_count(); ++v)
+      if ((m.position_[v] - m.position_at_build_[v]).squaredNorm() > limit2) return true;
+  return false;
+}
+
+// Calls visit(j) for every j > i within R_i + R_j + skin of i, cells in a fixed order.
+template <class Visit>
+void NeighborList::visit_pairs(const Particles& p, int i, Visit&& visit) const {
+  const Eigen::Vector3d& xi = p.position[i];
+  const double ri = p.radius[i] + skin_;
+  const auto c = grid_.coords(xi);
+  const int z0 = std::max(c[2] - 1, 0), z1 = std::min(c[2] + 1, grid_.nz - 1);
+  const int y0 = std::max(c[1] - 1, 0), y1 = std::min(c[1] + 1, grid_.ny - 1);
+  const int x0 = std::max(c[0] - 1, 0), x1 = std::min(c[0] + 1, grid_.nx - 1);
+  for (int iz = z0; iz <= z1; ++iz)
+    for (int iy = y0; iy <= y1; ++iy) {
+      const int first = cell_start_[grid_.index(x0, iy, iz)];
+      const int last = cell_start_[grid_.index(x1, iy, iz) + 1];
+      for (int k = first; k < last; ++k) {
+        const int j = cell_items_[k];
+        if (j <= i) continue;
+        const double cut = ri + p.radius[j];
+        if ((p.position[j] - xi).squaredNorm() < cut * cut) visit(j);
+      }
+    }
+}
+
+void NeighborList::build(const Particles& p, std::vector<TriangleMesh>& meshes) {
+  ++builds_;
+  const int n = static_cast<int>(p.size());
+  // Grid over the particles' bounding box, cells 2 R_max + skin wide (at most ~4 N cells).
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d hi = -lo;
+  double r_max = 0.0;
+  for (int i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(p.position[i]);
+    hi = hi.cwiseMax(p.position[i]);
+    r_max = std::max(r_max, p.radius[i]);
+  }
+  if (n == 0) lo = hi = Eigen::Vector3d::Zero();
+  double cell = std::max(2.0 * r_max + skin_, 1e-12);
+  const Eigen::Vector3d extent = hi - lo;
+  auto dims = [&](double h, int k) { return static_cast<int>(std::floor(extent[k] / h)) + 1; };
+  const double max_cells = 4.0 * n + 64.0;
+  while (static_cast<double>(dims(cell, 0)) * dims(cell, 1) * dims(cell, 2) > max_cells)
+    cell *= 1.26;
+  grid_.origin = lo;
+  grid_.inv_cell = 1.0 / cell;
+  grid_.nx = dims(cell, 0), grid_.ny = dims(cell, 1), grid_.nz = dims(cell, 2);
+
+  // Counting sort of the particles into cells (ascending index within a cell).
+  particle_cell_.resize(n);
+  cell_start_.assign(grid_.cells() + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    const auto c = grid_.coords(p.position[i]);
+    particle_cell_[i] = grid_.index(c[0], c[1], c[2]);
+    ++cell_start_[particle_cell_[i] + 1];
+  }
+  for (int c = 0; c < grid_.cells(); ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_items_.resize(n);
+  counts_.assign(grid_.cells(), 0);
+  for (int i = 0; i < n; ++i) {
+    const int c = particle_cell_[i];
+    cell_items_[cell_start_[c] + counts_[c]++] = i;
+  }
+
+  // Half list in two passes (count, fill), each row sorted by j.
+  new_offsets_.resize(n + 1);
+  new_offsets_[0] = 0;
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i) {
+    int count = 0;
+    visit_pairs(p, i, [&](int) { ++count; });
+    new_offsets_[i + 1] = count;
+  }
+  for (int i = 0; i < n; ++i) new_offsets_[i + 1] += new_offsets_[i];
+  new_neighbors_.resize(new_offsets_[n]);
+  new_shear_.resize(new_offsets_[n]);
+  // rows of the previous build (particles added since then have none)
+  const int old_n = valid_ ? std::min(n, static_cast<int>(offsets_.size()) - 1) : 0;
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i) {
+    int* row = new_neighbors_.data() + new_offsets_[i];
+    int k = 0;
+    visit_pairs(p, i, [&](int j) { row[k++] = j; });
+    std::sort(row, row + k);
+    // carry the tangential history of pairs that were already listed (both rows sorted)
+    int o = i < old_n ? offsets_[i] : 0;
+    const int o_end = i < old_n ? offsets_[i + 1] : 0;
+    for (int m = 0; m < k; ++m) {
+      while (o < o_end && neighbors_[o] < row[m]) ++o;
+      new_shear_[new_offsets_[i] + m] =
+          (o < o_end && neighbors_[o] == row[m]) ? shear_[o] : Eigen::Vector3d::Zero();
+    }
+  }
+  offsets_.swap(new_offsets_);
+  neighbors_.swap(new_neighbors_);
+  shear_.swap(new_shear_);
+  pair_force_.resize(neighbors_.size());
+
+  // Reverse index: for each j the slots (i, j), in slot order.
+  reverse_offsets_.assign(n + 1, 0);
+  for (int j : neighbors_) ++reverse_offsets_[j + 1];
+  for (int i = 0; i < n; ++i) reverse_offsets_[i + 1] += reverse_offsets_[i];
+  reverse_pairs_.resize(neighbors_.size());
+  counts_.assign(n, 0);
+  for (int s = 0; s < static_cast<int>(neighbors_.size()); ++s) {
+    const int j = neighbors_[s];
+    reverse_pairs_[reverse_offsets_[j] + counts_[j]++] = s;
+  }
+  position_at_build_ = p.position;
+  build_mesh_candidates(p, meshes, r_max);
+  valid_ = true;
+}
+
+void NeighborList::build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes,
+                                         double r_max) {
+  const int n = static_cast<int>(p.size());
+  mesh_offsets_.assign(n + 1, 0);
+  mesh_candidates_.clear();
+  if (meshes.empty()) return;
+  const double grow = r_max + skin_;
+  const double cell = 1.0 / grid_.inv_cell;
+  const Eigen::Vector3d grid_hi =
+      grid_.origin + cell * Eigen::Vector3d(grid_.nx, grid_.ny, grid_.nz);
+  // Bin every triangle into the cells its box (grown by R_max + skin) overlaps; two passes.
+  tri_cell_start_.assign(grid_.cells() + 1, 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {
+      for (int c = 0; c < grid_.cells(); ++c) tri_cell_start_[c + 1] += tri_cell_start_[c];
+      tri_cell_items_.resize(tri_cell_start_[grid_.cells()]);
+      counts_.assign(grid_.cells(), 0);
+    }
+    for (int m = 0; m < static_cast<int>(meshes.size()); ++m) {
+      const TriangleMesh& mesh = meshes[m];
+      for (int t = 0; t < mesh.triangle_count(); ++t) {
+        const auto& tri = mesh.triangle(t);
+        Eigen::Vector3d blo = mesh.position_[tri[0]], bhi = blo;
+        for (int k = 1; k < 3; ++k) {
+          blo = blo.cwiseMin(mesh.position_[tri[k]]);
+          bhi = bhi.cwiseMax(mesh.position_[tri[k]]);
+        }
+        blo.array() -= grow;
+        bhi.array() += grow;
+        if ((blo.array() > grid_hi.array()).any() || (bhi.array() < grid_.origin.array()).any())
+          continue;
+        const auto c0 = grid_.coords(blo), c1 = grid_.coords(bhi);
+        for (int iz = c0[2]; iz <= c1[2]; ++iz)
+          for (int iy = c0[1]; iy <= c1[1]; ++iy)
+            for (int ix = c0[0]; ix <= c1[0]; ++ix) {
+              const int c = grid_.index(ix, iy, iz);
+              if (pass == 0)
+                ++tri_cell_start_[c + 1];
+              else
+                tri_cell_items_[tri_cell_start_[c] + counts_[c]++] = {m, t};
+            }
+      }
+    }
+  }
+  // Each particle keeps the triangles of its own cell within R + skin (two passes).
+  auto visit = [&](int i, auto&& keep) {
+    const int c = particle_cell_[i];
+    const double cut = p.radius[i] + skin_;
+    for (int k = tri_cell_start_[c]; k < tri_cell_start_[c + 1]; ++k) {
+      const MeshCandidate mc = tri_cell_items_[k];
+      const auto cp = meshes[mc.mesh].closest_point(mc.triangle, p.position[i]);
+      if ((cp.point - p.position[i]).squaredNorm() < cut * cut) keep(mc);
+    }
+  };
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i) {
+    int count = 0;
+    visit(i, [&](MeshCandidate) { ++count; });
+    mesh_offsets_[i + 1] = count;
+  }
+  for (int i = 0; i < n; ++i) mesh_offsets_[i + 1] += mesh_offsets_[i];
+  mesh_candidates_.resize(mesh_offsets_[n]);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int i = 0; i < n; ++i) {
+    int k = mesh_offsets_[i];
+    visit(i, [&](MeshCandidate mc) { mesh_candidates_[k++] = mc; });
+  }
+  for (TriangleMesh& m : meshes) m.position_at_build_ = m.position_;
+}
+
+}  // namespace partita::dem

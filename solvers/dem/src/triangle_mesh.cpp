@@ -1,0 +1,122 @@
+#include "partita/dem/triangle_mesh.hpp"
+
+#include "partita/dem/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace partita::dem {
+
+TriangleMesh::TriangleMesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
+                           const Triangles& triangles, int material)
+    : material_(material) {
+  const int nv = static_cast<int>(vertices.rows());
+  if (nv < 3 || triangles.rows() < 1) {
+    std::ostringstream msg;
+    msg << "add_mesh: need at least 3 vertices and 1 triangle, got " << nv << " vertices and "
+        << triangles.rows() << " triangles";
+    throw Error(msg.str());
+  }
+  position_.resize(nv);
+  for (int v = 0; v < nv; ++v) {
+    position_[v] = vertices.row(v).transpose();
+    if (!position_[v].allFinite()) {
+      std::ostringstream msg;
+      msg << "add_mesh: vertex " << v << " has a non-finite coordinate";
+      throw Error(msg.str());
+    }
+  }
+  velocity_.assign(nv, Eigen::Vector3d::Zero());
+  position_last_step_ = position_;
+  position_at_build_ = position_;
+  std::map<std::pair<int, int>, int> edge_id;
+  for (int t = 0; t < triangles.rows(); ++t) {
+    std::array<int, 3> tri{triangles(t, 0), triangles(t, 1), triangles(t, 2)};
+    for (int k = 0; k < 3; ++k)
+      if (tri[k] < 0 || tri[k] >= nv) {
+        std::ostringstream msg;
+        msg << "add_mesh: triangle " << t << " refers to vertex " << tri[k]
+            << ", allowed indices are 0.." << nv - 1;
+        throw Error(msg.str());
+      }
+    const Eigen::Vector3d nrm =
+        (position_[tri[1]] - position_[tri[0]]).cross(position_[tri[2]] - position_[tri[0]]);
+    if (!(nrm.norm() > 0.0)) {
+      std::ostringstream msg;
+      msg << "add_mesh: triangle " << t << " (" << tri[0] << ", " << tri[1] << ", " << tri[2]
+          << ") is degenerate (zero area)";
+      throw Error(msg.str());
+    }
+    std::array<int, 3> te{};
+    for (int k = 0; k < 3; ++k) {
+      const int a = tri[k], b = tri[(k + 1) % 3];
+      const auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      auto it = edge_id.find(key);
+      if (it == edge_id.end()) {
+        it = edge_id.emplace(key, static_cast<int>(edges_.size())).first;
+        edges_.push_back({key.first, key.second});
+      }
+      te[k] = it->second;
+    }
+    triangles_.push_back(tri);
+    triangle_edges_.push_back(te);
+  }
+  triangle_force_ = Eigen::MatrixX3d::Zero(triangle_count(), 3);
+  vertex_force_ = Eigen::MatrixX3d::Zero(nv, 3);
+}
+
+TriangleClosestPoint TriangleMesh::closest_point(int t, const Eigen::Vector3d& p) const {
+  const Eigen::Vector3d& a = position_[triangles_[t][0]];
+  const Eigen::Vector3d& b = position_[triangles_[t][1]];
+  const Eigen::Vector3d& c = position_[triangles_[t][2]];
+  TriangleClosestPoint r;
+  // Voronoi regions of the vertices, edges and face, tested in turn.
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) {
+    r.point = a, r.barycentric = {1.0, 0.0, 0.0}, r.feature = r.vertex, r.local_index = 0;
+    return r;
+  }
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) {
+    r.point = b, r.barycentric = {0.0, 1.0, 0.0}, r.feature = r.vertex, r.local_index = 1;
+    return r;
+  }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double v = d1 / (d1 - d3);
+    r.point = a + v * ab, r.barycentric = {1.0 - v, v, 0.0}, r.feature = r.edge;
+    r.local_index = 0;
+    return r;
+  }
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) {
+    r.point = c, r.barycentric = {0.0, 0.0, 1.0}, r.feature = r.vertex, r.local_index = 2;
+    return r;
+  }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double w = d2 / (d2 - d6);
+    r.point = a + w * ac, r.barycentric = {1.0 - w, 0.0, w}, r.feature = r.edge;
+    r.local_index = 2;
+    return r;
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    r.point = b + w * (c - b), r.barycentric = {0.0, 1.0 - w, w}, r.feature = r.edge;
+    r.local_index = 1;
+    return r;
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  r.point = a + v * ab + w * ac, r.barycentric = {1.0 - v - w, v, w}, r.feature = r.face;
+  r.local_index = 0;
+  return r;
+}
+
+}  // namespace partita::dem
