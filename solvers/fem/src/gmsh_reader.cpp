@@ -204,9 +204,9 @@ Mesh read_gmsh(const std::string& path) {
         }
         for (long k = 0; k < bh[3]; ++k) {
           r.next("an element line 'tag node ...'");
-          const auto v = r.numbers<long>(1 + static_cast<std::size_t>(nn), "an element line (tag and its nodes)");
+          const auto v = r.numbers<long>(1, "an element line (tag and its nodes)");
           if (v.size() != 1 + static_cast<std::size_t>(nn)) {
-            r.fail("element of type " + std::to_string(gtype) + " needs " + std::to_string(nn) + " nodes, found " + std::to_string(v.size() - 1));
+            r.fail("element of gmsh type " + std::to_string(gtype) + " needs " + std::to_string(nn) + " nodes, found " + std::to_string(v.size() - 1));
           }
           if (dim <= 1) continue;
           std::array<std::size_t, kMaxElementNodes> g{};
