@@ -1,0 +1,104 @@
+#pragma once
+// One data field sent from a participant's mesh to another participant's mesh, with what the
+// core does in between:
+//
+//   sender:   writes once per substep; the window's value is the average over its m substeps
+//             (f = 1/m Σ_k f_k, `average`) or the last substep's value (`last`) — combined();
+//             an implicit scheme may replace it by an accelerated value — sent();
+//   mapping:  received = M sent (the mapper; identity when none) — transmit();
+//   receiver: at substep k of m it reads, for `linear`, d_n + (k/m) (d_{n+1} - d_n) between the
+//             window's start value d_n and the newest value d_{n+1}; for `constant`, d_{n+1}.
+//             Where no new value came yet (first participant of a serial scheme, parallel
+//             explicit schemes) d_{n+1} = d_n and both give the start value.
+//
+// Call order per window: begin_collect(); collect() after each substep of the writer;
+// finish_collect(); [remember_previous() per iteration]; set sent(); transmit();
+// read_at() during the reader's substeps; accept_window() once the window is accepted.
+
+#include <memory>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "partita/coupling/mapping/mapper.hpp"
+#include "partita/coupling/participant.hpp"
+#include "partita/interface/solver.hpp"
+
+namespace partita::coupling {
+
+enum class ReaderSees { constant, linear };
+enum class WriterCombines { average, last };
+
+class Exchange {
+ public:
+  struct End {
+    Participant* participant = nullptr;
+    std::string mesh;
+  };
+
+  /// `mapper` already computed from the sender's to the receiver's mesh; nullptr = identity
+  /// (the meshes must then have the same number of points).
+  Exchange(std::string data, End from, End to, DataSpec spec, std::unique_ptr<Mapper> mapper,
+           ReaderSees reader_sees = ReaderSees::linear, WriterCombines writer_combines = WriterCombines::average);
+
+  const std::string& data() const { return data_; }
+  Participant& from() const { return *from_.participant; }
+  Participant& to() const { return *to_.participant; }
+  const std::string& from_mesh() const { return from_.mesh; }
+  const std::string& to_mesh() const { return to_.mesh; }
+  const DataSpec& spec() const { return spec_; }
+  ReaderSees reader_sees() const { return reader_sees_; }
+  WriterCombines writer_combines() const { return writer_combines_; }
+  const Mapper* mapper() const { return mapper_.get(); }
+  /// "pressure fluid.nodes -> solid.nodes" for messages.
+  std::string label() const;
+
+  // --- sender side ------------------------------------------------------------------------
+  void begin_collect();
+  /// The writer's values after one substep (checked: points x components).
+  void collect(const Eigen::MatrixXd& values);
+  /// combined = average or last of the collected substeps.
+  void finish_collect();
+  const Eigen::MatrixXd& combined() const { return combined_; }
+  /// The values that transmit() maps (combined, or an accelerated iterate).
+  Eigen::MatrixXd& sent() { return sent_; }
+  const Eigen::MatrixXd& sent() const { return sent_; }
+  /// previous = sent (the iterate the readers saw), before an iteration overwrites sent().
+  void remember_previous() { previous_ = sent_; }
+  const Eigen::MatrixXd& previous() const { return previous_; }
+
+  /// received = M sent.
+  void transmit();
+
+  // --- receiver side ----------------------------------------------------------------------
+  /// The value the receiver sees after the fraction s = k/m of the window.
+  void read_at(double fraction, Eigen::MatrixXd& out) const;
+  /// The newest mapped value d_{n+1}.
+  const Eigen::MatrixXd& received() const { return end_; }
+  /// d_n = d_{n+1}: the window is accepted.
+  void accept_window() { start_ = end_; }
+
+  /// Initial data: combined = sent = previous = initial, transmitted, start = end.
+  void initialize(const Eigen::MatrixXd& initial);
+
+  /// Wall time spent mapping [s].
+  double mapping_seconds() const { return mapping_seconds_; }
+
+ private:
+  void check_shape(const Eigen::MatrixXd& values, const char* what) const;
+
+  std::string data_;
+  End from_, to_;
+  DataSpec spec_;
+  std::unique_ptr<Mapper> mapper_;
+  ReaderSees reader_sees_;
+  WriterCombines writer_combines_;
+  Eigen::Index from_points_ = 0;
+
+  Eigen::MatrixXd accumulated_, combined_, sent_, previous_;
+  int collected_ = 0;
+  Eigen::MatrixXd start_, end_;
+  double mapping_seconds_ = 0.0;
+};
+
+}  // namespace partita::coupling

@@ -1,0 +1,160 @@
+#include "partita/coupling/acceleration/iqn_ils.hpp"
+
+#include "partita/interface/error.hpp"
+
+namespace partita::coupling {
+
+IqnIls::IqnIls(Options options) : options_(options) {
+  if (!(options_.initial_relaxation > 0.0 && options_.initial_relaxation <= 1.0))
+    throw Error("IQN-ILS initial relaxation must satisfy 0 < omega <= 1, found " +
+                std::to_string(options_.initial_relaxation));
+  if (options_.max_columns < 1) throw Error("IQN-ILS needs max_columns >= 1");
+  if (options_.reused_windows < 0) throw Error("IQN-ILS needs reused_windows >= 0");
+  window_columns_.push_front(0);
+}
+
+void IqnIls::remove_column(Eigen::Index j) {
+  const Eigen::Index n = v_.cols();
+  if (j + 1 < n) {
+    v_.middleCols(j, n - j - 1) = v_.rightCols(n - j - 1).eval();
+    w_.middleCols(j, n - j - 1) = w_.rightCols(n - j - 1).eval();
+  }
+  v_.conservativeResize(Eigen::NoChange, n - 1);
+  w_.conservativeResize(Eigen::NoChange, n - 1);
+  // Which window owned column j (windows hold consecutive columns, current window first)?
+  Eigen::Index first = 0;
+  for (auto& count : window_columns_) {
+    if (j < first + count) {
+      --count;
+      return;
+    }
+    first += count;
+  }
+}
+
+void IqnIls::add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde) {
+  const Eigen::VectorXd r = x_tilde - x;
+  if (!first_iteration_ && previous_residual_.size() == r.size()) {
+    // V = [r_k - r_{k-1}, ...], W = [H(x_k) - H(x_{k-1}), ...], newest first
+    const Eigen::Index n = v_.cols();
+    Eigen::MatrixXd v(r.size(), n + 1), w(r.size(), n + 1);
+    v.col(0) = r - previous_residual_;
+    w.col(0) = x_tilde - previous_x_tilde_;
+    if (n > 0) {
+      v.rightCols(n) = v_;
+      w.rightCols(n) = w_;
+    }
+    v_.swap(v);
+    w_.swap(w);
+    ++window_columns_.front();
+    while (v_.cols() > options_.max_columns) remove_column(v_.cols() - 1);
+  }
+  previous_residual_ = r;
+  previous_x_tilde_ = x_tilde;
+}
+
+void IqnIls::apply_filter(const Eigen::VectorXd& weights) {
+  // Rebuild the QR decomposition of D V newest column first; drop nearly dependent columns.
+  bool again = true;
+  while (again) {
+    again = false;
+    qr_.reset(v_.rows());
+    for (Eigen::Index j = 0; j < v_.cols(); ++j) {
+      const Eigen::VectorXd col = weights.cwiseProduct(v_.col(j));
+      const double limit = options_.filter == Filter::qr2 ? options_.filter_limit : 0.0;
+      if (!qr_.append(col, limit)) {
+        remove_column(j);
+        ++filtered_;
+        again = true;  // the factorisation so far is valid, but simplest to rebuild
+        break;
+      }
+    }
+    if (!again && options_.filter == Filter::qr1) {
+      const double rn = qr_.r_norm();
+      for (Eigen::Index j = 0; j < qr_.cols(); ++j) {
+        if (std::abs(qr_.diagonal(j)) < options_.filter_limit * rn) {
+          remove_column(j);
+          ++filtered_;
+          again = true;
+          break;
+        }
+      }
+    }
+  }
+}
+
+void IqnIls::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde, const Eigen::VectorXd& weights,
+                        Eigen::VectorXd& next) {
+  if (v_.rows() != x.size() && v_.cols() > 0) {  // the data changed size: start over
+    v_.resize(x.size(), 0);
+    w_.resize(x.size(), 0);
+    for (auto& c : window_columns_) c = 0;
+  }
+  if (v_.cols() == 0) {
+    v_.resize(x.size(), 0);
+    w_.resize(x.size(), 0);
+  }
+  add_columns(x, x_tilde);
+  first_iteration_ = false;
+  if (v_.cols() > 0) apply_filter(weights);
+  if (v_.cols() == 0) {
+    // no model yet: x_{k+1} = x_k + ω_0 r_k
+    next = x + options_.initial_relaxation * (x_tilde - x);
+    return;
+  }
+  // c = argmin |D (V c + r_k)|;  x_{k+1} = H(x_k) + W c
+  const Eigen::VectorXd c = qr_.solve(-weights.cwiseProduct(x_tilde - x));
+  next = x_tilde + w_ * c;
+}
+
+void IqnIls::window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                              const Eigen::VectorXd& /*weights*/) {
+  // The converged iteration's differences belong to the model too (preCICE adds them here).
+  if (v_.rows() == x.size() || v_.cols() == 0) {
+    if (v_.cols() == 0) {
+      v_.resize(x.size(), 0);
+      w_.resize(x.size(), 0);
+    }
+    add_columns(x, x_tilde);
+  }
+  first_iteration_ = true;
+  // Keep the columns of the current window and `reused_windows` before it.
+  window_columns_.push_front(0);
+  while (static_cast<int>(window_columns_.size()) > options_.reused_windows + 1) {
+    const int count = window_columns_.back();
+    window_columns_.pop_back();
+    const Eigen::Index keep = v_.cols() - count;
+    v_.conservativeResize(Eigen::NoChange, keep);
+    w_.conservativeResize(Eigen::NoChange, keep);
+  }
+}
+
+std::shared_ptr<const config::Spec> IqnIls::spec() {
+  auto s = std::make_shared<config::Spec>(
+      "iqn-ils", "interface quasi-Newton, inverse Jacobian from a least-squares model (Degroote et al. 2009)");
+  s->string("type", "the acceleration's name").required();
+  s->real("initial_relaxation", "relaxation factor while there are no columns (first iteration)")
+      .min(0.0, true)
+      .max(1.0)
+      .def(0.1);
+  s->integer("max_columns", "most columns kept in V and W (oldest dropped first)").min(1).def(50);
+  s->integer("reused_windows", "past windows whose columns are kept").non_negative().def(8);
+  s->choice("filter", "filter of nearly dependent columns", {"none", "qr1", "qr2"}).def("qr2");
+  s->real("filter_limit", "limit of the filter").positive().def(1e-3);
+  s->strings("data", "the data fields to accelerate (default: what the last participant in order writes, "
+                     "or every exchange for parallel schemes)");
+  return s;
+}
+
+std::unique_ptr<Acceleration> IqnIls::create(const config::Node& node) {
+  Options o;
+  o.initial_relaxation = node.real("initial_relaxation");
+  o.max_columns = static_cast<int>(node.integer("max_columns"));
+  o.reused_windows = static_cast<int>(node.integer("reused_windows"));
+  const std::string f = node.string("filter");
+  o.filter = f == "qr1" ? Filter::qr1 : f == "qr2" ? Filter::qr2 : Filter::none;
+  o.filter_limit = node.real("filter_limit");
+  return std::make_unique<IqnIls>(o);
+}
+
+}  // namespace partita::coupling

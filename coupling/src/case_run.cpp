@@ -1,0 +1,474 @@
+#include "partita/coupling/case_run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "partita/coupling/progress_line.hpp"
+#include "partita/coupling/stopwatch.hpp"
+#include "partita/interface/error.hpp"
+#include "partita/interface/log.hpp"
+
+namespace partita::coupling {
+
+namespace fs = std::filesystem;
+
+struct CaseRun::Monitor {
+  std::string name;
+  std::vector<std::pair<Participant*, std::string>> quantities;
+  CsvSeries csv;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Schema
+
+std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
+  using config::Spec;
+  auto time = std::make_shared<Spec>("time", "fixed time windows");
+  time->real("window", "size of a coupling time window").unit("s").positive().required();
+  time->real("end", "end time (the last window ends at or just after it)").unit("s").positive();
+  time->integer("windows", "number of windows (instead of end)").min(1);
+  time->one_of({"end", "windows"});
+
+  auto exchange = std::make_shared<Spec>("exchange", "one data field sent from one mesh to another");
+  exchange->string("data", "name of the field (a write of the sender's mesh and a read of the receiver's)")
+      .required();
+  exchange->string("from", "sender as participant.mesh").required();
+  exchange->string("to", "receiver as participant.mesh").required();
+  exchange->any("mapper", "mapper name or {type: name, options}; known: " + join_names(registries.mappers.names()))
+      .def("nearest-neighbor");
+  exchange->choice("constraint", "override the constraint that the data kind implies (intensive: consistent, "
+                                 "extensive: conservative)", {"consistent", "conservative"});
+  exchange->choice("reader_sees", "what a subcycling reader sees at substep k/m: the newest value (constant) or "
+                                  "linear interpolation between the window's start and end values",
+                   {"constant", "linear"})
+      .def("linear");
+  exchange->choice("writer_combines", "how a subcycling writer's substep values make the window's value",
+                   {"average", "last"})
+      .def("average");
+
+  auto coupling = std::make_shared<Spec>("coupling", "how the participants advance together");
+  coupling->string("scheme", "coupling scheme; known: " + join_names(registries.schemes.names())).required();
+  coupling->strings("order", "participants in scheme order (default: file order); a serial scheme runs the first "
+                             "first");
+  coupling->any("substeps", "per participant: a number of substeps per window (>= 1) or auto (from its "
+                            "stable time step); default 1");
+  coupling->list("exchanges", "the exchanged fields", exchange).required();
+  coupling->list("convergence", "implicit schemes: measures, all must hold; each {type, data, limit}; known "
+                                "types: " + join_names(registries.convergence_measures.names()),
+                 nullptr);
+  coupling->any("acceleration", "implicit schemes: {type, options}; known: " +
+                                    join_names(registries.accelerations.names()));
+  coupling->integer("max_iterations", "implicit schemes: most iterations per window").min(1).def(100);
+  coupling->choice("on_max_iterations", "implicit schemes: at max_iterations stop with an error, or accept the "
+                                        "window with a warning", {"error", "accept"})
+      .def("accept");
+
+  auto monitor = std::make_shared<Spec>("monitor", "a CSV time series DIR/<name>.csv of solver quantities");
+  monitor->string("name", "file name without .csv").required();
+  monitor->strings("quantities", "participant.quantity of each column").required();
+
+  auto output = std::make_shared<Spec>("output", "VTK output under DIR/vtk");
+  output->real("every", "simulated time between frames (default: first and last frame only)").unit("s").positive();
+  output->boolean("interface", "also write the interface meshes with their exchanged data (.vtp)").def(true);
+
+  auto root = std::make_shared<Spec>("case", "a coupled simulation");
+  root->string("case", "the case's name (output goes to out/<name> by default)").required();
+  root->section("time", "time windows", time).required();
+  root->any("participants", "map of participant name -> {solver: <registered solver>, solver keys...}; solvers: " +
+                                join_names(registries.solvers.names()))
+      .required();
+  root->section("coupling", "coupling scheme and exchanges", coupling).required();
+  root->list("monitors", "scalar time series", monitor);
+  root->section("output", "VTK output", output);
+  return root;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Building
+
+namespace {
+
+std::pair<std::string, std::string> split_dot(const config::Node& n, const char* what) {
+  const std::string s = n.as_string();
+  const auto dot = s.find('.');
+  if (dot == std::string::npos || dot == 0 || dot + 1 == s.size())
+    n.fail(std::string("expected ") + what + " written participant." + (std::string(what) == "a quantity" ? "quantity" : "mesh") +
+           ", found '" + s + "'");
+  return {s.substr(0, dot), s.substr(dot + 1)};
+}
+
+}  // namespace
+
+Participant* CaseRun::participant(const std::string& name) const {
+  for (const auto& p : participants_)
+    if (p->name() == name) return p.get();
+  return nullptr;
+}
+
+CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOptions options)
+    : registries_(registries), options_(std::move(options)) {
+  const config::Node root = config::Node::load_file(case_file).validated(case_spec(registries));
+  name_ = root.string("case");
+  case_dir_ = fs::absolute(case_file).parent_path();
+  output_dir_ = options_.output_dir.empty() ? fs::current_path() / "out" / name_ : options_.output_dir;
+
+  const config::Node time = root["time"];
+  window_size_ = time.real("window");
+  window_count_ = time.has("windows") ? time.integer("windows") : TimeWindow::count_to(time.real("end"), window_size_);
+  if (root.has("output") && root["output"].has("every")) output_every_ = root["output"].real("every");
+
+  build_participants(root);
+  const config::Node coupling = root["coupling"];
+  build_exchanges(coupling);
+
+  SchemeContext ctx;
+  ctx.config = coupling;
+  ctx.registries = &registries_;
+  for (auto& p : participants_) ctx.participants.push_back(p.get());
+  for (auto& e : exchanges_) ctx.exchanges.push_back(e.get());
+  const auto& entry = registries_.schemes.get(coupling["scheme"]);
+  scheme_ = entry.factory(ctx);
+
+  build_monitors(root);
+}
+
+CaseRun::~CaseRun() = default;
+
+void CaseRun::build_participants(const config::Node& root) {
+  const config::Node ps = root["participants"];
+  if (!ps.is_map() || ps.size() == 0)
+    ps.fail("expected a map of participants, e.g. participants: {fluid: {solver: tube1d-fluid}}; found " +
+            ps.describe());
+  std::vector<std::string> names = ps.keys();
+  // scheme order
+  const config::Node coupling = root["coupling"];
+  std::vector<std::string> order = names;
+  if (coupling.has("order")) {
+    order = coupling.strings("order");
+    const config::Node on = coupling["order"];
+    std::set<std::string> seen;
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const config::Node item = on.is_sequence() ? on[i] : on;
+      if (std::find(names.begin(), names.end(), order[i]) == names.end())
+        item.fail("unknown participant '" + order[i] + "'; participants: " + join_names(names) +
+                  did_you_mean(order[i], names));
+      if (!seen.insert(order[i]).second) item.fail("participant '" + order[i] + "' appears twice in the order");
+    }
+    if (order.size() != names.size()) {
+      std::vector<std::string> missing;
+      for (const auto& n : names)
+        if (!seen.count(n)) missing.push_back(n);
+      on.fail("the order must list every participant once; missing: " + join_names(missing));
+    }
+  }
+  if (names.size() < 2) ps.fail("a coupled case needs at least 2 participants, found " + std::to_string(names.size()));
+
+  // substeps
+  std::map<std::string, Substeps> substeps;
+  if (coupling.has("substeps")) {
+    const config::Node sn = coupling["substeps"];
+    if (!sn.is_map()) sn.fail("expected a map participant -> number of substeps or auto, found " + sn.describe());
+    for (const std::string& k : sn.keys()) {
+      const config::Node v = sn[k];
+      if (std::find(names.begin(), names.end(), k) == names.end())
+        v.fail("unknown participant '" + k + "'; participants: " + join_names(names) + did_you_mean(k, names));
+      Substeps s;
+      if (v.is_scalar() && v.as_string() == "auto") {
+        s.automatic = true;
+      } else {
+        if (!v.is_scalar()) v.fail("expected a number of substeps (>= 1) or auto, found " + v.describe());
+        std::string text = v.as_string();
+        long n = 0;
+        try {
+          n = v.as_integer();
+        } catch (const Error&) {
+          v.fail("expected a whole number of substeps (>= 1) or auto, found '" + text + "'" +
+                 did_you_mean(text, {"auto"}));
+        }
+        if (n < 1) v.fail("substeps must be >= 1 (or auto), found " + std::to_string(n));
+        s.count = static_cast<int>(n);
+      }
+      substeps[k] = s;
+    }
+  }
+
+  for (const std::string& name : order) {
+    const config::Node pn = ps[name];
+    if (name.find('.') != std::string::npos)
+      pn.fail("a participant name may not contain '.', found '" + name + "' (meshes are named participant.mesh)");
+    if (!pn.is_map() || !pn.has("solver"))
+      pn.fail("participant '" + name + "' needs 'solver: <name>'; known solvers: " +
+              join_names(registries_.solvers.names()));
+    const auto& entry = registries_.solvers.get(pn["solver"]);
+    config::Node validated = pn;
+    if (entry.spec) {
+      auto spec = std::make_shared<config::Spec>(*entry.spec);
+      if (!spec->find("solver")) spec->string("solver", "the registered solver's name").required();
+      validated = pn.validated(spec);
+    }
+    SolverContext ctx{name, validated, case_dir_, output_dir_, options_.threads};
+    std::unique_ptr<Solver> solver = entry.factory(ctx);
+    if (!solver) pn.fail("solver '" + entry.name + "' could not be built");
+    Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
+    participants_.push_back(std::make_unique<Participant>(name, std::move(solver), s));
+    if (participants_.back()->solver().meshes().empty())
+      pn.fail("solver '" + entry.name + "' of participant '" + name + "' exposes no coupling mesh");
+  }
+}
+
+void CaseRun::build_exchanges(const config::Node& coupling) {
+  std::vector<std::string> names;
+  for (const auto& p : participants_) names.push_back(p->name());
+  const std::vector<config::Node> items = coupling["exchanges"].items();
+  if (items.empty()) coupling["exchanges"].fail("a coupled case needs at least one exchange");
+
+  struct Resolved {
+    Participant* p;
+    const InterfaceMesh* mesh;
+  };
+  auto resolve = [&](const config::Node& n) {
+    const auto [pname, mname] = split_dot(n, "a mesh");
+    Participant* p = participant(pname);
+    if (!p) n.fail("unknown participant '" + pname + "'; participants: " + join_names(names) + did_you_mean(pname, names));
+    std::vector<std::string> meshes;
+    for (const auto& m : p->solver().meshes()) meshes.push_back(m.mesh.name());
+    const InterfaceMesh* m = p->find_mesh(mname);
+    if (!m)
+      n.fail("participant '" + pname + "' has no mesh '" + mname + "'; its meshes: " + join_names(meshes) +
+             did_you_mean(mname, meshes));
+    return Resolved{p, m};
+  };
+  auto names_of = [](const std::vector<DataSpec>& v) {
+    std::vector<std::string> n;
+    for (const auto& d : v) n.push_back(d.name);
+    return n;
+  };
+
+  for (const config::Node& item : items) {
+    const std::string data = item.string("data");
+    const Resolved from = resolve(item["from"]);
+    const Resolved to = resolve(item["to"]);
+    if (from.p == to.p) item["to"].fail("an exchange goes between two different participants");
+    const DataSpec* ws = nullptr;
+    for (const auto& d : from.mesh->writes)
+      if (d.name == data) ws = &d;
+    if (!ws) {
+      const auto w = names_of(from.mesh->writes);
+      item["data"].fail("participant '" + from.p->name() + "' does not write '" + data + "' on mesh '" +
+                        from.mesh->mesh.name() + "'; it writes: " + (w.empty() ? "nothing" : join_names(w)) +
+                        did_you_mean(data, w));
+    }
+    const DataSpec* rs = nullptr;
+    for (const auto& d : to.mesh->reads)
+      if (d.name == data) rs = &d;
+    if (!rs) {
+      const auto r = names_of(to.mesh->reads);
+      item["data"].fail("participant '" + to.p->name() + "' does not read '" + data + "' on mesh '" +
+                        to.mesh->mesh.name() + "'; it reads: " + (r.empty() ? "nothing" : join_names(r)) +
+                        did_you_mean(data, r));
+    }
+    if (ws->components != rs->components)
+      item["data"].fail("'" + data + "' has " + std::to_string(ws->components) + " components where '" +
+                        from.p->name() + "' writes it but " + std::to_string(rs->components) + " where '" +
+                        to.p->name() + "' reads it");
+    for (const auto& e : exchanges_)
+      if (&e->to() == to.p && e->to_mesh() == to.mesh->mesh.name() && e->data() == data)
+        item.fail("'" + data + "' on " + to.p->name() + "." + to.mesh->mesh.name() + " already has a sender (" +
+                  e->label() + ")");
+    Constraint constraint = ws->kind == DataKind::extensive ? Constraint::conservative : Constraint::consistent;
+    if (item.has("constraint"))
+      constraint = item.string("constraint") == "conservative" ? Constraint::conservative : Constraint::consistent;
+    std::unique_ptr<Mapper> mapper = create_mapper(registries_.mappers, MapperContext{item["mapper"], constraint});
+    mapper->compute(from.mesh->mesh, to.mesh->mesh);
+    const ReaderSees rsee = item.string("reader_sees") == "constant" ? ReaderSees::constant : ReaderSees::linear;
+    const WriterCombines wc = item.string("writer_combines") == "last" ? WriterCombines::last : WriterCombines::average;
+    exchanges_.push_back(std::make_unique<Exchange>(data, Exchange::End{from.p, from.mesh->mesh.name()},
+                                                    Exchange::End{to.p, to.mesh->mesh.name()}, *ws, std::move(mapper),
+                                                    rsee, wc));
+  }
+}
+
+void CaseRun::build_monitors(const config::Node& root) {
+  if (!root.has("monitors")) return;
+  std::vector<std::string> names;
+  for (const auto& p : participants_) names.push_back(p->name());
+  std::set<std::string> files;
+  for (const config::Node& m : root["monitors"].items()) {
+    Monitor mon;
+    mon.name = m.string("name");
+    if (mon.name.empty() || mon.name.find('/') != std::string::npos || mon.name == "coupling")
+      m["name"].fail("a monitor name becomes DIR/<name>.csv: it must be non-empty, without '/', and not 'coupling'");
+    if (!files.insert(mon.name).second) m["name"].fail("two monitors are named '" + mon.name + "'");
+    const config::Node qn = m["quantities"];
+    const std::vector<std::string> qs = m.strings("quantities");
+    for (std::size_t i = 0; i < qs.size(); ++i) {
+      const config::Node q = qn.is_sequence() ? qn[i] : qn;
+      const auto [pname, quantity] = split_dot(q, "a quantity");
+      Participant* p = participant(pname);
+      if (!p) q.fail("unknown participant '" + pname + "'; participants: " + join_names(names) + did_you_mean(pname, names));
+      std::vector<std::string> known;
+      for (const auto& v : p->solver().monitors()) known.push_back(v.name);
+      if (std::find(known.begin(), known.end(), quantity) == known.end())
+        q.fail("participant '" + pname + "' reports no quantity '" + quantity + "'; it reports: " +
+               (known.empty() ? "nothing" : join_names(known)) + did_you_mean(quantity, known));
+      mon.quantities.emplace_back(p, quantity);
+    }
+    monitors_.push_back(std::move(mon));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Running
+
+PvdSeries& CaseRun::pvd(const std::string& series) {
+  for (auto& [n, s] : pvds_)
+    if (n == series) return s;
+  pvds_.emplace_back(series, PvdSeries(output_dir_ / "vtk" / (series + ".pvd")));
+  return pvds_.back().second;
+}
+
+void CaseRun::write_output(int frame, double time) {
+  Stopwatch clock;
+  const fs::path vtk = output_dir_ / "vtk";
+  for (auto& p : participants_) {
+    Stopwatch sc;
+    OutputFrame f{vtk, p->name(), frame, time};
+    p->solver().write_output(f);
+    for (const auto& [series, file] : p->solver().output_files()) pvd(p->name() + "_" + series).add(time, file);
+    p->add_seconds(sc.seconds());
+    // interface meshes with their exchanged data
+    for (const auto& im : p->solver().meshes()) {
+      VtkArrays arrays;
+      for (const auto& e : exchanges_) {
+        if (&e->from() == p.get() && e->from_mesh() == im.mesh.name() && e->sent().rows() == im.mesh.size())
+          arrays.emplace_back(e->data(), e->sent());
+        if (&e->to() == p.get() && e->to_mesh() == im.mesh.name() && e->received().rows() == im.mesh.size())
+          arrays.emplace_back(e->data(), e->received());
+      }
+      if (arrays.empty() || im.mesh.size() > 200000) continue;
+      const std::string file = fmt::format("{}_interface_{}_{:06d}.vtp", p->name(), im.mesh.name(), frame);
+      write_vtp(vtk / file, im.mesh, arrays);
+      pvd(p->name() + "_interface_" + im.mesh.name()).add(time, file);
+    }
+  }
+  summary_.output_seconds += clock.seconds() ;
+}
+
+void CaseRun::run() {
+  if (options_.check_only) return;
+  auto logger = log::get("coupling");
+  Stopwatch wall;
+  fs::create_directories(output_dir_ / "vtk");
+
+  std::vector<std::pair<std::string, std::string>> columns = {{"time", "s"}, {"iterations", ""}};
+  for (const auto& c : scheme_->residual_columns()) columns.push_back(c);
+  CsvSeries coupling_csv(output_dir_ / "coupling.csv", "window", "", columns);
+  for (auto& m : monitors_) {
+    std::vector<std::pair<std::string, std::string>> mc;
+    for (const auto& [p, q] : m.quantities) {
+      std::string unit;
+      for (const auto& v : p->solver().monitors())
+        if (v.name == q) unit = v.unit;
+      mc.emplace_back(p->name() + "." + q, unit);
+    }
+    m.csv = CsvSeries(output_dir_ / (m.name + ".csv"), "time", "s", mc);
+  }
+  auto record_monitors = [&](double t) {
+    for (auto& m : monitors_) {
+      std::vector<double> row;
+      for (const auto& [p, q] : m.quantities) {
+        double v = std::nan("");
+        for (const auto& mv : p->solver().monitors())
+          if (mv.name == q) v = mv.value;
+        row.push_back(v);
+      }
+      m.csv.record(t, row);
+    }
+  };
+  auto flush_all = [&] {
+    coupling_csv.flush();
+    for (auto& m : monitors_) m.csv.flush();
+  };
+
+  logger->info("case '{}': {} windows of {} s to t = {} s, scheme {}, participants {}; output in {}", name_,
+               window_count_, window_size_, static_cast<double>(window_count_) * window_size_, scheme_->name(),
+               [&] {
+                 std::vector<std::string> n;
+                 for (auto& p : participants_) n.push_back(p->name());
+                 return join_names(n);
+               }(),
+               output_dir_.string());
+
+  ProgressLine progress(window_count_);
+  int frame = 0;
+  double next_output = output_every_;
+  Stopwatch since_flush;
+  try {
+    scheme_->initialize();
+    record_monitors(0.0);
+    write_output(frame++, 0.0);
+    TimeWindow window(window_size_, 0, 1);
+    for (std::int64_t n = 0; n < window_count_; ++n) {
+      window = TimeWindow(window_size_, n, 1);
+      const WindowReport r = scheme_->advance(window);
+      const double t = window.end();
+      summary_.windows = n + 1;
+      summary_.iterations += r.iterations;
+      summary_.max_window_iterations = std::max(summary_.max_window_iterations, r.iterations);
+      if (!r.converged) ++summary_.unconverged_windows;
+      std::vector<double> row = {t, static_cast<double>(r.iterations)};
+      row.insert(row.end(), r.residuals.begin(), r.residuals.end());
+      coupling_csv.record(static_cast<double>(n + 1), row);
+      record_monitors(t);
+      const bool last = n + 1 == window_count_;
+      if ((output_every_ > 0.0 && t >= next_output - 1e-9 * window_size_) || last) {
+        write_output(frame++, t);
+        while (output_every_ > 0.0 && next_output <= t + 1e-9 * window_size_)
+          next_output = static_cast<double>(frame) * output_every_;
+      }
+      if (since_flush.seconds() > 2.0) {
+        flush_all();
+        since_flush.restart();
+      }
+      progress.update(n + 1, t, r.iterations);
+    }
+  } catch (...) {
+    progress.finish();
+    flush_all();  // the complete rows so far stay readable
+    throw;
+  }
+  progress.finish();
+  flush_all();
+  coupling_csv.close();
+  for (auto& m : monitors_) m.csv.close();
+  for (auto& p : participants_) {
+    Stopwatch sc;
+    p->solver().finalize();
+    p->add_seconds(sc.seconds());
+  }
+
+  summary_.wall_seconds = wall.seconds();
+  double accounted = summary_.output_seconds;
+  for (auto& p : participants_) {
+    summary_.participant_seconds.emplace_back(p->name(), p->seconds());
+    accounted += p->seconds();
+  }
+  for (auto& e : exchanges_) summary_.mapping_seconds += e->mapping_seconds();
+  accounted += summary_.mapping_seconds;
+  summary_.core_seconds = std::max(0.0, summary_.wall_seconds - accounted);
+
+  std::string parts;
+  for (const auto& [n, s] : summary_.participant_seconds) parts += fmt::format("{} {:.3f} s, ", n, s);
+  logger->info("summary: {} windows, {} iterations (mean {:.2f}, max {}{}); wall {:.3f} s = {}mapping {:.3f} s, "
+               "output {:.3f} s, core {:.3f} s",
+               summary_.windows, summary_.iterations, summary_.mean_iterations(), summary_.max_window_iterations,
+               summary_.unconverged_windows ? fmt::format(", {} windows at max_iterations", summary_.unconverged_windows)
+                                            : std::string(),
+               summary_.wall_seconds, parts, summary_.mapping_seconds, summary_.output_seconds, summary_.core_seconds);
+}
+
+}  // namespace partita::coupling

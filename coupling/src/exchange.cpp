@@ -1,0 +1,86 @@
+#include "partita/coupling/exchange.hpp"
+
+#include "partita/coupling/stopwatch.hpp"
+#include "partita/interface/error.hpp"
+
+namespace partita::coupling {
+
+Exchange::Exchange(std::string data, End from, End to, DataSpec spec, std::unique_ptr<Mapper> mapper,
+                   ReaderSees reader_sees, WriterCombines writer_combines)
+    : data_(std::move(data)),
+      from_(std::move(from)),
+      to_(std::move(to)),
+      spec_(std::move(spec)),
+      mapper_(std::move(mapper)),
+      reader_sees_(reader_sees),
+      writer_combines_(writer_combines) {
+  const InterfaceMesh* fm = from_.participant->find_mesh(from_.mesh);
+  const InterfaceMesh* tm = to_.participant->find_mesh(to_.mesh);
+  if (!fm || !tm) throw Error("exchange " + label() + ": unknown mesh");
+  from_points_ = fm->mesh.size();
+  if (!mapper_ && fm->mesh.size() != tm->mesh.size())
+    throw Error("exchange " + label() + ": without a mapper the meshes need the same number of points (" +
+                std::to_string(fm->mesh.size()) + " and " + std::to_string(tm->mesh.size()) + ")");
+}
+
+std::string Exchange::label() const {
+  return "'" + data_ + "' " + from_.participant->name() + "." + from_.mesh + " -> " + to_.participant->name() +
+         "." + to_.mesh;
+}
+
+void Exchange::check_shape(const Eigen::MatrixXd& values, const char* what) const {
+  if (values.rows() != from_points_ || values.cols() != spec_.components)
+    throw Error("exchange " + label() + ": participant '" + from_.participant->name() + "' " + what + " a " +
+                std::to_string(values.rows()) + " x " + std::to_string(values.cols()) + " array; expected " +
+                std::to_string(from_points_) + " x " + std::to_string(spec_.components) +
+                " (points of mesh '" + from_.mesh + "' x components)");
+}
+
+void Exchange::begin_collect() {
+  accumulated_.setZero(from_points_, spec_.components);
+  collected_ = 0;
+}
+
+void Exchange::collect(const Eigen::MatrixXd& values) {
+  check_shape(values, "wrote");
+  ++collected_;
+  if (writer_combines_ == WriterCombines::average && collected_ > 1)
+    // running mean f̄_k = f̄_{k-1} + (f_k - f̄_{k-1}) / k: exact for a constant output
+    accumulated_ += (values - accumulated_) / static_cast<double>(collected_);
+  else
+    accumulated_ = values;
+}
+
+void Exchange::finish_collect() {
+  // average: f_{n+1} = 1/m Σ_{k=1..m} f_{n,k} (the running mean);  last: f_{n+1} = f_{n,m}
+  combined_ = accumulated_;
+}
+
+void Exchange::transmit() {
+  Stopwatch s;
+  if (mapper_)
+    mapper_->map(sent_, end_);
+  else
+    end_ = sent_;
+  mapping_seconds_ += s.seconds();
+}
+
+void Exchange::read_at(double fraction, Eigen::MatrixXd& out) const {
+  if (reader_sees_ == ReaderSees::constant || fraction >= 1.0) {
+    out = end_;
+    return;
+  }
+  // d_{n,k} = d_n + (k/m) (d_{n+1} - d_n)
+  out = start_ + fraction * (end_ - start_);
+}
+
+void Exchange::initialize(const Eigen::MatrixXd& initial) {
+  check_shape(initial, "gave as initial data");
+  combined_ = initial;
+  sent_ = initial;
+  previous_ = initial;
+  transmit();
+  start_ = end_;
+}
+
+}  // namespace partita::coupling

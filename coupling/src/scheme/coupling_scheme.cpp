@@ -1,0 +1,53 @@
+#include "partita/coupling/coupling_scheme.hpp"
+
+namespace partita::coupling {
+
+CouplingScheme::CouplingScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges)
+    : participants_(std::move(participants)), exchanges_(std::move(exchanges)) {}
+
+void CouplingScheme::initialize() {
+  for (Exchange* e : exchanges_) {
+    e->from().write(e->from_mesh(), e->data(), buffer_);
+    e->initialize(buffer_);
+  }
+}
+
+WindowReport CouplingScheme::advance(const TimeWindow& window) {
+  WindowReport report = run_window(window);
+  for (Exchange* e : exchanges_) e->accept_window();
+  return report;
+}
+
+void CouplingScheme::run_participant(Participant& p, const TimeWindow& window) {
+  TimeWindow w = window.with_substeps(p.substeps(window.size()));
+  for (Exchange* e : exchanges_)
+    if (&e->from() == &p) e->begin_collect();
+  // for k = 0..m-1: read d(t_{n,k+1}); advance(t_{n,k+1} - t_{n,k}); write f_{n,k+1}
+  while (!w.end_reached()) {
+    const double fraction = w.fraction_at(w.substep() + 1);
+    for (Exchange* e : exchanges_) {
+      if (&e->to() != &p) continue;
+      e->read_at(fraction, buffer_);
+      p.read(e->to_mesh(), e->data(), buffer_);
+    }
+    p.advance(w.next_substep_size());
+    w.advance_substep();
+    for (Exchange* e : exchanges_) {
+      if (&e->from() != &p) continue;
+      p.write(e->from_mesh(), e->data(), buffer_);
+      e->collect(buffer_);
+    }
+  }
+  for (Exchange* e : exchanges_)
+    if (&e->from() == &p) e->finish_collect();
+}
+
+void CouplingScheme::send_outputs(const Participant& p) {
+  for (Exchange* e : exchanges_) {
+    if (&e->from() != &p) continue;
+    e->sent() = e->combined();
+    e->transmit();
+  }
+}
+
+}  // namespace partita::coupling

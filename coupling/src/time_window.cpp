@@ -1,0 +1,62 @@
+#include "partita/coupling/time_window.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "partita/interface/error.hpp"
+
+namespace partita::coupling {
+
+TimeWindow::TimeWindow(double size, std::int64_t index, int substeps)
+    : size_(size), index_(index), substeps_(substeps) {
+  if (!(size > 0.0) || !std::isfinite(size))
+    throw Error("time window size must be a positive finite number, found " + std::to_string(size));
+  if (substeps < 1) throw Error("a window needs at least 1 substep, found " + std::to_string(substeps));
+  if (index < 0) throw Error("a window index must be >= 0, found " + std::to_string(index));
+}
+
+double TimeWindow::time_at(int k) const {
+  if (k >= substeps_) return end();
+  // t_{n,k} = t_n + (k / m) Δt
+  return start() + size_ * fraction_at(k);
+}
+
+void TimeWindow::advance_substep() {
+  if (k_ >= substeps_)
+    throw Error("window " + std::to_string(index_) + ": all " + std::to_string(substeps_) +
+                " substeps are done; start the next window");
+  ++k_;
+}
+
+TimeWindow TimeWindow::next(int substeps) const {
+  return TimeWindow(size_, index_ + 1, substeps > 0 ? substeps : substeps_);
+}
+
+namespace {
+// ceil(x) where x within 1e-9 relative of an integer counts as that integer.
+double tolerant_ceil(double x) {
+  const double r = std::round(x);
+  if (std::abs(x - r) <= 1e-9 * std::max(1.0, std::abs(x))) return r;
+  return std::ceil(x);
+}
+}  // namespace
+
+std::int64_t TimeWindow::count_to(double end, double size) {
+  if (!(size > 0.0)) throw Error("time window size must be positive, found " + std::to_string(size));
+  if (!(end > 0.0)) throw Error("end time must be positive, found " + std::to_string(end));
+  return static_cast<std::int64_t>(std::max(1.0, tolerant_ceil(end / size)));
+}
+
+int TimeWindow::substeps_for(double size, double max_step) {
+  if (!(max_step > 0.0))
+    throw Error("the solver's stable time step must be positive, found " + std::to_string(max_step));
+  if (std::isinf(max_step)) return 1;
+  const double m = tolerant_ceil(size / max_step);
+  if (m > static_cast<double>(std::numeric_limits<int>::max()))
+    throw Error("a window of " + std::to_string(size) + " s needs more than 2^31 substeps of " +
+                std::to_string(max_step) + " s; use a smaller window");
+  return std::max(1, static_cast<int>(m));
+}
+
+}  // namespace partita::coupling

@@ -1,0 +1,44 @@
+#include <catch2/catch.hpp>
+
+#include "partita/coupling/time_window.hpp"
+#include "partita/interface/error.hpp"
+
+using partita::coupling::TimeWindow;
+
+TEST_CASE("TimeWindow: a million tiny substeps reach the window end exactly, without drift", "[coupling][time]") {
+  const int m = 1000000;
+  TimeWindow w(1.0e-3, 41, m);
+  double summed = w.start();  // what an accumulating clock would do
+  int steps = 0;
+  while (!w.end_reached()) {
+    summed += w.substep_size();
+    w.advance_substep();
+    ++steps;
+  }
+  CHECK(steps == m);  // "end of window reached" after exactly m substeps
+  CHECK(w.time() == w.end());
+  CHECK(w.end() == w.next().start());
+  // A clock that accumulated dt / m would have drifted (why this one counts instead).
+  CHECK(std::abs(summed - w.end()) > 0.0);
+  // every substep time is within rounding of the exact t_n + k/m dt
+  CHECK(w.time_at(m / 2) == Approx(41.5e-3).epsilon(1e-15));
+}
+
+TEST_CASE("TimeWindow: substeps tile the window exactly and counts are robust", "[coupling][time]") {
+  TimeWindow w(0.1, 7, 3);
+  double total = 0.0;
+  while (!w.end_reached()) {
+    total += w.next_substep_size();
+    w.advance_substep();
+  }
+  CHECK(total == Approx(0.1).epsilon(1e-15));
+  CHECK_THROWS_AS(w.advance_substep(), partita::Error);
+  CHECK(TimeWindow::count_to(1.0, 0.01) == 100);  // 1.0 / 0.01 = 100.00000000000001 in floating point
+  CHECK(TimeWindow::count_to(0.3, 0.1) == 3);
+  CHECK(TimeWindow::count_to(0.35, 0.1) == 4);
+  CHECK(TimeWindow::substeps_for(1e-5, 1.9e-6) == 6);
+  CHECK(TimeWindow::substeps_for(1e-5, 2e-6) == 5);
+  CHECK(TimeWindow::substeps_for(1e-5, INFINITY) == 1);
+  CHECK_THROWS_AS(TimeWindow(0.0), partita::Error);
+  CHECK_THROWS_AS(TimeWindow(0.1, 0, 0), partita::Error);
+}
