@@ -1,0 +1,19 @@
+#include "partita/adapters/register_all.hpp"
+
+#ifdef PARTITA_HAVE_TUBE1D
+#include "tube1d/tube_adapters.hpp"
+#endif
+
+namespace partita::adapters {
+
+void register_all(coupling::Registries& r) {
+#ifdef PARTITA_HAVE_TUBE1D
+  r.solvers.add("tube1d-fluid", "1D elastic tube: quasi-1D incompressible flow (writes pressure, reads area)",
+                TubeFluidAdapter::create, TubeFluidAdapter::spec());
+  r.solvers.add("tube1d-solid", "1D elastic tube: tube law a(p) (reads pressure, writes cross_section_area)",
+                TubeSolidAdapter::create, TubeSolidAdapter::spec());
+#endif
+  (void)r;
+}
+
+}  // namespace partita::adapters
