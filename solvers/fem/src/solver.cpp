@@ -1,6 +1,7 @@
 #include "partita/fem/solver.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -410,14 +411,17 @@ void Solver::initialise_acceleration() {
   if (options_.mass == MassType::Lumped) {
     af = rf.cwiseQuotient(Eigen::VectorXd(m_ff_.diagonal()));
   } else {
-    const auto t0 = Clock::now();
-    mass_factor_ = std::make_unique<Factorisation>();
-    mass_factor_->compute(m_ff_);
-    check_factorisation(*mass_factor_, "mass matrix M_ff");
-    ++timings_.factorisations;
-    timings_.factorisation += seconds_since(t0);
-    af = mass_factor_->solve(rf);
-    mass_factor_.reset();
+    // The consistent mass matrix is well conditioned (independent of the mesh size), so
+    // Jacobi-preconditioned CG to round-off is far cheaper than a second factorisation.
+    Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper> cg;
+    cg.setTolerance(1e-15);
+    cg.setMaxIterations(1000);
+    cg.compute(m_ff_);
+    af = cg.solve(rf);
+    if (cg.info() != Eigen::Success && !(cg.error() < 1e-12)) {
+      throw Error("initial acceleration: CG on the mass matrix did not converge (error " +
+                  std::to_string(cg.error()) + "); is the density > 0 everywhere?");
+    }
   }
   a_.setZero();
   for (std::size_t k = 0; k < free_dofs_.size(); ++k) a_[free_dofs_[k]] = af[static_cast<Eigen::Index>(k)];

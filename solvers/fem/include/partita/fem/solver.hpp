@@ -36,8 +36,9 @@ namespace partita::fem {
 //        step(dt)                                           time() += dt
 //        displacement(), face displacements, reaction(set), monitors ...
 //        [implicit coupling, not converged: restore_state(state), new loads, step(dt) again]
-//   The first step() computes the initial acceleration from M a = F - K u - C v unless a
-//   static solve or a restored state provides it. The effective matrix
+//   The first step() computes the initial acceleration from M a = F - K u - C v (lumped: a
+//   division; consistent: Jacobi-CG to round-off) unless a static solve or a restored state
+//   provides it. The effective matrix
 //   K + gamma/(beta dt) C + 1/(beta dt^2) M is factorised on the first step and whenever dt
 //   changes; otherwise each step is one right-hand side and one pair of triangular solves.
 class Solver {
@@ -137,7 +138,7 @@ class Solver {
   // matrices (full and partitioned)
   SparseMatrix k_, m_, k_ff_, k_fc_, m_ff_, m_fc_, keff_fc_;
   bool mass_ready_ = false;
-  std::unique_ptr<Factorisation> static_factor_, dynamic_factor_, mass_factor_;
+  std::unique_ptr<Factorisation> static_factor_, dynamic_factor_;
   double factor_dt_ = -1.0;
 
   // loads

@@ -1,0 +1,209 @@
+// bench_fem_plate: the seed plate (20 x 20 x 2 mm steel, E = 250 GPa, nu = 0.3, rho = 7850;
+// lateral-face nodes fixed in x, y; four bottom corners fixed in z; 10 kPa on the top face),
+// C3D8-like Hex8 meshes as in the CalculiX peer decks (shared/bench/peers/fem/gen_plate.py).
+// Static: reaction of the corners (4 N). Transient: load applied at t = 0 and held, undamped,
+// dt = 1e-6 s, 100 steps. Prints assembly, factorisation and per-step times, and the per-step
+// ratio to CalculiX: run live (same invocation) when `ccx` is on PATH, else the recorded
+// figures of shared/bench/peers/RESULTS.md (0.155 s/increment at 20x20x2, 2.28 s at 40x40x4).
+//
+// usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] [--lumped] [--no-ccx]
+//                        [--peers DIR]
+// Timings are wall-clock on a possibly shared machine: read them with that caveat.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "partita/fem/box_mesher.hpp"
+#include "partita/fem/solver.hpp"
+
+using namespace partita::fem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+struct Options {
+  std::vector<std::array<int, 3>> meshes;
+  int steps = 100;
+  double dt = 1e-6;
+  bool qm6 = false, lumped = false, ccx = true;
+  std::string peers = PARTITA_PEERS_DIR;
+};
+
+Model plate_model(std::array<int, 3> cells, bool qm6) {
+  const double lx = 0.02, ly = 0.02, lz = 0.002;
+  Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(lx, ly, lz), cells, ElementType::Hex8});
+  mesh.add_node_set_where("lateral", [&](const Vec3& x) {
+    const double tol = 1e-12;
+    return x[0] < tol || x[0] > lx - tol || x[1] < tol || x[1] > ly - tol;
+  });
+  mesh.add_node_set_where("corners", [&](const Vec3& x) {
+    const double tol = 1e-12;
+    return x[2] < tol && (x[0] < tol || x[0] > lx - tol) && (x[1] < tol || x[1] > ly - tol);
+  });
+  Model model(mesh, Material{250e9, 0.3, 7850});
+  model.set_hex8_formulation(qm6 ? Hex8Formulation::IncompatibleModes : Hex8Formulation::Full);
+  model.fix("lateral", {0, 1});
+  model.fix("corners", {2});
+  model.add_pressure("zmax", 10e3);
+  return model;
+}
+
+std::string find_on_path(const std::string& exe) {
+  const char* path = std::getenv("PATH");
+  if (path == nullptr) return {};
+  std::stringstream ss(path);
+  std::string dir;
+  while (std::getline(ss, dir, ':')) {
+    const auto p = std::filesystem::path(dir) / exe;
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(p, ec)) return p.string();
+  }
+  return {};
+}
+
+// Runs the CalculiX dynamic deck for this mesh; returns seconds per increment, or < 0.
+double run_ccx(const Options& opt, std::array<int, 3> c) {
+  const std::string gen = opt.peers + "/fem/gen_plate.py";
+  if (!std::filesystem::exists(gen)) {
+    std::cout << "  ccx: " << gen << " not found, using recorded figures\n";
+    return -1.0;
+  }
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("bench_fem_plate_ccx_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+  std::filesystem::create_directories(dir);
+  const std::string tag = "plate_" + std::to_string(c[0]) + "x" + std::to_string(c[1]) + "x" + std::to_string(c[2]);
+  char dt[32];
+  std::snprintf(dt, sizeof dt, "%g", opt.dt);
+  const std::string generate = "python3 '" + gen + "' " + std::to_string(c[0]) + " " + std::to_string(c[1]) + " " +
+                               std::to_string(c[2]) + " '" + dir.string() + "' " + dt + " " +
+                               std::to_string(opt.steps) + " 2>/dev/null";
+  if (std::system(generate.c_str()) != 0) {
+    std::cout << "  ccx: deck generation failed, using recorded figures\n";
+    return -1.0;
+  }
+  const std::string deck = tag + "_dynamic_n" + std::to_string(opt.steps);
+  const std::string run = "cd '" + dir.string() +
+                          "' && OMP_NUM_THREADS=1 CCX_NPROC_EQUATION_SOLVER=1 CCX_NPROC_STIFFNESS=1 "
+                          "CCX_NPROC_RESULTS=1 ccx -i " + deck + " > ccx.log 2>&1";
+  const auto t0 = Clock::now();
+  const int rc = std::system(run.c_str());
+  const double wall = since(t0);
+  std::filesystem::remove_all(dir);
+  if (rc != 0) {
+    std::cout << "  ccx: run failed (exit " << rc << "), using recorded figures\n";
+    return -1.0;
+  }
+  std::cout << "  ccx (live, 1 thread): " << wall << " s for " << opt.steps << " increments\n";
+  return wall / opt.steps;
+}
+
+void bench(const Options& opt, std::array<int, 3> cells) {
+  const std::string tag = std::to_string(cells[0]) + "x" + std::to_string(cells[1]) + "x" + std::to_string(cells[2]);
+  std::printf("\n== plate %s Hex8 (%s), %d elements\n", tag.c_str(), opt.qm6 ? "incompatible modes" : "full integration, as C3D8",
+              cells[0] * cells[1] * cells[2]);
+  const Model model = plate_model(cells, opt.qm6);
+
+  // static
+  {
+    const auto t0 = Clock::now();
+    Solver s(model);
+    const double t_setup = since(t0);
+    const auto t1 = Clock::now();
+    s.solve_static();
+    const double t_solve = since(t1);
+    const Vec3 r = s.reaction("corners");
+    std::printf("  static: %zu dofs, set-up (assembly) %.3f s, factorise + solve %.3f s (factorisation %.3f s), "
+                "total %.3f s\n", s.num_dofs(), t_setup, t_solve, s.timings().factorisation, t_setup + t_solve);
+    std::printf("  static corner reaction: Rz = %.9f N (p A = 4 N), Rx = %.2e, Ry = %.2e\n", r[2], r[0], r[1]);
+  }
+
+  // transient
+  SolverOptions so;
+  so.mass = opt.lumped ? MassType::Lumped : MassType::Consistent;
+  const auto t0 = Clock::now();
+  Solver s(model, so);
+  double rmin = 1e300, rmax = -1e300, rmean = 0.0, rlast = 0.0;
+  double first_step = 0.0, later_steps = 0.0;
+  for (int k = 0; k < opt.steps; ++k) {
+    const auto ts = Clock::now();
+    s.step(opt.dt);
+    (k == 0 ? first_step : later_steps) += since(ts);
+    const double r = s.reaction("corners")[2];
+    rmin = std::min(rmin, r);
+    rmax = std::max(rmax, r);
+    rmean += r / opt.steps;
+    rlast = r;
+  }
+  const double total = since(t0);
+  const auto& tm = s.timings();
+  const double per_step = opt.steps > 1 ? later_steps / (opt.steps - 1) : first_step;
+  const double amortised = (tm.assembly + tm.factorisation + tm.solve) / opt.steps;
+  std::printf("  transient (%s mass, dt = %g s, %d steps): assembly K+M %.3f s, factorisations %zu in %.3f s "
+              "(K_eff once), per step %.2f ms (steady), first step %.3f s, total %.3f s incl. reactions\n",
+              opt.lumped ? "lumped" : "consistent", opt.dt, opt.steps, tm.assembly, tm.factorisations,
+              tm.factorisation, 1e3 * per_step, first_step, total);
+  std::printf("  transient corner reaction Rz: min %.3f max %.3f mean %.3f last %.3f N\n", rmin, rmax, rmean, rlast);
+
+  const std::map<std::string, double> recorded = {{"20x20x2", 0.155}, {"40x40x4", 2.28}};
+  double ccx = -1.0;
+  if (opt.ccx && !find_on_path("ccx").empty()) ccx = run_ccx(opt, cells);
+  std::string source = "live";
+  if (ccx < 0.0) {
+    const auto it = recorded.find(tag);
+    if (it == recorded.end()) {
+      std::printf("  no CalculiX figure for this mesh (ccx not on PATH, none recorded)\n");
+      return;
+    }
+    ccx = it->second;
+    source = "recorded, RESULTS.md";
+  }
+  std::printf("  CalculiX %.3f s/increment (%s): ratio ccx/partita = %.0fx per steady step, %.0fx amortised "
+              "(assembly + factorisations + %d steps)\n",
+              ccx, source.c_str(), ccx / per_step, ccx / amortised, opt.steps);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string a = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
+        return argv[++i];
+      };
+      if (a == "--steps") opt.steps = std::stoi(value());
+      else if (a == "--dt") opt.dt = std::stod(value());
+      else if (a == "--qm6") opt.qm6 = true;
+      else if (a == "--lumped") opt.lumped = true;
+      else if (a == "--no-ccx") opt.ccx = false;
+      else if (a == "--peers") opt.peers = value();
+      else if (a == "-h" || a == "--help") {
+        std::cout << "usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] [--lumped] [--no-ccx] [--peers DIR]\n";
+        return 0;
+      } else {
+        std::array<int, 3> c{};
+        if (std::sscanf(a.c_str(), "%dx%dx%d", &c[0], &c[1], &c[2]) != 3) throw std::runtime_error("unknown argument " + a);
+        opt.meshes.push_back(c);
+      }
+    }
+    if (opt.meshes.empty()) opt.meshes = {{20, 20, 2}, {40, 40, 4}};
+    std::printf("bench_fem_plate: seed plate, %d steps of %g s. Wall-clock timings on a possibly shared machine.\n",
+                opt.steps, opt.dt);
+    for (const auto& c : opt.meshes) bench(opt, c);
+  } catch (const std::exception& e) {
+    std::cerr << "bench_fem_plate: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
