@@ -34,7 +34,7 @@ bool NeighborList::needs_rebuild(const Particles& p, const std::vector<TriangleM
   const double limit2 = 0.25 * skin_ * skin_;
   const long n = static_cast<long>(p.size());
   double max2 = 0.0;
-#pragma omp parallel for reduction(max : max2) schedule(static)
+#pragma omp parallel for reduction(max : max2) schedule(static) if (n >= 1024)
   for (long i = 0; i < n; ++i) max2 = std::max(max2, (p.position[i] - position_at_build_[i]).squaredNorm());
   if (max2 > limit2) return true;
   for (const TriangleMesh& m : meshes)
@@ -107,7 +107,7 @@ void NeighborList::build(const Particles& p, std::vector<TriangleMesh>& meshes) 
   // Half list in two passes (count, fill), each row sorted by j.
   new_offsets_.resize(n + 1);
   new_offsets_[0] = 0;
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, 64) if (n >= 1024)
   for (int i = 0; i < n; ++i) {
     int count = 0;
     visit_pairs(p, i, [&](int) { ++count; });
@@ -118,7 +118,7 @@ void NeighborList::build(const Particles& p, std::vector<TriangleMesh>& meshes) 
   new_shear_.resize(new_offsets_[n]);
   // rows of the previous build (particles added since then have none)
   const int old_n = valid_ ? std::min(n, static_cast<int>(offsets_.size()) - 1) : 0;
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, 64) if (n >= 1024)
   for (int i = 0; i < n; ++i) {
     int* row = new_neighbors_.data() + new_offsets_[i];
     int k = 0;
@@ -207,7 +207,7 @@ void NeighborList::build_mesh_candidates(const Particles& p, std::vector<Triangl
       if ((cp.point - p.position[i]).squaredNorm() < cut * cut) keep(mc);
     }
   };
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, 64) if (n >= 1024)
   for (int i = 0; i < n; ++i) {
     int count = 0;
     visit(i, [&](MeshCandidate) { ++count; });
@@ -215,7 +215,7 @@ void NeighborList::build_mesh_candidates(const Particles& p, std::vector<Triangl
   }
   for (int i = 0; i < n; ++i) mesh_offsets_[i + 1] += mesh_offsets_[i];
   mesh_candidates_.resize(mesh_offsets_[n]);
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, 64) if (n >= 1024)
   for (int i = 0; i < n; ++i) {
     int k = mesh_offsets_[i];
     visit(i, [&](MeshCandidate mc) { mesh_candidates_[k++] = mc; });

@@ -104,7 +104,7 @@ Packing PackingGenerator::generate(const PackingSpec& spec) {
     for (int i = 0; i < n; ++i) items[start[cell_of[i]] + fill[cell_of[i]]++] = i;
     // Jacobi sweep: dx_i = sum_j w_i (delta_ij + margin) n_ij, w_i = V_j/(V_i + V_j).
     worst = 0.0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(max : worst)
+#pragma omp parallel for schedule(dynamic, 256) reduction(max : worst) if (n >= 1024)
     for (int i = 0; i < n; ++i) {
       Eigen::Vector3d d = Eigen::Vector3d::Zero();
       const int cx = coord(x[i].x(), 0), cy = coord(x[i].y(), 1), cz = coord(x[i].z(), 2);

@@ -331,7 +331,7 @@ void System::step(double dt) {
   const long n = static_cast<long>(p.size());
   const double half = 0.5 * dt;
   // Velocity Verlet, first half: v += dt/2 F/m, x += dt v, omega += dt/2 T/I.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= 1024)
   for (long i = 0; i < n; ++i) {
     p.velocity[i] += (half / p.mass[i]) * p.force[i];
     p.position[i] += dt * p.velocity[i];
@@ -341,7 +341,7 @@ void System::step(double dt) {
   if (neighbors_.needs_rebuild(p, meshes_)) neighbors_.build(p, meshes_);
   compute_forces(dt, true);
   // Second half: v += dt/2 F/m, omega += dt/2 T/I.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= 1024)
   for (long i = 0; i < n; ++i) {
     p.velocity[i] += (half / p.mass[i]) * p.force[i];
     p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
@@ -369,7 +369,7 @@ void System::compute_pair_forces(double dt, bool update_history) {
   // Each pair (i, j > i) once: Hertz-Mindlin force on i into the pair's buffer, torques
   // T_i = -cr_i n x F_t, T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling
   // resistance T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
-#pragma omp parallel for schedule(dynamic, 128)
+#pragma omp parallel for schedule(dynamic, 128) if (n >= 1024)
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d xi = p.position[i];
     const Eigen::Vector3d vi = p.velocity[i];
@@ -426,7 +426,7 @@ void System::gather_forces(double dt, bool update_history) {
   const bool have_meshes = !meshes_.empty();
   // Per particle, in a fixed order: F_i = m_i g + sum_(i,j) F_ij - sum_(j,i) F_ji + walls + meshes.
   // Plane forces are summed per block of particles, then over blocks (fixed order).
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= 1024)
   for (int b = 0; b < blocks; ++b) {
     Eigen::Vector3d* block_wall = wall_block_force_.data() + static_cast<std::size_t>(b) * np;
     for (int k = 0; k < np; ++k) block_wall[k].setZero();
@@ -690,27 +690,31 @@ double System::elastic_energy() const {
   const NeighborList& nl = neighbors_;
   double e = 0.0;
   const int n = static_cast<int>(p.size());
-  if (nl.offsets_.size() == p.size() + 1) {
+  const Eigen::Vector3d no_shear = Eigen::Vector3d::Zero();
+  auto pair_energy = [&](int i, int j, const Eigen::Vector3d& shear) {
+    const double rsum = p.radius[i] + p.radius[j];
+    const double delta = rsum - (p.position[i] - p.position[j]).norm();
+    if (delta <= 0.0) return 0.0;
+    return hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
+                                p.radius[i] * p.radius[j] / rsum, shear);
+  };
+  if (prepared_ && nl.offsets_.size() == p.size() + 1) {
     for (int i = 0; i < n; ++i)
-      for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
-        const int j = nl.neighbors_[s];
-        const double rsum = p.radius[i] + p.radius[j];
-        const double delta = rsum - (p.position[i] - p.position[j]).norm();
-        if (delta <= 0.0) continue;
-        e += hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
-                                  p.radius[i] * p.radius[j] / rsum, nl.shear_[s]);
-      }
+      for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s)
+        e += pair_energy(i, nl.neighbors_[s], nl.shear_[s]);
+  } else {  // before the first step: no lists yet, all pairs (no tangential history either)
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) e += pair_energy(i, j, no_shear);
   }
   const std::size_t np = planes_.size();
-  if (plane_shear_.size() == p.size() * np) {
-    for (int i = 0; i < n; ++i)
-      for (std::size_t k = 0; k < np; ++k) {
-        const double delta = p.radius[i] - (p.position[i] - planes_[k].point).dot(planes_[k].normal);
-        if (delta <= 0.0) continue;
-        e += hertz_elastic_energy(model_.pair(p.material[i], planes_[k].material), delta,
-                                  p.radius[i], plane_shear_[i * np + k]);
-      }
-  }
+  const bool have_shear = plane_shear_.size() == p.size() * np;
+  for (int i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < np; ++k) {
+      const double delta = p.radius[i] - (p.position[i] - planes_[k].point).dot(planes_[k].normal);
+      if (delta <= 0.0) continue;
+      e += hertz_elastic_energy(model_.pair(p.material[i], planes_[k].material), delta, p.radius[i],
+                                have_shear ? plane_shear_[i * np + k] : no_shear);
+    }
   if (mesh_slot_count_.size() == p.size()) {
     for (int i = 0; i < n; ++i)
       for (int c = 0; c < mesh_slot_count_[i]; ++c) {

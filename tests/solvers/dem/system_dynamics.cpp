@@ -1,0 +1,95 @@
+// Energy conservation of a dense random packing and the static load of a settled column.
+
+#include "dem_test_helpers.hpp"
+
+#include "partita/dem/packing_generator.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstdint>
+
+using namespace partita::dem;
+
+namespace {
+
+// Deterministic velocities in [-a, a]^3 (SplitMix64).
+Eigen::Vector3d random_velocity(std::uint64_t& s, double a) {
+  Eigen::Vector3d v;
+  for (int k = 0; k < 3; ++k) {
+    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    v[k] = a * (2.0 * static_cast<double>(z >> 11) * 0x1.0p-53 - 1.0);
+  }
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("dem: energy is conserved without damping or friction", "[dem][physics]") {
+  // ~150 spheres at 45 % solids in a closed box, random velocities, e = 1, mu = 0, no gravity:
+  // E = kinetic + sum over contacts 8/15 E* sqrt(R*) delta^(5/2) (spheres and walls).
+  PackingSpec spec;
+  spec.hi = Eigen::Vector3d(8e-3, 8e-3, 8e-3);
+  spec.diameters = {1.6e-3, 1.2e-3};
+  spec.fractions = {1.0, 1.0};
+  spec.porosity = 0.55;
+  spec.seed = 7;
+  const Packing pk = PackingGenerator::generate(spec);
+  System sys = test::single_material(1.0e7, 0.3, 2500.0, 1.0, 0.0);
+  sys.add_particles(pk.positions, pk.radii, 0);
+  sys.add_box(spec.lo, spec.hi, 0);
+  std::uint64_t seed = 3;
+  for (std::size_t i = 0; i < sys.particle_count(); ++i)
+    sys.set_particle_velocity(i, random_velocity(seed, 0.2));
+  const double dt = 0.1 * sys.rayleigh_time_step();
+  const double e0 = sys.kinetic_energy() + sys.elastic_energy();
+  double max_drift = 0.0;
+  long contacts = 0;
+  for (int block = 0; block < 100; ++block) {
+    sys.run(1000, dt);
+    const double e = sys.kinetic_energy() + sys.elastic_energy();
+    max_drift = std::max(max_drift, std::abs(e - e0) / e0);
+    contacts += static_cast<long>(sys.contact_count());
+  }
+  INFO(sys.particle_count() << " particles, 1e5 steps, " << contacts / 100.0
+                            << " contacts on average, max relative energy drift " << max_drift);
+  CHECK(sys.step_count() == 100000);
+  CHECK(contacts > 0);
+  CHECK(max_drift < 1e-3);
+}
+
+TEST_CASE("dem: a settled column puts its whole weight on the floor", "[dem][physics]") {
+  // Frictionless side walls (they carry no vertical load), friction between spheres and with
+  // the floor, restitution 0.3: at rest the floor force equals the total weight.
+  System sys;
+  const int grain = sys.add_material({1.0e7, 0.3, 2500.0});
+  const int smooth = sys.add_material({1.0e7, 0.3, 2500.0});
+  sys.add_interaction(grain, grain, {0.5, 0.3, 0.0});
+  sys.add_interaction(grain, smooth, {0.0, 0.3, 0.0});
+  sys.set_gravity({0, 0, -9.81});
+  PackingSpec spec;
+  spec.hi = Eigen::Vector3d(5e-3, 5e-3, 15e-3);
+  spec.diameters = {1.2e-3, 1.0e-3};
+  spec.fractions = {1.0, 1.0};
+  spec.porosity = 0.6;
+  spec.seed = 11;
+  const Packing pk = PackingGenerator::generate(spec);
+  sys.add_particles(pk.positions, pk.radii, grain);
+  const int floor = sys.add_plane({0, 0, 0}, {0, 0, 1}, grain);
+  sys.add_box(spec.lo, Eigen::Vector3d(5e-3, 5e-3, 1.0), smooth, 0b001111);  // four sides
+  double weight = 0.0;
+  for (double m : sys.particles().mass) weight += 9.81 * m;
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  sys.run(static_cast<long>(0.3 / dt), dt);  // 0.3 s
+  double mean = 0.0;
+  const int n_avg = 2000;
+  for (int s = 0; s < n_avg; ++s) {
+    sys.step(dt);
+    mean += -sys.wall_force(floor).z() / n_avg;
+  }
+  INFO(sys.particle_count() << " spheres, weight " << weight << " N, floor force " << mean
+                            << " N, kinetic energy " << sys.kinetic_energy() << " J");
+  CHECK(mean == Approx(weight).epsilon(0.005));
+}

@@ -1,0 +1,183 @@
+// Save/restore, thread-count independence, errors, the peer bed reader and VTK output.
+
+#include "dem_test_helpers.hpp"
+
+#include "partita/dem/error.hpp"
+#include "partita/dem/lammps_data.hpp"
+#include "partita/dem/packing_generator.hpp"
+#include "partita/dem/parallel.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace partita::dem;
+
+namespace {
+
+// A granular bed falling under gravity into a box with a triangulated bump: every kind of
+// contact and history is exercised (pairs, planes, mesh faces/edges/vertices, friction).
+System falling_bed(double box, double porosity, std::uint64_t seed) {
+  System sys;
+  const int m = sys.add_material({1.0e7, 0.3, 2500.0});
+  sys.add_interaction(m, m, {0.4, 0.5, 0.05});
+  sys.set_gravity({0, 0, -9.81});
+  PackingSpec spec;
+  spec.lo = Eigen::Vector3d(0, 0, 1e-3);
+  spec.hi = Eigen::Vector3d(box, box, box);
+  spec.diameters = {1.2e-3, 0.8e-3};
+  spec.fractions = {1.0, 1.0};
+  spec.porosity = porosity;
+  spec.seed = seed;
+  const Packing pk = PackingGenerator::generate(spec);
+  sys.add_particles(pk.positions, pk.radii, m);
+  sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(box, box, 2 * box), m, 0b001111);
+  Eigen::MatrixX3d v(5, 3);  // pyramid floor (apex up), 4 triangles
+  v << 0, 0, 0, box, 0, 0, box, box, 0, 0, box, 0, 0.5 * box, 0.5 * box, 0.1 * box;
+  TriangleMesh::Triangles t(4, 3);
+  t << 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4;
+  sys.add_mesh(v, t, m);
+  return sys;
+}
+
+bool same_state(const System& a, const System& b) {
+  const Particles& p = a.particles();
+  const Particles& q = b.particles();
+  return p.position == q.position && p.velocity == q.velocity &&
+         p.angular_velocity == q.angular_velocity && p.force == q.force && p.torque == q.torque &&
+         a.vertex_forces(0) == b.vertex_forces(0) && a.wall_force(0) == b.wall_force(0);
+}
+
+}  // namespace
+
+TEST_CASE("dem: restoring a saved state continues bit-identically", "[dem][state]") {
+  System sys = falling_bed(6e-3, 0.6, 5);
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  sys.run(1500, dt);
+  const SystemState saved = sys.save_state();
+  // move the mesh in the window, as a coupling would
+  Eigen::MatrixX3d x(5, 3);
+  for (int k = 0; k < 5; ++k) x.row(k) = sys.mesh(0).positions()[k].transpose();
+  auto window = [&](System& s) {
+    for (int k = 0; k < 300; ++k) {
+      Eigen::MatrixX3d y = x;
+      y(4, 2) += 1e-6 * k;
+      s.set_vertex_positions(0, y);
+      s.step(dt);
+    }
+  };
+  window(sys);
+  System first = sys;  // copy of the state after the window
+  sys.restore_state(saved);
+  CHECK(sys.time() == saved.time());
+  window(sys);
+  CHECK(sys.mesh_force(0).norm() > 0.0);
+  CHECK(sys.contact_count() > 0);
+  CHECK(same_state(sys, first));
+  System other = falling_bed(6e-3, 0.6, 6);
+  other.add_particle({1e-3, 1e-3, 5e-3}, 1e-4, 0);
+  CHECK_THROWS_AS(other.restore_state(saved), Error);
+}
+
+TEST_CASE("dem: results do not depend on the number of threads", "[dem][threads]") {
+  // > 1024 particles so that the parallel loops run in parallel
+  auto run = [](int threads) {
+    set_num_threads(threads);
+    System sys = falling_bed(14e-3, 0.6, 9);
+    const double dt = 0.2 * sys.rayleigh_time_step();
+    sys.run(400, dt);
+    return sys;
+  };
+  const int before = max_threads();
+  const System one = run(1);
+  const System two = run(2);
+  set_num_threads(before);
+  INFO(one.particle_count() << " particles");
+  CHECK(one.particle_count() > 1024);
+  CHECK(same_state(one, two));
+  CHECK(one.kinetic_energy() == two.kinetic_energy());
+}
+
+TEST_CASE("dem: user errors throw partita::dem::Error with the value", "[dem][errors]") {
+  System sys;
+  CHECK_THROWS_WITH(sys.add_particle({0, 0, 0}, 1e-3, 0), Catch::Contains("unknown material id 0"));
+  CHECK_THROWS_AS(sys.add_material({-1.0, 0.3, 1000.0}), Error);
+  CHECK_THROWS_WITH(sys.add_material({1e7, 0.6, 1000.0}), Catch::Contains("0.6"));
+  const int m = sys.add_material({1.0e7, 0.3, 2500.0});
+  CHECK_THROWS_WITH(sys.add_particle({0, 0, 0}, -1e-3, m), Catch::Contains("-0.001"));
+  CHECK_THROWS_WITH(sys.add_particle({0, 0, 0}, 1e-3, 3), Catch::Contains("unknown material id 3"));
+  CHECK_THROWS_AS(sys.add_interaction(m, m, {0.3, 1.5, 0.0}), Error);
+  sys.add_particle({0, 0, 0}, 1e-3, m);
+  CHECK_THROWS_WITH(sys.step(1e-6), Catch::Contains("add_interaction(0, 0"));
+  sys.add_interaction(m, m, {0.3, 0.5, 0.0});
+  const double dt_r = sys.rayleigh_time_step();
+  CHECK_THROWS_WITH(sys.step(1.5 * dt_r), Catch::Contains("above the Rayleigh time step"));
+  CHECK_THROWS_AS(sys.step(-1.0), Error);
+  CHECK_NOTHROW(sys.step(0.2 * dt_r));
+  CHECK_THROWS_AS(sys.wall_force(0), Error);
+  CHECK_THROWS_AS(sys.vertex_forces(0), Error);
+  Eigen::MatrixX3d v(3, 3);
+  v << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+  TriangleMesh::Triangles t(1, 3);
+  t << 0, 1, 5;
+  CHECK_THROWS_WITH(sys.add_mesh(v, t, m), Catch::Contains("vertex 5"));
+  t << 0, 1, 2;
+  const int mesh = sys.add_mesh(v, t, m);
+  CHECK_THROWS_AS(sys.set_vertex_positions(mesh, Eigen::MatrixX3d::Zero(4, 3)), Error);
+  CHECK_THROWS_AS(LammpsData::read("/nonexistent/bed.data"), Error);
+}
+
+TEST_CASE("dem: Rayleigh time step", "[dem]") {
+  // the peer bed: R = 1.25 mm, E = 200 MPa, nu = 0.23, rho = 400 -> 9.529e-6 s (RESULTS.md)
+  System sys;
+  const int m = sys.add_material({2.0e8, 0.23, 400.0});
+  sys.add_particle({0, 0, 0}, 2.0e-3, m);
+  sys.add_particle({1, 0, 0}, 1.25e-3, m);
+  CHECK(sys.rayleigh_time_step() == Approx(9.529e-6).epsilon(1e-3));
+}
+
+TEST_CASE("dem: reads the peer bed file", "[dem][io]") {
+  const std::string path =
+      std::string(PARTITA_SOURCE_DIR) + "/../shared/bench/peers/dem/data/bed_small.data";
+  if (!std::filesystem::exists(path)) {
+    WARN("peer data not found at " << path << "; skipped");
+    return;
+  }
+  const LammpsData d = LammpsData::read(path);
+  CHECK(d.size() == 2001);
+  CHECK(d.id[0] == 1);
+  CHECK(d.diameter[0] == 0.004);
+  CHECK(d.density[1] == 400.0);
+  CHECK(d.position[0].x() == Approx(0.001999545126));
+  CHECK(d.velocity[0].x() == Approx(-3.29134e-09));
+  CHECK(d.angular_velocity[1].z() == Approx(-6.14662e-05));
+  CHECK(d.box_hi.x() == Approx(0.021));
+}
+
+TEST_CASE("dem: VTK output is complete and written atomically", "[dem][io]") {
+  System sys = falling_bed(6e-3, 0.6, 5);
+  sys.run(10, 0.1 * sys.rayleigh_time_step());
+  const auto dir = std::filesystem::path(PARTITA_BINARY_DIR) / "test_output" / "dem";
+  std::filesystem::create_directories(dir);
+  const auto particles = dir / "particles.vtp";
+  const auto mesh = dir / "mesh.vtp";
+  sys.write_particles_vtp(particles.string());
+  sys.write_mesh_vtp(0, mesh.string());
+  CHECK(!std::filesystem::exists(particles.string() + ".tmp"));
+  std::ifstream in(particles);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string s = text.str();
+  CHECK(s.find("NumberOfPoints=\"" + std::to_string(sys.particle_count()) + "\"") != std::string::npos);
+  for (const char* name : {"radius", "velocity", "angular_velocity", "force", "\"id\""})
+    CHECK(s.find(name) != std::string::npos);
+  CHECK(s.find("</VTKFile>") != std::string::npos);
+  std::ifstream in2(mesh);
+  std::stringstream text2;
+  text2 << in2.rdbuf();
+  CHECK(text2.str().find("NumberOfPolys=\"4\"") != std::string::npos);
+  CHECK(text2.str().find("CellData") != std::string::npos);
+  CHECK_THROWS_AS(sys.write_particles_vtp("/nonexistent/dir/p.vtp"), Error);
+}
