@@ -9,7 +9,6 @@
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
-#include <Eigen/SparseLU>
 
 #include "local_frame.hpp"
 #include "partita/interface/error.hpp"
@@ -39,22 +38,39 @@ struct RbfMapper::System {
   Eigen::Index n = 0;  ///< centres
   int q = 0;           ///< polynomial terms (0: off)
   bool dense = false;
-  Polynomial polynomial = Polynomial::separate;
 
   SparseRow eval;                ///< E = Phi(evaluation points, centres), compact basis
   Eigen::MatrixXd eval_dense;    ///< E, global basis
   Eigen::MatrixXd poly_centres;  ///< P_C, n x q
   Eigen::MatrixXd poly_eval;     ///< P_X, n_eval x q
   Eigen::MatrixXd pinv;          ///< (P_C^T P_C)^-1 P_C^T, q x n (separate)
-  Eigen::SimplicialLDLT<SparseCol> ldlt;                         ///< Phi (separate/off)
-  Eigen::SparseLU<SparseCol, Eigen::COLAMDOrdering<int>> lu;     ///< [Phi P; P^T 0] (on)
-  Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu;                 ///< global bases
+  Eigen::SimplicialLDLT<SparseCol> ldlt;         ///< Phi, compact basis
+  Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu;  ///< Phi or [Phi P; P^T 0], global basis
+  Eigen::MatrixXd phi_inv_p;                     ///< Y = Phi^-1 P_C, n x q (on, compact)
+  Eigen::LDLT<Eigen::MatrixXd> schur;            ///< S = P_C^T Phi^-1 P_C, q x q (on, compact)
 
-  /// K^-1 rhs, K symmetric (so also K^-T rhs).
+  /// Phi^-1 rhs (global basis with `on`: K^-1 rhs with K = [Phi P; P^T 0]); symmetric.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const {
     if (dense) return dense_lu.solve(rhs);
-    if (polynomial == Polynomial::on) return lu.solve(rhs);
     return ldlt.solve(rhs);
+  }
+  /// [alpha; c] = K^-1 [f; g] for K = [Phi P_C; P_C^T 0] (on). Compact basis: through the
+  /// Schur complement, keeping the sparse Cholesky factor of Phi:
+  ///   c = S^-1 (Y^T f - g),  alpha = Phi^-1 f - Y c.
+  void solve_saddle(const Eigen::MatrixXd& f, const Eigen::MatrixXd& g, Eigen::MatrixXd& alpha,
+                    Eigen::MatrixXd& c) const {
+    if (dense) {
+      Eigen::MatrixXd rhs(n + q, f.cols());
+      rhs.topRows(n) = f;
+      rhs.bottomRows(q) = g;
+      const Eigen::MatrixXd z = dense_lu.solve(rhs);
+      alpha = z.topRows(n);
+      c = z.bottomRows(q);
+      return;
+    }
+    alpha = ldlt.solve(f);
+    c = schur.solve(phi_inv_p.transpose() * f - g);
+    alpha.noalias() -= phi_inv_p * c;
   }
   /// E a.
   Eigen::MatrixXd apply_eval(const Eigen::MatrixXd& a) const {
@@ -141,7 +157,6 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
 
   auto sys = std::make_unique<System>();
   sys->dense = dense;
-  sys->polynomial = polynomial_;
   const Eigen::Index n = centres.size();
   const Eigen::Index m = points.size();
   sys->n = n;
@@ -200,35 +215,28 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
     for (Eigen::Index i = 0; i < n; ++i) {
       tree.within(xc.row(i).transpose(), radius_, found);
       for (const auto& [j, d2] : found)
-        if (saddle || static_cast<Eigen::Index>(j) >= i)  // LDL^T reads the lower triangle
+        if (static_cast<Eigen::Index>(j) >= i)  // LDL^T reads the lower triangle
           k.emplace_back(static_cast<Eigen::Index>(j), i, phi(std::sqrt(d2)));
     }
-    const double neighbours = static_cast<double>(k.size()) / static_cast<double>(n) * (saddle ? 1.0 : 2.0) - 1.0;
+    const double neighbours = static_cast<double>(k.size()) / static_cast<double>(n) * 2.0 - 1.0;
     if (neighbours < 2.0)
       log::get("coupling")->warn(
           "rbf from '{}' to '{}': support_radius {} m reaches only {:.1f} other points per centre on average; "
           "about 3 to 5 mesh spacings (10 to 30 neighbours) interpolate better",
           from.name(), to.name(), radius_, neighbours);
-    if (saddle)
-      for (Eigen::Index i = 0; i < n; ++i)
-        for (int c = 0; c < q; ++c) {
-          k.emplace_back(i, n + c, sys->poly_centres(i, c));
-          k.emplace_back(n + c, i, sys->poly_centres(i, c));
-        }
-    System::SparseCol kk(n + (saddle ? q : 0), n + (saddle ? q : 0));
+    System::SparseCol kk(n, n);
     kk.setFromTriplets(k.begin(), k.end());
     k = {};
+    sys->ldlt.compute(kk);
+    if (sys->ldlt.info() != Eigen::Success || sys->ldlt.vectorD().minCoeff() <= 0.0)
+      throw Error("mapper 'rbf': the interpolation matrix on mesh '" + centres.name() +
+                  "' is not positive definite (duplicate points?)");
     if (saddle) {
-      sys->lu.analyzePattern(kk);
-      sys->lu.factorize(kk);
-      if (sys->lu.info() != Eigen::Success)
-        throw Error("mapper 'rbf': the interpolation system on mesh '" + centres.name() +
-                    "' is singular (duplicate points, or too few points for the polynomial?): " + sys->lu.lastErrorMessage());
-    } else {
-      sys->ldlt.compute(kk);
-      if (sys->ldlt.info() != Eigen::Success || sys->ldlt.vectorD().minCoeff() <= 0.0)
-        throw Error("mapper 'rbf': the interpolation matrix on mesh '" + centres.name() +
-                    "' is not positive definite (duplicate points?)");
+      // Y = Phi^-1 P_C and the Schur complement S = P_C^T Y of the saddle-point system
+      sys->phi_inv_p = sys->ldlt.solve(sys->poly_centres);
+      sys->schur.compute(sys->poly_centres.transpose() * sys->phi_inv_p);
+      if (sys->schur.info() != Eigen::Success)
+        throw Error("mapper 'rbf': the polynomial part on mesh '" + centres.name() + "' is singular");
     }
     // E_ij = phi(|y_i - x_j|), y_i the evaluation points
     std::vector<Eigen::Triplet<double>> e;
@@ -269,7 +277,6 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
 void RbfMapper::map(const Eigen::MatrixXd& in, Eigen::MatrixXd& out) const {
   check_input(in);
   const System& s = *system_;
-  const Eigen::Index n = s.n;
   const int q = s.q;
   if (constraint_ == Constraint::consistent) {
     switch (polynomial_) {
@@ -286,11 +293,10 @@ void RbfMapper::map(const Eigen::MatrixXd& in, Eigen::MatrixXd& out) const {
       }
       case Polynomial::on: {
         // [alpha; c] = K^-1 [f; 0],  out = E alpha + P_X c
-        Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n + q, in.cols());
-        rhs.topRows(n) = in;
-        const Eigen::MatrixXd z = s.solve(rhs);
-        out = s.apply_eval(z.topRows(n));
-        out.noalias() += s.poly_eval * z.bottomRows(q);
+        Eigen::MatrixXd alpha, c;
+        s.solve_saddle(in, Eigen::MatrixXd::Zero(q, in.cols()), alpha, c);
+        out = s.apply_eval(alpha);
+        out.noalias() += s.poly_eval * c;
         break;
       }
     }
@@ -311,10 +317,8 @@ void RbfMapper::map(const Eigen::MatrixXd& in, Eigen::MatrixXd& out) const {
       }
       case Polynomial::on: {
         // W^T g = [I 0] K^-1 [E^T g; P_X^T g]   (K symmetric)
-        Eigen::MatrixXd rhs(n + q, in.cols());
-        rhs.topRows(n) = s.apply_eval_transposed(in);
-        rhs.bottomRows(q) = s.poly_eval.transpose() * in;
-        out = s.solve(rhs).topRows(n);
+        Eigen::MatrixXd c;
+        s.solve_saddle(s.apply_eval_transposed(in), s.poly_eval.transpose() * in, out, c);
         break;
       }
     }

@@ -14,11 +14,14 @@
 // plate gets no term normal to it and a straight line only one):
 //   separate (default) p fitted first by least squares, the RBF interpolates the residual:
 //                      Phi alpha = f - P c; Phi is symmetric positive definite (Cholesky LDL^T)
-//   on                 the saddle-point system [Phi P; P^T 0] [alpha; c] = [f; 0] (sparse LU)
+//   on                 the saddle-point system [Phi P; P^T 0] [alpha; c] = [f; 0], solved
+//                      through its q x q Schur complement P^T Phi^-1 P (sparse Cholesky of Phi)
 //   off                no polynomial: constants are not reproduced, so not allowed for a
 //                      conservative mapping (the total would not be preserved)
 // Unlike the sparse-matrix mappers, the operator E K^-1 is dense; compute() factorises K and
 // map() does one solve and one sparse product (with temporaries of the mesh size).
+// Global bases factorise densely (Phi, or the whole saddle-point system: thin-plate splines
+// are only conditionally positive definite).
 
 #include <memory>
 
