@@ -96,6 +96,7 @@ void ContactModel::update() {
       p.g_star =
           1.0 / (2.0 * (2.0 - ma.poisson_ratio) * (1.0 + ma.poisson_ratio) / ma.youngs_modulus +
                  2.0 * (2.0 - mb.poisson_ratio) * (1.0 + mb.poisson_ratio) / mb.youngs_modulus);
+      p.st_over_sn_sqrt = std::sqrt(4.0 * p.g_star / p.e_star);
       p.defined = interaction_set_[a * n + b];
       if (!p.defined) continue;
       const Interaction& in = interactions_[a * n + b];

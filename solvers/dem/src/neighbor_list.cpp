@@ -23,15 +23,21 @@ void NeighborList::clear() {
   neighbors_.clear();
   shear_.clear();
   pair_force_.clear();
+  touching_.clear();
+  plane_mask_.clear();
   reverse_offsets_.assign(1, 0);
   reverse_pairs_.clear();
   mesh_offsets_.assign(1, 0);
   mesh_candidates_.clear();
 }
 
-bool NeighborList::needs_rebuild(const Particles& p, const std::vector<TriangleMesh>& meshes) const {
-  if (!valid_ || position_at_build_.size() != p.size()) return true;
+bool NeighborList::needs_rebuild(const Particles& p, const std::vector<PlaneWall>& planes,
+                                 const std::vector<TriangleMesh>& meshes) const {
+  if (!valid_ || position_at_build_.size() != p.size() || plane_at_build_.size() != planes.size())
+    return true;
   const double limit2 = 0.25 * skin_ * skin_;
+  for (std::size_t k = 0; k < planes.size(); ++k)
+    if ((planes[k].point - plane_at_build_[k]).squaredNorm() > limit2) return true;
   const long n = static_cast<long>(p.size());
   double max2 = 0.0;
 #pragma omp parallel for reduction(max : max2) schedule(static) if (n >= 1024)
@@ -65,7 +71,8 @@ void NeighborList::visit_pairs(const Particles& p, int i, Visit&& visit) const {
     }
 }
 
-void NeighborList::build(const Particles& p, std::vector<TriangleMesh>& meshes) {
+void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& planes,
+                         std::vector<TriangleMesh>& meshes) {
   ++builds_;
   const int n = static_cast<int>(p.size());
   // Grid over the particles' bounding box, cells 2 R_max + skin wide (at most ~4 N cells).
@@ -137,6 +144,7 @@ void NeighborList::build(const Particles& p, std::vector<TriangleMesh>& meshes) 
   neighbors_.swap(new_neighbors_);
   shear_.swap(new_shear_);
   pair_force_.resize(neighbors_.size());
+  touching_.assign(neighbors_.size(), 1);  // the next evaluation settles forces and histories
 
   // Reverse index: for each j the slots (i, j), in slot order.
   reverse_offsets_.assign(n + 1, 0);
@@ -149,6 +157,22 @@ void NeighborList::build(const Particles& p, std::vector<TriangleMesh>& meshes) 
     reverse_pairs_[reverse_offsets_[j] + counts_[j]++] = s;
   }
   position_at_build_ = p.position;
+  // Planes within R + skin of each particle.
+  plane_at_build_.resize(planes.size());
+  for (std::size_t k = 0; k < planes.size(); ++k) plane_at_build_[k] = planes[k].point;
+  plane_mask_.resize(n);
+  const int np = static_cast<int>(planes.size());
+  for (int i = 0; i < n; ++i) {
+    std::uint64_t mask = 0;
+    if (np > 64) {
+      mask = ~std::uint64_t{0};
+    } else {
+      for (int k = 0; k < np; ++k)
+        if ((p.position[i] - planes[k].point).dot(planes[k].normal) < p.radius[i] + skin_)
+          mask |= std::uint64_t{1} << k;
+    }
+    plane_mask_[i] = mask;
+  }
   build_mesh_candidates(p, meshes, r_max);
   valid_ = true;
 }

@@ -4,6 +4,7 @@
 #include "partita/dem/vtk_writer.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -299,7 +300,7 @@ void System::prepare() {
   }
   neighbors_.set_skin(skin_);
   resize_histories();
-  neighbors_.build(particles_, meshes_);
+  neighbors_.build(particles_, planes_, meshes_);
   prepared_ = true;
 }
 
@@ -338,7 +339,7 @@ void System::step(double dt) {
     p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
   }
   for (PlaneWall& w : planes_) w.point += dt * w.velocity;
-  if (neighbors_.needs_rebuild(p, meshes_)) neighbors_.build(p, meshes_);
+  if (neighbors_.needs_rebuild(p, planes_, meshes_)) neighbors_.build(p, planes_, meshes_);
   compute_forces(dt, true);
   // Second half: v += dt/2 F/m, omega += dt/2 T/I.
 #pragma omp parallel for schedule(static) if (n >= 1024)
@@ -366,9 +367,11 @@ void System::compute_pair_forces(double dt, bool update_history) {
   Particles& p = particles_;
   NeighborList& nl = neighbors_;
   const int n = static_cast<int>(p.size());
-  // Each pair (i, j > i) once: Hertz-Mindlin force on i into the pair's buffer, torques
-  // T_i = -cr_i n x F_t, T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling
-  // resistance T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
+  // Each pair (i, j > i) once, Hertz-Mindlin force F on i. Torques T_i = -cr_i n x F_t,
+  // T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
+  // T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
+  // i starts its sum here, F_i = m_i g + sum over its pairs in order; j's share (-F, T_j) goes to
+  // the pair's buffer for gather_forces().
 #pragma omp parallel for schedule(dynamic, 128) if (n >= 1024)
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d xi = p.position[i];
@@ -377,43 +380,54 @@ void System::compute_pair_forces(double dt, bool update_history) {
     const double ri = p.radius[i];
     const double mi = p.mass[i];
     const int mat_i = p.material[i];
+    Eigen::Vector3d f = mi * gravity_;
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
     for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
       const int j = nl.neighbors_[s];
-      PairForce& pf = nl.pair_force_[s];
       const Eigen::Vector3d d = xi - p.position[j];
-      const double rsum = ri + p.radius[j];
+      const double rj = p.radius[j];
+      const double rsum = ri + rj;
       const double r2 = d.squaredNorm();
       if (r2 >= rsum * rsum) {
-        pf.force.setZero(), pf.torque_i.setZero(), pf.torque_j.setZero();
-        nl.shear_[s].setZero();
+        if (nl.touching_[s]) {
+          nl.touching_[s] = 0;
+          nl.shear_[s].setZero();
+        }
         continue;
       }
+      nl.touching_[s] = 1;
+      PairForce& pf = nl.pair_force_[s];
       const double r = std::sqrt(r2);
-      const Eigen::Vector3d nrm = r > 0.0 ? Eigen::Vector3d(d / r) : Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d nrm = r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
       const double delta = rsum - r;
-      const double rj = p.radius[j];
       const double mj = p.mass[j];
       const PairParameters& pp = model_.pair(mat_i, p.material[j]);
       const double r_eff = ri * rj / rsum;
       const double m_eff = mi * mj / (mi + mj);
       const double cri = ri - 0.5 * delta, crj = rj - 0.5 * delta;
-      const Eigen::Vector3d w_arm = cri * wi + crj * p.angular_velocity[j];
-      Eigen::Vector3d ft;
+      const Eigen::Vector3d wj = p.angular_velocity[j];
+      const Eigen::Vector3d w_arm = cri * wi + crj * wj;
+      Eigen::Vector3d fij, ft;
       const double fn = hertz_mindlin(pp, delta, r_eff, m_eff, nrm, vi - p.velocity[j], w_arm,
-                                      nl.shear_[s], dt, update_history, pf.force, ft);
+                                      nl.shear_[s], dt, update_history, fij, ft);
       const Eigen::Vector3d c = nrm.cross(ft);
-      pf.torque_i = -cri * c;
+      Eigen::Vector3d ti = -cri * c;
       pf.torque_j = -crj * c;
       if (pp.rolling_friction > 0.0) {
-        const Eigen::Vector3d w_rel = wi - p.angular_velocity[j];
+        const Eigen::Vector3d w_rel = wi - wj;
         const double wn = w_rel.norm();
         if (wn > 0.0) {
           const Eigen::Vector3d tr = (-pp.rolling_friction * std::abs(fn) * r_eff / wn) * w_rel;
-          pf.torque_i += tr;
+          ti += tr;
           pf.torque_j -= tr;
         }
       }
+      pf.force_j = -fij;
+      f += fij;
+      t += ti;
     }
+    p.force[i] = f;
+    p.torque[i] = t;
   }
 }
 
@@ -424,7 +438,8 @@ void System::gather_forces(double dt, bool update_history) {
   const int np = static_cast<int>(planes_.size());
   const int blocks = (n + block_size - 1) / block_size;
   const bool have_meshes = !meshes_.empty();
-  // Per particle, in a fixed order: F_i = m_i g + sum_(i,j) F_ij - sum_(j,i) F_ji + walls + meshes.
+  // Per particle, continuing the sum of compute_pair_forces() in a fixed order:
+  // F_i += sum over pairs (j, i) of their share + planes + meshes.
   // Plane forces are summed per block of particles, then over blocks (fixed order).
 #pragma omp parallel for schedule(static) if (n >= 1024)
   for (int b = 0; b < blocks; ++b) {
@@ -432,26 +447,23 @@ void System::gather_forces(double dt, bool update_history) {
     for (int k = 0; k < np; ++k) block_wall[k].setZero();
     const int i_end = std::min(n, (b + 1) * block_size);
     for (int i = b * block_size; i < i_end; ++i) {
-      Eigen::Vector3d f = p.mass[i] * gravity_;
-      Eigen::Vector3d t = Eigen::Vector3d::Zero();
-      for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
-        f += nl.pair_force_[s].force;
-        t += nl.pair_force_[s].torque_i;
-      }
+      Eigen::Vector3d f = p.force[i];
+      Eigen::Vector3d t = p.torque[i];
       for (int k = nl.reverse_offsets_[i]; k < nl.reverse_offsets_[i + 1]; ++k) {
-        const PairForce& pf = nl.pair_force_[nl.reverse_pairs_[k]];
-        f -= pf.force;
-        t += pf.torque_j;
+        const int s = nl.reverse_pairs_[k];
+        if (!nl.touching_[s]) continue;
+        f += nl.pair_force_[s].force_j;
+        t += nl.pair_force_[s].torque_j;
       }
-      // Planes: overlap delta = R - (x - x_w).n_w, R* = R, m* = m.
+      // Planes near i: overlap delta = R - (x - x_w).n_w, R* = R, m* = m.
       const double ri = p.radius[i];
-      for (int k = 0; k < np; ++k) {
+      auto plane_contact = [&](int k) {
         const PlaneWall& w = planes_[k];
         Eigen::Vector3d& shear = plane_shear_[static_cast<std::size_t>(i) * np + k];
         const double delta = ri - (p.position[i] - w.point).dot(w.normal);
         if (delta <= 0.0) {
           shear.setZero();
-          continue;
+          return;
         }
         const PairParameters& pp = model_.pair(p.material[i], w.material);
         const double cr = ri - 0.5 * delta;
@@ -465,6 +477,12 @@ void System::gather_forces(double dt, bool update_history) {
           if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * ri / wn) * p.angular_velocity[i];
         }
         block_wall[k] -= fw;
+      };
+      if (np <= 64) {
+        for (std::uint64_t mask = nl.plane_mask_[i]; mask != 0; mask &= mask - 1)
+          plane_contact(std::countr_zero(mask));
+      } else {
+        for (int k = 0; k < np; ++k) plane_contact(k);
       }
       if (have_meshes) mesh_contacts(i, dt, update_history, f, t);
       p.force[i] = f;

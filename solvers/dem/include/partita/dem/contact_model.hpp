@@ -17,6 +17,12 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#if defined(__GNUC__)
+#define PARTITA_DEM_INLINE inline __attribute__((always_inline))
+#else
+#define PARTITA_DEM_INLINE inline
+#endif
+
 namespace partita::dem {
 
 /// Everything the force law needs about one pair of materials, precomputed.
@@ -24,6 +30,7 @@ struct PairParameters {
   double e_star = 0.0;            ///< E* [Pa]
   double g_star = 0.0;            ///< G* [Pa]
   double zeta = 0.0;              ///< damping ratio: gamma = 2 zeta sqrt(S m*)
+  double st_over_sn_sqrt = 0.0;   ///< sqrt(S_t/S_n) = sqrt(4 G*/E*)
   double friction = 0.0;          ///< mu
   double rolling_friction = 0.0;  ///< mu_r
   bool no_tension = true;  ///< clamp F_n >= 0
@@ -71,7 +78,7 @@ class ContactModel {
 ///   w_arm  cr_i omega_i + cr_j omega_j with cr = R - delta/2 (wall: cr_i omega_i)
 ///   shear  tangential displacement history, updated in place when update_history
 /// Returns the normal force magnitude F_n; writes the total force on i and its tangential part.
-inline double hertz_mindlin(const PairParameters& p, double delta, double r_eff, double m_eff,
+PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, double r_eff, double m_eff,
                             const Eigen::Vector3d& n, const Eigen::Vector3d& v_rel,
                             const Eigen::Vector3d& w_arm, Eigen::Vector3d& shear, double dt,
                             bool update_history, Eigen::Vector3d& force,
@@ -82,7 +89,9 @@ inline double hertz_mindlin(const PairParameters& p, double delta, double r_eff,
   const double s_n = 2.0 * p.e_star * a;
   const double v_n = v_rel.dot(n);
   double f_n = (2.0 / 3.0) * s_n * delta;
-  if (p.zeta > 0.0) f_n -= 2.0 * p.zeta * std::sqrt(s_n * m_eff) * v_n;
+  // gamma_n = 2 zeta sqrt(S_n m*); gamma_t = gamma_n sqrt(S_t/S_n)
+  const double gamma_n = p.zeta > 0.0 ? 2.0 * p.zeta * std::sqrt(s_n * m_eff) : 0.0;
+  f_n -= gamma_n * v_n;
   if (p.no_tension && f_n < 0.0) f_n = 0.0;
   force = f_n * n;
   if (p.friction <= 0.0) {
@@ -104,8 +113,7 @@ inline double hertz_mindlin(const PairParameters& p, double delta, double r_eff,
   }
   const double k_t = 8.0 * p.g_star * a;
   if (p.cap_total_tangential) {
-    f_tangential = -k_t * shear;
-    if (p.zeta > 0.0) f_tangential -= (2.0 * p.zeta * std::sqrt(k_t * m_eff)) * v_t;
+    f_tangential = -k_t * shear - (gamma_n * p.st_over_sn_sqrt) * v_t;
     const double ft2 = f_tangential.squaredNorm();
     const double cap = p.friction * f_n;
     if (ft2 > cap * cap) {
@@ -127,8 +135,7 @@ inline double hertz_mindlin(const PairParameters& p, double delta, double r_eff,
       f_tangential.setZero();
     }
   } else {
-    f_tangential = -k_t * shear;
-    if (p.zeta > 0.0) f_tangential -= (2.0 * p.zeta * std::sqrt(k_t * m_eff)) * v_t;
+    f_tangential = -k_t * shear - (gamma_n * p.st_over_sn_sqrt) * v_t;
   }
   force += f_tangential;
   return f_n;

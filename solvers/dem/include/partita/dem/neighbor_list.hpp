@@ -9,23 +9,26 @@
 // Particle-triangle candidates: triangles are binned into the same cells (box grown by
 // R_max + skin), each particle keeps the triangles within R + skin; valid until a particle or a
 // mesh vertex has moved more than skin/2.
+// Planes: each particle keeps a bit mask of the planes within R + skin (up to 64 planes; more
+// are all checked every step); valid until a particle or plane has moved more than skin/2.
 // Cells are 2 R_max + skin wide (correct for any size distribution; with very wide ones the
 // cells hold many small particles). Vectors are reused: no allocation between rebuilds.
 
 #include "partita/dem/particles.hpp"
+#include "partita/dem/plane_wall.hpp"
 #include "partita/dem/triangle_mesh.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
 
 namespace partita::dem {
 
-/// Force of one pair on i and torques on i and j (force on j is -force).
+/// Force of one pair on j and torque on j, kept for j's gather (i adds its share at once).
 struct PairForce {
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();
-  Eigen::Vector3d torque_i = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force_j = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_j = Eigen::Vector3d::Zero();
 };
 
@@ -41,9 +44,13 @@ class NeighborList {
   /// Forgets the lists (next needs_rebuild() is true); histories are dropped.
   void clear();
   /// True when a particle or mesh vertex moved more than skin/2 since the last build.
-  bool needs_rebuild(const Particles& particles, const std::vector<TriangleMesh>& meshes) const;
+  bool needs_rebuild(const Particles& particles, const std::vector<PlaneWall>& planes,
+                     const std::vector<TriangleMesh>& meshes) const;
   /// Rebuilds cells and lists, carrying the tangential histories of surviving pairs over.
-  void build(const Particles& particles, std::vector<TriangleMesh>& meshes);
+  void build(const Particles& particles, const std::vector<PlaneWall>& planes,
+             std::vector<TriangleMesh>& meshes);
+  /// Planes near particle i (bit k: plane k); all bits set when there are more than 64 planes.
+  std::uint64_t plane_mask(std::size_t i) const { return plane_mask_[i]; }
 
   std::size_t pair_count() const { return neighbors_.size(); }
   long build_count() const { return builds_; }
@@ -75,8 +82,11 @@ class NeighborList {
   std::vector<int> offsets_, neighbors_;
   std::vector<Eigen::Vector3d> shear_;
   std::vector<PairForce> pair_force_;
+  std::vector<char> touching_;  // overlap > 0 in the last force evaluation (pair_force_ valid)
   std::vector<int> reverse_offsets_, reverse_pairs_;
   std::vector<Eigen::Vector3d> position_at_build_;
+  std::vector<Eigen::Vector3d> plane_at_build_;
+  std::vector<std::uint64_t> plane_mask_;
   // scratch reused between builds
   std::vector<int> new_offsets_, new_neighbors_, counts_;
   std::vector<Eigen::Vector3d> new_shear_;

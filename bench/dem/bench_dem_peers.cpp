@@ -1,0 +1,189 @@
+// DEM peer benchmark (shared/bench/peers/README.md, RESULTS.md): a settled bed of Hertz-Mindlin
+// granules read from the common bed file, 500 untimed warm-up steps, then 20,000 (small) or 5,000
+// (large) timed steps with 1 and 2 threads. Prints particle-steps/s, the mean number of
+// particle-particle contacts per particle (peers: 4.14 small, 4.62 large) and the ratio to
+// LIGGGHTS: measured in the same invocation when `liggghts` is on PATH, else the recorded figures.
+//
+// usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] [--quick]
+//                        [--vtk DIR]
+// Physics as the decks dem/liggghts/model.in + bench.in: E = 200 MPa, nu = 0.23, e = 0.5 with
+// LIGGGHTS-style damping, mu = 0.3, Mindlin tangential history, walls x = 0, W, y = 0, W, z = 0
+// of the same material, g = 9.81 m/s^2, dt = 1.9e-6 s, skin 0.5 mm.
+
+#include "partita/dem/error.hpp"
+#include "partita/dem/lammps_data.hpp"
+#include "partita/dem/parallel.hpp"
+#include "partita/dem/system.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace partita::dem;
+
+namespace {
+
+struct Case {
+  std::string name;
+  double width;
+  long steps;
+  double peer_contacts;
+  double liggghts_1, liggghts_2;  // recorded particle-steps/s (RESULTS.md)
+};
+
+System make_system(const LammpsData& d, double width) {
+  System sys;
+  std::map<double, int> material_of_density;
+  for (double rho : d.density)
+    if (!material_of_density.count(rho))
+      material_of_density[rho] = sys.add_material({2.0e8, 0.23, rho});
+  const int wall = material_of_density.begin()->second;
+  for (const auto& [rho_a, a] : material_of_density)
+    for (const auto& [rho_b, b] : material_of_density) sys.add_interaction(a, b, {0.3, 0.5, 0.0});
+  sys.set_damping_model(DampingModel::liggghts);
+  sys.set_gravity({0.0, 0.0, -9.81});
+  sys.set_skin(0.5e-3);
+  for (std::size_t i = 0; i < d.size(); ++i)
+    sys.add_particle(d.position[i], 0.5 * d.diameter[i], material_of_density[d.density[i]],
+                     d.velocity[i], d.angular_velocity[i], d.id[i]);
+  sys.add_plane({0, 0, 0}, {1, 0, 0}, wall);
+  sys.add_plane({width, 0, 0}, {-1, 0, 0}, wall);
+  sys.add_plane({0, 0, 0}, {0, 1, 0}, wall);
+  sys.add_plane({0, width, 0}, {0, -1, 0}, wall);
+  sys.add_plane({0, 0, 0}, {0, 0, 1}, wall);
+  return sys;
+}
+
+bool on_path(const std::string& exe) {
+  return std::system(("command -v " + exe + " > /dev/null 2>&1").c_str()) == 0;
+}
+
+// Runs the LIGGGHTS deck as run_one.sh does; returns particle-steps/s of the timed run or 0.
+double run_liggghts(const std::string& dem_dir, const Case& c, long n_atoms, int ranks, long steps) {
+  const std::string log = (std::filesystem::temp_directory_path() /
+                           ("bench_dem_liggghts_" + c.name + std::to_string(ranks) + ".log"))
+                              .string();
+  std::ostringstream cmd;
+  cmd << "cd '" << dem_dir << "/liggghts' && OMP_NUM_THREADS=1 "
+      << (ranks > 1 ? "mpirun --allow-run-as-root -np " + std::to_string(ranks) + " --bind-to core "
+                    : std::string())
+      << "liggghts -in bench.in -var data ../data/bed_" << c.name << ".data -var W " << c.width
+      << " -var nsteps " << steps << " -log '" << log << "' -screen none > /dev/null 2>&1";
+  if (std::system(cmd.str().c_str()) != 0) return 0.0;
+  std::ifstream in(log);
+  std::string line;
+  int seen = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("Loop time", 0) != 0) continue;
+    if (++seen == 2) {  // the first is the warm-up run
+      std::istringstream is(line);
+      std::string w;
+      double seconds = 0.0;
+      is >> w >> w >> w >> seconds;
+      return seconds > 0.0 ? static_cast<double>(n_atoms) * steps / seconds : 0.0;
+    }
+  }
+  return 0.0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string dem_dir = PARTITA_PEER_DEM_DIR;
+  std::string data_dir = dem_dir + "/data";
+  std::string which = "all", vtk_dir;
+  std::vector<int> threads = {1, 2};
+  bool quick = false;
+  for (int a = 1; a < argc; ++a) {
+    const std::string arg = argv[a];
+    auto next = [&]() -> std::string {
+      if (a + 1 >= argc) {
+        std::cerr << "bench_dem_peers: " << arg << " needs a value\n";
+        std::exit(2);
+      }
+      return argv[++a];
+    };
+    if (arg == "--data") {
+      data_dir = next();
+      dem_dir = (std::filesystem::path(data_dir) / "..").lexically_normal().string();
+    } else if (arg == "--case") {
+      which = next();
+    } else if (arg == "--threads") {
+      threads.clear();
+      std::istringstream is(next());
+      std::string t;
+      while (std::getline(is, t, ',')) threads.push_back(std::stoi(t));
+    } else if (arg == "--quick") {
+      quick = true;
+    } else if (arg == "--vtk") {
+      vtk_dir = next();
+    } else {
+      std::cerr << "usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] "
+                   "[--quick] [--vtk DIR]\n";
+      return arg == "--help" || arg == "-h" ? 0 : 2;
+    }
+  }
+  const std::vector<Case> cases = {{"small", 0.02, 20000, 4.14, 5.58e6, 1.09e7},
+                                   {"large", 0.06, 5000, 4.62, 4.79e6, 9.62e6}};
+  const bool liggghts = on_path("liggghts");
+  const long warmup = quick ? 100 : 500;
+  std::printf("# partita::dem peer benchmark%s; LIGGGHTS %s\n", quick ? " (quick mode)" : "",
+              liggghts ? "on PATH: measured in this run" : "not on PATH: recorded figures");
+  std::printf("# machine shared with other jobs: timings are noisy\n");
+  std::printf("# psteps/s = N x steps / wall seconds of the timed loop; cpu_s = process CPU time of\n"
+              "# the loop (with 1 thread, N x steps / cpu_s estimates an unloaded machine)\n");
+  std::printf("%-6s %3s %8s %7s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N",
+              "steps", "loop_s", "cpu_s", "psteps/s", "cn/atom", "peer_cn", "KE_J", "KEtrans_J",
+              "vs_LIGG");
+  try {
+    for (const Case& c : cases) {
+      if (which != "all" && which != c.name) continue;
+      const LammpsData data = LammpsData::read(data_dir + "/bed_" + c.name + ".data");
+      const long steps = quick ? c.steps / 20 : c.steps;
+      for (int nt : threads) {
+        set_num_threads(nt);
+        System sys = make_system(data, c.width);
+        const double dt = 1.9e-6;
+        sys.run(warmup, dt);
+        const auto t0 = std::chrono::steady_clock::now();
+        const std::clock_t c0 = std::clock();
+        sys.run(steps, dt);
+        const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        double ke_trans = 0.0;
+        for (std::size_t i = 0; i < sys.particle_count(); ++i)
+          ke_trans += 0.5 * sys.particles().mass[i] * sys.particles().velocity[i].squaredNorm();
+        const double rate = static_cast<double>(sys.particle_count()) * steps / seconds;
+        const double cn = sys.mean_contacts_per_particle();
+        double peer = nt == 1 ? c.liggghts_1 : c.liggghts_2;
+        const char* peer_kind = "rec";
+        if (liggghts) {
+          const double measured = run_liggghts(dem_dir, c, static_cast<long>(data.size()), nt, steps);
+          if (measured > 0.0) peer = measured, peer_kind = "meas";
+        }
+        std::printf("%-6s %3d %8zu %7ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx %s%s\n",
+                    c.name.c_str(), nt, sys.particle_count(), steps, seconds, cpu, rate, cn,
+                    c.peer_contacts, sys.kinetic_energy(), ke_trans, rate / peer, peer_kind,
+                    std::abs(cn / c.peer_contacts - 1.0) > 0.02 ? "  CONTACTS DIFFER >2%" : "");
+        std::fflush(stdout);
+        if (!vtk_dir.empty()) {
+          std::filesystem::create_directories(vtk_dir);
+          sys.write_particles_vtp(vtk_dir + "/bed_" + c.name + ".vtp");
+        }
+      }
+    }
+  } catch (const Error& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
