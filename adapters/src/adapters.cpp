@@ -1,7 +1,8 @@
 #include "partita/adapters/register_all.hpp"
 
 #ifdef PARTITA_HAVE_TUBE1D
-#include "tube1d/tube_adapters.hpp"
+#include "tube1d/tube_fluid_adapter.hpp"
+#include "tube1d/tube_solid_adapter.hpp"
 #endif
 
 namespace partita::adapters {

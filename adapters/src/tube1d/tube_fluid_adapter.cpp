@@ -1,0 +1,68 @@
+#include "tube_fluid_adapter.hpp"
+
+#include <fmt/format.h>
+
+#include "partita/interface/error.hpp"
+#include "partita/interface/output.hpp"
+#include "tube_config.hpp"
+#include "tube_mesh.hpp"
+
+namespace partita::adapters {
+
+TubeFluidAdapter::TubeFluidAdapter(const tube1d::TubeParameters& parameters) : flow_(parameters) {
+  InterfaceMesh m;
+  m.mesh = tube_nodes(parameters);
+  m.writes.push_back(DataSpec{"pressure", 1, "Pa", DataKind::intensive});
+  m.reads.push_back(DataSpec{"cross_section_area", 1, "m^2", DataKind::intensive});
+  meshes_.push_back(std::move(m));
+  checkpoint_ = flow_.state();
+}
+
+void TubeFluidAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
+  if (mesh != "nodes" || data != "cross_section_area")
+    throw Error("tube1d-fluid reads only 'cross_section_area' on mesh 'nodes', not '" + std::string(data) +
+                "' on '" + std::string(mesh) + "'");
+  flow_.set_area(values.col(0));
+}
+
+void TubeFluidAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
+  if (mesh != "nodes" || data != "pressure")
+    throw Error("tube1d-fluid writes only 'pressure' on mesh 'nodes', not '" + std::string(data) + "' on '" +
+                std::string(mesh) + "'");
+  values = flow_.pressure();
+}
+
+void TubeFluidAdapter::advance(double dt) {
+  try {
+    flow_.advance(dt);
+  } catch (const std::exception& e) {
+    throw Error(std::string("tube1d-fluid: ") + e.what() +
+                "; if this happens during coupling iterations, the iteration probably diverged (use a smaller "
+                "relaxation factor, aitken or iqn-ils)");
+  }
+}
+
+void TubeFluidAdapter::write_output(const OutputFrame& frame) {
+  const std::string file = fmt::format("{}_tube_{:06d}.vtp", frame.prefix, frame.index);
+  write_vtp(frame.vtk_directory / file, meshes_.front().mesh,
+            {{"velocity", flow_.velocity()}, {"pressure", flow_.pressure()}, {"cross_section_area", flow_.area()}});
+  files_ = {{"tube", file}};
+}
+
+std::vector<MonitorValue> TubeFluidAdapter::monitors() const {
+  const auto& p = flow_.pressure();
+  return {{"inlet_pressure", "Pa", p(0)},
+          {"outlet_pressure", "Pa", p(p.size() - 1)},
+          {"inlet_velocity", "m/s", flow_.velocity()(0)}};
+}
+
+std::shared_ptr<const config::Spec> TubeFluidAdapter::spec() {
+  static const auto s = tube_spec("tube1d-fluid", "quasi-1D incompressible flow in the elastic tube", true);
+  return s;
+}
+
+std::unique_ptr<Solver> TubeFluidAdapter::create(const SolverContext& context) {
+  return std::make_unique<TubeFluidAdapter>(tube_parameters(context.config, true));
+}
+
+}  // namespace partita::adapters

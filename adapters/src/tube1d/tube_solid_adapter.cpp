@@ -1,0 +1,59 @@
+#include "tube_solid_adapter.hpp"
+
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "partita/interface/error.hpp"
+#include "partita/interface/output.hpp"
+#include "tube_config.hpp"
+#include "tube_mesh.hpp"
+
+namespace partita::adapters {
+
+TubeSolidAdapter::TubeSolidAdapter(const tube1d::TubeParameters& parameters)
+    : wall_(parameters), checkpoint_(parameters) {
+  InterfaceMesh m;
+  m.mesh = tube_nodes(parameters);
+  m.reads.push_back(DataSpec{"pressure", 1, "Pa", DataKind::intensive});
+  m.writes.push_back(DataSpec{"cross_section_area", 1, "m^2", DataKind::intensive});
+  meshes_.push_back(std::move(m));
+}
+
+void TubeSolidAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
+  if (mesh != "nodes" || data != "pressure")
+    throw Error("tube1d-solid reads only 'pressure' on mesh 'nodes', not '" + std::string(data) + "' on '" +
+                std::string(mesh) + "'");
+  wall_.set_pressure(values.col(0));
+}
+
+void TubeSolidAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
+  if (mesh != "nodes" || data != "cross_section_area")
+    throw Error("tube1d-solid writes only 'cross_section_area' on mesh 'nodes', not '" + std::string(data) +
+                "' on '" + std::string(mesh) + "'");
+  values = wall_.area();
+}
+
+void TubeSolidAdapter::write_output(const OutputFrame& frame) {
+  const std::string file = fmt::format("{}_wall_{:06d}.vtp", frame.prefix, frame.index);
+  const Eigen::VectorXd radius = (wall_.area().array() / std::numbers::pi).sqrt();
+  write_vtp(frame.vtk_directory / file, meshes_.front().mesh,
+            {{"cross_section_area", wall_.area()}, {"radius", radius}, {"pressure", wall_.pressure()}});
+  files_ = {{"wall", file}};
+}
+
+std::vector<MonitorValue> TubeSolidAdapter::monitors() const {
+  const auto& a = wall_.area();
+  return {{"mid_area", "m^2", a(a.size() / 2)}, {"max_area", "m^2", a.maxCoeff()}};
+}
+
+std::shared_ptr<const config::Spec> TubeSolidAdapter::spec() {
+  static const auto s = tube_spec("tube1d-solid", "the elastic tube's wall: tube law a(p)", false);
+  return s;
+}
+
+std::unique_ptr<Solver> TubeSolidAdapter::create(const SolverContext& context) {
+  return std::make_unique<TubeSolidAdapter>(tube_parameters(context.config, false));
+}
+
+}  // namespace partita::adapters
