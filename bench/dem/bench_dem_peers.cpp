@@ -17,8 +17,8 @@
 
 #include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -67,7 +67,8 @@ bool on_path(const std::string& exe) {
 }
 
 // Runs the LIGGGHTS deck as run_one.sh does; returns particle-steps/s of the timed run or 0.
-double run_liggghts(const std::string& dem_dir, const Case& c, long n_atoms, int ranks, long steps) {
+double run_liggghts(const std::string& dem_dir, const Case& c, long n_atoms, int ranks,
+                    long steps) {
   const std::string log = (std::filesystem::temp_directory_path() /
                            ("bench_dem_liggghts_" + c.name + std::to_string(ranks) + ".log"))
                               .string();
@@ -138,11 +139,11 @@ int main(int argc, char** argv) {
   std::printf("# partita::dem peer benchmark%s; LIGGGHTS %s\n", quick ? " (quick mode)" : "",
               liggghts ? "on PATH: measured in this run" : "not on PATH: recorded figures");
   std::printf("# machine shared with other jobs: timings are noisy\n");
-  std::printf("# psteps/s = N x steps / wall seconds of the timed loop; cpu_s = process CPU time of\n"
-              "# the loop (with 1 thread, N x steps / cpu_s estimates an unloaded machine)\n");
-  std::printf("%-6s %3s %8s %7s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N",
-              "steps", "loop_s", "cpu_s", "psteps/s", "cn/atom", "peer_cn", "KE_J", "KEtrans_J",
-              "vs_LIGG");
+  std::printf(
+      "# psteps/s = N x steps / wall seconds of the timed loop; cpu_s = process CPU time of\n"
+      "# the loop (with 1 thread, N x steps / cpu_s estimates an unloaded machine)\n");
+  std::printf("%-6s %3s %8s %7s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N", "steps",
+              "loop_s", "cpu_s", "psteps/s", "cn/atom", "peer_cn", "KE_J", "KEtrans_J", "vs_LIGG");
   try {
     for (const Case& c : cases) {
       if (which != "all" && which != c.name) continue;
@@ -167,7 +168,8 @@ int main(int argc, char** argv) {
         double peer = nt == 1 ? c.liggghts_1 : c.liggghts_2;
         const char* peer_kind = "rec";
         if (liggghts) {
-          const double measured = run_liggghts(dem_dir, c, static_cast<long>(data.size()), nt, steps);
+          const double measured =
+              run_liggghts(dem_dir, c, static_cast<long>(data.size()), nt, steps);
           if (measured > 0.0) peer = measured, peer_kind = "meas";
         }
         std::printf("%-6s %3d %8zu %7ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx %s%s\n",

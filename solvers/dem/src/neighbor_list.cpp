@@ -13,8 +13,7 @@ int NeighborList::Grid::coord(double x, double o, int n) const {
 }
 
 std::array<int, 3> NeighborList::Grid::coords(const Eigen::Vector3d& x) const {
-  return {coord(x.x(), origin.x(), nx), coord(x.y(), origin.y(), ny),
-          coord(x.z(), origin.z(), nz)};
+  return {coord(x.x(), origin.x(), nx), coord(x.y(), origin.y(), ny), coord(x.z(), origin.z(), nz)};
 }
 
 void NeighborList::clear() {
@@ -33,16 +32,22 @@ void NeighborList::clear() {
 
 bool NeighborList::needs_rebuild(const Particles& p, const std::vector<PlaneWall>& planes,
                                  const std::vector<TriangleMesh>& meshes) const {
-  if (!valid_ || position_at_build_.size() != p.size() || plane_at_build_.size() != planes.size())
-    return true;
-  const double limit2 = 0.25 * skin_ * skin_;
-  for (std::size_t k = 0; k < planes.size(); ++k)
-    if ((planes[k].point - plane_at_build_[k]).squaredNorm() > limit2) return true;
+  if (!valid_ || position_at_build_.size() != p.size()) return true;
   const long n = static_cast<long>(p.size());
   double max2 = 0.0;
 #pragma omp parallel for reduction(max : max2) schedule(static) if (n >= 1024)
-  for (long i = 0; i < n; ++i) max2 = std::max(max2, (p.position[i] - position_at_build_[i]).squaredNorm());
-  if (max2 > limit2) return true;
+  for (long i = 0; i < n; ++i)
+    max2 = std::max(max2, (p.position[i] - position_at_build_[i]).squaredNorm());
+  return needs_rebuild(max2, planes, meshes);
+}
+
+bool NeighborList::needs_rebuild(double max_moved2, const std::vector<PlaneWall>& planes,
+                                 const std::vector<TriangleMesh>& meshes) const {
+  if (!valid_ || plane_at_build_.size() != planes.size()) return true;
+  const double limit2 = 0.25 * skin_ * skin_;
+  if (max_moved2 > limit2) return true;
+  for (std::size_t k = 0; k < planes.size(); ++k)
+    if ((planes[k].point - plane_at_build_[k]).squaredNorm() > limit2) return true;
   for (const TriangleMesh& m : meshes)
     for (int v = 0; v < m.vertex_count(); ++v)
       if ((m.position_[v] - m.position_at_build_[v]).squaredNorm() > limit2) return true;

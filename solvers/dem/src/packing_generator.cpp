@@ -53,7 +53,8 @@ Packing PackingGenerator::generate(const PackingSpec& spec) {
   for (std::size_t k = 0; k < nk; ++k) {
     const double d = spec.diameters[k];
     vol[k] = std::numbers::pi / 6.0 * d * d * d;
-    p[k] = spec.basis == PackingSpec::Basis::number ? spec.fractions[k] : spec.fractions[k] / vol[k];
+    p[k] =
+        spec.basis == PackingSpec::Basis::number ? spec.fractions[k] : spec.fractions[k] / vol[k];
     psum += p[k];
   }
   if (!(psum > 0.0)) throw Error("packing: all fractions are zero");
@@ -96,7 +97,8 @@ Packing PackingGenerator::generate(const PackingSpec& spec) {
   for (; sweep < spec.max_sweeps; ++sweep) {
     std::fill(start.begin(), start.end(), 0);
     for (int i = 0; i < n; ++i) {
-      cell_of[i] = (coord(x[i].z(), 2) * dims[1] + coord(x[i].y(), 1)) * dims[0] + coord(x[i].x(), 0);
+      cell_of[i] =
+          (coord(x[i].z(), 2) * dims[1] + coord(x[i].y(), 1)) * dims[0] + coord(x[i].x(), 0);
       ++start[cell_of[i] + 1];
     }
     for (int c = 0; c < ncell; ++c) start[c + 1] += start[c];

@@ -28,7 +28,9 @@ std::int64_t feature_key(int mesh, int type, int index) {
 
 }  // namespace
 
-System::System() { neighbors_.clear(); }
+System::System() {
+  neighbors_.clear();
+}
 
 // ---- set-up ---------------------------------------------------------------------------------
 
@@ -207,8 +209,8 @@ void System::set_vertex_positions(int mesh, const Eigen::Ref<const Eigen::Matrix
   TriangleMesh& m = meshes_[mesh];
   if (x.rows() != m.vertex_count()) {
     std::ostringstream msg;
-    msg << "set_vertex_positions: mesh " << mesh << " has " << m.vertex_count()
-        << " vertices, got " << x.rows() << " rows";
+    msg << "set_vertex_positions: mesh " << mesh << " has " << m.vertex_count() << " vertices, got "
+        << x.rows() << " rows";
     throw Error(msg.str());
   }
   if (!x.allFinite()) throw Error("set_vertex_positions: non-finite coordinate");
@@ -276,7 +278,8 @@ void System::resize_histories() {
   if (old_n != n || old_np != np) {
     std::vector<Eigen::Vector3d> s(n * np, Eigen::Vector3d::Zero());
     for (std::size_t i = 0; i < std::min(n, old_n); ++i)
-      for (std::size_t k = 0; k < std::min(np, old_np); ++k) s[i * np + k] = plane_shear_[i * old_np + k];
+      for (std::size_t k = 0; k < std::min(np, old_np); ++k)
+        s[i * np + k] = plane_shear_[i * old_np + k];
     plane_shear_.swap(s);
   }
   mesh_slot_count_.resize(n, 0);
@@ -320,7 +323,7 @@ void System::step(double dt) {
     throw Error(msg.str());
   }
   if (!forces_valid_) {
-    compute_forces(dt, false);
+    compute_forces(dt, false, 0.0);
     forces_valid_ = true;
   }
   for (TriangleMesh& m : meshes_) {
@@ -331,22 +334,22 @@ void System::step(double dt) {
   Particles& p = particles_;
   const long n = static_cast<long>(p.size());
   const double half = 0.5 * dt;
+  const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
+  const bool have_build = x_build.size() == p.size();
+  double moved2 = 0.0;  // largest squared displacement since the last neighbour build
   // Velocity Verlet, first half: v += dt/2 F/m, x += dt v, omega += dt/2 T/I.
-#pragma omp parallel for schedule(static) if (n >= 1024)
+#pragma omp parallel for schedule(static) reduction(max : moved2) if (n >= 1024)
   for (long i = 0; i < n; ++i) {
     p.velocity[i] += (half / p.mass[i]) * p.force[i];
     p.position[i] += dt * p.velocity[i];
     p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
+    if (have_build) moved2 = std::max(moved2, (p.position[i] - x_build[i]).squaredNorm());
   }
   for (PlaneWall& w : planes_) w.point += dt * w.velocity;
-  if (neighbors_.needs_rebuild(p, planes_, meshes_)) neighbors_.build(p, planes_, meshes_);
-  compute_forces(dt, true);
-  // Second half: v += dt/2 F/m, omega += dt/2 T/I.
-#pragma omp parallel for schedule(static) if (n >= 1024)
-  for (long i = 0; i < n; ++i) {
-    p.velocity[i] += (half / p.mass[i]) * p.force[i];
-    p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
-  }
+  if (!have_build || neighbors_.needs_rebuild(moved2, planes_, meshes_))
+    neighbors_.build(p, planes_, meshes_);
+  // forces at t + dt, then the second half: v += dt/2 F/m, omega += dt/2 T/I (in the gather)
+  compute_forces(dt, true, half);
   for (TriangleMesh& m : meshes_) m.position_last_step_ = m.position_;
   time_ += dt;
   ++steps_;
@@ -358,9 +361,15 @@ void System::run(long steps, double dt) {
 
 // ---- forces -----------------------------------------------------------------------------------
 
-void System::compute_forces(double dt, bool update_history) {
-  compute_pair_forces(dt, update_history);
-  gather_forces(dt, update_history);
+void System::compute_forces(double dt, bool update_history, double kick) {
+  const int n = static_cast<int>(particles_.size());
+  // One parallel region: the pair loop, a barrier, the per-particle gather (+ half kick).
+#pragma omp parallel if (n >= 1024)
+  {
+    compute_pair_forces(dt, update_history);
+    gather_forces(dt, update_history, kick);
+  }
+  reduce_wall_and_mesh_forces();
 }
 
 void System::compute_pair_forces(double dt, bool update_history) {
@@ -372,7 +381,7 @@ void System::compute_pair_forces(double dt, bool update_history) {
   // T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
   // i starts its sum here, F_i = m_i g + sum over its pairs in order; j's share (-F, T_j) goes to
   // the pair's buffer for gather_forces().
-#pragma omp parallel for schedule(dynamic, 128) if (n >= 1024)
+#pragma omp for schedule(dynamic, 128)
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d xi = p.position[i];
     const Eigen::Vector3d vi = p.velocity[i];
@@ -398,7 +407,8 @@ void System::compute_pair_forces(double dt, bool update_history) {
       nl.touching_[s] = 1;
       PairForce& pf = nl.pair_force_[s];
       const double r = std::sqrt(r2);
-      const Eigen::Vector3d nrm = r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d nrm =
+          r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
       const double delta = rsum - r;
       const double mj = p.mass[j];
       const PairParameters& pp = model_.pair(mat_i, p.material[j]);
@@ -431,7 +441,7 @@ void System::compute_pair_forces(double dt, bool update_history) {
   }
 }
 
-void System::gather_forces(double dt, bool update_history) {
+void System::gather_forces(double dt, bool update_history, double kick) {
   Particles& p = particles_;
   const NeighborList& nl = neighbors_;
   const int n = static_cast<int>(p.size());
@@ -441,7 +451,7 @@ void System::gather_forces(double dt, bool update_history) {
   // Per particle, continuing the sum of compute_pair_forces() in a fixed order:
   // F_i += sum over pairs (j, i) of their share + planes + meshes.
   // Plane forces are summed per block of particles, then over blocks (fixed order).
-#pragma omp parallel for schedule(static) if (n >= 1024)
+#pragma omp for schedule(static)
   for (int b = 0; b < blocks; ++b) {
     Eigen::Vector3d* block_wall = wall_block_force_.data() + static_cast<std::size_t>(b) * np;
     for (int k = 0; k < np; ++k) block_wall[k].setZero();
@@ -468,8 +478,9 @@ void System::gather_forces(double dt, bool update_history) {
         const PairParameters& pp = model_.pair(p.material[i], w.material);
         const double cr = ri - 0.5 * delta;
         Eigen::Vector3d fw, ft;
-        const double fn = hertz_mindlin(pp, delta, ri, p.mass[i], w.normal, p.velocity[i] - w.velocity,
-                                        cr * p.angular_velocity[i], shear, dt, update_history, fw, ft);
+        const double fn =
+            hertz_mindlin(pp, delta, ri, p.mass[i], w.normal, p.velocity[i] - w.velocity,
+                          cr * p.angular_velocity[i], shear, dt, update_history, fw, ft);
         f += fw;
         t -= cr * w.normal.cross(ft);
         if (pp.rolling_friction > 0.0) {
@@ -487,8 +498,19 @@ void System::gather_forces(double dt, bool update_history) {
       if (have_meshes) mesh_contacts(i, dt, update_history, f, t);
       p.force[i] = f;
       p.torque[i] = t;
+      if (kick > 0.0) {
+        p.velocity[i] += (kick / p.mass[i]) * f;
+        p.angular_velocity[i] += (kick / p.inertia[i]) * t;
+      }
     }
   }
+}
+
+void System::reduce_wall_and_mesh_forces() {
+  const int n = static_cast<int>(particles_.size());
+  const int np = static_cast<int>(planes_.size());
+  const int blocks = (n + block_size - 1) / block_size;
+  const bool have_meshes = !meshes_.empty();
   // Wall totals (fixed order: blocks, then planes).
   for (Eigen::Vector3d& w : wall_force_) w.setZero();
   for (int b = 0; b < blocks; ++b)
@@ -503,11 +525,13 @@ void System::gather_forces(double dt, bool update_history) {
   }
   for (int i = 0; i < n; ++i) {
     for (int c = 0; c < mesh_slot_count_[i]; ++c) {
-      const MeshContactRecord& rec = mesh_records_[static_cast<std::size_t>(i) * max_mesh_contacts + c];
+      const MeshContactRecord& rec =
+          mesh_records_[static_cast<std::size_t>(i) * max_mesh_contacts + c];
       TriangleMesh& m = meshes_[rec.mesh];
       m.triangle_force_.row(rec.triangle) -= rec.force.transpose();
       const auto& tri = m.triangle(rec.triangle);
-      for (int k = 0; k < 3; ++k) m.vertex_force_.row(tri[k]) -= rec.barycentric[k] * rec.force.transpose();
+      for (int k = 0; k < 3; ++k)
+        m.vertex_force_.row(tri[k]) -= rec.barycentric[k] * rec.force.transpose();
     }
   }
 }
@@ -543,9 +567,10 @@ void System::mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3
     c.mesh = mc.mesh;
     c.triangle = mc.triangle;
     c.type = c.cp.feature;
-    c.feature = c.type == TriangleClosestPoint::face   ? mc.triangle
-                : c.type == TriangleClosestPoint::edge ? m.triangle_edges(mc.triangle)[c.cp.local_index]
-                                                       : m.triangle(mc.triangle)[c.cp.local_index];
+    c.feature = c.type == TriangleClosestPoint::face ? mc.triangle
+                : c.type == TriangleClosestPoint::edge
+                    ? m.triangle_edges(mc.triangle)[c.cp.local_index]
+                    : m.triangle(mc.triangle)[c.cp.local_index];
     const double dist = std::sqrt(c.dist2);
     if (dist > 1e-12 * r) {
       c.normal = (x - c.cp.point) / dist;

@@ -58,7 +58,8 @@ void write_atomically(const std::string& path, Body&& body) {
   }
   std::error_code ec;
   std::filesystem::rename(tmp, target, ec);
-  if (ec) throw Error("VTK output: cannot rename " + tmp.string() + " to " + path + ": " + ec.message());
+  if (ec)
+    throw Error("VTK output: cannot rename " + tmp.string() + " to " + path + ": " + ec.message());
 }
 
 }  // namespace

@@ -18,7 +18,9 @@ inline System single_material(double youngs, double poisson, double density, dou
   return sys;
 }
 
-inline double sphere_mass(double r, double rho) { return rho * 4.0 / 3.0 * std::numbers::pi * r * r * r; }
+inline double sphere_mass(double r, double rho) {
+  return rho * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+}
 
 /// Hertz impact theory (REFERENCES.md): maximum overlap, force and contact time.
 struct HertzImpact {

@@ -58,7 +58,8 @@ TEST_CASE("dem: sphere-sphere normal impact matches Hertz theory", "[dem][physic
   double delta_max = 0.0, force_max = 0.0, prev = 0.0, t_c = 0.0;
   for (int s = 0; s < 1'000'000; ++s) {
     sys.step(dt);
-    const double delta = 2.0 * R - (sys.particles().position[1] - sys.particles().position[0]).norm();
+    const double delta =
+        2.0 * R - (sys.particles().position[1] - sys.particles().position[0]).norm();
     delta_max = std::max(delta_max, delta);
     force_max = std::max(force_max, sys.particles().force[0].norm());
     if (delta < 0.0) {
@@ -70,7 +71,8 @@ TEST_CASE("dem: sphere-sphere normal impact matches Hertz theory", "[dem][physic
   const double m = test::sphere_mass(R, RHO);
   const HertzImpact th(0.5 * m, 0.5 * R, E_STAR_SAME, v);
   INFO("delta_max " << delta_max << " theory " << th.delta_max << "; F_max " << force_max
-                    << " theory " << th.force_max << "; t_c " << t_c << " theory " << th.contact_time);
+                    << " theory " << th.force_max << "; t_c " << t_c << " theory "
+                    << th.contact_time);
   CHECK(delta_max == Approx(th.delta_max).epsilon(0.02));
   CHECK(force_max == Approx(th.force_max).epsilon(0.02));
   CHECK(t_c == Approx(th.contact_time).epsilon(0.02));
@@ -108,8 +110,7 @@ TEST_CASE("dem: calibrated damping realises the requested restitution at any spe
   }
 }
 
-TEST_CASE("dem: LIGGGHTS damping realises the restitution of its damping ratio",
-          "[dem][physics]") {
+TEST_CASE("dem: LIGGGHTS damping realises the restitution of its damping ratio", "[dem][physics]") {
   // The simulation must agree with the scaled-oscillator prediction for its zeta (no tension
   // clamp). Measured: without the clamp the LIGGGHTS zeta(e) realises e to ~1e-5 in the scaled
   // equation; with the clamp (no attraction) it does not, hence the calibrated default.

@@ -1,7 +1,7 @@
 // The box filler: porosity, overlap bound, determinism, errors.
 
-#include "partita/dem/error.hpp"
 #include "partita/dem/packing_generator.hpp"
+#include "partita/dem/error.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -25,7 +25,8 @@ double max_overlap(const Packing& p) {
   double worst = 0.0;
   for (Eigen::Index i = 0; i < p.radii.size(); ++i)
     for (Eigen::Index j = i + 1; j < p.radii.size(); ++j)
-      worst = std::max(worst, p.radii[i] + p.radii[j] - (p.positions.row(i) - p.positions.row(j)).norm());
+      worst = std::max(worst,
+                       p.radii[i] + p.radii[j] - (p.positions.row(i) - p.positions.row(j)).norm());
   return worst;
 }
 
@@ -35,7 +36,8 @@ TEST_CASE("dem: packing generator reaches the porosity with bounded overlaps", "
   const PackingSpec spec = seed_spec(0.03);
   const auto t0 = std::chrono::steady_clock::now();
   const Packing p = PackingGenerator::generate(spec);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double r_min = 1.25e-3;
   INFO(p.radii.size() << " spheres, porosity " << p.porosity << ", max overlap "
                       << max_overlap(p) / r_min << " R_min, " << p.sweeps << " sweeps, " << seconds

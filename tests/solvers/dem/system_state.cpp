@@ -170,7 +170,8 @@ TEST_CASE("dem: VTK output is complete and written atomically", "[dem][io]") {
   std::stringstream text;
   text << in.rdbuf();
   const std::string s = text.str();
-  CHECK(s.find("NumberOfPoints=\"" + std::to_string(sys.particle_count()) + "\"") != std::string::npos);
+  CHECK(s.find("NumberOfPoints=\"" + std::to_string(sys.particle_count()) + "\"") !=
+        std::string::npos);
   for (const char* name : {"radius", "velocity", "angular_velocity", "force", "\"id\""})
     CHECK(s.find(name) != std::string::npos);
   CHECK(s.find("</VTKFile>") != std::string::npos);

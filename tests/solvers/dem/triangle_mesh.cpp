@@ -68,7 +68,8 @@ TEST_CASE("dem: bounce on a triangulated plane equals bounce on a plane", "[dem]
   // the midpoint of a shared edge, (0.6 mm, 0.3 mm) inside a face, (1 mm, 1 mm) on a diagonal.
   const Bounce ref = bounce(false, 0.0, 0.0);
   REQUIRE(ref.v.z() > 0.0);
-  const double points[][2] = {{0.0, 0.0}, {1e-3, 0.0}, {0.6e-3, 0.3e-3}, {1e-3, 1e-3}, {2e-3, 2e-3}};
+  const double points[][2] = {
+      {0.0, 0.0}, {1e-3, 0.0}, {0.6e-3, 0.3e-3}, {1e-3, 1e-3}, {2e-3, 2e-3}};
   for (const auto& pt : points) {
     const Bounce b = bounce(true, pt[0], pt[1]);
     INFO("impact at (" << pt[0] << ", " << pt[1] << "): v_z " << b.v.z() << " plane " << ref.v.z()
@@ -80,8 +81,7 @@ TEST_CASE("dem: bounce on a triangulated plane equals bounce on a plane", "[dem]
   }
 }
 
-TEST_CASE("dem: mesh forces are distributed to vertices and balance the particle",
-          "[dem][mesh]") {
+TEST_CASE("dem: mesh forces are distributed to vertices and balance the particle", "[dem][mesh]") {
   System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
   sys.set_gravity({0, 0, -9.81});
   Eigen::MatrixX3d v(3, 3);
@@ -102,8 +102,7 @@ TEST_CASE("dem: mesh forces are distributed to vertices and balance the particle
   CHECK(fv(0, 2) == Approx(-0.25 * weight).epsilon(1e-3));
 }
 
-TEST_CASE("dem: a mesh moved by the caller pushes a particle like a moving plane",
-          "[dem][mesh]") {
+TEST_CASE("dem: a mesh moved by the caller pushes a particle like a moving plane", "[dem][mesh]") {
   // A resting sphere hit by a wall moving up at 0.2 m/s: the relative velocity enters the
   // contact, so the sphere leaves at (1 + e) 0.2 m/s whether the wall is a plane or a mesh whose
   // vertices the caller displaces every step (velocities from the motion).

@@ -33,11 +33,11 @@ struct PairParameters {
   double st_over_sn_sqrt = 0.0;   ///< sqrt(S_t/S_n) = sqrt(4 G*/E*)
   double friction = 0.0;          ///< mu
   double rolling_friction = 0.0;  ///< mu_r
-  bool no_tension = true;  ///< clamp F_n >= 0
+  bool no_tension = true;         ///< clamp F_n >= 0
   /// Cap spring + damping tangential force at mu F_n (calibrated model); false: LIGGGHTS, which
   /// caps the spring only and adds the damping force while sticking.
   bool cap_total_tangential = true;
-  bool defined = false;           ///< an interaction was given for this pair
+  bool defined = false;  ///< an interaction was given for this pair
 };
 
 /// Materials, interactions and the damping model; turns them into a PairParameters table.
@@ -78,11 +78,11 @@ class ContactModel {
 ///   w_arm  cr_i omega_i + cr_j omega_j with cr = R - delta/2 (wall: cr_i omega_i)
 ///   shear  tangential displacement history, updated in place when update_history
 /// Returns the normal force magnitude F_n; writes the total force on i and its tangential part.
-PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, double r_eff, double m_eff,
-                            const Eigen::Vector3d& n, const Eigen::Vector3d& v_rel,
-                            const Eigen::Vector3d& w_arm, Eigen::Vector3d& shear, double dt,
-                            bool update_history, Eigen::Vector3d& force,
-                            Eigen::Vector3d& f_tangential) {
+PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, double r_eff,
+                                        double m_eff, const Eigen::Vector3d& n,
+                                        const Eigen::Vector3d& v_rel, const Eigen::Vector3d& w_arm,
+                                        Eigen::Vector3d& shear, double dt, bool update_history,
+                                        Eigen::Vector3d& force, Eigen::Vector3d& f_tangential) {
   // Normal: F_n = 4/3 E* sqrt(R*) delta^(3/2) - gamma_n v_n, S_n = 2 E* sqrt(R* delta),
   // gamma_n = 2 zeta sqrt(S_n m*) (v_n < 0 while approaching).
   const double a = std::sqrt(r_eff * delta);  // contact radius
@@ -146,8 +146,7 @@ PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, d
 inline double hertz_elastic_energy(const PairParameters& p, double delta, double r_eff,
                                    const Eigen::Vector3d& shear) {
   const double a = std::sqrt(r_eff * delta);
-  return 8.0 / 15.0 * p.e_star * a * delta * delta +
-         0.5 * 8.0 * p.g_star * a * shear.squaredNorm();
+  return 8.0 / 15.0 * p.e_star * a * delta * delta + 0.5 * 8.0 * p.g_star * a * shear.squaredNorm();
 }
 
 }  // namespace partita::dem

@@ -46,6 +46,10 @@ class NeighborList {
   /// True when a particle or mesh vertex moved more than skin/2 since the last build.
   bool needs_rebuild(const Particles& particles, const std::vector<PlaneWall>& planes,
                      const std::vector<TriangleMesh>& meshes) const;
+  /// Same, given the largest squared particle displacement since the build (computed by the
+  /// caller's integration loop).
+  bool needs_rebuild(double max_moved2, const std::vector<PlaneWall>& planes,
+                     const std::vector<TriangleMesh>& meshes) const;
   /// Rebuilds cells and lists, carrying the tangential histories of surviving pairs over.
   void build(const Particles& particles, const std::vector<PlaneWall>& planes,
              std::vector<TriangleMesh>& meshes);
@@ -70,8 +74,7 @@ class NeighborList {
 
   template <class Visit>
   void visit_pairs(const Particles& p, int i, Visit&& visit) const;
-  void build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes,
-                             double r_max);
+  void build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes, double r_max);
 
   double skin_ = 0.0;
   long builds_ = 0;

@@ -140,9 +140,12 @@ class System {
   void check_interactions() const;
   void check_mesh(int mesh, const char* what) const;
   void resize_histories();
-  void compute_forces(double dt, bool update_history);
+  // forces at the current positions; kick > 0: then v += kick F/m, omega += kick T/I
+  void compute_forces(double dt, bool update_history, double kick);
+  // called inside a parallel region (orphaned omp for)
   void compute_pair_forces(double dt, bool update_history);
-  void gather_forces(double dt, bool update_history);
+  void gather_forces(double dt, bool update_history, double kick);
+  void reduce_wall_and_mesh_forces();
   void mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3d& force,
                      Eigen::Vector3d& torque);
 
@@ -166,7 +169,7 @@ class System {
   std::vector<Eigen::Vector3d> mesh_slot_shear_;
   std::vector<int> mesh_slot_count_;
   // per-contact results of the last force evaluation (for deterministic wall/mesh reductions)
-  std::vector<MeshContactRecord> mesh_records_;  // N x max_mesh_contacts
+  std::vector<MeshContactRecord> mesh_records_;    // N x max_mesh_contacts
   std::vector<Eigen::Vector3d> wall_block_force_;  // blocks x planes
   std::vector<Eigen::Vector3d> wall_force_;        // per wall
   long dropped_mesh_contacts_ = 0;

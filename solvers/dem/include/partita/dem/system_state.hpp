@@ -22,7 +22,7 @@ struct MeshContactRecord {
   int triangle = 0;
   std::array<double, 3> barycentric{};
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< on the particle [N]
-  double delta = 0.0;                                ///< overlap [m]
+  double delta = 0.0;                               ///< overlap [m]
   double r_eff = 0.0;
   int material = 0;
 };
