@@ -139,3 +139,23 @@ TEST_CASE("dem: oblique impact in gross sliding", "[dem][physics]") {
   CHECK(std::abs(r.w_after.y()) == Approx(w_expected).epsilon(0.02));
   CHECK(r.w_after.y() > 0.0);  // rolls forward in +x: spin about +y
 }
+
+TEST_CASE("dem: rolling resistance decelerates a rolling sphere at 5/7 mu_r g", "[dem][physics]") {
+  // Constant rolling torque mu_r F_n R on a sphere rolling without slip on a plane:
+  // (m + I/R^2) dv/dt = -mu_r m g  =>  dv/dt = -5/7 mu_r g.
+  const double mu_r = 0.05, g = 9.81, v0 = 0.2;
+  System sys;
+  const int m = sys.add_material({E, NU, RHO});
+  sys.add_interaction(m, m, {0.5, 0.5, mu_r});
+  sys.set_gravity({0, 0, -g});
+  const double delta0 =
+      std::pow(3.0 * test::sphere_mass(R, RHO) * g / (4.0 * E_STAR_SAME * std::sqrt(R)), 2.0 / 3.0);
+  sys.add_particle({0, 0, R - delta0}, R, m, {v0, 0, 0}, {0, v0 / R, 0});
+  sys.add_plane({0, 0, 0}, {0, 0, 1}, m);
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  const double t_end = 0.5 * v0 / (5.0 / 7.0 * mu_r * g);  // half way to rest
+  sys.run(static_cast<long>(t_end / dt), dt);
+  const double expected = v0 - 5.0 / 7.0 * mu_r * g * sys.time();
+  INFO("v " << sys.particles().velocity[0].x() << " expected " << expected);
+  CHECK(sys.particles().velocity[0].x() == Approx(expected).epsilon(0.02));
+}
