@@ -42,7 +42,8 @@ Mesh plate_mesh(const std::string& name, int n, unsigned seed, bool triangles) {
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
       const double dx = u(rng), dy = u(rng);
-      p.row(j * (n + 1) + i) << i * h + (i > 0 && i < n ? dx * h : 0.0), j * h + (j > 0 && j < n ? dy * h : 0.0), 0.0;
+      p.row(j * (n + 1) + i) << i * h + (i > 0 && i < n ? dx * h : 0.0),
+          j * h + (j > 0 && j < n ? dy * h : 0.0), 0.0;
     }
   Mesh::Triangles t(triangles ? 2 * n * n : 0, 3);
   if (triangles)
@@ -105,7 +106,8 @@ int main(int argc, char** argv) {
     } else if (a == "--repeat" && i + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else {
-      std::fprintf(stderr, "usage: bench_mapping [--quick] [--max-n N] [--rbf-max-n N] [--repeat R]\n");
+      std::fprintf(stderr,
+                   "usage: bench_mapping [--quick] [--max-n N] [--rbf-max-n N] [--repeat R]\n");
       return a == "--help" || a == "-h" ? 0 : 2;
     }
   }
@@ -114,35 +116,49 @@ int main(int argc, char** argv) {
   Registry<MapperFactory> registry("mapper");
   register_mappers(registry);
   // Support radius of the compact RBF: 3 source spacings (about 28 neighbours), scaled per size.
-  const std::vector<Case> cases = {
+  std::vector<Case> cases = {
       {"nearest-neighbor", "nearest-neighbor", true, Constraint::consistent, false},
       {"nearest-projection", "nearest-projection", true, Constraint::consistent, false},
-      {"nearest-projection (conservative)", "nearest-projection", true, Constraint::conservative, false},
-      {"nearest-projection (point cloud)", "nearest-projection", false, Constraint::consistent, false},
-      {"rbf wendland-c2 separate", "{type: rbf, support_radius: @}", true, Constraint::consistent, true},
-      {"rbf wendland-c2 on", "{type: rbf, support_radius: @, polynomial: on}", true, Constraint::consistent, true},
+      {"nearest-projection (conservative)", "nearest-projection", true, Constraint::conservative,
+       false},
+      {"nearest-projection (point cloud)", "nearest-projection", false, Constraint::consistent,
+       false},
+      {"rbf wendland-c2 separate", "{type: rbf, support_radius: @}", true, Constraint::consistent,
+       true},
+      {"rbf wendland-c2 on", "{type: rbf, support_radius: @, polynomial: on}", true,
+       Constraint::consistent, true},
   };
+  cases.push_back({"rbf wendland-c2 separate cg", "{type: rbf, support_radius: @, solver: cg}",
+                   true, Constraint::consistent, true});
   const std::vector<double> sizes = {1e3, 3e3, 1e4, 3e4, 1e5, 3e5, 1e6};
 
-  std::printf("# partita mapping benchmark: plate %.0f mm, source/target non-matching perturbed triangulations\n",
-              plate * 1e3);
-  std::printf("# times: compute once; map = mean of %d maps of a 3-component field. 'x sort' = time / std::sort(n doubles)\n",
-              repeat);
-  std::printf("%-36s %9s %9s %10s %12s %9s %10s %12s %9s\n", "mapper", "n_source", "n_target", "compute[s]",
-              "compute/pt", "x sort", "map[s]", "map/pt", "x sort");
+  std::printf(
+      "# partita mapping benchmark: plate %.0f mm, source/target non-matching perturbed "
+      "triangulations\n",
+      plate * 1e3);
+  std::printf(
+      "# times: compute once; map = mean of %d maps of a 3-component field. 'x sort' = time / "
+      "std::sort(n doubles)\n",
+      repeat);
+  std::printf("%-36s %9s %9s %10s %12s %9s %10s %12s %9s\n", "mapper", "n_source", "n_target",
+              "compute[s]", "compute/pt", "x sort", "map[s]", "map/pt", "x sort");
   for (const Case& c : cases) {
     std::vector<double> ns, tc, tm;
     for (double size : sizes) {
       if (size > (c.rbf ? rbf_max_n : max_n) * 1.0001) break;
       const int n_src = static_cast<int>(std::lround(std::sqrt(size))) - 1;
-      const int n_tgt = static_cast<int>(std::lround(std::sqrt(1.1 * size))) - 1;  // ~10 % more points
+      const int n_tgt =
+          static_cast<int>(std::lround(std::sqrt(1.1 * size))) - 1;  // ~10 % more points
       const Mesh source_tri = plate_mesh("source", n_src, 1, true);
-      const Mesh source = c.source_triangles ? source_tri : Mesh("source_centres", source_tri.triangle_centroids());
+      const Mesh source =
+          c.source_triangles ? source_tri : Mesh("source_centres", source_tri.triangle_centroids());
       const Mesh target = plate_mesh("target", n_tgt, 2, true);
       std::string yaml = c.yaml;
-      if (const auto at = yaml.find('@'); at != std::string::npos) yaml.replace(at, 1, std::to_string(3.0 * plate / n_src));
+      if (const auto at = yaml.find('@'); at != std::string::npos)
+        yaml.replace(at, 1, std::to_string(3.0 * plate / n_src));
       try {
-        const config::Node node = config::Node::load_string("mapper: " + yaml + "\n", "bench")["mapper"];
+        const config::Node node =
+            config::Node::load_string("mapper: " + yaml + "\n", "bench")["mapper"];
         auto mapper = create_mapper(registry, MapperContext{node, c.constraint});
         auto t0 = std::chrono::steady_clock::now();
         mapper->compute(source, target);
@@ -155,25 +171,28 @@ int main(int argc, char** argv) {
         const double map = seconds_since(t0) / repeat;
         const double n = static_cast<double>(std::max(source.size(), target.size()));
         const double ref = sort_time(static_cast<Eigen::Index>(n));
-        std::printf("%-36s %9ld %9ld %10.4f %9.3f us %9.1f %10.5f %9.1f ns %9.2f\n", c.label.c_str(),
-                    static_cast<long>(source.size()), static_cast<long>(target.size()), compute, compute / n * 1e6,
-                    compute / ref, map, map / n * 1e9, map / ref);
+        std::printf("%-36s %9ld %9ld %10.4f %9.3f us %9.1f %10.5f %9.1f ns %9.2f\n",
+                    c.label.c_str(), static_cast<long>(source.size()),
+                    static_cast<long>(target.size()), compute, compute / n * 1e6, compute / ref,
+                    map, map / n * 1e9, map / ref);
         std::fflush(stdout);
         ns.push_back(n);
         tc.push_back(compute);
         tm.push_back(map);
       } catch (const partita::Error& e) {
-        std::printf("%-36s %9ld: %s\n", c.label.c_str(), static_cast<long>(source.size()), e.what());
+        std::printf("%-36s %9ld: %s\n", c.label.c_str(), static_cast<long>(source.size()),
+                    e.what());
       }
     }
     if (ns.size() >= 2)
-      std::printf("%-36s growth exponent (log-log slope): compute %.2f, map %.2f  (n log n over this range: %.2f)\n\n",
-                  c.label.c_str(), slope(ns, tc), slope(ns, tm),
-                  [&] {
-                    std::vector<double> nl;
-                    for (double n : ns) nl.push_back(n * std::log(n));
-                    return slope(ns, nl);
-                  }());
+      std::printf(
+          "%-36s growth exponent (log-log slope): compute %.2f, map %.2f  (n log n over this "
+          "range: %.2f)\n\n",
+          c.label.c_str(), slope(ns, tc), slope(ns, tm), [&] {
+            std::vector<double> nl;
+            for (double n : ns) nl.push_back(n * std::log(n));
+            return slope(ns, nl);
+          }());
   }
   return 0;
 }

@@ -10,7 +10,8 @@ namespace partita::coupling {
 /// Barycentric coordinates (l0, l1, l2) of the point of triangle (a, b, c) closest to p:
 /// closest = l0 a + l1 b + l2 c, l_k >= 0, l0 + l1 + l2 = 1. The triangle must have area > 0.
 inline Eigen::Vector3d closest_point_barycentric(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                                 const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+                                                 const Eigen::Vector3d& b,
+                                                 const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0.0 && d2 <= 0.0) return {1.0, 0.0, 0.0};  // vertex a

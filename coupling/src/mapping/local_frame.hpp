@@ -14,7 +14,9 @@ struct LocalFrame {
   double scale = 1.0;                              ///< largest standard deviation [m]
   int dims() const { return static_cast<int>(axes.cols()); }
   /// Scaled coordinates (xi_1 .. xi_d) of x in the frame.
-  Eigen::VectorXd coordinates(const Eigen::Vector3d& x) const { return axes.transpose() * (x - origin); }
+  Eigen::VectorXd coordinates(const Eigen::Vector3d& x) const {
+    return axes.transpose() * (x - origin);
+  }
 };
 
 /// The frame of the points x_i (rows of `points` selected by `index`, or all when empty).

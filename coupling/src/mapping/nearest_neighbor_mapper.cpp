@@ -8,7 +8,8 @@ namespace partita::coupling {
 
 std::shared_ptr<const config::Spec> NearestNeighborMapper::spec() {
   auto s = std::make_shared<config::Spec>(
-      "nearest-neighbor", "Value of the nearest source point (k-d tree); first order, any point sets");
+      "nearest-neighbor",
+      "Value of the nearest source point (k-d tree); first order, any point sets");
   s->string("type", "the mapper's name, when the mapper is given as a map");
   return s;
 }
@@ -18,7 +19,8 @@ std::unique_ptr<Mapper> NearestNeighborMapper::create(const MapperContext& conte
   return std::make_unique<NearestNeighborMapper>(context.constraint);
 }
 
-SparseMapper::Matrix NearestNeighborMapper::interpolation(const Mesh& source, const Mesh& target) const {
+SparseMapper::Matrix NearestNeighborMapper::interpolation(const Mesh& source,
+                                                          const Mesh& target) const {
   return weights(source, target);
 }
 

@@ -24,20 +24,24 @@ std::shared_ptr<const config::Spec> NearestProjectionMapper::spec() {
   s->choice("point_cloud", "what to do when the mesh to project onto has no triangles",
             {"linear-fit", "nearest", "error"})
       .def("linear-fit");
-  s->integer("neighbors", "number of nearest points of a linear fit on a point cloud").min(3).def(8);
+  s->integer("neighbors", "number of nearest points of a linear fit on a point cloud")
+      .min(3)
+      .def(8);
   return s;
 }
 
 std::unique_ptr<Mapper> NearestProjectionMapper::create(const MapperContext& context) {
   const config::Node o = mapper_options(context.config, spec());
   const std::string pc = o.string("point_cloud");
-  const PointCloud mode =
-      pc == "nearest" ? PointCloud::nearest : (pc == "error" ? PointCloud::error : PointCloud::linear_fit);
+  const PointCloud mode = pc == "nearest"
+                              ? PointCloud::nearest
+                              : (pc == "error" ? PointCloud::error : PointCloud::linear_fit);
   return std::make_unique<NearestProjectionMapper>(context.constraint, mode,
                                                    static_cast<int>(o.integer("neighbors")));
 }
 
-SparseMapper::Matrix NearestProjectionMapper::interpolation(const Mesh& source, const Mesh& target) const {
+SparseMapper::Matrix NearestProjectionMapper::interpolation(const Mesh& source,
+                                                            const Mesh& target) const {
   if (source.has_triangles()) return project(source, target);
   switch (point_cloud_) {
     case PointCloud::error:
@@ -45,17 +49,20 @@ SparseMapper::Matrix NearestProjectionMapper::interpolation(const Mesh& source, 
                   "' has no triangles to project onto (a point cloud); use mapper 'rbf' or "
                   "'nearest-neighbor', or set point_cloud: linear-fit");
     case PointCloud::nearest: {
-      log::get("coupling")->debug("nearest-projection: mesh '{}' has no triangles; nearest point", source.name());
+      log::get("coupling")
+          ->debug("nearest-projection: mesh '{}' has no triangles; nearest point", source.name());
       return NearestNeighborMapper::weights(source, target);
     }
     case PointCloud::linear_fit:
       break;
   }
-  log::get("coupling")->debug("nearest-projection: mesh '{}' has no triangles; local linear fit", source.name());
+  log::get("coupling")
+      ->debug("nearest-projection: mesh '{}' has no triangles; local linear fit", source.name());
   return linear_fit(source, target);
 }
 
-SparseMapper::Matrix NearestProjectionMapper::project(const Mesh& source, const Mesh& target) const {
+SparseMapper::Matrix NearestProjectionMapper::project(const Mesh& source,
+                                                      const Mesh& target) const {
   const Mesh::Points& x = source.points();
   const Mesh::Triangles& tri = source.triangles();
   const Mesh::Points centroids = source.triangle_centroids();
@@ -65,10 +72,12 @@ SparseMapper::Matrix NearestProjectionMapper::project(const Mesh& source, const 
   std::vector<char> usable(static_cast<std::size_t>(tri.rows()), 0);
   for (Eigen::Index t = 0; t < tri.rows(); ++t) {
     const Eigen::Vector3d a = x.row(tri(t, 0)), b = x.row(tri(t, 1)), c = x.row(tri(t, 2));
-    const double h2 = std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+    const double h2 =
+        std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
     if ((b - a).cross(c - a).squaredNorm() <= 1e-24 * h2 * h2) continue;
     usable[static_cast<std::size_t>(t)] = 1;
-    for (int k = 0; k < 3; ++k) r_max = std::max(r_max, (x.row(tri(t, k)) - centroids.row(t)).norm());
+    for (int k = 0; k < 3; ++k)
+      r_max = std::max(r_max, (x.row(tri(t, k)) - centroids.row(t)).norm());
   }
   const PointTree tree(centroids);
   std::vector<Eigen::Triplet<double>> w;
@@ -97,8 +106,8 @@ SparseMapper::Matrix NearestProjectionMapper::project(const Mesh& source, const 
     }
     if (best_t < 0)
       throw Error("mapper 'nearest-projection': mesh '" + source.name() +
-                  "' has only degenerate (zero-area) triangles near point " + std::to_string(i) + " of mesh '" +
-                  target.name() + "'");
+                  "' has only degenerate (zero-area) triangles near point " + std::to_string(i) +
+                  " of mesh '" + target.name() + "'");
     // value(p) = sum_k l_k value(v_k): barycentric interpolation on the closest triangle
     for (int k = 0; k < 3; ++k)
       if (best_l(k) != 0.0) w.emplace_back(i, tri(best_t, k), best_l(k));
@@ -108,10 +117,12 @@ SparseMapper::Matrix NearestProjectionMapper::project(const Mesh& source, const 
   return m;
 }
 
-SparseMapper::Matrix NearestProjectionMapper::linear_fit(const Mesh& source, const Mesh& target) const {
+SparseMapper::Matrix NearestProjectionMapper::linear_fit(const Mesh& source,
+                                                         const Mesh& target) const {
   const Mesh::Points& x = source.points();
   const PointTree tree(x);
-  const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(neighbors_), static_cast<std::size_t>(x.rows()));
+  const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(neighbors_),
+                                              static_cast<std::size_t>(x.rows()));
   std::vector<Eigen::Triplet<double>> w;
   w.reserve(static_cast<std::size_t>(target.size()) * k);
   std::vector<std::uint32_t> index;
@@ -156,7 +167,8 @@ SparseMapper::Matrix NearestProjectionMapper::linear_fit(const Mesh& source, con
       }
     }
     for (std::size_t j = 0; j < n; ++j)
-      if (omega(static_cast<Eigen::Index>(j)) != 0.0) w.emplace_back(i, index[j], omega(static_cast<Eigen::Index>(j)));
+      if (omega(static_cast<Eigen::Index>(j)) != 0.0)
+        w.emplace_back(i, index[j], omega(static_cast<Eigen::Index>(j)));
   }
   Matrix m(target.size(), source.size());
   m.setFromTriplets(w.begin(), w.end());

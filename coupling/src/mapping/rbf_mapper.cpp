@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <Eigen/Cholesky>
+#include <Eigen/IterativeLinearSolvers>
 #include <Eigen/LU>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -21,9 +22,12 @@ namespace {
 
 const char* basis_name(RbfMapper::Basis b) {
   switch (b) {
-    case RbfMapper::Basis::wendland_c2: return "wendland-c2";
-    case RbfMapper::Basis::gaussian: return "gaussian";
-    case RbfMapper::Basis::thin_plate_spline: return "thin-plate-spline";
+    case RbfMapper::Basis::wendland_c2:
+      return "wendland-c2";
+    case RbfMapper::Basis::gaussian:
+      return "gaussian";
+    case RbfMapper::Basis::thin_plate_spline:
+      return "thin-plate-spline";
   }
   return "?";
 }
@@ -39,20 +43,29 @@ struct RbfMapper::System {
   int q = 0;           ///< polynomial terms (0: off)
   bool dense = false;
 
-  SparseRow eval;                ///< E = Phi(evaluation points, centres), compact basis
-  Eigen::MatrixXd eval_dense;    ///< E, global basis
-  Eigen::MatrixXd poly_centres;  ///< P_C, n x q
-  Eigen::MatrixXd poly_eval;     ///< P_X, n_eval x q
-  Eigen::MatrixXd pinv;          ///< (P_C^T P_C)^-1 P_C^T, q x n (separate)
-  Eigen::SimplicialLDLT<SparseCol> ldlt;         ///< Phi, compact basis
+  SparseRow eval;                         ///< E = Phi(evaluation points, centres), compact basis
+  Eigen::MatrixXd eval_dense;             ///< E, global basis
+  Eigen::MatrixXd poly_centres;           ///< P_C, n x q
+  Eigen::MatrixXd poly_eval;              ///< P_X, n_eval x q
+  Eigen::MatrixXd pinv;                   ///< (P_C^T P_C)^-1 P_C^T, q x n (separate)
+  Eigen::SimplicialLDLT<SparseCol> ldlt;  ///< Phi, compact basis (cholesky)
+  SparseCol phi;                          ///< Phi, lower triangle (cg keeps a reference)
+  Eigen::ConjugateGradient<SparseCol, Eigen::Lower, Eigen::IncompleteCholesky<double>> cg;
+  bool iterative = false;
   Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu;  ///< Phi or [Phi P; P^T 0], global basis
-  Eigen::MatrixXd phi_inv_p;                     ///< Y = Phi^-1 P_C, n x q (on, compact)
-  Eigen::LDLT<Eigen::MatrixXd> schur;            ///< S = P_C^T Phi^-1 P_C, q x q (on, compact)
+  Eigen::MatrixXd phi_inv_p;                      ///< Y = Phi^-1 P_C, n x q (on, compact)
+  Eigen::LDLT<Eigen::MatrixXd> schur;             ///< S = P_C^T Phi^-1 P_C, q x q (on, compact)
 
   /// Phi^-1 rhs (global basis with `on`: K^-1 rhs with K = [Phi P; P^T 0]); symmetric.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const {
     if (dense) return dense_lu.solve(rhs);
-    return ldlt.solve(rhs);
+    if (!iterative) return ldlt.solve(rhs);
+    Eigen::MatrixXd x = cg.solve(rhs);
+    if (cg.info() != Eigen::Success)
+      throw Error("mapper 'rbf': conjugate gradients did not reach the tolerance in " +
+                  std::to_string(cg.iterations()) + " iterations (relative residual " +
+                  std::to_string(cg.error()) + "); use solver: cholesky");
+    return x;
   }
   /// [alpha; c] = K^-1 [f; g] for K = [Phi P_C; P_C^T 0] (on). Compact basis: through the
   /// Schur complement, keeping the sparse Cholesky factor of Phi:
@@ -68,7 +81,7 @@ struct RbfMapper::System {
       c = z.bottomRows(q);
       return;
     }
-    alpha = ldlt.solve(f);
+    alpha = solve(f);
     c = schur.solve(phi_inv_p.transpose() * f - g);
     alpha.noalias() -= phi_inv_p * c;
   }
@@ -84,59 +97,89 @@ struct RbfMapper::System {
   }
 };
 
-RbfMapper::RbfMapper(Constraint constraint, Basis basis, double support_radius, Polynomial polynomial)
-    : constraint_(constraint), basis_(basis), radius_(support_radius), polynomial_(polynomial) {
+RbfMapper::RbfMapper(Constraint constraint, Basis basis, double support_radius,
+                     Polynomial polynomial, Solver solver, double tolerance)
+    : constraint_(constraint),
+      basis_(basis),
+      radius_(support_radius),
+      polynomial_(polynomial),
+      solver_(solver),
+      tolerance_(tolerance) {
   if (basis_ != Basis::thin_plate_spline && !(radius_ > 0.0 && std::isfinite(radius_)))
-    throw Error("mapper 'rbf' with basis " + std::string(basis_name(basis_)) + ": support_radius must be a positive length, found " +
-                std::to_string(radius_) + "; choose about 3 to 5 mesh spacings");
+    throw Error("mapper 'rbf' with basis " + std::string(basis_name(basis_)) +
+                ": support_radius must be a positive length, found " + std::to_string(radius_) +
+                "; choose about 3 to 5 mesh spacings");
   if (polynomial_ == Polynomial::off && constraint_ == Constraint::conservative)
-    throw Error("mapper 'rbf' with polynomial: off does not reproduce constants, so a conservative mapping would not "
-                "preserve the total; use polynomial: separate or on");
+    throw Error(
+        "mapper 'rbf' with polynomial: off does not reproduce constants, so a conservative "
+        "mapping would not preserve the total; use polynomial: separate or on");
   if (polynomial_ == Polynomial::off && basis_ == Basis::thin_plate_spline)
-    throw Error("mapper 'rbf' with basis thin-plate-spline needs the linear polynomial; use polynomial: on");
+    throw Error(
+        "mapper 'rbf' with basis thin-plate-spline needs the linear polynomial; use polynomial: "
+        "on");
 }
 
 RbfMapper::~RbfMapper() = default;
 
-int RbfMapper::polynomial_terms() const { return system_ ? system_->q : 0; }
+int RbfMapper::polynomial_terms() const {
+  return system_ ? system_->q : 0;
+}
 
 std::shared_ptr<const config::Spec> RbfMapper::spec() {
-  auto s = std::make_shared<config::Spec>(
-      "rbf", "Radial basis functions with a linear polynomial (compact Wendland C2: sparse factorisation)");
+  auto s = std::make_shared<config::Spec>("rbf",
+                                          "Radial basis functions with a linear polynomial "
+                                          "(compact Wendland C2: sparse factorisation)");
   s->string("type", "the mapper's name, when the mapper is given as a map");
-  s->choice("basis", "radial basis: compact wendland-c2, or global (dense, small meshes) gaussian, thin-plate-spline",
+  s->choice("basis",
+            "radial basis: compact wendland-c2, or global (dense, small meshes) gaussian, "
+            "thin-plate-spline",
             {"wendland-c2", "gaussian", "thin-plate-spline"})
       .def("wendland-c2");
-  s->real("support_radius", "support radius R of wendland-c2 (about 3-5 mesh spacings); length scale of gaussian")
+  s->real("support_radius",
+          "support radius R of wendland-c2 (about 3-5 mesh spacings); length scale of gaussian")
       .unit("m")
       .positive();
-  s->choice("polynomial", "linear polynomial: separate (fitted first), on (saddle-point system), off",
+  s->choice("polynomial",
+            "linear polynomial: separate (fitted first), on (saddle-point system), off",
             {"separate", "on", "off"})
       .def("separate");
+  s->choice("solver",
+            "compact system: cholesky (sparse factorisation) or cg (conjugate gradients, large "
+            "meshes)",
+            {"cholesky", "cg"})
+      .def("cholesky");
+  s->real("tolerance", "relative residual at which cg stops").positive().def(1e-10);
   return s;
 }
 
 std::unique_ptr<Mapper> RbfMapper::create(const MapperContext& context) {
   const config::Node& node = context.config;
   if (!node.is_map())
-    node.fail("mapper 'rbf' needs its support radius; write it as a map, e.g. {type: rbf, support_radius: 2.0e-3} "
-              "(a length of about 3 to 5 mesh spacings)");
+    node.fail(
+        "mapper 'rbf' needs its support radius; write it as a map, e.g. {type: rbf, "
+        "support_radius: 2.0e-3} "
+        "(a length of about 3 to 5 mesh spacings)");
   const config::Node o = mapper_options(node, spec());
   const std::string b = o.string("basis");
-  const Basis basis = b == "gaussian" ? Basis::gaussian
+  const Basis basis = b == "gaussian"            ? Basis::gaussian
                       : b == "thin-plate-spline" ? Basis::thin_plate_spline
                                                  : Basis::wendland_c2;
   const std::string p = o.string("polynomial");
-  const Polynomial poly = p == "on" ? Polynomial::on : p == "off" ? Polynomial::off : Polynomial::separate;
+  const Polynomial poly = p == "on"    ? Polynomial::on
+                          : p == "off" ? Polynomial::off
+                                       : Polynomial::separate;
   double radius = 0.0;
   if (basis != Basis::thin_plate_spline) {
     if (!o.has("support_radius"))
       node.fail("mapper 'rbf' with basis " + b +
-                " needs support_radius (a length of about 3 to 5 mesh spacings), e.g. {type: rbf, support_radius: 2.0e-3}");
+                " needs support_radius (a length of about 3 to 5 mesh spacings), e.g. {type: rbf, "
+                "support_radius: 2.0e-3}");
     radius = o.real("support_radius");
   }
   try {
-    return std::make_unique<RbfMapper>(context.constraint, basis, radius, poly);
+    const Solver solver = o.string("solver") == "cg" ? Solver::cg : Solver::cholesky;
+    return std::make_unique<RbfMapper>(context.constraint, basis, radius, poly, solver,
+                                       o.real("tolerance"));
   } catch (const Error& e) {
     node.fail(e.what());
   }
@@ -150,10 +193,11 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
                 (from.size() == 0 ? from.name() : to.name()) + "' has no points");
   const bool dense = basis_ != Basis::wendland_c2;
   if (dense && std::max(from.size(), to.size()) > max_dense_points)
-    throw Error("mapper 'rbf' with the global basis " + std::string(basis_name(basis_)) + ": meshes '" + from.name() +
-                "' (" + std::to_string(from.size()) + " points) and '" + to.name() + "' (" + std::to_string(to.size()) +
-                " points) are too large for a dense system (at most " + std::to_string(max_dense_points) +
-                "); use basis wendland-c2 with a support_radius");
+    throw Error(
+        "mapper 'rbf' with the global basis " + std::string(basis_name(basis_)) + ": meshes '" +
+        from.name() + "' (" + std::to_string(from.size()) + " points) and '" + to.name() + "' (" +
+        std::to_string(to.size()) + " points) are too large for a dense system (at most " +
+        std::to_string(max_dense_points) + "); use basis wendland-c2 with a support_radius");
 
   auto sys = std::make_unique<System>();
   sys->dense = dense;
@@ -173,7 +217,8 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
     auto basis_rows = [&](const Mesh::Points& x) {
       Eigen::MatrixXd p(x.rows(), sys->q);
       p.col(0).setOnes();
-      if (d > 0) p.rightCols(d) = ((x.rowwise() - frame.origin.transpose()) * frame.axes).leftCols(d);
+      if (d > 0)
+        p.rightCols(d) = ((x.rowwise() - frame.origin.transpose()) * frame.axes).leftCols(d);
       return p;
     };
     sys->poly_centres = basis_rows(xc);
@@ -220,23 +265,37 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
     }
     const double neighbours = static_cast<double>(k.size()) / static_cast<double>(n) * 2.0 - 1.0;
     if (neighbours < 2.0)
-      log::get("coupling")->warn(
-          "rbf from '{}' to '{}': support_radius {} m reaches only {:.1f} other points per centre on average; "
-          "about 3 to 5 mesh spacings (10 to 30 neighbours) interpolate better",
-          from.name(), to.name(), radius_, neighbours);
+      log::get("coupling")
+          ->warn(
+              "rbf from '{}' to '{}': support_radius {} m reaches only {:.1f} other points per "
+              "centre on average; "
+              "about 3 to 5 mesh spacings (10 to 30 neighbours) interpolate better",
+              from.name(), to.name(), radius_, neighbours);
     System::SparseCol kk(n, n);
     kk.setFromTriplets(k.begin(), k.end());
     k = {};
-    sys->ldlt.compute(kk);
-    if (sys->ldlt.info() != Eigen::Success || sys->ldlt.vectorD().minCoeff() <= 0.0)
-      throw Error("mapper 'rbf': the interpolation matrix on mesh '" + centres.name() +
-                  "' is not positive definite (duplicate points?)");
+    if (solver_ == Solver::cholesky) {
+      sys->ldlt.compute(kk);
+      if (sys->ldlt.info() != Eigen::Success || sys->ldlt.vectorD().minCoeff() <= 0.0)
+        throw Error("mapper 'rbf': the interpolation matrix on mesh '" + centres.name() +
+                    "' is not positive definite (duplicate points?)");
+    } else {
+      sys->iterative = true;
+      sys->phi = std::move(kk);
+      sys->cg.setTolerance(tolerance_);
+      sys->cg.setMaxIterations(std::max<Eigen::Index>(1000, n / 10));
+      sys->cg.compute(sys->phi);
+      if (sys->cg.info() != Eigen::Success)
+        throw Error("mapper 'rbf': the incomplete Cholesky preconditioner failed on mesh '" +
+                    centres.name() + "' (duplicate points?); use solver: cholesky");
+    }
     if (saddle) {
       // Y = Phi^-1 P_C and the Schur complement S = P_C^T Y of the saddle-point system
-      sys->phi_inv_p = sys->ldlt.solve(sys->poly_centres);
+      sys->phi_inv_p = sys->solve(sys->poly_centres);
       sys->schur.compute(sys->poly_centres.transpose() * sys->phi_inv_p);
       if (sys->schur.info() != Eigen::Success)
-        throw Error("mapper 'rbf': the polynomial part on mesh '" + centres.name() + "' is singular");
+        throw Error("mapper 'rbf': the polynomial part on mesh '" + centres.name() +
+                    "' is singular");
     }
     // E_ij = phi(|y_i - x_j|), y_i the evaluation points
     std::vector<Eigen::Triplet<double>> e;
@@ -263,12 +322,14 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
     sys->dense_lu.compute(kk);
     const double rcond = sys->dense_lu.rcond();
     if (!(rcond > 1e-15))
-      throw Error("mapper 'rbf' (" + std::string(basis_name(basis_)) + "): the interpolation system on mesh '" +
-                  centres.name() + "' is singular or too ill-conditioned (reciprocal condition " + std::to_string(rcond) +
-                  "); use a smaller length scale or basis wendland-c2");
+      throw Error("mapper 'rbf' (" + std::string(basis_name(basis_)) +
+                  "): the interpolation system on mesh '" + centres.name() +
+                  "' is singular or too ill-conditioned (reciprocal condition " +
+                  std::to_string(rcond) + "); use a smaller length scale or basis wendland-c2");
     sys->eval_dense.resize(m, n);
     for (Eigen::Index j = 0; j < n; ++j)
-      for (Eigen::Index i = 0; i < m; ++i) sys->eval_dense(i, j) = phi((xe.row(i) - xc.row(j)).norm());
+      for (Eigen::Index i = 0; i < m; ++i)
+        sys->eval_dense(i, j) = phi((xe.row(i) - xc.row(j)).norm());
   }
   system_ = std::move(sys);
   set_meshes(from, to);

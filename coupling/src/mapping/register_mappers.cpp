@@ -10,10 +10,13 @@ void register_mappers(Registry<MapperFactory>& registry) {
   registry.add("nearest-neighbor", "value of the nearest source point (k-d tree); first order",
                NearestNeighborMapper::create, NearestNeighborMapper::spec());
   registry.add("nearest-projection",
-               "projection onto the source triangles, barycentric; second order (point clouds: local linear fit)",
+               "projection onto the source triangles, barycentric; second order (point clouds: "
+               "local linear fit)",
                NearestProjectionMapper::create, NearestProjectionMapper::spec());
-  registry.add("rbf", "radial basis functions + linear polynomial (compact Wendland C2, sparse factorisation)",
-               RbfMapper::create, RbfMapper::spec());
+  registry.add(
+      "rbf",
+      "radial basis functions + linear polynomial (compact Wendland C2, sparse factorisation)",
+      RbfMapper::create, RbfMapper::spec());
 }
 
 }  // namespace partita::coupling

@@ -6,8 +6,8 @@ namespace partita::coupling {
 
 void SparseMapper::compute(const Mesh& from, const Mesh& to) {
   if (from.size() == 0 || to.size() == 0)
-    throw Error("mapper '" + name() + "' from mesh '" + from.name() + "' to mesh '" + to.name() + "': mesh '" +
-                (from.size() == 0 ? from.name() : to.name()) + "' has no points");
+    throw Error("mapper '" + name() + "' from mesh '" + from.name() + "' to mesh '" + to.name() +
+                "': mesh '" + (from.size() == 0 ? from.name() : to.name()) + "' has no points");
   if (constraint_ == Constraint::consistent) {
     matrix_ = interpolation(from, to);  // |to| x |from|
   } else {

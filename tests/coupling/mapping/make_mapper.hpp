@@ -22,7 +22,8 @@ inline const Registry<MapperFactory>& mapper_registry() {
 /// `yaml` is what follows `mapper:` in a case file, e.g. "nearest-projection" or
 /// "{type: rbf, support_radius: 3 mm}".
 inline std::unique_ptr<Mapper> make_mapper(const std::string& yaml, Constraint constraint) {
-  const config::Node node = config::Node::load_string("mapper: " + yaml + "\n", "case.yaml")["mapper"];
+  const config::Node node =
+      config::Node::load_string("mapper: " + yaml + "\n", "case.yaml")["mapper"];
   return create_mapper(mapper_registry(), MapperContext{node, constraint});
 }
 

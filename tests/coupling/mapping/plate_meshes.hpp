@@ -38,7 +38,8 @@ inline Mesh::Points plate_grid(int nx, int ny, double perturb, unsigned seed) {
 }
 
 /// STL-like triangulation of the plate: every grid cell split in two, diagonals alternating.
-inline Mesh plate_triangles(const std::string& name, int nx, int ny, double perturb, unsigned seed) {
+inline Mesh plate_triangles(const std::string& name, int nx, int ny, double perturb,
+                            unsigned seed) {
   Mesh::Triangles t(2 * nx * ny, 3);
   int k = 0;
   for (int j = 0; j < ny; ++j)
@@ -67,8 +68,8 @@ struct QuadFaces {
   Eigen::VectorXd weights;  ///< w_q = det J(xi_q) (Gauss weights are 1) [m^2]
 };
 
-inline QuadFaces plate_quads(const std::string& nodes_name, const std::string& qp_name, int nx, int ny,
-                             double perturb, unsigned seed) {
+inline QuadFaces plate_quads(const std::string& nodes_name, const std::string& qp_name, int nx,
+                             int ny, double perturb, unsigned seed) {
   const Mesh::Points x = plate_grid(nx, ny, perturb, seed);
   Mesh::Triangles t(2 * nx * ny, 3);
   Mesh::Points qp(4 * nx * ny, 3);
@@ -77,7 +78,8 @@ inline QuadFaces plate_quads(const std::string& nodes_name, const std::string& q
   int k = 0, q = 0;
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
-      const int n[4] = {j * (nx + 1) + i, j * (nx + 1) + i + 1, (j + 1) * (nx + 1) + i + 1, (j + 1) * (nx + 1) + i};
+      const int n[4] = {j * (nx + 1) + i, j * (nx + 1) + i + 1, (j + 1) * (nx + 1) + i + 1,
+                        (j + 1) * (nx + 1) + i};
       t.row(k++) << n[0], n[1], n[2];
       t.row(k++) << n[0], n[2], n[3];
       for (double eta : {-g, g})
@@ -89,7 +91,8 @@ inline QuadFaces plate_quads(const std::string& nodes_name, const std::string& q
           for (int a = 0; a < 4; ++a) {
             const Eigen::Vector3d xn = x.row(n[a]).transpose();
             pos += 0.25 * (1 + xi * xa[a]) * (1 + eta * ea[a]) * xn;
-            const double dxi = 0.25 * xa[a] * (1 + eta * ea[a]), deta = 0.25 * ea[a] * (1 + xi * xa[a]);
+            const double dxi = 0.25 * xa[a] * (1 + eta * ea[a]),
+                         deta = 0.25 * ea[a] * (1 + xi * xa[a]);
             jac(0, 0) += dxi * xn.x();
             jac(0, 1) += deta * xn.x();
             jac(1, 0) += dxi * xn.y();
@@ -120,28 +123,36 @@ inline Eigen::MatrixXd sample(const Mesh::Points& x, int columns,
 }
 
 /// Integral of f over each triangle (7-point Dunavant rule, degree 5), rows = triangles.
-inline Eigen::MatrixXd triangle_integrals(const Mesh& m, int columns,
-                                          const std::function<Eigen::VectorXd(const Eigen::Vector3d&)>& f) {
+inline Eigen::MatrixXd triangle_integrals(
+    const Mesh& m, int columns, const std::function<Eigen::VectorXd(const Eigen::Vector3d&)>& f) {
   struct P {
     double w, l0, l1, l2;
   };
   const double a1 = 0.059715871789770, b1 = 0.470142064105115, w1 = 0.132394152788506;
   const double a2 = 0.797426985353087, b2 = 0.101286507323456, w2 = 0.125939180544827;
-  const P rule[7] = {{0.225, 1.0 / 3, 1.0 / 3, 1.0 / 3}, {w1, a1, b1, b1}, {w1, b1, a1, b1}, {w1, b1, b1, a1},
-                     {w2, a2, b2, b2}, {w2, b2, a2, b2}, {w2, b2, b2, a2}};
+  const P rule[7] = {{0.225, 1.0 / 3, 1.0 / 3, 1.0 / 3},
+                     {w1, a1, b1, b1},
+                     {w1, b1, a1, b1},
+                     {w1, b1, b1, a1},
+                     {w2, a2, b2, b2},
+                     {w2, b2, a2, b2},
+                     {w2, b2, b2, a2}};
   const Eigen::VectorXd area = m.triangle_areas();
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(m.num_triangles(), columns);
   for (Eigen::Index t = 0; t < m.num_triangles(); ++t) {
-    const Eigen::Vector3d a = m.points().row(m.triangles()(t, 0)), b = m.points().row(m.triangles()(t, 1)),
+    const Eigen::Vector3d a = m.points().row(m.triangles()(t, 0)),
+                          b = m.points().row(m.triangles()(t, 1)),
                           c = m.points().row(m.triangles()(t, 2));
-    for (const P& p : rule) out.row(t) += area(t) * p.w * f(p.l0 * a + p.l1 * b + p.l2 * c).transpose();
+    for (const P& p : rule)
+      out.row(t) += area(t) * p.w * f(p.l0 * a + p.l1 * b + p.l2 * c).transpose();
   }
   return out;
 }
 
 /// A cylinder patch of radius r, angle 0..theta, height 0..h: n_theta x n_z cells, two
 /// triangles each, vertices on the cylinder.
-inline Mesh cylinder_patch(const std::string& name, double r, double theta, double h, int n_theta, int n_z) {
+inline Mesh cylinder_patch(const std::string& name, double r, double theta, double h, int n_theta,
+                           int n_z) {
   Mesh::Points p((n_theta + 1) * (n_z + 1), 3);
   for (int j = 0; j <= n_z; ++j)
     for (int i = 0; i <= n_theta; ++i) {

@@ -19,6 +19,7 @@ const char* const conservative_mappers[] = {
     "{type: nearest-projection, point_cloud: nearest}",
     "{type: rbf, support_radius: 3.5e-3}",
     "{type: rbf, support_radius: 3.5e-3, polynomial: on}",
+    "{type: rbf, support_radius: 3.5e-3, solver: cg}",
     "{type: rbf, basis: gaussian, support_radius: 1.5e-3}",
     "{type: rbf, basis: thin-plate-spline, polynomial: on}",
 };
@@ -46,7 +47,8 @@ TEST_CASE("conservative mappers preserve the total force", "[mapping]") {
     const Mesh* from;
     const Mesh* to;
   };
-  const Route routes[] = {{&centres, &fe.nodes}, {&centres, &fe_points}, {&fe.nodes, &stl}, {&stl, &fe.quadrature}};
+  const Route routes[] = {
+      {&centres, &fe.nodes}, {&centres, &fe_points}, {&fe.nodes, &stl}, {&stl, &fe.quadrature}};
   double worst = 0.0;
   for (const char* yaml : conservative_mappers)
     for (const Route& r : routes) {
@@ -69,8 +71,9 @@ TEST_CASE("conservative mappers preserve the total force", "[mapping]") {
   WARN("worst relative conservation error " << worst);
 }
 
-TEST_CASE("conservative nearest-projection distributes a force to the vertices of the triangle it hits",
-          "[mapping]") {
+TEST_CASE(
+    "conservative nearest-projection distributes a force to the vertices of the triangle it hits",
+    "[mapping]") {
   // One force at (0.3, 0.2) on the unit square split along its diagonal: the barycentric
   // weights of the lower triangle (0,0),(1,0),(1,1) are (0.7, 0.1, 0.2).
   Mesh::Points x(4, 3);

@@ -19,49 +19,61 @@ TEST_CASE("every mapper is registered with its options", "[mapping]") {
     CHECK(!e.doc.empty());
     CHECK(e.spec->find("type") != nullptr);
   }
-  CHECK_THAT(r.get("rbf").spec->docs(), Contains("support_radius") && Contains("polynomial") && Contains("basis"));
+  CHECK_THAT(r.get("rbf").spec->docs(),
+             Contains("support_radius") && Contains("polynomial") && Contains("basis"));
   CHECK_THAT(r.get("nearest-projection").spec->docs(), Contains("point_cloud"));
 }
 
 TEST_CASE("mappers are chosen by name, as a plain name or a map", "[mapping]") {
   CHECK(make_mapper("nearest-neighbor", Constraint::consistent)->name() == "nearest-neighbor");
-  CHECK(make_mapper("{type: nearest-projection}", Constraint::conservative)->constraint() == Constraint::conservative);
-  auto rbf = make_mapper("{type: rbf, support_radius: 2 mm, polynomial: on}", Constraint::consistent);
+  CHECK(make_mapper("{type: nearest-projection}", Constraint::conservative)->constraint() ==
+        Constraint::conservative);
+  auto rbf =
+      make_mapper("{type: rbf, support_radius: 2 mm, polynomial: on}", Constraint::consistent);
   CHECK(rbf->name() == "rbf");
 }
 
 TEST_CASE("an unknown mapper name lists the known ones and the nearest", "[mapping]") {
   CHECK_THROWS_WITH(make_mapper("nearest-projektion", Constraint::consistent),
-                    Contains("unknown mapper 'nearest-projektion'") && Contains("did you mean 'nearest-projection'") &&
-                        Contains("rbf") && Contains("case.yaml:1"));
+                    Contains("unknown mapper 'nearest-projektion'") &&
+                        Contains("did you mean 'nearest-projection'") && Contains("rbf") &&
+                        Contains("case.yaml:1"));
   CHECK_THROWS_WITH(make_mapper("{type: rbff, support_radius: 1.0e-3}", Constraint::consistent),
                     Contains("did you mean 'rbf'"));
-  CHECK_THROWS_WITH(make_mapper("{support_radius: 1.0e-3}", Constraint::consistent), Contains("needs 'type"));
-  CHECK_THROWS_WITH(make_mapper("[rbf]", Constraint::consistent), Contains("expected a mapper name"));
-  CHECK_THROWS_AS(make_mapper("{type: nearest-neighbor, support_radius: 1.0e-3}", Constraint::consistent),
-                  partita::Error);  // an option that mapper does not have
+  CHECK_THROWS_WITH(make_mapper("{support_radius: 1.0e-3}", Constraint::consistent),
+                    Contains("needs 'type"));
+  CHECK_THROWS_WITH(make_mapper("[rbf]", Constraint::consistent),
+                    Contains("expected a mapper name"));
+  CHECK_THROWS_AS(
+      make_mapper("{type: nearest-neighbor, support_radius: 1.0e-3}", Constraint::consistent),
+      partita::Error);  // an option that mapper does not have
 }
 
 TEST_CASE("rbf needs a positive support radius", "[mapping]") {
-  CHECK_THROWS_WITH(make_mapper("rbf", Constraint::consistent), Contains("support_radius") && Contains("{type: rbf"));
+  CHECK_THROWS_WITH(make_mapper("rbf", Constraint::consistent),
+                    Contains("support_radius") && Contains("{type: rbf"));
   CHECK_THROWS_WITH(make_mapper("{type: rbf}", Constraint::consistent),
                     Contains("support_radius") && Contains("case.yaml:1"));
   CHECK_THROWS_WITH(make_mapper("{type: rbf, support_radius: -2.0e-3}", Constraint::consistent),
                     Contains("support_radius") && Contains("-0.002") && Contains("0 < value"));
-  CHECK_THROWS_AS(make_mapper("{type: rbf, support_radius: 0}", Constraint::consistent), partita::Error);
+  CHECK_THROWS_AS(make_mapper("{type: rbf, support_radius: 0}", Constraint::consistent),
+                  partita::Error);
   CHECK_THROWS_WITH(RbfMapper(Constraint::consistent, RbfMapper::Basis::wendland_c2, -1.0),
                     Contains("positive"));
   // thin-plate-spline takes no radius
-  CHECK_NOTHROW(make_mapper("{type: rbf, basis: thin-plate-spline, polynomial: on}", Constraint::consistent));
-  CHECK_THROWS_WITH(make_mapper("{type: rbf, support_radius: 1.0e-3, polynomial: off}", Constraint::conservative),
-                    Contains("total") && Contains("polynomial: separate"));
+  CHECK_NOTHROW(
+      make_mapper("{type: rbf, basis: thin-plate-spline, polynomial: on}", Constraint::consistent));
+  CHECK_THROWS_WITH(
+      make_mapper("{type: rbf, support_radius: 1.0e-3, polynomial: off}", Constraint::conservative),
+      Contains("total") && Contains("polynomial: separate"));
 }
 
 TEST_CASE("mapping a field with the wrong number of rows", "[mapping]") {
   const Mesh stl = plate_triangles("plate", 4, 4, 0.0, 1);
   const Mesh centres = cell_centres("plate_centres", stl);
   const QuadFaces fe = plate_quads("bottom", "bottom_quadrature", 3, 3, 0.0, 2);
-  for (const char* yaml : {"nearest-neighbor", "nearest-projection", "{type: rbf, support_radius: 10 mm}"}) {
+  for (const char* yaml :
+       {"nearest-neighbor", "nearest-projection", "{type: rbf, support_radius: 10 mm}"}) {
     CAPTURE(yaml);
     auto m = make_mapper(yaml, Constraint::consistent);
     Eigen::MatrixXd out;
@@ -80,14 +92,17 @@ TEST_CASE("nearest-projection onto a point cloud when told to refuse", "[mapping
   const QuadFaces fe = plate_quads("bottom", "bottom_quadrature", 3, 3, 0.0, 2);
   auto m = make_mapper("{type: nearest-projection, point_cloud: error}", Constraint::consistent);
   CHECK_THROWS_WITH(m->compute(centres, fe.quadrature),
-                    Contains("'plate_centres' has no triangles") && Contains("rbf") && Contains("nearest-neighbor"));
-  CHECK_THROWS_WITH(make_mapper("{type: nearest-projection, point_cloud: nerest}", Constraint::consistent),
-                    Contains("nearest"));
+                    Contains("'plate_centres' has no triangles") && Contains("rbf") &&
+                        Contains("nearest-neighbor"));
+  CHECK_THROWS_WITH(
+      make_mapper("{type: nearest-projection, point_cloud: nerest}", Constraint::consistent),
+      Contains("nearest"));
 }
 
 TEST_CASE("global rbf bases refuse large meshes", "[mapping]") {
   const Mesh big = plate_random_points("big", RbfMapper::max_dense_points + 1, 3);
   const Mesh small = plate_random_points("small", 10, 4);
-  auto m = make_mapper("{type: rbf, basis: gaussian, support_radius: 1 mm}", Constraint::consistent);
+  auto m =
+      make_mapper("{type: rbf, basis: gaussian, support_radius: 1 mm}", Constraint::consistent);
   CHECK_THROWS_WITH(m->compute(big, small), Contains("wendland-c2") && Contains("'big'"));
 }

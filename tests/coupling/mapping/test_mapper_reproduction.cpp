@@ -22,6 +22,7 @@ const char* const consistent_mappers[] = {
     "{type: rbf, support_radius: 3.5 mm}",
     "{type: rbf, support_radius: 3.5e-3, polynomial: on}",
     "{type: rbf, support_radius: 3.5e-3, polynomial: off}",
+    "{type: rbf, support_radius: 3.5e-3, solver: cg}",
     "{type: rbf, basis: gaussian, support_radius: 1.5e-3}",
     "{type: rbf, basis: thin-plate-spline, polynomial: on}",
 };
@@ -32,6 +33,8 @@ const char* const linear_mappers[] = {
     "nearest-projection",
     "{type: rbf, support_radius: 3.5e-3}",
     "{type: rbf, support_radius: 3.5e-3, polynomial: on}",
+    "{type: rbf, support_radius: 3.5e-3, polynomial: on, solver: cg, tolerance: 1.0e-13}",
+    "{type: rbf, support_radius: 3.5e-3, solver: cg}",
     "{type: rbf, basis: gaussian, support_radius: 1.5e-3}",
     "{type: rbf, basis: thin-plate-spline, polynomial: on}",
 };
@@ -52,7 +55,8 @@ TEST_CASE("consistent mappers reproduce a constant field exactly", "[mapping]") 
     for (const Mesh* source : {&stl, &centres}) {
       CAPTURE(yaml, source->name());
       auto m = make_mapper(yaml, Constraint::consistent);
-      if (std::string(yaml).find("polynomial: off") != std::string::npos) continue;  // no constants: see below
+      if (std::string(yaml).find("polynomial: off") != std::string::npos)
+        continue;  // no constants: see below
       m->compute(*source, fe.quadrature);
       Eigen::MatrixXd out;
       m->map(Eigen::MatrixXd(c.replicate(source->size(), 1)), out);
@@ -65,10 +69,12 @@ TEST_CASE("consistent mappers reproduce a constant field exactly", "[mapping]") 
   }
 }
 
-TEST_CASE("rbf without polynomial does not hold constants (so conservative use is refused)", "[mapping]") {
+TEST_CASE("rbf without polynomial does not hold constants (so conservative use is refused)",
+          "[mapping]") {
   const Mesh stl = plate_triangles("plate", 17, 17, 0.3, 1);
   const QuadFaces fe = plate_quads("bottom", "bottom_quadrature", 13, 13, 0.3, 2);
-  auto m = make_mapper("{type: rbf, support_radius: 3.5e-3, polynomial: off}", Constraint::consistent);
+  auto m =
+      make_mapper("{type: rbf, support_radius: 3.5e-3, polynomial: off}", Constraint::consistent);
   m->compute(stl, fe.quadrature);
   Eigen::MatrixXd out;
   m->map(Eigen::MatrixXd::Ones(stl.size(), 1), out);
@@ -77,12 +83,14 @@ TEST_CASE("rbf without polynomial does not hold constants (so conservative use i
   CHECK((out.array() - 1.0).abs().maxCoeff() < 0.2);
 }
 
-TEST_CASE("nearest-projection and rbf with polynomial reproduce a linear field on a plane", "[mapping]") {
+TEST_CASE("nearest-projection and rbf with polynomial reproduce a linear field on a plane",
+          "[mapping]") {
   // The plane z = 0.02 as given, and the same meshes rotated by 35 degrees about (1, 1, 0.3):
   // then x, y and z all vary but the points stay coplanar, and the polynomial must drop its
   // term normal to the plane (the principal direction without extent).
-  const Eigen::Matrix3d rot = Eigen::AngleAxisd(35.0 * EIGEN_PI / 180.0, Eigen::Vector3d(1, 1, 0.3).normalized())
-                                  .toRotationMatrix();
+  const Eigen::Matrix3d rot =
+      Eigen::AngleAxisd(35.0 * EIGEN_PI / 180.0, Eigen::Vector3d(1, 1, 0.3).normalized())
+          .toRotationMatrix();
   for (bool tilt : {false, true}) {
     const Eigen::Matrix3d r = tilt ? rot : Eigen::Matrix3d::Identity();
     const Mesh stl = rotated(plate_triangles("plate", 17, 17, 0.3, 1), r);
@@ -91,7 +99,8 @@ TEST_CASE("nearest-projection and rbf with polynomial reproduce a linear field o
     const Mesh target = rotated(fe.quadrature, r);
     auto f = [](const Eigen::Vector3d& x) {
       // f(x) = (1 + 300 x - 200 y + 100 z, 5 - 400 x + 50 z) (a linear field, two components)
-      return Eigen::Vector2d(1.0 + 300.0 * x.x() - 200.0 * x.y() + 100.0 * x.z(), 5.0 - 400.0 * x.x() + 50.0 * x.z());
+      return Eigen::Vector2d(1.0 + 300.0 * x.x() - 200.0 * x.y() + 100.0 * x.z(),
+                             5.0 - 400.0 * x.x() + 50.0 * x.z());
     };
     const Eigen::MatrixXd expected = sample(target.points(), 2, f);
     for (const char* yaml : linear_mappers)
@@ -111,7 +120,9 @@ TEST_CASE("recompute after the target mesh moved", "[mapping]") {
   const Mesh stl = plate_triangles("plate", 10, 10, 0.3, 4);
   Mesh target = plate_random_points("probe", 200, 5);
   auto m = make_mapper("nearest-projection", Constraint::consistent);
-  auto f = [](const Eigen::Vector3d& x) { return Eigen::VectorXd::Constant(1, 2.0 + 100.0 * x.x() + 30.0 * x.y()); };
+  auto f = [](const Eigen::Vector3d& x) {
+    return Eigen::VectorXd::Constant(1, 2.0 + 100.0 * x.x() + 30.0 * x.y());
+  };
   const Eigen::MatrixXd in = sample(stl.points(), 1, f);
   m->compute(stl, target);
   // move the probe points in-plane (shrink towards the centre) and compute again
@@ -122,4 +133,23 @@ TEST_CASE("recompute after the target mesh moved", "[mapping]") {
   Eigen::MatrixXd out;
   m->map(in, out);
   CHECK((out - sample(moved, 1, f)).cwiseAbs().maxCoeff() <= 1e-12 * 4.0);
+}
+
+TEST_CASE("rbf: conjugate gradients give the Cholesky solution to their tolerance", "[mapping]") {
+  const Mesh stl = plate_triangles("plate", 30, 30, 0.3, 7);
+  const Mesh target = plate_random_points("probe", 500, 8);
+  auto f = [](const Eigen::Vector3d& x) {
+    return Eigen::VectorXd::Constant(1, std::sin(300.0 * x.x()) * std::cos(200.0 * x.y()));
+  };
+  const Eigen::MatrixXd in = sample(stl.points(), 1, f);
+  Eigen::MatrixXd direct, iterative;
+  auto a = make_mapper("{type: rbf, support_radius: 2.5e-3}", Constraint::consistent);
+  auto b = make_mapper("{type: rbf, support_radius: 2.5e-3, solver: cg, tolerance: 1.0e-12}",
+                       Constraint::consistent);
+  a->compute(stl, target);
+  b->compute(stl, target);
+  a->map(in, direct);
+  b->map(in, iterative);
+  // ||x - x*|| <= cond(Phi) tol ||x*||; the values are O(1)
+  CHECK((direct - iterative).cwiseAbs().maxCoeff() < 1e-8);
 }

@@ -21,7 +21,8 @@ constexpr double radius = 0.01, angle = EIGEN_PI / 2.0, height = 0.02;
 // f(theta, z) = sin(2 theta) cos(pi z / H) (+ a second column)
 Eigen::VectorXd field(const Eigen::Vector3d& x) {
   const double th = std::atan2(x.y(), x.x());
-  return Eigen::Vector2d(std::sin(2.0 * th) * std::cos(EIGEN_PI * x.z() / height), std::cos(th) + x.z() / height);
+  return Eigen::Vector2d(std::sin(2.0 * th) * std::cos(EIGEN_PI * x.z() / height),
+                         std::cos(th) + x.z() / height);
 }
 
 /// Least-squares slope of log(e) against log(h).
@@ -63,15 +64,18 @@ TEST_CASE("nearest-projection converges with order 2 on a cylinder patch", "[map
   }
   const double order = fitted_order(hs, errors);
   CAPTURE(errors[0], errors[1], errors[2], errors[3], order);
-  WARN("nearest-projection on a cylinder: max errors " << errors[0] << ", " << errors[1] << ", " << errors[2] << ", "
-                                                       << errors[3] << "; fitted order " << order);
+  WARN("nearest-projection on a cylinder: max errors " << errors[0] << ", " << errors[1] << ", "
+                                                       << errors[2] << ", " << errors[3]
+                                                       << "; fitted order " << order);
   CHECK(order == Approx(2.0).margin(0.3));
 }
 
-TEST_CASE("nearest-projection's linear fit on a point cloud converges with order 2 on the plate", "[mapping]") {
+TEST_CASE("nearest-projection's linear fit on a point cloud converges with order 2 on the plate",
+          "[mapping]") {
   // Cell centres of the perturbed plate triangulation as the source (no triangles).
   auto f = [](const Eigen::Vector3d& x) {
-    return Eigen::VectorXd::Constant(1, std::sin(EIGEN_PI * x.x() / plate_size) * std::cos(EIGEN_PI * x.y() / plate_size));
+    return Eigen::VectorXd::Constant(
+        1, std::sin(EIGEN_PI * x.x() / plate_size) * std::cos(EIGEN_PI * x.y() / plate_size));
   };
   const Mesh target = plate_random_points("probe", 3000, 32);
   const Eigen::MatrixXd exact = sample(target.points(), 1, f);
@@ -86,7 +90,8 @@ TEST_CASE("nearest-projection's linear fit on a point cloud converges with order
     errors.push_back((out - exact).cwiseAbs().maxCoeff());
   }
   const double order = fitted_order(hs, errors);
-  WARN("linear fit on the cell centres: max errors " << errors[0] << ", " << errors[1] << ", " << errors[2] << ", "
-                                                     << errors[3] << "; fitted order " << order);
+  WARN("linear fit on the cell centres: max errors " << errors[0] << ", " << errors[1] << ", "
+                                                     << errors[2] << ", " << errors[3]
+                                                     << "; fitted order " << order);
   CHECK(order == Approx(2.0).margin(0.3));
 }

@@ -21,12 +21,14 @@ namespace {
 //   t(x, y) = p0 (0.1 s, -0.05 s, -(1 + 0.5 s)),  s = sin(pi x / L) cos(2 pi y / L)
 constexpr double p0 = 10.0e3;
 Eigen::VectorXd traction(const Eigen::Vector3d& x) {
-  const double s = std::sin(EIGEN_PI * x.x() / plate_size) * std::cos(2.0 * EIGEN_PI * x.y() / plate_size);
+  const double s =
+      std::sin(EIGEN_PI * x.x() / plate_size) * std::cos(2.0 * EIGEN_PI * x.y() / plate_size);
   return p0 * Eigen::Vector3d(0.1 * s, -0.05 * s, -(1.0 + 0.5 * s));
 }
 // Bound on the second derivatives: |D^2 t_k| <= p0 0.5 (a^2 + b^2), a = pi/L, b = 2 pi/L
 // (the largest amplitude of s among the components is 0.5 p0).
-const double m2 = p0 * 0.5 * (std::pow(EIGEN_PI / plate_size, 2) + std::pow(2.0 * EIGEN_PI / plate_size, 2));
+const double m2 =
+    p0 * 0.5 * (std::pow(EIGEN_PI / plate_size, 2) + std::pow(2.0 * EIGEN_PI / plate_size, 2));
 const double m1 = p0 * 0.5 * std::hypot(EIGEN_PI / plate_size, 2.0 * EIGEN_PI / plate_size);
 
 struct Route {
@@ -40,11 +42,14 @@ double longest_edge(const Mesh& m) {
   double h = 0.0;
   for (Eigen::Index t = 0; t < m.num_triangles(); ++t)
     for (int k = 0; k < 3; ++k)
-      h = std::max(h, (m.points().row(m.triangles()(t, k)) - m.points().row(m.triangles()(t, (k + 1) % 3))).norm());
+      h = std::max(
+          h, (m.points().row(m.triangles()(t, k)) - m.points().row(m.triangles()(t, (k + 1) % 3)))
+                 .norm());
   return h;
 }
 
-Route run_route(const std::string& mapper, int n_cells, int n_quads, const Eigen::RowVector3d& uniform = {0, 0, 0}) {
+Route run_route(const std::string& mapper, int n_cells, int n_quads,
+                const Eigen::RowVector3d& uniform = {0, 0, 0}) {
   const Mesh stl = plate_triangles("plate", n_cells, n_cells, 0.3, 21);
   const Mesh plate_centres = cell_centres("plate_centres", stl);
   const QuadFaces face = plate_quads("bottom", "bottom_quadrature", n_quads, n_quads, 0.3, 22);
@@ -60,7 +65,8 @@ Route run_route(const std::string& mapper, int n_cells, int n_quads, const Eigen
   // The reading side: F = sum_q t_q w_q.
   const Eigen::RowVector3d integral = face.weights.transpose() * t_q;
   const Eigen::RowVector3d total = f.colwise().sum();
-  return Route{(integral - total).cwiseAbs().maxCoeff(), std::abs(total(2)), longest_edge(stl), longest_edge(face.nodes)};
+  return Route{(integral - total).cwiseAbs().maxCoeff(), std::abs(total(2)), longest_edge(stl),
+               longest_edge(face.nodes)};
 }
 
 }  // namespace
@@ -68,7 +74,8 @@ Route run_route(const std::string& mapper, int n_cells, int n_quads, const Eigen
 TEST_CASE("seed route: a uniform traction arrives exactly", "[mapping]") {
   // Constant tractions are reproduced exactly and sum_q w_q = area = sum_c A_c: roundoff only.
   const Eigen::RowVector3d t(200.0, -100.0, -10.0e3);
-  for (const char* mapper : {"nearest-projection", "nearest-neighbor", "{type: rbf, support_radius: 3 mm}"}) {
+  for (const char* mapper :
+       {"nearest-projection", "nearest-neighbor", "{type: rbf, support_radius: 3 mm}"}) {
     CAPTURE(mapper);
     const Route r = run_route(mapper, 20, 12, t);
     CHECK(r.error <= 1e-12 * 10.0e3 * plate_size * plate_size);
@@ -83,13 +90,16 @@ TEST_CASE("seed route: the integral of the mapped traction equals the total forc
   // Bound asserted: |sum_q t_q w_q - sum_c f_c| <= A M2 (2 h_c^2 + h_f^2).
   // (nearest-neighbor is first order: A M1 h_c.)
   const double area = plate_size * plate_size;
-  for (const char* mapper : {"nearest-projection", "{type: rbf, support_radius: 3 mm}", "nearest-neighbor"}) {
+  for (const char* mapper :
+       {"nearest-projection", "{type: rbf, support_radius: 3 mm}", "nearest-neighbor"}) {
     CAPTURE(mapper);
     const Route coarse = run_route(mapper, 16, 10);
     const Route fine = run_route(mapper, 32, 20);
     const bool first_order = std::string(mapper) == "nearest-neighbor";
     for (const Route& r : {coarse, fine}) {
-      const double bound = first_order ? area * m1 * r.h_cell : area * m2 * (2.0 * r.h_cell * r.h_cell + r.h_face * r.h_face);
+      const double bound = first_order
+                               ? area * m1 * r.h_cell
+                               : area * m2 * (2.0 * r.h_cell * r.h_cell + r.h_face * r.h_face);
       CAPTURE(r.error, bound, r.total, r.h_cell, r.h_face);
       CHECK(r.error <= bound);
       CHECK(r.error <= 0.01 * r.total);  // and under 1 % of the total force
@@ -97,10 +107,12 @@ TEST_CASE("seed route: the integral of the mapped traction equals the total forc
     // second order: halving h cuts the error by about 4 (at least 3 asserted)
     if (!first_order) CHECK(fine.error < coarse.error / 3.0);
     auto ratio = [&](const Route& r) {
-      return r.error / (first_order ? area * m1 * r.h_cell : area * m2 * (2.0 * r.h_cell * r.h_cell + r.h_face * r.h_face));
+      return r.error / (first_order
+                            ? area * m1 * r.h_cell
+                            : area * m2 * (2.0 * r.h_cell * r.h_cell + r.h_face * r.h_face));
     };
-    WARN(mapper << ": |sum t_q w_q - sum f_c| / |F_z| = " << coarse.error / coarse.total << " (16/10 cells), "
-                << fine.error / fine.total << " (32/20 cells); error / bound = " << ratio(coarse) << ", "
-                << ratio(fine));
+    WARN(mapper << ": |sum t_q w_q - sum f_c| / |F_z| = " << coarse.error / coarse.total
+                << " (16/10 cells), " << fine.error / fine.total
+                << " (32/20 cells); error / bound = " << ratio(coarse) << ", " << ratio(fine));
   }
 }

@@ -86,6 +86,7 @@ std::unique_ptr<Mapper> create_mapper(const Registry<MapperFactory>& registry,
 /// For factories: the options of the mapper node validated against `spec` (defaults filled in).
 /// A plain-name node gives an empty map with the defaults; if `spec` has required keys, that
 /// fails at the node and shows how to write the map form.
-config::Node mapper_options(const config::Node& node, const std::shared_ptr<const config::Spec>& spec);
+config::Node mapper_options(const config::Node& node,
+                            const std::shared_ptr<const config::Spec>& spec);
 
 }  // namespace partita::coupling

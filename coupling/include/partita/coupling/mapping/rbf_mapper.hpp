@@ -18,6 +18,9 @@
 //                      through its q x q Schur complement P^T Phi^-1 P (sparse Cholesky of Phi)
 //   off                no polynomial: constants are not reproduced, so not allowed for a
 //                      conservative mapping (the total would not be preserved)
+// Solver of the compact system (option `solver`): cholesky (default) or cg (preconditioned
+// conjugate gradients to `tolerance`, for large meshes; a conservative mapping then keeps the
+// total exactly with polynomial: separate, to the tolerance with polynomial: on).
 // Unlike the sparse-matrix mappers, the operator E K^-1 is dense; compute() factorises K and
 // map() does one solve and one sparse product (with temporaries of the mesh size).
 // Global bases factorise densely (Phi, or the whole saddle-point system: thin-plate splines
@@ -35,11 +38,17 @@ class RbfMapper final : public Mapper {
  public:
   enum class Basis { wendland_c2, gaussian, thin_plate_spline };
   enum class Polynomial { separate, on, off };
+  /// How the compact system Phi is solved: a sparse Cholesky factorisation (LDL^T, AMD
+  /// ordering; exact, but its fill grows faster than n on a surface), or conjugate gradients
+  /// preconditioned with an incomplete Cholesky factor (each map() iterates to `tolerance`).
+  enum class Solver { cholesky, cg };
 
   /// `support_radius` [m]: R of wendland-c2 and gaussian (ignored by thin-plate-spline).
   /// Throws partita::Error for an invalid combination (radius <= 0, conservative without
   /// polynomial, thin-plate-spline without polynomial).
-  RbfMapper(Constraint constraint, Basis basis, double support_radius, Polynomial polynomial = Polynomial::separate);
+  RbfMapper(Constraint constraint, Basis basis, double support_radius,
+            Polynomial polynomial = Polynomial::separate, Solver solver = Solver::cholesky,
+            double tolerance = 1e-10);
   ~RbfMapper() override;
 
   void compute(const Mesh& from, const Mesh& to) override;
@@ -63,6 +72,8 @@ class RbfMapper final : public Mapper {
   Basis basis_;
   double radius_;
   Polynomial polynomial_;
+  Solver solver_;
+  double tolerance_;
   std::unique_ptr<System> system_;
 };
 
