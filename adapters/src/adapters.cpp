@@ -1,5 +1,8 @@
 #include "partita/adapters/register_all.hpp"
 
+#ifdef PARTITA_HAVE_FEM
+#include "fem/fem_adapter.hpp"
+#endif
 #ifdef PARTITA_HAVE_TUBE1D
 #include "tube1d/tube_fluid_adapter.hpp"
 #include "tube1d/tube_solid_adapter.hpp"
@@ -8,6 +11,10 @@
 namespace partita::adapters {
 
 void register_all(coupling::Registries& r) {
+#ifdef PARTITA_HAVE_FEM
+  r.solvers.add("fem", "native linear-elastic FEM: Hex8/Hex20/Tet4/Tet10, static or Newmark transient",
+                FemAdapter::create, FemAdapter::spec());
+#endif
 #ifdef PARTITA_HAVE_TUBE1D
   r.solvers.add("tube1d-fluid", "1D elastic tube: quasi-1D incompressible flow (writes pressure, reads area)",
                 TubeFluidAdapter::create, TubeFluidAdapter::spec());

@@ -399,6 +399,13 @@ void Solver::solve_static() {
   timings_.solve += seconds_since(t1);
 }
 
+void Solver::step_static(double dt) {
+  if (!(dt > 0.0)) throw Error("step_static: the time step must be positive, got " + std::to_string(dt));
+  time_ += dt;
+  ++steps_;
+  solve_static();
+}
+
 void Solver::initialise_acceleration() {
   // M_ff a_f = F_f - (K u + C v)_f   (prescribed accelerations taken as zero)
   evaluate_external_force(time_, f_);

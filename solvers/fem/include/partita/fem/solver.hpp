@@ -70,6 +70,8 @@ class Solver {
   void solve_static();
   // One Newmark step from time() to time() + dt.
   void step(double dt);
+  // Quasi-static step: time() += dt, then solve_static() with the loads at the new time.
+  void step_static(double dt);
   double time() const { return time_; }
   std::size_t step_count() const { return steps_; }
 

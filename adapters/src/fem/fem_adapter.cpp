@@ -1,0 +1,336 @@
+#include "fem_adapter.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+
+#include "partita/interface/error.hpp"
+#include "partita/interface/log.hpp"
+
+namespace partita::adapters {
+
+namespace {
+
+using config::Node;
+using config::Spec;
+
+const std::vector<std::string> kComponents = {"x", "y", "z"};
+
+std::shared_ptr<Spec> make_spec() {
+  auto box = std::make_shared<Spec>("box", "a structured box mesh with faces and node sets xmin, xmax, ymin, "
+                                           "ymax, zmin, zmax and all");
+  box->reals("origin", "lower corner").unit("m").size(3).required();
+  box->reals("size", "edge lengths").unit("m").size(3).min(0.0, true).required();
+  box->integers("cells", "cells along x, y, z").size(3).min(1).required();
+
+  auto mesh = std::make_shared<Spec>("mesh", "the finite element mesh: a box or a Gmsh 4.1 ASCII file");
+  mesh->section("box", "structured box", box);
+  mesh->string("gmsh", "Gmsh 4.1 ASCII .msh file (physical groups become named faces and node sets), relative "
+                       "to the case file");
+  mesh->real("scale", "factor applied to the Gmsh coordinates (e.g. 1.0e-3 for a file in mm)").positive().def(1.0);
+  mesh->choice("element", "element type of the box mesh (Gmsh files carry their own)", {"hex8", "hex20", "tet4", "tet10"})
+      .def("hex8");
+  mesh->choice("hex8", "Hex8 formulation: incompatible modes (no shear or volumetric locking) or plain full "
+                       "integration", {"incompatible-modes", "full"})
+      .def("incompatible-modes");
+  mesh->one_of({"box", "gmsh"});
+
+  auto material = std::make_shared<Spec>("material", "isotropic linear-elastic material");
+  material->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
+  material->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
+  material->real("density", "mass density rho").unit("kg/m^3").positive().required();
+
+  auto constraint = std::make_shared<Spec>("constraint", "a Dirichlet condition on a node set");
+  constraint->string("set", "node set (box: all, xmin ... zmax; Gmsh: physical group names)").required();
+  constraint->strings("fix", "components held at zero").choices(kComponents);
+  constraint->choice("component", "component of a prescribed displacement", kComponents);
+  constraint->real("displacement", "prescribed displacement of that component (reached over ramp)").unit("m");
+  constraint->real("ramp", "time over which the prescribed displacement grows linearly from 0").unit("s")
+      .non_negative().def(0.0);
+  constraint->one_of({"fix", "displacement"});
+
+  auto load = std::make_shared<Spec>("load", "a load: pressure or traction on a face, or gravity");
+  load->string("face", "face name (box: xmin ... zmax; Gmsh: physical surface names)");
+  load->real("pressure", "uniform pressure, positive pushing into the body (against the outward normal)").unit("Pa");
+  load->reals("traction", "uniform traction vector").unit("Pa").size(3);
+  load->reals("gravity", "gravitational acceleration acting on the whole body").unit("m/s^2").size(3);
+  load->real("ramp", "time over which the load grows linearly from 0 to its value (0: applied at once)").unit("s")
+      .non_negative().def(0.0);
+  load->one_of({"pressure", "traction", "gravity"});
+
+  auto interface = std::make_shared<Spec>("interface", "a coupling interface on a face");
+  interface->string("name", "interface name: meshes <name> (nodes) and <name>_quadrature (quadrature points)")
+      .required();
+  interface->string("face", "the face it lies on").required();
+
+  auto newmark = std::make_shared<Spec>("newmark", "Newmark parameters");
+  newmark->real("beta", "beta (1/4: average acceleration)").positive().max(0.5).def(0.25);
+  newmark->real("gamma", "gamma (1/2: no numerical damping)").min(0.5).max(1.0).def(0.5);
+  auto rayleigh = std::make_shared<Spec>("rayleigh", "Rayleigh damping C = alpha M + beta K");
+  rayleigh->real("alpha", "mass-proportional coefficient").unit("1/s").non_negative().def(0.0);
+  rayleigh->real("beta", "stiffness-proportional coefficient").unit("s").non_negative().def(0.0);
+  auto analysis = std::make_shared<Spec>("analysis", "static or transient analysis");
+  analysis->choice("type", "transient (Newmark) or static (each step solves K u = F(t))", {"transient", "static"})
+      .def("transient");
+  analysis->section("newmark", "Newmark parameters", newmark);
+  analysis->choice("mass", "mass matrix", {"consistent", "lumped"}).def("consistent");
+  analysis->section("rayleigh", "Rayleigh damping", rayleigh);
+
+  auto s = std::make_shared<Spec>("fem", "native linear-elastic FEM (solvers/fem): Hex8 (incompatible modes), "
+                                         "Hex20, Tet4, Tet10; static or Newmark transient");
+  s->section("mesh", "the mesh", mesh).required();
+  s->section("material", "the material", material).required();
+  s->list("constraints", "Dirichlet conditions", constraint);
+  s->list("loads", "applied loads", load);
+  s->list("interfaces", "coupling interfaces", interface).required();
+  s->section("analysis", "analysis type and time integration", analysis);
+  return s;
+}
+
+int component_index(const Node& n) {
+  const std::string c = n.as_string();
+  for (int i = 0; i < 3; ++i)
+    if (kComponents[static_cast<std::size_t>(i)] == c) return i;
+  n.fail("unknown component '" + c + "'; allowed: x, y, z");
+}
+
+fem::TimeFunction ramp_function(double ramp) {
+  if (ramp <= 0) return {};
+  return [ramp](double t) { return std::min(1.0, std::max(0.0, t / ramp)); };
+}
+
+void require_name(const Node& n, const std::string& name, const std::vector<std::string>& known, const char* what) {
+  if (std::find(known.begin(), known.end(), name) == known.end())
+    n.fail(std::string("unknown ") + what + " '" + name + "'; the mesh has: " + join_names(known) +
+           did_you_mean(name, known));
+}
+
+fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
+  if (m.has("box")) {
+    fem::BoxSpec b;
+    b.origin = m["box"].vec3("origin");
+    b.size = m["box"].vec3("size");
+    const auto cells = m["box"].integers("cells");
+    b.cells = {static_cast<int>(cells[0]), static_cast<int>(cells[1]), static_cast<int>(cells[2])};
+    const std::string e = m.string("element");
+    b.element = e == "hex8" ? fem::ElementType::Hex8 : e == "hex20" ? fem::ElementType::Hex20
+              : e == "tet4" ? fem::ElementType::Tet4 : fem::ElementType::Tet10;
+    return fem::make_box_mesh(b);
+  }
+  std::filesystem::path file = m.string("gmsh");
+  if (file.is_relative()) file = case_dir / file;
+  if (!std::filesystem::exists(file)) m["gmsh"].fail("mesh file '" + file.string() + "' does not exist");
+  fem::Mesh mesh = fem::read_gmsh(file.string());
+  const double scale = m.real("scale");
+  if (scale != 1.0)
+    for (std::size_t i = 0; i < mesh.num_nodes(); ++i) mesh.set_node(i, mesh.node(i) * scale);
+  return mesh;
+}
+
+}  // namespace
+
+std::shared_ptr<const config::Spec> FemAdapter::spec() {
+  static const std::shared_ptr<const config::Spec> s = make_spec();
+  return s;
+}
+
+std::unique_ptr<Solver> FemAdapter::create(const SolverContext& context) {
+  return std::make_unique<FemAdapter>(context);
+}
+
+FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
+  const Node& c = context.config;
+  try {
+    fem::Mesh mesh = build_mesh(c["mesh"], context.case_dir);
+    const Node mat = c["material"];
+    fem::Material material{mat.real("youngs_modulus"), mat.real("poisson_ratio"), mat.real("density")};
+    fem::Model model(std::move(mesh), material);
+    model.set_hex8_formulation(c["mesh"].string("hex8") == "full" ? fem::Hex8Formulation::Full
+                                                                   : fem::Hex8Formulation::IncompatibleModes);
+    const auto sets = model.mesh().node_set_names();
+    const auto faces = model.mesh().face_names();
+
+    for (const Node& k : c["constraints"].items()) {
+      const std::string set = k.string("set");
+      require_name(k["set"], set, sets, "node set");
+      if (k.has("fix")) {
+        std::vector<int> comps;
+        for (const Node& x : k["fix"].items()) comps.push_back(component_index(x));
+        model.fix(set, comps);
+      } else {
+        if (!k.has("component")) k.fail("a prescribed displacement needs 'component: x|y|z'");
+        const double value = k.real("displacement");
+        const double ramp = k.real("ramp");
+        model.prescribe(set, component_index(k["component"]), [value, ramp](double t) {
+          return ramp > 0 ? value * std::min(1.0, t / ramp) : value;
+        });
+      }
+    }
+    for (const Node& l : c["loads"].items()) {
+      const auto amp = ramp_function(l.real("ramp"));
+      if (l.has("gravity")) {
+        if (l.has("face")) l["face"].fail("gravity acts on the whole body; remove 'face'");
+        model.add_gravity(l.vec3("gravity"), amp);
+        continue;
+      }
+      if (!l.has("face")) l.fail("a pressure or traction load needs 'face: <name>'; faces: " + join_names(faces));
+      const std::string face = l.string("face");
+      require_name(l["face"], face, faces, "face");
+      if (l.has("pressure")) model.add_pressure(face, l.real("pressure"), amp);
+      else model.add_traction(face, l.vec3("traction"), amp);
+    }
+
+    const Node an = c["analysis"];
+    transient_ = an.string("type") == "transient";
+    fem::SolverOptions options;
+    options.newmark_beta = an["newmark"].real("beta");
+    options.newmark_gamma = an["newmark"].real("gamma");
+    options.mass = an.string("mass") == "lumped" ? fem::MassType::Lumped : fem::MassType::Consistent;
+    options.rayleigh_alpha = an["rayleigh"].real("alpha");
+    options.rayleigh_beta = an["rayleigh"].real("beta");
+    solver_ = std::make_unique<fem::Solver>(std::move(model), options);
+
+    const auto ifaces = c["interfaces"].items();
+    if (ifaces.empty()) c["interfaces"].fail("at least one interface is needed: [{name: bottom, face: zmin}]");
+    for (const Node& i : ifaces) {
+      Interface itf;
+      itf.name = i.string("name");
+      itf.face = i.string("face");
+      require_name(i["face"], itf.face, faces, "face");
+      for (const auto& other : interfaces_)
+        if (other.name == itf.name) i["name"].fail("interface name '" + itf.name + "' is used twice");
+      const fem::FaceMesh fm = solver_->face_mesh(itf.face);
+      itf.nodes = fm.nodes;
+      Mesh::Triangles tris(static_cast<Eigen::Index>(fm.triangles.size()), 3);
+      for (std::size_t t = 0; t < fm.triangles.size(); ++t)
+        tris.row(static_cast<Eigen::Index>(t)) << fm.triangles[t][0], fm.triangles[t][1], fm.triangles[t][2];
+      InterfaceMesh nodes;
+      nodes.mesh = Mesh(itf.name, fm.positions, tris);
+      nodes.writes.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});
+      nodes.reads.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
+      const auto qps = solver_->face_quadrature_points(itf.face);
+      Mesh::Points qx(static_cast<Eigen::Index>(qps.size()), 3);
+      for (std::size_t q = 0; q < qps.size(); ++q) {
+        qx.row(static_cast<Eigen::Index>(q)) = qps[q].position.transpose();
+        itf.qp_weights.push_back(qps[q].weight);
+      }
+      InterfaceMesh quad;
+      quad.mesh = Mesh(itf.name + "_quadrature", qx);
+      quad.reads.push_back(DataSpec{"traction", 3, "Pa", DataKind::intensive});
+      itf.nodal_forces = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(itf.nodes.size()), 3);
+      itf.tractions = Eigen::MatrixX3d::Zero(qx.rows(), 3);
+      meshes_.push_back(std::move(nodes));
+      meshes_.push_back(std::move(quad));
+      interfaces_.push_back(std::move(itf));
+    }
+    if (!transient_) solver_->solve_static();
+  } catch (const fem::Error& e) {
+    c.fail(std::string("FEM model of participant '") + context.name + "': " + e.what());
+  }
+  log::get("adapters")->info("fem '{}': {} nodes, {} elements, {} dofs, {} analysis", name_, solver_->mesh().num_nodes(),
+                             solver_->mesh().num_elements(), solver_->num_dofs(), transient_ ? "transient" : "static");
+}
+
+const FemAdapter::Interface& FemAdapter::find_interface(std::string_view mesh, bool* quadrature) const {
+  for (const auto& i : interfaces_) {
+    if (mesh == i.name) {
+      *quadrature = false;
+      return i;
+    }
+    if (mesh == i.name + "_quadrature") {
+      *quadrature = true;
+      return i;
+    }
+  }
+  throw Error("fem '" + name_ + "' has no mesh '" + std::string(mesh) + "'");
+}
+
+void FemAdapter::apply_nodal_forces() {
+  std::vector<std::size_t> nodes;
+  std::size_t n = 0;
+  for (const auto& i : interfaces_)
+    if (i.has_forces) n += i.nodes.size();
+  fem::MatrixX3 f(static_cast<Eigen::Index>(n), 3);
+  Eigen::Index row = 0;
+  for (const auto& i : interfaces_) {
+    if (!i.has_forces) continue;
+    nodes.insert(nodes.end(), i.nodes.begin(), i.nodes.end());
+    f.middleRows(row, i.nodal_forces.rows()) = i.nodal_forces;
+    row += i.nodal_forces.rows();
+  }
+  solver_->set_nodal_forces(nodes, f);
+}
+
+void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
+  bool quadrature = false;
+  const Interface& ci = find_interface(mesh, &quadrature);
+  Interface& i = const_cast<Interface&>(ci);
+  if (quadrature && data == "traction") {
+    i.tractions = values;
+    i.has_tractions = true;
+    solver_->set_face_tractions_at_quadrature_points(i.face, i.tractions);
+  } else if (!quadrature && data == "force") {
+    i.nodal_forces = values;
+    i.has_forces = true;
+    apply_nodal_forces();
+  } else {
+    throw Error("fem '" + name_ + "' reads 'force' on mesh '" + i.name + "' and 'traction' on '" + i.name +
+                "_quadrature', not '" + std::string(data) + "' on '" + std::string(mesh) + "'");
+  }
+}
+
+void FemAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
+  bool quadrature = false;
+  const Interface& i = find_interface(mesh, &quadrature);
+  if (quadrature || data != "displacement")
+    throw Error("fem '" + name_ + "' writes only 'displacement' on mesh '" + i.name + "'");
+  values = solver_->displacements(i.nodes);
+}
+
+void FemAdapter::advance(double dt) {
+  try {
+    if (transient_) solver_->step(dt);
+    else solver_->step_static(dt);  // quasi-static: equilibrium with the loads at the new time
+  } catch (const fem::Error& e) {
+    throw Error("fem '" + name_ + "' at t = " + fmt::format("{:.6g}", solver_->time()) + " s: " + e.what());
+  }
+}
+
+void FemAdapter::save_checkpoint() {
+  checkpoint_ = solver_->save_state();
+  has_checkpoint_ = true;
+}
+
+void FemAdapter::restore_checkpoint() {
+  if (!has_checkpoint_) throw Error("fem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
+  solver_->restore_state(checkpoint_);
+}
+
+void FemAdapter::write_output(const OutputFrame& frame) {
+  const std::string file = fmt::format("{}_fem_{:06d}.vtu", frame.prefix, frame.index);
+  fem::write_vtu((frame.vtk_directory / file).string(), *solver_);
+  files_ = {{"fem", file}};
+}
+
+std::vector<MonitorValue> FemAdapter::monitors() const {
+  std::vector<MonitorValue> m;
+  for (const auto& i : interfaces_) {
+    // Total force the interface received: sum_q t_q w_q (tractions) + sum_a f_a (nodal forces).
+    Eigen::Vector3d f = Eigen::Vector3d::Zero();
+    if (i.has_tractions)
+      for (Eigen::Index q = 0; q < i.tractions.rows(); ++q)
+        f += i.tractions.row(q).transpose() * i.qp_weights[static_cast<std::size_t>(q)];
+    if (i.has_forces) f += i.nodal_forces.colwise().sum().transpose();
+    for (int k = 0; k < 3; ++k) m.push_back({i.name + ".force_" + kComponents[static_cast<std::size_t>(k)], "N", f(k)});
+  }
+  // Minus the applied loads (gravity included): what the interfaces carry in static equilibrium.
+  const Eigen::Vector3d applied = solver_->total_external_force() - solver_->total_coupling_force();
+  m.push_back({"static_reaction_x", "N", -applied.x()});
+  m.push_back({"static_reaction_y", "N", -applied.y()});
+  m.push_back({"static_reaction_z", "N", -applied.z()});
+  m.push_back({"max_displacement", "m", solver_->max_displacement()});
+  m.push_back({"kinetic_energy", "J", solver_->kinetic_energy()});
+  m.push_back({"strain_energy", "J", solver_->strain_energy()});
+  return m;
+}
+
+}  // namespace partita::adapters

@@ -1,0 +1,68 @@
+#pragma once
+// Adapter of the native FEM solver (solvers/fem) to the Solver contract.
+//
+// YAML (see spec() or `partita docs fem`): mesh (structured box or Gmsh file), material,
+// constraints, loads, interfaces, analysis (static or Newmark transient).
+//
+// For each interface {name: N, face: F} it exposes two meshes:
+//   N             the face's nodes (with the face triangulated): writes "displacement" [m],
+//                 reads "force" [N] (nodal forces: the conservative coupling input)
+//   N_quadrature  the face's surface quadrature points: reads "traction" [Pa] (the seed's
+//                 route: tractions at the quadrature points, integrated with the face rule)
+// Monitors: N.force_x|y|z (total interface force received [N]), static_reaction_z (the force the
+// interfaces must carry for static equilibrium: minus the sum of the applied loads, gravity
+// included [N]), max_displacement [m], kinetic_energy, strain_energy [J].
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "partita/fem/fem.hpp"
+#include "partita/interface/solver.hpp"
+
+namespace partita::adapters {
+
+class FemAdapter : public Solver {
+ public:
+  FemAdapter(const SolverContext& context);
+
+  const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
+  void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) override;
+  void write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) override;
+  void advance(double dt) override;
+  double time() const override { return solver_->time(); }
+  void save_checkpoint() override;
+  void restore_checkpoint() override;
+  void write_output(const OutputFrame& frame) override;
+  std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
+  std::vector<MonitorValue> monitors() const override;
+
+  static std::shared_ptr<const config::Spec> spec();
+  static std::unique_ptr<Solver> create(const SolverContext& context);
+
+ private:
+  struct Interface {
+    std::string name;
+    std::string face;
+    std::vector<std::size_t> nodes;            // global node ids of the face mesh
+    std::vector<double> qp_weights;            // area of each quadrature point [m^2]
+    Eigen::MatrixX3d nodal_forces;             // last "force" read
+    Eigen::MatrixX3d tractions;                // last "traction" read
+    bool has_forces = false;
+    bool has_tractions = false;
+  };
+  const Interface& find_interface(std::string_view mesh, bool* quadrature) const;
+  void apply_nodal_forces();
+
+  std::string name_;
+  bool transient_ = true;
+  std::unique_ptr<fem::Solver> solver_;
+  fem::SolverState checkpoint_;
+  bool has_checkpoint_ = false;
+  std::vector<Interface> interfaces_;
+  std::vector<InterfaceMesh> meshes_;
+  std::vector<std::pair<std::string, std::string>> files_;
+  Eigen::Vector3d applied_per_unit_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace partita::adapters
