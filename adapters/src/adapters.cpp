@@ -1,5 +1,8 @@
 #include "partita/adapters/register_all.hpp"
 
+#ifdef PARTITA_HAVE_DEM
+#include "dem/dem_adapter.hpp"
+#endif
 #ifdef PARTITA_HAVE_FEM
 #include "fem/fem_adapter.hpp"
 #endif
@@ -11,6 +14,10 @@
 namespace partita::adapters {
 
 void register_all(coupling::Registries& r) {
+#ifdef PARTITA_HAVE_DEM
+  r.solvers.add("dem", "native DEM: Hertz-Mindlin spheres, walls, STL meshes as coupling interfaces",
+                DemAdapter::create, DemAdapter::spec());
+#endif
 #ifdef PARTITA_HAVE_FEM
   r.solvers.add("fem", "native linear-elastic FEM: Hex8/Hex20/Tet4/Tet10, static or Newmark transient",
                 FemAdapter::create, FemAdapter::spec());

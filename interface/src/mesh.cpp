@@ -33,6 +33,15 @@ void Mesh::set_points(Points points) {
   check();
 }
 
+void Mesh::set_weights(Eigen::VectorXd weights) {
+  if (weights.size() != points_.rows())
+    throw Error("mesh '" + name_ + "': " + std::to_string(weights.size()) + " weights for " +
+                std::to_string(points_.rows()) + " points");
+  if (!weights.allFinite() || (weights.size() > 0 && weights.minCoeff() < 0))
+    throw Error("mesh '" + name_ + "': point weights must be finite and >= 0");
+  weights_ = std::move(weights);
+}
+
 Eigen::VectorXd Mesh::triangle_areas() const {
   Eigen::VectorXd a(triangles_.rows());
   // A = |(x1 - x0) x (x2 - x0)| / 2

@@ -215,6 +215,8 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       }
       InterfaceMesh quad;
       quad.mesh = Mesh(itf.name + "_quadrature", qx);
+      quad.mesh.set_weights(Eigen::Map<const Eigen::VectorXd>(itf.qp_weights.data(),
+                                                               static_cast<Eigen::Index>(itf.qp_weights.size())));
       quad.reads.push_back(DataSpec{"traction", 3, "Pa", DataKind::intensive});
       itf.nodal_forces = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(itf.nodes.size()), 3);
       itf.tractions = Eigen::MatrixX3d::Zero(qx.rows(), 3);

@@ -1,5 +1,6 @@
 #include "partita/coupling/mapping/register_mappers.hpp"
 
+#include "partita/coupling/mapping/area_balanced_mapper.hpp"
 #include "partita/coupling/mapping/nearest_neighbor_mapper.hpp"
 #include "partita/coupling/mapping/nearest_projection_mapper.hpp"
 #include "partita/coupling/mapping/rbf_mapper.hpp"
@@ -17,6 +18,10 @@ void register_mappers(Registry<MapperFactory>& registry) {
       "rbf",
       "radial basis functions + linear polynomial (compact Wendland C2, sparse factorisation)",
       RbfMapper::create, RbfMapper::spec());
+  registry.add("area-balanced",
+               "densities between weighted point sets (cell centres <-> quadrature points): "
+               "consistent and integral-preserving (Sinkhorn-balanced Gaussian weights)",
+               AreaBalancedMapper::create, AreaBalancedMapper::spec());
 }
 
 }  // namespace partita::coupling

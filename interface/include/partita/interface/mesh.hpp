@@ -36,6 +36,13 @@ class Mesh {
   /// Replace the coordinates (same number of points), e.g. after a mesh moved.
   void set_points(Points points);
 
+  /// Optional point weights: the area [m^2] each point stands for (a cell-centre mesh: the cell
+  /// areas; a quadrature-point mesh: the quadrature weights). Empty when not given. Mappers that
+  /// preserve integrals of densities use them. Throws on a wrong length or a negative weight.
+  void set_weights(Eigen::VectorXd weights);
+  const Eigen::VectorXd& weights() const { return weights_; }
+  bool has_weights() const { return weights_.size() > 0; }
+
   /// Area of each triangle [m^2] (M).
   Eigen::VectorXd triangle_areas() const;
   /// Unit normal of each triangle, right-hand rule on (v0, v1, v2) (M x 3).
@@ -53,6 +60,7 @@ class Mesh {
   std::string name_;
   Points points_ = Points(0, 3);
   Triangles triangles_ = Triangles(0, 3);
+  Eigen::VectorXd weights_;
 };
 
 }  // namespace partita

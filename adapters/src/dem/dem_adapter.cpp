@@ -1,0 +1,368 @@
+#include "dem_adapter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <map>
+
+#include "partita/dem/error.hpp"
+#include "partita/dem/lammps_data.hpp"
+#include "partita/interface/error.hpp"
+#include "partita/interface/log.hpp"
+#include "partita/interface/stl.hpp"
+
+namespace partita::adapters {
+
+namespace {
+
+using config::Node;
+using config::Spec;
+
+std::shared_ptr<Spec> make_spec() {
+  auto material = std::make_shared<Spec>("material", "bulk properties of a DEM material (particles, walls, meshes)");
+  material->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
+  material->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
+  material->real("density", "mass density rho (used for particles)").unit("kg/m^3").positive().def(2500.0);
+
+  auto interaction = std::make_shared<Spec>("interaction", "contact parameters of a pair of materials");
+  interaction->strings("pair", "the two material names (the same name twice for like contacts)").size(2).required();
+  interaction->real("friction", "Coulomb friction coefficient mu").non_negative().def(0.3);
+  interaction->real("restitution", "normal coefficient of restitution e").range(0.0, 1.0).min(0.0, true).def(0.5);
+  interaction->real("rolling_friction", "rolling friction coefficient mu_r (constant torque mu_r F_n R*)")
+      .non_negative().def(0.0);
+
+  auto box = std::make_shared<Spec>("box", "an axis-aligned box");
+  box->reals("origin", "lower corner").unit("m").size(3).required();
+  box->reals("size", "edge lengths").unit("m").size(3).min(0.0, true).required();
+
+  auto generate = std::make_shared<Spec>("generate", "fill a box with a size distribution to a target porosity");
+  generate->section("box", "the region to fill", box).required();
+  generate->reals("diameters", "particle diameters").unit("m").min(0.0, true).required();
+  generate->reals("fractions", "share of each diameter (any positive scale; default: equal)").min(0.0, true);
+  generate->choice("basis", "fractions by number of particles or by mass", {"number", "mass"}).def("number");
+  generate->real("porosity", "target porosity 1 - solid volume / box volume").range(0.3, 1.0, true).def(0.5);
+  generate->integer("seed", "random seed (same seed, same packing)").min(0).def(1);
+
+  auto particles = std::make_shared<Spec>("particles", "the particles: generated or read from a file");
+  particles->string("material", "material name of the particles").required();
+  particles->section("generate", "generate a packing", generate);
+  particles->string("file", "LAMMPS data file (id type diameter density x y z [+ Velocities]), relative to the case");
+  particles->one_of({"generate", "file"});
+
+  auto plane = std::make_shared<Spec>("plane", "an infinite plane");
+  plane->reals("point", "a point on the plane").unit("m").size(3).required();
+  plane->reals("normal", "normal pointing to the side where the particles are").size(3).required();
+
+  auto wall = std::make_shared<Spec>("wall", "a rigid wall: a plane or the inside of a box");
+  wall->string("name", "name used by the monitors (default: wall<i>)");
+  wall->section("plane", "an infinite plane", plane);
+  wall->section("box", "a box holding the particles inside", box);
+  wall->strings("open", "box faces to leave open").choices({"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"});
+  wall->string("material", "material name").required();
+  wall->reals("velocity", "prescribed translation velocity").unit("m/s").size(3).def(std::vector<double>{0, 0, 0});
+  wall->one_of({"plane", "box"});
+
+  auto grid = std::make_shared<Spec>("rectangle", "a flat rectangle z = origin.z, triangulated in 2 nx ny triangles");
+  grid->reals("origin", "corner with the smallest x and y").unit("m").size(3).required();
+  grid->reals("size", "edge lengths along x and y").unit("m").size(2).min(0.0, true).required();
+  grid->integers("cells", "cells along x and y").size(2).min(1).required();
+  grid->choice("facing", "the side the particles are on", {"down", "up"}).def("down");
+
+  auto mesh = std::make_shared<Spec>("mesh", "a triangle mesh the particles touch; a coupling interface");
+  mesh->string("name", "name: coupling meshes <name> (vertices) and <name>_centres (triangle centroids)").required();
+  mesh->string("stl", "STL file (ASCII or binary), relative to the case file");
+  mesh->real("scale", "factor applied to the STL coordinates (e.g. 1.0e-3 for a file in mm)").positive().def(1.0);
+  mesh->section("rectangle", "generated flat rectangle", grid);
+  mesh->string("material", "material name").required();
+  mesh->one_of({"stl", "rectangle"});
+
+  auto s = std::make_shared<Spec>("dem", "native DEM (solvers/dem): Hertz-Mindlin spheres, planes, triangle meshes");
+  s->any("materials", "map of material name -> {youngs_modulus, poisson_ratio, density}").required();
+  s->list("interactions", "contact parameters of each pair of materials that can touch", interaction).required();
+  s->choice("damping", "restitution model: calibrated (exact e for Hertz) or liggghts (the LIGGGHTS formula)",
+            {"calibrated", "liggghts"}).def("calibrated");
+  s->section("particles", "the particles", particles).required();
+  s->list("walls", "rigid walls", wall);
+  s->list("meshes", "triangle meshes (coupling interfaces)", mesh);
+  s->reals("gravity", "gravitational acceleration").unit("m/s^2").size(3).def(std::vector<double>{0, 0, -9.81});
+  s->real("time_step_fraction", "time step as a fraction of the Rayleigh step of the smallest particle")
+      .range(0.0, 1.0).min(0.0, true).def(0.2);
+  s->real("skin", "Verlet skin (default: 10 % of the largest radius)").unit("m").non_negative();
+  return s;
+}
+
+const std::vector<std::string> kFaces = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+
+Mesh rectangle(const Node& g, const std::string& name) {
+  const Eigen::Vector3d o = g.vec3("origin");
+  const auto size = g.reals("size");
+  const auto cells = g.integers("cells");
+  const long nx = cells[0], ny = cells[1];
+  Mesh::Points p((nx + 1) * (ny + 1), 3);
+  for (long j = 0; j <= ny; ++j)
+    for (long i = 0; i <= nx; ++i)
+      p.row(j * (nx + 1) + i) << o.x() + size[0] * static_cast<double>(i) / static_cast<double>(nx),
+          o.y() + size[1] * static_cast<double>(j) / static_cast<double>(ny), o.z();
+  Mesh::Triangles t(2 * nx * ny, 3);
+  const bool down = g.string("facing") == "down";
+  long k = 0;
+  for (long j = 0; j < ny; ++j)
+    for (long i = 0; i < nx; ++i) {
+      const int a = static_cast<int>(j * (nx + 1) + i), b = a + 1, c = a + static_cast<int>(nx) + 1, d = c + 1;
+      if (down) {
+        t.row(k++) << a, d, b;
+        t.row(k++) << a, c, d;
+      } else {
+        t.row(k++) << a, b, d;
+        t.row(k++) << a, d, c;
+      }
+    }
+  return Mesh(name, p, t);
+}
+
+}  // namespace
+
+std::shared_ptr<const config::Spec> DemAdapter::spec() {
+  static const std::shared_ptr<const config::Spec> s = make_spec();
+  return s;
+}
+
+std::unique_ptr<Solver> DemAdapter::create(const SolverContext& context) { return std::make_unique<DemAdapter>(context); }
+
+DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
+  const Node& c = context.config;
+  auto resolve = [&](const std::filesystem::path& f) { return f.is_relative() ? context.case_dir / f : f; };
+  try {
+    // Materials: a map name -> properties, each validated against the material spec.
+    std::map<std::string, int> materials;
+    std::vector<std::string> material_names;
+    const Node mats = c["materials"];
+    if (!mats.is_map() || mats.size() == 0)
+      mats.fail("expected a map of materials, e.g. materials: {glass: {youngs_modulus: 200 MPa, poisson_ratio: "
+                "0.23, density: 400}}; found " + mats.describe());
+    auto mspec = std::make_shared<Spec>("material", "bulk properties of a DEM material");
+    mspec->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
+    mspec->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
+    mspec->real("density", "mass density rho (used for particles)").unit("kg/m^3").positive().def(2500.0);
+    for (const std::string& m : mats.keys()) {
+      const Node mn = mats[m].validated(mspec);
+      dem::Material mat{mn.real("youngs_modulus"), mn.real("poisson_ratio"), mn.real("density")};
+      materials[m] = system_.add_material(mat);
+      material_names.push_back(m);
+    }
+    auto material_id = [&](const Node& n) {
+      const std::string m = n.as_string();
+      auto it = materials.find(m);
+      if (it == materials.end())
+        n.fail("unknown material '" + m + "'; materials: " + join_names(material_names) + did_you_mean(m, material_names));
+      return it->second;
+    };
+
+    for (const Node& in : c["interactions"].items()) {
+      const auto pair = in["pair"].items();
+      dem::Interaction it{in.real("friction"), in.real("restitution"), in.real("rolling_friction")};
+      system_.add_interaction(material_id(pair[0]), material_id(pair[1]), it);
+    }
+    system_.set_damping_model(c.string("damping") == "liggghts" ? dem::DampingModel::liggghts
+                                                                : dem::DampingModel::calibrated);
+    system_.set_gravity(c.vec3("gravity"));
+    if (c.has("skin")) system_.set_skin(c.real("skin"));
+    time_step_fraction_ = c.real("time_step_fraction");
+
+    // Particles.
+    const Node pn = c["particles"];
+    const int pm = material_id(pn["material"]);
+    if (pn.has("generate")) {
+      const Node g = pn["generate"];
+      dem::PackingSpec ps;
+      ps.lo = g["box"].vec3("origin");
+      ps.hi = ps.lo + g["box"].vec3("size");
+      ps.diameters = g.reals("diameters");
+      ps.fractions = g.has("fractions") ? g.reals("fractions") : std::vector<double>(ps.diameters.size(), 1.0);
+      if (ps.fractions.size() != ps.diameters.size())
+        g["fractions"].fail("expected one fraction per diameter (" + std::to_string(ps.diameters.size()) + "), found " +
+                            std::to_string(ps.fractions.size()));
+      ps.basis = g.string("basis") == "mass" ? dem::PackingSpec::Basis::mass : dem::PackingSpec::Basis::number;
+      ps.porosity = g.real("porosity");
+      ps.seed = static_cast<std::uint64_t>(g.integer("seed"));
+      dem::Packing packing;
+      try {
+        packing = dem::PackingGenerator::generate(ps);
+      } catch (const dem::Error& e) {
+        g.fail(std::string("cannot generate the packing: ") + e.what());
+      }
+      system_.add_particles(packing.positions, packing.radii, pm);
+      log::get("adapters")->info("dem '{}': generated {} particles, porosity {:.3f}, largest overlap {:.2e} m",
+                                 name_, packing.radii.size(), packing.porosity, packing.max_overlap);
+    } else {
+      const std::filesystem::path f = resolve(pn.string("file"));
+      if (!std::filesystem::exists(f)) pn["file"].fail("particle file '" + f.string() + "' does not exist");
+      const dem::LammpsData d = dem::LammpsData::read(f.string());
+      for (std::size_t i = 0; i < d.size(); ++i)
+        system_.add_particle(d.position[i], d.diameter[i] / 2, pm, d.velocity[i], d.angular_velocity[i], d.id[i]);
+    }
+
+    // Walls.
+    int wi = 0;
+    for (const Node& w : c["walls"].items()) {
+      Wall wall;
+      wall.name = w.has("name") ? w.string("name") : "wall" + std::to_string(wi);
+      ++wi;
+      const int mid = material_id(w["material"]);
+      const Eigen::Vector3d v = w.vec3("velocity");
+      if (w.has("plane")) {
+        const Eigen::Vector3d n = w["plane"].vec3("normal");
+        if (!(n.norm() > 0)) w["plane"]["normal"].fail("the normal must not be zero");
+        wall.id = system_.add_plane(w["plane"].vec3("point"), n.normalized(), mid, v);
+      } else {
+        unsigned faces = 0b111111;
+        if (w.has("open"))
+          for (const std::string& f : w.strings("open"))
+            faces &= ~(1u << static_cast<unsigned>(std::find(kFaces.begin(), kFaces.end(), f) - kFaces.begin()));
+        const Eigen::Vector3d lo = w["box"].vec3("origin");
+        wall.id = system_.add_box(lo, lo + w["box"].vec3("size"), mid, faces);
+        if (v.norm() > 0) system_.set_wall_velocity(wall.id, v);
+      }
+      walls_.push_back(wall);
+    }
+
+    // Meshes: the coupling interfaces.
+    for (const Node& m : c["meshes"].items()) {
+      CouplingMesh cm;
+      cm.name = m.string("name");
+      for (const auto& other : meshes_dem_)
+        if (other.name == cm.name) m["name"].fail("mesh name '" + cm.name + "' is used twice");
+      Mesh mesh;
+      if (m.has("stl")) {
+        const std::filesystem::path f = resolve(m.string("stl"));
+        try {
+          mesh = read_stl(f, cm.name, m.real("scale"));
+        } catch (const Error& e) {
+          m["stl"].fail(e.what());
+        }
+      } else {
+        mesh = rectangle(m["rectangle"], cm.name);
+      }
+      cm.reference = mesh.points();
+      cm.positions = mesh.points();
+      cm.areas = mesh.triangle_areas();
+      cm.id = system_.add_mesh(mesh.points(), mesh.triangles(), material_id(m["material"]));
+      InterfaceMesh vertices;
+      vertices.mesh = mesh;
+      vertices.reads.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});
+      vertices.writes.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
+      InterfaceMesh centres;
+      centres.mesh = Mesh(cm.name + "_centres", mesh.triangle_centroids());
+      centres.mesh.set_weights(cm.areas);  // each centre stands for its triangle's area
+      centres.writes.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
+      centres.writes.push_back(DataSpec{"traction", 3, "Pa", DataKind::intensive});
+      meshes_.push_back(std::move(vertices));
+      meshes_.push_back(std::move(centres));
+      meshes_dem_.push_back(std::move(cm));
+    }
+    // Validate the set-up now (interactions of every pair in use, the Rayleigh step).
+    (void)system_.rayleigh_time_step();
+  } catch (const dem::Error& e) {
+    c.fail(std::string("DEM model of participant '") + context.name + "': " + e.what());
+  }
+  log::get("adapters")->info("dem '{}': {} particles, {} walls, {} meshes, Rayleigh step {:.3e} s, time step {:.3e} s",
+                             name_, system_.particle_count(), walls_.size(), meshes_dem_.size(),
+                             system_.rayleigh_time_step(), stable_time_step());
+}
+
+const DemAdapter::CouplingMesh& DemAdapter::find(std::string_view mesh, bool* centres) const {
+  for (const auto& m : meshes_dem_) {
+    if (mesh == m.name) {
+      *centres = false;
+      return m;
+    }
+    if (mesh == m.name + "_centres") {
+      *centres = true;
+      return m;
+    }
+  }
+  throw Error("dem '" + name_ + "' has no mesh '" + std::string(mesh) + "'");
+}
+
+void DemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
+  bool centres = false;
+  const CouplingMesh& cm = find(mesh, &centres);
+  if (centres || data != "displacement")
+    throw Error("dem '" + name_ + "' reads only 'displacement' on mesh '" + cm.name + "'");
+  auto& m = const_cast<CouplingMesh&>(cm);
+  // x = X + d: the vertices follow the other side's displacement.
+  m.positions = m.reference + values;
+  system_.set_vertex_positions(m.id, m.positions);
+}
+
+void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
+  bool centres = false;
+  const CouplingMesh& cm = find(mesh, &centres);
+  if (!centres) {
+    if (data != "force") throw Error("dem '" + name_ + "' writes only 'force' on mesh '" + cm.name + "'");
+    values = system_.vertex_forces(cm.id);
+    return;
+  }
+  const Eigen::MatrixX3d& f = system_.triangle_forces(cm.id);
+  if (data == "force") {
+    values = f;
+  } else if (data == "traction") {
+    // t_i = f_i / A_i (seed 000, Algorithm 1), with the reference areas.
+    values.resize(f.rows(), 3);
+    for (Eigen::Index i = 0; i < f.rows(); ++i) values.row(i) = f.row(i) / cm.areas(i);
+  } else {
+    throw Error("dem '" + name_ + "' writes 'force' and 'traction' on mesh '" + cm.name + "_centres', not '" +
+                std::string(data) + "'");
+  }
+}
+
+double DemAdapter::stable_time_step() const { return time_step_fraction_ * system_.rayleigh_time_step(); }
+
+void DemAdapter::advance(double dt) {
+  try {
+    system_.step(dt);
+  } catch (const dem::Error& e) {
+    throw Error("dem '" + name_ + "' at t = " + fmt::format("{:.6g}", system_.time()) + " s: " + e.what());
+  }
+}
+
+void DemAdapter::save_checkpoint() {
+  checkpoint_ = system_.save_state();
+  has_checkpoint_ = true;
+}
+
+void DemAdapter::restore_checkpoint() {
+  if (!has_checkpoint_) throw Error("dem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
+  system_.restore_state(checkpoint_);
+}
+
+void DemAdapter::write_output(const OutputFrame& frame) {
+  files_.clear();
+  const std::string pfile = fmt::format("{}_particles_{:06d}.vtp", frame.prefix, frame.index);
+  system_.write_particles_vtp((frame.vtk_directory / pfile).string());
+  files_.emplace_back("particles", pfile);
+  for (const auto& m : meshes_dem_) {
+    const std::string mfile = fmt::format("{}_{}_{:06d}.vtp", frame.prefix, m.name, frame.index);
+    system_.write_mesh_vtp(m.id, (frame.vtk_directory / mfile).string());
+    files_.emplace_back(m.name, mfile);
+  }
+}
+
+std::vector<MonitorValue> DemAdapter::monitors() const {
+  std::vector<MonitorValue> v;
+  v.push_back({"kinetic_energy", "J", system_.kinetic_energy()});
+  v.push_back({"particles", "", static_cast<double>(system_.particle_count())});
+  v.push_back({"contacts_per_particle", "", system_.mean_contacts_per_particle()});
+  const char* xyz[] = {"x", "y", "z"};
+  for (const auto& m : meshes_dem_) {
+    const Eigen::Vector3d f = system_.mesh_force(m.id);
+    for (int k = 0; k < 3; ++k) v.push_back({m.name + ".force_" + xyz[k], "N", f(k)});
+  }
+  for (const auto& w : walls_) {
+    const Eigen::Vector3d f = system_.wall_force(w.id);
+    for (int k = 0; k < 3; ++k) v.push_back({w.name + ".force_" + xyz[k], "N", f(k)});
+  }
+  return v;
+}
+
+}  // namespace partita::adapters

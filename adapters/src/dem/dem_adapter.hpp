@@ -1,0 +1,72 @@
+#pragma once
+// Adapter of the native DEM solver (solvers/dem) to the Solver contract.
+//
+// YAML (see spec() or `partita docs dem`): materials, interactions, particles (generated to a
+// porosity or read from a LAMMPS data file), walls (planes, boxes), meshes (STL files or
+// generated rectangles) that are coupling interfaces, gravity, time step fraction, skin.
+//
+// For each mesh {name: M} it exposes two coupling meshes:
+//   M          the mesh vertices with their triangles (reference configuration):
+//              reads "displacement" [m] (vertices placed at reference + displacement; the wall
+//              velocity follows from the motion), writes "force" [N] (contact forces distributed
+//              to the vertices by barycentric weights: the conservative route)
+//   M_centres  the triangle centroids: writes "force" [N] per triangle and "traction" [Pa] =
+//              force / triangle area (the seed's route, Algorithm 1 of seed 000)
+// Monitors: kinetic_energy [J], M.force_x|y|z [N] (force of the particles on mesh M),
+// <wall>.force_x|y|z [N], particles, contacts_per_particle.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "partita/dem/packing_generator.hpp"
+#include "partita/dem/system.hpp"
+#include "partita/interface/solver.hpp"
+
+namespace partita::adapters {
+
+class DemAdapter : public Solver {
+ public:
+  explicit DemAdapter(const SolverContext& context);
+
+  const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
+  void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) override;
+  void write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) override;
+  double stable_time_step() const override;
+  void advance(double dt) override;
+  double time() const override { return system_.time(); }
+  void save_checkpoint() override;
+  void restore_checkpoint() override;
+  void write_output(const OutputFrame& frame) override;
+  std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
+  std::vector<MonitorValue> monitors() const override;
+
+  static std::shared_ptr<const config::Spec> spec();
+  static std::unique_ptr<Solver> create(const SolverContext& context);
+
+ private:
+  struct CouplingMesh {
+    std::string name;
+    int id = -1;                       // DEM mesh id
+    Eigen::MatrixX3d reference;        // vertex positions, reference configuration
+    Eigen::VectorXd areas;             // triangle areas (reference) [m^2]
+    Eigen::MatrixX3d positions;        // current vertex positions (work array)
+  };
+  struct Wall {
+    std::string name;
+    int id = -1;
+  };
+  const CouplingMesh& find(std::string_view mesh, bool* centres) const;
+
+  std::string name_;
+  dem::System system_;
+  double time_step_fraction_ = 0.2;
+  dem::SystemState checkpoint_;
+  bool has_checkpoint_ = false;
+  std::vector<CouplingMesh> meshes_dem_;
+  std::vector<Wall> walls_;
+  std::vector<InterfaceMesh> meshes_;
+  std::vector<std::pair<std::string, std::string>> files_;
+};
+
+}  // namespace partita::adapters
