@@ -87,7 +87,7 @@ TEST_CASE("dem: results do not depend on the number of threads", "[dem][threads]
     set_num_threads(threads);
     System sys = falling_bed(14e-3, 0.6, 9);
     const double dt = 0.2 * sys.rayleigh_time_step();
-    sys.run(400, dt);
+    sys.run(200, dt);
     return sys;
   };
   const int before = max_threads();
