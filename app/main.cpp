@@ -135,9 +135,14 @@ int main(int argc, char** argv) {
   run->add_option("-o,--output", output_dir, "Output folder (default: out/<case name>/)");
   run->add_option("-t,--threads", threads, "Threads for the solvers (default: all cores)")->check(CLI::PositiveNumber);
   run->add_option("--log-level", log_level, "Log level: trace, debug, info, warn, error, critical, off");
+  std::vector<std::string> overrides;
+  run->add_option("--set", overrides, "Change a value of the case: KEY.PATH=VALUE (e.g. time.end=0.01, "
+                                      "participants.plate.loads[0].pressure='20 kPa'); repeatable")
+      ->take_all();
   auto* check = app.add_subcommand("check", "Validate a case completely without running it (or an STL file)");
   check->add_option("case", case_file, "The case file (YAML), or an STL mesh (.stl)")->required();
   check->add_option("--log-level", log_level, "Log level");
+  check->add_option("--set", overrides, "Change a value of the case before checking it: KEY.PATH=VALUE")->take_all();
   app.add_subcommand("list", "List every registered solver, mapper, scheme, acceleration and convergence measure");
   auto* doc = app.add_subcommand("docs", "The parameter reference, generated from the declarations");
   doc->add_option("name", doc_name, "A registered name (see partita list), or 'case' (default)");
@@ -156,6 +161,7 @@ int main(int argc, char** argv) {
 
     partita::coupling::RunOptions options;
     options.output_dir = output_dir;
+    options.overrides = overrides;
 #ifdef _OPENMP
     options.threads = threads > 0 ? threads : omp_get_num_procs();
     omp_set_num_threads(options.threads);
@@ -172,7 +178,8 @@ int main(int argc, char** argv) {
     partita::coupling::CaseRun c(case_file, registries, options);
     c.run();
     plot_csv_files(c.output_dir());
-    std::cout << "partita run: finished; output in " << c.output_dir().string() << "/\n";
+    std::cout << "partita run: finished; output in " << c.output_dir().string() << "/ (CSV time series and their "
+              << "PNG plots; VTK series for ParaView in vtk/*.pvd)\n";
     return 0;
   } catch (const partita::Error& e) {
     std::cerr << "partita: error: " << e.what() << "\n";

@@ -111,7 +111,7 @@ Participant* CaseRun::participant(const std::string& name) const {
 
 CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOptions options)
     : registries_(registries), options_(std::move(options)) {
-  const config::Node root = config::Node::load_file(case_file).validated(case_spec(registries));
+  const config::Node root = config::Node::load_file(case_file, options_.overrides).validated(case_spec(registries));
   name_ = root.string("case");
   case_dir_ = fs::absolute(case_file).parent_path();
   output_dir_ = options_.output_dir.empty() ? fs::current_path() / "out" / name_ : options_.output_dir;

@@ -363,6 +363,68 @@ Node Node::load_file(const std::filesystem::path& file) {
   return load_string(ss.str(), file.string());
 }
 
+Node Node::load_file(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  Node n = load_file(file);
+  if (overrides.empty()) return n;
+  if (!n.node_.IsDefined() || n.node_.IsNull()) n.node_ = YAML::Node(YAML::NodeType::Map);
+  for (const std::string& a : overrides) {
+    const auto eq = a.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw Error("--set '" + a + "': expected KEY.PATH=VALUE, e.g. time.end=0.01 or coupling.exchanges[0].mapper=rbf");
+    const std::string path = a.substr(0, eq);
+    YAML::Node value;
+    try {
+      value = YAML::Load(a.substr(eq + 1));
+    } catch (const YAML::Exception& e) {
+      throw Error("--set '" + a + "': the value is not valid YAML: " + e.msg);
+    }
+    // Walk the path: names separated by '.', indices in brackets.
+    std::vector<YAML::Node> chain{n.node_};
+    std::size_t i = 0;
+    std::string walked;
+    while (i < path.size()) {
+      YAML::Node cur = chain.back();
+      if (path[i] == '[') {
+        const auto close = path.find(']', i);
+        if (close == std::string::npos) throw Error("--set '" + a + "': unclosed '[' in the key path");
+        const std::string idx = path.substr(i + 1, close - i - 1);
+        std::size_t k = 0;
+        try {
+          k = std::stoul(idx);
+        } catch (...) {
+          throw Error("--set '" + a + "': index '" + idx + "' is not a number");
+        }
+        if (!cur.IsSequence() || k >= cur.size())
+          throw Error("--set '" + a + "': '" + walked + "' has no element [" + idx + "]" +
+                      (cur.IsSequence() ? " (it has " + std::to_string(cur.size()) + ")" : " (not a list)"));
+        walked += "[" + idx + "]";
+        i = close + 1;
+        if (i < path.size() && path[i] == '.') ++i;
+        if (i >= path.size()) {
+          cur[k] = value;
+          break;
+        }
+        chain.push_back(cur[k]);
+        continue;
+      }
+      auto end = path.find_first_of(".[", i);
+      if (end == std::string::npos) end = path.size();
+      const std::string key = path.substr(i, end - i);
+      if (key.empty()) throw Error("--set '" + a + "': empty key in the path");
+      if (cur.IsDefined() && !cur.IsNull() && !cur.IsMap())
+        throw Error("--set '" + a + "': '" + walked + "' is not a map, it cannot have key '" + key + "'");
+      walked += (walked.empty() ? "" : ".") + key;
+      i = end < path.size() && path[end] == '.' ? end + 1 : end;
+      if (end >= path.size()) {
+        cur[key] = value;
+        break;
+      }
+      chain.push_back(cur[key]);
+    }
+  }
+  return n;
+}
+
 const std::string& Node::file() const { return file_ ? *file_ : empty_string(); }
 
 SourceLocation Node::location() const {

@@ -45,6 +45,8 @@ struct RunOptions {
   std::filesystem::path output_dir;  ///< empty: out/<case name>/ relative to the current directory
   int threads = 1;
   bool check_only = false;  ///< validate and build everything, write nothing, run nothing
+  /// "key.path[i].key=YAML value" assignments applied to the case file before validation.
+  std::vector<std::string> overrides;
 };
 
 /// What run() measured.

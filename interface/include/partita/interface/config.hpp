@@ -172,6 +172,9 @@ class Node {
 
   /// Parse a YAML file; syntax errors become partita::Error with file, line and column.
   static Node load_file(const std::filesystem::path& file);
+  /// Parse a YAML file, then apply assignments "a.b[2].c=VALUE" (VALUE is YAML: a number, a
+  /// string, [a, b] or {k: v}); a missing key is created, a bad path is a partita::Error.
+  static Node load_file(const std::filesystem::path& file, const std::vector<std::string>& overrides);
   /// Parse YAML text; `name` stands for the file name in messages.
   static Node load_string(const std::string& text, const std::string& name = "<string>");
 
