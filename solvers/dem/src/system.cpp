@@ -364,8 +364,18 @@ void System::run(long steps, double dt) {
 void System::compute_forces(double dt, bool update_history, double kick) {
   const int n = static_cast<int>(particles_.size());
   // One parallel region: the pair loop, a barrier, the per-particle gather (+ half kick).
+  packed_.resize(n);
 #pragma omp parallel if (n >= 1024)
   {
+    // the neighbour data of the pair loop packed together: 96 bytes per particle, so a
+    // neighbour costs 2 cache lines instead of one per array
+    const Particles& p = particles_;
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      PackedParticle& q = packed_[i];
+      q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
+      q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
+    }
     compute_pair_forces(dt, update_history);
     gather_forces(dt, update_history, kick);
   }
@@ -383,18 +393,19 @@ void System::compute_pair_forces(double dt, bool update_history) {
   // the pair's buffer for gather_forces().
 #pragma omp for schedule(dynamic, 128)
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector3d xi = p.position[i];
-    const Eigen::Vector3d vi = p.velocity[i];
-    const Eigen::Vector3d wi = p.angular_velocity[i];
-    const double ri = p.radius[i];
-    const double mi = p.mass[i];
-    const int mat_i = p.material[i];
+    const PackedParticle& qi = packed_[i];
+    const Eigen::Vector3d xi = qi.x;
+    const Eigen::Vector3d vi = qi.v;
+    const Eigen::Vector3d wi = qi.w;
+    const double ri = qi.r;
+    const double mi = qi.m;
+    const int mat_i = qi.material;
     Eigen::Vector3d f = mi * gravity_;
     Eigen::Vector3d t = Eigen::Vector3d::Zero();
     for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
-      const int j = nl.neighbors_[s];
-      const Eigen::Vector3d d = xi - p.position[j];
-      const double rj = p.radius[j];
+      const PackedParticle& qj = packed_[nl.neighbors_[s]];
+      const Eigen::Vector3d d = xi - qj.x;
+      const double rj = qj.r;
       const double rsum = ri + rj;
       const double r2 = d.squaredNorm();
       if (r2 >= rsum * rsum) {
@@ -410,16 +421,16 @@ void System::compute_pair_forces(double dt, bool update_history) {
       const Eigen::Vector3d nrm =
           r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
       const double delta = rsum - r;
-      const double mj = p.mass[j];
-      const PairParameters& pp = model_.pair(mat_i, p.material[j]);
+      const double mj = qj.m;
+      const PairParameters& pp = model_.pair(mat_i, qj.material);
       const double r_eff = ri * rj / rsum;
       const double m_eff = mi * mj / (mi + mj);
       const double cri = ri - 0.5 * delta, crj = rj - 0.5 * delta;
-      const Eigen::Vector3d wj = p.angular_velocity[j];
+      const Eigen::Vector3d wj = qj.w;
       const Eigen::Vector3d w_arm = cri * wi + crj * wj;
       Eigen::Vector3d fij, ft;
-      const double fn = hertz_mindlin(pp, delta, r_eff, m_eff, nrm, vi - p.velocity[j], w_arm,
-                                      nl.shear_[s], dt, update_history, fij, ft);
+      const double fn = hertz_mindlin(pp, delta, r_eff, m_eff, nrm, vi - qj.v, w_arm, nl.shear_[s],
+                                      dt, update_history, fij, ft);
       const Eigen::Vector3d c = nrm.cross(ft);
       Eigen::Vector3d ti = -cri * c;
       pf.torque_j = -crj * c;

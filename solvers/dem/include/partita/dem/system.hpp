@@ -169,7 +169,16 @@ class System {
   std::vector<Eigen::Vector3d> mesh_slot_shear_;
   std::vector<int> mesh_slot_count_;
   // per-contact results of the last force evaluation (for deterministic wall/mesh reductions)
-  std::vector<MeshContactRecord> mesh_records_;    // N x max_mesh_contacts
+  std::vector<MeshContactRecord> mesh_records_;  // N x max_mesh_contacts
+  struct PackedParticle {  // copy of what the pair loop reads about a neighbour
+    Eigen::Vector3d x;
+    double r;
+    Eigen::Vector3d v;
+    double m;
+    Eigen::Vector3d w;
+    int material;
+  };
+  std::vector<PackedParticle> packed_;
   std::vector<Eigen::Vector3d> wall_block_force_;  // blocks x planes
   std::vector<Eigen::Vector3d> wall_force_;        // per wall
   long dropped_mesh_contacts_ = 0;
