@@ -12,7 +12,7 @@ using Catch::Matchers::Contains;
 
 TEST_CASE("every mapper is registered with its options", "[mapping]") {
   const auto& r = mapper_registry();
-  CHECK(r.names() == std::vector<std::string>{"nearest-neighbor", "nearest-projection", "rbf"});
+  for (const char* name : {"nearest-neighbor", "nearest-projection", "rbf"}) CHECK(r.contains(name));
   for (const auto& e : r.entries()) {
     CAPTURE(e.name);
     REQUIRE(e.spec);
