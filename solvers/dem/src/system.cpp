@@ -323,7 +323,7 @@ void System::step(double dt) {
     throw Error(msg.str());
   }
   if (!forces_valid_) {
-    compute_forces(dt, false, 0.0);
+    compute_forces(dt, false, 0.0, false);
     forces_valid_ = true;
   }
   for (TriangleMesh& m : meshes_) {
@@ -337,19 +337,22 @@ void System::step(double dt) {
   const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
   const bool have_build = x_build.size() == p.size();
   double moved2 = 0.0;  // largest squared displacement since the last neighbour build
-  // Velocity Verlet, first half: v += dt/2 F/m, x += dt v, omega += dt/2 T/I.
+  packed_.resize(n);
+  // Velocity Verlet, first half: v += dt/2 F/m, x += dt v, omega += dt/2 T/I (and the packed
+  // copy the pair loop reads).
 #pragma omp parallel for schedule(static) reduction(max : moved2) if (n >= 1024)
   for (long i = 0; i < n; ++i) {
     p.velocity[i] += (half / p.mass[i]) * p.force[i];
     p.position[i] += dt * p.velocity[i];
     p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
     if (have_build) moved2 = std::max(moved2, (p.position[i] - x_build[i]).squaredNorm());
+    pack(i);
   }
   for (PlaneWall& w : planes_) w.point += dt * w.velocity;
   if (!have_build || neighbors_.needs_rebuild(moved2, planes_, meshes_))
     neighbors_.build(p, planes_, meshes_);
   // forces at t + dt, then the second half: v += dt/2 F/m, omega += dt/2 T/I (in the gather)
-  compute_forces(dt, true, half);
+  compute_forces(dt, true, half, true);
   for (TriangleMesh& m : meshes_) m.position_last_step_ = m.position_;
   time_ += dt;
   ++steps_;
@@ -361,21 +364,24 @@ void System::run(long steps, double dt) {
 
 // ---- forces -----------------------------------------------------------------------------------
 
-void System::compute_forces(double dt, bool update_history, double kick) {
+// The neighbour data of the pair loop packed together: 96 bytes per particle, so a neighbour
+// costs 2 cache lines instead of one per array.
+void System::pack(long i) {
+  const Particles& p = particles_;
+  PackedParticle& q = packed_[i];
+  q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
+  q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
+}
+
+void System::compute_forces(double dt, bool update_history, double kick, bool packed) {
   const int n = static_cast<int>(particles_.size());
+  if (!packed) {
+    packed_.resize(n);
+    for (int i = 0; i < n; ++i) pack(i);
+  }
   // One parallel region: the pair loop, a barrier, the per-particle gather (+ half kick).
-  packed_.resize(n);
 #pragma omp parallel if (n >= 1024)
   {
-    // the neighbour data of the pair loop packed together: 96 bytes per particle, so a
-    // neighbour costs 2 cache lines instead of one per array
-    const Particles& p = particles_;
-#pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      PackedParticle& q = packed_[i];
-      q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
-      q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
-    }
     compute_pair_forces(dt, update_history);
     gather_forces(dt, update_history, kick);
   }

@@ -141,7 +141,9 @@ class System {
   void check_mesh(int mesh, const char* what) const;
   void resize_histories();
   // forces at the current positions; kick > 0: then v += kick F/m, omega += kick T/I
-  void compute_forces(double dt, bool update_history, double kick);
+  // packed: packed_ is up to date (else it is filled first)
+  void compute_forces(double dt, bool update_history, double kick, bool packed);
+  void pack(long i);
   // called inside a parallel region (orphaned omp for)
   void compute_pair_forces(double dt, bool update_history);
   void gather_forces(double dt, bool update_history, double kick);
