@@ -15,7 +15,7 @@ cd "$(dirname "$0")"
 
 PACKAGES=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
           catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib)
-DEFAULT_CASE=cases/elastic_tube_1d/iqn-ils.yaml
+DEFAULT_CASE=cases/uniaxial_compaction/steel.yaml
 JOBS=${JOBS:-$(nproc)}
 
 install_deps() {

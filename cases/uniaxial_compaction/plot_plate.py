@@ -73,8 +73,15 @@ def main(argv):
     deflection = max(abs(w) for w in fw)
     print(f"largest deflection of the FE lower face: {deflection:.4e} m; largest distance of an STL "
           f"vertex from it: {gap:.4e} m ({100 * gap / deflection:.3f} % of the deflection)")
+    span = max(fw) - min(fw)
+    print(f"stl_gap_fraction={gap / deflection:.6g}")
+    print(f"stl_gap_fraction_of_bending={gap / span:.6g}  (bending: max - min of u_z = {span:.4e} m)")
 
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError:
+        print("plot_plate: python3-matplotlib is not installed; no picture", file=sys.stderr)
+        return 0
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 3, figsize=(14, 4.2), dpi=110)
@@ -88,11 +95,9 @@ def main(argv):
         a.set_xlabel("x [mm]")
         a.set_ylabel("y [mm]")
         fig.colorbar(c, ax=a, label="deflection u_z [um]")
-    ymid = xs[len(ys) // 2] if ys else 0.01
     ymid = ys[len(ys) // 2]
     fsec = sorted((x, w) for x, y, w in zip(fx, fy, fw) if abs(y - ymid) < 1e-9)
     ax[2].plot([p[0] * 1e3 for p in fsec], [p[1] * 1e6 for p in fsec], "o-", ms=3, label="FE lower face")
-    ssec = sorted((x, fe_z(x, ymid) - zmin, ) for x in sorted(set(sx)))
     near = sorted((x, w) for x, y, w in zip(sx, sy, sw) if abs(y - ymid) <= 0.6 * (ys[1] - ys[0]))
     ax[2].plot([p[0] * 1e3 for p in near], [p[1] * 1e6 for p in near], "s", ms=4, mfc="none",
                label="STL vertices near the section")

@@ -214,6 +214,15 @@ void CaseRun::build_participants(const config::Node& root) {
     std::unique_ptr<Solver> solver = entry.factory(ctx);
     if (!solver) pn.fail("solver '" + entry.name + "' could not be built");
     Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
+    // A fixed number of substeps must not exceed the solver's stable time step.
+    const double stable = solver->stable_time_step();
+    if (!s.automatic && window_size_ / s.count > stable * (1.0 + 1e-12)) {
+      const config::Node where = substeps.count(name) ? coupling["substeps"][name] : pn;
+      where.fail(fmt::format("participant '{}' would step {:.4g} s (window {:.4g} s / {} substeps), above its stable "
+                             "time step {:.4g} s; use substeps: {{{}: {}}} or more, or {{{}: auto}}",
+                             name, window_size_ / s.count, window_size_, s.count, stable, name,
+                             static_cast<long>(std::ceil(window_size_ / stable * (1.0 - 1e-12))), name));
+    }
     participants_.push_back(std::make_unique<Participant>(name, std::move(solver), s));
     if (participants_.back()->solver().meshes().empty())
       pn.fail("solver '" + entry.name + "' of participant '" + name + "' exposes no coupling mesh");

@@ -13,6 +13,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Options by name (robust to fields added later).
+coupling::RunOptions run_options(const std::filesystem::path& dir, bool check_only) {
+  coupling::RunOptions o;
+  o.output_dir = dir;
+  o.check_only = check_only;
+  return o;
+}
+
 coupling::Registries registries() {
   coupling::Registries r;
   coupling::register_builtin(r);
@@ -80,9 +88,9 @@ TEST_CASE("Elastic tube (t = 0.1): IQN-ILS converges in every window, with fewer
           "[adapters][tube1d][case]") {
   const auto r = registries();
   const fs::path out = fs::temp_directory_path() / ("partita_tube_out_" + std::to_string(::getpid()));
-  coupling::CaseRun iqn(shortened("iqn-ils", "0.1"), r, coupling::RunOptions{out / "iqn", 1, false});
+  coupling::CaseRun iqn(shortened("iqn-ils", "0.1"), r, run_options(out / "iqn", false));
   iqn.run();
-  coupling::CaseRun aitken(shortened("aitken", "0.1"), r, coupling::RunOptions{out / "aitken", 1, false});
+  coupling::CaseRun aitken(shortened("aitken", "0.1"), r, run_options(out / "aitken", false));
   aitken.run();
   const auto& si = iqn.summary();
   const auto& sa = aitken.summary();
@@ -100,7 +108,7 @@ TEST_CASE("Every elastic tube case file validates (check_only)", "[adapters][tub
   const auto r = registries();
   for (const char* c : {"constant", "aitken", "iqn-ils"}) {
     coupling::CaseRun run(fs::path(PARTITA_SOURCE_DIR) / "cases/elastic_tube_1d" / (std::string(c) + ".yaml"), r,
-                          coupling::RunOptions{"unused", 1, true});
+                          run_options("unused", true));
     CHECK(run.window_count() == 100);
   }
 }

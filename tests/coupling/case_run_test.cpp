@@ -14,6 +14,14 @@ using namespace partita::coupling;
 
 namespace {
 
+// Options by name (robust to fields added later).
+RunOptions run_options(const std::filesystem::path& dir, bool check_only) {
+  RunOptions o;
+  o.output_dir = dir;
+  o.check_only = check_only;
+  return o;
+}
+
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
@@ -60,7 +68,7 @@ std::string implicit_case(const std::string& acceleration = "{type: iqn-ils, ini
 std::string error_of(const std::string& name, const std::string& text) {
   const Registries r = test::test_registries();
   try {
-    CaseRun run(write_case(name, text), r, RunOptions{scratch("out_" + name), 1, true});
+    CaseRun run(write_case(name, text), r, run_options(scratch("out_" + name), true));
   } catch (const Error& e) {
     return e.what();
   }
@@ -72,7 +80,7 @@ std::string error_of(const std::string& name, const std::string& text) {
 TEST_CASE("CaseRun runs a YAML case and writes coupling.csv, monitors and VTK series", "[coupling][case]") {
   const Registries r = test::test_registries();
   const fs::path out = scratch("run_ok");
-  CaseRun run(write_case("ok", implicit_case()), r, RunOptions{out, 1, false});
+  CaseRun run(write_case("ok", implicit_case()), r, run_options(out, false));
   CHECK(run.window_count() == 10);
   run.run();
   const std::string csv = read_text(out / "coupling.csv");
@@ -92,7 +100,7 @@ TEST_CASE("CaseRun runs a YAML case and writes coupling.csv, monitors and VTK se
 TEST_CASE("CaseRun check_only builds everything and writes nothing", "[coupling][case]") {
   const Registries r = test::test_registries();
   const fs::path out = scratch("check_only") / "never";
-  CaseRun run(write_case("check", implicit_case()), r, RunOptions{out, 1, true});
+  CaseRun run(write_case("check", implicit_case()), r, run_options(out, true));
   run.run();
   CHECK_FALSE(fs::exists(out));
   CHECK(run.scheme().name() == "implicit-serial");
@@ -160,7 +168,7 @@ TEST_CASE("CaseRun: substeps auto follow the solver's stable time step", "[coupl
   std::string text = implicit_case();
   text.replace(text.find("reads: y1, a: 1.5"), 17, "reads: y1, stable_dt: 0.03, a: 1.5");
   text.replace(text.find("  exchanges:"), 0, "  substeps: {two: auto}\n");
-  CaseRun run(write_case("auto", text), r, RunOptions{scratch("auto_out"), 1, true});
+  CaseRun run(write_case("auto", text), r, run_options(scratch("auto_out"), true));
   CHECK(run.participant("two")->substeps(0.1) == 4);  // ceil(0.1 / 0.03)
   CHECK(run.participant("one")->substeps(0.1) == 1);
 }

@@ -260,6 +260,18 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
       meshes_.push_back(std::move(centres));
       meshes_dem_.push_back(std::move(cm));
     }
+    // Every pair that can touch needs an interaction: particles with particles, walls and meshes.
+    std::vector<int> partners{pm};
+    for (const Node& w : c["walls"].items()) partners.push_back(material_id(w["material"]));
+    for (const Node& m : c["meshes"].items()) partners.push_back(material_id(m["material"]));
+    for (int b : partners)
+      if (!system_.contact_model().has_interaction(pm, b)) {
+        const std::string& na = material_names[static_cast<std::size_t>(pm)];
+        const std::string& nb = material_names[static_cast<std::size_t>(b)];
+        c["interactions"].fail("no interaction between materials '" + na + "' and '" + nb +
+                               "', which can touch; add {pair: [" + na + ", " + nb +
+                               "], friction: 0.3, restitution: 0.5}");
+      }
     // Validate the set-up now (interactions of every pair in use, the Rayleigh step).
     (void)system_.rayleigh_time_step();
   } catch (const dem::Error& e) {

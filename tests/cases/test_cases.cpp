@@ -1,0 +1,166 @@
+// The generic case test: for every cases/<name>/checks.yaml, run each listed (shortened) run of a
+// case through the partita executable and assert its checks. A check compares the mean of a CSV
+// column over the last fraction of the rows with another column's mean, a value, or a bound, or
+// reads "key=value" lines printed by a post-processing script of the case folder.
+
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::pair<int, std::string> shell(const std::string& cmd) {
+  std::string out;
+  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+  if (!p) return {-1, "popen failed"};
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  int column(const std::string& name) const {
+    for (std::size_t i = 0; i < header.size(); ++i)
+      if (header[i] == name) return static_cast<int>(i);
+    return -1;
+  }
+  double mean(int col, double over_last) const {
+    const std::size_t n = rows.size();
+    const std::size_t first = n - std::max<std::size_t>(1, static_cast<std::size_t>(over_last * static_cast<double>(n)));
+    double s = 0;
+    for (std::size_t r = first; r < n; ++r) s += rows[r][static_cast<std::size_t>(col)];
+    return s / static_cast<double>(n - first);
+  }
+};
+
+Csv read_csv(const fs::path& f) {
+  Csv c;
+  std::ifstream in(f);
+  std::string line;
+  if (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) c.header.push_back(cell);
+  }
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) row.push_back(std::stod(cell));
+    if (row.size() == c.header.size()) c.rows.push_back(row);
+  }
+  return c;
+}
+
+std::map<std::string, double> key_values(const std::string& text) {
+  std::map<std::string, double> kv;
+  std::stringstream ss(text);
+  std::string line;
+  while (std::getline(ss, line)) {
+    const auto eq = line.find('=');
+    if (eq == std::string::npos || line.find(' ') < eq) continue;
+    try {
+      kv[line.substr(0, eq)] = std::stod(line.substr(eq + 1));
+    } catch (...) {
+    }
+  }
+  return kv;
+}
+
+void compare(const YAML::Node& check, double value, const std::string& what, const std::function<double(const std::string&)>& column_mean) {
+  INFO(what << " = " << value);
+  if (check["equals_mean_of"]) {
+    const double ref = column_mean(check["equals_mean_of"].as<std::string>());
+    INFO("reference (mean of " << check["equals_mean_of"].as<std::string>() << ") = " << ref);
+    CHECK(std::abs(value - ref) <= check["rel_tol"].as<double>() * std::abs(ref));
+  }
+  if (check["equals"]) {
+    const double ref = check["equals"].as<double>();
+    INFO("reference = " << ref);
+    CHECK(std::abs(value - ref) <= check["rel_tol"].as<double>() * std::abs(ref));
+  }
+  if (check["at_most"]) CHECK(value <= check["at_most"].as<double>());
+  if (check["at_least"]) CHECK(value >= check["at_least"].as<double>());
+}
+
+}  // namespace
+
+TEST_CASE("cases: shortened runs meet their reference values", "[cases]") {
+  const fs::path root = fs::path(PARTITA_SOURCE_DIR) / "cases";
+  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  int runs = 0;
+  for (const auto& dir : fs::directory_iterator(root)) {
+    const fs::path checks = dir.path() / "checks.yaml";
+    if (!fs::exists(checks)) continue;
+    const YAML::Node doc = YAML::LoadFile(checks.string());
+    for (const YAML::Node& run : doc["runs"]) {
+      const std::string name = run["name"].as<std::string>();
+      DYNAMIC_SECTION(dir.path().filename().string() << "/" << name) {
+        ++runs;
+        const fs::path out = fs::temp_directory_path() / ("partita_case_" + name + "_" + std::to_string(::getpid()));
+        fs::remove_all(out);
+        std::string cmd = quote(PARTITA_EXECUTABLE) + " run " + quote((dir.path() / run["case"].as<std::string>()).string()) +
+                          " --output " + quote(out.string()) + " --threads 1 --log-level warn";
+        for (const auto& s : run["set"]) cmd += " --set " + quote(s.as<std::string>());
+        const auto [status, output] = shell(cmd);
+        INFO("command: " << cmd << "\noutput:\n" << output);
+        REQUIRE(status == 0);
+        std::map<std::string, Csv> csvs;
+        auto csv = [&](const std::string& file) -> const Csv& {
+          if (!csvs.count(file)) csvs[file] = read_csv(out / file);
+          return csvs[file];
+        };
+        for (const YAML::Node& check : run["checks"]) {
+          if (check["script"]) {
+            const auto [st, text] = shell(python + " " + quote((dir.path() / check["script"].as<std::string>()).string()) +
+                                          " " + quote(out.string()));
+            INFO("script output:\n" << text);
+            REQUIRE(st == 0);
+            const auto kv = key_values(text);
+            const std::string key = check["key"].as<std::string>();
+            REQUIRE(kv.count(key) == 1);
+            compare(check, kv.at(key), key, {});
+            continue;
+          }
+          const std::string file = check["file"].as<std::string>();
+          const Csv& c = csv(file);
+          REQUIRE(c.rows.size() > 0);
+          const double over = check["over_last"] ? check["over_last"].as<double>() : 0.2;
+          auto column_mean = [&](const std::string& col) {
+            const int k = c.column(col);
+            INFO("column '" << col << "' of " << file);
+            REQUIRE(k >= 0);
+            return c.mean(k, over);
+          };
+          const std::string col = check["mean_of"].as<std::string>();
+          compare(check, column_mean(col), "mean of " + col + " over the last " + std::to_string(over) + " of " + file,
+                  column_mean);
+        }
+        fs::remove_all(out);
+      }
+    }
+  }
+  CHECK(runs >= 0);
+}
