@@ -4,7 +4,7 @@
 Usage: plot_monitors.py FILE.csv [FILE.csv ...]
 Each CSV has a header like "time [s],granules.plate.force_z [N],plate.applied_force_z [N]".
 The PNG is written beside the CSV (same name, .png), under a temporary name and then renamed.
-Columns whose name contains "applied" or "reference" are drawn dashed (the expected value).
+Columns whose name contains "applied", "reference" or "static" are drawn dashed (expected values).
 """
 import csv
 import os
@@ -28,7 +28,7 @@ def plot(path):
     fig, ax = plt.subplots(figsize=(7, 4.2), dpi=120)
     units = set()
     for name, y in zip(header[1:], cols[1:]):
-        dashed = "applied" in name or "reference" in name
+        dashed = any(k in name for k in ("applied", "reference", "static"))
         ax.plot(x, y, "--" if dashed else "-", lw=1.6 if dashed else 1.2, label=name)
         if "[" in name:
             units.add(name[name.index("[") + 1:name.rindex("]")])
