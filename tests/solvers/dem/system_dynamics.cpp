@@ -93,3 +93,32 @@ TEST_CASE("dem: a settled column puts its whole weight on the floor", "[dem][phy
                             << " N, kinetic energy " << sys.kinetic_energy() << " J");
   CHECK(mean == Approx(weight).epsilon(0.005));
 }
+
+TEST_CASE("dem: wide size distribution: a large sphere rests on a bed of small ones",
+          "[dem][physics]") {
+  // Radius ratio 10: cells are sized by the largest sphere; every contact must still be found.
+  // A 5 mm sphere settles on a layer of 0.5 mm spheres: the floor carries the total weight and
+  // the large sphere does not fall through.
+  System sys;
+  const int m = sys.add_material({1.0e7, 0.3, 2500.0});
+  sys.add_interaction(m, m, {0.3, 0.3, 0.0});
+  sys.set_gravity({0, 0, -9.81});
+  const double r = 0.5e-3, big = 5e-3, w = 12e-3;
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j) sys.add_particle({r + 2 * r * i, r + 2 * r * j, r}, r, m);
+  const std::size_t b = sys.add_particle({w / 2, w / 2, 2 * r + big + 1e-4}, big, m);
+  sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(w, w, 1.0), m, 0b011111);
+  double weight = 0.0;
+  for (double mass : sys.particles().mass) weight += 9.81 * mass;
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  sys.run(static_cast<long>(0.3 / dt), dt);
+  double mean = 0.0;
+  for (int s = 0; s < 2000; ++s) {
+    sys.step(dt);
+    mean += -sys.wall_force(0).z() / 2000;
+  }
+  INFO("floor force " << mean << " N, weight " << weight
+                      << " N, big sphere at z = " << sys.particles().position[b].z());
+  CHECK(sys.particles().position[b].z() > r + big);  // held by the small spheres, not the floor
+  CHECK(mean == Approx(weight).epsilon(0.005));
+}
