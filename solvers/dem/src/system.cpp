@@ -484,13 +484,20 @@ void System::gather_forces(double dt, bool update_history, double kick) {
       }
       // Planes near i: overlap delta = R - (x - x_w).n_w, R* = R, m* = m.
       const double ri = p.radius[i];
-      auto plane_contact = [&](int k) {
+      // (a plain loop, no lambda: f and t stay in registers)
+      std::uint64_t mask = np <= 64 ? nl.plane_mask_[i] : 0;
+      for (int k = 0; k < np; ++k) {
+        if (np <= 64) {  // jump to the next plane near i
+          if (mask == 0) break;
+          k = std::countr_zero(mask);
+          mask &= mask - 1;
+        }
         const PlaneWall& w = planes_[k];
         Eigen::Vector3d& shear = plane_shear_[static_cast<std::size_t>(i) * np + k];
         const double delta = ri - (p.position[i] - w.point).dot(w.normal);
         if (delta <= 0.0) {
           shear.setZero();
-          return;
+          continue;
         }
         const PairParameters& pp = model_.pair(p.material[i], w.material);
         const double cr = ri - 0.5 * delta;
@@ -505,14 +512,13 @@ void System::gather_forces(double dt, bool update_history, double kick) {
           if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * ri / wn) * p.angular_velocity[i];
         }
         block_wall[k] -= fw;
-      };
-      if (np <= 64) {
-        for (std::uint64_t mask = nl.plane_mask_[i]; mask != 0; mask &= mask - 1)
-          plane_contact(std::countr_zero(mask));
-      } else {
-        for (int k = 0; k < np; ++k) plane_contact(k);
       }
-      if (have_meshes) mesh_contacts(i, dt, update_history, f, t);
+      if (have_meshes) {  // own accumulators: f and t keep their registers
+        Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
+        mesh_contacts(i, dt, update_history, fm, tm);
+        f += fm;
+        t += tm;
+      }
       p.force[i] = f;
       p.torque[i] = t;
       if (kick > 0.0) {
