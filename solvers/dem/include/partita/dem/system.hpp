@@ -41,7 +41,8 @@ namespace partita::dem {
 
 class System {
  public:
-  /// Contacts one particle keeps with mesh features (faces, edges, vertices) at a time.
+  /// Contacts one particle keeps with mesh features (faces, edges, vertices) at a time; further
+  /// ones (only in extreme geometries) are ignored.
   static constexpr int max_mesh_contacts = 8;
 
   System();
@@ -183,7 +184,6 @@ class System {
   std::vector<PackedParticle> packed_;
   std::vector<Eigen::Vector3d> wall_block_force_;  // blocks x planes
   std::vector<Eigen::Vector3d> wall_force_;        // per wall
-  long dropped_mesh_contacts_ = 0;
 };
 
 }  // namespace partita::dem
