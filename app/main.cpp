@@ -83,6 +83,16 @@ void plot_csv_files(const std::filesystem::path& dir) {
     partita::log::get("app")->info("plots: {}/*.png", dir.string());
 }
 
+// The case's post-processing scripts (output.scripts), with the output folder as argument.
+void run_scripts(const std::vector<std::filesystem::path>& scripts, const std::filesystem::path& dir) {
+  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  for (const auto& s : scripts) {
+    const std::string cmd = python + " '" + s.string() + "' '" + dir.string() + "'";
+    partita::log::get("app")->info("post-processing: {}", s.filename().string());
+    if (std::system(cmd.c_str()) != 0) partita::log::get("app")->warn("post-processing script {} failed", s.string());
+  }
+}
+
 int list(const Registries& r) {
   for_each_registry(r, [](const char* heading, const auto& reg) {
     std::cout << heading << ":\n";
@@ -178,6 +188,7 @@ int main(int argc, char** argv) {
     partita::coupling::CaseRun c(case_file, registries, options);
     c.run();
     plot_csv_files(c.output_dir());
+    run_scripts(c.scripts(), c.output_dir());
     std::cout << "partita run: finished; output in " << c.output_dir().string() << "/ (CSV time series and their "
               << "PNG plots; VTK series for ParaView in vtk/*.pvd)\n";
     return 0;

@@ -74,6 +74,8 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
   auto output = std::make_shared<Spec>("output", "VTK output under DIR/vtk");
   output->real("every", "simulated time between frames (default: first and last frame only)").unit("s").positive();
   output->boolean("interface", "also write the interface meshes with their exchanged data (.vtp)").def(true);
+  output->strings("scripts", "post-processing scripts of the case folder, run by `partita run` after the last "
+                             "window with the output folder as argument (e.g. plots of the final state)");
 
   auto root = std::make_shared<Spec>("case", "a coupled simulation");
   root->string("case", "the case's name (output goes to out/<name> by default)").required();
@@ -120,6 +122,12 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
   window_size_ = time.real("window");
   window_count_ = time.has("windows") ? time.integer("windows") : TimeWindow::count_to(time.real("end"), window_size_);
   if (root.has("output") && root["output"].has("every")) output_every_ = root["output"].real("every");
+  if (root.has("output") && root["output"].has("scripts"))
+    for (const config::Node& sn : root["output"]["scripts"].items()) {
+      const fs::path script = case_dir_ / sn.as_string();
+      if (!fs::exists(script)) sn.fail("post-processing script '" + script.string() + "' does not exist");
+      scripts_.push_back(script);
+    }
 
   build_participants(root);
   const config::Node coupling = root["coupling"];

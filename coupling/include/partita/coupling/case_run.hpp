@@ -76,6 +76,8 @@ class CaseRun {
   void run();
 
   const std::filesystem::path& output_dir() const { return output_dir_; }
+  /// Post-processing scripts of the case (output.scripts), as paths; the caller runs them.
+  const std::vector<std::filesystem::path>& scripts() const { return scripts_; }
   const std::string& name() const { return name_; }
   const RunSummary& summary() const { return summary_; }
   double window_size() const { return window_size_; }
@@ -95,6 +97,7 @@ class CaseRun {
   RunOptions options_;
   std::string name_;
   std::filesystem::path case_dir_, output_dir_;
+  std::vector<std::filesystem::path> scripts_;
   double window_size_ = 0.0;
   std::int64_t window_count_ = 0;
   double output_every_ = 0.0;  // 0: first and last frame only
