@@ -17,6 +17,9 @@ PACKAGES=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libspdl
           catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib)
 DEFAULT_CASE=cases/uniaxial_compaction/steel.yaml
 JOBS=${JOBS:-$(nproc)}
+# OpenMP threads sleep instead of spinning when they wait: tests run side by side (ctest -j) and a
+# spinning barrier on an oversubscribed core costs a whole scheduler slice.
+export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
 
 install_deps() {
   local missing=()

@@ -392,12 +392,18 @@ void CaseRun::run() {
     }
     m.csv = CsvSeries(output_dir_ / (m.name + ".csv"), "time", "s", mc);
   }
+  // The quantities each participant must report, asked for once per window.
+  std::map<Participant*, std::vector<std::string>> wanted;
+  for (const auto& m : monitors_)
+    for (const auto& [p, q] : m.quantities) wanted[p].push_back(q);
+  std::map<Participant*, std::vector<MonitorValue>> values;
   auto record_monitors = [&](double t) {
+    for (const auto& [p, names] : wanted) values[p] = p->solver().monitor_values(names);
     for (auto& m : monitors_) {
       std::vector<double> row;
       for (const auto& [p, q] : m.quantities) {
         double v = std::nan("");
-        for (const auto& mv : p->solver().monitors())
+        for (const auto& mv : values[p])
           if (mv.name == q) v = mv.value;
         row.push_back(v);
       }

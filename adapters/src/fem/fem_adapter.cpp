@@ -313,7 +313,14 @@ void FemAdapter::write_output(const OutputFrame& frame) {
   files_ = {{"fem", file}};
 }
 
-std::vector<MonitorValue> FemAdapter::monitors() const {
+std::vector<MonitorValue> FemAdapter::monitors() const { return monitor_values({}); }
+
+// names empty: all quantities. The energies (a sparse product over the whole mesh each) are
+// computed only when asked for.
+std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::string>& names) const {
+  auto wanted = [&](const std::string& n) {
+    return names.empty() || std::find(names.begin(), names.end(), n) != names.end();
+  };
   std::vector<MonitorValue> m;
   for (const auto& i : interfaces_) {
     // Total force the interface received: sum_q t_q w_q (tractions) + sum_a f_a (nodal forces).
@@ -330,9 +337,13 @@ std::vector<MonitorValue> FemAdapter::monitors() const {
   m.push_back({"static_reaction_y", "N", -applied.y()});
   m.push_back({"static_reaction_z", "N", -applied.z()});
   m.push_back({"max_displacement", "m", solver_->max_displacement()});
-  m.push_back({"kinetic_energy", "J", solver_->kinetic_energy()});
-  m.push_back({"strain_energy", "J", solver_->strain_energy()});
-  return m;
+  if (wanted("kinetic_energy")) m.push_back({"kinetic_energy", "J", solver_->kinetic_energy()});
+  if (wanted("strain_energy")) m.push_back({"strain_energy", "J", solver_->strain_energy()});
+  if (names.empty()) return m;
+  std::vector<MonitorValue> out;
+  for (auto& v : m)
+    if (wanted(v.name)) out.push_back(v);
+  return out;
 }
 
 }  // namespace partita::adapters

@@ -36,6 +36,7 @@ class FemAdapter : public Solver {
   void write_output(const OutputFrame& frame) override;
   std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
   std::vector<MonitorValue> monitors() const override;
+  std::vector<MonitorValue> monitor_values(const std::vector<std::string>& names) const override;
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);

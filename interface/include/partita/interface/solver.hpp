@@ -110,8 +110,19 @@ class Solver {
   /// name each (e.g. {"particles", "granules_particles_000012.vtp"}).
   virtual std::vector<std::pair<std::string, std::string>> output_files() const { return {}; }
 
-  /// Scalar quantities after the last accepted window.
+  /// Scalar quantities after the last accepted window (all of them: names, units, values).
   virtual std::vector<MonitorValue> monitors() const { return {}; }
+
+  /// Only the named quantities (unknown names are left out). The core calls this once per
+  /// window with the quantities the case records. The default filters monitors(); a solver with
+  /// expensive quantities (energies over a whole mesh) overrides it to compute only those asked.
+  virtual std::vector<MonitorValue> monitor_values(const std::vector<std::string>& names) const {
+    std::vector<MonitorValue> all = monitors(), out;
+    for (auto& v : all)
+      for (const auto& n : names)
+        if (v.name == n) out.push_back(v);
+    return out;
+  }
 
   /// Once after the last window.
   virtual void finalize() {}
