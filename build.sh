@@ -59,8 +59,10 @@ case "$cmd" in
   test)
     install_deps
     if [ "${1:-}" = "--sanitize" ]; then
-      # Sanitizers: RelWithDebInfo (-O2 -g), benchmarks not built; ASan's leak checker on.
-      configure_and_build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARTITA_SANITIZE=ON -DPARTITA_BUILD_BENCH=OFF
+      # Sanitizers: -O1 with assertions on (no NDEBUG), benchmarks not built; ASan's leak checker on.
+      # (-O1 builds in about 4.5 min on 2 cores and runs the suite in about 2 min.)
+      configure_and_build build-asan -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O1" \
+        -DPARTITA_SANITIZE=ON -DPARTITA_BUILD_BENCH=OFF
       export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
       ctest --test-dir build-asan --output-on-failure -j "$JOBS"
     else
