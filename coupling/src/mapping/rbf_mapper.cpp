@@ -144,10 +144,10 @@ std::shared_ptr<const config::Spec> RbfMapper::spec() {
             {"separate", "on", "off"})
       .def("separate");
   s->choice("solver",
-            "compact system: cholesky (sparse factorisation) or cg (conjugate gradients, large "
-            "meshes)",
-            {"cholesky", "cg"})
-      .def("cholesky");
+            "compact system: cholesky (sparse factorisation), cg (conjugate gradients, large "
+            "meshes) or auto (cholesky up to 20000 points, cg above)",
+            {"auto", "cholesky", "cg"})
+      .def("auto");
   s->real("tolerance", "relative residual at which cg stops").positive().def(1e-10);
   return s;
 }
@@ -177,7 +177,8 @@ std::unique_ptr<Mapper> RbfMapper::create(const MapperContext& context) {
     radius = o.real("support_radius");
   }
   try {
-    const Solver solver = o.string("solver") == "cg" ? Solver::cg : Solver::cholesky;
+    const std::string sv = o.string("solver");
+    const Solver solver = sv == "cg" ? Solver::cg : sv == "cholesky" ? Solver::cholesky : Solver::automatic;
     return std::make_unique<RbfMapper>(context.constraint, basis, radius, poly, solver,
                                        o.real("tolerance"));
   } catch (const Error& e) {
@@ -274,7 +275,8 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
     System::SparseCol kk(n, n);
     kk.setFromTriplets(k.begin(), k.end());
     k = {};
-    if (solver_ == Solver::cholesky) {
+    const bool use_cg = solver_ == Solver::cg || (solver_ == Solver::automatic && n > automatic_cg_threshold);
+    if (!use_cg) {
       sys->ldlt.compute(kk);
       if (sys->ldlt.info() != Eigen::Success || sys->ldlt.vectorD().minCoeff() <= 0.0)
         throw Error("mapper 'rbf': the interpolation matrix on mesh '" + centres.name() +

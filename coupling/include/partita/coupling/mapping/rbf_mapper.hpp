@@ -41,7 +41,10 @@ class RbfMapper final : public Mapper {
   /// How the compact system Phi is solved: a sparse Cholesky factorisation (LDL^T, AMD
   /// ordering; exact, but its fill grows faster than n on a surface), or conjugate gradients
   /// preconditioned with an incomplete Cholesky factor (each map() iterates to `tolerance`).
-  enum class Solver { cholesky, cg };
+  /// automatic: cholesky up to automatic_cg_threshold centres, cg above (keeps large meshes
+  /// near n log n; the sparse factorisation of a surface grows like n^1.5 or more).
+  enum class Solver { cholesky, cg, automatic };
+  static constexpr Eigen::Index automatic_cg_threshold = 20000;
 
   /// `support_radius` [m]: R of wendland-c2 and gaussian (ignored by thin-plate-spline).
   /// Throws partita::Error for an invalid combination (radius <= 0, conservative without
