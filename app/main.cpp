@@ -50,9 +50,10 @@ void for_each_registry(const Registries& r, F&& f) {
 int check_stl(const std::string& file) {
   const partita::Mesh m = partita::read_stl(file, "mesh");
   const auto box = m.bounding_box();
-  std::cout << "partita check: " << file << " is a valid STL: " << m.num_triangles() << " triangles, " << m.size()
-            << " distinct vertices, area " << m.total_area() << " m^2 (if in metres), bounding box [" << box.min.transpose()
-            << "] .. [" << box.max.transpose() << "]\n";
+  std::cout << "partita check: " << file << " is a valid STL: " << m.num_triangles()
+            << " triangles, " << m.size() << " distinct vertices, area " << m.total_area()
+            << " m^2 (if in metres), bounding box [" << box.min.transpose() << "] .. ["
+            << box.max.transpose() << "]\n";
   return 0;
 }
 
@@ -71,25 +72,30 @@ void plot_csv_files(const std::filesystem::path& dir) {
     if (e.path().extension() == ".csv") csvs.push_back(e.path().string());
   if (csvs.empty()) return;
   fs::path script = PARTITA_PLOT_SCRIPT;
-  if (!fs::exists(script)) script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_monitors.py";
+  if (!fs::exists(script))
+    script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_monitors.py";
   if (!fs::exists(script)) return;
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   std::string cmd = python + " '" + script.string() + "'";
   for (const auto& c : csvs) cmd += " '" + c + "'";
   cmd += " >/dev/null";
   if (std::system(cmd.c_str()) != 0)
-    partita::log::get("app")->warn("plotting the CSV files failed (is python3-matplotlib installed?)");
+    partita::log::get("app")->warn(
+        "plotting the CSV files failed (is python3-matplotlib installed?)");
   else
     partita::log::get("app")->info("plots: {}/*.png", dir.string());
 }
 
 // The case's post-processing scripts (output.scripts), with the output folder as argument.
-void run_scripts(const std::vector<std::filesystem::path>& scripts, const std::filesystem::path& dir) {
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+void run_scripts(const std::vector<std::filesystem::path>& scripts,
+                 const std::filesystem::path& dir) {
+  const std::string python =
+      std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   for (const auto& s : scripts) {
     const std::string cmd = python + " '" + s.string() + "' '" + dir.string() + "'";
     partita::log::get("app")->info("post-processing: {}", s.filename().string());
-    if (std::system(cmd.c_str()) != 0) partita::log::get("app")->warn("post-processing script {} failed", s.string());
+    if (std::system(cmd.c_str()) != 0)
+      partita::log::get("app")->warn("post-processing script {} failed", s.string());
   }
 }
 
@@ -118,12 +124,15 @@ int docs(const Registries& r, const std::string& name) {
       if (e.name != name) continue;
       found = true;
       std::cout << e.name << " (" << reg.kind() << "): " << e.doc << "\n";
-      if (e.spec) std::cout << e.spec->docs(2);
-      else std::cout << "  (no parameters)\n";
+      if (e.spec)
+        std::cout << e.spec->docs(2);
+      else
+        std::cout << "  (no parameters)\n";
     }
   });
   if (!found)
-    throw partita::Error("no documentation for '" + name + "': it is not a registered name; known names: " +
+    throw partita::Error("no documentation for '" + name +
+                         "': it is not a registered name; known names: " +
                          partita::join_names(all) + partita::did_you_mean(name, all));
   return 0;
 }
@@ -131,30 +140,42 @@ int docs(const Registries& r, const std::string& name) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"partita: partitioned coupling of simulation codes (DEM granules and FEM structures first)"};
+  CLI::App app{
+      "partita: partitioned coupling of simulation codes (DEM granules and FEM structures first)"};
   app.set_version_flag("--version", std::string("partita ") + partita::version());
   app.require_subcommand(1);
   std::string log_level = "info";
-  app.add_option("--log-level", log_level, "Log level: trace, debug, info, warn, error, critical, off")
+  app.add_option("--log-level", log_level,
+                 "Log level: trace, debug, info, warn, error, critical, off")
       ->capture_default_str();
 
   std::string case_file, output_dir, doc_name;
   int threads = 0;
-  auto* run = app.add_subcommand("run", "Run a case: partita run CASE.yaml [--output DIR] [--threads N]");
+  auto* run =
+      app.add_subcommand("run", "Run a case: partita run CASE.yaml [--output DIR] [--threads N]");
   run->add_option("case", case_file, "The case file (YAML)")->required();
   run->add_option("-o,--output", output_dir, "Output folder (default: out/<case name>/)");
-  run->add_option("-t,--threads", threads, "Threads for the solvers (default: all cores)")->check(CLI::PositiveNumber);
-  run->add_option("--log-level", log_level, "Log level: trace, debug, info, warn, error, critical, off");
+  run->add_option("-t,--threads", threads, "Threads for the solvers (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  run->add_option("--log-level", log_level,
+                  "Log level: trace, debug, info, warn, error, critical, off");
   std::vector<std::string> overrides;
-  run->add_option("--set", overrides, "Change a value of the case: KEY.PATH=VALUE (e.g. time.end=0.01, "
-                                      "participants.plate.loads[0].pressure='20 kPa'); repeatable")
+  run->add_option("--set", overrides,
+                  "Change a value of the case: KEY.PATH=VALUE (e.g. time.end=0.01, "
+                  "participants.plate.loads[0].pressure='20 kPa'); repeatable")
       ->take_all();
-  auto* check = app.add_subcommand("check", "Validate a case completely without running it (or an STL file)");
+  auto* check =
+      app.add_subcommand("check", "Validate a case completely without running it (or an STL file)");
   check->add_option("case", case_file, "The case file (YAML), or an STL mesh (.stl)")->required();
   check->add_option("--log-level", log_level, "Log level");
-  check->add_option("--set", overrides, "Change a value of the case before checking it: KEY.PATH=VALUE")->take_all();
-  app.add_subcommand("list", "List every registered solver, mapper, scheme, acceleration and convergence measure");
-  auto* doc = app.add_subcommand("docs", "The parameter reference, generated from the declarations");
+  check
+      ->add_option("--set", overrides,
+                   "Change a value of the case before checking it: KEY.PATH=VALUE")
+      ->take_all();
+  app.add_subcommand(
+      "list", "List every registered solver, mapper, scheme, acceleration and convergence measure");
+  auto* doc =
+      app.add_subcommand("docs", "The parameter reference, generated from the declarations");
   doc->add_option("name", doc_name, "A registered name (see partita list), or 'case' (default)");
 
   try {
@@ -189,7 +210,8 @@ int main(int argc, char** argv) {
     c.run();
     plot_csv_files(c.output_dir());
     run_scripts(c.scripts(), c.output_dir());
-    std::cout << "partita run: finished; output in " << c.output_dir().string() << "/ (CSV time series and their "
+    std::cout << "partita run: finished; output in " << c.output_dir().string()
+              << "/ (CSV time series and their "
               << "PNG plots; VTK series for ParaView in vtk/*.pvd)\n";
     return 0;
   } catch (const partita::Error& e) {

@@ -15,17 +15,21 @@ namespace partita::adapters {
 
 void register_all(coupling::Registries& r) {
 #ifdef PARTITA_HAVE_DEM
-  r.solvers.add("dem", "native DEM: Hertz-Mindlin spheres, walls, STL meshes as coupling interfaces",
+  r.solvers.add("dem",
+                "native DEM: Hertz-Mindlin spheres, walls, STL meshes as coupling interfaces",
                 DemAdapter::create, DemAdapter::spec());
 #endif
 #ifdef PARTITA_HAVE_FEM
-  r.solvers.add("fem", "native linear-elastic FEM: Hex8/Hex20/Tet4/Tet10, static or Newmark transient",
+  r.solvers.add("fem",
+                "native linear-elastic FEM: Hex8/Hex20/Tet4/Tet10, static or Newmark transient",
                 FemAdapter::create, FemAdapter::spec());
 #endif
 #ifdef PARTITA_HAVE_TUBE1D
-  r.solvers.add("tube1d-fluid", "1D elastic tube: quasi-1D incompressible flow (writes pressure, reads area)",
+  r.solvers.add("tube1d-fluid",
+                "1D elastic tube: quasi-1D incompressible flow (writes pressure, reads area)",
                 TubeFluidAdapter::create, TubeFluidAdapter::spec());
-  r.solvers.add("tube1d-solid", "1D elastic tube: tube law a(p) (reads pressure, writes cross_section_area)",
+  r.solvers.add("tube1d-solid",
+                "1D elastic tube: tube law a(p) (reads pressure, writes cross_section_area)",
                 TubeSolidAdapter::create, TubeSolidAdapter::spec());
 #endif
   (void)r;

@@ -28,7 +28,9 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 struct Options {
   std::vector<std::array<int, 3>> meshes;
@@ -78,22 +80,27 @@ double run_ccx(const Options& opt, std::array<int, 3> c) {
     return -1.0;
   }
   const auto dir = std::filesystem::temp_directory_path() /
-                   ("bench_fem_plate_ccx_" + std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+                   ("bench_fem_plate_ccx_" +
+                    std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
   std::filesystem::create_directories(dir);
-  const std::string tag = "plate_" + std::to_string(c[0]) + "x" + std::to_string(c[1]) + "x" + std::to_string(c[2]);
+  const std::string tag =
+      "plate_" + std::to_string(c[0]) + "x" + std::to_string(c[1]) + "x" + std::to_string(c[2]);
   char dt[32];
   std::snprintf(dt, sizeof dt, "%g", opt.dt);
-  const std::string generate = "python3 '" + gen + "' " + std::to_string(c[0]) + " " + std::to_string(c[1]) + " " +
-                               std::to_string(c[2]) + " '" + dir.string() + "' " + dt + " " +
-                               std::to_string(opt.steps) + " 2>/dev/null";
+  const std::string generate = "python3 '" + gen + "' " + std::to_string(c[0]) + " " +
+                               std::to_string(c[1]) + " " + std::to_string(c[2]) + " '" +
+                               dir.string() + "' " + dt + " " + std::to_string(opt.steps) +
+                               " 2>/dev/null";
   if (std::system(generate.c_str()) != 0) {
     std::cout << "  ccx: deck generation failed, using recorded figures\n";
     return -1.0;
   }
   const std::string deck = tag + "_dynamic_n" + std::to_string(opt.steps);
-  const std::string run = "cd '" + dir.string() +
-                          "' && OMP_NUM_THREADS=1 CCX_NPROC_EQUATION_SOLVER=1 CCX_NPROC_STIFFNESS=1 "
-                          "CCX_NPROC_RESULTS=1 ccx -i " + deck + " > ccx.log 2>&1";
+  const std::string run =
+      "cd '" + dir.string() +
+      "' && OMP_NUM_THREADS=1 CCX_NPROC_EQUATION_SOLVER=1 CCX_NPROC_STIFFNESS=1 "
+      "CCX_NPROC_RESULTS=1 ccx -i " +
+      deck + " > ccx.log 2>&1";
   const auto t0 = Clock::now();
   const int rc = std::system(run.c_str());
   const double wall = since(t0);
@@ -107,8 +114,10 @@ double run_ccx(const Options& opt, std::array<int, 3> c) {
 }
 
 void bench(const Options& opt, std::array<int, 3> cells) {
-  const std::string tag = std::to_string(cells[0]) + "x" + std::to_string(cells[1]) + "x" + std::to_string(cells[2]);
-  std::printf("\n== plate %s Hex8 (%s), %d elements\n", tag.c_str(), opt.qm6 ? "incompatible modes" : "full integration, as C3D8",
+  const std::string tag =
+      std::to_string(cells[0]) + "x" + std::to_string(cells[1]) + "x" + std::to_string(cells[2]);
+  std::printf("\n== plate %s Hex8 (%s), %d elements\n", tag.c_str(),
+              opt.qm6 ? "incompatible modes" : "full integration, as C3D8",
               cells[0] * cells[1] * cells[2]);
   const Model model = plate_model(cells, opt.qm6);
 
@@ -121,9 +130,13 @@ void bench(const Options& opt, std::array<int, 3> cells) {
     s.solve_static();
     const double t_solve = since(t1);
     const Vec3 r = s.reaction("corners");
-    std::printf("  static: %zu dofs, set-up (assembly) %.3f s, factorise + solve %.3f s (factorisation %.3f s), "
-                "total %.3f s\n", s.num_dofs(), t_setup, t_solve, s.timings().factorisation, t_setup + t_solve);
-    std::printf("  static corner reaction: Rz = %.9f N (p A = 4 N), Rx = %.2e, Ry = %.2e\n", r[2], r[0], r[1]);
+    std::printf(
+        "  static: %zu dofs, set-up (assembly) %.3f s, factorise + solve %.3f s (factorisation "
+        "%.3f s), "
+        "total %.3f s\n",
+        s.num_dofs(), t_setup, t_solve, s.timings().factorisation, t_setup + t_solve);
+    std::printf("  static corner reaction: Rz = %.9f N (p A = 4 N), Rx = %.2e, Ry = %.2e\n", r[2],
+                r[0], r[1]);
   }
 
   // transient
@@ -147,11 +160,14 @@ void bench(const Options& opt, std::array<int, 3> cells) {
   const auto& tm = s.timings();
   const double per_step = opt.steps > 1 ? later_steps / (opt.steps - 1) : first_step;
   const double amortised = (tm.assembly + tm.factorisation + tm.solve) / opt.steps;
-  std::printf("  transient (%s mass, dt = %g s, %d steps): assembly K+M %.3f s, factorisations %zu in %.3f s "
-              "(K_eff once), per step %.2f ms (steady), first step %.3f s, total %.3f s incl. reactions\n",
-              opt.lumped ? "lumped" : "consistent", opt.dt, opt.steps, tm.assembly, tm.factorisations,
-              tm.factorisation, 1e3 * per_step, first_step, total);
-  std::printf("  transient corner reaction Rz: min %.3f max %.3f mean %.3f last %.3f N\n", rmin, rmax, rmean, rlast);
+  std::printf(
+      "  transient (%s mass, dt = %g s, %d steps): assembly K+M %.3f s, factorisations %zu in %.3f "
+      "s "
+      "(K_eff once), per step %.2f ms (steady), first step %.3f s, total %.3f s incl. reactions\n",
+      opt.lumped ? "lumped" : "consistent", opt.dt, opt.steps, tm.assembly, tm.factorisations,
+      tm.factorisation, 1e3 * per_step, first_step, total);
+  std::printf("  transient corner reaction Rz: min %.3f max %.3f mean %.3f last %.3f N\n", rmin,
+              rmax, rmean, rlast);
 
   const std::map<std::string, double> recorded = {{"20x20x2", 0.155}, {"40x40x4", 2.28}};
   double ccx = -1.0;
@@ -166,9 +182,11 @@ void bench(const Options& opt, std::array<int, 3> cells) {
     ccx = it->second;
     source = "recorded, RESULTS.md";
   }
-  std::printf("  CalculiX %.3f s/increment (%s): ratio ccx/partita = %.0fx per steady step, %.0fx amortised "
-              "(assembly + factorisations + %d steps)\n",
-              ccx, source.c_str(), ccx / per_step, ccx / amortised, opt.steps);
+  std::printf(
+      "  CalculiX %.3f s/increment (%s): ratio ccx/partita = %.0fx per steady step, %.0fx "
+      "amortised "
+      "(assembly + factorisations + %d steps)\n",
+      ccx, source.c_str(), ccx / per_step, ccx / amortised, opt.steps);
 }
 
 }  // namespace
@@ -182,24 +200,34 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
         return argv[++i];
       };
-      if (a == "--steps") opt.steps = std::stoi(value());
-      else if (a == "--dt") opt.dt = std::stod(value());
-      else if (a == "--qm6") opt.qm6 = true;
-      else if (a == "--lumped") opt.lumped = true;
-      else if (a == "--no-ccx") opt.ccx = false;
-      else if (a == "--peers") opt.peers = value();
+      if (a == "--steps")
+        opt.steps = std::stoi(value());
+      else if (a == "--dt")
+        opt.dt = std::stod(value());
+      else if (a == "--qm6")
+        opt.qm6 = true;
+      else if (a == "--lumped")
+        opt.lumped = true;
+      else if (a == "--no-ccx")
+        opt.ccx = false;
+      else if (a == "--peers")
+        opt.peers = value();
       else if (a == "-h" || a == "--help") {
-        std::cout << "usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] [--lumped] [--no-ccx] [--peers DIR]\n";
+        std::cout << "usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] "
+                     "[--lumped] [--no-ccx] [--peers DIR]\n";
         return 0;
       } else {
         std::array<int, 3> c{};
-        if (std::sscanf(a.c_str(), "%dx%dx%d", &c[0], &c[1], &c[2]) != 3) throw std::runtime_error("unknown argument " + a);
+        if (std::sscanf(a.c_str(), "%dx%dx%d", &c[0], &c[1], &c[2]) != 3)
+          throw std::runtime_error("unknown argument " + a);
         opt.meshes.push_back(c);
       }
     }
     if (opt.meshes.empty()) opt.meshes = {{20, 20, 2}, {40, 40, 4}};
-    std::printf("bench_fem_plate: seed plate, %d steps of %g s. Wall-clock timings on a possibly shared machine.\n",
-                opt.steps, opt.dt);
+    std::printf(
+        "bench_fem_plate: seed plate, %d steps of %g s. Wall-clock timings on a possibly shared "
+        "machine.\n",
+        opt.steps, opt.dt);
     for (const auto& c : opt.meshes) bench(opt, c);
   } catch (const std::exception& e) {
     std::cerr << "bench_fem_plate: " << e.what() << "\n";

@@ -125,8 +125,8 @@ int main(int argc, char** argv) {
        false},
       {"rbf wendland-c2 separate (default: auto solver)", "{type: rbf, support_radius: @}", true,
        Constraint::consistent, true},
-      {"rbf wendland-c2 separate cholesky", "{type: rbf, support_radius: @, solver: cholesky}", true,
-       Constraint::consistent, true},
+      {"rbf wendland-c2 separate cholesky", "{type: rbf, support_radius: @, solver: cholesky}",
+       true, Constraint::consistent, true},
       {"rbf wendland-c2 on", "{type: rbf, support_radius: @, polynomial: on}", true,
        Constraint::consistent, true},
   };

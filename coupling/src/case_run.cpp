@@ -33,55 +33,83 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
   time->integer("windows", "number of windows (instead of end)").min(1);
   time->one_of({"end", "windows"});
 
-  auto exchange = std::make_shared<Spec>("exchange", "one data field sent from one mesh to another");
-  exchange->string("data", "name of the field (a write of the sender's mesh and a read of the receiver's)")
+  auto exchange =
+      std::make_shared<Spec>("exchange", "one data field sent from one mesh to another");
+  exchange
+      ->string("data",
+               "name of the field (a write of the sender's mesh and a read of the receiver's)")
       .required();
   exchange->string("from", "sender as participant.mesh").required();
   exchange->string("to", "receiver as participant.mesh").required();
-  exchange->any("mapper", "mapper name or {type: name, options}; known: " + join_names(registries.mappers.names()))
+  exchange
+      ->any("mapper", "mapper name or {type: name, options}; known: " +
+                          join_names(registries.mappers.names()))
       .def("nearest-neighbor");
-  exchange->choice("constraint", "override the constraint that the data kind implies (intensive: consistent, "
-                                 "extensive: conservative)", {"consistent", "conservative"});
-  exchange->choice("reader_sees", "what a subcycling reader sees at substep k/m: the newest value (constant) or "
-                                  "linear interpolation between the window's start and end values",
-                   {"constant", "linear"})
+  exchange->choice("constraint",
+                   "override the constraint that the data kind implies (intensive: consistent, "
+                   "extensive: conservative)",
+                   {"consistent", "conservative"});
+  exchange
+      ->choice("reader_sees",
+               "what a subcycling reader sees at substep k/m: the newest value (constant) or "
+               "linear interpolation between the window's start and end values",
+               {"constant", "linear"})
       .def("linear");
-  exchange->choice("writer_combines", "how a subcycling writer's substep values make the window's value",
-                   {"average", "last"})
+  exchange
+      ->choice("writer_combines",
+               "how a subcycling writer's substep values make the window's value",
+               {"average", "last"})
       .def("average");
 
   auto coupling = std::make_shared<Spec>("coupling", "how the participants advance together");
-  coupling->string("scheme", "coupling scheme; known: " + join_names(registries.schemes.names())).required();
-  coupling->strings("order", "participants in scheme order (default: file order); a serial scheme runs the first "
-                             "first");
-  coupling->any("substeps", "per participant: a number of substeps per window (>= 1) or auto (from its "
-                            "stable time step); default 1");
+  coupling->string("scheme", "coupling scheme; known: " + join_names(registries.schemes.names()))
+      .required();
+  coupling->strings(
+      "order",
+      "participants in scheme order (default: file order); a serial scheme runs the first "
+      "first");
+  coupling->any("substeps",
+                "per participant: a number of substeps per window (>= 1) or auto (from its "
+                "stable time step); default 1");
   coupling->list("exchanges", "the exchanged fields", exchange).required();
-  coupling->list("convergence", "implicit schemes: measures, all must hold; each {type, data, limit}; known "
-                                "types: " + join_names(registries.convergence_measures.names()),
+  coupling->list("convergence",
+                 "implicit schemes: measures, all must hold; each {type, data, limit}; known "
+                 "types: " +
+                     join_names(registries.convergence_measures.names()),
                  nullptr);
   coupling->any("acceleration", "implicit schemes: {type, options}; known: " +
                                     join_names(registries.accelerations.names()));
-  coupling->integer("max_iterations", "implicit schemes: most iterations per window").min(1).def(100);
-  coupling->choice("on_max_iterations", "implicit schemes: at max_iterations stop with an error, or accept the "
-                                        "window with a warning", {"error", "accept"})
+  coupling->integer("max_iterations", "implicit schemes: most iterations per window")
+      .min(1)
+      .def(100);
+  coupling
+      ->choice("on_max_iterations",
+               "implicit schemes: at max_iterations stop with an error, or accept the "
+               "window with a warning",
+               {"error", "accept"})
       .def("accept");
 
-  auto monitor = std::make_shared<Spec>("monitor", "a CSV time series DIR/<name>.csv of solver quantities");
+  auto monitor =
+      std::make_shared<Spec>("monitor", "a CSV time series DIR/<name>.csv of solver quantities");
   monitor->string("name", "file name without .csv").required();
   monitor->strings("quantities", "participant.quantity of each column").required();
 
   auto output = std::make_shared<Spec>("output", "VTK output under DIR/vtk");
-  output->real("every", "simulated time between frames (default: first and last frame only)").unit("s").positive();
-  output->boolean("interface", "also write the interface meshes with their exchanged data (.vtp)").def(true);
-  output->strings("scripts", "post-processing scripts of the case folder, run by `partita run` after the last "
-                             "window with the output folder as argument (e.g. plots of the final state)");
+  output->real("every", "simulated time between frames (default: first and last frame only)")
+      .unit("s")
+      .positive();
+  output->boolean("interface", "also write the interface meshes with their exchanged data (.vtp)")
+      .def(true);
+  output->strings("scripts",
+                  "post-processing scripts of the case folder, run by `partita run` after the last "
+                  "window with the output folder as argument (e.g. plots of the final state)");
 
   auto root = std::make_shared<Spec>("case", "a coupled simulation");
   root->string("case", "the case's name (output goes to out/<name> by default)").required();
   root->section("time", "time windows", time).required();
-  root->any("participants", "map of participant name -> {solver: <registered solver>, solver keys...}; solvers: " +
-                                join_names(registries.solvers.names()))
+  root->any("participants",
+            "map of participant name -> {solver: <registered solver>, solver keys...}; solvers: " +
+                join_names(registries.solvers.names()))
       .required();
   root->section("coupling", "coupling scheme and exchanges", coupling).required();
   root->list("monitors", "scalar time series", monitor);
@@ -98,8 +126,8 @@ std::pair<std::string, std::string> split_dot(const config::Node& n, const char*
   const std::string s = n.as_string();
   const auto dot = s.find('.');
   if (dot == std::string::npos || dot == 0 || dot + 1 == s.size())
-    n.fail(std::string("expected ") + what + " written participant." + (std::string(what) == "a quantity" ? "quantity" : "mesh") +
-           ", found '" + s + "'");
+    n.fail(std::string("expected ") + what + " written participant." +
+           (std::string(what) == "a quantity" ? "quantity" : "mesh") + ", found '" + s + "'");
   return {s.substr(0, dot), s.substr(dot + 1)};
 }
 
@@ -113,19 +141,24 @@ Participant* CaseRun::participant(const std::string& name) const {
 
 CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOptions options)
     : registries_(registries), options_(std::move(options)) {
-  const config::Node root = config::Node::load_file(case_file, options_.overrides).validated(case_spec(registries));
+  const config::Node root =
+      config::Node::load_file(case_file, options_.overrides).validated(case_spec(registries));
   name_ = root.string("case");
   case_dir_ = fs::absolute(case_file).parent_path();
-  output_dir_ = options_.output_dir.empty() ? fs::current_path() / "out" / name_ : options_.output_dir;
+  output_dir_ =
+      options_.output_dir.empty() ? fs::current_path() / "out" / name_ : options_.output_dir;
 
   const config::Node time = root["time"];
   window_size_ = time.real("window");
-  window_count_ = time.has("windows") ? time.integer("windows") : TimeWindow::count_to(time.real("end"), window_size_);
-  if (root.has("output") && root["output"].has("every")) output_every_ = root["output"].real("every");
+  window_count_ = time.has("windows") ? time.integer("windows")
+                                      : TimeWindow::count_to(time.real("end"), window_size_);
+  if (root.has("output") && root["output"].has("every"))
+    output_every_ = root["output"].real("every");
   if (root.has("output") && root["output"].has("scripts"))
     for (const config::Node& sn : root["output"]["scripts"].items()) {
       const fs::path script = case_dir_ / sn.as_string();
-      if (!fs::exists(script)) sn.fail("post-processing script '" + script.string() + "' does not exist");
+      if (!fs::exists(script))
+        sn.fail("post-processing script '" + script.string() + "' does not exist");
       scripts_.push_back(script);
     }
 
@@ -149,8 +182,10 @@ CaseRun::~CaseRun() = default;
 void CaseRun::build_participants(const config::Node& root) {
   const config::Node ps = root["participants"];
   if (!ps.is_map() || ps.size() == 0)
-    ps.fail("expected a map of participants, e.g. participants: {fluid: {solver: tube1d-fluid}}; found " +
-            ps.describe());
+    ps.fail(
+        "expected a map of participants, e.g. participants: {fluid: {solver: tube1d-fluid}}; "
+        "found " +
+        ps.describe());
   std::vector<std::string> names = ps.keys();
   // scheme order
   const config::Node coupling = root["coupling"];
@@ -164,7 +199,8 @@ void CaseRun::build_participants(const config::Node& root) {
       if (std::find(names.begin(), names.end(), order[i]) == names.end())
         item.fail("unknown participant '" + order[i] + "'; participants: " + join_names(names) +
                   did_you_mean(order[i], names));
-      if (!seen.insert(order[i]).second) item.fail("participant '" + order[i] + "' appears twice in the order");
+      if (!seen.insert(order[i]).second)
+        item.fail("participant '" + order[i] + "' appears twice in the order");
     }
     if (order.size() != names.size()) {
       std::vector<std::string> missing;
@@ -173,22 +209,26 @@ void CaseRun::build_participants(const config::Node& root) {
       on.fail("the order must list every participant once; missing: " + join_names(missing));
     }
   }
-  if (names.size() < 2) ps.fail("a coupled case needs at least 2 participants, found " + std::to_string(names.size()));
+  if (names.size() < 2)
+    ps.fail("a coupled case needs at least 2 participants, found " + std::to_string(names.size()));
 
   // substeps
   std::map<std::string, Substeps> substeps;
   if (coupling.has("substeps")) {
     const config::Node sn = coupling["substeps"];
-    if (!sn.is_map()) sn.fail("expected a map participant -> number of substeps or auto, found " + sn.describe());
+    if (!sn.is_map())
+      sn.fail("expected a map participant -> number of substeps or auto, found " + sn.describe());
     for (const std::string& k : sn.keys()) {
       const config::Node v = sn[k];
       if (std::find(names.begin(), names.end(), k) == names.end())
-        v.fail("unknown participant '" + k + "'; participants: " + join_names(names) + did_you_mean(k, names));
+        v.fail("unknown participant '" + k + "'; participants: " + join_names(names) +
+               did_you_mean(k, names));
       Substeps s;
       if (v.is_scalar() && v.as_string() == "auto") {
         s.automatic = true;
       } else {
-        if (!v.is_scalar()) v.fail("expected a number of substeps (>= 1) or auto, found " + v.describe());
+        if (!v.is_scalar())
+          v.fail("expected a number of substeps (>= 1) or auto, found " + v.describe());
         std::string text = v.as_string();
         long n = 0;
         try {
@@ -207,7 +247,8 @@ void CaseRun::build_participants(const config::Node& root) {
   for (const std::string& name : order) {
     const config::Node pn = ps[name];
     if (name.find('.') != std::string::npos)
-      pn.fail("a participant name may not contain '.', found '" + name + "' (meshes are named participant.mesh)");
+      pn.fail("a participant name may not contain '.', found '" + name +
+              "' (meshes are named participant.mesh)");
     if (!pn.is_map() || !pn.has("solver"))
       pn.fail("participant '" + name + "' needs 'solver: <name>'; known solvers: " +
               join_names(registries_.solvers.names()));
@@ -226,10 +267,11 @@ void CaseRun::build_participants(const config::Node& root) {
     const double stable = solver->stable_time_step();
     if (!s.automatic && window_size_ / s.count > stable * (1.0 + 1e-12)) {
       const config::Node where = substeps.count(name) ? coupling["substeps"][name] : pn;
-      where.fail(fmt::format("participant '{}' would step {:.4g} s (window {:.4g} s / {} substeps), above its stable "
-                             "time step {:.4g} s; use substeps: {{{}: {}}} or more, or {{{}: auto}}",
-                             name, window_size_ / s.count, window_size_, s.count, stable, name,
-                             static_cast<long>(std::ceil(window_size_ / stable * (1.0 - 1e-12))), name));
+      where.fail(fmt::format(
+          "participant '{}' would step {:.4g} s (window {:.4g} s / {} substeps), above its stable "
+          "time step {:.4g} s; use substeps: {{{}: {}}} or more, or {{{}: auto}}",
+          name, window_size_ / s.count, window_size_, s.count, stable, name,
+          static_cast<long>(std::ceil(window_size_ / stable * (1.0 - 1e-12))), name));
     }
     participants_.push_back(std::make_unique<Participant>(name, std::move(solver), s));
     if (participants_.back()->solver().meshes().empty())
@@ -250,13 +292,15 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
   auto resolve = [&](const config::Node& n) {
     const auto [pname, mname] = split_dot(n, "a mesh");
     Participant* p = participant(pname);
-    if (!p) n.fail("unknown participant '" + pname + "'; participants: " + join_names(names) + did_you_mean(pname, names));
+    if (!p)
+      n.fail("unknown participant '" + pname + "'; participants: " + join_names(names) +
+             did_you_mean(pname, names));
     std::vector<std::string> meshes;
     for (const auto& m : p->solver().meshes()) meshes.push_back(m.mesh.name());
     const InterfaceMesh* m = p->find_mesh(mname);
     if (!m)
-      n.fail("participant '" + pname + "' has no mesh '" + mname + "'; its meshes: " + join_names(meshes) +
-             did_you_mean(mname, meshes));
+      n.fail("participant '" + pname + "' has no mesh '" + mname +
+             "'; its meshes: " + join_names(meshes) + did_you_mean(mname, meshes));
     return Resolved{p, m};
   };
   auto names_of = [](const std::vector<DataSpec>& v) {
@@ -275,37 +319,42 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
       if (d.name == data) ws = &d;
     if (!ws) {
       const auto w = names_of(from.mesh->writes);
-      item["data"].fail("participant '" + from.p->name() + "' does not write '" + data + "' on mesh '" +
-                        from.mesh->mesh.name() + "'; it writes: " + (w.empty() ? "nothing" : join_names(w)) +
-                        did_you_mean(data, w));
+      item["data"].fail("participant '" + from.p->name() + "' does not write '" + data +
+                        "' on mesh '" + from.mesh->mesh.name() + "'; it writes: " +
+                        (w.empty() ? "nothing" : join_names(w)) + did_you_mean(data, w));
     }
     const DataSpec* rs = nullptr;
     for (const auto& d : to.mesh->reads)
       if (d.name == data) rs = &d;
     if (!rs) {
       const auto r = names_of(to.mesh->reads);
-      item["data"].fail("participant '" + to.p->name() + "' does not read '" + data + "' on mesh '" +
-                        to.mesh->mesh.name() + "'; it reads: " + (r.empty() ? "nothing" : join_names(r)) +
-                        did_you_mean(data, r));
+      item["data"].fail("participant '" + to.p->name() + "' does not read '" + data +
+                        "' on mesh '" + to.mesh->mesh.name() + "'; it reads: " +
+                        (r.empty() ? "nothing" : join_names(r)) + did_you_mean(data, r));
     }
     if (ws->components != rs->components)
-      item["data"].fail("'" + data + "' has " + std::to_string(ws->components) + " components where '" +
-                        from.p->name() + "' writes it but " + std::to_string(rs->components) + " where '" +
-                        to.p->name() + "' reads it");
+      item["data"].fail("'" + data + "' has " + std::to_string(ws->components) +
+                        " components where '" + from.p->name() + "' writes it but " +
+                        std::to_string(rs->components) + " where '" + to.p->name() + "' reads it");
     for (const auto& e : exchanges_)
       if (&e->to() == to.p && e->to_mesh() == to.mesh->mesh.name() && e->data() == data)
-        item.fail("'" + data + "' on " + to.p->name() + "." + to.mesh->mesh.name() + " already has a sender (" +
-                  e->label() + ")");
-    Constraint constraint = ws->kind == DataKind::extensive ? Constraint::conservative : Constraint::consistent;
+        item.fail("'" + data + "' on " + to.p->name() + "." + to.mesh->mesh.name() +
+                  " already has a sender (" + e->label() + ")");
+    Constraint constraint =
+        ws->kind == DataKind::extensive ? Constraint::conservative : Constraint::consistent;
     if (item.has("constraint"))
-      constraint = item.string("constraint") == "conservative" ? Constraint::conservative : Constraint::consistent;
-    std::unique_ptr<Mapper> mapper = create_mapper(registries_.mappers, MapperContext{item["mapper"], constraint});
+      constraint = item.string("constraint") == "conservative" ? Constraint::conservative
+                                                               : Constraint::consistent;
+    std::unique_ptr<Mapper> mapper =
+        create_mapper(registries_.mappers, MapperContext{item["mapper"], constraint});
     mapper->compute(from.mesh->mesh, to.mesh->mesh);
-    const ReaderSees rsee = item.string("reader_sees") == "constant" ? ReaderSees::constant : ReaderSees::linear;
-    const WriterCombines wc = item.string("writer_combines") == "last" ? WriterCombines::last : WriterCombines::average;
-    exchanges_.push_back(std::make_unique<Exchange>(data, Exchange::End{from.p, from.mesh->mesh.name()},
-                                                    Exchange::End{to.p, to.mesh->mesh.name()}, *ws, std::move(mapper),
-                                                    rsee, wc));
+    const ReaderSees rsee =
+        item.string("reader_sees") == "constant" ? ReaderSees::constant : ReaderSees::linear;
+    const WriterCombines wc =
+        item.string("writer_combines") == "last" ? WriterCombines::last : WriterCombines::average;
+    exchanges_.push_back(std::make_unique<Exchange>(
+        data, Exchange::End{from.p, from.mesh->mesh.name()},
+        Exchange::End{to.p, to.mesh->mesh.name()}, *ws, std::move(mapper), rsee, wc));
   }
 }
 
@@ -318,7 +367,9 @@ void CaseRun::build_monitors(const config::Node& root) {
     Monitor mon;
     mon.name = m.string("name");
     if (mon.name.empty() || mon.name.find('/') != std::string::npos || mon.name == "coupling")
-      m["name"].fail("a monitor name becomes DIR/<name>.csv: it must be non-empty, without '/', and not 'coupling'");
+      m["name"].fail(
+          "a monitor name becomes DIR/<name>.csv: it must be non-empty, without '/', and not "
+          "'coupling'");
     if (!files.insert(mon.name).second) m["name"].fail("two monitors are named '" + mon.name + "'");
     const config::Node qn = m["quantities"];
     const std::vector<std::string> qs = m.strings("quantities");
@@ -326,7 +377,9 @@ void CaseRun::build_monitors(const config::Node& root) {
       const config::Node q = qn.is_sequence() ? qn[i] : qn;
       const auto [pname, quantity] = split_dot(q, "a quantity");
       Participant* p = participant(pname);
-      if (!p) q.fail("unknown participant '" + pname + "'; participants: " + join_names(names) + did_you_mean(pname, names));
+      if (!p)
+        q.fail("unknown participant '" + pname + "'; participants: " + join_names(names) +
+               did_you_mean(pname, names));
       std::vector<std::string> known;
       for (const auto& v : p->solver().monitors()) known.push_back(v.name);
       if (std::find(known.begin(), known.end(), quantity) == known.end())
@@ -354,23 +407,27 @@ void CaseRun::write_output(int frame, double time) {
   for (auto& p : participants_) {
     OutputFrame f{vtk, p->name(), frame, time};
     p->solver().write_output(f);  // counted as output time, not the participant's
-    for (const auto& [series, file] : p->solver().output_files()) pvd(p->name() + "_" + series).add(time, file);
+    for (const auto& [series, file] : p->solver().output_files())
+      pvd(p->name() + "_" + series).add(time, file);
     // interface meshes with their exchanged data
     for (const auto& im : p->solver().meshes()) {
       VtkArrays arrays;
       for (const auto& e : exchanges_) {
-        if (&e->from() == p.get() && e->from_mesh() == im.mesh.name() && e->sent().rows() == im.mesh.size())
+        if (&e->from() == p.get() && e->from_mesh() == im.mesh.name() &&
+            e->sent().rows() == im.mesh.size())
           arrays.emplace_back(e->data(), e->sent());
-        if (&e->to() == p.get() && e->to_mesh() == im.mesh.name() && e->received().rows() == im.mesh.size())
+        if (&e->to() == p.get() && e->to_mesh() == im.mesh.name() &&
+            e->received().rows() == im.mesh.size())
           arrays.emplace_back(e->data(), e->received());
       }
       if (arrays.empty() || im.mesh.size() > 200000) continue;
-      const std::string file = fmt::format("{}_interface_{}_{:06d}.vtp", p->name(), im.mesh.name(), frame);
+      const std::string file =
+          fmt::format("{}_interface_{}_{:06d}.vtp", p->name(), im.mesh.name(), frame);
       write_vtp(vtk / file, im.mesh, arrays);
       pvd(p->name() + "_interface_" + im.mesh.name()).add(time, file);
     }
   }
-  summary_.output_seconds += clock.seconds() ;
+  summary_.output_seconds += clock.seconds();
 }
 
 void CaseRun::run() {
@@ -415,14 +472,16 @@ void CaseRun::run() {
     for (auto& m : monitors_) m.csv.flush();
   };
 
-  logger->info("case '{}': {} windows of {} s to t = {} s, scheme {}, participants {}; output in {}", name_,
-               window_count_, window_size_, static_cast<double>(window_count_) * window_size_, scheme_->name(),
-               [&] {
-                 std::vector<std::string> n;
-                 for (auto& p : participants_) n.push_back(p->name());
-                 return join_names(n);
-               }(),
-               output_dir_.string());
+  logger->info(
+      "case '{}': {} windows of {} s to t = {} s, scheme {}, participants {}; output in {}", name_,
+      window_count_, window_size_, static_cast<double>(window_count_) * window_size_,
+      scheme_->name(),
+      [&] {
+        std::vector<std::string> n;
+        for (auto& p : participants_) n.push_back(p->name());
+        return join_names(n);
+      }(),
+      output_dir_.string());
 
   ProgressLine progress(window_count_);
   int frame = 0;
@@ -483,13 +542,19 @@ void CaseRun::run() {
   summary_.core_seconds = std::max(0.0, summary_.wall_seconds - accounted);
 
   std::string parts;
-  for (const auto& [n, s] : summary_.participant_seconds) parts += fmt::format("{} {:.3f} s, ", n, s);
-  logger->info("summary: {} windows, {} iterations (mean {:.2f}, max {}{}); wall {:.3f} s = {}mapping {:.3f} s, "
-               "output {:.3f} s, core {:.3f} s",
-               summary_.windows, summary_.iterations, summary_.mean_iterations(), summary_.max_window_iterations,
-               summary_.unconverged_windows ? fmt::format(", {} windows at max_iterations", summary_.unconverged_windows)
-                                            : std::string(),
-               summary_.wall_seconds, parts, summary_.mapping_seconds, summary_.output_seconds, summary_.core_seconds);
+  for (const auto& [n, s] : summary_.participant_seconds)
+    parts += fmt::format("{} {:.3f} s, ", n, s);
+  logger->info(
+      "summary: {} windows, {} iterations (mean {:.2f}, max {}{}); wall {:.3f} s = {}mapping "
+      "{:.3f} s, "
+      "output {:.3f} s, core {:.3f} s",
+      summary_.windows, summary_.iterations, summary_.mean_iterations(),
+      summary_.max_window_iterations,
+      summary_.unconverged_windows
+          ? fmt::format(", {} windows at max_iterations", summary_.unconverged_windows)
+          : std::string(),
+      summary_.wall_seconds, parts, summary_.mapping_seconds, summary_.output_seconds,
+      summary_.core_seconds);
 }
 
 }  // namespace partita::coupling

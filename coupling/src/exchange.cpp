@@ -5,8 +5,9 @@
 
 namespace partita::coupling {
 
-Exchange::Exchange(std::string data, End from, End to, DataSpec spec, std::unique_ptr<Mapper> mapper,
-                   ReaderSees reader_sees, WriterCombines writer_combines)
+Exchange::Exchange(std::string data, End from, End to, DataSpec spec,
+                   std::unique_ptr<Mapper> mapper, ReaderSees reader_sees,
+                   WriterCombines writer_combines)
     : data_(std::move(data)),
       from_(std::move(from)),
       to_(std::move(to)),
@@ -19,21 +20,23 @@ Exchange::Exchange(std::string data, End from, End to, DataSpec spec, std::uniqu
   if (!fm || !tm) throw Error("exchange " + label() + ": unknown mesh");
   from_points_ = fm->mesh.size();
   if (!mapper_ && fm->mesh.size() != tm->mesh.size())
-    throw Error("exchange " + label() + ": without a mapper the meshes need the same number of points (" +
+    throw Error("exchange " + label() +
+                ": without a mapper the meshes need the same number of points (" +
                 std::to_string(fm->mesh.size()) + " and " + std::to_string(tm->mesh.size()) + ")");
 }
 
 std::string Exchange::label() const {
-  return "'" + data_ + "' " + from_.participant->name() + "." + from_.mesh + " -> " + to_.participant->name() +
-         "." + to_.mesh;
+  return "'" + data_ + "' " + from_.participant->name() + "." + from_.mesh + " -> " +
+         to_.participant->name() + "." + to_.mesh;
 }
 
 void Exchange::check_shape(const Eigen::MatrixXd& values, const char* what) const {
   if (values.rows() != from_points_ || values.cols() != spec_.components)
-    throw Error("exchange " + label() + ": participant '" + from_.participant->name() + "' " + what + " a " +
-                std::to_string(values.rows()) + " x " + std::to_string(values.cols()) + " array; expected " +
-                std::to_string(from_points_) + " x " + std::to_string(spec_.components) +
-                " (points of mesh '" + from_.mesh + "' x components)");
+    throw Error("exchange " + label() + ": participant '" + from_.participant->name() + "' " +
+                what + " a " + std::to_string(values.rows()) + " x " +
+                std::to_string(values.cols()) + " array; expected " + std::to_string(from_points_) +
+                " x " + std::to_string(spec_.components) + " (points of mesh '" + from_.mesh +
+                "' x components)");
 }
 
 void Exchange::begin_collect() {

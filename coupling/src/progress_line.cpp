@@ -1,7 +1,7 @@
 #include "partita/coupling/progress_line.hpp"
 
-#include <cstdio>
 #include <unistd.h>
+#include <cstdio>
 
 #include <fmt/format.h>
 
@@ -9,7 +9,8 @@
 
 namespace partita::coupling {
 
-ProgressLine::ProgressLine(std::int64_t windows) : windows_(windows), tty_(isatty(fileno(stderr)) != 0) {}
+ProgressLine::ProgressLine(std::int64_t windows)
+    : windows_(windows), tty_(isatty(fileno(stderr)) != 0) {}
 
 std::string ProgressLine::text(std::int64_t done, std::int64_t windows, double time, int iterations,
                                double elapsed) {
@@ -17,12 +18,14 @@ std::string ProgressLine::text(std::int64_t done, std::int64_t windows, double t
   if (done > 0) {
     // time left = elapsed (windows - done) / done
     const double left = elapsed * static_cast<double>(windows - done) / static_cast<double>(done);
-    eta = left < 120 ? fmt::format("{:.0f} s", left) : left < 7200 ? fmt::format("{:.1f} min", left / 60)
-                                                                    : fmt::format("{:.1f} h", left / 3600);
+    eta = left < 120    ? fmt::format("{:.0f} s", left)
+          : left < 7200 ? fmt::format("{:.1f} min", left / 60)
+                        : fmt::format("{:.1f} h", left / 3600);
   }
-  return fmt::format("t = {:.6g} s  window {}/{} ({:.0f} %)  iterations {}  left ~{}", time, done, windows,
-                     windows > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(windows) : 100.0,
-                     iterations, eta);
+  return fmt::format(
+      "t = {:.6g} s  window {}/{} ({:.0f} %)  iterations {}  left ~{}", time, done, windows,
+      windows > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(windows) : 100.0,
+      iterations, eta);
 }
 
 void ProgressLine::update(std::int64_t done, double time, int iterations) {

@@ -12,7 +12,8 @@ TimeWindow::TimeWindow(double size, std::int64_t index, int substeps)
     : size_(size), index_(index), substeps_(substeps) {
   if (!(size > 0.0) || !std::isfinite(size))
     throw Error("time window size must be a positive finite number, found " + std::to_string(size));
-  if (substeps < 1) throw Error("a window needs at least 1 substep, found " + std::to_string(substeps));
+  if (substeps < 1)
+    throw Error("a window needs at least 1 substep, found " + std::to_string(substeps));
   if (index < 0) throw Error("a window index must be >= 0, found " + std::to_string(index));
 }
 
@@ -43,14 +44,16 @@ double tolerant_ceil(double x) {
 }  // namespace
 
 std::int64_t TimeWindow::count_to(double end, double size) {
-  if (!(size > 0.0)) throw Error("time window size must be positive, found " + std::to_string(size));
+  if (!(size > 0.0))
+    throw Error("time window size must be positive, found " + std::to_string(size));
   if (!(end > 0.0)) throw Error("end time must be positive, found " + std::to_string(end));
   return static_cast<std::int64_t>(std::max(1.0, tolerant_ceil(end / size)));
 }
 
 int TimeWindow::substeps_for(double size, double max_step) {
   if (!(max_step > 0.0))
-    throw Error("the solver's stable time step must be positive, found " + std::to_string(max_step));
+    throw Error("the solver's stable time step must be positive, found " +
+                std::to_string(max_step));
   if (std::isinf(max_step)) return 1;
   const double m = tolerant_ceil(size / max_step);
   if (m > static_cast<double>(std::numeric_limits<int>::max()))

@@ -13,17 +13,28 @@ namespace partita::config {
 
 const char* type_name(Type t) {
   switch (t) {
-    case Type::real: return "real";
-    case Type::integer: return "integer";
-    case Type::boolean: return "boolean";
-    case Type::string: return "string";
-    case Type::choice: return "choice";
-    case Type::reals: return "list of reals";
-    case Type::integers: return "list of integers";
-    case Type::strings: return "list of strings";
-    case Type::section: return "section";
-    case Type::list: return "list of sections";
-    case Type::any: return "any";
+    case Type::real:
+      return "real";
+    case Type::integer:
+      return "integer";
+    case Type::boolean:
+      return "boolean";
+    case Type::string:
+      return "string";
+    case Type::choice:
+      return "choice";
+    case Type::reals:
+      return "list of reals";
+    case Type::integers:
+      return "list of integers";
+    case Type::strings:
+      return "list of strings";
+    case Type::section:
+      return "section";
+    case Type::list:
+      return "list of sections";
+    case Type::any:
+      return "any";
   }
   return "?";
 }
@@ -47,7 +58,9 @@ Param& Param::def(bool v) {
   default_ = YAML::Node(v);
   return *this;
 }
-Param& Param::def(const char* v) { return def(std::string(v)); }
+Param& Param::def(const char* v) {
+  return def(std::string(v));
+}
 Param& Param::def(std::string v) {
   default_ = YAML::Node(v);
   return *this;
@@ -157,8 +170,10 @@ bool is_number_text(const std::string& s) {
 
 void check_bounds(const Node& c, const Param& p, double v) {
   bool ok = true;
-  if (p.min_bound()) ok = ok && (p.min_bound()->second ? v > p.min_bound()->first : v >= p.min_bound()->first);
-  if (p.max_bound()) ok = ok && (p.max_bound()->second ? v < p.max_bound()->first : v <= p.max_bound()->first);
+  if (p.min_bound())
+    ok = ok && (p.min_bound()->second ? v > p.min_bound()->first : v >= p.min_bound()->first);
+  if (p.max_bound())
+    ok = ok && (p.max_bound()->second ? v < p.max_bound()->first : v <= p.max_bound()->first);
   if (!ok)
     c.fail("value " + num(v) + (p.unit_name().empty() ? "" : " " + p.unit_name()) +
            " is out of range; allowed: " + p.bounds_text() +
@@ -169,40 +184,60 @@ void check_choice(const Node& c, const Param& p, const std::string& v) {
   if (p.allowed().empty()) return;
   for (const auto& a : p.allowed())
     if (a == v) return;
-  c.fail("unknown value '" + v + "'; allowed: " + join_names(p.allowed()) + did_you_mean(v, p.allowed()));
+  c.fail("unknown value '" + v + "'; allowed: " + join_names(p.allowed()) +
+         did_you_mean(v, p.allowed()));
 }
 
 void check_value(const Node& c, const Param& p) {
   switch (p.type()) {
-    case Type::real: check_bounds(c, p, c.as_real(p.unit_name())); break;
-    case Type::integer: check_bounds(c, p, static_cast<double>(c.as_integer())); break;
-    case Type::boolean: c.as_boolean(); break;
-    case Type::string: c.as_string(); break;
-    case Type::choice: check_choice(c, p, c.as_string()); break;
+    case Type::real:
+      check_bounds(c, p, c.as_real(p.unit_name()));
+      break;
+    case Type::integer:
+      check_bounds(c, p, static_cast<double>(c.as_integer()));
+      break;
+    case Type::boolean:
+      c.as_boolean();
+      break;
+    case Type::string:
+      c.as_string();
+      break;
+    case Type::choice:
+      check_choice(c, p, c.as_string());
+      break;
     case Type::reals:
     case Type::integers:
     case Type::strings: {
       if (!c.is_sequence())
-        c.fail(std::string("expected a ") + type_name(p.type()) + " such as [1, 2, 3], found " + c.describe());
+        c.fail(std::string("expected a ") + type_name(p.type()) + " such as [1, 2, 3], found " +
+               c.describe());
       if (p.length() >= 0 && static_cast<int>(c.size()) != p.length())
-        c.fail("expected " + std::to_string(p.length()) + " values, found " + std::to_string(c.size()));
+        c.fail("expected " + std::to_string(p.length()) + " values, found " +
+               std::to_string(c.size()));
       for (const Node& e : c.items()) {
-        if (p.type() == Type::reals) check_bounds(e, p, e.as_real(p.unit_name()));
-        else if (p.type() == Type::integers) check_bounds(e, p, static_cast<double>(e.as_integer()));
-        else check_choice(e, p, e.as_string());
+        if (p.type() == Type::reals)
+          check_bounds(e, p, e.as_real(p.unit_name()));
+        else if (p.type() == Type::integers)
+          check_bounds(e, p, static_cast<double>(e.as_integer()));
+        else
+          check_choice(e, p, e.as_string());
       }
       break;
     }
     case Type::section:
-      if (p.sub_spec()) p.sub_spec()->validate(c);
-      else if (!c.is_map()) c.fail("expected a map, found " + c.describe());
+      if (p.sub_spec())
+        p.sub_spec()->validate(c);
+      else if (!c.is_map())
+        c.fail("expected a map, found " + c.describe());
       break;
     case Type::list:
-      if (!c.is_sequence()) c.fail("expected a list (a YAML sequence '- ...'), found " + c.describe());
+      if (!c.is_sequence())
+        c.fail("expected a list (a YAML sequence '- ...'), found " + c.describe());
       if (p.sub_spec())
         for (const Node& e : c.items()) p.sub_spec()->validate(e);
       break;
-    case Type::any: break;
+    case Type::any:
+      break;
   }
 }
 
@@ -217,7 +252,8 @@ void Spec::validate(const Node& node) const {
                   (p.unit_name().empty() ? "" : ", " + p.unit_name()) + ": " + p.doc() + ")");
     return;
   }
-  if (!node.is_map()) node.fail("expected a map for " + name_ + " (" + doc_ + "), found " + node.describe());
+  if (!node.is_map())
+    node.fail("expected a map for " + name_ + " (" + doc_ + "), found " + node.describe());
   std::set<std::string> seen;
   const std::vector<std::string> allowed = keys();
   for (auto it = node.yaml().begin(); it != node.yaml().end(); ++it) {
@@ -228,8 +264,8 @@ void Spec::validate(const Node& node) const {
       throw Error(where, key_node.path(), "duplicate key '" + key + "' (each key may appear once)");
     if (!find(key))
       throw Error(where, key_node.path(),
-                  "unknown key '" + key + "' in " + name_ + "; allowed keys: " + join_names(allowed) +
-                      did_you_mean(key, allowed));
+                  "unknown key '" + key + "' in " + name_ +
+                      "; allowed keys: " + join_names(allowed) + did_you_mean(key, allowed));
   }
   for (const auto& p : params_) {
     if (node.has(p.key()) && node[p.key()].defined()) {
@@ -244,7 +280,8 @@ void Spec::validate(const Node& node) const {
     for (const auto& k : group)
       if (node.has(k)) present.push_back(k);
     if (present.size() > 1)
-      node.fail("keys " + join_names(present) + " exclude each other; give only one of: " + join_names(group));
+      node.fail("keys " + join_names(present) +
+                " exclude each other; give only one of: " + join_names(group));
     if (required && present.empty()) node.fail("give exactly one of: " + join_names(group));
   }
 }
@@ -271,7 +308,8 @@ std::string Spec::docs(int indent) const {
 // ---------------------------------------------------------------------------------------------
 // Quantities with units
 
-std::optional<double> parse_quantity(std::string_view text, std::string_view unit, std::string* why) {
+std::optional<double> parse_quantity(std::string_view text, std::string_view unit,
+                                     std::string* why) {
   auto trim = [](std::string_view s) {
     while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
     while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
@@ -291,7 +329,8 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
     if (why) *why = "not a finite number";
     return std::nullopt;
   }
-  const std::string_view token = trim(std::string_view(r.ptr, static_cast<std::size_t>(end - r.ptr)));
+  const std::string_view token =
+      trim(std::string_view(r.ptr, static_cast<std::size_t>(end - r.ptr)));
   if (token.empty()) return value;
   if (unit.empty()) {
     if (why) *why = "'" + std::string(token) + "' follows the number, but this value takes no unit";
@@ -299,7 +338,8 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
   }
   if (token == unit) return value;
   static const std::vector<std::pair<std::string, double>> prefixes = {
-      {"G", 1e9}, {"M", 1e6}, {"k", 1e3}, {"c", 1e-2}, {"m", 1e-3}, {"u", 1e-6}, {"\xC2\xB5", 1e-6}, {"n", 1e-9}};
+      {"G", 1e9},  {"M", 1e6},  {"k", 1e3},         {"c", 1e-2},
+      {"m", 1e-3}, {"u", 1e-6}, {"\xC2\xB5", 1e-6}, {"n", 1e-9}};
   // The base symbol: a declared unit that itself carries a prefix (kg) is rebased (g).
   std::string base(unit);
   double base_factor = 1.0;
@@ -311,15 +351,16 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
   int power = 1;
   const auto slash = base.find('/');
   const auto caret = base.find('^');
-  if (caret != std::string::npos && (slash == std::string::npos || caret < slash) && caret + 1 < base.size())
+  if (caret != std::string::npos && (slash == std::string::npos || caret < slash) &&
+      caret + 1 < base.size())
     power = base[caret + 1] - '0';
   for (const auto& [p, f] : prefixes) {
     if (token == p + base) return value * std::pow(f, power) * base_factor;
   }
   if (base_factor != 1.0 && token == base) return value * base_factor;
   if (why)
-    *why = "unit '" + std::string(token) + "' is not allowed here; the unit is " + std::string(unit) +
-           " (SI prefixes G, M, k, m, u, n may precede it)";
+    *why = "unit '" + std::string(token) + "' is not allowed here; the unit is " +
+           std::string(unit) + " (SI prefixes G, M, k, m, u, n may precede it)";
   return std::nullopt;
 }
 
@@ -335,7 +376,10 @@ const std::string& empty_string() {
 
 Node::Node(YAML::Node node, std::shared_ptr<const std::string> file, std::string path,
            std::shared_ptr<const Spec> spec)
-    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)), spec_(std::move(spec)) {}
+    : node_(std::move(node)),
+      file_(std::move(file)),
+      path_(std::move(path)),
+      spec_(std::move(spec)) {}
 
 Node Node::load_string(const std::string& text, const std::string& name) {
   auto file = std::make_shared<const std::string>(name);
@@ -370,7 +414,9 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
   for (const std::string& a : overrides) {
     const auto eq = a.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw Error("--set '" + a + "': expected KEY.PATH=VALUE, e.g. time.end=0.01 or coupling.exchanges[0].mapper=rbf");
+      throw Error(
+          "--set '" + a +
+          "': expected KEY.PATH=VALUE, e.g. time.end=0.01 or coupling.exchanges[0].mapper=rbf");
     const std::string path = a.substr(0, eq);
     YAML::Node value;
     try {
@@ -386,7 +432,8 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
       YAML::Node cur = chain.back();
       if (path[i] == '[') {
         const auto close = path.find(']', i);
-        if (close == std::string::npos) throw Error("--set '" + a + "': unclosed '[' in the key path");
+        if (close == std::string::npos)
+          throw Error("--set '" + a + "': unclosed '[' in the key path");
         const std::string idx = path.substr(i + 1, close - i - 1);
         std::size_t k = 0;
         try {
@@ -396,7 +443,8 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
         }
         if (!cur.IsSequence() || k >= cur.size())
           throw Error("--set '" + a + "': '" + walked + "' has no element [" + idx + "]" +
-                      (cur.IsSequence() ? " (it has " + std::to_string(cur.size()) + ")" : " (not a list)"));
+                      (cur.IsSequence() ? " (it has " + std::to_string(cur.size()) + ")"
+                                        : " (not a list)"));
         walked += "[" + idx + "]";
         i = close + 1;
         if (i < path.size() && path[i] == '.') ++i;
@@ -412,7 +460,8 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
       const std::string key = path.substr(i, end - i);
       if (key.empty()) throw Error("--set '" + a + "': empty key in the path");
       if (cur.IsDefined() && !cur.IsNull() && !cur.IsMap())
-        throw Error("--set '" + a + "': '" + walked + "' is not a map, it cannot have key '" + key + "'");
+        throw Error("--set '" + a + "': '" + walked + "' is not a map, it cannot have key '" + key +
+                    "'");
       walked += (walked.empty() ? "" : ".") + key;
       i = end < path.size() && path[end] == '.' ? end + 1 : end;
       if (end >= path.size()) {
@@ -425,7 +474,9 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
   return n;
 }
 
-const std::string& Node::file() const { return file_ ? *file_ : empty_string(); }
+const std::string& Node::file() const {
+  return file_ ? *file_ : empty_string();
+}
 
 SourceLocation Node::location() const {
   if (node_.IsDefined()) {
@@ -445,9 +496,13 @@ std::string Node::describe() const {
   return "?";
 }
 
-void Node::fail(const std::string& message) const { throw Error(location(), path_, message); }
+void Node::fail(const std::string& message) const {
+  throw Error(location(), path_, message);
+}
 
-const Param* Node::param(std::string_view key) const { return spec_ ? spec_->find(key) : nullptr; }
+const Param* Node::param(std::string_view key) const {
+  return spec_ ? spec_->find(key) : nullptr;
+}
 
 Node Node::child(std::string_view key, const YAML::Node& n, bool from_default) const {
   std::string p = path_.empty() ? std::string(key) : path_ + "." + std::string(key);
@@ -479,14 +534,16 @@ Node Node::operator[](std::string_view key) const {
     for (auto it = node_.begin(); it != node_.end(); ++it)
       if (it->first.Scalar() == key) return child(key, it->second, false);
   }
-  if (const Param* p = param(key); p && p->default_value()) return child(key, *p->default_value(), true);
+  if (const Param* p = param(key); p && p->default_value())
+    return child(key, *p->default_value(), true);
   return child(key, YAML::Node(YAML::NodeType::Undefined), false);
 }
 
 Node Node::operator[](std::size_t i) const {
   if (!node_.IsDefined() || !node_.IsSequence()) fail("expected a sequence, found " + describe());
   if (i >= node_.size())
-    fail("index " + std::to_string(i) + " is past the end of a sequence of " + std::to_string(node_.size()));
+    fail("index " + std::to_string(i) + " is past the end of a sequence of " +
+         std::to_string(node_.size()));
   std::shared_ptr<const Spec> s;
   if (spec_ && spec_->params().size() == 1 && spec_->params().front().key() == "[]")
     s = spec_->params().front().sub_spec();
@@ -498,7 +555,8 @@ Node Node::operator[](std::size_t i) const {
 std::vector<Node> Node::items() const {
   std::vector<Node> v;
   if (!defined()) return v;
-  if (!node_.IsSequence()) fail("expected a sequence ('- ...' items or [a, b]), found " + describe());
+  if (!node_.IsSequence())
+    fail("expected a sequence ('- ...' items or [a, b]), found " + describe());
   for (std::size_t i = 0; i < node_.size(); ++i) v.push_back((*this)[i]);
   return v;
 }
@@ -518,18 +576,22 @@ Node Node::validated(std::shared_ptr<const Spec> spec) const {
   return n;
 }
 
-Node Node::validated(const Spec& spec) const { return validated(std::make_shared<const Spec>(spec)); }
+Node Node::validated(const Spec& spec) const {
+  return validated(std::make_shared<const Spec>(spec));
+}
 
 // --- typed values of this node ---------------------------------------------------------------
 
 double Node::as_real(std::string_view unit) const {
-  if (!defined()) fail("missing value; expected a real number" + (unit.empty() ? std::string() : " [" + std::string(unit) + "]"));
+  if (!defined())
+    fail("missing value; expected a real number" +
+         (unit.empty() ? std::string() : " [" + std::string(unit) + "]"));
   if (!node_.IsScalar()) fail("expected a real number, found " + describe());
   std::string why;
   auto v = parse_quantity(node_.Scalar(), unit, &why);
   if (!v)
-    fail("expected a real number" + (unit.empty() ? std::string() : " in " + std::string(unit)) + ", found " +
-         describe() + " (" + why + ")");
+    fail("expected a real number" + (unit.empty() ? std::string() : " in " + std::string(unit)) +
+         ", found " + describe() + " (" + why + ")");
   return *v;
 }
 
@@ -542,7 +604,8 @@ long Node::as_integer() const {
   if (!s.empty() && s[0] == '+') ++b;
   auto r = std::from_chars(b, s.data() + s.size(), v);
   if (r.ec != std::errc() || r.ptr != s.data() + s.size())
-    fail("expected an integer, found " + describe() + (is_number_text(s) ? " (a whole number is required)" : ""));
+    fail("expected an integer, found " + describe() +
+         (is_number_text(s) ? " (a whole number is required)" : ""));
   return v;
 }
 
@@ -578,12 +641,16 @@ Eigen::Vector3d Node::as_vec3(std::string_view unit) const {
 
 // --- typed values of children ----------------------------------------------------------------
 
-void Node::check_param(const Param& p) const { check_value(*this, p); }
+void Node::check_param(const Param& p) const {
+  check_value(*this, p);
+}
 
 namespace {
 [[noreturn]] void missing(const Node& parent, std::string_view key, const Param* p) {
   std::string what = "missing required key '" + std::string(key) + "'";
-  if (p) what += " (" + std::string(type_name(p->type())) + (p->unit_name().empty() ? "" : ", " + p->unit_name()) + ": " + p->doc() + ")";
+  if (p)
+    what += " (" + std::string(type_name(p->type())) +
+            (p->unit_name().empty() ? "" : ", " + p->unit_name()) + ": " + p->doc() + ")";
   parent.fail(what);
 }
 }  // namespace

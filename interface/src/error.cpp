@@ -14,7 +14,8 @@ std::string SourceLocation::str() const {
 }
 
 namespace {
-std::string located(const SourceLocation& where, const std::string& key_path, const std::string& message) {
+std::string located(const SourceLocation& where, const std::string& key_path,
+                    const std::string& message) {
   std::string s;
   const std::string w = where.str();
   if (!w.empty()) s += w + ": ";

@@ -42,7 +42,9 @@ void set_level(spdlog::level::level_enum level) {
   spdlog::apply_all([level](const std::shared_ptr<spdlog::logger>& l) { l->set_level(level); });
 }
 
-const char* level_names() { return "trace, debug, info, warn, error, critical, off"; }
+const char* level_names() {
+  return "trace, debug, info, warn, error, critical, off";
+}
 
 spdlog::level::level_enum parse_level(std::string_view name) {
   static const std::vector<std::pair<std::string, spdlog::level::level_enum>> levels = {

@@ -71,11 +71,14 @@ Mesh::Points Mesh::triangle_centroids() const {
   Points c(triangles_.rows(), 3);
   for (Eigen::Index t = 0; t < triangles_.rows(); ++t)
     c.row(t) = (points_.row(triangles_(t, 0)) + points_.row(triangles_(t, 1)) +
-                points_.row(triangles_(t, 2))) / 3.0;
+                points_.row(triangles_(t, 2))) /
+               3.0;
   return c;
 }
 
-double Mesh::total_area() const { return triangle_areas().sum(); }
+double Mesh::total_area() const {
+  return triangle_areas().sum();
+}
 
 Mesh::Box Mesh::bounding_box() const {
   Box b;

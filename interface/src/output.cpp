@@ -17,7 +17,8 @@ AtomicFile::AtomicFile(std::filesystem::path path, bool binary) : path_(std::mov
     std::filesystem::create_directories(path_.parent_path(), ec);
   }
   out_.open(tmp_, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
-  if (!out_) throw Error("cannot write '" + tmp_.string() + "' (does the folder exist and is it writable?)");
+  if (!out_)
+    throw Error("cannot write '" + tmp_.string() + "' (does the folder exist and is it writable?)");
 }
 
 AtomicFile::~AtomicFile() {
@@ -35,7 +36,9 @@ void AtomicFile::commit() {
   if (!ok) throw Error("writing '" + path_.string() + "' failed (disk full?)");
   std::error_code ec;
   std::filesystem::rename(tmp_, path_, ec);
-  if (ec) throw Error("cannot rename '" + tmp_.string() + "' to '" + path_.string() + "': " + ec.message());
+  if (ec)
+    throw Error("cannot rename '" + tmp_.string() + "' to '" + path_.string() +
+                "': " + ec.message());
   committed_ = true;
 }
 
@@ -68,8 +71,8 @@ CsvSeries::CsvSeries(std::filesystem::path path, std::string first_column, std::
 
 void CsvSeries::record(double first, const std::vector<double>& values) {
   if (values.size() != columns_)
-    throw Error("CSV '" + path_.string() + "': a row has " + std::to_string(values.size()) + " values, the header " +
-                std::to_string(columns_));
+    throw Error("CSV '" + path_.string() + "': a row has " + std::to_string(values.size()) +
+                " values, the header " + std::to_string(columns_));
   text_ += fmt_double(first);
   for (double v : values) text_ += "," + fmt_double(v);
   text_ += "\n";
@@ -91,10 +94,12 @@ PvdSeries::PvdSeries(std::filesystem::path path) : path_(std::move(path)) {}
 void PvdSeries::add(double time, const std::string& file) {
   entries_.emplace_back(time, file);
   std::ostringstream s;
-  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+  s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
+       "byte_order=\"LittleEndian\">\n"
        "  <Collection>\n";
   for (const auto& [t, f] : entries_)
-    s << "    <DataSet timestep=\"" << std::setprecision(12) << t << "\" group=\"\" part=\"0\" file=\"" << f << "\"/>\n";
+    s << "    <DataSet timestep=\"" << std::setprecision(12) << t
+      << "\" group=\"\" part=\"0\" file=\"" << f << "\"/>\n";
   s << "  </Collection>\n</VTKFile>\n";
   write_file_atomically(path_, s.str());
 }
@@ -102,8 +107,8 @@ void PvdSeries::add(double time, const std::string& file) {
 // ---------------------------------------------------------------------------------------------
 namespace {
 void write_array(std::ostream& out, const std::string& name, const Eigen::MatrixXd& a) {
-  out << "        <DataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\"" << a.cols()
-      << "\" format=\"ascii\">\n          ";
+  out << "        <DataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\""
+      << a.cols() << "\" format=\"ascii\">\n          ";
   for (Eigen::Index i = 0; i < a.rows(); ++i)
     for (Eigen::Index k = 0; k < a.cols(); ++k) {
       const double v = std::isfinite(a(i, k)) ? a(i, k) : 0.0;
@@ -120,15 +125,19 @@ void write_vtp(const std::filesystem::path& path, const Mesh& mesh, const VtkArr
   const bool tris = mesh.has_triangles();
   const Eigen::Index nc = tris ? mesh.num_triangles() : np;
   for (const auto& [n, a] : point_data)
-    if (a.rows() != np) throw Error("VTK output '" + path.string() + "': point array '" + n + "' has wrong length");
+    if (a.rows() != np)
+      throw Error("VTK output '" + path.string() + "': point array '" + n + "' has wrong length");
   for (const auto& [n, a] : cell_data)
-    if (a.rows() != nc) throw Error("VTK output '" + path.string() + "': cell array '" + n + "' has wrong length");
+    if (a.rows() != nc)
+      throw Error("VTK output '" + path.string() + "': cell array '" + n + "' has wrong length");
   AtomicFile f(path);
   auto& out = f.stream();
   out << std::setprecision(10);
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      << "  <PolyData>\n    <Piece NumberOfPoints=\"" << np << "\" NumberOfVerts=\"" << (tris ? 0 : np)
-      << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" << (tris ? nc : 0) << "\">\n";
+  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" "
+         "byte_order=\"LittleEndian\">\n"
+      << "  <PolyData>\n    <Piece NumberOfPoints=\"" << np << "\" NumberOfVerts=\""
+      << (tris ? 0 : np) << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\""
+      << (tris ? nc : 0) << "\">\n";
   out << "      <Points>\n";
   write_array(out, "Points", P);
   out << "      </Points>\n";
@@ -139,12 +148,15 @@ void write_vtp(const std::filesystem::path& path, const Mesh& mesh, const VtkArr
   out << "      </CellData>\n";
   const char* kind = tris ? "Polys" : "Verts";
   const int per = tris ? 3 : 1;
-  out << "      <" << kind << ">\n        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n          ";
+  out << "      <" << kind
+      << ">\n        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n          ";
   for (Eigen::Index c = 0; c < nc; ++c)
     for (int k = 0; k < per; ++k) out << (tris ? mesh.triangles()(c, k) : c) << ' ';
-  out << "\n        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n          ";
+  out << "\n        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" "
+         "format=\"ascii\">\n          ";
   for (Eigen::Index c = 0; c < nc; ++c) out << (c + 1) * per << ' ';
-  out << "\n        </DataArray>\n      </" << kind << ">\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+  out << "\n        </DataArray>\n      </" << kind
+      << ">\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
   f.commit();
 }
 

@@ -56,7 +56,8 @@ Soup parse_binary(const std::string& b, const std::string& source) {
 }
 
 Soup parse_ascii(const std::string& b, const std::string& source) {
-  // solid name / facet normal nx ny nz / outer loop / vertex x y z (x3) / endloop / endfacet / endsolid
+  // solid name / facet normal nx ny nz / outer loop / vertex x y z (x3) / endloop / endfacet /
+  // endsolid
   Soup s;
   std::istringstream in(b);
   std::string line;
@@ -71,7 +72,8 @@ Soup parse_ascii(const std::string& b, const std::string& source) {
     std::string word;
     if (!(ls >> word)) continue;
     auto expect = [&](const char* what) {
-      stl_error(source, lineno, "STL syntax error: expected " + std::string(what) + ", found '" + word + "'");
+      stl_error(source, lineno,
+                "STL syntax error: expected " + std::string(what) + ", found '" + word + "'");
     };
     switch (st) {
       case St::start:
@@ -95,12 +97,14 @@ Soup parse_ascii(const std::string& b, const std::string& source) {
       case St::loop: {
         if (word == "endloop") {
           if (nv != 3)
-            stl_error(source, lineno, "STL facet has " + std::to_string(nv) + " vertices; exactly 3 are required");
+            stl_error(source, lineno,
+                      "STL facet has " + std::to_string(nv) + " vertices; exactly 3 are required");
           st = St::endloop;
           break;
         }
         if (word != "vertex") expect("'vertex' or 'endloop'");
-        if (nv >= 3) stl_error(source, lineno, "STL facet has more than 3 vertices; exactly 3 are required");
+        if (nv >= 3)
+          stl_error(source, lineno, "STL facet has more than 3 vertices; exactly 3 are required");
         for (int k = 0; k < 3; ++k) {
           std::string tok;
           if (!(ls >> tok)) stl_error(source, lineno, "STL vertex needs 3 coordinates");
@@ -134,12 +138,14 @@ Soup parse_ascii(const std::string& b, const std::string& source) {
 
 }  // namespace
 
-Mesh parse_stl(const std::string& bytes, const std::string& source, const std::string& name, double scale) {
+Mesh parse_stl(const std::string& bytes, const std::string& source, const std::string& name,
+               double scale) {
   if (bytes.empty()) throw Error(source + ": the STL file is empty");
   if (!(scale > 0) || !std::isfinite(scale))
     throw Error(source + ": STL scale must be a positive number, got " + std::to_string(scale));
   Soup soup;
-  const bool ascii_start = bytes.compare(0, 5, "solid") == 0 && bytes.find("facet") != std::string::npos;
+  const bool ascii_start =
+      bytes.compare(0, 5, "solid") == 0 && bytes.find("facet") != std::string::npos;
   if (looks_binary(bytes)) {
     soup = parse_binary(bytes, source);
   } else if (ascii_start || bytes.compare(0, 5, "solid") == 0) {
@@ -147,9 +153,10 @@ Mesh parse_stl(const std::string& bytes, const std::string& source, const std::s
   } else if (bytes.size() >= 84) {
     std::uint32_t n = 0;
     std::memcpy(&n, bytes.data() + 80, 4);
-    throw Error(source + ": not a valid STL file: as binary STL its header announces " + std::to_string(n) +
-                " triangles (" + std::to_string(84 + 50ull * n) + " bytes) but the file has " +
-                std::to_string(bytes.size()) + " bytes (truncated?), and it does not start with 'solid' as ASCII STL does");
+    throw Error(source + ": not a valid STL file: as binary STL its header announces " +
+                std::to_string(n) + " triangles (" + std::to_string(84 + 50ull * n) +
+                " bytes) but the file has " + std::to_string(bytes.size()) +
+                " bytes (truncated?), and it does not start with 'solid' as ASCII STL does");
   } else {
     throw Error(source + ": not a valid STL file (" + std::to_string(bytes.size()) +
                 " bytes: too short for binary STL and not ASCII STL starting with 'solid')");
@@ -165,14 +172,16 @@ Mesh parse_stl(const std::string& bytes, const std::string& source, const std::s
     for (double v : t) extent = std::max(extent, std::abs(v));
   for (std::size_t t = 0; t < soup.tris.size(); ++t) {
     const auto& tri = soup.tris[t];
-    const std::string where =
-        soup.lines[t] ? "facet at line " + std::to_string(soup.lines[t]) : "triangle " + std::to_string(t);
+    const std::string where = soup.lines[t] ? "facet at line " + std::to_string(soup.lines[t])
+                                            : "triangle " + std::to_string(t);
     for (double v : tri)
-      if (!std::isfinite(v)) stl_error(source, soup.lines[t], where + " has a NaN or infinite coordinate");
+      if (!std::isfinite(v))
+        stl_error(source, soup.lines[t], where + " has a NaN or infinite coordinate");
     Eigen::Vector3d a(tri[0], tri[1], tri[2]), b(tri[3], tri[4], tri[5]), c(tri[6], tri[7], tri[8]);
     const double area2 = (b - a).cross(c - a).norm();
     if (!(area2 > 1e-12 * extent * extent))
-      stl_error(source, soup.lines[t], where + " has zero area (degenerate triangle); remove it or fix its vertices");
+      stl_error(source, soup.lines[t],
+                where + " has zero area (degenerate triangle); remove it or fix its vertices");
     for (int k = 0; k < 3; ++k) {
       std::array<double, 3> p{tri[3 * k] * scale, tri[3 * k + 1] * scale, tri[3 * k + 2] * scale};
       auto [it, inserted] = index.emplace(p, static_cast<int>(pts.size()));
@@ -188,7 +197,8 @@ Mesh parse_stl(const std::string& bytes, const std::string& source, const std::s
 
 Mesh read_stl(const std::filesystem::path& file, const std::string& name, double scale) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw Error("cannot open STL file '" + file.string() + "': no such file");
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw Error("cannot open STL file '" + file.string() + "': no such file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error("cannot open STL file '" + file.string() + "'");
   std::stringstream ss;
@@ -210,7 +220,8 @@ void write_stl_binary(const std::filesystem::path& file, const Mesh& mesh) {
     float buf[12];
     for (int k = 0; k < 3; ++k) buf[k] = static_cast<float>(normals(t, k));
     for (int v = 0; v < 3; ++v)
-      for (int k = 0; k < 3; ++k) buf[3 + 3 * v + k] = static_cast<float>(mesh.points()(mesh.triangles()(t, v), k));
+      for (int k = 0; k < 3; ++k)
+        buf[3 + 3 * v + k] = static_cast<float>(mesh.points()(mesh.triangles()(t, v), k));
     out.write(reinterpret_cast<const char*>(buf), sizeof buf);
     const std::uint16_t attr = 0;
     out.write(reinterpret_cast<const char*>(&attr), 2);
@@ -226,7 +237,8 @@ void write_stl_ascii(const std::filesystem::path& file, const Mesh& mesh) {
   out << "solid " << solid << "\n";
   const Mesh::Points normals = mesh.triangle_normals();
   for (Eigen::Index t = 0; t < mesh.num_triangles(); ++t) {
-    out << "  facet normal " << normals(t, 0) << " " << normals(t, 1) << " " << normals(t, 2) << "\n    outer loop\n";
+    out << "  facet normal " << normals(t, 0) << " " << normals(t, 1) << " " << normals(t, 2)
+        << "\n    outer loop\n";
     for (int v = 0; v < 3; ++v) {
       const auto p = mesh.points().row(mesh.triangles()(t, v));
       out << "      vertex " << p(0) << " " << p(1) << " " << p(2) << "\n";

@@ -1,5 +1,7 @@
 #include "partita/interface/version.hpp"
 
 namespace partita {
-const char* version() { return PARTITA_VERSION; }
+const char* version() {
+  return PARTITA_VERSION;
+}
 }  // namespace partita

@@ -33,10 +33,13 @@ const std::map<std::string, std::string>& samples() {
        "materials: {glass: {youngs_modulus: 200 MPa, poisson_ratio: 0.23, density: 400},\n"
        "            steel: {youngs_modulus: 250 GPa, poisson_ratio: 0.3, density: 7850}}\n"
        "interactions: [{pair: [glass, glass]}, {pair: [glass, steel], friction: 0.1}]\n"
-       "particles: {material: glass, generate: {box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.01]},\n"
+       "particles: {material: glass, generate: {box: {origin: [0, 0, 0], size: [0.01, 0.01, "
+       "0.01]},\n"
        "            diameters: [2.5 mm, 2.0 mm], porosity: 0.55, seed: 3}}\n"
-       "walls: [{box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.02]}, open: [zmax], material: steel}]\n"
-       "meshes: [{name: plate, rectangle: {origin: [0, 0, 0.0102], size: [0.01, 0.01], cells: [4, 4]}, material: steel}]\n"},
+       "walls: [{box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.02]}, open: [zmax], material: "
+       "steel}]\n"
+       "meshes: [{name: plate, rectangle: {origin: [0, 0, 0.0102], size: [0.01, 0.01], cells: [4, "
+       "4]}, material: steel}]\n"},
   };
   return s;
 }
@@ -48,7 +51,8 @@ Eigen::MatrixXd input(const InterfaceMesh& m, const DataSpec& d, double scale) {
   const double base = d.name == "cross_section_area" ? 1.0 : 0.0;
   Eigen::MatrixXd v = Eigen::MatrixXd::Constant(m.mesh.size(), d.components, base);
   for (Eigen::Index i = 0; i < v.rows(); ++i)
-    for (Eigen::Index k = 0; k < v.cols(); ++k) v(i, k) += scale * (1e-6 * static_cast<double>((i * 7 + k * 3) % 5));
+    for (Eigen::Index k = 0; k < v.cols(); ++k)
+      v(i, k) += scale * (1e-6 * static_cast<double>((i * 7 + k * 3) % 5));
   return v;
 }
 
@@ -76,12 +80,14 @@ TEST_CASE("every registered adapter honours the Solver contract", "[adapters][co
   coupling::register_builtin(r);
   adapters::register_all(r);
   REQUIRE(r.solvers.entries().size() >= 4);
-  const fs::path out = fs::temp_directory_path() / ("partita_conformance_" + std::to_string(::getpid()));
+  const fs::path out =
+      fs::temp_directory_path() / ("partita_conformance_" + std::to_string(::getpid()));
   fs::create_directories(out / "vtk");
   for (const auto& entry : r.solvers.entries()) {
     DYNAMIC_SECTION("solver " << entry.name) {
       const auto it = samples().find(entry.name);
-      INFO("add a sample configuration for '" << entry.name << "' to tests/adapters/conformance_test.cpp");
+      INFO("add a sample configuration for '" << entry.name
+                                              << "' to tests/adapters/conformance_test.cpp");
       REQUIRE(it != samples().end());
       config::Node node = config::Node::load_string(it->second, entry.name + ".yaml");
       if (entry.spec) {
@@ -128,7 +134,8 @@ TEST_CASE("every registered adapter honours the Solver contract", "[adapters][co
       CHECK(s->time() == t0);
       const auto again = window(*s, dt, 3);
       REQUIRE(first.size() == again.size());
-      for (std::size_t i = 0; i < first.size(); ++i) CHECK((first[i].array() == again[i].array()).all());
+      for (std::size_t i = 0; i < first.size(); ++i)
+        CHECK((first[i].array() == again[i].array()).all());
 
       // output and monitors
       s->write_output(OutputFrame{out / "vtk", "p_" + entry.name, 1, s->time()});

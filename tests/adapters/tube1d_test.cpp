@@ -37,7 +37,8 @@ fs::path shortened(const std::string& name, const std::string& end) {
   const auto at = text.find("end: 1.0");
   REQUIRE(at != std::string::npos);
   text.replace(at, 8, "end: " + end);
-  const fs::path dir = fs::temp_directory_path() / ("partita_tube_test_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("partita_tube_test_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path file = dir / (name + ".yaml");
   std::ofstream(file) << text;
@@ -55,7 +56,8 @@ std::unique_ptr<Solver> make(const coupling::Registries& r, const std::string& s
 
 }  // namespace
 
-TEST_CASE("Tube adapters follow the Solver contract; checkpoint/restore is bit-identical", "[adapters][tube1d]") {
+TEST_CASE("Tube adapters follow the Solver contract; checkpoint/restore is bit-identical",
+          "[adapters][tube1d]") {
   const auto r = registries();
   for (const char* name : {"tube1d-fluid", "tube1d-solid"}) {
     auto s = make(r, name);
@@ -65,7 +67,8 @@ TEST_CASE("Tube adapters follow the Solver contract; checkpoint/restore is bit-i
     CHECK(s->stable_time_step() > 0.0);
     Eigen::MatrixXd out;
     const std::string writes = s->meshes()[0].writes[0].name, reads = s->meshes()[0].reads[0].name;
-    const Eigen::MatrixXd in = Eigen::MatrixXd::Constant(101, 1, writes == "pressure" ? 1.001 : 50.0);
+    const Eigen::MatrixXd in =
+        Eigen::MatrixXd::Constant(101, 1, writes == "pressure" ? 1.001 : 50.0);
     s->save_checkpoint();
     s->read("nodes", reads, in);
     s->advance(0.01);
@@ -84,10 +87,12 @@ TEST_CASE("Tube adapters follow the Solver contract; checkpoint/restore is bit-i
   }
 }
 
-TEST_CASE("Elastic tube (t = 0.1): IQN-ILS converges in every window, with fewer iterations than Aitken",
-          "[adapters][tube1d][case]") {
+TEST_CASE(
+    "Elastic tube (t = 0.1): IQN-ILS converges in every window, with fewer iterations than Aitken",
+    "[adapters][tube1d][case]") {
   const auto r = registries();
-  const fs::path out = fs::temp_directory_path() / ("partita_tube_out_" + std::to_string(::getpid()));
+  const fs::path out =
+      fs::temp_directory_path() / ("partita_tube_out_" + std::to_string(::getpid()));
   coupling::CaseRun iqn(shortened("iqn-ils", "0.1"), r, run_options(out / "iqn", false));
   iqn.run();
   coupling::CaseRun aitken(shortened("aitken", "0.1"), r, run_options(out / "aitken", false));
@@ -107,8 +112,9 @@ TEST_CASE("Elastic tube (t = 0.1): IQN-ILS converges in every window, with fewer
 TEST_CASE("Every elastic tube case file validates (check_only)", "[adapters][tube1d][case]") {
   const auto r = registries();
   for (const char* c : {"constant", "aitken", "iqn-ils"}) {
-    coupling::CaseRun run(fs::path(PARTITA_SOURCE_DIR) / "cases/elastic_tube_1d" / (std::string(c) + ".yaml"), r,
-                          run_options("unused", true));
+    coupling::CaseRun run(
+        fs::path(PARTITA_SOURCE_DIR) / "cases/elastic_tube_1d" / (std::string(c) + ".yaml"), r,
+        run_options("unused", true));
     CHECK(run.window_count() == 100);
   }
 }

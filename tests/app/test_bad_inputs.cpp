@@ -113,7 +113,8 @@ TEST_CASE("cli: version, help, usage errors", "[app][cli]") {
 TEST_CASE("cli: list shows every registry", "[app][cli]") {
   const Result l = run_partita("list");
   REQUIRE(l.status == 0);
-  for (const char* heading : {"solvers:", "mappers:", "schemes:", "accelerations:", "convergence measures:"})
+  for (const char* heading :
+       {"solvers:", "mappers:", "schemes:", "accelerations:", "convergence measures:"})
     CHECK(l.output.find(heading) != std::string::npos);
   CHECK(l.output.find("nearest-neighbor") != std::string::npos);
   const Result d = run_partita("docs nearest-neighbr");

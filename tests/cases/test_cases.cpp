@@ -48,7 +48,8 @@ struct Csv {
   }
   double mean(int col, double over_last) const {
     const std::size_t n = rows.size();
-    const std::size_t first = n - std::max<std::size_t>(1, static_cast<std::size_t>(over_last * static_cast<double>(n)));
+    const std::size_t first =
+        n - std::max<std::size_t>(1, static_cast<std::size_t>(over_last * static_cast<double>(n)));
     double s = 0;
     for (std::size_t r = first; r < n; ++r) s += rows[r][static_cast<std::size_t>(col)];
     return s / static_cast<double>(n - first);
@@ -89,7 +90,8 @@ std::map<std::string, double> key_values(const std::string& text) {
   return kv;
 }
 
-void compare(const YAML::Node& check, double value, const std::string& what, const std::function<double(const std::string&)>& column_mean) {
+void compare(const YAML::Node& check, double value, const std::string& what,
+             const std::function<double(const std::string&)>& column_mean) {
   INFO(what << " = " << value);
   if (check["equals_mean_of"]) {
     const double ref = column_mean(check["equals_mean_of"].as<std::string>());
@@ -119,9 +121,11 @@ TEST_CASE("cases: shortened runs meet their reference values", "[cases]") {
       const std::string name = run["name"].as<std::string>();
       DYNAMIC_SECTION(dir.path().filename().string() << "/" << name) {
         ++runs;
-        const fs::path out = fs::temp_directory_path() / ("partita_case_" + name + "_" + std::to_string(::getpid()));
+        const fs::path out =
+            fs::temp_directory_path() / ("partita_case_" + name + "_" + std::to_string(::getpid()));
         fs::remove_all(out);
-        std::string cmd = quote(PARTITA_EXECUTABLE) + " run " + quote((dir.path() / run["case"].as<std::string>()).string()) +
+        std::string cmd = quote(PARTITA_EXECUTABLE) + " run " +
+                          quote((dir.path() / run["case"].as<std::string>()).string()) +
                           " --output " + quote(out.string()) + " --threads 1 --log-level warn";
         for (const auto& s : run["set"]) cmd += " --set " + quote(s.as<std::string>());
         const auto [status, output] = shell(cmd);
@@ -134,8 +138,9 @@ TEST_CASE("cases: shortened runs meet their reference values", "[cases]") {
         };
         for (const YAML::Node& check : run["checks"]) {
           if (check["script"]) {
-            const auto [st, text] = shell(python + " " + quote((dir.path() / check["script"].as<std::string>()).string()) +
-                                          " " + quote(out.string()));
+            const auto [st, text] = shell(
+                python + " " + quote((dir.path() / check["script"].as<std::string>()).string()) +
+                " " + quote(out.string()));
             INFO("script output:\n" << text);
             REQUIRE(st == 0);
             const auto kv = key_values(text);
@@ -155,7 +160,8 @@ TEST_CASE("cases: shortened runs meet their reference values", "[cases]") {
             return c.mean(k, over);
           };
           const std::string col = check["mean_of"].as<std::string>();
-          compare(check, column_mean(col), "mean of " + col + " over the last " + std::to_string(over) + " of " + file,
+          compare(check, column_mean(col),
+                  "mean of " + col + " over the last " + std::to_string(over) + " of " + file,
                   column_mean);
         }
         fs::remove_all(out);

@@ -11,7 +11,8 @@
 
 using namespace partita::coupling;
 
-TEST_CASE("IQN-ILS solves a linear fixed point of dimension n within n + 1 iterations", "[coupling][acceleration]") {
+TEST_CASE("IQN-ILS solves a linear fixed point of dimension n within n + 1 iterations",
+          "[coupling][acceleration]") {
   const int n = 12;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -93,8 +94,9 @@ TEST_CASE("IQN-ILS reuses columns of past windows and the QR2 filter drops depen
   CHECK(iqn.filtered_columns() >= 0);
 }
 
-TEST_CASE("Constant relaxation contracts by |1 - omega (1 - lambda)| per iteration on a diagonal map",
-          "[coupling][acceleration]") {
+TEST_CASE(
+    "Constant relaxation contracts by |1 - omega (1 - lambda)| per iteration on a diagonal map",
+    "[coupling][acceleration]") {
   const Eigen::Vector3d lambda(0.5, -0.8, 0.9);
   const Eigen::Vector3d b(1.0, 2.0, -1.0);
   const Eigen::Vector3d exact = b.cwiseQuotient(Eigen::Vector3d::Ones() - lambda);

@@ -25,7 +25,8 @@ RunOptions run_options(const std::filesystem::path& dir, bool check_only) {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("partita_coupling_test_" + std::to_string(::getpid())) / name;
+  fs::path d =
+      fs::temp_directory_path() / ("partita_coupling_test_" + std::to_string(::getpid())) / name;
   fs::create_directories(d);
   return d;
 }
@@ -55,12 +56,15 @@ const std::string exchanges = R"(
     - {data: y2, from: two.point, to: one.point}
 )";
 
-std::string implicit_case(const std::string& acceleration = "{type: iqn-ils, initial_relaxation: 0.5}") {
-  return "case: ode\ntime: {window: 0.1, end: 1.0}\n" + participants + "coupling:\n  scheme: implicit-serial\n" +
-         exchanges +
+std::string implicit_case(
+    const std::string& acceleration = "{type: iqn-ils, initial_relaxation: 0.5}") {
+  return "case: ode\ntime: {window: 0.1, end: 1.0}\n" + participants +
+         "coupling:\n  scheme: implicit-serial\n" + exchanges +
          "  convergence:\n    - {type: relative, data: y1, limit: 1.0e-8}\n"
          "    - {type: absolute, data: y2, limit: 1.0e-9}\n"
-         "  acceleration: " + acceleration + "\n"
+         "  acceleration: " +
+         acceleration +
+         "\n"
          "monitors:\n  - {name: state, quantities: [one.y, two.y]}\n"
          "output: {every: 0.5}\n";
 }
@@ -77,7 +81,8 @@ std::string error_of(const std::string& name, const std::string& text) {
 
 }  // namespace
 
-TEST_CASE("CaseRun runs a YAML case and writes coupling.csv, monitors and VTK series", "[coupling][case]") {
+TEST_CASE("CaseRun runs a YAML case and writes coupling.csv, monitors and VTK series",
+          "[coupling][case]") {
   const Registries r = test::test_registries();
   const fs::path out = scratch("run_ok");
   CaseRun run(write_case("ok", implicit_case()), r, run_options(out, false));
@@ -106,10 +111,12 @@ TEST_CASE("CaseRun check_only builds everything and writes nothing", "[coupling]
   CHECK(run.scheme().name() == "implicit-serial");
 }
 
-TEST_CASE("CaseRun: bad coupling settings are clear errors at the key", "[coupling][case][errors]") {
+TEST_CASE("CaseRun: bad coupling settings are clear errors at the key",
+          "[coupling][case][errors]") {
   SECTION("unknown acceleration names the key and the nearest name") {
     const std::string e = error_of("acc", implicit_case("{type: iqn-il}"));
-    CHECK_THAT(e, Catch::Contains("coupling.acceleration.type") && Catch::Contains("unknown acceleration 'iqn-il'") &&
+    CHECK_THAT(e, Catch::Contains("coupling.acceleration.type") &&
+                      Catch::Contains("unknown acceleration 'iqn-il'") &&
                       Catch::Contains("did you mean 'iqn-ils'"));
     CHECK_THAT(e, Catch::Contains("acc.yaml:"));
   }
@@ -129,37 +136,45 @@ TEST_CASE("CaseRun: bad coupling settings are clear errors at the key", "[coupli
     const std::string text = "case: x\ntime: {window: 0.1, end: 1.0}\n" + participants +
                              "coupling:\n  scheme: explicit-serail\n" + exchanges;
     const std::string e = error_of("scheme", text);
-    CHECK_THAT(e, Catch::Contains("coupling.scheme") && Catch::Contains("did you mean 'explicit-serial'"));
+    CHECK_THAT(
+        e, Catch::Contains("coupling.scheme") && Catch::Contains("did you mean 'explicit-serial'"));
   }
   SECTION("unknown convergence measure") {
     std::string text = implicit_case();
     text.replace(text.find("type: absolute"), 14, "type: absolut");
     const std::string e = error_of("measure", text);
-    CHECK_THAT(e, Catch::Contains("coupling.convergence[1].type") && Catch::Contains("did you mean 'absolute'"));
+    CHECK_THAT(e, Catch::Contains("coupling.convergence[1].type") &&
+                      Catch::Contains("did you mean 'absolute'"));
   }
   SECTION("exchange naming a missing participant, mesh or data") {
     std::string t1 = implicit_case();
     t1.replace(t1.find("from: one.point"), 15, "from: onr.point");
     CHECK_THAT(error_of("p", t1), Catch::Contains("coupling.exchanges[0].from") &&
-                                      Catch::Contains("unknown participant 'onr'") && Catch::Contains("'one'"));
+                                      Catch::Contains("unknown participant 'onr'") &&
+                                      Catch::Contains("'one'"));
     std::string t2 = implicit_case();
     t2.replace(t2.find("to: two.point"), 13, "to: two.poin");
-    CHECK_THAT(error_of("m", t2), Catch::Contains("exchanges[0].to") && Catch::Contains("no mesh 'poin'") &&
+    CHECK_THAT(error_of("m", t2), Catch::Contains("exchanges[0].to") &&
+                                      Catch::Contains("no mesh 'poin'") &&
                                       Catch::Contains("did you mean 'point'"));
     std::string t3 = implicit_case();
     t3.replace(t3.find("{data: y1"), 9, "{data: y2");
     CHECK_THAT(error_of("d", t3), Catch::Contains("exchanges[0].data") &&
-                                      Catch::Contains("'one' does not write 'y2'") && Catch::Contains("writes: y1"));
+                                      Catch::Contains("'one' does not write 'y2'") &&
+                                      Catch::Contains("writes: y1"));
   }
   SECTION("substeps < 1") {
     const std::string text = "case: x\ntime: {window: 0.1, end: 1.0}\n" + participants +
-                             "coupling:\n  scheme: explicit-serial\n  substeps: {two: 0}\n" + exchanges;
-    CHECK_THAT(error_of("sub", text), Catch::Contains("coupling.substeps.two") && Catch::Contains(">= 1"));
+                             "coupling:\n  scheme: explicit-serial\n  substeps: {two: 0}\n" +
+                             exchanges;
+    CHECK_THAT(error_of("sub", text),
+               Catch::Contains("coupling.substeps.two") && Catch::Contains(">= 1"));
   }
   SECTION("convergence keys on an explicit scheme") {
     std::string text = implicit_case();
     text.replace(text.find("implicit-serial"), 15, "explicit-serial");
-    CHECK_THAT(error_of("expl", text), Catch::Contains("coupling.convergence") && Catch::Contains("implicit-serial"));
+    CHECK_THAT(error_of("expl", text),
+               Catch::Contains("coupling.convergence") && Catch::Contains("implicit-serial"));
   }
 }
 

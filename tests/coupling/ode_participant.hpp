@@ -18,7 +18,8 @@ namespace partita::coupling::test {
 
 class OdeParticipant : public Solver {
  public:
-  OdeParticipant(std::string writes, std::string reads, double a, double b, double y0, double stable_dt = INFINITY)
+  OdeParticipant(std::string writes, std::string reads, double a, double b, double y0,
+                 double stable_dt = INFINITY)
       : a_(a), b_(b), y_(y0), stable_(stable_dt) {
     InterfaceMesh m;
     m.mesh = Mesh("point", Mesh::Points::Zero(1, 3));
@@ -64,7 +65,8 @@ class OdeParticipant : public Solver {
   std::vector<double> saved_ = {0, 0, 0};
 };
 
-/// Registries with the built-ins and the solver "test-ode" (keys a, b, y0, writes, reads, stable_dt).
+/// Registries with the built-ins and the solver "test-ode" (keys a, b, y0, writes, reads,
+/// stable_dt).
 inline Registries test_registries() {
   Registries r;
   register_builtin(r);
@@ -75,10 +77,14 @@ inline Registries test_registries() {
   spec->string("writes", "name of the written field").required();
   spec->string("reads", "name of the read field").required();
   spec->real("stable_dt", "stable time step").positive().def(1e300);
-  r.solvers.add("test-ode", "scalar linear ODE", [](const SolverContext& c) -> std::unique_ptr<Solver> {
-    return std::make_unique<OdeParticipant>(c.config.string("writes"), c.config.string("reads"), c.config.real("a"),
-                                            c.config.real("b"), c.config.real("y0"), c.config.real("stable_dt"));
-  }, spec);
+  r.solvers.add(
+      "test-ode", "scalar linear ODE",
+      [](const SolverContext& c) -> std::unique_ptr<Solver> {
+        return std::make_unique<OdeParticipant>(c.config.string("writes"), c.config.string("reads"),
+                                                c.config.real("a"), c.config.real("b"),
+                                                c.config.real("y0"), c.config.real("stable_dt"));
+      },
+      spec);
   return r;
 }
 

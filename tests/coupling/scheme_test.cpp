@@ -28,17 +28,20 @@ struct Setup {
   std::unique_ptr<Exchange> e12, e21;
   OdeParticipant* s1 = nullptr;
   OdeParticipant* s2 = nullptr;
-  Setup(int substeps2 = 1, ReaderSees sees = ReaderSees::linear, WriterCombines combines = WriterCombines::average) {
+  Setup(int substeps2 = 1, ReaderSees sees = ReaderSees::linear,
+        WriterCombines combines = WriterCombines::average) {
     auto o1 = std::make_unique<OdeParticipant>("y1", "y2", a1, b1, 1.0);
     auto o2 = std::make_unique<OdeParticipant>("y2", "y1", a2, b2, 0.0);
     s1 = o1.get();
     s2 = o2.get();
     p1 = std::make_unique<Participant>("one", std::move(o1));
     p2 = std::make_unique<Participant>("two", std::move(o2), Substeps{false, substeps2});
-    e12 = std::make_unique<Exchange>("y1", Exchange::End{p1.get(), "point"}, Exchange::End{p2.get(), "point"},
-                                     DataSpec{"y1", 1, "m"}, nullptr, sees, combines);
-    e21 = std::make_unique<Exchange>("y2", Exchange::End{p2.get(), "point"}, Exchange::End{p1.get(), "point"},
-                                     DataSpec{"y2", 1, "m"}, nullptr, sees, combines);
+    e12 = std::make_unique<Exchange>("y1", Exchange::End{p1.get(), "point"},
+                                     Exchange::End{p2.get(), "point"}, DataSpec{"y1", 1, "m"},
+                                     nullptr, sees, combines);
+    e21 = std::make_unique<Exchange>("y2", Exchange::End{p2.get(), "point"},
+                                     Exchange::End{p1.get(), "point"}, DataSpec{"y2", 1, "m"},
+                                     nullptr, sees, combines);
   }
   std::vector<Participant*> participants() { return {p1.get(), p2.get()}; }
   std::vector<Exchange*> exchanges() { return {e12.get(), e21.get()}; }
@@ -59,7 +62,8 @@ Eigen::Vector2d exact(double t) {
   const int n = 20000;
   const double h = t / n;
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector2d k1 = m * y, k2 = m * (y + 0.5 * h * k1), k3 = m * (y + 0.5 * h * k2), k4 = m * (y + h * k3);
+    const Eigen::Vector2d k1 = m * y, k2 = m * (y + 0.5 * h * k1), k3 = m * (y + 0.5 * h * k2),
+                          k4 = m * (y + h * k3);
     y += h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
   }
   return y;
@@ -74,7 +78,8 @@ Eigen::Vector2d monolithic(double dt, int windows) {
   Eigen::Matrix2d m;
   m << 1.0, -c1, -c2, 1.0;
   Eigen::Vector2d y(1.0, 0.0);
-  for (int n = 0; n < windows; ++n) y = m.partialPivLu().solve(Eigen::Vector2d(e1 * y(0), e2 * y(1)));
+  for (int n = 0; n < windows; ++n)
+    y = m.partialPivLu().solve(Eigen::Vector2d(e1 * y(0), e2 * y(1)));
   return y;
 }
 
@@ -110,13 +115,15 @@ TEST_CASE("Explicit schemes converge with order 1 in the window size", "[couplin
       errors.push_back((Eigen::Vector2d(s.s1->y(), s.s2->y()) - reference).norm());
     }
     const double order = fitted_order(dts, errors);
-    INFO((serial ? "explicit-serial" : "explicit-parallel") << ": errors " << errors[0] << " " << errors[1] << " "
-                                                             << errors[2] << " " << errors[3] << ", order " << order);
+    INFO((serial ? "explicit-serial" : "explicit-parallel")
+         << ": errors " << errors[0] << " " << errors[1] << " " << errors[2] << " " << errors[3]
+         << ", order " << order);
     CHECK(std::abs(order - 1.0) < 0.1);
   }
 }
 
-TEST_CASE("Implicit schemes reach the monolithic solution to the convergence tolerance", "[coupling][scheme]") {
+TEST_CASE("Implicit schemes reach the monolithic solution to the convergence tolerance",
+          "[coupling][scheme]") {
   const double dt = 0.1, limit = 1e-10;
   const int windows = 10;
   const Eigen::Vector2d mono = monolithic(dt, windows);
@@ -139,7 +146,8 @@ TEST_CASE("Implicit schemes reach the monolithic solution to the convergence tol
     ImplicitScheme::Options o;
     o.serial = v.serial;
     o.on_max_iterations = OnMaxIterations::error;
-    ImplicitScheme scheme(s.participants(), s.exchanges(), o, relative_measures(limit), v.acceleration());
+    ImplicitScheme scheme(s.participants(), s.exchanges(), o, relative_measures(limit),
+                          v.acceleration());
     int iterations = 0;
     run(scheme, dt, windows, &iterations);
     const Eigen::Vector2d y(s.s1->y(), s.s2->y());
@@ -172,8 +180,9 @@ TEST_CASE("Subcycling: linear interpolation reproduces a linear-in-time input at
   for (int i = 0; i < 8; ++i) CHECK(c.s2->reads_[i] == 1.0 + 2.0 * 0.25 * (i / 4 + 1));
 }
 
-TEST_CASE("Subcycling: averaging a constant output returns it exactly; last returns the last substep",
-          "[coupling][scheme][subcycling]") {
+TEST_CASE(
+    "Subcycling: averaging a constant output returns it exactly; last returns the last substep",
+    "[coupling][scheme][subcycling]") {
   for (int m : {3, 7, 1000}) {
     Setup s(m, ReaderSees::linear, WriterCombines::average);
     s.s2->output_ = [](double) { return 0.1 + 0.2; };  // not a binary fraction
@@ -194,8 +203,10 @@ TEST_CASE("Subcycling: averaging a constant output returns it exactly; last retu
   CHECK(avg.e21->combined()(0, 0) == Approx(5.0 / 8.0).epsilon(1e-15));
 }
 
-TEST_CASE("Checkpoint/restore through an implicit window leaves a participant as one clean run of the window",
-          "[coupling][scheme][checkpoint]") {
+TEST_CASE(
+    "Checkpoint/restore through an implicit window leaves a participant as one clean run of the "
+    "window",
+    "[coupling][scheme][checkpoint]") {
   Setup s;
   ImplicitScheme::Options o;
   ImplicitScheme scheme(s.participants(), s.exchanges(), o, relative_measures(1e-12),
@@ -211,7 +222,8 @@ TEST_CASE("Checkpoint/restore through an implicit window leaves a participant as
   CHECK(fresh.time() == s.s1->time());
 }
 
-TEST_CASE("Implicit scheme: max_iterations with policy error stops with a clear error", "[coupling][scheme]") {
+TEST_CASE("Implicit scheme: max_iterations with policy error stops with a clear error",
+          "[coupling][scheme]") {
   Setup s;
   ImplicitScheme::Options o;
   o.max_iterations = 2;
@@ -222,7 +234,8 @@ TEST_CASE("Implicit scheme: max_iterations with policy error stops with a clear 
     scheme.advance(TimeWindow(0.1, 0, 1));
     FAIL("no error");
   } catch (const Error& e) {
-    CHECK_THAT(e.what(), Catch::Contains("did not converge in 2 iterations") && Catch::Contains("max_iterations"));
+    CHECK_THAT(e.what(), Catch::Contains("did not converge in 2 iterations") &&
+                             Catch::Contains("max_iterations"));
   }
   o.on_max_iterations = OnMaxIterations::accept;
   Setup t;

@@ -5,7 +5,8 @@
 
 using partita::coupling::TimeWindow;
 
-TEST_CASE("TimeWindow: a million tiny substeps reach the window end exactly, without drift", "[coupling][time]") {
+TEST_CASE("TimeWindow: a million tiny substeps reach the window end exactly, without drift",
+          "[coupling][time]") {
   const int m = 1000000;
   TimeWindow w(1.0e-3, 41, m);
   double summed = w.start();  // what an accumulating clock would do
@@ -24,7 +25,8 @@ TEST_CASE("TimeWindow: a million tiny substeps reach the window end exactly, wit
   CHECK(w.time_at(m / 2) == Approx(41.5e-3).epsilon(1e-15));
 }
 
-TEST_CASE("TimeWindow: substeps tile the window exactly and counts are robust", "[coupling][time]") {
+TEST_CASE("TimeWindow: substeps tile the window exactly and counts are robust",
+          "[coupling][time]") {
   TimeWindow w(0.1, 7, 3);
   double total = 0.0;
   while (!w.end_reached()) {
@@ -33,7 +35,8 @@ TEST_CASE("TimeWindow: substeps tile the window exactly and counts are robust", 
   }
   CHECK(total == Approx(0.1).epsilon(1e-15));
   CHECK_THROWS_AS(w.advance_substep(), partita::Error);
-  CHECK(TimeWindow::count_to(1.0, 0.01) == 100);  // 1.0 / 0.01 = 100.00000000000001 in floating point
+  CHECK(TimeWindow::count_to(1.0, 0.01) ==
+        100);  // 1.0 / 0.01 = 100.00000000000001 in floating point
   CHECK(TimeWindow::count_to(0.3, 0.1) == 3);
   CHECK(TimeWindow::count_to(0.35, 0.1) == 4);
   CHECK(TimeWindow::substeps_for(1e-5, 1.9e-6) == 6);

@@ -17,7 +17,8 @@ std::shared_ptr<Spec> case_spec() {
   auto s = std::make_shared<Spec>("case", "A test case");
   s->string("case", "name").required();
   s->section("material", "the material", material_spec()).required();
-  s->choice("scheme", "coupling scheme", {"explicit-serial", "implicit-serial"}).def("explicit-serial");
+  s->choice("scheme", "coupling scheme", {"explicit-serial", "implicit-serial"})
+      .def("explicit-serial");
   s->reals("gravity", "gravity vector").unit("m/s^2").size(3).def(std::vector<double>{0, 0, -9.81});
   s->integer("substeps", "substeps per window").min(1).def(1);
   return s;
@@ -56,7 +57,8 @@ TEST_CASE("config: units are converted explicitly to SI", "[interface][config]")
   CHECK(*parse_quantity("2 mm", "m") == Approx(2.0e-3));
   CHECK(*parse_quantity("250 GPa", "Pa") == Approx(2.5e11));
   CHECK(*parse_quantity("3 cm^2", "m^2") == Approx(3.0e-4));
-  CHECK(parse_quantity("7.85 g/cm^3", "kg/m^3").value_or(-1) == -1.0);  // compound prefixes: not accepted
+  CHECK(parse_quantity("7.85 g/cm^3", "kg/m^3").value_or(-1) ==
+        -1.0);  // compound prefixes: not accepted
   CHECK(*parse_quantity("400 kg/m^3", "kg/m^3") == 400.0);
   CHECK(*parse_quantity("5 g", "kg") == Approx(5e-3));
   std::string why;
@@ -67,22 +69,26 @@ TEST_CASE("config: units are converted explicitly to SI", "[interface][config]")
   CHECK_FALSE(parse_quantity("nan", "Pa"));
 }
 
-TEST_CASE("config: errors name file, line, column, key path, value and what is allowed", "[interface][config]") {
+TEST_CASE("config: errors name file, line, column, key path, value and what is allowed",
+          "[interface][config]") {
   SECTION("out of range") {
-    const std::string m = message_of("case: x\nmaterial:\n  youngs_modulus: 1e9\n  poisson_ratio: 0.6\n");
+    const std::string m =
+        message_of("case: x\nmaterial:\n  youngs_modulus: 1e9\n  poisson_ratio: 0.6\n");
     CHECK_THAT(m, Catch::Contains("case.yaml:4:18") && Catch::Contains("material.poisson_ratio") &&
                       Catch::Contains("0.6") && Catch::Contains("-1 < value < 0.5"));
   }
   SECTION("negative value of a positive quantity") {
-    const std::string m = message_of("case: x\nmaterial:\n  youngs_modulus: -5\n  poisson_ratio: 0.3\n");
+    const std::string m =
+        message_of("case: x\nmaterial:\n  youngs_modulus: -5\n  poisson_ratio: 0.3\n");
     CHECK_THAT(m, Catch::Contains("case.yaml:3:19") && Catch::Contains("material.youngs_modulus") &&
                       Catch::Contains("0 < value"));
   }
   SECTION("unknown key with suggestion") {
-    const std::string m =
-        message_of("case: x\nmaterial:\n  youngs_modulus: 1e9\n  poisson_ratio: 0.3\n  densty: 5\n");
+    const std::string m = message_of(
+        "case: x\nmaterial:\n  youngs_modulus: 1e9\n  poisson_ratio: 0.3\n  densty: 5\n");
     CHECK_THAT(m, Catch::Contains("case.yaml:5:3") && Catch::Contains("material.densty") &&
-                      Catch::Contains("unknown key 'densty'") && Catch::Contains("did you mean 'density'?"));
+                      Catch::Contains("unknown key 'densty'") &&
+                      Catch::Contains("did you mean 'density'?"));
   }
   SECTION("missing required key") {
     const std::string m = message_of("case: x\nmaterial:\n  youngs_modulus: 1e9\n");
@@ -103,16 +109,21 @@ TEST_CASE("config: errors name file, line, column, key path, value and what is a
                       Catch::Contains("did you mean 'explicit-serial'?"));
   }
   SECTION("wrong vector length and integer expected") {
-    CHECK_THAT(message_of("case: x\nmaterial: {youngs_modulus: 1e9, poisson_ratio: 0.3}\ngravity: [0, -9.81]\n"),
-               Catch::Contains("expected 3 values"));
-    CHECK_THAT(message_of("case: x\nmaterial: {youngs_modulus: 1e9, poisson_ratio: 0.3}\nsubsteps: 2.5\n"),
-               Catch::Contains("expected an integer") && Catch::Contains("'2.5'"));
-    CHECK_THAT(message_of("case: x\nmaterial: {youngs_modulus: 1e9, poisson_ratio: 0.3}\nsubsteps: 0\n"),
-               Catch::Contains("1 <= value"));
+    CHECK_THAT(
+        message_of(
+            "case: x\nmaterial: {youngs_modulus: 1e9, poisson_ratio: 0.3}\ngravity: [0, -9.81]\n"),
+        Catch::Contains("expected 3 values"));
+    CHECK_THAT(
+        message_of("case: x\nmaterial: {youngs_modulus: 1e9, poisson_ratio: 0.3}\nsubsteps: 2.5\n"),
+        Catch::Contains("expected an integer") && Catch::Contains("'2.5'"));
+    CHECK_THAT(
+        message_of("case: x\nmaterial: {youngs_modulus: 1e9, poisson_ratio: 0.3}\nsubsteps: 0\n"),
+        Catch::Contains("1 <= value"));
   }
   SECTION("duplicate key") {
-    CHECK_THAT(message_of("case: x\ncase: y\nmaterial: {youngs_modulus: 1e9, poisson_ratio: 0.3}\n"),
-               Catch::Contains("duplicate key 'case'") && Catch::Contains("case.yaml:2:1"));
+    CHECK_THAT(
+        message_of("case: x\ncase: y\nmaterial: {youngs_modulus: 1e9, poisson_ratio: 0.3}\n"),
+        Catch::Contains("duplicate key 'case'") && Catch::Contains("case.yaml:2:1"));
   }
   SECTION("YAML syntax error") {
     CHECK_THAT(message_of("case: x\nmaterial: {youngs_modulus: 1e9\n"),

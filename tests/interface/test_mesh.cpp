@@ -21,7 +21,8 @@ Mesh unit_cube(double a = 1.0) {
 }
 }  // namespace
 
-TEST_CASE("closed cube: areas sum to the surface, area-weighted normals cancel", "[interface][mesh]") {
+TEST_CASE("closed cube: areas sum to the surface, area-weighted normals cancel",
+          "[interface][mesh]") {
   const double a = 0.02;
   const Mesh m = unit_cube(a);
   // Surface of a cube: 6 a^2.
@@ -35,10 +36,12 @@ TEST_CASE("closed cube: areas sum to the surface, area-weighted normals cancel",
   // Outward normals: (centroid - cube centre) . n > 0 for every face.
   const auto c = m.triangle_centroids();
   const Eigen::RowVector3d centre(a / 2, a / 2, a / 2);
-  for (Eigen::Index t = 0; t < m.num_triangles(); ++t) CHECK((c.row(t) - centre).dot(normals.row(t)) > 0);
+  for (Eigen::Index t = 0; t < m.num_triangles(); ++t)
+    CHECK((c.row(t) - centre).dot(normals.row(t)) > 0);
   // Volume by the divergence theorem: V = 1/3 sum A_i (c_i . n_i) = a^3.
   double vol = 0;
-  for (Eigen::Index t = 0; t < m.num_triangles(); ++t) vol += areas(t) * c.row(t).dot(normals.row(t)) / 3;
+  for (Eigen::Index t = 0; t < m.num_triangles(); ++t)
+    vol += areas(t) * c.row(t).dot(normals.row(t)) / 3;
   CHECK(vol == Approx(a * a * a).epsilon(1e-12));
   const auto box = m.bounding_box();
   CHECK(box.min.norm() == 0.0);
@@ -50,7 +53,8 @@ TEST_CASE("mesh rejects bad triangles and coordinates", "[interface][mesh]") {
   p << 0, 0, 0, 1, 0, 0, 0, 1, 0;
   Mesh::Triangles t(1, 3);
   t << 0, 1, 3;
-  CHECK_THROWS_WITH(Mesh("m", p, t), Catch::Contains("refers to point 3") && Catch::Contains("allowed: 0..2"));
+  CHECK_THROWS_WITH(Mesh("m", p, t),
+                    Catch::Contains("refers to point 3") && Catch::Contains("allowed: 0..2"));
   p(1, 1) = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_WITH(Mesh("m", p), Catch::Contains("NaN"));
 }

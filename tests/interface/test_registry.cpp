@@ -10,7 +10,8 @@ TEST_CASE("registry: lookup, duplicates and 'did you mean'", "[interface][regist
   r.add("implicit-serial", "iterated", [] { return 2; });
   CHECK(r.get("implicit-serial").factory() == 2);
   CHECK(r.names() == std::vector<std::string>{"explicit-serial", "implicit-serial"});
-  CHECK_THROWS_WITH(r.add("explicit-serial", "again", [] { return 3; }), Catch::Contains("registered twice"));
+  CHECK_THROWS_WITH(r.add("explicit-serial", "again", [] { return 3; }),
+                    Catch::Contains("registered twice"));
   CHECK_THROWS_WITH(r.get("explicit-seriel"),
                     Catch::Contains("unknown scheme 'explicit-seriel'") &&
                         Catch::Contains("explicit-serial, implicit-serial") &&

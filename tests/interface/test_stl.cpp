@@ -51,8 +51,10 @@ TEST_CASE("STL round trip, binary and ASCII, preserves coordinates exactly", "[i
   for (bool binary : {true, false}) {
     // The extension does not decide the format: both files are called .stl.
     const fs::path f = d / (binary ? "b.stl" : "a.stl");
-    if (binary) partita::write_stl_binary(f, m);
-    else partita::write_stl_ascii(f, m);
+    if (binary)
+      partita::write_stl_binary(f, m);
+    else
+      partita::write_stl_ascii(f, m);
     const Mesh r = partita::read_stl(f, "plate");
     REQUIRE(r.size() == m.size());  // shared vertices merged back
     REQUIRE(r.num_triangles() == m.num_triangles());
@@ -82,10 +84,12 @@ TEST_CASE("STL errors are clear", "[interface][stl]") {
   CHECK_THAT(msg(bin.substr(0, bin.size() - 7)), Catch::Contains("truncated"));
   CHECK_THAT(msg("solid a\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n"),
              Catch::Contains("x.stl:4") && Catch::Contains("endsolid"));
-  CHECK_THAT(msg("solid a\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 nan\n   vertex 1 0 0\n   vertex 0 1 0\n"
+  CHECK_THAT(msg("solid a\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 nan\n   vertex 1 0 0\n "
+                 "  vertex 0 1 0\n"
                  "  endloop\n endfacet\nendsolid a\n"),
              Catch::Contains("x.stl:2") && Catch::Contains("NaN or infinite"));
-  CHECK_THAT(msg("solid a\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 2 0 0\n"
+  CHECK_THAT(msg("solid a\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   "
+                 "vertex 2 0 0\n"
                  "  endloop\n endfacet\nendsolid a\n"),
              Catch::Contains("zero area"));
   CHECK_THAT(msg("solid a\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 zero\n"),

@@ -1,8 +1,8 @@
 #include "dem_adapter.hpp"
 
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 #include <map>
 
 #include "partita/dem/error.hpp"
@@ -19,34 +19,54 @@ using config::Node;
 using config::Spec;
 
 std::shared_ptr<Spec> make_spec() {
-  auto material = std::make_shared<Spec>("material", "bulk properties of a DEM material (particles, walls, meshes)");
+  auto material = std::make_shared<Spec>(
+      "material", "bulk properties of a DEM material (particles, walls, meshes)");
   material->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
   material->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
-  material->real("density", "mass density rho (used for particles)").unit("kg/m^3").positive().def(2500.0);
+  material->real("density", "mass density rho (used for particles)")
+      .unit("kg/m^3")
+      .positive()
+      .def(2500.0);
 
-  auto interaction = std::make_shared<Spec>("interaction", "contact parameters of a pair of materials");
-  interaction->strings("pair", "the two material names (the same name twice for like contacts)").size(2).required();
+  auto interaction =
+      std::make_shared<Spec>("interaction", "contact parameters of a pair of materials");
+  interaction->strings("pair", "the two material names (the same name twice for like contacts)")
+      .size(2)
+      .required();
   interaction->real("friction", "Coulomb friction coefficient mu").non_negative().def(0.3);
-  interaction->real("restitution", "normal coefficient of restitution e").range(0.0, 1.0).min(0.0, true).def(0.5);
-  interaction->real("rolling_friction", "rolling friction coefficient mu_r (constant torque mu_r F_n R*)")
-      .non_negative().def(0.0);
+  interaction->real("restitution", "normal coefficient of restitution e")
+      .range(0.0, 1.0)
+      .min(0.0, true)
+      .def(0.5);
+  interaction
+      ->real("rolling_friction", "rolling friction coefficient mu_r (constant torque mu_r F_n R*)")
+      .non_negative()
+      .def(0.0);
 
   auto box = std::make_shared<Spec>("box", "an axis-aligned box");
   box->reals("origin", "lower corner").unit("m").size(3).required();
   box->reals("size", "edge lengths").unit("m").size(3).min(0.0, true).required();
 
-  auto generate = std::make_shared<Spec>("generate", "fill a box with a size distribution to a target porosity");
+  auto generate = std::make_shared<Spec>(
+      "generate", "fill a box with a size distribution to a target porosity");
   generate->section("box", "the region to fill", box).required();
   generate->reals("diameters", "particle diameters").unit("m").min(0.0, true).required();
-  generate->reals("fractions", "share of each diameter (any positive scale; default: equal)").min(0.0, true);
-  generate->choice("basis", "fractions by number of particles or by mass", {"number", "mass"}).def("number");
-  generate->real("porosity", "target porosity 1 - solid volume / box volume").range(0.3, 1.0, true).def(0.5);
+  generate->reals("fractions", "share of each diameter (any positive scale; default: equal)")
+      .min(0.0, true);
+  generate->choice("basis", "fractions by number of particles or by mass", {"number", "mass"})
+      .def("number");
+  generate->real("porosity", "target porosity 1 - solid volume / box volume")
+      .range(0.3, 1.0, true)
+      .def(0.5);
   generate->integer("seed", "random seed (same seed, same packing)").min(0).def(1);
 
-  auto particles = std::make_shared<Spec>("particles", "the particles: generated or read from a file");
+  auto particles =
+      std::make_shared<Spec>("particles", "the particles: generated or read from a file");
   particles->string("material", "material name of the particles").required();
   particles->section("generate", "generate a packing", generate);
-  particles->string("file", "LAMMPS data file (id type diameter density x y z [+ Velocities]), relative to the case");
+  particles->string(
+      "file",
+      "LAMMPS data file (id type diameter density x y z [+ Velocities]), relative to the case");
   particles->one_of({"generate", "file"});
 
   auto plane = std::make_shared<Spec>("plane", "an infinite plane");
@@ -57,36 +77,58 @@ std::shared_ptr<Spec> make_spec() {
   wall->string("name", "name used by the monitors (default: wall<i>)");
   wall->section("plane", "an infinite plane", plane);
   wall->section("box", "a box holding the particles inside", box);
-  wall->strings("open", "box faces to leave open").choices({"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"});
+  wall->strings("open", "box faces to leave open")
+      .choices({"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"});
   wall->string("material", "material name").required();
-  wall->reals("velocity", "prescribed translation velocity").unit("m/s").size(3).def(std::vector<double>{0, 0, 0});
+  wall->reals("velocity", "prescribed translation velocity")
+      .unit("m/s")
+      .size(3)
+      .def(std::vector<double>{0, 0, 0});
   wall->one_of({"plane", "box"});
 
-  auto grid = std::make_shared<Spec>("rectangle", "a flat rectangle z = origin.z, triangulated in 2 nx ny triangles");
+  auto grid = std::make_shared<Spec>(
+      "rectangle", "a flat rectangle z = origin.z, triangulated in 2 nx ny triangles");
   grid->reals("origin", "corner with the smallest x and y").unit("m").size(3).required();
   grid->reals("size", "edge lengths along x and y").unit("m").size(2).min(0.0, true).required();
   grid->integers("cells", "cells along x and y").size(2).min(1).required();
   grid->choice("facing", "the side the particles are on", {"down", "up"}).def("down");
 
-  auto mesh = std::make_shared<Spec>("mesh", "a triangle mesh the particles touch; a coupling interface");
-  mesh->string("name", "name: coupling meshes <name> (vertices) and <name>_centres (triangle centroids)").required();
+  auto mesh =
+      std::make_shared<Spec>("mesh", "a triangle mesh the particles touch; a coupling interface");
+  mesh->string("name",
+               "name: coupling meshes <name> (vertices) and <name>_centres (triangle centroids)")
+      .required();
   mesh->string("stl", "STL file (ASCII or binary), relative to the case file");
-  mesh->real("scale", "factor applied to the STL coordinates (e.g. 1.0e-3 for a file in mm)").positive().def(1.0);
+  mesh->real("scale", "factor applied to the STL coordinates (e.g. 1.0e-3 for a file in mm)")
+      .positive()
+      .def(1.0);
   mesh->section("rectangle", "generated flat rectangle", grid);
   mesh->string("material", "material name").required();
   mesh->one_of({"stl", "rectangle"});
 
-  auto s = std::make_shared<Spec>("dem", "native DEM (solvers/dem): Hertz-Mindlin spheres, planes, triangle meshes");
-  s->any("materials", "map of material name -> {youngs_modulus, poisson_ratio, density}").required();
-  s->list("interactions", "contact parameters of each pair of materials that can touch", interaction).required();
-  s->choice("damping", "restitution model: calibrated (exact e for Hertz) or liggghts (the LIGGGHTS formula)",
-            {"calibrated", "liggghts"}).def("calibrated");
+  auto s = std::make_shared<Spec>(
+      "dem", "native DEM (solvers/dem): Hertz-Mindlin spheres, planes, triangle meshes");
+  s->any("materials", "map of material name -> {youngs_modulus, poisson_ratio, density}")
+      .required();
+  s->list("interactions", "contact parameters of each pair of materials that can touch",
+          interaction)
+      .required();
+  s->choice("damping",
+            "restitution model: calibrated (exact e for Hertz) or liggghts (the LIGGGHTS formula)",
+            {"calibrated", "liggghts"})
+      .def("calibrated");
   s->section("particles", "the particles", particles).required();
   s->list("walls", "rigid walls", wall);
   s->list("meshes", "triangle meshes (coupling interfaces)", mesh);
-  s->reals("gravity", "gravitational acceleration").unit("m/s^2").size(3).def(std::vector<double>{0, 0, -9.81});
-  s->real("time_step_fraction", "time step as a fraction of the Rayleigh step of the smallest particle")
-      .range(0.0, 1.0).min(0.0, true).def(0.2);
+  s->reals("gravity", "gravitational acceleration")
+      .unit("m/s^2")
+      .size(3)
+      .def(std::vector<double>{0, 0, -9.81});
+  s->real("time_step_fraction",
+          "time step as a fraction of the Rayleigh step of the smallest particle")
+      .range(0.0, 1.0)
+      .min(0.0, true)
+      .def(0.2);
   s->real("skin", "Verlet skin (default: 10 % of the largest radius)").unit("m").non_negative();
   return s;
 }
@@ -108,7 +150,8 @@ Mesh rectangle(const Node& g, const std::string& name) {
   long k = 0;
   for (long j = 0; j < ny; ++j)
     for (long i = 0; i < nx; ++i) {
-      const int a = static_cast<int>(j * (nx + 1) + i), b = a + 1, c = a + static_cast<int>(nx) + 1, d = c + 1;
+      const int a = static_cast<int>(j * (nx + 1) + i), b = a + 1, c = a + static_cast<int>(nx) + 1,
+                d = c + 1;
       if (down) {
         t.row(k++) << a, d, b;
         t.row(k++) << a, c, d;
@@ -127,23 +170,33 @@ std::shared_ptr<const config::Spec> DemAdapter::spec() {
   return s;
 }
 
-std::unique_ptr<Solver> DemAdapter::create(const SolverContext& context) { return std::make_unique<DemAdapter>(context); }
+std::unique_ptr<Solver> DemAdapter::create(const SolverContext& context) {
+  return std::make_unique<DemAdapter>(context);
+}
 
 DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
   const Node& c = context.config;
-  auto resolve = [&](const std::filesystem::path& f) { return f.is_relative() ? context.case_dir / f : f; };
+  auto resolve = [&](const std::filesystem::path& f) {
+    return f.is_relative() ? context.case_dir / f : f;
+  };
   try {
     // Materials: a map name -> properties, each validated against the material spec.
     std::map<std::string, int> materials;
     std::vector<std::string> material_names;
     const Node mats = c["materials"];
     if (!mats.is_map() || mats.size() == 0)
-      mats.fail("expected a map of materials, e.g. materials: {glass: {youngs_modulus: 200 MPa, poisson_ratio: "
-                "0.23, density: 400}}; found " + mats.describe());
+      mats.fail(
+          "expected a map of materials, e.g. materials: {glass: {youngs_modulus: 200 MPa, "
+          "poisson_ratio: "
+          "0.23, density: 400}}; found " +
+          mats.describe());
     auto mspec = std::make_shared<Spec>("material", "bulk properties of a DEM material");
     mspec->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
     mspec->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
-    mspec->real("density", "mass density rho (used for particles)").unit("kg/m^3").positive().def(2500.0);
+    mspec->real("density", "mass density rho (used for particles)")
+        .unit("kg/m^3")
+        .positive()
+        .def(2500.0);
     for (const std::string& m : mats.keys()) {
       const Node mn = mats[m].validated(mspec);
       dem::Material mat{mn.real("youngs_modulus"), mn.real("poisson_ratio"), mn.real("density")};
@@ -154,7 +207,8 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
       const std::string m = n.as_string();
       auto it = materials.find(m);
       if (it == materials.end())
-        n.fail("unknown material '" + m + "'; materials: " + join_names(material_names) + did_you_mean(m, material_names));
+        n.fail("unknown material '" + m + "'; materials: " + join_names(material_names) +
+               did_you_mean(m, material_names));
       return it->second;
     };
 
@@ -178,11 +232,14 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
       ps.lo = g["box"].vec3("origin");
       ps.hi = ps.lo + g["box"].vec3("size");
       ps.diameters = g.reals("diameters");
-      ps.fractions = g.has("fractions") ? g.reals("fractions") : std::vector<double>(ps.diameters.size(), 1.0);
+      ps.fractions =
+          g.has("fractions") ? g.reals("fractions") : std::vector<double>(ps.diameters.size(), 1.0);
       if (ps.fractions.size() != ps.diameters.size())
-        g["fractions"].fail("expected one fraction per diameter (" + std::to_string(ps.diameters.size()) + "), found " +
+        g["fractions"].fail("expected one fraction per diameter (" +
+                            std::to_string(ps.diameters.size()) + "), found " +
                             std::to_string(ps.fractions.size()));
-      ps.basis = g.string("basis") == "mass" ? dem::PackingSpec::Basis::mass : dem::PackingSpec::Basis::number;
+      ps.basis = g.string("basis") == "mass" ? dem::PackingSpec::Basis::mass
+                                             : dem::PackingSpec::Basis::number;
       ps.porosity = g.real("porosity");
       ps.seed = static_cast<std::uint64_t>(g.integer("seed"));
       dem::Packing packing;
@@ -192,14 +249,17 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
         g.fail(std::string("cannot generate the packing: ") + e.what());
       }
       system_.add_particles(packing.positions, packing.radii, pm);
-      log::get("adapters")->info("dem '{}': generated {} particles, porosity {:.3f}, largest overlap {:.2e} m",
-                                 name_, packing.radii.size(), packing.porosity, packing.max_overlap);
+      log::get("adapters")
+          ->info("dem '{}': generated {} particles, porosity {:.3f}, largest overlap {:.2e} m",
+                 name_, packing.radii.size(), packing.porosity, packing.max_overlap);
     } else {
       const std::filesystem::path f = resolve(pn.string("file"));
-      if (!std::filesystem::exists(f)) pn["file"].fail("particle file '" + f.string() + "' does not exist");
+      if (!std::filesystem::exists(f))
+        pn["file"].fail("particle file '" + f.string() + "' does not exist");
       const dem::LammpsData d = dem::LammpsData::read(f.string());
       for (std::size_t i = 0; i < d.size(); ++i)
-        system_.add_particle(d.position[i], d.diameter[i] / 2, pm, d.velocity[i], d.angular_velocity[i], d.id[i]);
+        system_.add_particle(d.position[i], d.diameter[i] / 2, pm, d.velocity[i],
+                             d.angular_velocity[i], d.id[i]);
     }
 
     // Walls.
@@ -218,7 +278,8 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
         unsigned faces = 0b111111;
         if (w.has("open"))
           for (const std::string& f : w.strings("open"))
-            faces &= ~(1u << static_cast<unsigned>(std::find(kFaces.begin(), kFaces.end(), f) - kFaces.begin()));
+            faces &= ~(1u << static_cast<unsigned>(std::find(kFaces.begin(), kFaces.end(), f) -
+                                                   kFaces.begin()));
         const Eigen::Vector3d lo = w["box"].vec3("origin");
         wall.id = system_.add_box(lo, lo + w["box"].vec3("size"), mid, faces);
         if (v.norm() > 0) system_.set_wall_velocity(wall.id, v);
@@ -277,9 +338,11 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
   } catch (const dem::Error& e) {
     c.fail(std::string("DEM model of participant '") + context.name + "': " + e.what());
   }
-  log::get("adapters")->info("dem '{}': {} particles, {} walls, {} meshes, Rayleigh step {:.3e} s, time step {:.3e} s",
-                             name_, system_.particle_count(), walls_.size(), meshes_dem_.size(),
-                             system_.rayleigh_time_step(), stable_time_step());
+  log::get("adapters")
+      ->info(
+          "dem '{}': {} particles, {} walls, {} meshes, Rayleigh step {:.3e} s, time step {:.3e} s",
+          name_, system_.particle_count(), walls_.size(), meshes_dem_.size(),
+          system_.rayleigh_time_step(), stable_time_step());
 }
 
 const DemAdapter::CouplingMesh& DemAdapter::find(std::string_view mesh, bool* centres) const {
@@ -311,7 +374,8 @@ void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
   bool centres = false;
   const CouplingMesh& cm = find(mesh, &centres);
   if (!centres) {
-    if (data != "force") throw Error("dem '" + name_ + "' writes only 'force' on mesh '" + cm.name + "'");
+    if (data != "force")
+      throw Error("dem '" + name_ + "' writes only 'force' on mesh '" + cm.name + "'");
     values = system_.vertex_forces(cm.id);
     return;
   }
@@ -323,18 +387,21 @@ void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
     values.resize(f.rows(), 3);
     for (Eigen::Index i = 0; i < f.rows(); ++i) values.row(i) = f.row(i) / cm.areas(i);
   } else {
-    throw Error("dem '" + name_ + "' writes 'force' and 'traction' on mesh '" + cm.name + "_centres', not '" +
-                std::string(data) + "'");
+    throw Error("dem '" + name_ + "' writes 'force' and 'traction' on mesh '" + cm.name +
+                "_centres', not '" + std::string(data) + "'");
   }
 }
 
-double DemAdapter::stable_time_step() const { return time_step_fraction_ * system_.rayleigh_time_step(); }
+double DemAdapter::stable_time_step() const {
+  return time_step_fraction_ * system_.rayleigh_time_step();
+}
 
 void DemAdapter::advance(double dt) {
   try {
     system_.step(dt);
   } catch (const dem::Error& e) {
-    throw Error("dem '" + name_ + "' at t = " + fmt::format("{:.6g}", system_.time()) + " s: " + e.what());
+    throw Error("dem '" + name_ + "' at t = " + fmt::format("{:.6g}", system_.time()) +
+                " s: " + e.what());
   }
 }
 
@@ -344,7 +411,8 @@ void DemAdapter::save_checkpoint() {
 }
 
 void DemAdapter::restore_checkpoint() {
-  if (!has_checkpoint_) throw Error("dem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
+  if (!has_checkpoint_)
+    throw Error("dem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   system_.restore_state(checkpoint_);
 }
 

@@ -47,10 +47,10 @@ class DemAdapter : public Solver {
  private:
   struct CouplingMesh {
     std::string name;
-    int id = -1;                       // DEM mesh id
-    Eigen::MatrixX3d reference;        // vertex positions, reference configuration
-    Eigen::VectorXd areas;             // triangle areas (reference) [m^2]
-    Eigen::MatrixX3d positions;        // current vertex positions (work array)
+    int id = -1;                 // DEM mesh id
+    Eigen::MatrixX3d reference;  // vertex positions, reference configuration
+    Eigen::VectorXd areas;       // triangle areas (reference) [m^2]
+    Eigen::MatrixX3d positions;  // current vertex positions (work array)
   };
   struct Wall {
     std::string name;

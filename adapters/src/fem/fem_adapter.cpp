@@ -1,7 +1,7 @@
 #include "fem_adapter.hpp"
 
-#include <algorithm>
 #include <fmt/format.h>
+#include <algorithm>
 
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -16,21 +16,32 @@ using config::Spec;
 const std::vector<std::string> kComponents = {"x", "y", "z"};
 
 std::shared_ptr<Spec> make_spec() {
-  auto box = std::make_shared<Spec>("box", "a structured box mesh with faces and node sets xmin, xmax, ymin, "
-                                           "ymax, zmin, zmax and all");
+  auto box =
+      std::make_shared<Spec>("box",
+                             "a structured box mesh with faces and node sets xmin, xmax, ymin, "
+                             "ymax, zmin, zmax and all");
   box->reals("origin", "lower corner").unit("m").size(3).required();
   box->reals("size", "edge lengths").unit("m").size(3).min(0.0, true).required();
   box->integers("cells", "cells along x, y, z").size(3).min(1).required();
 
-  auto mesh = std::make_shared<Spec>("mesh", "the finite element mesh: a box or a Gmsh 4.1 ASCII file");
+  auto mesh =
+      std::make_shared<Spec>("mesh", "the finite element mesh: a box or a Gmsh 4.1 ASCII file");
   mesh->section("box", "structured box", box);
-  mesh->string("gmsh", "Gmsh 4.1 ASCII .msh file (physical groups become named faces and node sets), relative "
-                       "to the case file");
-  mesh->real("scale", "factor applied to the Gmsh coordinates (e.g. 1.0e-3 for a file in mm)").positive().def(1.0);
-  mesh->choice("element", "element type of the box mesh (Gmsh files carry their own)", {"hex8", "hex20", "tet4", "tet10"})
+  mesh->string(
+      "gmsh",
+      "Gmsh 4.1 ASCII .msh file (physical groups become named faces and node sets), relative "
+      "to the case file");
+  mesh->real("scale", "factor applied to the Gmsh coordinates (e.g. 1.0e-3 for a file in mm)")
+      .positive()
+      .def(1.0);
+  mesh->choice("element", "element type of the box mesh (Gmsh files carry their own)",
+               {"hex8", "hex20", "tet4", "tet10"})
       .def("hex8");
-  mesh->choice("hex8", "Hex8 formulation: incompatible modes (no shear or volumetric locking) or plain full "
-                       "integration", {"incompatible-modes", "full"})
+  mesh->choice(
+          "hex8",
+          "Hex8 formulation: incompatible modes (no shear or volumetric locking) or plain full "
+          "integration",
+          {"incompatible-modes", "full"})
       .def("incompatible-modes");
   mesh->one_of({"box", "gmsh"});
 
@@ -40,21 +51,32 @@ std::shared_ptr<Spec> make_spec() {
   material->real("density", "mass density rho").unit("kg/m^3").positive().required();
 
   auto constraint = std::make_shared<Spec>("constraint", "a Dirichlet condition on a node set");
-  constraint->string("set", "node set (box: all, xmin ... zmax; Gmsh: physical group names)").required();
+  constraint->string("set", "node set (box: all, xmin ... zmax; Gmsh: physical group names)")
+      .required();
   constraint->strings("fix", "components held at zero").choices(kComponents);
   constraint->choice("component", "component of a prescribed displacement", kComponents);
-  constraint->real("displacement", "prescribed displacement of that component (reached over ramp)").unit("m");
-  constraint->real("ramp", "time over which the prescribed displacement grows linearly from 0").unit("s")
-      .non_negative().def(0.0);
+  constraint->real("displacement", "prescribed displacement of that component (reached over ramp)")
+      .unit("m");
+  constraint->real("ramp", "time over which the prescribed displacement grows linearly from 0")
+      .unit("s")
+      .non_negative()
+      .def(0.0);
   constraint->one_of({"fix", "displacement"});
 
   auto load = std::make_shared<Spec>("load", "a load: pressure or traction on a face, or gravity");
   load->string("face", "face name (box: xmin ... zmax; Gmsh: physical surface names)");
-  load->real("pressure", "uniform pressure, positive pushing into the body (against the outward normal)").unit("Pa");
+  load->real("pressure",
+             "uniform pressure, positive pushing into the body (against the outward normal)")
+      .unit("Pa");
   load->reals("traction", "uniform traction vector").unit("Pa").size(3);
-  load->reals("gravity", "gravitational acceleration acting on the whole body").unit("m/s^2").size(3);
-  load->real("ramp", "time over which the load grows linearly from 0 to its value (0: applied at once)").unit("s")
-      .non_negative().def(0.0);
+  load->reals("gravity", "gravitational acceleration acting on the whole body")
+      .unit("m/s^2")
+      .size(3);
+  load->real("ramp",
+             "time over which the load grows linearly from 0 to its value (0: applied at once)")
+      .unit("s")
+      .non_negative()
+      .def(0.0);
   load->one_of({"pressure", "traction", "gravity"});
 
   auto interface = std::make_shared<Spec>("interface", "a coupling interface on a face");
@@ -69,14 +91,18 @@ std::shared_ptr<Spec> make_spec() {
   rayleigh->real("alpha", "mass-proportional coefficient").unit("1/s").non_negative().def(0.0);
   rayleigh->real("beta", "stiffness-proportional coefficient").unit("s").non_negative().def(0.0);
   auto analysis = std::make_shared<Spec>("analysis", "static or transient analysis");
-  analysis->choice("type", "transient (Newmark) or static (each step solves K u = F(t))", {"transient", "static"})
+  analysis
+      ->choice("type", "transient (Newmark) or static (each step solves K u = F(t))",
+               {"transient", "static"})
       .def("transient");
   analysis->section("newmark", "Newmark parameters", newmark);
   analysis->choice("mass", "mass matrix", {"consistent", "lumped"}).def("consistent");
   analysis->section("rayleigh", "Rayleigh damping", rayleigh);
 
-  auto s = std::make_shared<Spec>("fem", "native linear-elastic FEM (solvers/fem): Hex8 (incompatible modes), "
-                                         "Hex20, Tet4, Tet10; static or Newmark transient");
+  auto s =
+      std::make_shared<Spec>("fem",
+                             "native linear-elastic FEM (solvers/fem): Hex8 (incompatible modes), "
+                             "Hex20, Tet4, Tet10; static or Newmark transient");
   s->section("mesh", "the mesh", mesh).required();
   s->section("material", "the material", material).required();
   s->list("constraints", "Dirichlet conditions", constraint);
@@ -98,7 +124,8 @@ fem::TimeFunction ramp_function(double ramp) {
   return [ramp](double t) { return std::min(1.0, std::max(0.0, t / ramp)); };
 }
 
-void require_name(const Node& n, const std::string& name, const std::vector<std::string>& known, const char* what) {
+void require_name(const Node& n, const std::string& name, const std::vector<std::string>& known,
+                  const char* what) {
   if (std::find(known.begin(), known.end(), name) == known.end())
     n.fail(std::string("unknown ") + what + " '" + name + "'; the mesh has: " + join_names(known) +
            did_you_mean(name, known));
@@ -112,13 +139,16 @@ fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
     const auto cells = m["box"].integers("cells");
     b.cells = {static_cast<int>(cells[0]), static_cast<int>(cells[1]), static_cast<int>(cells[2])};
     const std::string e = m.string("element");
-    b.element = e == "hex8" ? fem::ElementType::Hex8 : e == "hex20" ? fem::ElementType::Hex20
-              : e == "tet4" ? fem::ElementType::Tet4 : fem::ElementType::Tet10;
+    b.element = e == "hex8"    ? fem::ElementType::Hex8
+                : e == "hex20" ? fem::ElementType::Hex20
+                : e == "tet4"  ? fem::ElementType::Tet4
+                               : fem::ElementType::Tet10;
     return fem::make_box_mesh(b);
   }
   std::filesystem::path file = m.string("gmsh");
   if (file.is_relative()) file = case_dir / file;
-  if (!std::filesystem::exists(file)) m["gmsh"].fail("mesh file '" + file.string() + "' does not exist");
+  if (!std::filesystem::exists(file))
+    m["gmsh"].fail("mesh file '" + file.string() + "' does not exist");
   fem::Mesh mesh = fem::read_gmsh(file.string());
   const double scale = m.real("scale");
   if (scale != 1.0)
@@ -142,10 +172,12 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
   try {
     fem::Mesh mesh = build_mesh(c["mesh"], context.case_dir);
     const Node mat = c["material"];
-    fem::Material material{mat.real("youngs_modulus"), mat.real("poisson_ratio"), mat.real("density")};
+    fem::Material material{mat.real("youngs_modulus"), mat.real("poisson_ratio"),
+                           mat.real("density")};
     fem::Model model(std::move(mesh), material);
-    model.set_hex8_formulation(c["mesh"].string("hex8") == "full" ? fem::Hex8Formulation::Full
-                                                                   : fem::Hex8Formulation::IncompatibleModes);
+    model.set_hex8_formulation(c["mesh"].string("hex8") == "full"
+                                   ? fem::Hex8Formulation::Full
+                                   : fem::Hex8Formulation::IncompatibleModes);
     const auto sets = model.mesh().node_set_names();
     const auto faces = model.mesh().face_names();
 
@@ -172,11 +204,14 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         model.add_gravity(l.vec3("gravity"), amp);
         continue;
       }
-      if (!l.has("face")) l.fail("a pressure or traction load needs 'face: <name>'; faces: " + join_names(faces));
+      if (!l.has("face"))
+        l.fail("a pressure or traction load needs 'face: <name>'; faces: " + join_names(faces));
       const std::string face = l.string("face");
       require_name(l["face"], face, faces, "face");
-      if (l.has("pressure")) model.add_pressure(face, l.real("pressure"), amp);
-      else model.add_traction(face, l.vec3("traction"), amp);
+      if (l.has("pressure"))
+        model.add_pressure(face, l.real("pressure"), amp);
+      else
+        model.add_traction(face, l.vec3("traction"), amp);
     }
 
     const Node an = c["analysis"];
@@ -184,25 +219,29 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     fem::SolverOptions options;
     options.newmark_beta = an["newmark"].real("beta");
     options.newmark_gamma = an["newmark"].real("gamma");
-    options.mass = an.string("mass") == "lumped" ? fem::MassType::Lumped : fem::MassType::Consistent;
+    options.mass =
+        an.string("mass") == "lumped" ? fem::MassType::Lumped : fem::MassType::Consistent;
     options.rayleigh_alpha = an["rayleigh"].real("alpha");
     options.rayleigh_beta = an["rayleigh"].real("beta");
     solver_ = std::make_unique<fem::Solver>(std::move(model), options);
 
     const auto ifaces = c["interfaces"].items();
-    if (ifaces.empty()) c["interfaces"].fail("at least one interface is needed: [{name: bottom, face: zmin}]");
+    if (ifaces.empty())
+      c["interfaces"].fail("at least one interface is needed: [{name: bottom, face: zmin}]");
     for (const Node& i : ifaces) {
       Interface itf;
       itf.name = i.string("name");
       itf.face = i.string("face");
       require_name(i["face"], itf.face, faces, "face");
       for (const auto& other : interfaces_)
-        if (other.name == itf.name) i["name"].fail("interface name '" + itf.name + "' is used twice");
+        if (other.name == itf.name)
+          i["name"].fail("interface name '" + itf.name + "' is used twice");
       const fem::FaceMesh fm = solver_->face_mesh(itf.face);
       itf.nodes = fm.nodes;
       Mesh::Triangles tris(static_cast<Eigen::Index>(fm.triangles.size()), 3);
       for (std::size_t t = 0; t < fm.triangles.size(); ++t)
-        tris.row(static_cast<Eigen::Index>(t)) << fm.triangles[t][0], fm.triangles[t][1], fm.triangles[t][2];
+        tris.row(static_cast<Eigen::Index>(t)) << fm.triangles[t][0], fm.triangles[t][1],
+            fm.triangles[t][2];
       InterfaceMesh nodes;
       nodes.mesh = Mesh(itf.name, fm.positions, tris);
       nodes.writes.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});
@@ -215,8 +254,8 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       }
       InterfaceMesh quad;
       quad.mesh = Mesh(itf.name + "_quadrature", qx);
-      quad.mesh.set_weights(Eigen::Map<const Eigen::VectorXd>(itf.qp_weights.data(),
-                                                               static_cast<Eigen::Index>(itf.qp_weights.size())));
+      quad.mesh.set_weights(Eigen::Map<const Eigen::VectorXd>(
+          itf.qp_weights.data(), static_cast<Eigen::Index>(itf.qp_weights.size())));
       quad.reads.push_back(DataSpec{"traction", 3, "Pa", DataKind::intensive});
       itf.nodal_forces = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(itf.nodes.size()), 3);
       itf.tractions = Eigen::MatrixX3d::Zero(qx.rows(), 3);
@@ -228,11 +267,14 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
   } catch (const fem::Error& e) {
     c.fail(std::string("FEM model of participant '") + context.name + "': " + e.what());
   }
-  log::get("adapters")->info("fem '{}': {} nodes, {} elements, {} dofs, {} analysis", name_, solver_->mesh().num_nodes(),
-                             solver_->mesh().num_elements(), solver_->num_dofs(), transient_ ? "transient" : "static");
+  log::get("adapters")
+      ->info("fem '{}': {} nodes, {} elements, {} dofs, {} analysis", name_,
+             solver_->mesh().num_nodes(), solver_->mesh().num_elements(), solver_->num_dofs(),
+             transient_ ? "transient" : "static");
 }
 
-const FemAdapter::Interface& FemAdapter::find_interface(std::string_view mesh, bool* quadrature) const {
+const FemAdapter::Interface& FemAdapter::find_interface(std::string_view mesh,
+                                                        bool* quadrature) const {
   for (const auto& i : interfaces_) {
     if (mesh == i.name) {
       *quadrature = false;
@@ -275,8 +317,9 @@ void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen:
     i.has_forces = true;
     apply_nodal_forces();
   } else {
-    throw Error("fem '" + name_ + "' reads 'force' on mesh '" + i.name + "' and 'traction' on '" + i.name +
-                "_quadrature', not '" + std::string(data) + "' on '" + std::string(mesh) + "'");
+    throw Error("fem '" + name_ + "' reads 'force' on mesh '" + i.name + "' and 'traction' on '" +
+                i.name + "_quadrature', not '" + std::string(data) + "' on '" + std::string(mesh) +
+                "'");
   }
 }
 
@@ -290,10 +333,13 @@ void FemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
 
 void FemAdapter::advance(double dt) {
   try {
-    if (transient_) solver_->step(dt);
-    else solver_->step_static(dt);  // quasi-static: equilibrium with the loads at the new time
+    if (transient_)
+      solver_->step(dt);
+    else
+      solver_->step_static(dt);  // quasi-static: equilibrium with the loads at the new time
   } catch (const fem::Error& e) {
-    throw Error("fem '" + name_ + "' at t = " + fmt::format("{:.6g}", solver_->time()) + " s: " + e.what());
+    throw Error("fem '" + name_ + "' at t = " + fmt::format("{:.6g}", solver_->time()) +
+                " s: " + e.what());
   }
 }
 
@@ -303,7 +349,8 @@ void FemAdapter::save_checkpoint() {
 }
 
 void FemAdapter::restore_checkpoint() {
-  if (!has_checkpoint_) throw Error("fem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
+  if (!has_checkpoint_)
+    throw Error("fem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   solver_->restore_state(checkpoint_);
 }
 
@@ -313,7 +360,9 @@ void FemAdapter::write_output(const OutputFrame& frame) {
   files_ = {{"fem", file}};
 }
 
-std::vector<MonitorValue> FemAdapter::monitors() const { return monitor_values({}); }
+std::vector<MonitorValue> FemAdapter::monitors() const {
+  return monitor_values({});
+}
 
 // names empty: all quantities. The energies (a sparse product over the whole mesh each) are
 // computed only when asked for.
@@ -329,7 +378,8 @@ std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::stri
       for (Eigen::Index q = 0; q < i.tractions.rows(); ++q)
         f += i.tractions.row(q).transpose() * i.qp_weights[static_cast<std::size_t>(q)];
     if (i.has_forces) f += i.nodal_forces.colwise().sum().transpose();
-    for (int k = 0; k < 3; ++k) m.push_back({i.name + ".force_" + kComponents[static_cast<std::size_t>(k)], "N", f(k)});
+    for (int k = 0; k < 3; ++k)
+      m.push_back({i.name + ".force_" + kComponents[static_cast<std::size_t>(k)], "N", f(k)});
   }
   // Minus the applied loads (gravity included): what the interfaces carry in static equilibrium.
   const Eigen::Vector3d applied = solver_->total_external_force() - solver_->total_coupling_force();

@@ -45,10 +45,10 @@ class FemAdapter : public Solver {
   struct Interface {
     std::string name;
     std::string face;
-    std::vector<std::size_t> nodes;            // global node ids of the face mesh
-    std::vector<double> qp_weights;            // area of each quadrature point [m^2]
-    Eigen::MatrixX3d nodal_forces;             // last "force" read
-    Eigen::MatrixX3d tractions;                // last "traction" read
+    std::vector<std::size_t> nodes;  // global node ids of the face mesh
+    std::vector<double> qp_weights;  // area of each quadrature point [m^2]
+    Eigen::MatrixX3d nodal_forces;   // last "force" read
+    Eigen::MatrixX3d tractions;      // last "traction" read
     bool has_forces = false;
     bool has_tractions = false;
   };

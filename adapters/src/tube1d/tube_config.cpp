@@ -8,21 +8,34 @@ namespace partita::adapters {
 std::shared_ptr<const config::Spec> tube_spec(const char* name, const char* doc, bool fluid) {
   const tube1d::TubeParameters d;
   auto s = std::make_shared<config::Spec>(name, doc);
-  s->integer("cells", "number of cells N (the mesh 'nodes' has N + 1 points on the x axis)").min(3).def(d.cells);
+  s->integer("cells", "number of cells N (the mesh 'nodes' has N + 1 points on the x axis)")
+      .min(3)
+      .def(d.cells);
   s->real("length", "tube length L").unit("m").positive().def(d.length);
-  s->real("youngs_modulus", "Young's modulus E of the wall (c^2 = E / (2 rho r0))").unit("Pa").positive().def(
-      d.youngs_modulus);
+  s->real("youngs_modulus", "Young's modulus E of the wall (c^2 = E / (2 rho r0))")
+      .unit("Pa")
+      .positive()
+      .def(d.youngs_modulus);
   s->real("radius", "reference radius r0").unit("m").positive().def(d.radius);
-  s->real("reference_area", "cross-section area a0 at the reference pressure").unit("m^2").positive().def(
-      d.reference_area);
+  s->real("reference_area", "cross-section area a0 at the reference pressure")
+      .unit("m^2")
+      .positive()
+      .def(d.reference_area);
   s->real("reference_pressure", "reference pressure p0").unit("Pa").def(d.reference_pressure);
   s->real("density", "fluid density rho").unit("kg/m^3").positive().def(d.density);
   s->real("initial_pressure", "initial pressure at every node").unit("Pa").def(d.initial_pressure);
   if (fluid) {
     s->real("inlet_velocity", "mean inlet velocity u_in").unit("m/s").def(d.inlet_velocity);
-    s->real("inlet_amplitude", "amplitude A of u_in + A sin(2 pi f t)").unit("m/s").def(d.inlet_amplitude);
-    s->real("inlet_frequency", "frequency f of the inlet velocity").unit("Hz").non_negative().def(d.inlet_frequency);
-    s->real("initial_velocity", "initial velocity at every node").unit("m/s").def(d.initial_velocity);
+    s->real("inlet_amplitude", "amplitude A of u_in + A sin(2 pi f t)")
+        .unit("m/s")
+        .def(d.inlet_amplitude);
+    s->real("inlet_frequency", "frequency f of the inlet velocity")
+        .unit("Hz")
+        .non_negative()
+        .def(d.inlet_frequency);
+    s->real("initial_velocity", "initial velocity at every node")
+        .unit("m/s")
+        .def(d.initial_velocity);
   }
   return s;
 }
@@ -45,7 +58,8 @@ tube1d::TubeParameters tube_parameters(const config::Node& n, bool fluid) {
   }
   if (2.0 * p.density * p.wave_speed_squared() <= p.initial_pressure)
     n["initial_pressure"].fail("the initial pressure must stay below 2 rho c^2 = E / r0 = " +
-                               std::to_string(p.youngs_modulus / p.radius) + " Pa (the tube law's pole)");
+                               std::to_string(p.youngs_modulus / p.radius) +
+                               " Pa (the tube law's pole)");
   return p;
 }
 

@@ -18,17 +18,19 @@ TubeFluidAdapter::TubeFluidAdapter(const tube1d::TubeParameters& parameters) : f
   checkpoint_ = flow_.state();
 }
 
-void TubeFluidAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
+void TubeFluidAdapter::read(std::string_view mesh, std::string_view data,
+                            const Eigen::MatrixXd& values) {
   if (mesh != "nodes" || data != "cross_section_area")
-    throw Error("tube1d-fluid reads only 'cross_section_area' on mesh 'nodes', not '" + std::string(data) +
-                "' on '" + std::string(mesh) + "'");
+    throw Error("tube1d-fluid reads only 'cross_section_area' on mesh 'nodes', not '" +
+                std::string(data) + "' on '" + std::string(mesh) + "'");
   flow_.set_area(values.col(0));
 }
 
-void TubeFluidAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
+void TubeFluidAdapter::write(std::string_view mesh, std::string_view data,
+                             Eigen::MatrixXd& values) {
   if (mesh != "nodes" || data != "pressure")
-    throw Error("tube1d-fluid writes only 'pressure' on mesh 'nodes', not '" + std::string(data) + "' on '" +
-                std::string(mesh) + "'");
+    throw Error("tube1d-fluid writes only 'pressure' on mesh 'nodes', not '" + std::string(data) +
+                "' on '" + std::string(mesh) + "'");
   values = flow_.pressure();
 }
 
@@ -37,7 +39,8 @@ void TubeFluidAdapter::advance(double dt) {
     flow_.advance(dt);
   } catch (const std::exception& e) {
     throw Error(std::string("tube1d-fluid: ") + e.what() +
-                "; if this happens during coupling iterations, the iteration probably diverged (use a smaller "
+                "; if this happens during coupling iterations, the iteration probably diverged "
+                "(use a smaller "
                 "relaxation factor, aitken or iqn-ils)");
   }
 }
@@ -45,7 +48,9 @@ void TubeFluidAdapter::advance(double dt) {
 void TubeFluidAdapter::write_output(const OutputFrame& frame) {
   const std::string file = fmt::format("{}_tube_{:06d}.vtp", frame.prefix, frame.index);
   write_vtp(frame.vtk_directory / file, meshes_.front().mesh,
-            {{"velocity", flow_.velocity()}, {"pressure", flow_.pressure()}, {"cross_section_area", flow_.area()}});
+            {{"velocity", flow_.velocity()},
+             {"pressure", flow_.pressure()},
+             {"cross_section_area", flow_.area()}});
   files_ = {{"tube", file}};
 }
 
@@ -57,7 +62,8 @@ std::vector<MonitorValue> TubeFluidAdapter::monitors() const {
 }
 
 std::shared_ptr<const config::Spec> TubeFluidAdapter::spec() {
-  static const auto s = tube_spec("tube1d-fluid", "quasi-1D incompressible flow in the elastic tube", true);
+  static const auto s =
+      tube_spec("tube1d-fluid", "quasi-1D incompressible flow in the elastic tube", true);
   return s;
 }
 

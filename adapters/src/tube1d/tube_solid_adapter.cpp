@@ -20,25 +20,28 @@ TubeSolidAdapter::TubeSolidAdapter(const tube1d::TubeParameters& parameters)
   meshes_.push_back(std::move(m));
 }
 
-void TubeSolidAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
+void TubeSolidAdapter::read(std::string_view mesh, std::string_view data,
+                            const Eigen::MatrixXd& values) {
   if (mesh != "nodes" || data != "pressure")
-    throw Error("tube1d-solid reads only 'pressure' on mesh 'nodes', not '" + std::string(data) + "' on '" +
-                std::string(mesh) + "'");
+    throw Error("tube1d-solid reads only 'pressure' on mesh 'nodes', not '" + std::string(data) +
+                "' on '" + std::string(mesh) + "'");
   wall_.set_pressure(values.col(0));
 }
 
-void TubeSolidAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
+void TubeSolidAdapter::write(std::string_view mesh, std::string_view data,
+                             Eigen::MatrixXd& values) {
   if (mesh != "nodes" || data != "cross_section_area")
-    throw Error("tube1d-solid writes only 'cross_section_area' on mesh 'nodes', not '" + std::string(data) +
-                "' on '" + std::string(mesh) + "'");
+    throw Error("tube1d-solid writes only 'cross_section_area' on mesh 'nodes', not '" +
+                std::string(data) + "' on '" + std::string(mesh) + "'");
   values = wall_.area();
 }
 
 void TubeSolidAdapter::write_output(const OutputFrame& frame) {
   const std::string file = fmt::format("{}_wall_{:06d}.vtp", frame.prefix, frame.index);
   const Eigen::VectorXd radius = (wall_.area().array() / std::numbers::pi).sqrt();
-  write_vtp(frame.vtk_directory / file, meshes_.front().mesh,
-            {{"cross_section_area", wall_.area()}, {"radius", radius}, {"pressure", wall_.pressure()}});
+  write_vtp(
+      frame.vtk_directory / file, meshes_.front().mesh,
+      {{"cross_section_area", wall_.area()}, {"radius", radius}, {"pressure", wall_.pressure()}});
   files_ = {{"wall", file}};
 }
 

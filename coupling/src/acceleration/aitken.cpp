@@ -8,11 +8,12 @@ namespace partita::coupling {
 
 Aitken::Aitken(double initial_omega) : initial_omega_(initial_omega), omega_(initial_omega) {
   if (!(initial_omega > 0.0 && initial_omega <= 1.0))
-    throw Error("Aitken initial relaxation must satisfy 0 < omega <= 1, found " + std::to_string(initial_omega));
+    throw Error("Aitken initial relaxation must satisfy 0 < omega <= 1, found " +
+                std::to_string(initial_omega));
 }
 
-void Aitken::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde, const Eigen::VectorXd& weights,
-                        Eigen::VectorXd& next) {
+void Aitken::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                        const Eigen::VectorXd& weights, Eigen::VectorXd& next) {
   const Eigen::VectorXd r = weights.cwiseProduct(x_tilde - x);  // scaled residual
   if (first_iteration_ || previous_residual_.size() != r.size()) {
     // ω_1 = sign(ω) min(ω_0, |ω|)
@@ -29,20 +30,24 @@ void Aitken::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde
   first_iteration_ = false;
 }
 
-void Aitken::window_converged(const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd&) {
+void Aitken::window_converged(const Eigen::VectorXd&, const Eigen::VectorXd&,
+                              const Eigen::VectorXd&) {
   first_iteration_ = true;
 }
 
 std::shared_ptr<const config::Spec> Aitken::spec() {
-  auto s = std::make_shared<config::Spec>("aitken", "Aitken's dynamic under-relaxation (Kuettler & Wall 2008)");
+  auto s = std::make_shared<config::Spec>(
+      "aitken", "Aitken's dynamic under-relaxation (Kuettler & Wall 2008)");
   s->string("type", "the acceleration's name").required();
-  s->real("initial_relaxation", "relaxation factor of the first iteration (and upper bound of the first "
-                                "iteration of every window)")
+  s->real("initial_relaxation",
+          "relaxation factor of the first iteration (and upper bound of the first "
+          "iteration of every window)")
       .min(0.0, true)
       .max(1.0)
       .def(0.5);
-  s->strings("data", "the data fields to accelerate (default: what the last participant in order writes, "
-                     "or every exchange for parallel schemes)");
+  s->strings("data",
+             "the data fields to accelerate (default: what the last participant in order writes, "
+             "or every exchange for parallel schemes)");
   return s;
 }
 

@@ -6,7 +6,8 @@ namespace partita::coupling {
 
 ConstantRelaxation::ConstantRelaxation(double omega) : omega_(omega) {
   if (!(omega > 0.0 && omega <= 1.0))
-    throw Error("constant relaxation factor must satisfy 0 < omega <= 1, found " + std::to_string(omega));
+    throw Error("constant relaxation factor must satisfy 0 < omega <= 1, found " +
+                std::to_string(omega));
 }
 
 void ConstantRelaxation::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
@@ -16,11 +17,13 @@ void ConstantRelaxation::accelerate(const Eigen::VectorXd& x, const Eigen::Vecto
 }
 
 std::shared_ptr<const config::Spec> ConstantRelaxation::spec() {
-  auto s = std::make_shared<config::Spec>("constant", "constant under-relaxation x + omega (H(x) - x)");
+  auto s =
+      std::make_shared<config::Spec>("constant", "constant under-relaxation x + omega (H(x) - x)");
   s->string("type", "the acceleration's name").required();
   s->real("relaxation", "the relaxation factor omega").range(0.0, 1.0).min(0.0, true).def(0.5);
-  s->strings("data", "the data fields to accelerate (default: what the last participant in order writes, "
-                     "or every exchange for parallel schemes)");
+  s->strings("data",
+             "the data fields to accelerate (default: what the last participant in order writes, "
+             "or every exchange for parallel schemes)");
   return s;
 }
 

@@ -83,8 +83,8 @@ void IqnIls::apply_filter(const Eigen::VectorXd& weights) {
   }
 }
 
-void IqnIls::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde, const Eigen::VectorXd& weights,
-                        Eigen::VectorXd& next) {
+void IqnIls::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                        const Eigen::VectorXd& weights, Eigen::VectorXd& next) {
   if (v_.rows() != x.size() && v_.cols() > 0) {  // the data changed size: start over
     v_.resize(x.size(), 0);
     w_.resize(x.size(), 0);
@@ -131,7 +131,8 @@ void IqnIls::window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x
 
 std::shared_ptr<const config::Spec> IqnIls::spec() {
   auto s = std::make_shared<config::Spec>(
-      "iqn-ils", "interface quasi-Newton, inverse Jacobian from a least-squares model (Degroote et al. 2009)");
+      "iqn-ils",
+      "interface quasi-Newton, inverse Jacobian from a least-squares model (Degroote et al. 2009)");
   s->string("type", "the acceleration's name").required();
   s->real("initial_relaxation", "relaxation factor while there are no columns (first iteration)")
       .min(0.0, true)
@@ -141,8 +142,9 @@ std::shared_ptr<const config::Spec> IqnIls::spec() {
   s->integer("reused_windows", "past windows whose columns are kept").non_negative().def(8);
   s->choice("filter", "filter of nearly dependent columns", {"none", "qr1", "qr2"}).def("qr2");
   s->real("filter_limit", "limit of the filter").positive().def(1e-3);
-  s->strings("data", "the data fields to accelerate (default: what the last participant in order writes, "
-                     "or every exchange for parallel schemes)");
+  s->strings("data",
+             "the data fields to accelerate (default: what the last participant in order writes, "
+             "or every exchange for parallel schemes)");
   return s;
 }
 

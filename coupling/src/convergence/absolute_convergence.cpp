@@ -2,7 +2,8 @@
 
 namespace partita::coupling {
 
-double AbsoluteConvergence::compute(const Eigen::VectorXd& previous, const Eigen::VectorXd& current) {
+double AbsoluteConvergence::compute(const Eigen::VectorXd& previous,
+                                    const Eigen::VectorXd& current) {
   // |x^k - x^{k-1}|
   return (current - previous).norm();
 }

@@ -4,7 +4,8 @@
 
 namespace partita::coupling {
 
-double RelativeConvergence::compute(const Eigen::VectorXd& previous, const Eigen::VectorXd& current) {
+double RelativeConvergence::compute(const Eigen::VectorXd& previous,
+                                    const Eigen::VectorXd& current) {
   // |x^k - x^{k-1}| / |x^k|
   const double diff = (current - previous).norm();
   if (diff == 0.0) return 0.0;

@@ -2,7 +2,8 @@
 
 namespace partita::coupling {
 
-double ResidualRelativeConvergence::compute(const Eigen::VectorXd& previous, const Eigen::VectorXd& current) {
+double ResidualRelativeConvergence::compute(const Eigen::VectorXd& previous,
+                                            const Eigen::VectorXd& current) {
   // |x^k - x^{k-1}| / |x^1 - x^0|
   const double diff = (current - previous).norm();
   if (iteration() == 1) first_ = diff;

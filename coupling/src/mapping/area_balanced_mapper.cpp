@@ -26,19 +26,23 @@ std::unique_ptr<Mapper> AreaBalancedMapper::create(const MapperContext& context)
   return std::make_unique<AreaBalancedMapper>(context.constraint, k);
 }
 
-SparseMapper::Matrix AreaBalancedMapper::interpolation(const Mesh& source, const Mesh& target) const {
+SparseMapper::Matrix AreaBalancedMapper::interpolation(const Mesh& source,
+                                                       const Mesh& target) const {
   for (const Mesh* m : {&source, &target})
     if (!m->has_weights())
-      throw Error("mapper 'area-balanced' needs point weights (the area each point stands for) on both "
-                  "meshes, and mesh '" + m->name() + "' has none; it maps between cell-centre and "
-                  "quadrature-point meshes (e.g. a DEM mesh's <name>_centres and an FE interface's "
-                  "<name>_quadrature); use nearest-projection or rbf for other meshes");
+      throw Error(
+          "mapper 'area-balanced' needs point weights (the area each point stands for) on both "
+          "meshes, and mesh '" +
+          m->name() +
+          "' has none; it maps between cell-centre and "
+          "quadrature-point meshes (e.g. a DEM mesh's <name>_centres and an FE interface's "
+          "<name>_quadrature); use nearest-projection or rbf for other meshes");
   const Eigen::Index ns = source.size(), nt = target.size();
   const Eigen::VectorXd& a = source.weights();
   const Eigen::VectorXd& w = target.weights();
   if (a.sum() <= 0 || w.sum() <= 0)
-    throw Error("mapper 'area-balanced': the point weights of mesh '" + (a.sum() <= 0 ? source.name() : target.name()) +
-                "' sum to zero");
+    throw Error("mapper 'area-balanced': the point weights of mesh '" +
+                (a.sum() <= 0 ? source.name() : target.name()) + "' sum to zero");
 
   // Sparsity pattern: the k nearest source points of each target point, plus the nearest
   // target point of each source point. Initial weights exp(-(d / h)^2), h = sqrt(A_i).
@@ -54,7 +58,8 @@ SparseMapper::Matrix AreaBalancedMapper::interpolation(const Mesh& source, const
   for (Eigen::Index q = 0; q < nt; ++q) {
     stree.nearest(target.points().row(q).transpose(), k, idx, d2);
     for (std::size_t j = 0; j < idx.size(); ++j)
-      entries.emplace_back(q, static_cast<Eigen::Index>(idx[j]), kernel(static_cast<Eigen::Index>(idx[j]), d2[j]));
+      entries.emplace_back(q, static_cast<Eigen::Index>(idx[j]),
+                           kernel(static_cast<Eigen::Index>(idx[j]), d2[j]));
   }
   const PointTree ttree(target.points());
   for (Eigen::Index i = 0; i < ns; ++i) {
@@ -62,7 +67,8 @@ SparseMapper::Matrix AreaBalancedMapper::interpolation(const Mesh& source, const
     entries.emplace_back(q, i, kernel(i, dist2));
   }
   Eigen::SparseMatrix<double, Eigen::ColMajor> m(nt, ns);
-  m.setFromTriplets(entries.begin(), entries.end(), [](double x, double) { return x; });  // duplicates: keep one
+  m.setFromTriplets(entries.begin(), entries.end(),
+                    [](double x, double) { return x; });  // duplicates: keep one
   m.makeCompressed();
 
   // Sinkhorn balancing: columns to c_i = A_i sum(w)/sum(A), then rows to 1, repeated.
@@ -73,12 +79,14 @@ SparseMapper::Matrix AreaBalancedMapper::interpolation(const Mesh& source, const
     // column sums weighted by the target weights: sum_q w_q W_qi
     col.setZero();
     for (Eigen::Index i = 0; i < ns; ++i)
-      for (Eigen::SparseMatrix<double>::InnerIterator e(m, i); e; ++e) col(i) += w(e.row()) * e.value();
+      for (Eigen::SparseMatrix<double>::InnerIterator e(m, i); e; ++e)
+        col(i) += w(e.row()) * e.value();
     worst = 0;
     for (Eigen::Index i = 0; i < ns; ++i) {
       if (col(i) <= 0) continue;
       worst = std::max(worst, std::abs(col(i) - c(i)) / std::max(c(i), 1e-300));
-      for (Eigen::SparseMatrix<double>::InnerIterator e(m, i); e; ++e) e.valueRef() *= c(i) / col(i);
+      for (Eigen::SparseMatrix<double>::InnerIterator e(m, i); e; ++e)
+        e.valueRef() *= c(i) / col(i);
     }
     row.setZero();
     for (Eigen::Index i = 0; i < ns; ++i)
@@ -89,9 +97,12 @@ SparseMapper::Matrix AreaBalancedMapper::interpolation(const Mesh& source, const
   }
   // After the last row scaling the rows sum to 1 exactly; the columns hold to `worst`.
   if (worst > 1e-8)
-    log::get("coupling")->warn("mapper 'area-balanced' from '{}' to '{}': the integral is preserved only to {:.2e} "
-                               "(relative, per source point) after 2000 balancing sweeps; are the two meshes "
-                               "covering the same surface?", source.name(), target.name(), worst);
+    log::get("coupling")
+        ->warn(
+            "mapper 'area-balanced' from '{}' to '{}': the integral is preserved only to {:.2e} "
+            "(relative, per source point) after 2000 balancing sweeps; are the two meshes "
+            "covering the same surface?",
+            source.name(), target.name(), worst);
   return Matrix(m);
 }
 

@@ -178,7 +178,9 @@ std::unique_ptr<Mapper> RbfMapper::create(const MapperContext& context) {
   }
   try {
     const std::string sv = o.string("solver");
-    const Solver solver = sv == "cg" ? Solver::cg : sv == "cholesky" ? Solver::cholesky : Solver::automatic;
+    const Solver solver = sv == "cg"         ? Solver::cg
+                          : sv == "cholesky" ? Solver::cholesky
+                                             : Solver::automatic;
     return std::make_unique<RbfMapper>(context.constraint, basis, radius, poly, solver,
                                        o.real("tolerance"));
   } catch (const Error& e) {
@@ -275,7 +277,8 @@ void RbfMapper::compute(const Mesh& from, const Mesh& to) {
     System::SparseCol kk(n, n);
     kk.setFromTriplets(k.begin(), k.end());
     k = {};
-    const bool use_cg = solver_ == Solver::cg || (solver_ == Solver::automatic && n > automatic_cg_threshold);
+    const bool use_cg =
+        solver_ == Solver::cg || (solver_ == Solver::automatic && n > automatic_cg_threshold);
     if (!use_cg) {
       sys->ldlt.compute(kk);
       if (sys->ldlt.info() != Eigen::Success || sys->ldlt.vectorD().minCoeff() <= 0.0)

@@ -2,7 +2,8 @@
 
 namespace partita::coupling {
 
-CouplingScheme::CouplingScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges)
+CouplingScheme::CouplingScheme(std::vector<Participant*> participants,
+                               std::vector<Exchange*> exchanges)
     : participants_(std::move(participants)), exchanges_(std::move(exchanges)) {}
 
 void CouplingScheme::initialize() {

@@ -4,8 +4,8 @@
 
 namespace partita::coupling {
 
-ExplicitScheme::ExplicitScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges,
-                               bool serial)
+ExplicitScheme::ExplicitScheme(std::vector<Participant*> participants,
+                               std::vector<Exchange*> exchanges, bool serial)
     : CouplingScheme(std::move(participants), std::move(exchanges)), serial_(serial) {}
 
 WindowReport ExplicitScheme::run_window(const TimeWindow& window) {

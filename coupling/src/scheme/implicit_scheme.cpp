@@ -12,12 +12,16 @@
 namespace partita::coupling {
 
 namespace {
-Eigen::Map<const Eigen::VectorXd> flat(const Eigen::MatrixXd& m) { return {m.data(), m.size()}; }
+Eigen::Map<const Eigen::VectorXd> flat(const Eigen::MatrixXd& m) {
+  return {m.data(), m.size()};
+}
 }  // namespace
 
-ImplicitScheme::ImplicitScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges,
-                               Options options, std::vector<std::unique_ptr<ConvergenceMeasure>> measures,
-                               std::unique_ptr<Acceleration> acceleration, std::vector<Exchange*> accelerated)
+ImplicitScheme::ImplicitScheme(std::vector<Participant*> participants,
+                               std::vector<Exchange*> exchanges, Options options,
+                               std::vector<std::unique_ptr<ConvergenceMeasure>> measures,
+                               std::unique_ptr<Acceleration> acceleration,
+                               std::vector<Exchange*> accelerated)
     : CouplingScheme(std::move(participants), std::move(exchanges)),
       options_(options),
       measures_(std::move(measures)),
@@ -30,7 +34,8 @@ ImplicitScheme::ImplicitScheme(std::vector<Participant*> participants, std::vect
     std::vector<Exchange*> ex;
     for (Exchange* e : exchanges_)
       if (e->data() == m->data()) ex.push_back(e);
-    if (ex.empty()) throw Error("convergence measure on '" + m->data() + "': no exchange carries that data");
+    if (ex.empty())
+      throw Error("convergence measure on '" + m->data() + "': no exchange carries that data");
     measured_.push_back(std::move(ex));
   }
   if (acceleration_ && accelerated_.empty()) {
@@ -41,7 +46,8 @@ ImplicitScheme::ImplicitScheme(std::vector<Participant*> participants, std::vect
     for (Exchange* e : accelerated_)
       if (&e->from() != participants_.back())
         throw Error("scheme implicit-serial: exchange " + e->label() +
-                    " is written by participant '" + e->from().name() + "', which is not last in the order; "
+                    " is written by participant '" + e->from().name() +
+                    "', which is not last in the order; "
                     "a serial scheme accelerates only what the last participant writes");
 }
 
@@ -49,12 +55,14 @@ std::vector<std::pair<std::string, std::string>> ImplicitScheme::residual_column
   std::vector<std::pair<std::string, std::string>> c;
   for (std::size_t i = 0; i < measures_.size(); ++i) {
     const auto& m = measures_[i];
-    c.emplace_back(m->name() + " " + m->data(), m->dimensionless() ? "" : measured_[i].front()->spec().unit);
+    c.emplace_back(m->name() + " " + m->data(),
+                   m->dimensionless() ? "" : measured_[i].front()->spec().unit);
   }
   return c;
 }
 
-void ImplicitScheme::stack(const std::vector<Exchange*>& ex, bool previous, Eigen::VectorXd& out) const {
+void ImplicitScheme::stack(const std::vector<Exchange*>& ex, bool previous,
+                           Eigen::VectorXd& out) const {
   Eigen::Index n = 0;
   for (const Exchange* e : ex) n += (previous ? e->previous() : e->combined()).size();
   out.resize(n);
@@ -114,12 +122,16 @@ WindowReport ImplicitScheme::run_window(const TimeWindow& window) {
       if (!converged) {
         std::string values;
         for (const auto& m : measures_)
-          values += fmt::format("{}{} {} {:.3g} (limit {:.3g})", values.empty() ? "" : ", ", m->name(), m->data(),
-                                m->value(), m->limit());
-        const std::string msg = fmt::format("window {} (t = {:.6g} s) did not converge in {} iterations "
-                                            "(max_iterations): {}", window.index(), window.end(), k, values);
+          values += fmt::format("{}{} {} {:.3g} (limit {:.3g})", values.empty() ? "" : ", ",
+                                m->name(), m->data(), m->value(), m->limit());
+        const std::string msg = fmt::format(
+            "window {} (t = {:.6g} s) did not converge in {} iterations "
+            "(max_iterations): {}",
+            window.index(), window.end(), k, values);
         if (options_.on_max_iterations == OnMaxIterations::error)
-          throw Error(msg + "; raise max_iterations, use a stronger acceleration, or set on_max_iterations: accept");
+          throw Error(msg +
+                      "; raise max_iterations, use a stronger acceleration, or set "
+                      "on_max_iterations: accept");
         log::get("coupling")->warn("{}; accepting it (on_max_iterations: accept)", msg);
       }
       if (acceleration_) {
@@ -178,13 +190,18 @@ std::unique_ptr<CouplingScheme> create(const SchemeContext& c, bool serial) {
   std::vector<std::unique_ptr<ConvergenceMeasure>> measures;
   const config::Node conv = cfg["convergence"];
   if (!conv.defined() || (conv.is_sequence() && conv.size() == 0))
-    cfg.fail("scheme '" + scheme + "' needs a convergence measure: add key 'convergence', e.g. "
-             "convergence: [{type: relative, data: " + (data_names.empty() ? std::string("pressure") : data_names.front()) +
+    cfg.fail("scheme '" + scheme +
+             "' needs a convergence measure: add key 'convergence', e.g. "
+             "convergence: [{type: relative, data: " +
+             (data_names.empty() ? std::string("pressure") : data_names.front()) +
              ", limit: 1.0e-5}]; known measures: " + join_names(reg.convergence_measures.names()));
   for (const config::Node& item : conv.items()) {
     if (!item.is_map() || !item.has("type"))
-      item.fail("a convergence measure is a map with 'type', 'data' and 'limit', e.g. {type: relative, data: "
-                "pressure, limit: 1.0e-5}; known types: " + join_names(reg.convergence_measures.names()));
+      item.fail(
+          "a convergence measure is a map with 'type', 'data' and 'limit', e.g. {type: relative, "
+          "data: "
+          "pressure, limit: 1.0e-5}; known types: " +
+          join_names(reg.convergence_measures.names()));
     const auto& entry = reg.convergence_measures.get(item["type"]);
     const config::Node v = entry.spec ? item.validated(entry.spec) : item;
     check_data(v["data"]);
@@ -196,11 +213,15 @@ std::unique_ptr<CouplingScheme> create(const SchemeContext& c, bool serial) {
   const config::Node acc = cfg["acceleration"];
   if (acc.defined()) {
     config::Node a = acc;
-    if (acc.is_scalar()) a = config::Node(YAML::Load("{type: " + acc.as_string() + "}"),
-                                          std::make_shared<const std::string>(acc.file()), acc.path());
+    if (acc.is_scalar())
+      a = config::Node(YAML::Load("{type: " + acc.as_string() + "}"),
+                       std::make_shared<const std::string>(acc.file()), acc.path());
     if (!a.is_map() || !a.has("type"))
-      acc.fail("expected an acceleration name or a map with 'type' (e.g. {type: iqn-ils, initial_relaxation: "
-               "0.01}); known: " + join_names(reg.accelerations.names()));
+      acc.fail(
+          "expected an acceleration name or a map with 'type' (e.g. {type: iqn-ils, "
+          "initial_relaxation: "
+          "0.01}); known: " +
+          join_names(reg.accelerations.names()));
     const auto& entry = reg.accelerations.get(acc.is_scalar() ? acc : a["type"]);
     const config::Node v = entry.spec ? a.validated(entry.spec) : a;
     acceleration = entry.factory(v);
@@ -211,8 +232,8 @@ std::unique_ptr<CouplingScheme> create(const SchemeContext& c, bool serial) {
           if (e->data() == d.as_string()) {
             if (serial && &e->from() != c.participants.back())
               d.fail("a serial scheme accelerates only what the last participant ('" +
-                     c.participants.back()->name() + "') writes; '" + e->data() + "' is written by '" +
-                     e->from().name() + "'");
+                     c.participants.back()->name() + "') writes; '" + e->data() +
+                     "' is written by '" + e->from().name() + "'");
             accelerated.push_back(e);
           }
       }
@@ -221,9 +242,10 @@ std::unique_ptr<CouplingScheme> create(const SchemeContext& c, bool serial) {
   ImplicitScheme::Options o;
   o.serial = serial;
   o.max_iterations = static_cast<int>(cfg.integer("max_iterations"));
-  o.on_max_iterations = cfg.string("on_max_iterations") == "error" ? OnMaxIterations::error : OnMaxIterations::accept;
-  return std::make_unique<ImplicitScheme>(c.participants, c.exchanges, o, std::move(measures), std::move(acceleration),
-                                          std::move(accelerated));
+  o.on_max_iterations =
+      cfg.string("on_max_iterations") == "error" ? OnMaxIterations::error : OnMaxIterations::accept;
+  return std::make_unique<ImplicitScheme>(c.participants, c.exchanges, o, std::move(measures),
+                                          std::move(acceleration), std::move(accelerated));
 }
 
 }  // namespace

@@ -37,8 +37,8 @@ SparseMatrix BlockAssembler::make_matrix() const {
     }
   }
   std::vector<double> values(inner.size(), 0.0);
-  return Eigen::Map<SparseMatrix>(ndof, ndof, static_cast<Eigen::Index>(inner.size()),
-                                  outer.data(), inner.data(), values.data());
+  return Eigen::Map<SparseMatrix>(ndof, ndof, static_cast<Eigen::Index>(inner.size()), outer.data(),
+                                  inner.data(), values.data());
 }
 
 void BlockAssembler::add(SparseMatrix& a, std::span<const std::size_t> nodes,

@@ -21,7 +21,7 @@ class BlockAssembler {
 
  private:
   std::size_t num_nodes_ = 0;
-  std::vector<std::size_t> offsets_;    // CSR over nodes
+  std::vector<std::size_t> offsets_;  // CSR over nodes
   std::vector<std::size_t> neighbours_;
 };
 

@@ -62,8 +62,8 @@ Mesh make_box_mesh(const BoxSpec& spec) {
   const auto edges = quadratic_edges(type);
 
   // corners of one cell in lattice units (Hex8 order)
-  const std::array<GridIndex, 8> cube = {{{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0},
-                                          {0, 0, 2}, {2, 0, 2}, {2, 2, 2}, {0, 2, 2}}};
+  const std::array<GridIndex, 8> cube = {
+      {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 2, 0}, {0, 0, 2}, {2, 0, 2}, {2, 2, 2}, {0, 2, 2}}};
   // Kuhn split: for each axis permutation p, the tet (0, e_p0, e_p0 + e_p1, (1,1,1)).
   std::vector<std::array<GridIndex, 4>> tets;
   std::array<int, 3> perm = {0, 1, 2};
@@ -114,9 +114,8 @@ Mesh make_box_mesh(const BoxSpec& spec) {
       for (int side = 0; side < 6; ++side) {
         const int d = side / 2;
         const long plane = (side % 2 == 0) ? 0 : 2L * spec.cells[d];
-        const bool on = std::all_of(local.begin(), local.end(), [&](int a) {
-          return lattice.index(el.nodes[a])[d] == plane;
-        });
+        const bool on = std::all_of(local.begin(), local.end(),
+                                    [&](int a) { return lattice.index(el.nodes[a])[d] == plane; });
         if (on) {
           std::array<std::size_t, kMaxFaceNodes> ids{};
           for (std::size_t a = 0; a < local.size(); ++a) ids[a] = el.nodes[local[a]];

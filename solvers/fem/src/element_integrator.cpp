@@ -24,7 +24,8 @@ double physical_gradients(ElementType type, const ElementCoordinates& x, const V
     std::ostringstream msg;
     msg << to_string(type) << " element with non-positive Jacobian determinant " << det
         << " at reference point (" << xi.transpose()
-        << "): the element is inverted or degenerate (check node order and positions; first node at ("
+        << "): the element is inverted or degenerate (check node order and positions; first node "
+           "at ("
         << x.row(0) << "))";
     throw Error(msg.str());
   }
@@ -84,7 +85,9 @@ void ElementIntegrator::hex8_incompatible(const ElementCoordinates& x, const Mat
   const Mat3 j0 = dn0.transpose() * x;
   const double det0 = j0.determinant();
   if (!(det0 > 0.0)) {
-    throw Error("hex8 element with non-positive Jacobian determinant at its centre: inverted or degenerate");
+    throw Error(
+        "hex8 element with non-positive Jacobian determinant at its centre: inverted or "
+        "degenerate");
   }
   const Mat3 j0inv = j0.inverse();
 

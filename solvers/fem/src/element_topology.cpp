@@ -18,10 +18,26 @@ constexpr std::array<std::array<int, 6>, 4> kTetFaces = {{
     {0, 3, 2, 7, 9, 6},
 }};
 constexpr std::array<std::array<int, 2>, 12> kHexEdges = {{
-    {0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6}, {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7},
+    {0, 1},
+    {1, 2},
+    {2, 3},
+    {3, 0},
+    {4, 5},
+    {5, 6},
+    {6, 7},
+    {7, 4},
+    {0, 4},
+    {1, 5},
+    {2, 6},
+    {3, 7},
 }};
 constexpr std::array<std::array<int, 2>, 6> kTetEdges = {{
-    {0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3},
+    {0, 1},
+    {1, 2},
+    {2, 0},
+    {0, 3},
+    {1, 3},
+    {2, 3},
 }};
 
 }  // namespace
@@ -32,10 +48,14 @@ int local_face_count(ElementType type) {
 
 FaceType local_face_type(ElementType type, int) {
   switch (type) {
-    case ElementType::Hex8: return FaceType::Quad4;
-    case ElementType::Hex20: return FaceType::Quad8;
-    case ElementType::Tet4: return FaceType::Tri3;
-    case ElementType::Tet10: return FaceType::Tri6;
+    case ElementType::Hex8:
+      return FaceType::Quad4;
+    case ElementType::Hex20:
+      return FaceType::Quad8;
+    case ElementType::Tet4:
+      return FaceType::Tri3;
+    case ElementType::Tet10:
+      return FaceType::Tri6;
   }
   return FaceType::Quad4;
 }
@@ -49,9 +69,12 @@ std::span<const int> local_face_nodes(ElementType type, int face) {
 
 std::span<const std::array<int, 2>> quadratic_edges(ElementType type) {
   switch (type) {
-    case ElementType::Hex20: return {kHexEdges.data(), kHexEdges.size()};
-    case ElementType::Tet10: return {kTetEdges.data(), kTetEdges.size()};
-    default: return {};
+    case ElementType::Hex20:
+      return {kHexEdges.data(), kHexEdges.size()};
+    case ElementType::Tet10:
+      return {kTetEdges.data(), kTetEdges.size()};
+    default:
+      return {};
   }
 }
 

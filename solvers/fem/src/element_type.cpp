@@ -9,10 +9,14 @@ namespace partita::fem {
 
 int node_count(ElementType type) {
   switch (type) {
-    case ElementType::Hex8: return 8;
-    case ElementType::Hex20: return 20;
-    case ElementType::Tet4: return 4;
-    case ElementType::Tet10: return 10;
+    case ElementType::Hex8:
+      return 8;
+    case ElementType::Hex20:
+      return 20;
+    case ElementType::Tet4:
+      return 4;
+    case ElementType::Tet10:
+      return 10;
   }
   return 0;
 }
@@ -23,10 +27,14 @@ int corner_count(ElementType type) {
 
 std::string_view to_string(ElementType type) {
   switch (type) {
-    case ElementType::Hex8: return "hex8";
-    case ElementType::Hex20: return "hex20";
-    case ElementType::Tet4: return "tet4";
-    case ElementType::Tet10: return "tet10";
+    case ElementType::Hex8:
+      return "hex8";
+    case ElementType::Hex20:
+      return "hex20";
+    case ElementType::Tet4:
+      return "tet4";
+    case ElementType::Tet10:
+      return "tet10";
   }
   return "?";
 }

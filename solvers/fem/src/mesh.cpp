@@ -47,7 +47,9 @@ std::size_t Mesh::add_node(const Vec3& x) {
   return nodes_.size() - 1;
 }
 
-void Mesh::set_node(std::size_t i, const Vec3& x) { nodes_.at(i) = x; }
+void Mesh::set_node(std::size_t i, const Vec3& x) {
+  nodes_.at(i) = x;
+}
 
 int Mesh::add_region(const std::string& name) {
   auto it = std::find(region_names_.begin(), region_names_.end(), name);
@@ -148,7 +150,8 @@ void Mesh::orient_faces_outward() {
       std::array<std::size_t, 4> corners{};
       const int nc = corner_count(local_face_type(el.type, f));
       for (int a = 0; a < nc; ++a) corners[a] = el.nodes[local[a]];
-      lookup.emplace(make_key({corners.data(), static_cast<std::size_t>(nc)}), std::make_pair(e, f));
+      lookup.emplace(make_key({corners.data(), static_cast<std::size_t>(nc)}),
+                     std::make_pair(e, f));
     }
   }
   for (auto& [name, list] : faces_) {
@@ -189,13 +192,15 @@ void Mesh::validate() const {
   }
   for (const auto& [name, set] : node_sets_) {
     for (auto n : set) {
-      if (n >= nodes_.size()) throw Error("node set '" + name + "' refers to missing node " + std::to_string(n));
+      if (n >= nodes_.size())
+        throw Error("node set '" + name + "' refers to missing node " + std::to_string(n));
     }
   }
   for (const auto& [name, list] : faces_) {
     for (const auto& s : list) {
       for (auto n : s.node_span()) {
-        if (n >= nodes_.size()) throw Error("face '" + name + "' refers to missing node " + std::to_string(n));
+        if (n >= nodes_.size())
+          throw Error("face '" + name + "' refers to missing node " + std::to_string(n));
       }
     }
   }

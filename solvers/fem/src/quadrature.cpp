@@ -12,7 +12,8 @@ struct Gauss1d {
 
 Gauss1d gauss_legendre(int n) {
   switch (n) {
-    case 1: return {{0.0}, {2.0}};
+    case 1:
+      return {{0.0}, {2.0}};
     case 2: {
       const double a = 1.0 / std::sqrt(3.0);
       return {{-a, a}, {1.0, 1.0}};
@@ -61,7 +62,9 @@ std::vector<VolumeRulePoint> collapsed_tet_rule(int n) {
   return r;
 }
 
-std::vector<VolumeRulePoint> tet_rule_1() { return {{Vec3(0.25, 0.25, 0.25), 1.0 / 6.0}}; }
+std::vector<VolumeRulePoint> tet_rule_1() {
+  return {{Vec3(0.25, 0.25, 0.25), 1.0 / 6.0}};
+}
 
 std::vector<VolumeRulePoint> tet_rule_4() {
   const double a = 0.5854101966249685, b = 0.1381966011250105;
@@ -89,9 +92,9 @@ std::vector<FaceRulePoint> tri_rule_3() {
 std::vector<FaceRulePoint> tri_rule_6() {
   const double a1 = 0.445948490915965, w1 = 0.5 * 0.223381589678011;
   const double a2 = 0.091576213509771, w2 = 0.5 * 0.109951743655322;
-  return {{Eigen::Vector2d(a1, a1), w1},          {Eigen::Vector2d(1 - 2 * a1, a1), w1},
-          {Eigen::Vector2d(a1, 1 - 2 * a1), w1},  {Eigen::Vector2d(a2, a2), w2},
-          {Eigen::Vector2d(1 - 2 * a2, a2), w2},  {Eigen::Vector2d(a2, 1 - 2 * a2), w2}};
+  return {{Eigen::Vector2d(a1, a1), w1},         {Eigen::Vector2d(1 - 2 * a1, a1), w1},
+          {Eigen::Vector2d(a1, 1 - 2 * a1), w1}, {Eigen::Vector2d(a2, a2), w2},
+          {Eigen::Vector2d(1 - 2 * a2, a2), w2}, {Eigen::Vector2d(a2, 1 - 2 * a2), w2}};
 }
 
 }  // namespace
@@ -103,10 +106,14 @@ const std::vector<VolumeRulePoint>& volume_rule(ElementType type, QuadratureUse 
   static const std::vector<VolumeRulePoint> tet4 = tet_rule_4();
   static const std::vector<VolumeRulePoint> tet64 = collapsed_tet_rule(4);
   switch (type) {
-    case ElementType::Hex8: return hex2;
-    case ElementType::Hex20: return hex3;
-    case ElementType::Tet4: return use == QuadratureUse::Stiffness ? tet1 : tet4;
-    case ElementType::Tet10: return use == QuadratureUse::Stiffness ? tet4 : tet64;
+    case ElementType::Hex8:
+      return hex2;
+    case ElementType::Hex20:
+      return hex3;
+    case ElementType::Tet4:
+      return use == QuadratureUse::Stiffness ? tet1 : tet4;
+    case ElementType::Tet10:
+      return use == QuadratureUse::Stiffness ? tet4 : tet64;
   }
   return hex2;
 }
@@ -117,10 +124,14 @@ const std::vector<FaceRulePoint>& face_rule(FaceType type) {
   static const std::vector<FaceRulePoint> tri3 = tri_rule_3();
   static const std::vector<FaceRulePoint> tri6 = tri_rule_6();
   switch (type) {
-    case FaceType::Quad4: return quad2;
-    case FaceType::Quad8: return quad3;
-    case FaceType::Tri3: return tri3;
-    case FaceType::Tri6: return tri6;
+    case FaceType::Quad4:
+      return quad2;
+    case FaceType::Quad8:
+      return quad3;
+    case FaceType::Tri3:
+      return tri3;
+    case FaceType::Tri6:
+      return tri6;
   }
   return quad2;
 }

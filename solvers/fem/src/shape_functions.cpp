@@ -7,19 +7,33 @@ namespace {
 
 // Reference coordinates of the Hex20 nodes (the first 8 are the Hex8 corners).
 constexpr std::array<std::array<double, 3>, 20> kHexNodes = {{
-    {-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
-    {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1},
-    {0, -1, -1},  {1, 0, -1},  {0, 1, -1}, {-1, 0, -1},
-    {0, -1, 1},   {1, 0, 1},   {0, 1, 1},  {-1, 0, 1},
-    {-1, -1, 0},  {1, -1, 0},  {1, 1, 0},  {-1, 1, 0},
+    {-1, -1, -1}, {1, -1, -1}, {1, 1, -1},  {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1},
+    {-1, 1, 1},   {0, -1, -1}, {1, 0, -1},  {0, 1, -1},  {-1, 0, -1}, {0, -1, 1}, {1, 0, 1},
+    {0, 1, 1},    {-1, 0, 1},  {-1, -1, 0}, {1, -1, 0},  {1, 1, 0},   {-1, 1, 0},
 }};
 constexpr std::array<std::array<double, 3>, 10> kTetNodes = {{
-    {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1},
-    {0.5, 0, 0}, {0.5, 0.5, 0}, {0, 0.5, 0}, {0, 0, 0.5}, {0.5, 0, 0.5}, {0, 0.5, 0.5},
+    {0, 0, 0},
+    {1, 0, 0},
+    {0, 1, 0},
+    {0, 0, 1},
+    {0.5, 0, 0},
+    {0.5, 0.5, 0},
+    {0, 0.5, 0},
+    {0, 0, 0.5},
+    {0.5, 0, 0.5},
+    {0, 0.5, 0.5},
 }};
-constexpr std::array<std::array<int, 2>, 6> kTetEdges = {{{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}};
+constexpr std::array<std::array<int, 2>, 6> kTetEdges = {
+    {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}}};
 constexpr std::array<std::array<double, 2>, 8> kQuadNodes = {{
-    {-1, -1}, {1, -1}, {1, 1}, {-1, 1}, {0, -1}, {1, 0}, {0, 1}, {-1, 0},
+    {-1, -1},
+    {1, -1},
+    {1, 1},
+    {-1, 1},
+    {0, -1},
+    {1, 0},
+    {0, 1},
+    {-1, 0},
 }};
 constexpr std::array<std::array<int, 2>, 3> kTriEdges = {{{0, 1}, {1, 2}, {2, 0}}};
 
@@ -43,7 +57,8 @@ void hex20(const Vec3& x, ShapeVector& n, ShapeGradient& dn) {
     const double xa = kHexNodes[a][0], ya = kHexNodes[a][1], za = kHexNodes[a][2];
     const double p = 1 + x[0] * xa, q = 1 + x[1] * ya, r = 1 + x[2] * za;
     if (a < 8) {
-      // N = 1/8 (1 + xi xi_a)(1 + eta eta_a)(1 + zeta zeta_a)(xi xi_a + eta eta_a + zeta zeta_a - 2)
+      // N = 1/8 (1 + xi xi_a)(1 + eta eta_a)(1 + zeta zeta_a)(xi xi_a + eta eta_a + zeta zeta_a -
+      // 2)
       const double s = x[0] * xa + x[1] * ya + x[2] * za - 2;
       n[a] = 0.125 * p * q * r * s;
       dn(a, 0) = 0.125 * xa * q * r * (s + p);
@@ -101,10 +116,18 @@ void tet(const Vec3& x, bool quadratic, ShapeVector& n, ShapeGradient& dn) {
 
 void shape_functions(ElementType type, const Vec3& xi, ShapeVector& n, ShapeGradient& dn) {
   switch (type) {
-    case ElementType::Hex8: hex8(xi, n, dn); return;
-    case ElementType::Hex20: hex20(xi, n, dn); return;
-    case ElementType::Tet4: tet(xi, false, n, dn); return;
-    case ElementType::Tet10: tet(xi, true, n, dn); return;
+    case ElementType::Hex8:
+      hex8(xi, n, dn);
+      return;
+    case ElementType::Hex20:
+      hex20(xi, n, dn);
+      return;
+    case ElementType::Tet4:
+      tet(xi, false, n, dn);
+      return;
+    case ElementType::Tet10:
+      tet(xi, true, n, dn);
+      return;
   }
 }
 

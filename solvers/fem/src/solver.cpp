@@ -27,7 +27,9 @@ ElementCoordinates coordinates(const Mesh& mesh, const Element& e) {
   return x;
 }
 
-double amplitude_at(const TimeFunction& f, double t) { return f ? f(t) : 1.0; }
+double amplitude_at(const TimeFunction& f, double t) {
+  return f ? f(t) : 1.0;
+}
 
 }  // namespace
 
@@ -52,7 +54,8 @@ Solver::Solver(Model model, SolverOptions options)
   // Start from rest with the prescribed values of t = 0.
   Eigen::VectorXd uc;
   prescribed_values(0.0, uc);
-  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k) u_[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k)
+    u_[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
   evaluate_external_force(0.0, f_);
 }
 
@@ -117,7 +120,8 @@ void Solver::assemble_stiffness() {
   }
   // K = sum_e A_e^T K_e A_e
   for (const auto& e : mesh().elements()) {
-    integrator_.stiffness(e.type, coordinates(mesh(), e), d[static_cast<std::size_t>(e.region)], ke);
+    integrator_.stiffness(e.type, coordinates(mesh(), e), d[static_cast<std::size_t>(e.region)],
+                          ke);
     assembler.add(k_, e.node_span(), ke);
   }
   partition(k_, k_ff_, k_fc_);
@@ -133,7 +137,8 @@ void Solver::assemble_mass() {
     ElementMatrix me;
     // M = sum_e A_e^T M_e A_e
     for (const auto& e : mesh().elements()) {
-      integrator_.consistent_mass(e.type, coordinates(mesh(), e), model_.material(e.region).density, me);
+      integrator_.consistent_mass(e.type, coordinates(mesh(), e), model_.material(e.region).density,
+                                  me);
       assembler.add(m_, e.node_span(), me);
     }
   } else {
@@ -168,7 +173,8 @@ void Solver::assemble_loads() {
         const auto& op = face_operator(load.target);
         for (std::size_t k = 0; k < op.node.size(); ++k) {
           const auto& qp = qps[op.qp[k]];
-          const Vec3 t = load.kind == LoadKind::Pressure ? Vec3(-load.pressure * qp.normal) : load.vector;
+          const Vec3 t =
+              load.kind == LoadKind::Pressure ? Vec3(-load.pressure * qp.normal) : load.vector;
           f.segment<3>(3 * static_cast<Eigen::Index>(op.node[k])) += op.coefficient[k] * t;
         }
         break;
@@ -214,7 +220,8 @@ std::vector<FaceQuadraturePoint> Solver::face_quadrature_points(const std::strin
       const Vec3 t2 = x.transpose() * dn.col(1);
       const Vec3 nv = t1.cross(t2);
       const double area = nv.norm();
-      if (!(area > 0.0)) throw Error("face '" + face + "': degenerate surface element " + std::to_string(s));
+      if (!(area > 0.0))
+        throw Error("face '" + face + "': degenerate surface element " + std::to_string(s));
       out.push_back({x.transpose() * n, nv / area, q.weight * area, s});
     }
   }
@@ -260,7 +267,9 @@ FaceMesh Solver::face_mesh(const std::string& face) const {
     fm.cells.push_back(c);
     const auto& v = c.nodes;
     switch (se.type) {
-      case FaceType::Tri3: fm.triangles.push_back({v[0], v[1], v[2]}); break;
+      case FaceType::Tri3:
+        fm.triangles.push_back({v[0], v[1], v[2]});
+        break;
       case FaceType::Quad4:
         fm.triangles.push_back({v[0], v[1], v[2]});
         fm.triangles.push_back({v[0], v[2], v[3]});
@@ -290,9 +299,11 @@ void Solver::set_face_tractions_at_quadrature_points(const std::string& face,
   if (static_cast<std::size_t>(tractions.rows()) != op.num_qp) {
     throw Error("set_face_tractions_at_quadrature_points('" + face + "'): the face has " +
                 std::to_string(op.num_qp) + " quadrature points, got " +
-                std::to_string(tractions.rows()) + " tractions (one row per point, see face_quadrature_points())");
+                std::to_string(tractions.rows()) +
+                " tractions (one row per point, see face_quadrature_points())");
   }
-  if (!tractions.allFinite()) throw Error("set_face_tractions_at_quadrature_points('" + face + "'): non-finite traction");
+  if (!tractions.allFinite())
+    throw Error("set_face_tractions_at_quadrature_points('" + face + "'): non-finite traction");
   face_tractions_[face] = tractions;
   update_coupling_force();
 }
@@ -358,8 +369,9 @@ void Solver::prescribed_values(double t, Eigen::VectorXd& uc) const {
 // ---------------------------------------------------------------- analyses
 
 namespace {
-void check_factorisation(const Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>& f,
-                         const char* what) {
+void check_factorisation(
+    const Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>& f,
+    const char* what) {
   if (f.info() != Eigen::Success) {
     throw Error(std::string(what) + ": factorisation failed (singular matrix)");
   }
@@ -387,11 +399,14 @@ void Solver::solve_static() {
   prescribed_values(time_, uc);
   // K_ff u_f = F_f - K_fc u_c
   Eigen::VectorXd rhs(static_cast<Eigen::Index>(free_dofs_.size()));
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k) rhs[static_cast<Eigen::Index>(k)] = f_[free_dofs_[k]];
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
+    rhs[static_cast<Eigen::Index>(k)] = f_[free_dofs_[k]];
   if (uc.size() > 0 && uc.cwiseAbs().maxCoeff() > 0.0) rhs -= k_fc_ * uc;
   const Eigen::VectorXd uf = static_factor_->solve(rhs);
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k) u_[free_dofs_[k]] = uf[static_cast<Eigen::Index>(k)];
-  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k) u_[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
+    u_[free_dofs_[k]] = uf[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k)
+    u_[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
   v_.setZero();
   a_.setZero();
   acceleration_valid_ = true;
@@ -400,7 +415,8 @@ void Solver::solve_static() {
 }
 
 void Solver::step_static(double dt) {
-  if (!(dt > 0.0)) throw Error("step_static: the time step must be positive, got " + std::to_string(dt));
+  if (!(dt > 0.0))
+    throw Error("step_static: the time step must be positive, got " + std::to_string(dt));
   time_ += dt;
   ++steps_;
   solve_static();
@@ -413,7 +429,8 @@ void Solver::initialise_acceleration() {
   if (options_.rayleigh_alpha != 0.0) r -= options_.rayleigh_alpha * (m_ * v_);
   if (options_.rayleigh_beta != 0.0) r -= options_.rayleigh_beta * (k_ * v_);
   Eigen::VectorXd rf(static_cast<Eigen::Index>(free_dofs_.size()));
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k) rf[static_cast<Eigen::Index>(k)] = r[free_dofs_[k]];
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
+    rf[static_cast<Eigen::Index>(k)] = r[free_dofs_[k]];
   Eigen::VectorXd af;
   if (options_.mass == MassType::Lumped) {
     af = rf.cwiseQuotient(Eigen::VectorXd(m_ff_.diagonal()));
@@ -431,7 +448,8 @@ void Solver::initialise_acceleration() {
     }
   }
   a_.setZero();
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k) a_[free_dofs_[k]] = af[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
+    a_[free_dofs_[k]] = af[static_cast<Eigen::Index>(k)];
   acceleration_valid_ = true;
 }
 
@@ -456,7 +474,8 @@ void Solver::factorise_dynamic(double dt) {
 }
 
 void Solver::step(double dt) {
-  if (!(dt > 0.0) || !std::isfinite(dt)) throw Error("step(dt): dt must be > 0, got " + std::to_string(dt));
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    throw Error("step(dt): dt must be > 0, got " + std::to_string(dt));
   assemble_mass();
   if (!acceleration_valid_) initialise_acceleration();
   if (dt != factor_dt_) factorise_dynamic(dt);
@@ -481,13 +500,16 @@ void Solver::step(double dt) {
   Eigen::VectorXd uc;
   prescribed_values(t1, uc);
   Eigen::VectorXd rf(static_cast<Eigen::Index>(free_dofs_.size()));
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k) rf[static_cast<Eigen::Index>(k)] = rhs[free_dofs_[k]];
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
+    rf[static_cast<Eigen::Index>(k)] = rhs[free_dofs_[k]];
   if (uc.size() > 0 && uc.cwiseAbs().maxCoeff() > 0.0) rf -= keff_fc_ * uc;
   const Eigen::VectorXd uf = dynamic_factor_->solve(rf);
 
   Eigen::VectorXd u1(u_.size());
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k) u1[free_dofs_[k]] = uf[static_cast<Eigen::Index>(k)];
-  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k) u1[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
+    u1[free_dofs_[k]] = uf[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k)
+    u1[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
   // a1 = c0 (u1 - u) - c2 v - c3 a;  v1 = v + dt ((1 - gamma) a + gamma a1)
   Eigen::VectorXd a1 = c0 * (u1 - u_) - c2 * v_ - c3 * a_;
   v_ += dt * ((1.0 - gamma) * a_ + gamma * a1);
@@ -505,7 +527,8 @@ void Solver::step(double dt) {
 
 MatrixX3 Solver::displacements(const std::vector<std::size_t>& nodes) const {
   MatrixX3 d(static_cast<Eigen::Index>(nodes.size()), 3);
-  for (std::size_t k = 0; k < nodes.size(); ++k) d.row(static_cast<Eigen::Index>(k)) = displacement(nodes.at(k)).transpose();
+  for (std::size_t k = 0; k < nodes.size(); ++k)
+    d.row(static_cast<Eigen::Index>(k)) = displacement(nodes.at(k)).transpose();
   return d;
 }
 
@@ -531,7 +554,8 @@ MatrixX6 Solver::nodal_stress() const {
   for (const auto& e : mesh().elements()) {
     const int n = node_count(e.type);
     ue.resize(3 * n);
-    for (int a = 0; a < n; ++a) ue.segment<3>(3 * a) = u_.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a]));
+    for (int a = 0; a < n; ++a)
+      ue.segment<3>(3 * a) = u_.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a]));
     integrator_.stresses_at_nodes(e.type, coordinates(mesh(), e),
                                   model_.material(e.region).elasticity_matrix(), ue, se);
     for (int a = 0; a < n; ++a) {
@@ -557,8 +581,12 @@ Eigen::VectorXd Solver::von_mises(const MatrixX6& s) {
   return vm;
 }
 
-double Solver::kinetic_energy() const { return mass_ready_ ? 0.5 * v_.dot(m_ * v_) : 0.0; }
-double Solver::strain_energy() const { return 0.5 * u_.dot(k_ * u_); }
+double Solver::kinetic_energy() const {
+  return mass_ready_ ? 0.5 * v_.dot(m_ * v_) : 0.0;
+}
+double Solver::strain_energy() const {
+  return 0.5 * u_.dot(k_ * u_);
+}
 
 double Solver::max_displacement() const {
   double m = 0.0;
@@ -570,7 +598,9 @@ Vec3 Solver::total_coupling_force() const {
   return coupling_force_.reshaped(3, coupling_force_.size() / 3).rowwise().sum();
 }
 
-Vec3 Solver::total_external_force() const { return f_.reshaped(3, f_.size() / 3).rowwise().sum(); }
+Vec3 Solver::total_external_force() const {
+  return f_.reshaped(3, f_.size() / 3).rowwise().sum();
+}
 
 // ---------------------------------------------------------------- state
 
@@ -596,7 +626,8 @@ void Solver::restore_state(const SolverState& s) {
   if (s.displacement.size() != n || s.velocity.size() != n || s.acceleration.size() != n ||
       s.external_force.size() != n || s.coupling_force.size() != n) {
     throw Error("restore_state: the state has " + std::to_string(s.displacement.size()) +
-                " dofs but this solver has " + std::to_string(ndof_) + " (state of another model?)");
+                " dofs but this solver has " + std::to_string(ndof_) +
+                " (state of another model?)");
   }
   time_ = s.time;
   steps_ = s.steps;

@@ -11,10 +11,14 @@ namespace {
 
 int vtk_cell_type(ElementType type) {
   switch (type) {
-    case ElementType::Hex8: return 12;   // VTK_HEXAHEDRON
-    case ElementType::Hex20: return 25;  // VTK_QUADRATIC_HEXAHEDRON
-    case ElementType::Tet4: return 10;   // VTK_TETRA
-    case ElementType::Tet10: return 24;  // VTK_QUADRATIC_TETRA
+    case ElementType::Hex8:
+      return 12;  // VTK_HEXAHEDRON
+    case ElementType::Hex20:
+      return 25;  // VTK_QUADRATIC_HEXAHEDRON
+    case ElementType::Tet4:
+      return 10;  // VTK_TETRA
+    case ElementType::Tet10:
+      return 24;  // VTK_QUADRATIC_TETRA
   }
   return 0;
 }

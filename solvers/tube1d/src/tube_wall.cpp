@@ -22,13 +22,14 @@ double TubeWall::area_of(double p) const {
 double TubeWall::pressure_of(double a) const {
   // p = 2 rho c^2 - (2 rho c^2 - p0) sqrt(a0 / a)
   const double two_rho_c2 = 2.0 * parameters_.density * parameters_.wave_speed_squared();
-  return two_rho_c2 - (two_rho_c2 - parameters_.reference_pressure) * std::sqrt(parameters_.reference_area / a);
+  return two_rho_c2 -
+         (two_rho_c2 - parameters_.reference_pressure) * std::sqrt(parameters_.reference_area / a);
 }
 
 void TubeWall::set_pressure(const Eigen::VectorXd& p) {
   if (p.size() != pressure_.size())
-    throw std::invalid_argument("tube1d wall: pressure has " + std::to_string(p.size()) + " values, expected " +
-                                std::to_string(pressure_.size()));
+    throw std::invalid_argument("tube1d wall: pressure has " + std::to_string(p.size()) +
+                                " values, expected " + std::to_string(pressure_.size()));
   pressure_ = p;
 }
 

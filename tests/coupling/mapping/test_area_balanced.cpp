@@ -23,7 +23,8 @@ Mesh centres(int n, double L, unsigned seed) {
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
       const bool inner = i > 0 && i < n && j > 0 && j < n;
-      p[j * (n + 1) + i] = Eigen::Vector2d(L * (i + (inner ? jit(rng) : 0.0)) / n, L * (j + (inner ? jit(rng) : 0.0)) / n);
+      p[j * (n + 1) + i] = Eigen::Vector2d(L * (i + (inner ? jit(rng) : 0.0)) / n,
+                                           L * (j + (inner ? jit(rng) : 0.0)) / n);
     }
   Mesh::Points c(2 * n * n, 3);
   Eigen::VectorXd a(2 * n * n);
@@ -53,7 +54,8 @@ Mesh quadrature(int m, double L) {
   for (int j = 0; j < m; ++j)
     for (int i = 0; i < m; ++i)
       for (int b = 0; b < 2; ++b)
-        for (int a = 0; a < 2; ++a) q.row(k++) << (i + 0.5) * h + (a ? g : -g), (j + 0.5) * h + (b ? g : -g), 0.0;
+        for (int a = 0; a < 2; ++a)
+          q.row(k++) << (i + 0.5) * h + (a ? g : -g), (j + 0.5) * h + (b ? g : -g), 0.0;
   Mesh mesh("bottom_quadrature", q);
   mesh.set_weights(Eigen::VectorXd::Constant(4 * m * m, h * h / 4));
   return mesh;
@@ -96,5 +98,6 @@ TEST_CASE("area-balanced: needs point weights on both meshes", "[mapping]") {
   Mesh weighted("centres", p);
   weighted.set_weights(Eigen::Vector3d(1, 1, 1));
   AreaBalancedMapper m(Constraint::consistent, 2);
-  CHECK_THROWS_WITH(m.compute(weighted, plain), Catch::Contains("needs point weights") && Catch::Contains("'vertices'"));
+  CHECK_THROWS_WITH(m.compute(weighted, plain),
+                    Catch::Contains("needs point weights") && Catch::Contains("'vertices'"));
 }

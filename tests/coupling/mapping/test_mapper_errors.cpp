@@ -12,7 +12,8 @@ using Catch::Matchers::Contains;
 
 TEST_CASE("every mapper is registered with its options", "[mapping]") {
   const auto& r = mapper_registry();
-  for (const char* name : {"nearest-neighbor", "nearest-projection", "rbf"}) CHECK(r.contains(name));
+  for (const char* name : {"nearest-neighbor", "nearest-projection", "rbf"})
+    CHECK(r.contains(name));
   for (const auto& e : r.entries()) {
     CAPTURE(e.name);
     REQUIRE(e.spec);

@@ -24,9 +24,11 @@ class Lcg {
 };
 
 // Union of node sets.
-inline void add_union_set(Mesh& mesh, const std::string& name, const std::vector<std::string>& sets) {
+inline void add_union_set(Mesh& mesh, const std::string& name,
+                          const std::vector<std::string>& sets) {
   std::vector<std::size_t> ids;
-  for (const auto& s : sets) ids.insert(ids.end(), mesh.node_set(s).begin(), mesh.node_set(s).end());
+  for (const auto& s : sets)
+    ids.insert(ids.end(), mesh.node_set(s).begin(), mesh.node_set(s).end());
   mesh.add_node_set(name, ids);
 }
 
@@ -36,20 +38,23 @@ inline void straighten_edges(Mesh& mesh) {
     const int nc = corner_count(e.type);
     const auto edges = quadratic_edges(e.type);
     for (std::size_t k = 0; k < edges.size(); ++k) {
-      mesh.set_node(e.nodes[nc + k], 0.5 * (mesh.node(e.nodes[edges[k][0]]) + mesh.node(e.nodes[edges[k][1]])));
+      mesh.set_node(e.nodes[nc + k],
+                    0.5 * (mesh.node(e.nodes[edges[k][0]]) + mesh.node(e.nodes[edges[k][1]])));
     }
   }
 }
 
 // Moves every node not on the box boundary by up to `amount` (fraction of the cell size h) in
 // each direction, then straightens the edges of quadratic elements.
-inline void distort_interior(Mesh& mesh, const BoxSpec& spec, double amount, unsigned long long seed) {
+inline void distort_interior(Mesh& mesh, const BoxSpec& spec, double amount,
+                             unsigned long long seed) {
   Lcg rng(seed);
   const Vec3 lo = spec.origin, hi = spec.origin + spec.size;
   for (std::size_t i = 0; i < mesh.num_nodes(); ++i) {
     Vec3 x = mesh.node(i);
     bool boundary = false;
-    for (int d = 0; d < 3; ++d) boundary = boundary || std::abs(x[d] - lo[d]) < 1e-12 || std::abs(x[d] - hi[d]) < 1e-12;
+    for (int d = 0; d < 3; ++d)
+      boundary = boundary || std::abs(x[d] - lo[d]) < 1e-12 || std::abs(x[d] - hi[d]) < 1e-12;
     if (boundary) continue;
     for (int d = 0; d < 3; ++d) x[d] += amount * spec.size[d] / spec.cells[d] * rng.next();
     mesh.set_node(i, x);

@@ -49,20 +49,21 @@ TEST_CASE("fem gmsh import of committed meshes", "[fem][gmsh]") {
     }
     CHECK(volume == Approx(1.0).epsilon(1e-12));
     // patch test on the imported mesh: u = G x prescribed on the cube's boundary
-    mesh.add_node_set_where("boundary", [](const Vec3& x) {
-      return x.minCoeff() < 1e-12 || x.maxCoeff() > 1 - 1e-12;
-    });
+    mesh.add_node_set_where(
+        "boundary", [](const Vec3& x) { return x.minCoeff() < 1e-12 || x.maxCoeff() > 1 - 1e-12; });
     Model model(mesh);
     Mat3 g;
     g << 1e-3, 2e-4, 0, -1e-4, 5e-4, 3e-4, 0, 1e-4, -2e-4;
     for (int c = 0; c < 3; ++c) {
-      model.prescribe_field("boundary", c, [g, c](const Vec3& x, double) { return g.row(c).dot(x); });
+      model.prescribe_field("boundary", c,
+                            [g, c](const Vec3& x, double) { return g.row(c).dot(x); });
     }
     model.add_pressure("top", 0.0);
     Solver s(model);
     s.solve_static();
     double err = 0.0;
-    for (std::size_t i = 0; i < mesh.num_nodes(); ++i) err = std::max(err, (s.displacement(i) - g * mesh.node(i)).norm());
+    for (std::size_t i = 0; i < mesh.num_nodes(); ++i)
+      err = std::max(err, (s.displacement(i) - g * mesh.node(i)).norm());
     CHECK(err < 1e-10 * 1e-3);
     // faces are oriented outward
     Vec3 top = Vec3::Zero(), bottom = Vec3::Zero();
@@ -74,40 +75,54 @@ TEST_CASE("fem gmsh import of committed meshes", "[fem][gmsh]") {
 }
 
 TEST_CASE("fem gmsh import: malformed files are clear errors", "[fem][gmsh]") {
-  CHECK_THROWS_WITH(read_gmsh("/nonexistent/mesh.msh"), Catch::Contains("/nonexistent/mesh.msh") && Catch::Contains("cannot open"));
+  CHECK_THROWS_WITH(read_gmsh("/nonexistent/mesh.msh"),
+                    Catch::Contains("/nonexistent/mesh.msh") && Catch::Contains("cannot open"));
 
   const auto v22 = write_temp("v22.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n");
   CHECK_THROWS_WITH(read_gmsh(v22), Catch::Contains("v22.msh:2:") && Catch::Contains("4.1"));
 
   const auto binary = write_temp("binary.msh", "$MeshFormat\n4.1 1 8\n$EndMeshFormat\n");
-  CHECK_THROWS_WITH(read_gmsh(binary), Catch::Contains("binary.msh:2:") && Catch::Contains("ASCII"));
+  CHECK_THROWS_WITH(read_gmsh(binary),
+                    Catch::Contains("binary.msh:2:") && Catch::Contains("ASCII"));
 
-  const auto short_element = write_temp(
-      "short.msh", std::string(kHeader) + kNodes + "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3\n$EndElements\n");
-  CHECK_THROWS_WITH(read_gmsh(short_element), Catch::Contains("short.msh:19:") && Catch::Contains("needs 4 nodes"));
+  const auto short_element =
+      write_temp("short.msh", std::string(kHeader) + kNodes +
+                                  "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3\n$EndElements\n");
+  CHECK_THROWS_WITH(read_gmsh(short_element),
+                    Catch::Contains("short.msh:19:") && Catch::Contains("needs 4 nodes"));
 
-  const auto prism = write_temp(
-      "prism.msh", std::string(kHeader) + kNodes + "$Elements\n1 1 1 1\n3 1 6 1\n1 1 2 3 4 1 2\n$EndElements\n");
-  CHECK_THROWS_WITH(read_gmsh(prism), Catch::Contains("prism.msh:18:") && Catch::Contains("not supported") &&
+  const auto prism =
+      write_temp("prism.msh", std::string(kHeader) + kNodes +
+                                  "$Elements\n1 1 1 1\n3 1 6 1\n1 1 2 3 4 1 2\n$EndElements\n");
+  CHECK_THROWS_WITH(read_gmsh(prism), Catch::Contains("prism.msh:18:") &&
+                                          Catch::Contains("not supported") &&
                                           Catch::Contains("17 (hex20)"));
 
-  const auto missing_node = write_temp(
-      "missing.msh", std::string(kHeader) + kNodes + "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 9\n$EndElements\n");
-  CHECK_THROWS_WITH(read_gmsh(missing_node), Catch::Contains("missing.msh:19:") && Catch::Contains("node 9"));
+  const auto missing_node =
+      write_temp("missing.msh", std::string(kHeader) + kNodes +
+                                    "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 9\n$EndElements\n");
+  CHECK_THROWS_WITH(read_gmsh(missing_node),
+                    Catch::Contains("missing.msh:19:") && Catch::Contains("node 9"));
 
-  const auto garbage = write_temp(
-      "garbage.msh", std::string(kHeader) + "$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n0 0 0\n1 zero 0\n");
-  CHECK_THROWS_WITH(read_gmsh(garbage), Catch::Contains("garbage.msh:12:") && Catch::Contains("node coordinates"));
+  const auto garbage =
+      write_temp("garbage.msh",
+                 std::string(kHeader) + "$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n0 0 0\n1 zero 0\n");
+  CHECK_THROWS_WITH(read_gmsh(garbage),
+                    Catch::Contains("garbage.msh:12:") && Catch::Contains("node coordinates"));
 
-  const auto truncated = write_temp("truncated.msh", std::string(kHeader) + "$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n");
-  CHECK_THROWS_WITH(read_gmsh(truncated), Catch::Contains("truncated.msh:") && Catch::Contains("unexpected end of file"));
+  const auto truncated =
+      write_temp("truncated.msh", std::string(kHeader) + "$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n");
+  CHECK_THROWS_WITH(read_gmsh(truncated),
+                    Catch::Contains("truncated.msh:") && Catch::Contains("unexpected end of file"));
 
-  const auto no_volume = write_temp("novolume.msh", std::string(kHeader) + kNodes +
-                                                        "$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n");
+  const auto no_volume =
+      write_temp("novolume.msh", std::string(kHeader) + kNodes +
+                                     "$Elements\n1 1 1 1\n2 1 2 1\n1 1 2 3\n$EndElements\n");
   CHECK_THROWS_WITH(read_gmsh(no_volume), Catch::Contains("no volume elements"));
 
   // a good one-element file reads
-  const auto good = write_temp("good.msh", std::string(kHeader) + kNodes +
-                                               "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n");
+  const auto good =
+      write_temp("good.msh", std::string(kHeader) + kNodes +
+                                 "$Elements\n1 1 1 1\n3 1 4 1\n1 1 2 3 4\n$EndElements\n");
   CHECK(read_gmsh(good).num_elements() == 1);
 }

@@ -11,8 +11,10 @@ using namespace partita::fem;
 TEST_CASE("fem vtu output for every element type", "[fem][output]") {
   const auto dir = std::filesystem::temp_directory_path() / "partita_fem_tests";
   std::filesystem::create_directories(dir);
-  const std::vector<std::pair<ElementType, int>> types = {
-      {ElementType::Hex8, 12}, {ElementType::Hex20, 25}, {ElementType::Tet4, 10}, {ElementType::Tet10, 24}};
+  const std::vector<std::pair<ElementType, int>> types = {{ElementType::Hex8, 12},
+                                                          {ElementType::Hex20, 25},
+                                                          {ElementType::Tet4, 10},
+                                                          {ElementType::Tet10, 24}};
   for (const auto& [type, vtk] : types) {
     Model model(make_box_mesh({Vec3::Zero(), Vec3(1, 0.2, 0.2), {4, 1, 1}, type}));
     model.fix("xmin");
@@ -27,7 +29,8 @@ TEST_CASE("fem vtu output for every element type", "[fem][output]") {
     text << in.rdbuf();
     const std::string xml = text.str();
     CHECK(xml.find("<VTKFile type=\"UnstructuredGrid\"") != std::string::npos);
-    CHECK(xml.find("NumberOfPoints=\"" + std::to_string(s.mesh().num_nodes()) + "\"") != std::string::npos);
+    CHECK(xml.find("NumberOfPoints=\"" + std::to_string(s.mesh().num_nodes()) + "\"") !=
+          std::string::npos);
     for (const char* name : {"displacement", "velocity", "stress", "von_mises"}) {
       CHECK(xml.find(std::string("Name=\"") + name + "\"") != std::string::npos);
     }
@@ -42,14 +45,14 @@ TEST_CASE("fem vtu output for every element type", "[fem][output]") {
     CHECK(vm.minCoeff() >= 0.0);
     CHECK(vm.maxCoeff() > 0.0);
   }
-  CHECK_THROWS_AS(write_vtu("/nonexistent/dir/out.vtu",
-                            Solver(Model(make_box_mesh({}))) ), Error);
+  CHECK_THROWS_AS(write_vtu("/nonexistent/dir/out.vtu", Solver(Model(make_box_mesh({})))), Error);
 }
 
 TEST_CASE("fem hex8 incompatible modes: no volumetric locking at nu = 0.45", "[fem][static]") {
   // Cantilever of nearly incompressible material: QM6 stays close to Hex20, plain Hex8 locks.
   auto tip = [](ElementType type, Hex8Formulation f) {
-    Model m(make_box_mesh({Vec3::Zero(), Vec3(1, 0.1, 0.1), {20, 2, 2}, type}), Material{2.5e6, 0.45, 1000});
+    Model m(make_box_mesh({Vec3::Zero(), Vec3(1, 0.1, 0.1), {20, 2, 2}, type}),
+            Material{2.5e6, 0.45, 1000});
     m.set_hex8_formulation(f);
     m.fix("xmin");
     m.add_traction("xmax", Vec3(0, 0, -100.0));

@@ -13,9 +13,7 @@ namespace {
 const Vec3 kU0(1e-4, -2e-4, 3e-4);
 Mat3 gradient() {
   Mat3 g;
-  g << 1e-3, 2e-4, -3e-4,
-       -1e-4, -5e-4, 4e-4,
-       2.5e-4, 3e-4, 8e-4;
+  g << 1e-3, 2e-4, -3e-4, -1e-4, -5e-4, 4e-4, 2.5e-4, 3e-4, 8e-4;
   return g;
 }
 
@@ -32,7 +30,8 @@ void run_patch(ElementType type, Hex8Formulation formulation) {
   model.set_hex8_formulation(formulation);
   const Mat3 g = gradient();
   for (int c = 0; c < 3; ++c) {
-    model.prescribe_field("boundary", c, [g, c](const Vec3& x, double) { return kU0[c] + g.row(c).dot(x); });
+    model.prescribe_field("boundary", c,
+                          [g, c](const Vec3& x, double) { return kU0[c] + g.row(c).dot(x); });
   }
   Solver solver(model);
   solver.solve_static();
@@ -51,7 +50,8 @@ void run_patch(ElementType type, Hex8Formulation formulation) {
   const Voigt sigma = mat.elasticity_matrix() * ev;
   const MatrixX6 s = solver.nodal_stress();
   double serr = 0.0;
-  for (Eigen::Index i = 0; i < s.rows(); ++i) serr = std::max(serr, (s.row(i).transpose() - sigma).norm());
+  for (Eigen::Index i = 0; i < s.rows(); ++i)
+    serr = std::max(serr, (s.row(i).transpose() - sigma).norm());
   INFO("max stress error / |sigma| = " << serr / sigma.norm());
   CHECK(serr / sigma.norm() < 1e-8);
 }
@@ -59,11 +59,21 @@ void run_patch(ElementType type, Hex8Formulation formulation) {
 }  // namespace
 
 TEST_CASE("fem patch test: linear field on a distorted mesh", "[fem][patch]") {
-  SECTION("hex8 incompatible modes") { run_patch(ElementType::Hex8, Hex8Formulation::IncompatibleModes); }
-  SECTION("hex8 full integration") { run_patch(ElementType::Hex8, Hex8Formulation::Full); }
-  SECTION("hex20") { run_patch(ElementType::Hex20, Hex8Formulation::IncompatibleModes); }
-  SECTION("tet4") { run_patch(ElementType::Tet4, Hex8Formulation::IncompatibleModes); }
-  SECTION("tet10") { run_patch(ElementType::Tet10, Hex8Formulation::IncompatibleModes); }
+  SECTION("hex8 incompatible modes") {
+    run_patch(ElementType::Hex8, Hex8Formulation::IncompatibleModes);
+  }
+  SECTION("hex8 full integration") {
+    run_patch(ElementType::Hex8, Hex8Formulation::Full);
+  }
+  SECTION("hex20") {
+    run_patch(ElementType::Hex20, Hex8Formulation::IncompatibleModes);
+  }
+  SECTION("tet4") {
+    run_patch(ElementType::Tet4, Hex8Formulation::IncompatibleModes);
+  }
+  SECTION("tet10") {
+    run_patch(ElementType::Tet10, Hex8Formulation::IncompatibleModes);
+  }
 }
 
 TEST_CASE("fem box mesher: sets, faces and volumes", "[fem][mesh]") {

@@ -50,17 +50,20 @@ double cantilever_ratio(ElementType type, std::array<int, 3> cells, Hex8Formulat
 
 TEST_CASE("fem cantilever under tip load vs beam theory", "[fem][static][cantilever]") {
   SECTION("hex20 within 2 %") {
-    const double r = cantilever_ratio(ElementType::Hex20, {20, 1, 1}, Hex8Formulation::IncompatibleModes);
+    const double r =
+        cantilever_ratio(ElementType::Hex20, {20, 1, 1}, Hex8Formulation::IncompatibleModes);
     INFO("hex20 w/w_beam = " << r);
     CHECK(std::abs(r - 1.0) < 0.02);
   }
   SECTION("tet10 within 2 %") {
-    const double r = cantilever_ratio(ElementType::Tet10, {20, 2, 2}, Hex8Formulation::IncompatibleModes);
+    const double r =
+        cantilever_ratio(ElementType::Tet10, {20, 2, 2}, Hex8Formulation::IncompatibleModes);
     INFO("tet10 w/w_beam = " << r);
     CHECK(std::abs(r - 1.0) < 0.02);
   }
   SECTION("hex8 incompatible modes within 5 %, plain hex8 locks") {
-    const double r = cantilever_ratio(ElementType::Hex8, {20, 1, 1}, Hex8Formulation::IncompatibleModes);
+    const double r =
+        cantilever_ratio(ElementType::Hex8, {20, 1, 1}, Hex8Formulation::IncompatibleModes);
     const double full = cantilever_ratio(ElementType::Hex8, {20, 1, 1}, Hex8Formulation::Full);
     INFO("hex8 QM6 w/w_beam = " << r << ", full integration w/w_beam = " << full);
     CHECK(std::abs(r - 1.0) < 0.05);
@@ -73,7 +76,8 @@ TEST_CASE("fem seed plate under 10 kPa: support reactions equal p A", "[fem][sta
   const double lx = 0.02, ly = 0.02, lz = 0.002, p = 10e3;
   for (auto type : {ElementType::Hex8, ElementType::Hex20}) {
     // the decks' 20 x 20 x 2 cells for Hex8; 10 x 10 x 1 Hex20 (same node count, keeps it fast)
-    const std::array<int, 3> cells = type == ElementType::Hex8 ? std::array<int, 3>{20, 20, 2} : std::array<int, 3>{10, 10, 1};
+    const std::array<int, 3> cells =
+        type == ElementType::Hex8 ? std::array<int, 3>{20, 20, 2} : std::array<int, 3>{10, 10, 1};
     Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(lx, ly, lz), cells, type});
     test::add_union_set(mesh, "lateral", {"xmin", "xmax", "ymin", "ymax"});
     mesh.add_node_set_where("corners", [&](const Vec3& x) {
@@ -95,7 +99,8 @@ TEST_CASE("fem seed plate under 10 kPa: support reactions equal p A", "[fem][sta
   }
 }
 
-TEST_CASE("fem thick-walled cylinder under internal pressure (Lame, plane strain)", "[fem][static][lame]") {
+TEST_CASE("fem thick-walled cylinder under internal pressure (Lame, plane strain)",
+          "[fem][static][lame]") {
   const double a = 0.1, b = 0.2, t = 0.01, p = 100e6, e = 200e9, nu = 0.3;
   BoxSpec spec{Vec3(a, 0, 0), Vec3(b - a, std::numbers::pi / 2, t), {8, 12, 1}, ElementType::Hex20};
   Mesh mesh = make_box_mesh(spec);
@@ -128,7 +133,8 @@ TEST_CASE("fem thick-walled cylinder under internal pressure (Lame, plane strain
     sig << v(0), v(3), v(5), v(3), v(1), v(4), v(5), v(4), v(2);
     worst_s = std::max(worst_s, std::abs(et.dot(sig * et) / st - 1));
   }
-  INFO("inner wall: worst radial displacement error " << worst_u * 100 << " %, hoop stress " << worst_s * 100 << " %");
+  INFO("inner wall: worst radial displacement error " << worst_u * 100 << " %, hoop stress "
+                                                      << worst_s * 100 << " %");
   CHECK(worst_u < 0.02);
   CHECK(worst_s < 0.02);
 }

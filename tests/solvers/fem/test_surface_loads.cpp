@@ -27,7 +27,7 @@ TEST_CASE("fem face quadrature points integrate area and normals", "[fem][surfac
     model.fix("xmin");
     Solver s(model);
     const std::vector<std::pair<std::string, Vec3>> faces = {
-        {"xmin", Vec3(-0.05, 0, 0)}, {"xmax", Vec3(0.05, 0, 0)}, {"ymin", Vec3(0, -0.1, 0)},
+        {"xmin", Vec3(-0.05, 0, 0)}, {"xmax", Vec3(0.05, 0, 0)},   {"ymin", Vec3(0, -0.1, 0)},
         {"ymax", Vec3(0, 0.1, 0)},   {"zmin", Vec3(0, 0, -0.125)}, {"zmax", Vec3(0, 0, 0.125)}};
     for (const auto& [face, area_normal] : faces) {
       Vec3 sum = Vec3::Zero();
@@ -45,7 +45,8 @@ TEST_CASE("fem face quadrature points integrate area and normals", "[fem][surfac
       const FaceMesh fm = s.face_mesh(face);
       double tri_area = 0.0;
       for (const auto& t : fm.triangles) {
-        const Vec3 a = fm.positions.row(t[0]), b = fm.positions.row(t[1]), c = fm.positions.row(t[2]);
+        const Vec3 a = fm.positions.row(t[0]), b = fm.positions.row(t[1]),
+                   c = fm.positions.row(t[2]);
         const Vec3 n = (b - a).cross(c - a);
         tri_area += 0.5 * n.norm();
         CHECK(n.normalized().dot(area_normal.normalized()) > 1 - 1e-12);
@@ -68,7 +69,8 @@ TEST_CASE("fem uniform traction at quadrature points equals the pressure load", 
     Solver a(with_pressure), b(plain);
     const auto qps = b.face_quadrature_points("zmax");
     MatrixX3 t(static_cast<Eigen::Index>(qps.size()), 3);
-    for (std::size_t q = 0; q < qps.size(); ++q) t.row(static_cast<Eigen::Index>(q)) = -p * qps[q].normal.transpose();
+    for (std::size_t q = 0; q < qps.size(); ++q)
+      t.row(static_cast<Eigen::Index>(q)) = -p * qps[q].normal.transpose();
     b.set_face_tractions_at_quadrature_points("zmax", t);
     b.solve_static();
     a.solve_static();
@@ -78,7 +80,8 @@ TEST_CASE("fem uniform traction at quadrature points equals the pressure load", 
     CHECK((a.displacement() - b.displacement()).norm() < 1e-12 * a.displacement().norm());
     // the sum of the nodal loads is the integral of the traction
     Vec3 integral = Vec3::Zero();
-    for (std::size_t q = 0; q < qps.size(); ++q) integral += qps[q].weight * t.row(static_cast<Eigen::Index>(q)).transpose();
+    for (std::size_t q = 0; q < qps.size(); ++q)
+      integral += qps[q].weight * t.row(static_cast<Eigen::Index>(q)).transpose();
     CHECK((b.total_coupling_force() - integral).norm() < 1e-13 * integral.norm());
     // wrong number of rows is a clear error
     CHECK_THROWS_WITH(b.set_face_tractions_at_quadrature_points("zmax", MatrixX3::Zero(3, 3)),

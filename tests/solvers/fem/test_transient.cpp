@@ -15,16 +15,19 @@ constexpr double kL = 1.0, kH = 0.05, kE = 210e9, kRho = 7800, kP = 100.0;
 
 // Cantilever, clamped at x = 0, tip load on x = L held for t <= 0 and released afterwards.
 Model released_cantilever(ElementType type = ElementType::Hex20) {
-  Model m(make_box_mesh({Vec3::Zero(), Vec3(kL, kH, kH), {20, 1, 1}, type}), Material{kE, 0.3, kRho});
+  Model m(make_box_mesh({Vec3::Zero(), Vec3(kL, kH, kH), {20, 1, 1}, type}),
+          Material{kE, 0.3, kRho});
   m.fix("xmin");
-  m.add_traction("xmax", Vec3(0, 0, -kP / (kH * kH)), [](double t) { return t <= 0.0 ? 1.0 : 0.0; });
+  m.add_traction("xmax", Vec3(0, 0, -kP / (kH * kH)),
+                 [](double t) { return t <= 0.0 ? 1.0 : 0.0; });
   return m;
 }
 
 // first bending period 2 pi / (1.8751^2 sqrt(E I / (rho A L^4)))
 double beam_period() {
   const double i = std::pow(kH, 4) / 12.0, a = kH * kH;
-  return 2 * std::numbers::pi / (1.8751 * 1.8751 * std::sqrt(kE * i / (kRho * a * std::pow(kL, 4))));
+  return 2 * std::numbers::pi /
+         (1.8751 * 1.8751 * std::sqrt(kE * i / (kRho * a * std::pow(kL, 4))));
 }
 
 double tip(const Solver& s) {
@@ -57,13 +60,15 @@ TEST_CASE("fem cantilever free vibration: first period vs beam theory", "[fem][t
     Solver s(released_cantilever(), opt);
     s.solve_static();
     const double period = measured_period(s, t_beam / 200, 700);
-    INFO((mass == MassType::Consistent ? "consistent" : "lumped") << " mass: T = " << period
-         << " s, beam theory " << t_beam << " s, error " << 100 * (period / t_beam - 1) << " %");
+    INFO((mass == MassType::Consistent ? "consistent" : "lumped")
+         << " mass: T = " << period << " s, beam theory " << t_beam << " s, error "
+         << 100 * (period / t_beam - 1) << " %");
     CHECK(std::abs(period / t_beam - 1) < 0.03);
   }
 }
 
-TEST_CASE("fem undamped average-acceleration Newmark conserves energy", "[fem][transient][energy]") {
+TEST_CASE("fem undamped average-acceleration Newmark conserves energy",
+          "[fem][transient][energy]") {
   Solver s(released_cantilever(ElementType::Hex8));
   s.solve_static();
   const double e0 = s.kinetic_energy() + s.strain_energy() - s.external_work();
@@ -80,7 +85,8 @@ TEST_CASE("fem undamped average-acceleration Newmark conserves energy", "[fem][t
   CHECK(max_kinetic > 0.5 * e0);  // it really vibrates
 
   SECTION("with a suddenly applied load the balance includes the external work") {
-    Model m(make_box_mesh({Vec3::Zero(), Vec3(kL, kH, kH), {10, 1, 1}, ElementType::Hex8}), Material{kE, 0.3, kRho});
+    Model m(make_box_mesh({Vec3::Zero(), Vec3(kL, kH, kH), {10, 1, 1}, ElementType::Hex8}),
+            Material{kE, 0.3, kRho});
     m.fix("xmin");
     m.add_traction("xmax", Vec3(0, 0, -kP / (kH * kH)));
     Solver s2(m);

@@ -8,12 +8,14 @@
 
 using namespace partita::tube1d;
 
-TEST_CASE("Tube law: a(p) and p(a) are inverse; dp/da at a0 gives the wave speed c^2 = E / (2 rho r0)",
-          "[tube1d]") {
+TEST_CASE(
+    "Tube law: a(p) and p(a) are inverse; dp/da at a0 gives the wave speed c^2 = E / (2 rho r0)",
+    "[tube1d]") {
   TubeParameters prm;
   prm.density = 1.3;
   TubeWall wall(prm);
-  for (double a : {0.8, 1.0, 1.05, 1.7}) CHECK(wall.area_of(wall.pressure_of(a)) == Approx(a).epsilon(1e-13));
+  for (double a : {0.8, 1.0, 1.05, 1.7})
+    CHECK(wall.area_of(wall.pressure_of(a)) == Approx(a).epsilon(1e-13));
   CHECK(wall.area_of(prm.reference_pressure) == Approx(prm.reference_area).epsilon(1e-15));
   // Moens-Korteweg: c^2 = (a / rho) dp/da at the reference state
   const double h = 1e-6;
@@ -49,7 +51,8 @@ TEST_CASE("Tube flow conserves mass: the area change balances the face fluxes", 
   }
 }
 
-TEST_CASE("Tube flow reaches a steady state in a rigid narrowing tube: uniform flux, Bernoulli", "[tube1d]") {
+TEST_CASE("Tube flow reaches a steady state in a rigid narrowing tube: uniform flux, Bernoulli",
+          "[tube1d]") {
   // Steady inflow u = 10 through a rigid tube with a throat a = 0.8 at mid-length.
   auto steady = [](int cells) {
     TubeParameters prm;
@@ -79,13 +82,16 @@ TEST_CASE("Tube flow reaches a steady state in a rigid narrowing tube: uniform f
   // momentum: the head p + rho u^2 / 2 is constant along the tube (Bernoulli) up to the
   // discretisation error, which is first order in dx: halving dx halves the defect.
   auto head_range = [](const TubeFlow& f) {
-    const Eigen::VectorXd h = f.pressure().array() + 0.5 * f.parameters().density * f.velocity().array().square();
+    const Eigen::VectorXd h =
+        f.pressure().array() + 0.5 * f.parameters().density * f.velocity().array().square();
     return h.maxCoeff() - h.minCoeff();
   };
-  const double swing = flow.pressure().maxCoeff() - flow.pressure().minCoeff();  // ~ rho (12.5^2 - 10^2) / 2
+  const double swing =
+      flow.pressure().maxCoeff() - flow.pressure().minCoeff();  // ~ rho (12.5^2 - 10^2) / 2
   CHECK(swing == Approx(0.5 * (12.5 * 12.5 - 100.0)).epsilon(0.05));
   const double d100 = head_range(flow), d200 = head_range(steady(200));
-  INFO("head defect: N = 100 " << d100 << ", N = 200 " << d200 << " (pressure swing " << swing << ")");
+  INFO("head defect: N = 100 " << d100 << ", N = 200 " << d200 << " (pressure swing " << swing
+                               << ")");
   CHECK(d100 < 0.05 * swing);
   CHECK(d200 / d100 == Approx(0.5).margin(0.05));
 }

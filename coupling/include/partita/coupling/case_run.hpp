@@ -52,15 +52,17 @@ struct RunOptions {
 /// What run() measured.
 struct RunSummary {
   std::int64_t windows = 0;
-  long iterations = 0;            ///< total over the windows
-  long unconverged_windows = 0;   ///< accepted at max_iterations
+  long iterations = 0;           ///< total over the windows
+  long unconverged_windows = 0;  ///< accepted at max_iterations
   int max_window_iterations = 0;
   double wall_seconds = 0.0;
   std::vector<std::pair<std::string, double>> participant_seconds;
   double mapping_seconds = 0.0;
   double output_seconds = 0.0;
   double core_seconds = 0.0;  ///< the rest: scheme, acceleration, time interpolation
-  double mean_iterations() const { return windows > 0 ? static_cast<double>(iterations) / windows : 0.0; }
+  double mean_iterations() const {
+    return windows > 0 ? static_cast<double>(iterations) / windows : 0.0;
+  }
 };
 
 class CaseRun {
@@ -100,7 +102,7 @@ class CaseRun {
   std::vector<std::filesystem::path> scripts_;
   double window_size_ = 0.0;
   std::int64_t window_count_ = 0;
-  double output_every_ = 0.0;  // 0: first and last frame only
+  double output_every_ = 0.0;                               // 0: first and last frame only
   std::vector<std::unique_ptr<Participant>> participants_;  // in scheme order
   std::vector<std::unique_ptr<Exchange>> exchanges_;
   std::unique_ptr<CouplingScheme> scheme_;

@@ -24,9 +24,9 @@
 namespace partita::coupling {
 
 struct WindowReport {
-  int iterations = 1;              ///< times the participants ran the window
-  bool converged = true;           ///< false if an implicit scheme stopped at max_iterations
-  std::vector<double> residuals;   ///< one per residual_columns() entry (last iteration)
+  int iterations = 1;             ///< times the participants ran the window
+  bool converged = true;          ///< false if an implicit scheme stopped at max_iterations
+  std::vector<double> residuals;  ///< one per residual_columns() entry (last iteration)
 };
 
 class CouplingScheme {

@@ -39,7 +39,8 @@ class Exchange {
   /// `mapper` already computed from the sender's to the receiver's mesh; nullptr = identity
   /// (the meshes must then have the same number of points).
   Exchange(std::string data, End from, End to, DataSpec spec, std::unique_ptr<Mapper> mapper,
-           ReaderSees reader_sees = ReaderSees::linear, WriterCombines writer_combines = WriterCombines::average);
+           ReaderSees reader_sees = ReaderSees::linear,
+           WriterCombines writer_combines = WriterCombines::average);
 
   const std::string& data() const { return data_; }
   Participant& from() const { return *from_.participant; }

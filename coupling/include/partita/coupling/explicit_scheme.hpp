@@ -16,7 +16,8 @@ struct SchemeContext;
 
 class ExplicitScheme : public CouplingScheme {
  public:
-  ExplicitScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges, bool serial);
+  ExplicitScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges,
+                 bool serial);
   std::string name() const override { return serial_ ? "explicit-serial" : "explicit-parallel"; }
 
   static std::unique_ptr<CouplingScheme> create_serial(const SchemeContext& context);

@@ -39,11 +39,14 @@ class ImplicitScheme : public CouplingScheme {
   /// `accelerated`: the exchanges the acceleration acts on (empty: plain fixed-point iteration
   /// when `acceleration` is null; else the default set: the last participant's outputs for a
   /// serial scheme, every exchange for a parallel one).
-  ImplicitScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges, Options options,
-                 std::vector<std::unique_ptr<ConvergenceMeasure>> measures,
-                 std::unique_ptr<Acceleration> acceleration, std::vector<Exchange*> accelerated = {});
+  ImplicitScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges,
+                 Options options, std::vector<std::unique_ptr<ConvergenceMeasure>> measures,
+                 std::unique_ptr<Acceleration> acceleration,
+                 std::vector<Exchange*> accelerated = {});
 
-  std::string name() const override { return options_.serial ? "implicit-serial" : "implicit-parallel"; }
+  std::string name() const override {
+    return options_.serial ? "implicit-serial" : "implicit-parallel";
+  }
   std::vector<std::pair<std::string, std::string>> residual_columns() const override;
   const Acceleration* acceleration() const { return acceleration_.get(); }
   const std::vector<Exchange*>& accelerated() const { return accelerated_; }

@@ -18,7 +18,8 @@ class ProgressLine {
   /// End the line (newline on a terminal).
   void finish();
   /// The text of the line for these values (for tests).
-  static std::string text(std::int64_t done, std::int64_t windows, double time, int iterations, double elapsed);
+  static std::string text(std::int64_t done, std::int64_t windows, double time, int iterations,
+                          double elapsed);
 
  private:
   std::int64_t windows_;

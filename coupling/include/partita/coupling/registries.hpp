@@ -25,7 +25,7 @@ struct Registries;
 
 /// What a scheme factory receives: the validated `coupling` section and the built pieces.
 struct SchemeContext {
-  config::Node config;                    ///< the case's `coupling` section
+  config::Node config;                     ///< the case's `coupling` section
   const Registries* registries = nullptr;  ///< for accelerations and convergence measures
   std::vector<Participant*> participants;  ///< in scheme order
   std::vector<Exchange*> exchanges;

@@ -33,7 +33,9 @@ class TimeWindow {
   /// The current time: time_at(substep()).
   double time() const { return time_at(k_); }
   /// Fraction of the window done after k substeps: k / m (exactly 1 at the end).
-  double fraction_at(int k) const { return static_cast<double>(k) / static_cast<double>(substeps_); }
+  double fraction_at(int k) const {
+    return static_cast<double>(k) / static_cast<double>(substeps_);
+  }
   /// The length of the next substep, time_at(k + 1) - time_at(k): the substeps tile the window.
   double next_substep_size() const { return time_at(k_ + 1) - time_at(k_); }
   /// The nominal substep Δt / m.

@@ -28,25 +28,25 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
+#include <Eigen/Core>
 
 #include "partita/interface/error.hpp"
 
 namespace partita::config {
 
 enum class Type {
-  real,         ///< a floating-point number (optionally with a unit)
-  integer,      ///< a whole number
-  boolean,      ///< true / false
-  string,       ///< free text (file names, ...)
-  choice,       ///< one of the declared names
-  reals,        ///< a sequence of reals (fixed length if size() is set)
-  integers,     ///< a sequence of integers
-  strings,      ///< a sequence of strings (each among the choices, if declared)
-  section,      ///< a map validated with its own Spec
-  list,         ///< a sequence of maps, each validated with its own Spec
-  any,          ///< anything; the owner validates it later (e.g. one-of sections)
+  real,      ///< a floating-point number (optionally with a unit)
+  integer,   ///< a whole number
+  boolean,   ///< true / false
+  string,    ///< free text (file names, ...)
+  choice,    ///< one of the declared names
+  reals,     ///< a sequence of reals (fixed length if size() is set)
+  integers,  ///< a sequence of integers
+  strings,   ///< a sequence of strings (each among the choices, if declared)
+  section,   ///< a map validated with its own Spec
+  list,      ///< a sequence of maps, each validated with its own Spec
+  any,       ///< anything; the owner validates it later (e.g. one-of sections)
 };
 
 /// "real", "integer", ... for messages and docs.
@@ -116,23 +116,39 @@ class Spec {
   Spec(std::string name, std::string doc);
 
   Param& add(std::string key, Type type, std::string doc);
-  Param& real(std::string key, std::string doc) { return add(std::move(key), Type::real, std::move(doc)); }
-  Param& integer(std::string key, std::string doc) { return add(std::move(key), Type::integer, std::move(doc)); }
-  Param& boolean(std::string key, std::string doc) { return add(std::move(key), Type::boolean, std::move(doc)); }
-  Param& string(std::string key, std::string doc) { return add(std::move(key), Type::string, std::move(doc)); }
+  Param& real(std::string key, std::string doc) {
+    return add(std::move(key), Type::real, std::move(doc));
+  }
+  Param& integer(std::string key, std::string doc) {
+    return add(std::move(key), Type::integer, std::move(doc));
+  }
+  Param& boolean(std::string key, std::string doc) {
+    return add(std::move(key), Type::boolean, std::move(doc));
+  }
+  Param& string(std::string key, std::string doc) {
+    return add(std::move(key), Type::string, std::move(doc));
+  }
   Param& choice(std::string key, std::string doc, std::vector<std::string> names) {
     return add(std::move(key), Type::choice, std::move(doc)).choices(std::move(names));
   }
-  Param& reals(std::string key, std::string doc) { return add(std::move(key), Type::reals, std::move(doc)); }
-  Param& integers(std::string key, std::string doc) { return add(std::move(key), Type::integers, std::move(doc)); }
-  Param& strings(std::string key, std::string doc) { return add(std::move(key), Type::strings, std::move(doc)); }
+  Param& reals(std::string key, std::string doc) {
+    return add(std::move(key), Type::reals, std::move(doc));
+  }
+  Param& integers(std::string key, std::string doc) {
+    return add(std::move(key), Type::integers, std::move(doc));
+  }
+  Param& strings(std::string key, std::string doc) {
+    return add(std::move(key), Type::strings, std::move(doc));
+  }
   Param& section(std::string key, std::string doc, std::shared_ptr<const Spec> s) {
     return add(std::move(key), Type::section, std::move(doc)).spec(std::move(s));
   }
   Param& list(std::string key, std::string doc, std::shared_ptr<const Spec> s) {
     return add(std::move(key), Type::list, std::move(doc)).spec(std::move(s));
   }
-  Param& any(std::string key, std::string doc) { return add(std::move(key), Type::any, std::move(doc)); }
+  Param& any(std::string key, std::string doc) {
+    return add(std::move(key), Type::any, std::move(doc));
+  }
 
   /// Keys of this spec may also be absent in favour of a one-of choice: at most one of `keys`
   /// may be present; `required` asks for exactly one.
@@ -160,7 +176,8 @@ class Spec {
 
 /// Convert "10 kPa" / "2 mm" / "3.5" to SI for a parameter whose unit is `unit`.
 /// Returns nullopt when the text is not a number followed by an allowed unit; `why` says what.
-std::optional<double> parse_quantity(std::string_view text, std::string_view unit, std::string* why = nullptr);
+std::optional<double> parse_quantity(std::string_view text, std::string_view unit,
+                                     std::string* why = nullptr);
 
 /// A position in a YAML document: the node, the file it came from and its key path.
 /// Cheap to copy. Typed getters check types (and ranges, when a Spec is attached).
@@ -174,7 +191,8 @@ class Node {
   static Node load_file(const std::filesystem::path& file);
   /// Parse a YAML file, then apply assignments "a.b[2].c=VALUE" (VALUE is YAML: a number, a
   /// string, [a, b] or {k: v}); a missing key is created, a bad path is a partita::Error.
-  static Node load_file(const std::filesystem::path& file, const std::vector<std::string>& overrides);
+  static Node load_file(const std::filesystem::path& file,
+                        const std::vector<std::string>& overrides);
   /// Parse YAML text; `name` stands for the file name in messages.
   static Node load_string(const std::string& text, const std::string& name = "<string>");
 

@@ -11,7 +11,7 @@ namespace partita {
 
 class Mesh {
  public:
-  using Points = Eigen::MatrixX3d;                           ///< N x 3 coordinates [m]
+  using Points = Eigen::MatrixX3d;                          ///< N x 3 coordinates [m]
   using Triangles = Eigen::Matrix<int, Eigen::Dynamic, 3>;  ///< M x 3 point indices
 
   struct Box {

@@ -19,7 +19,7 @@ class Registry {
  public:
   struct Entry {
     std::string name;
-    std::string doc;                     ///< one line
+    std::string doc;  ///< one line
     Factory factory;
     std::shared_ptr<const config::Spec> spec;  ///< its parameters (may be null)
   };
@@ -64,8 +64,8 @@ class Registry {
   const std::string& kind() const { return kind_; }
 
   std::string unknown_message(std::string_view name) const {
-    return "unknown " + kind_ + " '" + std::string(name) + "'; known " + kind_ + "s: " +
-           join_names(names()) + did_you_mean(name, names());
+    return "unknown " + kind_ + " '" + std::string(name) + "'; known " + kind_ +
+           "s: " + join_names(names()) + did_you_mean(name, names());
   }
 
  private:

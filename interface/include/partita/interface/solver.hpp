@@ -47,9 +47,9 @@ enum class DataKind {
 
 /// A field a solver sends or receives on one of its meshes.
 struct DataSpec {
-  std::string name;     ///< "displacement", "traction", "force", "pressure", ...
-  int components = 3;   ///< columns of the values matrix
-  std::string unit;     ///< SI unit, e.g. "m", "Pa", "N"
+  std::string name;    ///< "displacement", "traction", "force", "pressure", ...
+  int components = 3;  ///< columns of the values matrix
+  std::string unit;    ///< SI unit, e.g. "m", "Pa", "N"
   DataKind kind = DataKind::intensive;
 };
 
@@ -84,7 +84,8 @@ class Solver {
   virtual const std::vector<InterfaceMesh>& meshes() const = 0;
 
   /// Give the solver the values of a field it receives (N x C on that mesh's points).
-  virtual void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) = 0;
+  virtual void read(std::string_view mesh, std::string_view data,
+                    const Eigen::MatrixXd& values) = 0;
 
   /// Ask the solver for the values of a field it sends (resized to N x C by the solver).
   virtual void write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) = 0;
@@ -130,11 +131,11 @@ class Solver {
 
 /// What a solver factory receives.
 struct SolverContext {
-  std::string name;                    ///< participant name in the case
-  config::Node config;                 ///< the participant's YAML section
-  std::filesystem::path case_dir;      ///< folder of the case file (relative inputs)
-  std::filesystem::path output_dir;    ///< the run's output folder
-  int threads = 1;                     ///< threads the solver may use
+  std::string name;                  ///< participant name in the case
+  config::Node config;               ///< the participant's YAML section
+  std::filesystem::path case_dir;    ///< folder of the case file (relative inputs)
+  std::filesystem::path output_dir;  ///< the run's output folder
+  int threads = 1;                   ///< threads the solver may use
 };
 
 using SolverFactory = std::function<std::unique_ptr<Solver>(const SolverContext&)>;

@@ -12,9 +12,10 @@ namespace partita::coupling {
 class ConstantRelaxation : public Acceleration {
  public:
   explicit ConstantRelaxation(double omega);
-  void accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde, const Eigen::VectorXd& weights,
-                  Eigen::VectorXd& next) override;
-  void window_converged(const Eigen::VectorXd&, const Eigen::VectorXd&, const Eigen::VectorXd&) override {}
+  void accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                  const Eigen::VectorXd& weights, Eigen::VectorXd& next) override;
+  void window_converged(const Eigen::VectorXd&, const Eigen::VectorXd&,
+                        const Eigen::VectorXd&) override {}
   std::string name() const override { return "constant"; }
   double omega() const { return omega_; }
 

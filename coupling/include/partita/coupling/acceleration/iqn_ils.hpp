@@ -10,8 +10,8 @@
 // The columns of the last `reused_windows` windows are kept (at most `max_columns` in all, the
 // oldest dropped first). Before each solve the QR decomposition of D V is rebuilt column by
 // column, newest first, and nearly dependent columns are removed from V and W
-// (filter qr2: |orthogonal part| < limit |column|, Haelterman et al. 2016; qr1: |R_ii| < limit |R|_F).
-// When there are no columns (first iteration of the first window) the step is a constant
+// (filter qr2: |orthogonal part| < limit |column|, Haelterman et al. 2016; qr1: |R_ii| < limit
+// |R|_F). When there are no columns (first iteration of the first window) the step is a constant
 // relaxation with `initial_relaxation`. On a linear map of dimension n the iteration converges
 // in at most n + 1 evaluations of H (it is then equivalent to GMRES).
 
@@ -38,8 +38,8 @@ class IqnIls : public Acceleration {
   };
 
   explicit IqnIls(Options options);
-  void accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde, const Eigen::VectorXd& weights,
-                  Eigen::VectorXd& next) override;
+  void accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                  const Eigen::VectorXd& weights, Eigen::VectorXd& next) override;
   void window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
                         const Eigen::VectorXd& weights) override;
   std::string name() const override { return "iqn-ils"; }
@@ -58,7 +58,7 @@ class IqnIls : public Acceleration {
   void apply_filter(const Eigen::VectorXd& weights);
 
   Options options_;
-  Eigen::MatrixXd v_, w_;          // columns newest first
+  Eigen::MatrixXd v_, w_;           // columns newest first
   std::deque<int> window_columns_;  // columns per window, current window first
   Eigen::VectorXd previous_residual_, previous_x_tilde_;
   bool first_iteration_ = true;

@@ -22,7 +22,8 @@ namespace partita::coupling {
 
 class AreaBalancedMapper final : public SparseMapper {
  public:
-  AreaBalancedMapper(Constraint constraint, int neighbors) : SparseMapper(constraint), neighbors_(neighbors) {}
+  AreaBalancedMapper(Constraint constraint, int neighbors)
+      : SparseMapper(constraint), neighbors_(neighbors) {}
 
   std::string name() const override { return "area-balanced"; }
 

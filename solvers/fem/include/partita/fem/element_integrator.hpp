@@ -7,8 +7,8 @@
 namespace partita::fem {
 
 using ElementCoordinates = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
-using ElementMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxElementDofs,
-                                    kMaxElementDofs>;
+using ElementMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxElementDofs, kMaxElementDofs>;
 using ElementVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementDofs, 1>;
 using ElementStresses = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, kMaxElementNodes, 6>;
 

@@ -6,10 +6,10 @@
 namespace partita::fem {
 
 enum class LoadKind {
-  Pressure,   // pressure p [Pa] on face `target`, acting against the outward normal: t = -p n
-  Traction,   // traction vector [Pa] on face `target`
-  NodalForce, // force [N] on every node of node set `target`
-  Gravity,    // body acceleration [m/s^2] on every element (force density rho g)
+  Pressure,    // pressure p [Pa] on face `target`, acting against the outward normal: t = -p n
+  Traction,    // traction vector [Pa] on face `target`
+  NodalForce,  // force [N] on every node of node set `target`
+  Gravity,     // body acceleration [m/s^2] on every element (force density rho g)
 };
 
 // A load defined with the model: its magnitude times amplitude(t) (1 when empty).

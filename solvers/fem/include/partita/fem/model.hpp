@@ -22,7 +22,9 @@ class Model {
   // --- material ---
   void set_material(const Material& material);  // every region
   void set_material(const std::string& region, const Material& material);
-  const Material& material(int region) const { return materials_.at(static_cast<std::size_t>(region)); }
+  const Material& material(int region) const {
+    return materials_.at(static_cast<std::size_t>(region));
+  }
   void set_hex8_formulation(Hex8Formulation f) { hex8_ = f; }
   Hex8Formulation hex8_formulation() const { return hex8_; }
 

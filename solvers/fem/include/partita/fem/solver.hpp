@@ -79,7 +79,9 @@ class Solver {
   const Eigen::VectorXd& displacement() const { return u_; }
   const Eigen::VectorXd& velocity() const { return v_; }
   const Eigen::VectorXd& acceleration() const { return a_; }
-  Vec3 displacement(std::size_t node) const { return u_.segment<3>(3 * static_cast<Eigen::Index>(node)); }
+  Vec3 displacement(std::size_t node) const {
+    return u_.segment<3>(3 * static_cast<Eigen::Index>(node));
+  }
   MatrixX3 displacements(const std::vector<std::size_t>& nodes) const;
   // Sum over the set's nodes of the nodal residual K u + C v + M a - F [N]: the force the
   // supports exert on the body. (Zero, up to round-off, on nodes without Dirichlet dofs.)
@@ -92,12 +94,12 @@ class Solver {
   const Eigen::VectorXd& external_force() const { return f_; }
 
   // --- scalar monitors ---
-  double kinetic_energy() const;   // 1/2 v^T M v
-  double strain_energy() const;    // 1/2 u^T K u
+  double kinetic_energy() const;                           // 1/2 v^T M v
+  double strain_energy() const;                            // 1/2 u^T K u
   double external_work() const { return external_work_; }  // sum 1/2 (F_n + F_n+1).(u_n+1 - u_n)
-  double max_displacement() const;                  // max over nodes of |u|
-  Vec3 total_coupling_force() const;                // sum of the coupling loads [N]
-  Vec3 total_external_force() const;                // sum of F(time()) [N]
+  double max_displacement() const;                         // max over nodes of |u|
+  Vec3 total_coupling_force() const;                       // sum of the coupling loads [N]
+  Vec3 total_external_force() const;                       // sum of F(time()) [N]
 
   // --- state ---
   SolverState save_state() const;

@@ -5,9 +5,9 @@
 //   continuity  d(a)/dt + d(a u)/dx = 0
 //   momentum    d(a u)/dt + d(a u^2)/dx + (a / rho) dp/dx = 0
 //
-// Implicit Euler in time, central fluxes at the cell faces (F_{i+1/2} = (a_i + a_{i+1})(u_i + u_{i+1}) / 4),
-// the nonlinear system solved by Newton's method with the exact Jacobian and a sparse LU.
-// Boundaries: inlet velocity u_0 = u_in(t_{n+1}); inlet pressure extrapolated linearly
+// Implicit Euler in time, central fluxes at the cell faces (F_{i+1/2} = (a_i + a_{i+1})(u_i +
+// u_{i+1}) / 4), the nonlinear system solved by Newton's method with the exact Jacobian and a
+// sparse LU. Boundaries: inlet velocity u_0 = u_in(t_{n+1}); inlet pressure extrapolated linearly
 // (p_0 - 2 p_1 + p_2 = 0); outlet velocity extrapolated linearly; non-reflecting outlet
 //   p_N = 2 rho (c^2 - (sqrt(c^2 - p_N^n / (2 rho)) - (u_N - u_N^n) / 4)^2).
 //
