@@ -18,16 +18,23 @@ namespace {
 using config::Node;
 using config::Spec;
 
-std::shared_ptr<Spec> make_spec() {
-  auto material = std::make_shared<Spec>(
-      "material", "bulk properties of a DEM material (particles, walls, meshes)");
-  material->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
-  material->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
-  material->real("density", "mass density rho (used for particles)")
-      .unit("kg/m^3")
-      .positive()
-      .def(2500.0);
+// One entry of `materials` (a map name -> material, validated entry by entry).
+std::shared_ptr<const Spec> material_spec() {
+  static const std::shared_ptr<const Spec> spec = [] {
+    auto m = std::make_shared<Spec>("material",
+                                    "bulk properties of a DEM material (particles, walls, meshes)");
+    m->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
+    m->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
+    m->real("density", "mass density rho (used for particles)")
+        .unit("kg/m^3")
+        .positive()
+        .def(2500.0);
+    return m;
+  }();
+  return spec;
+}
 
+std::shared_ptr<Spec> make_spec() {
   auto interaction =
       std::make_shared<Spec>("interaction", "contact parameters of a pair of materials");
   interaction->strings("pair", "the two material names (the same name twice for like contacts)")
@@ -108,7 +115,9 @@ std::shared_ptr<Spec> make_spec() {
 
   auto s = std::make_shared<Spec>(
       "dem", "native DEM (solvers/dem): Hertz-Mindlin spheres, planes, triangle meshes");
-  s->any("materials", "map of material name -> {youngs_modulus, poisson_ratio, density}")
+  s->any("materials",
+         "map of material name -> {youngs_modulus (Pa, required), poisson_ratio (required), "
+         "density (kg/m^3, default 2500)}")
       .required();
   s->list("interactions", "contact parameters of each pair of materials that can touch",
           interaction)
@@ -190,15 +199,8 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
           "poisson_ratio: "
           "0.23, density: 400}}; found " +
           mats.describe());
-    auto mspec = std::make_shared<Spec>("material", "bulk properties of a DEM material");
-    mspec->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
-    mspec->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
-    mspec->real("density", "mass density rho (used for particles)")
-        .unit("kg/m^3")
-        .positive()
-        .def(2500.0);
     for (const std::string& m : mats.keys()) {
-      const Node mn = mats[m].validated(mspec);
+      const Node mn = mats[m].validated(material_spec());
       dem::Material mat{mn.real("youngs_modulus"), mn.real("poisson_ratio"), mn.real("density")};
       materials[m] = system_.add_material(mat);
       material_names.push_back(m);
