@@ -410,6 +410,7 @@ Node Node::load_file(const std::filesystem::path& file) {
 Node Node::load_file(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   Node n = load_file(file);
   if (overrides.empty()) return n;
+  std::vector<std::string> overridden;
   if (!n.node_.IsDefined() || n.node_.IsNull()) n.node_ = YAML::Node(YAML::NodeType::Map);
   for (const std::string& a : overrides) {
     const auto eq = a.find('=');
@@ -418,6 +419,7 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
           "--set '" + a +
           "': expected KEY.PATH=VALUE, e.g. time.end=0.01 or coupling.exchanges[0].mapper=rbf");
     const std::string path = a.substr(0, eq);
+    overridden.push_back(path);
     YAML::Node value;
     try {
       value = YAML::Load(a.substr(eq + 1));
@@ -471,6 +473,7 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
       chain.push_back(cur[key]);
     }
   }
+  n.overridden_ = std::make_shared<const std::vector<std::string>>(std::move(overridden));
   return n;
 }
 
@@ -479,6 +482,10 @@ const std::string& Node::file() const {
 }
 
 SourceLocation Node::location() const {
+  if (overridden_)
+    for (const std::string& p : *overridden_)
+      if (path_ == p || path_.rfind(p + ".", 0) == 0 || path_.rfind(p + "[", 0) == 0)
+        return SourceLocation{"command line (--set " + p + "=...)", 0, 0};
   if (node_.IsDefined()) {
     const YAML::Mark m = node_.Mark();
     if (m.line >= 0) return SourceLocation{file(), m.line + 1, m.column + 1};
@@ -510,6 +517,7 @@ Node Node::child(std::string_view key, const YAML::Node& n, bool from_default) c
   if (const Param* pr = param(key); pr && pr->type() == Type::section) s = pr->sub_spec();
   Node c(n, file_, std::move(p), s);
   c.fallback_ = location();
+  c.overridden_ = overridden_;
   if (const Param* pr = param(key); pr && pr->type() == Type::list && pr->sub_spec()) {
     // Items of a declared list get the item spec: remember it through a one-param wrapper.
     auto w = std::make_shared<Spec>(pr->key(), pr->doc());
@@ -549,6 +557,7 @@ Node Node::operator[](std::size_t i) const {
     s = spec_->params().front().sub_spec();
   Node c(node_[i], file_, path_ + "[" + std::to_string(i) + "]", s);
   c.fallback_ = location();
+  c.overridden_ = overridden_;
   return c;
 }
 

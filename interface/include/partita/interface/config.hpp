@@ -263,6 +263,7 @@ class Node {
   std::string path_;
   std::shared_ptr<const Spec> spec_;
   SourceLocation fallback_;  // where a missing (defaulted) node would have been
+  std::shared_ptr<const std::vector<std::string>> overridden_;  // key paths set by --set
 };
 
 }  // namespace partita::config
