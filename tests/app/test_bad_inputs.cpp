@@ -121,3 +121,16 @@ TEST_CASE("cli: list shows every registry", "[app][cli]") {
   CHECK(d.status == 1);
   CHECK(d.output.find("did you mean 'nearest-neighbor'") != std::string::npos);
 }
+
+TEST_CASE("cli: --set changes a case value, and a bad one is reported at the command line", "[app][cli]") {
+  const std::string c = quote(std::string(PARTITA_SOURCE_DIR) + "/cases/uniaxial_compaction/steel.yaml");
+  const Result ok = run_partita("check " + c + " --log-level warn --set 'participants.plate.loads[0].pressure=20 kPa'");
+  CHECK(ok.status == 0);
+  const Result bad = run_partita("check " + c + " --set time.window=-1");
+  CHECK(bad.status == 1);
+  CHECK(bad.output.find("command line (--set time.window=...)") != std::string::npos);
+  CHECK(bad.output.find("0 < value") != std::string::npos);
+  const Result path = run_partita("check " + c + " --set 'participants.plate.loads[7].pressure=1'");
+  CHECK(path.status == 1);
+  CHECK(path.output.find("has no element [7] (it has 2)") != std::string::npos);
+}
