@@ -1,5 +1,7 @@
 #include "partita/coupling/acceleration/iqn_ils.hpp"
 
+#include <cmath>
+
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -13,7 +15,7 @@ IqnIls::IqnIls(Options options) : options_(options) {
   window_columns_.push_front(0);
 }
 
-void IqnIls::remove_column(Eigen::Index j) {
+void IqnIls::erase_column(Eigen::Index j) {
   const Eigen::Index n = v_.cols();
   if (j + 1 < n) {
     v_.middleCols(j, n - j - 1) = v_.rightCols(n - j - 1).eval();
@@ -32,7 +34,56 @@ void IqnIls::remove_column(Eigen::Index j) {
   }
 }
 
-void IqnIls::add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde) {
+void IqnIls::remove_column(Eigen::Index j) {
+  erase_column(j);
+  if (qr_.cols() > j) qr_.delete_column(j);
+}
+
+void IqnIls::clear(Eigen::Index rows) {
+  v_.resize(rows, 0);
+  w_.resize(rows, 0);
+  for (auto& c : window_columns_) c = 0;
+  qr_.reset(rows);
+  qr_weights_.resize(0);
+}
+
+void IqnIls::rebuild(const Eigen::VectorXd& weights) {
+  // QR of D V by appending the columns newest first (insert_column at the back: no rotations);
+  // with QR2 a column whose orthogonal part is below the limit is dropped on the way.
+  ++rebuilds_;
+  qr_.reset(v_.rows());
+  qr_weights_ = weights;
+  const double limit = options_.filter == Filter::qr2 ? options_.filter_limit : 0.0;
+  for (Eigen::Index j = 0; j < v_.cols();) {
+    if (qr_.append(weights.cwiseProduct(v_.col(j)), limit)) {
+      ++j;
+    } else {
+      erase_column(j);
+      ++filtered_;
+    }
+  }
+}
+
+void IqnIls::match_weights(const Eigen::VectorXd& weights) {
+  if (qr_weights_.size() != weights.size() || qr_.cols() != v_.cols() || qr_.rows() != v_.rows()) {
+    rebuild(weights);
+    return;
+  }
+  if (qr_weights_ == weights) return;
+  // D' = s D (one accelerated field, or fields scaled alike): D' V = Q (s R).
+  const double s = weights(0) / qr_weights_(0);
+  if (std::isfinite(s) && s > 0.0 &&
+      (weights - s * qr_weights_).lpNorm<Eigen::Infinity>() <=
+          1e-14 * weights.lpNorm<Eigen::Infinity>()) {
+    qr_.scale(s);
+    qr_weights_ = weights;
+    return;
+  }
+  rebuild(weights);
+}
+
+void IqnIls::add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                         const Eigen::VectorXd& weights) {
   const Eigen::VectorXd r = x_tilde - x;
   if (!first_iteration_ && previous_residual_.size() == r.size()) {
     // V = [r_k - r_{k-1}, ...], W = [H(x_k) - H(x_{k-1}), ...], newest first
@@ -44,32 +95,37 @@ void IqnIls::add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tild
       v.rightCols(n) = v_;
       w.rightCols(n) = w_;
     }
-    v_.swap(v);
-    w_.swap(w);
     ++window_columns_.front();
+    if (qr_.insert_column(0, weights.cwiseProduct(v.col(0)))) {
+      v_.swap(v);
+      w_.swap(w);
+    } else {
+      // zero, or dependent on the columns in to rounding: not a usable secant
+      --window_columns_.front();
+      ++filtered_;
+    }
     while (v_.cols() > options_.max_columns) remove_column(v_.cols() - 1);
   }
   previous_residual_ = r;
   previous_x_tilde_ = x_tilde;
 }
 
-void IqnIls::apply_filter(const Eigen::VectorXd& weights) {
-  // Rebuild the QR decomposition of D V newest column first; drop nearly dependent columns.
-  bool again = true;
-  while (again) {
-    again = false;
-    qr_.reset(v_.rows());
-    for (Eigen::Index j = 0; j < v_.cols(); ++j) {
-      const Eigen::VectorXd col = weights.cwiseProduct(v_.col(j));
-      const double limit = options_.filter == Filter::qr2 ? options_.filter_limit : 0.0;
-      if (!qr_.append(col, limit)) {
+void IqnIls::apply_filter() {
+  // On the updated factorisation: removing column j updates R for the columns after it, so each
+  // test sees the columns that are still in (as a rebuild newest first would).
+  if (options_.filter == Filter::qr2) {
+    for (Eigen::Index j = 0; j < qr_.cols();) {
+      if (std::abs(qr_.diagonal(j)) < options_.filter_limit * qr_.column_norm(j)) {
         remove_column(j);
         ++filtered_;
-        again = true;  // the factorisation so far is valid, but simplest to rebuild
-        break;
+      } else {
+        ++j;
       }
     }
-    if (!again && options_.filter == Filter::qr1) {
+  } else if (options_.filter == Filter::qr1) {
+    bool again = true;
+    while (again) {
+      again = false;
       const double rn = qr_.r_norm();
       for (Eigen::Index j = 0; j < qr_.cols(); ++j) {
         if (std::abs(qr_.diagonal(j)) < options_.filter_limit * rn) {
@@ -85,18 +141,11 @@ void IqnIls::apply_filter(const Eigen::VectorXd& weights) {
 
 void IqnIls::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
                         const Eigen::VectorXd& weights, Eigen::VectorXd& next) {
-  if (v_.rows() != x.size() && v_.cols() > 0) {  // the data changed size: start over
-    v_.resize(x.size(), 0);
-    w_.resize(x.size(), 0);
-    for (auto& c : window_columns_) c = 0;
-  }
-  if (v_.cols() == 0) {
-    v_.resize(x.size(), 0);
-    w_.resize(x.size(), 0);
-  }
-  add_columns(x, x_tilde);
+  if (v_.rows() != x.size()) clear(x.size());  // the data changed size: start over
+  match_weights(weights);
+  add_columns(x, x_tilde, weights);
   first_iteration_ = false;
-  if (v_.cols() > 0) apply_filter(weights);
+  if (v_.cols() > 0) apply_filter();
   if (v_.cols() == 0) {
     // no model yet: x_{k+1} = x_k + ω_0 r_k
     next = x + options_.initial_relaxation * (x_tilde - x);
@@ -108,24 +157,26 @@ void IqnIls::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde
 }
 
 void IqnIls::window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                              const Eigen::VectorXd& /*weights*/) {
+                              const Eigen::VectorXd& weights) {
   // The converged iteration's differences belong to the model too (preCICE adds them here).
   if (v_.rows() == x.size() || v_.cols() == 0) {
-    if (v_.cols() == 0) {
-      v_.resize(x.size(), 0);
-      w_.resize(x.size(), 0);
-    }
-    add_columns(x, x_tilde);
+    if (v_.rows() != x.size()) clear(x.size());
+    match_weights(weights);
+    add_columns(x, x_tilde, weights);
   }
   first_iteration_ = true;
-  // Keep the columns of the current window and `reused_windows` before it.
+  // Keep the columns of the current window and `reused_windows` before it (deleting the last
+  // column of the factorisation needs no rotation).
   window_columns_.push_front(0);
   while (static_cast<int>(window_columns_.size()) > options_.reused_windows + 1) {
     const int count = window_columns_.back();
     window_columns_.pop_back();
-    const Eigen::Index keep = v_.cols() - count;
-    v_.conservativeResize(Eigen::NoChange, keep);
-    w_.conservativeResize(Eigen::NoChange, keep);
+    for (int i = 0; i < count; ++i) {
+      const Eigen::Index last = v_.cols() - 1;
+      v_.conservativeResize(Eigen::NoChange, last);
+      w_.conservativeResize(Eigen::NoChange, last);
+      if (qr_.cols() > last) qr_.delete_column(last);
+    }
   }
 }
 

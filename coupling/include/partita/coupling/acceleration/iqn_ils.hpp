@@ -8,10 +8,21 @@
 //   x_{k+1} = H(x_k) + W c
 //
 // The columns of the last `reused_windows` windows are kept (at most `max_columns` in all, the
-// oldest dropped first). Before each solve the QR decomposition of D V is rebuilt column by
-// column, newest first, and nearly dependent columns are removed from V and W
-// (filter qr2: |orthogonal part| < limit |column|, Haelterman et al. 2016; qr1: |R_ii| < limit
-// |R|_F). When there are no columns (first iteration of the first window) the step is a constant
+// oldest dropped first). The QR decomposition of D V is kept across iterations and windows and
+// *updated* (QrFactorization, Givens rotations, O(rows x columns) per change): each iteration
+// inserts its new column at the front; columns beyond `max_columns` and the columns of windows
+// older than `reused_windows` are deleted from the back; the filter deletes columns anywhere.
+// Nearly dependent columns are removed from V, W and the factorisation (filter qr2:
+// |R_ii| < limit |V_i| with V_i in the weighted norm, i.e. the part of column i orthogonal to
+// the newer columns is short, Haelterman et al. 2016 / preCICE; qr1: |R_ii| < limit |R|_F).
+// Each test runs on the updated R after the insertion, newest column first, so it sees exactly
+// what a rebuild of the QR newest column first would. A column that is dependent to rounding on
+// the ones in (or zero) is not inserted at all.
+// Rebuilt (by appending the columns one by one with the same insert routine, the qr2 test
+// applied on the way) only when the weights D change other than by a common factor (several
+// accelerated fields whose norms change differently; a common factor s just scales R), when the
+// data change size, and on the first call. When there are no columns (first iteration of the
+// first window) the step is a constant
 // relaxation with `initial_relaxation`. On a linear map of dimension n the iteration converges
 // in at most n + 1 evaluations of H (it is then equivalent to GMRES).
 
@@ -48,22 +59,36 @@ class IqnIls : public Acceleration {
   Eigen::Index columns() const { return v_.cols(); }
   /// Columns removed by the filter so far.
   long filtered_columns() const { return filtered_; }
+  /// Times the QR decomposition was rebuilt from V (instead of updated).
+  long qr_rebuilds() const { return rebuilds_; }
+  /// The factorisation of D V (D: the weights of the last call).
+  const QrFactorization& qr() const { return qr_; }
+  /// V and W, newest column first.
+  const Eigen::MatrixXd& v() const { return v_; }
+  const Eigen::MatrixXd& w() const { return w_; }
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Acceleration> create(const config::Node& node);
 
  private:
-  void add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde);
-  void remove_column(Eigen::Index j);
-  void apply_filter(const Eigen::VectorXd& weights);
+  void add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                   const Eigen::VectorXd& weights);
+  void erase_column(Eigen::Index j);   // from V, W and the window counts
+  void remove_column(Eigen::Index j);  // ... and from the factorisation
+  void clear(Eigen::Index rows);
+  void rebuild(const Eigen::VectorXd& weights);
+  void match_weights(const Eigen::VectorXd& weights);
+  void apply_filter();
 
   Options options_;
   Eigen::MatrixXd v_, w_;           // columns newest first
   std::deque<int> window_columns_;  // columns per window, current window first
   Eigen::VectorXd previous_residual_, previous_x_tilde_;
   bool first_iteration_ = true;
-  QrFactorization qr_;
+  QrFactorization qr_;          // of D V, D = diag(qr_weights_)
+  Eigen::VectorXd qr_weights_;  // empty: no factorisation yet
   long filtered_ = 0;
+  long rebuilds_ = 0;
 };
 
 }  // namespace partita::coupling
