@@ -337,22 +337,39 @@ void System::step(double dt) {
   const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
   const bool have_build = x_build.size() == p.size();
   double moved2 = 0.0;  // largest squared displacement since the last neighbour build
+  bool rebuild = !have_build;
   packed_.resize(n);
-  // Velocity Verlet, first half: v += dt/2 F/m, x += dt v, omega += dt/2 T/I (and the packed
-  // copy the pair loop reads).
-#pragma omp parallel for schedule(static) reduction(max : moved2) if (n >= 1024)
-  for (long i = 0; i < n; ++i) {
-    p.velocity[i] += (half / p.mass[i]) * p.force[i];
-    p.position[i] += dt * p.velocity[i];
-    p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
-    if (have_build) moved2 = std::max(moved2, (p.position[i] - x_build[i]).squaredNorm());
-    pack(i);
-  }
   for (PlaneWall& w : planes_) w.point += dt * w.velocity;
-  if (!have_build || neighbors_.needs_rebuild(moved2, planes_, meshes_))
+    // One parallel region for the whole step unless the lists need a rebuild: velocity Verlet,
+    // first half (v += dt/2 F/m, x += dt v, omega += dt/2 T/I and the packed copy the pair loop
+    // reads), then the forces at t + dt and the second half (v += dt/2 F/m, omega += dt/2 T/I, in
+    // the gather). With a rebuild the region ends after the first half and the (parallel) build
+    // and force evaluation follow.
+#pragma omp parallel if (n >= 1024)
+  {
+#pragma omp for schedule(static) reduction(max : moved2)
+    for (long i = 0; i < n; ++i) {
+      p.velocity[i] += (half / p.mass[i]) * p.force[i];
+      p.position[i] += dt * p.velocity[i];
+      p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
+      if (have_build) moved2 = std::max(moved2, (p.position[i] - x_build[i]).squaredNorm());
+      pack(i);
+    }
+    // moved2 is complete after the loop's barrier; every thread reaches the same decision
+    const bool rebuild_here = !have_build || neighbors_.needs_rebuild(moved2, planes_, meshes_);
+    if (!rebuild_here) {
+      compute_pair_forces(dt, true);
+      gather_forces(dt, true, half);
+    }
+#pragma omp master
+    rebuild = rebuild_here;
+  }
+  if (rebuild) {
     neighbors_.build(p, planes_, meshes_);
-  // forces at t + dt, then the second half: v += dt/2 F/m, omega += dt/2 T/I (in the gather)
-  compute_forces(dt, true, half, true);
+    compute_forces(dt, true, half, true);
+  } else {
+    reduce_wall_and_mesh_forces();
+  }
   for (TriangleMesh& m : meshes_) m.position_last_step_ = m.position_;
   time_ += dt;
   ++steps_;
