@@ -3,6 +3,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "../support/run_command.hpp"
+
 #include <sys/wait.h>
 
 #include <array>
@@ -16,28 +18,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int status = 0;
-  bool signalled = false;
-  std::string output;
-};
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using Result = partita::test::CommandResult;
+using partita::test::quote;
 
 Result run_partita(const std::string& args) {
-  const std::string cmd = quote(PARTITA_EXECUTABLE) + " " + args + " 2>&1";
-  Result r;
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) r.output += buf.data();
-  const int st = pclose(p);
-  r.signalled = WIFSIGNALED(st);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  const Result r = partita::test::run_command(quote(PARTITA_EXECUTABLE) + " " + args);
+  REQUIRE(r.output != "popen failed");
   return r;
 }
 
@@ -122,9 +108,12 @@ TEST_CASE("cli: list shows every registry", "[app][cli]") {
   CHECK(d.output.find("did you mean 'nearest-neighbor'") != std::string::npos);
 }
 
-TEST_CASE("cli: --set changes a case value, and a bad one is reported at the command line", "[app][cli]") {
-  const std::string c = quote(std::string(PARTITA_SOURCE_DIR) + "/cases/uniaxial_compaction/steel.yaml");
-  const Result ok = run_partita("check " + c + " --log-level warn --set 'participants.plate.loads[0].pressure=20 kPa'");
+TEST_CASE("cli: --set changes a case value, and a bad one is reported at the command line",
+          "[app][cli]") {
+  const std::string c =
+      quote(std::string(PARTITA_SOURCE_DIR) + "/cases/uniaxial_compaction/steel.yaml");
+  const Result ok = run_partita(
+      "check " + c + " --log-level warn --set 'participants.plate.loads[0].pressure=20 kPa'");
   CHECK(ok.status == 0);
   const Result bad = run_partita("check " + c + " --set time.window=-1");
   CHECK(bad.status == 1);

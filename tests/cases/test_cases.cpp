@@ -5,6 +5,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "../support/run_command.hpp"
+
 #include <sys/wait.h>
 
 #include <array>
@@ -22,20 +24,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using partita::test::quote;
 
 std::pair<int, std::string> shell(const std::string& cmd) {
-  std::string out;
-  FILE* p = popen((cmd + " 2>&1").c_str(), "r");
-  if (!p) return {-1, "popen failed"};
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  const partita::test::CommandResult r = partita::test::run_command(cmd);
+  return {r.status, r.output};
 }
 
 struct Csv {
