@@ -347,15 +347,12 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
           system_.rayleigh_time_step(), stable_time_step());
 }
 
-const DemAdapter::CouplingMesh& DemAdapter::find(std::string_view mesh, bool* centres) const {
-  for (const auto& m : meshes_dem_) {
-    if (mesh == m.name) {
-      *centres = false;
-      return m;
-    }
-    if (mesh == m.name + "_centres") {
-      *centres = true;
-      return m;
+std::size_t DemAdapter::find(std::string_view mesh, bool* centres) const {
+  for (std::size_t k = 0; k < meshes_dem_.size(); ++k) {
+    const auto& m = meshes_dem_[k];
+    if (mesh == m.name || mesh == m.name + "_centres") {
+      *centres = mesh != m.name;
+      return k;
     }
   }
   throw Error("dem '" + name_ + "' has no mesh '" + std::string(mesh) + "'");
@@ -363,18 +360,17 @@ const DemAdapter::CouplingMesh& DemAdapter::find(std::string_view mesh, bool* ce
 
 void DemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
   bool centres = false;
-  const CouplingMesh& cm = find(mesh, &centres);
+  CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
   if (centres || data != "displacement")
     throw Error("dem '" + name_ + "' reads only 'displacement' on mesh '" + cm.name + "'");
-  auto& m = const_cast<CouplingMesh&>(cm);
-  // x = X + d: the vertices follow the other side's displacement.
-  m.positions = m.reference + values;
-  system_.set_vertex_positions(m.id, m.positions);
+  // x = X + d: the vertices follow the other side's displacement (no allocation: same size).
+  cm.positions = cm.reference + values;
+  system_.set_vertex_positions(cm.id, cm.positions);
 }
 
 void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
   bool centres = false;
-  const CouplingMesh& cm = find(mesh, &centres);
+  const CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
   if (!centres) {
     if (data != "force")
       throw Error("dem '" + name_ + "' writes only 'force' on mesh '" + cm.name + "'");

@@ -56,7 +56,8 @@ class DemAdapter : public Solver {
     std::string name;
     int id = -1;
   };
-  const CouplingMesh& find(std::string_view mesh, bool* centres) const;
+  /// Index into meshes_dem_ of the coupling mesh `mesh` (vertices or centres); throws if unknown.
+  std::size_t find(std::string_view mesh, bool* centres) const;
 
   std::string name_;
   dem::System system_;

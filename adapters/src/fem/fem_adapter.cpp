@@ -273,16 +273,12 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
              transient_ ? "transient" : "static");
 }
 
-const FemAdapter::Interface& FemAdapter::find_interface(std::string_view mesh,
-                                                        bool* quadrature) const {
-  for (const auto& i : interfaces_) {
-    if (mesh == i.name) {
-      *quadrature = false;
-      return i;
-    }
-    if (mesh == i.name + "_quadrature") {
-      *quadrature = true;
-      return i;
+std::size_t FemAdapter::find_interface(std::string_view mesh, bool* quadrature) const {
+  for (std::size_t k = 0; k < interfaces_.size(); ++k) {
+    const auto& i = interfaces_[k];
+    if (mesh == i.name || mesh == i.name + "_quadrature") {
+      *quadrature = mesh != i.name;
+      return k;
     }
   }
   throw Error("fem '" + name_ + "' has no mesh '" + std::string(mesh) + "'");
@@ -306,8 +302,7 @@ void FemAdapter::apply_nodal_forces() {
 
 void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
   bool quadrature = false;
-  const Interface& ci = find_interface(mesh, &quadrature);
-  Interface& i = const_cast<Interface&>(ci);
+  Interface& i = interfaces_[find_interface(mesh, &quadrature)];
   if (quadrature && data == "traction") {
     i.tractions = values;
     i.has_tractions = true;
@@ -325,7 +320,7 @@ void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen:
 
 void FemAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
   bool quadrature = false;
-  const Interface& i = find_interface(mesh, &quadrature);
+  const Interface& i = interfaces_[find_interface(mesh, &quadrature)];
   if (quadrature || data != "displacement")
     throw Error("fem '" + name_ + "' writes only 'displacement' on mesh '" + i.name + "'");
   values = solver_->displacements(i.nodes);

@@ -52,7 +52,8 @@ class FemAdapter : public Solver {
     bool has_forces = false;
     bool has_tractions = false;
   };
-  const Interface& find_interface(std::string_view mesh, bool* quadrature) const;
+  /// Index into interfaces_ of the coupling mesh `mesh` (nodes or quadrature); throws if unknown.
+  std::size_t find_interface(std::string_view mesh, bool* quadrature) const;
   void apply_nodal_forces();
 
   std::string name_;
