@@ -5,7 +5,7 @@
 // LIGGGHTS: measured in the same invocation when `liggghts` is on PATH, else the recorded figures.
 //
 // usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] [--quick]
-//                        [--vtk DIR]
+//                        [--vtk DIR] [--no-peer]
 // Physics as the decks dem/liggghts/model.in + bench.in: E = 200 MPa, nu = 0.23, e = 0.5 with
 // LIGGGHTS-style damping, mu = 0.3, Mindlin tangential history, walls x = 0, W, y = 0, W, z = 0
 // of the same material, g = 9.81 m/s^2, dt = 1.9e-6 s, skin 0.5 mm.
@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
   std::string data_dir = dem_dir + "/data";
   std::string which = "all", vtk_dir;
   std::vector<int> threads = {1, 2};
-  bool quick = false;
+  bool quick = false, no_peer = false;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     auto next = [&]() -> std::string {
@@ -124,25 +124,30 @@ int main(int argc, char** argv) {
       while (std::getline(is, t, ',')) threads.push_back(std::stoi(t));
     } else if (arg == "--quick") {
       quick = true;
+    } else if (arg == "--no-peer") {
+      no_peer = true;
     } else if (arg == "--vtk") {
       vtk_dir = next();
     } else {
       std::cerr << "usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] "
-                   "[--quick] [--vtk DIR]\n";
+                   "[--quick] [--vtk DIR] [--no-peer]\n"
+                   "  --no-peer: do not run LIGGGHTS; ratios use the recorded figures\n";
       return arg == "--help" || arg == "-h" ? 0 : 2;
     }
   }
   const std::vector<Case> cases = {{"small", 0.02, 20000, 4.14, 5.58e6, 1.09e7},
                                    {"large", 0.06, 5000, 4.62, 4.79e6, 9.62e6}};
-  const bool liggghts = on_path("liggghts");
+  const bool liggghts = !no_peer && on_path("liggghts");
   const long warmup = quick ? 100 : 500;
   std::printf("# partita::dem peer benchmark%s; LIGGGHTS %s\n", quick ? " (quick mode)" : "",
-              liggghts ? "on PATH: measured in this run" : "not on PATH: recorded figures");
+              liggghts  ? "on PATH: measured in this run"
+              : no_peer ? "not run (--no-peer): recorded figures"
+                        : "not on PATH: recorded figures");
   std::printf("# machine shared with other jobs: timings are noisy\n");
   std::printf(
       "# psteps/s = N x steps / wall seconds of the timed loop; cpu_s = process CPU time of\n"
       "# the loop (with 1 thread, N x steps / cpu_s estimates an unloaded machine)\n");
-  std::printf("%-6s %3s %8s %7s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N", "steps",
+  std::printf("%-6s %3s %8s %7s %6s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N", "steps", "builds",
               "loop_s", "cpu_s", "psteps/s", "cn/atom", "peer_cn", "KE_J", "KEtrans_J", "vs_LIGG");
   try {
     for (const Case& c : cases) {
@@ -156,7 +161,9 @@ int main(int argc, char** argv) {
         sys.run(warmup, dt);
         const auto t0 = std::chrono::steady_clock::now();
         const std::clock_t c0 = std::clock();
+        const long builds0 = sys.neighbor_list().build_count();
         sys.run(steps, dt);
+        const long builds = sys.neighbor_list().build_count() - builds0;
         const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -172,8 +179,8 @@ int main(int argc, char** argv) {
               run_liggghts(dem_dir, c, static_cast<long>(data.size()), nt, steps);
           if (measured > 0.0) peer = measured, peer_kind = "meas";
         }
-        std::printf("%-6s %3d %8zu %7ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx %s%s\n",
-                    c.name.c_str(), nt, sys.particle_count(), steps, seconds, cpu, rate, cn,
+        std::printf("%-6s %3d %8zu %7ld %6ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx %s%s\n",
+                    c.name.c_str(), nt, sys.particle_count(), steps, builds, seconds, cpu, rate, cn,
                     c.peer_contacts, sys.kinetic_energy(), ke_trans, rate / peer, peer_kind,
                     std::abs(cn / c.peer_contacts - 1.0) > 0.02 ? "  CONTACTS DIFFER >2%" : "");
         std::fflush(stdout);

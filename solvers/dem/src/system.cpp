@@ -414,7 +414,7 @@ void System::compute_pair_forces(double dt, bool update_history) {
   // T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
   // i starts its sum here, F_i = m_i g + sum over its pairs in order; j's share (-F, T_j) goes to
   // the pair's buffer for gather_forces().
-#pragma omp for schedule(dynamic, 128)
+#pragma omp for schedule(static)
   for (int i = 0; i < n; ++i) {
     const PackedParticle& qi = packed_[i];
     const Eigen::Vector3d xi = qi.x;
