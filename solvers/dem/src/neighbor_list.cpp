@@ -21,11 +21,8 @@ void NeighborList::clear() {
   offsets_.assign(1, 0);
   neighbors_.clear();
   shear_.clear();
-  pair_force_.clear();
   touching_.clear();
   plane_mask_.clear();
-  reverse_offsets_.assign(1, 0);
-  reverse_pairs_.clear();
   mesh_offsets_.assign(1, 0);
   mesh_candidates_.clear();
 }
@@ -148,19 +145,8 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   offsets_.swap(new_offsets_);
   neighbors_.swap(new_neighbors_);
   shear_.swap(new_shear_);
-  pair_force_.resize(neighbors_.size());
   touching_.assign(neighbors_.size(), 1);  // the next evaluation settles forces and histories
 
-  // Reverse index: for each j the slots (i, j), in slot order.
-  reverse_offsets_.assign(n + 1, 0);
-  for (int j : neighbors_) ++reverse_offsets_[j + 1];
-  for (int i = 0; i < n; ++i) reverse_offsets_[i + 1] += reverse_offsets_[i];
-  reverse_pairs_.resize(neighbors_.size());
-  counts_.assign(n, 0);
-  for (int s = 0; s < static_cast<int>(neighbors_.size()); ++s) {
-    const int j = neighbors_[s];
-    reverse_pairs_[reverse_offsets_[j] + counts_[j]++] = s;
-  }
   position_at_build_ = p.position;
   // Planes within R + skin of each particle.
   plane_at_build_.resize(planes.size());

@@ -1,6 +1,7 @@
 #include "partita/dem/system.hpp"
 
 #include "partita/dem/error.hpp"
+#include "partita/dem/parallel.hpp"
 #include "partita/dem/vtk_writer.hpp"
 
 #include <algorithm>
@@ -14,6 +15,7 @@ namespace partita::dem {
 namespace {
 
 constexpr int block_size = 256;  // particles per block of the deterministic wall-force sums
+constexpr int parallel_min_particles = 1024;  // fewer: one thread (a fork costs more)
 
 std::string vec_str(const Eigen::Vector3d& v) {
   std::ostringstream s;
@@ -303,7 +305,7 @@ void System::prepare() {
   }
   neighbors_.set_skin(skin_);
   resize_histories();
-  neighbors_.build(particles_, planes_, meshes_);
+  rebuild_lists();
   prepared_ = true;
 }
 
@@ -332,7 +334,7 @@ void System::step(double dt) {
       m.velocity_[v] = (m.position_[v] - m.position_last_step_[v]) / dt;
   }
   Particles& p = particles_;
-  const long n = static_cast<long>(p.size());
+  const int n = static_cast<int>(p.size());
   const double half = 0.5 * dt;
   const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
   const bool have_build = x_build.size() == p.size();
@@ -340,32 +342,34 @@ void System::step(double dt) {
   bool rebuild = !have_build;
   packed_.resize(n);
   for (PlaneWall& w : planes_) w.point += dt * w.velocity;
-    // One parallel region for the whole step unless the lists need a rebuild: velocity Verlet,
-    // first half (v += dt/2 F/m, x += dt v, omega += dt/2 T/I and the packed copy the pair loop
-    // reads), then the forces at t + dt and the second half (v += dt/2 F/m, omega += dt/2 T/I, in
-    // the gather). With a rebuild the region ends after the first half and the (parallel) build
-    // and force evaluation follow.
-#pragma omp parallel if (n >= 1024)
+  const int parts = set_partition();
+  prepare_cross_pairs();  // for the current lists (a rebuild below prepares its own)
+  // One parallel region for the whole step unless the lists need a rebuild: velocity Verlet,
+  // first half (v += dt/2 F/m, x += dt v, omega += dt/2 T/I, the packed copy the pair loop reads,
+  // F = m g, T = 0), then the forces at t + dt and the second half (v += dt/2 F/m,
+  // omega += dt/2 T/I) particle by particle as each total is complete. With a rebuild the region
+  // ends after the first half and the (parallel) build and force evaluation follow. Every loop
+  // runs over the same parts (thread t: part t), so a particle's data stays in one core's cache.
+#pragma omp parallel if (parts > 1) num_threads(parts)
   {
-#pragma omp for schedule(static) reduction(max : moved2)
-    for (long i = 0; i < n; ++i) {
-      p.velocity[i] += (half / p.mass[i]) * p.force[i];
-      p.position[i] += dt * p.velocity[i];
-      p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
-      if (have_build) moved2 = std::max(moved2, (p.position[i] - x_build[i]).squaredNorm());
-      pack(i);
+#pragma omp for schedule(static, 1) reduction(max : moved2)
+    for (int part = 0; part < parts; ++part) {
+      for (int i = partition_[part]; i < partition_[part + 1]; ++i) {
+        p.velocity[i] += (half / p.mass[i]) * p.force[i];
+        p.position[i] += dt * p.velocity[i];
+        p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
+        if (have_build) moved2 = std::max(moved2, (p.position[i] - x_build[i]).squaredNorm());
+        pack(i);
+      }
     }
     // moved2 is complete after the loop's barrier; every thread reaches the same decision
     const bool rebuild_here = !have_build || neighbors_.needs_rebuild(moved2, planes_, meshes_);
-    if (!rebuild_here) {
-      compute_pair_forces(dt, true);
-      gather_forces(dt, true, half);
-    }
+    if (!rebuild_here) evaluate_forces(dt, true, half);
 #pragma omp master
     rebuild = rebuild_here;
   }
   if (rebuild) {
-    neighbors_.build(p, planes_, meshes_);
+    rebuild_lists();
     compute_forces(dt, true, half, true);
   } else {
     reduce_wall_and_mesh_forces();
@@ -382,165 +386,234 @@ void System::run(long steps, double dt) {
 // ---- forces -----------------------------------------------------------------------------------
 
 // The neighbour data of the pair loop packed together: 96 bytes per particle, so a neighbour
-// costs 2 cache lines instead of one per array.
-void System::pack(long i) {
-  const Particles& p = particles_;
+// costs 2 cache lines instead of one per array. Also starts the force sums: F = m g, T = 0.
+void System::pack(int i) {
+  Particles& p = particles_;
   PackedParticle& q = packed_[i];
   q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
   q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
+  p.force[i] = q.m * gravity_;
+  p.torque[i].setZero();
+}
+
+void System::rebuild_lists() {
+  neighbors_.build(particles_, planes_, meshes_);
+  cross_valid_ = false;
+}
+
+int System::set_partition() {
+  const int n = static_cast<int>(particles_.size());
+  const int blocks = (n + block_size - 1) / block_size;
+  const int parts = n >= parallel_min_particles ? std::max(1, std::min(max_threads(), blocks)) : 1;
+  if (static_cast<int>(partition_.size()) == parts + 1 && partition_.back() == n) return parts;
+  partition_.resize(parts + 1);
+  for (int t = 0; t <= parts; ++t)
+    partition_[t] = std::min(n, static_cast<int>(static_cast<long>(blocks) * t / parts) * block_size);
+  cross_valid_ = false;
+  return parts;
+}
+
+int System::part_of(int i) const {
+  return static_cast<int>(std::upper_bound(partition_.begin(), partition_.end(), i) -
+                          partition_.begin()) - 1;
+}
+
+void System::prepare_cross_pairs() {
+  if (cross_valid_) return;
+  const NeighborList& nl = neighbors_;
+  const int parts = static_cast<int>(partition_.size()) - 1;
+  cross_pairs_.clear();
+  cross_out_begin_.assign(parts + 1, 0);
+  for (int t = 0; t < parts; ++t) {
+    const int hi = partition_[t + 1];
+    for (int i = partition_[t]; i < hi; ++i) {
+      // rows are sorted: the pairs with j beyond the part come last
+      int s = nl.offsets_[i + 1];
+      while (s > nl.offsets_[i] && nl.neighbors_[s - 1] >= hi) --s;
+      for (; s < nl.offsets_[i + 1]; ++s) cross_pairs_.push_back({i, nl.neighbors_[s], s});
+    }
+    cross_out_begin_[t + 1] = static_cast<int>(cross_pairs_.size());
+  }
+  cross_force_.resize(cross_pairs_.size());
+  // incoming: for each part, the cross pairs whose j it owns, in the order of cross_pairs_
+  // (ascending i, then j)
+  cross_in_begin_.assign(parts + 1, 0);
+  for (const CrossPair& c : cross_pairs_) ++cross_in_begin_[part_of(c.j) + 1];
+  for (int t = 0; t < parts; ++t) cross_in_begin_[t + 1] += cross_in_begin_[t];
+  cross_in_.resize(cross_pairs_.size());
+  counts_.assign(parts, 0);
+  for (int k = 0; k < static_cast<int>(cross_pairs_.size()); ++k) {
+    const int t = part_of(cross_pairs_[k].j);
+    cross_in_[cross_in_begin_[t] + counts_[t]++] = k;
+  }
+  cross_valid_ = true;
 }
 
 void System::compute_forces(double dt, bool update_history, double kick, bool packed) {
   const int n = static_cast<int>(particles_.size());
-  if (!packed) {
-    packed_.resize(n);
-    for (int i = 0; i < n; ++i) pack(i);
-  }
-  // One parallel region: the pair loop, a barrier, the per-particle gather (+ half kick).
-#pragma omp parallel if (n >= 1024)
+  packed_.resize(n);
+  const int parts = set_partition();
+  prepare_cross_pairs();
+#pragma omp parallel if (parts > 1) num_threads(parts)
   {
-    compute_pair_forces(dt, update_history);
-    gather_forces(dt, update_history, kick);
+    if (!packed) {
+#pragma omp for schedule(static, 1)
+      for (int part = 0; part < parts; ++part)
+        for (int i = partition_[part]; i < partition_[part + 1]; ++i) pack(i);
+    }
+    evaluate_forces(dt, update_history, kick);
   }
   reduce_wall_and_mesh_forces();
 }
 
-void System::compute_pair_forces(double dt, bool update_history) {
-  Particles& p = particles_;
+// Hertz-Mindlin force of the pair in slot s (i < j): F on i, the torques on i and j. Returns
+// false (and settles the history) when the spheres do not overlap. Torques T_i = -cr_i n x F_t,
+// T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
+// T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
+inline bool System::pair_force(const PackedParticle& qi, int j, int s, double dt,
+                               bool update_history, Eigen::Vector3d& fij, Eigen::Vector3d& ti,
+                               Eigen::Vector3d& tj) {
   NeighborList& nl = neighbors_;
-  const int n = static_cast<int>(p.size());
-  // Each pair (i, j > i) once, Hertz-Mindlin force F on i. Torques T_i = -cr_i n x F_t,
-  // T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
-  // T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
-  // i starts its sum here, F_i = m_i g + sum over its pairs in order; j's share (-F, T_j) goes to
-  // the pair's buffer for gather_forces().
-#pragma omp for schedule(static)
-  for (int i = 0; i < n; ++i) {
-    const PackedParticle& qi = packed_[i];
-    const Eigen::Vector3d xi = qi.x;
-    const Eigen::Vector3d vi = qi.v;
-    const Eigen::Vector3d wi = qi.w;
-    const double ri = qi.r;
-    const double mi = qi.m;
-    const int mat_i = qi.material;
-    Eigen::Vector3d f = mi * gravity_;
-    Eigen::Vector3d t = Eigen::Vector3d::Zero();
-    for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
-      const PackedParticle& qj = packed_[nl.neighbors_[s]];
-      const Eigen::Vector3d d = xi - qj.x;
-      const double rj = qj.r;
-      const double rsum = ri + rj;
-      const double r2 = d.squaredNorm();
-      if (r2 >= rsum * rsum) {
-        if (nl.touching_[s]) {
-          nl.touching_[s] = 0;
-          nl.shear_[s].setZero();
-        }
-        continue;
-      }
-      nl.touching_[s] = 1;
-      PairForce& pf = nl.pair_force_[s];
-      const double r = std::sqrt(r2);
-      const Eigen::Vector3d nrm =
-          r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
-      const double delta = rsum - r;
-      const double mj = qj.m;
-      const PairParameters& pp = model_.pair(mat_i, qj.material);
-      const double r_eff = ri * rj / rsum;
-      const double m_eff = mi * mj / (mi + mj);
-      const double cri = ri - 0.5 * delta, crj = rj - 0.5 * delta;
-      const Eigen::Vector3d wj = qj.w;
-      const Eigen::Vector3d w_arm = cri * wi + crj * wj;
-      Eigen::Vector3d fij, ft;
-      const double fn = hertz_mindlin(pp, delta, r_eff, m_eff, nrm, vi - qj.v, w_arm, nl.shear_[s],
-                                      dt, update_history, fij, ft);
-      const Eigen::Vector3d c = nrm.cross(ft);
-      Eigen::Vector3d ti = -cri * c;
-      pf.torque_j = -crj * c;
-      if (pp.rolling_friction > 0.0) {
-        const Eigen::Vector3d w_rel = wi - wj;
-        const double wn = w_rel.norm();
-        if (wn > 0.0) {
-          const Eigen::Vector3d tr = (-pp.rolling_friction * std::abs(fn) * r_eff / wn) * w_rel;
-          ti += tr;
-          pf.torque_j -= tr;
-        }
-      }
-      pf.force_j = -fij;
-      f += fij;
-      t += ti;
+  const PackedParticle& qj = packed_[j];
+  const Eigen::Vector3d d = qi.x - qj.x;
+  const double ri = qi.r, rj = qj.r;
+  const double rsum = ri + rj;
+  const double r2 = d.squaredNorm();
+  if (r2 >= rsum * rsum) {
+    if (nl.touching_[s]) {
+      nl.touching_[s] = 0;
+      nl.shear_[s].setZero();
     }
-    p.force[i] = f;
-    p.torque[i] = t;
+    return false;
   }
+  nl.touching_[s] = 1;
+  const double r = std::sqrt(r2);
+  const Eigen::Vector3d nrm = r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
+  const double delta = rsum - r;
+  const double mi = qi.m, mj = qj.m;
+  const PairParameters& pp = model_.pair(qi.material, qj.material);
+  const double r_eff = ri * rj / rsum;
+  const double m_eff = mi * mj / (mi + mj);
+  const double cri = ri - 0.5 * delta, crj = rj - 0.5 * delta;
+  const Eigen::Vector3d w_arm = cri * qi.w + crj * qj.w;
+  Eigen::Vector3d ft;
+  const double fn = hertz_mindlin(pp, delta, r_eff, m_eff, nrm, qi.v - qj.v, w_arm, nl.shear_[s],
+                                  dt, update_history, fij, ft);
+  const Eigen::Vector3d c = nrm.cross(ft);
+  ti = -cri * c;
+  tj = -crj * c;
+  if (pp.rolling_friction > 0.0) {
+    const Eigen::Vector3d w_rel = qi.w - qj.w;
+    const double wn = w_rel.norm();
+    if (wn > 0.0) {
+      const Eigen::Vector3d tr = (-pp.rolling_friction * std::abs(fn) * r_eff / wn) * w_rel;
+      ti += tr;
+      tj -= tr;
+    }
+  }
+  return true;
 }
 
-void System::gather_forces(double dt, bool update_history, double kick) {
+// Called inside a parallel region. Each particle's force is a sum in a fixed order, whatever the
+// number of threads: F_i = m_i g (pack()) + the pairs (k, i), k < i, in ascending k + the pairs
+// (i, j), j > i, in ascending j + planes + meshes. Rows are processed in ascending i, so the pairs
+// (k, i) have all been added when row i starts and i's total is complete at the end of its row.
+// Part t owns the particles [partition_[t], partition_[t+1]) and adds pair forces to j directly
+// when j is its own; pairs reaching into a later part (cross pairs) are evaluated first, each once,
+// into cross_force_, then added by both owners in the same place of their sums.
+void System::evaluate_forces(double dt, bool update_history, double kick) {
   Particles& p = particles_;
   const NeighborList& nl = neighbors_;
-  const int n = static_cast<int>(p.size());
+  const int parts = static_cast<int>(partition_.size()) - 1;
   const int np = static_cast<int>(planes_.size());
-  const int blocks = (n + block_size - 1) / block_size;
   const bool have_meshes = !meshes_.empty();
-  // Per particle, continuing the sum of compute_pair_forces() in a fixed order:
-  // F_i += sum over pairs (j, i) of their share + planes + meshes.
-  // Plane forces are summed per block of particles, then over blocks (fixed order).
+  if (parts > 1) {  // the cross pairs, shared evenly among the threads
+    const int n_cross = static_cast<int>(cross_pairs_.size());
 #pragma omp for schedule(static)
-  for (int b = 0; b < blocks; ++b) {
-    Eigen::Vector3d* block_wall = wall_block_force_.data() + static_cast<std::size_t>(b) * np;
-    for (int k = 0; k < np; ++k) block_wall[k].setZero();
-    const int i_end = std::min(n, (b + 1) * block_size);
-    for (int i = b * block_size; i < i_end; ++i) {
-      Eigen::Vector3d f = p.force[i];
-      Eigen::Vector3d t = p.torque[i];
-      for (int k = nl.reverse_offsets_[i]; k < nl.reverse_offsets_[i + 1]; ++k) {
-        const int s = nl.reverse_pairs_[k];
-        if (!nl.touching_[s]) continue;
-        f += nl.pair_force_[s].force_j;
-        t += nl.pair_force_[s].torque_j;
-      }
-      // Planes near i: overlap delta = R - (x - x_w).n_w, R* = R, m* = m.
-      const double ri = p.radius[i];
-      // (a plain loop, no lambda: f and t stay in registers)
-      std::uint64_t mask = np <= 64 ? nl.plane_mask_[i] : 0;
-      for (int k = 0; k < np; ++k) {
-        if (np <= 64) {  // jump to the next plane near i
-          if (mask == 0) break;
-          k = std::countr_zero(mask);
-          mask &= mask - 1;
+    for (int k = 0; k < n_cross; ++k) {
+      const CrossPair& c = cross_pairs_[k];
+      CrossForce& cf = cross_force_[k];
+      cf.touching = pair_force(packed_[c.i], c.j, c.slot, dt, update_history, cf.force_i,
+                               cf.torque_i, cf.torque_j);
+    }
+  }
+#pragma omp for schedule(static, 1)
+  for (int part = 0; part < parts; ++part) {
+    // pairs (k, i) from earlier parts, ascending k
+    for (int k = cross_in_begin_[part]; k < cross_in_begin_[part + 1]; ++k) {
+      const int c = cross_in_[k];
+      const CrossForce& cf = cross_force_[c];
+      if (!cf.touching) continue;
+      const int j = cross_pairs_[c].j;
+      p.force[j] -= cf.force_i;
+      p.torque[j] += cf.torque_j;
+    }
+    int cross = cross_out_begin_[part];
+    const int lo = partition_[part], hi = partition_[part + 1];
+    for (int b = lo / block_size; b * block_size < hi; ++b) {
+      // plane forces summed per block of particles, then over blocks (fixed order)
+      Eigen::Vector3d* block_wall = wall_block_force_.data() + static_cast<std::size_t>(b) * np;
+      for (int k = 0; k < np; ++k) block_wall[k].setZero();
+      const int i_end = std::min(hi, (b + 1) * block_size);
+      for (int i = b * block_size; i < i_end; ++i) {
+        const PackedParticle& qi = packed_[i];
+        Eigen::Vector3d f = p.force[i];
+        Eigen::Vector3d t = p.torque[i];
+        for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
+          const int j = nl.neighbors_[s];
+          if (j >= hi) {  // a cross pair, already evaluated
+            const CrossForce& cf = cross_force_[cross++];
+            if (cf.touching) f += cf.force_i, t += cf.torque_i;
+            continue;
+          }
+          Eigen::Vector3d fij, ti, tj;
+          if (!pair_force(qi, j, s, dt, update_history, fij, ti, tj)) continue;
+          f += fij;
+          t += ti;
+          p.force[j] -= fij;
+          p.torque[j] += tj;
         }
-        const PlaneWall& w = planes_[k];
-        Eigen::Vector3d& shear = plane_shear_[static_cast<std::size_t>(i) * np + k];
-        const double delta = ri - (p.position[i] - w.point).dot(w.normal);
-        if (delta <= 0.0) {
-          shear.setZero();
-          continue;
+        // Planes near i: overlap delta = R - (x - x_w).n_w, R* = R, m* = m.
+        const double ri = qi.r;
+        std::uint64_t mask = np <= 64 ? nl.plane_mask_[i] : 0;
+        for (int k = 0; k < np; ++k) {
+          if (np <= 64) {  // jump to the next plane near i
+            if (mask == 0) break;
+            k = std::countr_zero(mask);
+            mask &= mask - 1;
+          }
+          const PlaneWall& w = planes_[k];
+          Eigen::Vector3d& shear = plane_shear_[static_cast<std::size_t>(i) * np + k];
+          const double delta = ri - (qi.x - w.point).dot(w.normal);
+          if (delta <= 0.0) {
+            shear.setZero();
+            continue;
+          }
+          const PairParameters& pp = model_.pair(qi.material, w.material);
+          const double cr = ri - 0.5 * delta;
+          Eigen::Vector3d fw, ft;
+          const double fn = hertz_mindlin(pp, delta, ri, qi.m, w.normal, qi.v - w.velocity,
+                                          cr * qi.w, shear, dt, update_history, fw, ft);
+          f += fw;
+          t -= cr * w.normal.cross(ft);
+          if (pp.rolling_friction > 0.0) {
+            const double wn = qi.w.norm();
+            if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * ri / wn) * qi.w;
+          }
+          block_wall[k] -= fw;
         }
-        const PairParameters& pp = model_.pair(p.material[i], w.material);
-        const double cr = ri - 0.5 * delta;
-        Eigen::Vector3d fw, ft;
-        const double fn =
-            hertz_mindlin(pp, delta, ri, p.mass[i], w.normal, p.velocity[i] - w.velocity,
-                          cr * p.angular_velocity[i], shear, dt, update_history, fw, ft);
-        f += fw;
-        t -= cr * w.normal.cross(ft);
-        if (pp.rolling_friction > 0.0) {
-          const double wn = p.angular_velocity[i].norm();
-          if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * ri / wn) * p.angular_velocity[i];
+        if (have_meshes) {  // own accumulators: f and t keep their registers
+          Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
+          mesh_contacts(i, dt, update_history, fm, tm);
+          f += fm;
+          t += tm;
         }
-        block_wall[k] -= fw;
-      }
-      if (have_meshes) {  // own accumulators: f and t keep their registers
-        Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
-        mesh_contacts(i, dt, update_history, fm, tm);
-        f += fm;
-        t += tm;
-      }
-      p.force[i] = f;
-      p.torque[i] = t;
-      if (kick > 0.0) {
-        p.velocity[i] += (kick / p.mass[i]) * f;
-        p.angular_velocity[i] += (kick / p.inertia[i]) * t;
+        p.force[i] = f;
+        p.torque[i] = t;
+        if (kick > 0.0) {
+          p.velocity[i] += (kick / qi.m) * f;
+          p.angular_velocity[i] += (kick / p.inertia[i]) * t;
+        }
       }
     }
   }
@@ -746,6 +819,7 @@ void System::restore_state(const SystemState& s) {
   time_ = s.time_;
   steps_ = s.steps_;
   forces_valid_ = s.forces_valid_;
+  cross_valid_ = false;
   if (!s.prepared_) prepared_ = false;
 }
 

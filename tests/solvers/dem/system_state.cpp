@@ -93,11 +93,14 @@ TEST_CASE("dem: results do not depend on the number of threads", "[dem][threads]
   const int before = max_threads();
   const System one = run(1);
   const System two = run(2);
+  const System three = run(3);  // a middle part with pairs crossing into and out of it
   set_num_threads(before);
   INFO(one.particle_count() << " particles");
   CHECK(one.particle_count() > 1024);
   CHECK(same_state(one, two));
+  CHECK(same_state(one, three));
   CHECK(one.kinetic_energy() == two.kinetic_energy());
+  CHECK(one.kinetic_energy() == three.kinetic_energy());
 }
 
 TEST_CASE("dem: user errors throw partita::dem::Error with the value", "[dem][errors]") {

@@ -3,9 +3,7 @@
 //
 // Particle pairs: a half list in compressed rows (pairs (i, j) with j > i, j ascending), cut-off
 // R_i + R_j + skin, so that it stays valid until some particle has moved more than skin/2 since
-// the build. Each pair slot carries its tangential history (moved to the new slot at a rebuild)
-// and a force buffer; a reverse index (for each j, the slots (i, j)) lets every particle gather
-// its forces in a fixed order, which makes the results independent of the thread count.
+// the build. Each pair slot carries its tangential history (moved to the new slot at a rebuild).
 // Particle-triangle candidates: triangles are binned into the same cells (box grown by
 // R_max + skin), each particle keeps the triangles within R + skin; valid until a particle or a
 // mesh vertex has moved more than skin/2.
@@ -25,12 +23,6 @@
 #include <Eigen/Core>
 
 namespace partita::dem {
-
-/// Force of one pair on j and torque on j, kept for j's gather (i adds its share at once).
-struct PairForce {
-  Eigen::Vector3d force_j = Eigen::Vector3d::Zero();
-  Eigen::Vector3d torque_j = Eigen::Vector3d::Zero();
-};
 
 struct MeshCandidate {
   int mesh = 0;
@@ -84,9 +76,7 @@ class NeighborList {
   // half list (compressed rows) with per-pair history and force buffers
   std::vector<int> offsets_, neighbors_;
   std::vector<Eigen::Vector3d> shear_;
-  std::vector<PairForce> pair_force_;
-  std::vector<char> touching_;  // overlap > 0 in the last force evaluation (pair_force_ valid)
-  std::vector<int> reverse_offsets_, reverse_pairs_;
+  std::vector<char> touching_;  // overlap > 0 in the last force evaluation
   std::vector<Eigen::Vector3d> position_at_build_;
   std::vector<Eigen::Vector3d> plane_at_build_;
   std::vector<std::uint64_t> plane_mask_;

@@ -144,10 +144,18 @@ class System {
   // forces at the current positions; kick > 0: then v += kick F/m, omega += kick T/I
   // packed: packed_ is up to date (else it is filled first)
   void compute_forces(double dt, bool update_history, double kick, bool packed);
-  void pack(long i);
+  void pack(int i);
+  void rebuild_lists();
+  // Splits the particles into parts of whole blocks, one per thread; returns the count.
+  int set_partition();
+  int part_of(int i) const;
+  // Lists the pairs whose j lies in a later part than i (after a rebuild or a new partition).
+  void prepare_cross_pairs();
+  struct PackedParticle;
+  bool pair_force(const PackedParticle& qi, int j, int slot, double dt, bool update_history,
+                  Eigen::Vector3d& force_i, Eigen::Vector3d& torque_i, Eigen::Vector3d& torque_j);
   // called inside a parallel region (orphaned omp for)
-  void compute_pair_forces(double dt, bool update_history);
-  void gather_forces(double dt, bool update_history, double kick);
+  void evaluate_forces(double dt, bool update_history, double kick);
   void reduce_wall_and_mesh_forces();
   void mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3d& force,
                      Eigen::Vector3d& torque);
@@ -182,6 +190,22 @@ class System {
     int material;
   };
   std::vector<PackedParticle> packed_;
+  // threads: part t owns particles [partition_[t], partition_[t+1])
+  std::vector<int> partition_;
+  struct CrossPair {  // a listed pair (i, j) with j in a later part than i
+    int i, j, slot;
+  };
+  struct CrossForce {  // its force on i and torques, evaluated before the parts' row loops
+    Eigen::Vector3d force_i, torque_i, torque_j;
+    bool touching = false;
+  };
+  std::vector<CrossPair> cross_pairs_;  // by part of i, then ascending i, j
+  std::vector<int> cross_out_begin_;    // parts + 1
+  std::vector<int> cross_in_;           // indices into cross_pairs_, by part of j
+  std::vector<int> cross_in_begin_;     // parts + 1
+  std::vector<CrossForce> cross_force_;
+  std::vector<int> counts_;
+  bool cross_valid_ = false;
   std::vector<Eigen::Vector3d> wall_block_force_;  // blocks x planes
   std::vector<Eigen::Vector3d> wall_force_;        // per wall
 };
