@@ -470,7 +470,7 @@ void System::compute_forces(double dt, bool update_history, double kick, bool pa
 // false (and settles the history) when the spheres do not overlap. Torques T_i = -cr_i n x F_t,
 // T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
 // T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
-inline bool System::pair_force(const PackedParticle& qi, int j, int s, double dt,
+PARTITA_DEM_INLINE bool System::pair_force(const PackedParticle& qi, int j, int s, double dt,
                                bool update_history, Eigen::Vector3d& fij, Eigen::Vector3d& ti,
                                Eigen::Vector3d& tj) {
   NeighborList& nl = neighbors_;
