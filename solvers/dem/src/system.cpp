@@ -14,7 +14,7 @@ namespace partita::dem {
 
 namespace {
 
-constexpr int block_size = 256;  // particles per block of the deterministic wall-force sums
+constexpr int block_size = 64;  // particles per block of the deterministic wall-force sums
 constexpr int parallel_min_particles = 1024;  // fewer: one thread (a fork costs more)
 
 std::string vec_str(const Eigen::Vector3d& v) {
@@ -405,10 +405,28 @@ int System::set_partition() {
   const int n = static_cast<int>(particles_.size());
   const int blocks = (n + block_size - 1) / block_size;
   const int parts = n >= parallel_min_particles ? std::max(1, std::min(max_threads(), blocks)) : 1;
-  if (static_cast<int>(partition_.size()) == parts + 1 && partition_.back() == n) return parts;
-  partition_.resize(parts + 1);
-  for (int t = 0; t <= parts; ++t)
-    partition_[t] = std::min(n, static_cast<int>(static_cast<long>(blocks) * t / parts) * block_size);
+  if (cross_valid_ && static_cast<int>(partition_.size()) == parts + 1 && partition_.back() == n)
+    return parts;
+  // Whole blocks per part, balancing the work of the force pass: per particle a fixed cost worth
+  // about two listed pairs, plus its listed pairs (known since the last build).
+  const NeighborList& nl = neighbors_;
+  const bool have_lists = static_cast<int>(nl.offsets_.size()) == n + 1;
+  auto block_cost = [&](int b) {
+    const int lo = b * block_size, hi = std::min(n, lo + block_size);
+    return 2.0 * (hi - lo) + (have_lists ? nl.offsets_[hi] - nl.offsets_[lo] : 0);
+  };
+  double total = 0.0;
+  for (int b = 0; b < blocks; ++b) total += block_cost(b);
+  partition_.assign(parts + 1, n);
+  partition_[0] = 0;
+  double sum = 0.0;
+  int t = 1;
+  for (int b = 0; b + 1 < blocks && t < parts; ++b) {
+    sum += block_cost(b);
+    // part t starts after block b once the parts before it have their share, or when every
+    // later part needs one of the blocks left
+    if (sum >= total * t / parts || blocks - (b + 1) == parts - t) partition_[t++] = (b + 1) * block_size;
+  }
   cross_valid_ = false;
   return parts;
 }
