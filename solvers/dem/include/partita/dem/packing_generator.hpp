@@ -8,7 +8,9 @@
 // by Jacobi relaxation: every overlapping pair is pushed apart along its normal (each sphere by a
 // share inversely proportional to its volume) and spheres are kept inside the box, until the
 // largest overlap is below max_overlap * R_min. Porosities above random loose packing (~0.4) are
-// reachable; 0.5 takes a few hundred sweeps.
+// reachable; 0.5 takes a few hundred sweeps. The spheres come out in cell order (by z, then y,
+// then x, cells 2 R_max wide), so that neighbours have nearby indices (the solver's cache and
+// thread parts depend on it).
 
 #include <cstdint>
 #include <vector>
@@ -31,7 +33,7 @@ struct PackingSpec {
 };
 
 struct Packing {
-  Eigen::MatrixX3d positions;  ///< N x 3 centres
+  Eigen::MatrixX3d positions;  ///< N x 3 centres, in cell order
   Eigen::VectorXd radii;       ///< N
   double porosity = 0.0;       ///< realised, 1 - sum V / box volume
   double max_overlap = 0.0;    ///< realised largest overlap [m]
