@@ -123,12 +123,11 @@ PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, d
     force += f_tangential;
     return f_n;
   }
-  const double shear_norm = shear.norm();
-  const double ft_spring = k_t * shear_norm;
+  const double shear2 = shear.squaredNorm();
   const double ft_cap = p.friction * std::abs(f_n);
-  if (ft_spring > ft_cap) {
-    if (shear_norm > 0.0) {
-      const double ratio = ft_cap / ft_spring;
+  if (k_t * k_t * shear2 > ft_cap * ft_cap) {  // |F_spring| > cap, without a square root
+    if (shear2 > 0.0) {
+      const double ratio = ft_cap / (k_t * std::sqrt(shear2));
       f_tangential = (-k_t * ratio) * shear;
       if (update_history) shear *= ratio;
     } else {
