@@ -64,6 +64,7 @@ void System::set_skin(double skin) {
 std::size_t System::add_particle(const Eigen::Vector3d& x, double radius, int material,
                                  const Eigen::Vector3d& v, const Eigen::Vector3d& w,
                                  std::int64_t id) {
+  sync_particles();
   const std::size_t index = particles_.size();
   if (!(radius > 0.0) || !std::isfinite(radius)) {
     std::ostringstream msg;
@@ -92,6 +93,7 @@ std::size_t System::add_particle(const Eigen::Vector3d& x, double radius, int ma
   p.id.push_back(id < 0 ? static_cast<std::int64_t>(index) : id);
   prepared_ = false;
   forces_valid_ = false;
+  packed_valid_ = false;
   return index;
 }
 
@@ -117,9 +119,11 @@ void System::set_particle_velocity(std::size_t i, const Eigen::Vector3d& v,
     msg << "set_particle_velocity: no particle " << i << "; there are " << particles_.size();
     throw Error(msg.str());
   }
+  sync_particles();
   particles_.velocity[i] = v;
   particles_.angular_velocity[i] = w;
   forces_valid_ = false;
+  packed_valid_ = false;
 }
 
 int System::add_plane(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, int material,
@@ -324,6 +328,7 @@ void System::step(double dt) {
         << "rayleigh_time_step())";
     throw Error(msg.str());
   }
+  if (!packed_valid_) load_packed();
   if (!forces_valid_) {
     compute_forces(dt, false, 0.0, false);
     forces_valid_ = true;
@@ -334,20 +339,18 @@ void System::step(double dt) {
       m.velocity_[v] = (m.position_[v] - m.position_last_step_[v]) / dt;
   }
   Particles& p = particles_;
-  const int n = static_cast<int>(p.size());
   const double half = 0.5 * dt;
   const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
   const bool have_build = x_build.size() == p.size();
   double moved2 = 0.0;  // largest squared displacement since the last neighbour build
   bool rebuild = !have_build;
-  packed_.resize(n);
   for (PlaneWall& w : planes_) w.point += dt * w.velocity;
   const int parts = set_partition();
   prepare_cross_pairs();  // for the current lists (a rebuild below prepares its own)
   // One parallel region for the whole step unless the lists need a rebuild: velocity Verlet,
-  // first half (v += dt/2 F/m, x += dt v, omega += dt/2 T/I, the packed copy the pair loop reads,
-  // F = m g, T = 0), then the forces at t + dt and the second half (v += dt/2 F/m,
-  // omega += dt/2 T/I) particle by particle as each total is complete. With a rebuild the region
+  // first half (v += dt/2 F/m, x += dt v, omega += dt/2 T/I on packed_, F = m g, T = 0), then the
+  // forces at t + dt and the second half (v += dt/2 F/m, omega += dt/2 T/I) particle by particle
+  // as each total is complete. With a rebuild the region
   // ends after the first half and the (parallel) build and force evaluation follow. Every loop
   // runs over the same parts (thread t: part t), so a particle's data stays in one core's cache.
 #pragma omp parallel if (parts > 1) num_threads(parts)
@@ -355,11 +358,12 @@ void System::step(double dt) {
 #pragma omp for schedule(static, 1) reduction(max : moved2)
     for (int part = 0; part < parts; ++part) {
       for (int i = partition_[part]; i < partition_[part + 1]; ++i) {
-        p.velocity[i] += (half / p.mass[i]) * p.force[i];
-        p.position[i] += dt * p.velocity[i];
-        p.angular_velocity[i] += (half / p.inertia[i]) * p.torque[i];
-        if (have_build) moved2 = std::max(moved2, (p.position[i] - x_build[i]).squaredNorm());
-        pack(i);
+        PackedParticle& q = packed_[i];
+        q.v += (half / q.m) * p.force[i];
+        q.x += dt * q.v;
+        q.w += (half / p.inertia[i]) * p.torque[i];
+        if (have_build) moved2 = std::max(moved2, (q.x - x_build[i]).squaredNorm());
+        start_sums(i);
       }
     }
     // moved2 is complete after the loop's barrier; every thread reaches the same decision
@@ -374,6 +378,7 @@ void System::step(double dt) {
   } else {
     reduce_wall_and_mesh_forces();
   }
+  mirror_valid_ = false;
   for (TriangleMesh& m : meshes_) m.position_last_step_ = m.position_;
   time_ += dt;
   ++steps_;
@@ -385,18 +390,41 @@ void System::run(long steps, double dt) {
 
 // ---- forces -----------------------------------------------------------------------------------
 
-// The neighbour data of the pair loop packed together: 96 bytes per particle, so a neighbour
-// costs 2 cache lines instead of one per array. Also starts the force sums: F = m g, T = 0.
-void System::pack(int i) {
+// Positions, velocities and angular velocities live in packed_ while stepping (with what the pair
+// loop reads about a neighbour: 96 bytes per particle, 2 cache lines instead of one per array);
+// particles_ mirrors them for the caller, copied on demand.
+void System::load_packed() {
+  const Particles& p = particles_;
+  const int n = static_cast<int>(p.size());
+  packed_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    PackedParticle& q = packed_[i];
+    q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
+    q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
+  }
+  packed_valid_ = true;
+  mirror_valid_ = true;
+}
+
+void System::sync_particles() const {
+  if (mirror_valid_) return;
   Particles& p = particles_;
-  PackedParticle& q = packed_[i];
-  q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
-  q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
-  p.force[i] = q.m * gravity_;
-  p.torque[i].setZero();
+  for (std::size_t i = 0; i < packed_.size(); ++i) {
+    p.position[i] = packed_[i].x;
+    p.velocity[i] = packed_[i].v;
+    p.angular_velocity[i] = packed_[i].w;
+  }
+  mirror_valid_ = true;
+}
+
+// Starts the force sums of a step: F = m g, T = 0.
+void System::start_sums(int i) {
+  particles_.force[i] = packed_[i].m * gravity_;
+  particles_.torque[i].setZero();
 }
 
 void System::rebuild_lists() {
+  sync_particles();
   neighbors_.build(particles_, planes_, meshes_);
   cross_valid_ = false;
 }
@@ -467,17 +495,16 @@ void System::prepare_cross_pairs() {
   cross_valid_ = true;
 }
 
-void System::compute_forces(double dt, bool update_history, double kick, bool packed) {
-  const int n = static_cast<int>(particles_.size());
-  packed_.resize(n);
+void System::compute_forces(double dt, bool update_history, double kick, bool started) {
+  if (!packed_valid_) load_packed();
   const int parts = set_partition();
   prepare_cross_pairs();
 #pragma omp parallel if (parts > 1) num_threads(parts)
   {
-    if (!packed) {
+    if (!started) {
 #pragma omp for schedule(static, 1)
       for (int part = 0; part < parts; ++part)
-        for (int i = partition_[part]; i < partition_[part + 1]; ++i) pack(i);
+        for (int i = partition_[part]; i < partition_[part + 1]; ++i) start_sums(i);
     }
     evaluate_forces(dt, update_history, kick);
   }
@@ -533,7 +560,7 @@ PARTITA_DEM_INLINE bool System::pair_force(const PackedParticle& qi, int j, int 
 }
 
 // Called inside a parallel region. Each particle's force is a sum in a fixed order, whatever the
-// number of threads: F_i = m_i g (pack()) + the pairs (k, i), k < i, in ascending k + the pairs
+// number of threads: F_i = m_i g (start_sums()) + the pairs (k, i), k < i, in ascending k + the pairs
 // (i, j), j > i, in ascending j + planes + meshes. Rows are processed in ascending i, so the pairs
 // (k, i) have all been added when row i starts and i's total is complete at the end of its row.
 // Part t owns the particles [partition_[t], partition_[t+1]) and adds pair forces to j directly
@@ -574,7 +601,7 @@ void System::evaluate_forces(double dt, bool update_history, double kick) {
       for (int k = 0; k < np; ++k) block_wall[k].setZero();
       const int i_end = std::min(hi, (b + 1) * block_size);
       for (int i = b * block_size; i < i_end; ++i) {
-        const PackedParticle& qi = packed_[i];
+        PackedParticle& qi = packed_[i];
         Eigen::Vector3d f = p.force[i];
         Eigen::Vector3d t = p.torque[i];
         for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
@@ -628,9 +655,9 @@ void System::evaluate_forces(double dt, bool update_history, double kick) {
         }
         p.force[i] = f;
         p.torque[i] = t;
-        if (kick > 0.0) {
-          p.velocity[i] += (kick / qi.m) * f;
-          p.angular_velocity[i] += (kick / p.inertia[i]) * t;
+        if (kick > 0.0) {  // (no other row reads particle i any more in this pass)
+          qi.v += (kick / qi.m) * f;
+          qi.w += (kick / p.inertia[i]) * t;
         }
       }
     }
@@ -684,10 +711,10 @@ void System::mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3
   constexpr int max_candidates = 32;
   Candidate cand[max_candidates];
   int nc = 0;
-  const Particles& p = particles_;
+  const PackedParticle& q = packed_[i];
   const NeighborList& nl = neighbors_;
-  const Eigen::Vector3d& x = p.position[i];
-  const double r = p.radius[i];
+  const Eigen::Vector3d& x = q.x;
+  const double r = q.r;
   for (int k = nl.mesh_offsets_[i]; k < nl.mesh_offsets_[i + 1] && nc < max_candidates; ++k) {
     const MeshCandidate mc = nl.mesh_candidates_[k];
     const TriangleMesh& m = meshes_[mc.mesh];
@@ -765,15 +792,14 @@ void System::mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3
                                    k.cp.barycentric[2] * m.velocity_[tri[2]];
     const double delta = r - std::sqrt(k.dist2);
     const double cr = r - 0.5 * delta;
-    const PairParameters& pp = model_.pair(p.material[i], m.material());
+    const PairParameters& pp = model_.pair(q.material, m.material());
     Eigen::Vector3d fw, ft;
-    const double fn = hertz_mindlin(pp, delta, r, p.mass[i], k.normal, p.velocity[i] - v_wall,
-                                    cr * p.angular_velocity[i], shear, dt, update_history, fw, ft);
+    const double fn = hertz_mindlin(pp, delta, r, q.m, k.normal, q.v - v_wall, cr * q.w, shear, dt, update_history, fw, ft);
     f += fw;
     t -= cr * k.normal.cross(ft);
     if (pp.rolling_friction > 0.0) {
-      const double wn = p.angular_velocity[i].norm();
-      if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * r / wn) * p.angular_velocity[i];
+      const double wn = q.w.norm();
+      if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * r / wn) * q.w;
     }
     mesh_slot_key_[base + a] = key;
     mesh_slot_shear_[base + a] = shear;
@@ -792,6 +818,7 @@ void System::mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3
 // ---- state ------------------------------------------------------------------------------------
 
 SystemState System::save_state() const {
+  sync_particles();
   SystemState s;
   s.particles_ = particles_;
   s.planes_ = planes_;
@@ -825,6 +852,8 @@ void System::restore_state(const SystemState& s) {
     throw Error(msg.str());
   }
   particles_ = s.particles_;
+  mirror_valid_ = true;
+  packed_valid_ = false;
   planes_ = s.planes_;
   meshes_ = s.meshes_;
   neighbors_ = s.neighbors_;
@@ -844,6 +873,7 @@ void System::restore_state(const SystemState& s) {
 // ---- monitors ---------------------------------------------------------------------------------
 
 double System::kinetic_energy() const {
+  sync_particles();
   double e = 0.0;
   const Particles& p = particles_;
   for (std::size_t i = 0; i < p.size(); ++i)
@@ -853,6 +883,7 @@ double System::kinetic_energy() const {
 }
 
 double System::potential_energy() const {
+  sync_particles();
   double e = 0.0;
   for (std::size_t i = 0; i < particles_.size(); ++i)
     e -= particles_.mass[i] * gravity_.dot(particles_.position[i]);
@@ -860,6 +891,7 @@ double System::potential_energy() const {
 }
 
 double System::elastic_energy() const {
+  sync_particles();
   const_cast<ContactModel&>(model_).update();
   const Particles& p = particles_;
   const NeighborList& nl = neighbors_;
@@ -927,6 +959,7 @@ const Eigen::MatrixX3d& System::vertex_forces(int mesh) const {
 }
 
 std::size_t System::contact_count() const {
+  sync_particles();
   const Particles& p = particles_;
   const NeighborList& nl = neighbors_;
   std::size_t count = 0;
@@ -947,6 +980,7 @@ double System::mean_contacts_per_particle() const {
 // ---- output -----------------------------------------------------------------------------------
 
 void System::write_particles_vtp(const std::string& path) const {
+  sync_particles();
   const Particles& p = particles_;
   const std::size_t n = p.size();
   std::vector<VtkArray> data(5);

@@ -185,3 +185,30 @@ TEST_CASE("dem: VTK output is complete and written atomically", "[dem][io]") {
   CHECK(text2.str().find("CellData") != std::string::npos);
   CHECK_THROWS_AS(sys.write_particles_vtp("/nonexistent/dir/p.vtp"), Error);
 }
+
+TEST_CASE("dem: changes made between steps take effect and are seen at once", "[dem][state]") {
+  // The moving state lives in the solver's packed arrays while stepping; particles() must show
+  // it after every step, and set_particle_velocity()/add_particle() between steps must be used.
+  System sys;
+  const int m = sys.add_material({1.0e7, 0.3, 2500.0});
+  sys.add_interaction(m, m, {0.4, 0.5, 0.0});
+  sys.add_particle({0, 0, 0}, 1e-3, m, {0.5, 0, 0});
+  sys.add_particle({0.1, 0, 0}, 1e-3, m);
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  sys.run(10, dt);
+  // free flight: x = v t
+  CHECK(sys.particles().position[0].x() == Approx(0.5 * 10 * dt).epsilon(1e-12));
+  sys.set_particle_velocity(0, {0, 2.0, 0}, {0, 0, 3.0});
+  CHECK(sys.particles().velocity[0] == Eigen::Vector3d(0, 2.0, 0));
+  const Eigen::Vector3d x0 = sys.particles().position[0];
+  sys.step(dt);
+  CHECK((sys.particles().position[0] - (x0 + dt * Eigen::Vector3d(0, 2.0, 0))).norm() < 1e-15);
+  CHECK(sys.particles().angular_velocity[0].z() == 3.0);
+  const Eigen::Vector3d x1 = sys.particles().position[1];
+  sys.add_particle({0.2, 0, 0}, 1e-3, m, {-1.0, 0, 0});
+  CHECK(sys.particles().position[1] == x1);
+  CHECK(sys.particles().position[0].y() > 0.0);
+  sys.step(dt);
+  CHECK(sys.particles().position[2].x() == Approx(0.2 - dt).epsilon(1e-12));
+  CHECK(sys.kinetic_energy() > 0.5 * sys.particles().mass[2] * 1.0 * 0.999);
+}

@@ -109,7 +109,10 @@ class System {
   void restore_state(const SystemState& state);
 
   // ---- access and monitors ------------------------------------------------------------------
-  const Particles& particles() const { return particles_; }
+  const Particles& particles() const {
+    sync_particles();
+    return particles_;
+  }
   std::size_t particle_count() const { return particles_.size(); }
   const ContactModel& contact_model() const { return model_; }
   const NeighborList& neighbor_list() const { return neighbors_; }
@@ -143,8 +146,11 @@ class System {
   void resize_histories();
   // forces at the current positions; kick > 0: then v += kick F/m, omega += kick T/I
   // packed: packed_ is up to date (else it is filled first)
-  void compute_forces(double dt, bool update_history, double kick, bool packed);
-  void pack(int i);
+  // started: the sums were started (start_sums()) by the caller
+  void compute_forces(double dt, bool update_history, double kick, bool started);
+  void load_packed();
+  void sync_particles() const;
+  void start_sums(int i);
   void rebuild_lists();
   // Splits the particles into parts of whole blocks, one per thread; returns the count.
   int set_partition();
@@ -161,7 +167,11 @@ class System {
                      Eigen::Vector3d& torque);
 
   ContactModel model_;
-  Particles particles_;
+  // position, velocity and angular velocity: packed_ holds them while stepping; particles_ is
+  // brought up to date on demand (mirror_valid_), and packed_ reloaded after a caller's change
+  mutable Particles particles_;
+  mutable bool mirror_valid_ = true;
+  bool packed_valid_ = false;
   std::vector<PlaneWall> planes_;
   std::vector<TriangleMesh> meshes_;
   NeighborList neighbors_;
@@ -181,7 +191,7 @@ class System {
   std::vector<int> mesh_slot_count_;
   // per-contact results of the last force evaluation (for deterministic wall/mesh reductions)
   std::vector<MeshContactRecord> mesh_records_;  // N x max_mesh_contacts
-  struct PackedParticle {  // copy of what the pair loop reads about a neighbour
+  struct PackedParticle {  // the moving state and what the pair loop reads about a neighbour
     Eigen::Vector3d x;
     double r;
     Eigen::Vector3d v;
