@@ -147,8 +147,9 @@ int main(int argc, char** argv) {
   std::printf(
       "# psteps/s = N x steps / wall seconds of the timed loop; cpu_s = process CPU time of\n"
       "# the loop (with 1 thread, N x steps / cpu_s estimates an unloaded machine)\n");
-  std::printf("%-6s %3s %8s %7s %6s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N", "steps", "builds",
-              "loop_s", "cpu_s", "psteps/s", "cn/atom", "peer_cn", "KE_J", "KEtrans_J", "vs_LIGG");
+  std::printf("%-6s %3s %8s %7s %6s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N",
+              "steps", "builds", "loop_s", "cpu_s", "psteps/s", "cn/atom", "peer_cn", "KE_J",
+              "KEtrans_J", "vs_LIGG");
   try {
     for (const Case& c : cases) {
       if (which != "all" && which != c.name) continue;
@@ -179,10 +180,11 @@ int main(int argc, char** argv) {
               run_liggghts(dem_dir, c, static_cast<long>(data.size()), nt, steps);
           if (measured > 0.0) peer = measured, peer_kind = "meas";
         }
-        std::printf("%-6s %3d %8zu %7ld %6ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx %s%s\n",
-                    c.name.c_str(), nt, sys.particle_count(), steps, builds, seconds, cpu, rate, cn,
-                    c.peer_contacts, sys.kinetic_energy(), ke_trans, rate / peer, peer_kind,
-                    std::abs(cn / c.peer_contacts - 1.0) > 0.02 ? "  CONTACTS DIFFER >2%" : "");
+        std::printf(
+            "%-6s %3d %8zu %7ld %6ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx %s%s\n",
+            c.name.c_str(), nt, sys.particle_count(), steps, builds, seconds, cpu, rate, cn,
+            c.peer_contacts, sys.kinetic_energy(), ke_trans, rate / peer, peer_kind,
+            std::abs(cn / c.peer_contacts - 1.0) > 0.02 ? "  CONTACTS DIFFER >2%" : "");
         std::fflush(stdout);
         if (!vtk_dir.empty()) {
           std::filesystem::create_directories(vtk_dir);

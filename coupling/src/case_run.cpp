@@ -473,8 +473,8 @@ void CaseRun::run() {
   };
 
   logger->info(
-      "case '{}': {} windows of {:.6g} s to t = {:.6g} s, scheme {}, participants {}; output in {}", name_,
-      window_count_, window_size_, static_cast<double>(window_count_) * window_size_,
+      "case '{}': {} windows of {:.6g} s to t = {:.6g} s, scheme {}, participants {}; output in {}",
+      name_, window_count_, window_size_, static_cast<double>(window_count_) * window_size_,
       scheme_->name(),
       [&] {
         std::vector<std::string> n;

@@ -453,7 +453,8 @@ int System::set_partition() {
     sum += block_cost(b);
     // part t starts after block b once the parts before it have their share, or when every
     // later part needs one of the blocks left
-    if (sum >= total * t / parts || blocks - (b + 1) == parts - t) partition_[t++] = (b + 1) * block_size;
+    if (sum >= total * t / parts || blocks - (b + 1) == parts - t)
+      partition_[t++] = (b + 1) * block_size;
   }
   cross_valid_ = false;
   return parts;
@@ -461,7 +462,8 @@ int System::set_partition() {
 
 int System::part_of(int i) const {
   return static_cast<int>(std::upper_bound(partition_.begin(), partition_.end(), i) -
-                          partition_.begin()) - 1;
+                          partition_.begin()) -
+         1;
 }
 
 void System::prepare_cross_pairs() {
@@ -516,8 +518,8 @@ void System::compute_forces(double dt, bool update_history, double kick, bool st
 // T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
 // T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
 PARTITA_DEM_INLINE bool System::pair_force(const PackedParticle& qi, int j, int s, double dt,
-                               bool update_history, Eigen::Vector3d& fij, Eigen::Vector3d& ti,
-                               Eigen::Vector3d& tj) {
+                                           bool update_history, Eigen::Vector3d& fij,
+                                           Eigen::Vector3d& ti, Eigen::Vector3d& tj) {
   NeighborList& nl = neighbors_;
   const PackedParticle& qj = packed_[j];
   const Eigen::Vector3d d = qi.x - qj.x;
@@ -560,12 +562,12 @@ PARTITA_DEM_INLINE bool System::pair_force(const PackedParticle& qi, int j, int 
 }
 
 // Called inside a parallel region. Each particle's force is a sum in a fixed order, whatever the
-// number of threads: F_i = m_i g (start_sums()) + the pairs (k, i), k < i, in ascending k + the pairs
-// (i, j), j > i, in ascending j + planes + meshes. Rows are processed in ascending i, so the pairs
-// (k, i) have all been added when row i starts and i's total is complete at the end of its row.
-// Part t owns the particles [partition_[t], partition_[t+1]) and adds pair forces to j directly
-// when j is its own; pairs reaching into a later part (cross pairs) are evaluated first, each once,
-// into cross_force_, then added by both owners in the same place of their sums.
+// number of threads: F_i = m_i g (start_sums()) + the pairs (k, i), k < i, in ascending k + the
+// pairs (i, j), j > i, in ascending j + planes + meshes. Rows are processed in ascending i, so the
+// pairs (k, i) have all been added when row i starts and i's total is complete at the end of its
+// row. Part t owns the particles [partition_[t], partition_[t+1]) and adds pair forces to j
+// directly when j is its own; pairs reaching into a later part (cross pairs) are evaluated first,
+// each once, into cross_force_, then added by both owners in the same place of their sums.
 void System::evaluate_forces(double dt, bool update_history, double kick) {
   Particles& p = particles_;
   const NeighborList& nl = neighbors_;
@@ -794,7 +796,8 @@ void System::mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3
     const double cr = r - 0.5 * delta;
     const PairParameters& pp = model_.pair(q.material, m.material());
     Eigen::Vector3d fw, ft;
-    const double fn = hertz_mindlin(pp, delta, r, q.m, k.normal, q.v - v_wall, cr * q.w, shear, dt, update_history, fw, ft);
+    const double fn = hertz_mindlin(pp, delta, r, q.m, k.normal, q.v - v_wall, cr * q.w, shear, dt,
+                                    update_history, fw, ft);
     f += fw;
     t -= cr * k.normal.cross(ft);
     if (pp.rolling_friction > 0.0) {
