@@ -435,6 +435,9 @@ void CaseRun::run() {
   auto logger = log::get("coupling");
   Stopwatch wall;
   fs::create_directories(output_dir_ / "vtk");
+  if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
+    logger->info("removed {} VTK files of an earlier run from {}", removed,
+                 (output_dir_ / "vtk").string());
 
   std::vector<std::pair<std::string, std::string>> columns = {{"time", "s"}, {"iterations", ""}};
   for (const auto& c : scheme_->residual_columns()) columns.push_back(c);
@@ -487,6 +490,7 @@ void CaseRun::run() {
   int frame = 0;
   double next_output = output_every_;
   Stopwatch since_flush;
+  double flush_interval = 2.0;  // [s]
   try {
     scheme_->initialize();
     record_monitors(0.0);
@@ -510,8 +514,12 @@ void CaseRun::run() {
         while (output_every_ > 0.0 && next_output <= t + 1e-9 * window_size_)
           next_output = static_cast<double>(frame) * output_every_;
       }
-      if (since_flush.seconds() > 2.0) {
+      // CSV files are rewritten whole at each flush (always complete on disk): flush every 2 s,
+      // or less often once a flush takes longer than 2 % of the interval (very long runs)
+      if (since_flush.seconds() > flush_interval) {
+        Stopwatch flush_clock;
         flush_all();
+        flush_interval = std::max(2.0, 50.0 * flush_clock.seconds());
         since_flush.restart();
       }
       progress.update(n + 1, t, r.iterations);

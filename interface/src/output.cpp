@@ -79,8 +79,9 @@ void CsvSeries::record(double first, const std::vector<double>& values) {
 }
 
 void CsvSeries::flush() {
-  if (path_.empty()) return;
+  if (path_.empty() || flushed_size_ == text_.size()) return;  // nothing new
   write_file_atomically(path_, text_);
+  flushed_size_ = text_.size();
 }
 
 void CsvSeries::close() {
@@ -102,6 +103,35 @@ void PvdSeries::add(double time, const std::string& file) {
       << "\" group=\"\" part=\"0\" file=\"" << f << "\"/>\n";
   s << "  </Collection>\n</VTKFile>\n";
   write_file_atomically(path_, s.str());
+}
+
+int remove_pvd_series(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return 0;
+  std::vector<fs::path> collections;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file(ec) && entry.path().extension() == ".pvd")
+      collections.push_back(entry.path());
+  int removed = 0;
+  for (const fs::path& pvd : collections) {
+    std::ifstream in(pvd);
+    std::string line;
+    while (std::getline(in, line)) {
+      const std::string key = "file=\"";
+      const auto a = line.find(key);
+      if (a == std::string::npos) continue;
+      const auto b = line.find('"', a + key.size());
+      if (b == std::string::npos) continue;
+      const fs::path name = line.substr(a + key.size(), b - a - key.size());
+      // a plain name only: nothing outside the folder, no "..", no absolute path
+      if (name.empty() || name.has_parent_path() || name == "." || name == "..") continue;
+      if (fs::remove(dir / name, ec)) ++removed;
+    }
+    in.close();
+    if (fs::remove(pvd, ec)) ++removed;
+  }
+  return removed;
 }
 
 // ---------------------------------------------------------------------------------------------

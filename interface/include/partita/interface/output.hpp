@@ -57,6 +57,7 @@ class CsvSeries {
  private:
   std::filesystem::path path_;
   std::string text_;
+  std::size_t flushed_size_ = 0;  // text_ already on disk
   std::size_t columns_ = 0;
 };
 
@@ -73,6 +74,12 @@ class PvdSeries {
   std::filesystem::path path_;
   std::vector<std::pair<double, std::string>> entries_;
 };
+
+/// Removes the ParaView collections (*.pvd) in `dir` and the files they list, so that a new run
+/// into an existing output folder leaves no frames of an earlier, longer run behind. Only plain
+/// file names inside `dir` are removed (never a path with a folder part); other files stay.
+/// Returns the number of files removed. A missing folder is not an error.
+int remove_pvd_series(const std::filesystem::path& dir);
 
 /// Named point or cell arrays for VTK output (N x C each).
 using VtkArrays = std::vector<std::pair<std::string, Eigen::MatrixXd>>;
