@@ -1,0 +1,92 @@
+// The step loop allocates no memory once its arrays have their size: not in a plain step, not in
+// a step that rebuilds the neighbour lists, with one thread or two. The global operator new of
+// the test program is replaced by one that counts (forwarding to malloc).
+
+#include "partita/dem/packing_generator.hpp"
+#include "partita/dem/parallel.hpp"
+#include "partita/dem/system.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#if defined(__SANITIZE_ADDRESS__)
+#define PARTITA_COUNT_ALLOCATIONS 0  // keep the sanitizer's own operator new
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define PARTITA_COUNT_ALLOCATIONS 0
+#else
+#define PARTITA_COUNT_ALLOCATIONS 1
+#endif
+#else
+#define PARTITA_COUNT_ALLOCATIONS 1
+#endif
+
+namespace {
+std::atomic<long> allocations{0};
+}
+
+#if PARTITA_COUNT_ALLOCATIONS
+void* operator new(std::size_t size) {
+  allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+#endif
+
+using namespace partita::dem;
+
+namespace {
+
+// A packed bed drifting at constant velocity without gravity: lists are rebuilt every few steps
+// while the neighbourhoods stay the same, so every rebuild reuses the arrays of the first.
+System drifting_bed() {
+  System sys;
+  const int m = sys.add_material({1.0e7, 0.3, 2500.0});
+  sys.add_interaction(m, m, {0.4, 0.5, 0.05});
+  PackingSpec spec;
+  spec.lo = Eigen::Vector3d::Zero();
+  spec.hi = Eigen::Vector3d(12e-3, 12e-3, 12e-3);
+  spec.diameters = {1.2e-3, 0.8e-3};
+  spec.fractions = {1.0, 1.0};
+  spec.porosity = 0.6;
+  spec.seed = 3;
+  const Packing pk = PackingGenerator::generate(spec);
+  sys.add_particles(pk.positions, pk.radii, m);
+  for (std::size_t i = 0; i < sys.particle_count(); ++i)
+    sys.set_particle_velocity(i, {0.5, 0.2, 0.0});
+  sys.add_plane({0, 0, -1.0}, {0, 0, 1}, m);  // far away: checked, never touched
+  return sys;
+}
+
+}  // namespace
+
+TEST_CASE("dem: steps allocate no memory with or without a list rebuild", "[dem][performance]") {
+  if (!PARTITA_COUNT_ALLOCATIONS) SUCCEED("allocation counting is off in sanitizer builds");
+  const int before = max_threads();
+  for (int threads : {1, 2}) {
+    set_num_threads(threads);
+    System sys = drifting_bed();
+    REQUIRE(sys.particle_count() > 1024);  // the parallel path
+    const double dt = 0.2 * sys.rayleigh_time_step();
+    sys.run(100, dt);  // first steps size the arrays
+    const long builds = sys.neighbor_list().build_count();
+    const long count = allocations.load();
+    if (PARTITA_COUNT_ALLOCATIONS) CHECK(count > 0);  // the counter does count
+    sys.run(400, dt);
+    const long made = allocations.load() - count;
+    const long rebuilt = sys.neighbor_list().build_count() - builds;
+    INFO(threads << " threads: " << made << " allocations in 400 steps with " << rebuilt
+                 << " list rebuilds");
+    CHECK(rebuilt >= 2);  // the rebuild path was taken
+    if (PARTITA_COUNT_ALLOCATIONS) CHECK(made == 0);
+  }
+  set_num_threads(before);
+}
