@@ -1,10 +1,12 @@
 #pragma once
 // Shared set-ups for the DEM tests.
 
+#include "partita/dem/packing_generator.hpp"
 #include "partita/dem/system.hpp"
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 namespace partita::dem::test {
 
@@ -16,6 +18,19 @@ inline System single_material(double youngs, double poisson, double density, dou
   sys.add_interaction(m, m, {friction, restitution, 0.0});
   sys.set_damping_model(damping);
   return sys;
+}
+
+/// A random packing of spheres of the given diameters in equal numbers in the box [lo, hi].
+inline Packing two_size_packing(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double d1,
+                                double d2, double porosity, std::uint64_t seed) {
+  PackingSpec spec;
+  spec.lo = lo;
+  spec.hi = hi;
+  spec.diameters = {d1, d2};
+  spec.fractions = {1.0, 1.0};
+  spec.porosity = porosity;
+  spec.seed = seed;
+  return PackingGenerator::generate(spec);
 }
 
 inline double sphere_mass(double r, double rho) {

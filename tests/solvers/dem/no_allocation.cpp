@@ -2,7 +2,8 @@
 // a step that rebuilds the neighbour lists, with one thread or two. The global operator new of
 // the test program is replaced by one that counts (forwarding to malloc).
 
-#include "partita/dem/packing_generator.hpp"
+#include "dem_test_helpers.hpp"
+
 #include "partita/dem/parallel.hpp"
 #include "partita/dem/system.hpp"
 
@@ -34,11 +35,21 @@ void* operator new(std::size_t size) {
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void* operator new[](std::size_t size) {
+  return operator new(size);
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  std::free(p);
+}
 #endif
 
 using namespace partita::dem;
@@ -51,14 +62,8 @@ System drifting_bed() {
   System sys;
   const int m = sys.add_material({1.0e7, 0.3, 2500.0});
   sys.add_interaction(m, m, {0.4, 0.5, 0.05});
-  PackingSpec spec;
-  spec.lo = Eigen::Vector3d::Zero();
-  spec.hi = Eigen::Vector3d(12e-3, 12e-3, 12e-3);
-  spec.diameters = {1.2e-3, 0.8e-3};
-  spec.fractions = {1.0, 1.0};
-  spec.porosity = 0.6;
-  spec.seed = 3;
-  const Packing pk = PackingGenerator::generate(spec);
+  const Packing pk = test::two_size_packing(
+      Eigen::Vector3d::Zero(), Eigen::Vector3d(12e-3, 12e-3, 12e-3), 1.2e-3, 0.8e-3, 0.6, 3);
   sys.add_particles(pk.positions, pk.radii, m);
   for (std::size_t i = 0; i < sys.particle_count(); ++i)
     sys.set_particle_velocity(i, {0.5, 0.2, 0.0});

@@ -30,16 +30,11 @@ Eigen::Vector3d random_velocity(std::uint64_t& s, double a) {
 TEST_CASE("dem: energy is conserved without damping or friction", "[dem][physics]") {
   // ~150 spheres at 45 % solids in a closed box, random velocities, e = 1, mu = 0, no gravity:
   // E = kinetic + sum over contacts 8/15 E* sqrt(R*) delta^(5/2) (spheres and walls).
-  PackingSpec spec;
-  spec.hi = Eigen::Vector3d(8e-3, 8e-3, 8e-3);
-  spec.diameters = {1.6e-3, 1.2e-3};
-  spec.fractions = {1.0, 1.0};
-  spec.porosity = 0.55;
-  spec.seed = 7;
-  const Packing pk = PackingGenerator::generate(spec);
+  const Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi(8e-3, 8e-3, 8e-3);
+  const Packing pk = test::two_size_packing(lo, hi, 1.6e-3, 1.2e-3, 0.55, 7);
   System sys = test::single_material(1.0e7, 0.3, 2500.0, 1.0, 0.0);
   sys.add_particles(pk.positions, pk.radii, 0);
-  sys.add_box(spec.lo, spec.hi, 0);
+  sys.add_box(lo, hi, 0);
   std::uint64_t seed = 3;
   for (std::size_t i = 0; i < sys.particle_count(); ++i)
     sys.set_particle_velocity(i, random_velocity(seed, 0.2));
@@ -69,16 +64,12 @@ TEST_CASE("dem: a settled column puts its whole weight on the floor", "[dem][phy
   sys.add_interaction(grain, grain, {0.5, 0.3, 0.0});
   sys.add_interaction(grain, smooth, {0.0, 0.3, 0.0});
   sys.set_gravity({0, 0, -9.81});
-  PackingSpec spec;
-  spec.hi = Eigen::Vector3d(4e-3, 4e-3, 12e-3);
-  spec.diameters = {1.2e-3, 1.0e-3};
-  spec.fractions = {1.0, 1.0};
-  spec.porosity = 0.6;
-  spec.seed = 11;
-  const Packing pk = PackingGenerator::generate(spec);
+  const Packing pk = test::two_size_packing(
+      Eigen::Vector3d::Zero(), Eigen::Vector3d(4e-3, 4e-3, 12e-3), 1.2e-3, 1.0e-3, 0.6, 11);
   sys.add_particles(pk.positions, pk.radii, grain);
   const int floor = sys.add_plane({0, 0, 0}, {0, 0, 1}, grain);
-  sys.add_box(spec.lo, Eigen::Vector3d(4e-3, 4e-3, 1.0), smooth, 0b001111);  // four sides
+  sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(4e-3, 4e-3, 1.0), smooth,
+              0b001111);  // four sides
   double weight = 0.0;
   for (double m : sys.particles().mass) weight += 9.81 * m;
   const double dt = 0.2 * sys.rayleigh_time_step();

@@ -24,14 +24,8 @@ System falling_bed(double box, double porosity, std::uint64_t seed) {
   const int m = sys.add_material({1.0e7, 0.3, 2500.0});
   sys.add_interaction(m, m, {0.4, 0.5, 0.05});
   sys.set_gravity({0, 0, -9.81});
-  PackingSpec spec;
-  spec.lo = Eigen::Vector3d(0, 0, 1e-3);
-  spec.hi = Eigen::Vector3d(box, box, box);
-  spec.diameters = {1.2e-3, 0.8e-3};
-  spec.fractions = {1.0, 1.0};
-  spec.porosity = porosity;
-  spec.seed = seed;
-  const Packing pk = PackingGenerator::generate(spec);
+  const Packing pk = test::two_size_packing(
+      Eigen::Vector3d(0, 0, 1e-3), Eigen::Vector3d(box, box, box), 1.2e-3, 0.8e-3, porosity, seed);
   sys.add_particles(pk.positions, pk.radii, m);
   sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(box, box, 2 * box), m, 0b001111);
   Eigen::MatrixX3d v(5, 3);  // pyramid floor (apex up), 4 triangles
