@@ -149,8 +149,19 @@ std::vector<std::string> Spec::keys() const {
 
 namespace {
 
+bool is_number_text(const std::string& s);
+
 std::string default_text(const YAML::Node& n) {
-  if (n.IsScalar()) return n.Scalar();
+  if (n.IsScalar()) {
+    // numbers in their shortest exact form (0.3, not the 0.29999999999999999 yaml-cpp emits)
+    const std::string& t = n.Scalar();
+    if (!is_number_text(t)) return t;
+    double v = 0.0;
+    std::from_chars(t.data(), t.data() + t.size(), v);
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, r.ptr);
+  }
   if (n.IsSequence()) {
     std::string s = "[";
     for (std::size_t i = 0; i < n.size(); ++i) s += (i ? ", " : "") + default_text(n[i]);

@@ -136,4 +136,7 @@ TEST_CASE("config: docs come from the declarations", "[interface][config]") {
   CHECK_THAT(d, Catch::Contains("youngs_modulus (real, Pa, required)") &&
                     Catch::Contains("poisson_ratio") && Catch::Contains("-1 < value < 0.5") &&
                     Catch::Contains("default explicit-serial"));
+  // defaults in their shortest exact form, not with 17 digits
+  CHECK_THAT(d, Catch::Contains("default [0, 0, -9.81]") && Catch::Contains("default 1000"));
+  CHECK_THAT(d, !Catch::Contains("9.8100000"));
 }
