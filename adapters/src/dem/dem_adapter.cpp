@@ -139,6 +139,11 @@ std::shared_ptr<Spec> make_spec() {
       .min(0.0, true)
       .def(0.2);
   s->real("skin", "Verlet skin (default: 10 % of the largest radius)").unit("m").non_negative();
+  s->integer("sort_interval",
+             "renumber the particles in cell order at the first step and every N-th "
+             "neighbour-list build (keeps neighbours close in memory; 0: never)")
+      .min(0)
+      .def(10);
   return s;
 }
 
@@ -223,6 +228,7 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
                                                                 : dem::DampingModel::calibrated);
     system_.set_gravity(c.vec3("gravity"));
     if (c.has("skin")) system_.set_skin(c.real("skin"));
+    system_.set_sort_interval(static_cast<int>(c.integer("sort_interval")));
     time_step_fraction_ = c.real("time_step_fraction");
 
     // Particles.

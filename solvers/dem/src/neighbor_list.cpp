@@ -51,6 +51,46 @@ bool NeighborList::needs_rebuild(double max_moved2, const std::vector<PlaneWall>
   return false;
 }
 
+void NeighborList::renumber(const std::vector<int>& new_of_old) {
+  const int n = static_cast<int>(new_of_old.size());
+  const int rows = static_cast<int>(offsets_.size()) - 1;  // particles added since: no rows
+  if (!valid_ || rows > n) {
+    clear();
+    return;
+  }
+  // Each pair (i, j) becomes (min(a, b), max(a, b)) with a = new(i), b = new(j); the history is
+  // that of the first particle relative to the second, so it changes sign when they swap.
+  new_offsets_.assign(n + 1, 0);
+  for (int i = 0; i < rows; ++i)
+    for (int s = offsets_[i]; s < offsets_[i + 1]; ++s)
+      ++new_offsets_[std::min(new_of_old[i], new_of_old[neighbors_[s]]) + 1];
+  for (int i = 0; i < n; ++i) new_offsets_[i + 1] += new_offsets_[i];
+  new_neighbors_.resize(neighbors_.size());
+  new_shear_.resize(neighbors_.size());
+  counts_.assign(n, 0);
+  for (int i = 0; i < rows; ++i)
+    for (int s = offsets_[i]; s < offsets_[i + 1]; ++s) {
+      const int a = new_of_old[i], b = new_of_old[neighbors_[s]];
+      const int row = std::min(a, b);
+      const int slot = new_offsets_[row] + counts_[row]++;
+      new_neighbors_[slot] = std::max(a, b);
+      new_shear_[slot] = a < b ? shear_[s] : Eigen::Vector3d(-shear_[s]);
+    }
+  // rows sorted by neighbour (short rows: insertion sort, histories moved along)
+  for (int r = 0; r < n; ++r)
+    for (int s = new_offsets_[r] + 1; s < new_offsets_[r + 1]; ++s)
+      for (int t = s; t > new_offsets_[r] && new_neighbors_[t - 1] > new_neighbors_[t]; --t) {
+        std::swap(new_neighbors_[t - 1], new_neighbors_[t]);
+        std::swap(new_shear_[t - 1], new_shear_[t]);
+      }
+  offsets_.swap(new_offsets_);
+  neighbors_.swap(new_neighbors_);
+  shear_.swap(new_shear_);
+  // the build positions are only compared with the same particle's: drop them (next build sets
+  // them); the lists must be rebuilt before use
+  position_at_build_.clear();
+}
+
 // Calls visit(j) for every j > i within R_i + R_j + skin of i, cells in a fixed order.
 template <class Visit>
 void NeighborList::visit_pairs(const Particles& p, int i, Visit&& visit) const {
@@ -97,8 +137,12 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   grid_.inv_cell = 1.0 / cell;
   grid_.nx = dims(cell, 0), grid_.ny = dims(cell, 1), grid_.nz = dims(cell, 2);
 
-  // Counting sort of the particles into cells (ascending index within a cell).
+  // Counting sort of the particles into cells (ascending index within a cell). The cell arrays
+  // get room for the most cells at once, so a growing grid does not reallocate them.
   particle_cell_.resize(n);
+  cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
+  counts_.reserve(std::max(static_cast<std::size_t>(max_cells), static_cast<std::size_t>(n)) + 1);
+  tri_cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
   cell_start_.assign(grid_.cells() + 1, 0);
   for (int i = 0; i < n; ++i) {
     const auto c = grid_.coords(p.position[i]);

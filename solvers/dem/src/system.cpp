@@ -309,6 +309,7 @@ void System::prepare() {
   }
   neighbors_.set_skin(skin_);
   resize_histories();
+  if (sort_interval_ > 0) reorder_particles();
   rebuild_lists();
   prepared_ = true;
 }
@@ -373,6 +374,7 @@ void System::step(double dt) {
     rebuild = rebuild_here;
   }
   if (rebuild) {
+    if (sort_interval_ > 0 && ++builds_since_sort_ >= sort_interval_) reorder_particles();
     rebuild_lists();
     compute_forces(dt, true, half, true);
   } else {
@@ -421,6 +423,91 @@ void System::sync_particles() const {
 void System::start_sums(int i) {
   particles_.force[i] = packed_[i].m * gravity_;
   particles_.torque[i].setZero();
+}
+
+void System::set_sort_interval(int rebuilds) {
+  if (rebuilds < 0)
+    throw Error("set_sort_interval: need a number of list builds >= 0 (0: never), got " +
+                std::to_string(rebuilds));
+  sort_interval_ = rebuilds;
+}
+
+void System::sort_particles() {
+  if (particles_.size() == 0) return;
+  if (prepared_) resize_histories();
+  reorder_particles();
+  if (prepared_) rebuild_lists();
+}
+
+// Counting sort of the particles by cell (cells 2 R_max + skin wide over the bounding box, in the
+// order z, y, x; stable, so equal cells keep their order), then every per-particle array and
+// history is permuted alike and the pair histories are renumbered for the next build.
+void System::reorder_particles() {
+  sync_particles();
+  Particles& p = particles_;
+  const int n = static_cast<int>(p.size());
+  builds_since_sort_ = 0;
+  if (n < 2) return;
+  Eigen::Vector3d lo = p.position[0], hi = p.position[0];
+  double r_max = 0.0;
+  for (int i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(p.position[i]);
+    hi = hi.cwiseMax(p.position[i]);
+    r_max = std::max(r_max, p.radius[i]);
+  }
+  double h = std::max(2.0 * r_max + std::max(skin_, 0.0), 1e-12);
+  auto dim = [&](int k) { return static_cast<long>((hi[k] - lo[k]) / h) + 1; };
+  while (dim(0) * dim(1) * dim(2) > 4L * n + 64) h *= 1.26;
+  const long nx = dim(0), ny = dim(1), nz = dim(2);
+  auto cell = [&](double x, double o, long cells) {
+    return std::clamp(static_cast<long>((x - o) / h), 0L, cells - 1);
+  };
+  sort_key_.resize(n);
+  sort_start_.reserve(4 * static_cast<std::size_t>(n) + 65);  // the most cells: no regrowth
+  sort_start_.assign(nx * ny * nz + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d& x = p.position[i];
+    sort_key_[i] = static_cast<int>((cell(x.z(), lo.z(), nz) * ny + cell(x.y(), lo.y(), ny)) * nx +
+                                    cell(x.x(), lo.x(), nx));
+    ++sort_start_[sort_key_[i] + 1];
+  }
+  for (std::size_t c = 1; c < sort_start_.size(); ++c) sort_start_[c] += sort_start_[c - 1];
+  sort_order_.resize(n);  // new index -> old index
+  for (int i = 0; i < n; ++i) sort_order_[sort_start_[sort_key_[i]]++] = i;
+  bool identity = true;
+  for (int k = 0; k < n && identity; ++k) identity = sort_order_[k] == k;
+  if (identity) return;
+  sort_new_of_old_.resize(n);
+  for (int k = 0; k < n; ++k) sort_new_of_old_[sort_order_[k]] = k;
+  // permute an array of `width` entries per particle (through a scratch copy that keeps its
+  // capacity: no allocation once it has the largest size)
+  auto permute = [&](auto& v, auto& scratch, std::size_t width) {
+    if (v.size() != static_cast<std::size_t>(n) * width) return;  // not sized yet
+    scratch.resize(v.size());
+    for (int k = 0; k < n; ++k)
+      for (std::size_t w = 0; w < width; ++w)
+        scratch[k * width + w] = v[static_cast<std::size_t>(sort_order_[k]) * width + w];
+    std::copy(scratch.begin(), scratch.end(), v.begin());
+  };
+  permute(p.position, scratch_vec3_, 1);
+  permute(p.velocity, scratch_vec3_, 1);
+  permute(p.angular_velocity, scratch_vec3_, 1);
+  permute(p.force, scratch_vec3_, 1);
+  permute(p.torque, scratch_vec3_, 1);
+  permute(p.radius, scratch_real_, 1);
+  permute(p.mass, scratch_real_, 1);
+  permute(p.inertia, scratch_real_, 1);
+  permute(p.material, scratch_int_, 1);
+  permute(p.id, scratch_int64_, 1);
+  permute(plane_shear_, scratch_vec3_, planes_.size());
+  permute(mesh_slot_count_, scratch_int_, 1);
+  permute(mesh_slot_key_, scratch_int64_, max_mesh_contacts);
+  permute(mesh_slot_shear_, scratch_vec3_, max_mesh_contacts);
+  permute(mesh_records_, scratch_records_, max_mesh_contacts);
+  neighbors_.renumber(sort_new_of_old_);
+  packed_valid_ = false;
+  cross_valid_ = false;
+  ++sorts_;
 }
 
 void System::rebuild_lists() {
@@ -837,6 +924,7 @@ SystemState System::save_state() const {
   s.steps_ = steps_;
   s.forces_valid_ = forces_valid_;
   s.prepared_ = prepared_;
+  s.builds_since_sort_ = builds_since_sort_;
   return s;
 }
 
@@ -869,6 +957,7 @@ void System::restore_state(const SystemState& s) {
   time_ = s.time_;
   steps_ = s.steps_;
   forces_valid_ = s.forces_valid_;
+  builds_since_sort_ = s.builds_since_sort_;
   cross_valid_ = false;
   if (!s.prepared_) prepared_ = false;
 }

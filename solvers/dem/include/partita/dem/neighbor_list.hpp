@@ -45,6 +45,11 @@ class NeighborList {
   /// Rebuilds cells and lists, carrying the tangential histories of surviving pairs over.
   void build(const Particles& particles, const std::vector<PlaneWall>& planes,
              std::vector<TriangleMesh>& meshes);
+  /// After the caller renumbered the particles (old index i is now new_of_old[i]): rewrites the
+  /// pair rows and their tangential histories in the new numbering (a pair whose order flips
+  /// keeps its history with the sign changed), so that the next build() carries them over. The
+  /// lists must be rebuilt before they are used again.
+  void renumber(const std::vector<int>& new_of_old);
   /// Planes near particle i (bit k: plane k); all bits set when there are more than 64 planes.
   std::uint64_t plane_mask(std::size_t i) const { return plane_mask_[i]; }
 

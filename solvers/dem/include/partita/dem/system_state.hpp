@@ -48,6 +48,7 @@ class SystemState {
   long steps_ = 0;
   bool forces_valid_ = false;
   bool prepared_ = false;
+  int builds_since_sort_ = 0;
 };
 
 }  // namespace partita::dem
