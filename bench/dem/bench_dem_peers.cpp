@@ -5,7 +5,10 @@
 // LIGGGHTS: measured in the same invocation when `liggghts` is on PATH, else the recorded figures.
 //
 // usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] [--quick]
-//                        [--vtk DIR] [--no-peer]
+//                        [--vtk DIR] [--no-peer] [--shuffle] [--sort N]
+// --shuffle numbers the bed's particles in a random order (as a data file written by another code
+// may); --sort N renumbers them in cell order at the first step and every N-th list build
+// (System::set_sort_interval; default 0: the file's order, which is already spatial).
 // Physics as the decks dem/liggghts/model.in + bench.in: E = 200 MPa, nu = 0.23, e = 0.5 with
 // LIGGGHTS-style damping, mu = 0.3, Mindlin tangential history, walls x = 0, W, y = 0, W, z = 0
 // of the same material, g = 9.81 m/s^2, dt = 1.9e-6 s, skin 0.5 mm.
@@ -39,7 +42,7 @@ struct Case {
   double liggghts_1, liggghts_2;  // recorded particle-steps/s (RESULTS.md)
 };
 
-System make_system(const LammpsData& d, double width) {
+System make_system(const LammpsData& d, double width, bool shuffle, int sort_interval) {
   System sys;
   std::map<double, int> material_of_density;
   for (double rho : d.density)
@@ -51,7 +54,17 @@ System make_system(const LammpsData& d, double width) {
   sys.set_damping_model(DampingModel::liggghts);
   sys.set_gravity({0.0, 0.0, -9.81});
   sys.set_skin(0.5e-3);
-  for (std::size_t i = 0; i < d.size(); ++i)
+  sys.set_sort_interval(sort_interval);
+  std::vector<std::size_t> order(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) order[i] = i;
+  if (shuffle) {  // a fixed pseudo-random permutation (64-bit LCG, Fisher-Yates)
+    std::uint64_t state = 12345;
+    for (std::size_t i = order.size() - 1; i > 0; --i) {
+      state = state * 6364136223846793005ull + 1442695040888963407ull;
+      std::swap(order[i], order[(state >> 33) % (i + 1)]);
+    }
+  }
+  for (std::size_t i : order)
     sys.add_particle(d.position[i], 0.5 * d.diameter[i], material_of_density[d.density[i]],
                      d.velocity[i], d.angular_velocity[i], d.id[i]);
   sys.add_plane({0, 0, 0}, {1, 0, 0}, wall);
@@ -102,7 +115,8 @@ int main(int argc, char** argv) {
   std::string data_dir = dem_dir + "/data";
   std::string which = "all", vtk_dir;
   std::vector<int> threads = {1, 2};
-  bool quick = false, no_peer = false;
+  bool quick = false, no_peer = false, shuffle = false;
+  int sort_interval = 0;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     auto next = [&]() -> std::string {
@@ -126,11 +140,15 @@ int main(int argc, char** argv) {
       quick = true;
     } else if (arg == "--no-peer") {
       no_peer = true;
+    } else if (arg == "--shuffle") {
+      shuffle = true;
+    } else if (arg == "--sort") {
+      sort_interval = std::stoi(next());
     } else if (arg == "--vtk") {
       vtk_dir = next();
     } else {
       std::cerr << "usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] "
-                   "[--quick] [--vtk DIR] [--no-peer]\n"
+                   "[--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N]\n"
                    "  --no-peer: do not run LIGGGHTS; ratios use the recorded figures\n";
       return arg == "--help" || arg == "-h" ? 0 : 2;
     }
@@ -144,6 +162,12 @@ int main(int argc, char** argv) {
               : no_peer ? "not run (--no-peer): recorded figures"
                         : "not on PATH: recorded figures");
   std::printf("# machine shared with other jobs: timings are noisy\n");
+  if (shuffle || sort_interval > 0)
+    std::printf("# particle order: %s, renumbered in cell order %s\n",
+                shuffle ? "shuffled" : "as in the file",
+                sort_interval > 0
+                    ? ("every " + std::to_string(sort_interval) + " list builds").c_str()
+                    : "never");
   std::printf(
       "# psteps/s = N x steps / wall seconds of the timed loop; cpu_s = process CPU time of\n"
       "# the loop (with 1 thread, N x steps / cpu_s estimates an unloaded machine)\n");
@@ -157,7 +181,7 @@ int main(int argc, char** argv) {
       const long steps = quick ? c.steps / 20 : c.steps;
       for (int nt : threads) {
         set_num_threads(nt);
-        System sys = make_system(data, c.width);
+        System sys = make_system(data, c.width, shuffle, sort_interval);
         const double dt = 1.9e-6;
         sys.run(warmup, dt);
         const auto t0 = std::chrono::steady_clock::now();
