@@ -158,6 +158,10 @@ class Solver {
   std::size_t steps_ = 0;
   Eigen::VectorXd u_, v_, a_, f_;
   bool acceleration_valid_ = false;
+  struct Work {  // vectors of a dynamic step, kept between steps
+    Eigen::VectorXd f1, pm, pc, rhs, uc, rf, uf, u1, a1;
+  };
+  Work work_;
   double external_work_ = 0.0;
 
   SolverTimings timings_;
