@@ -14,7 +14,8 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 PACKAGES=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
-          catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib)
+          catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib
+          python3-vtk9)
 DEFAULT_CASE=cases/uniaxial_compaction/steel.yaml
 JOBS=${JOBS:-$(nproc)}
 

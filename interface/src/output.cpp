@@ -1,5 +1,6 @@
 #include "partita/interface/output.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -136,13 +137,21 @@ int remove_pvd_series(const std::filesystem::path& dir) {
 
 // ---------------------------------------------------------------------------------------------
 namespace {
+// A double as text with `digits` significant digits (std::to_chars: several times faster than
+// an ostream's formatting, which dominated the output time).
+void put_number(std::ostream& out, double v, int digits) {
+  char buf[40];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
+  out.write(buf, r.ptr - buf);
+}
+
 void write_array(std::ostream& out, const std::string& name, const Eigen::MatrixXd& a) {
   out << "        <DataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\""
       << a.cols() << "\" format=\"ascii\">\n          ";
   for (Eigen::Index i = 0; i < a.rows(); ++i)
     for (Eigen::Index k = 0; k < a.cols(); ++k) {
-      const double v = std::isfinite(a(i, k)) ? a(i, k) : 0.0;
-      out << v << ' ';
+      put_number(out, std::isfinite(a(i, k)) ? a(i, k) : 0.0, 10);
+      out << ' ';
     }
   out << "\n        </DataArray>\n";
 }

@@ -2,6 +2,7 @@
 
 #include "partita/dem/error.hpp"
 
+#include <charconv>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,14 @@
 namespace partita::dem {
 
 namespace {
+
+// A double as text with `digits` significant digits (std::to_chars: several times faster than
+// an ostream's formatting, which dominated the output time).
+void put_number(std::ostream& out, double v, int digits) {
+  char buf[40];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
+  out.write(buf, r.ptr - buf);
+}
 
 void write_arrays(std::ostream& out, const char* tag, const std::vector<VtkArray>& arrays,
                   std::size_t count, const std::string& path) {
@@ -28,7 +37,7 @@ void write_arrays(std::ostream& out, const char* tag, const std::vector<VtkArray
       if (a.integer)
         out << static_cast<std::int64_t>(a.values[k]);
       else
-        out << a.values[k];
+        put_number(out, a.values[k], 12);
       out << ((k + 1) % a.components == 0 ? '\n' : ' ');
     }
     out << "        </DataArray>\n";
@@ -39,7 +48,14 @@ void write_arrays(std::ostream& out, const char* tag, const std::vector<VtkArray
 void write_points_array(std::ostream& out, const std::vector<Eigen::Vector3d>& points) {
   out << "      <Points>\n        <DataArray type=\"Float64\" NumberOfComponents=\"3\" "
          "format=\"ascii\">\n";
-  for (const Eigen::Vector3d& x : points) out << x.x() << ' ' << x.y() << ' ' << x.z() << '\n';
+  for (const Eigen::Vector3d& x : points) {
+    put_number(out, x.x(), 12);
+    out << ' ';
+    put_number(out, x.y(), 12);
+    out << ' ';
+    put_number(out, x.z(), 12);
+    out << '\n';
+  }
   out << "        </DataArray>\n      </Points>\n";
 }
 

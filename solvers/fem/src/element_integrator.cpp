@@ -114,7 +114,7 @@ void ElementIntegrator::hex8_incompatible(const ElementCoordinates& x, const Mat
     strain_matrix(g, b);
     incompatible_matrix(q.xi, det);
     const Matrix6 dw = d * (det * q.weight);
-    kuu.noalias() += b.transpose() * dw * b;
+    if (s == nullptr) kuu.noalias() += b.transpose() * dw * b;  // (stresses need K_ua, K_aa only)
     kua.noalias() += b.transpose() * dw * ba;
     kaa.noalias() += ba.transpose() * dw * ba;
   }
