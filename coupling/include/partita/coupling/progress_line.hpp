@@ -17,15 +17,18 @@ class ProgressLine {
   void update(std::int64_t done, double time, int iterations);
   /// End the line (newline on a terminal).
   void finish();
-  /// The text of the line for these values (for tests).
+  /// The text of the line for these values: the time left is estimated from `elapsed` seconds
+  /// spent on the last `counted` windows ("?" when counted is 0).
   static std::string text(std::int64_t done, std::int64_t windows, double time, int iterations,
-                          double elapsed);
+                          double elapsed, std::int64_t counted);
 
  private:
   std::int64_t windows_;
   bool tty_;
   Stopwatch clock_;
   double last_ = -1e300;
+  std::int64_t first_done_ = -1;  // the window of the first update and its time
+  double first_seconds_ = 0.0;
   bool printed_ = false;
 };
 
