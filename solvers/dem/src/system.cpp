@@ -784,7 +784,9 @@ void System::reduce_wall_and_mesh_forces() {
 }
 
 // Contacts of particle i with the meshes, each counted once:
-//  - candidates: triangles whose closest point is within R (face, edge or vertex feature);
+//  - candidates: triangles whose closest point is within R (face, edge or vertex feature) and
+//    is a local closest point of the mesh surface (an edge or vertex only where no triangle
+//    sharing it comes nearer: on a fine flat mesh only the face under the centre touches);
 //  - accepted in the order faces, edges, vertices (then by distance): a face always; an edge
 //    only if no accepted face has it as an edge; a vertex only if no accepted face or edge has
 //    it; and any contact only if its normal differs from all accepted ones (a sphere cannot
@@ -797,20 +799,31 @@ void System::mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3
     double dist2;
     Eigen::Vector3d normal;
   };
+  // Order of preference: faces, edges, vertices, then by distance (the order of acceptance).
+  const auto before = [](const Candidate& a, const Candidate& b) {
+    if (a.type != b.type) return a.type < b.type;
+    if (a.dist2 != b.dist2) return a.dist2 < b.dist2;
+    if (a.mesh != b.mesh) return a.mesh < b.mesh;
+    return a.triangle < b.triangle;
+  };
+  // At most max_candidates touching triangles are kept: when more touch (a fine mesh under a
+  // large sphere), the least preferred one gives way, so the faces and the nearest features
+  // always take part.
   constexpr int max_candidates = 32;
-  Candidate cand[max_candidates];
+  Candidate cand[max_candidates + 1];
   int nc = 0;
+  int worst = -1;  // index of the least preferred kept candidate once the array is full
   const PackedParticle& q = packed_[i];
   const NeighborList& nl = neighbors_;
   const Eigen::Vector3d& x = q.x;
   const double r = q.r;
-  for (int k = nl.mesh_offsets_[i]; k < nl.mesh_offsets_[i + 1] && nc < max_candidates; ++k) {
+  for (int k = nl.mesh_offsets_[i]; k < nl.mesh_offsets_[i + 1]; ++k) {
     const MeshCandidate mc = nl.mesh_candidates_[k];
     const TriangleMesh& m = meshes_[mc.mesh];
-    Candidate& c = cand[nc];
+    Candidate& c = cand[nc];  // cand[max_candidates] is scratch once the array is full
     c.cp = m.closest_point(mc.triangle, x);
     c.dist2 = (x - c.cp.point).squaredNorm();
-    if (c.dist2 >= r * r) continue;
+    if (c.dist2 >= r * r || !m.feature_is_local_closest(mc.triangle, c.cp, x)) continue;
     c.mesh = mc.mesh;
     c.triangle = mc.triangle;
     c.type = c.cp.feature;
@@ -827,14 +840,23 @@ void System::mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3
                      .cross(m.position_[tri[2]] - m.position_[tri[0]])
                      .normalized();
     }
-    ++nc;
+    if (nc < max_candidates) {
+      ++nc;
+      continue;
+    }
+    if (worst < 0) {
+      worst = 0;
+      for (int w = 1; w < max_candidates; ++w)
+        if (before(cand[worst], cand[w])) worst = w;
+    }
+    if (before(c, cand[worst])) {
+      cand[worst] = c;
+      worst = 0;
+      for (int w = 1; w < max_candidates; ++w)
+        if (before(cand[worst], cand[w])) worst = w;
+    }
   }
-  std::sort(cand, cand + nc, [](const Candidate& a, const Candidate& b) {
-    if (a.type != b.type) return a.type < b.type;
-    if (a.dist2 != b.dist2) return a.dist2 < b.dist2;
-    if (a.mesh != b.mesh) return a.mesh < b.mesh;
-    return a.triangle < b.triangle;
-  });
+  std::sort(cand, cand + nc, before);
   int accepted[max_mesh_contacts];
   int na = 0;
   constexpr double same_normal = 1.0 - 5.0e-5;  // about 0.6 degrees

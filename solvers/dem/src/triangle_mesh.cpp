@@ -65,6 +65,57 @@ TriangleMesh::TriangleMesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
   }
   triangle_force_ = Eigen::MatrixX3d::Zero(triangle_count(), 3);
   vertex_force_ = Eigen::MatrixX3d::Zero(nv, 3);
+
+  // Topology for the local-closest test: opposite vertices of each edge, neighbours of each
+  // vertex (compressed rows).
+  const int ne = static_cast<int>(edges_.size());
+  edge_opposite_offset_.assign(ne + 1, 0);
+  vertex_neighbor_offset_.assign(nv + 1, 0);
+  for (const auto& te : triangle_edges_)
+    for (int e : te) ++edge_opposite_offset_[e + 1];
+  for (const auto& e : edges_) ++vertex_neighbor_offset_[e[0] + 1], ++vertex_neighbor_offset_[e[1] + 1];
+  for (int e = 0; e < ne; ++e) edge_opposite_offset_[e + 1] += edge_opposite_offset_[e];
+  for (int v = 0; v < nv; ++v) vertex_neighbor_offset_[v + 1] += vertex_neighbor_offset_[v];
+  edge_opposite_.resize(edge_opposite_offset_[ne]);
+  vertex_neighbor_.resize(vertex_neighbor_offset_[nv]);
+  std::vector<int> fill(edge_opposite_offset_.begin(), edge_opposite_offset_.end() - 1);
+  for (std::size_t t = 0; t < triangles_.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      edge_opposite_[fill[triangle_edges_[t][k]]++] = triangles_[t][(k + 2) % 3];
+  fill.assign(vertex_neighbor_offset_.begin(), vertex_neighbor_offset_.end() - 1);
+  for (const auto& e : edges_) {
+    vertex_neighbor_[fill[e[0]]++] = e[1];
+    vertex_neighbor_[fill[e[1]]++] = e[0];
+  }
+}
+
+bool TriangleMesh::feature_is_local_closest(int t, const TriangleClosestPoint& cp,
+                                            const Eigen::Vector3d& p) const {
+  if (cp.feature == TriangleClosestPoint::face) return true;
+  const Eigen::Vector3d d = p - cp.point;
+  const double dn = d.norm();
+  if (dn == 0.0) return true;  // on the surface
+  // A neighbouring triangle is nearer than the feature when p lies beyond the feature's
+  // boundary with it: d . (w - feature) > 0 for a vertex w of that triangle off the feature
+  // (the Voronoi tests of closest_point, seen from the feature). The tolerance keeps a point
+  // exactly over a shared edge of coplanar triangles a contact of that edge.
+  constexpr double tol = 1e-9;
+  if (cp.feature == TriangleClosestPoint::edge) {
+    const int e = triangle_edges_[t][cp.local_index];
+    const Eigen::Vector3d& a = position_[edges_[e][0]];
+    for (int k = edge_opposite_offset_[e]; k < edge_opposite_offset_[e + 1]; ++k) {
+      const Eigen::Vector3d w = position_[edge_opposite_[k]] - a;
+      if (d.dot(w) > tol * dn * w.norm()) return false;
+    }
+    return true;
+  }
+  const int v = triangles_[t][cp.local_index];
+  const Eigen::Vector3d& a = position_[v];
+  for (int k = vertex_neighbor_offset_[v]; k < vertex_neighbor_offset_[v + 1]; ++k) {
+    const Eigen::Vector3d w = position_[vertex_neighbor_[k]] - a;
+    if (d.dot(w) > tol * dn * w.norm()) return false;
+  }
+  return true;
 }
 
 TriangleClosestPoint TriangleMesh::closest_point(int t, const Eigen::Vector3d& p) const {

@@ -38,15 +38,19 @@ struct Bounce {
   double force_max;
 };
 
-// Drops a sphere vertically (with friction and damping on) at (x, y) onto a plane or a mesh.
-Bounce bounce(bool on_mesh, double x, double y) {
+// Drops a sphere vertically (with friction and damping on) at (x, y, z0) onto a plane or a
+// mesh. The mesh is the triangulated plane folded along x = 0 to z = fold |x| (fold 0: flat;
+// fold 1: a 90-degree V-groove; fold -1: a 90-degree ridge).
+Bounce bounce(bool on_mesh, double x, double y, int cells = 4, double fold = 0.0,
+              double z0 = R + 1e-5) {
   System sys = test::single_material(E, NU, RHO, 0.5, 0.4);
-  sys.add_particle({x, y, R + 1e-5}, R, 0, {0.0, 0.0, -0.5});
+  sys.add_particle({x, y, z0}, R, 0, {0.0, 0.0, -0.5});
   int mesh = -1, wall = -1;
   if (on_mesh) {
     Eigen::MatrixX3d v;
     TriangleMesh::Triangles t;
-    triangulated_plane(4.0 * R, 4, v, t);
+    triangulated_plane(4.0 * R, cells, v, t);
+    v.col(2) = fold * v.col(0).cwiseAbs();
     mesh = sys.add_mesh(v, t, 0);
   } else {
     wall = sys.add_plane({0, 0, 0}, {0, 0, 1}, 0);
@@ -57,6 +61,22 @@ Bounce bounce(bool on_mesh, double x, double y) {
     sys.step(dt);
     const Eigen::Vector3d f = on_mesh ? sys.mesh_force(mesh) : sys.wall_force(wall);
     fmax = std::max(fmax, f.norm());
+  }
+  return {sys.particles().velocity[0], sys.particles().angular_velocity[0], fmax};
+}
+
+// The same drop into a V-groove of two rigid planes z = |x| (normals (-+1, 0, 1)/sqrt 2).
+Bounce bounce_in_planes_groove(double z0) {
+  System sys = test::single_material(E, NU, RHO, 0.5, 0.4);
+  sys.add_particle({0.0, 0.0, z0}, R, 0, {0.0, 0.0, -0.5});
+  const double c = std::sqrt(0.5);
+  const int w1 = sys.add_plane({0, 0, 0}, {-c, 0, c}, 0);
+  const int w2 = sys.add_plane({0, 0, 0}, {c, 0, c}, 0);
+  const double dt = 0.1 * sys.rayleigh_time_step();
+  double fmax = 0.0;
+  for (int s = 0; s < 4000; ++s) {
+    sys.step(dt);
+    fmax = std::max(fmax, (sys.wall_force(w1) + sys.wall_force(w2)).norm());
   }
   return {sys.particles().velocity[0], sys.particles().angular_velocity[0], fmax};
 }
@@ -79,6 +99,43 @@ TEST_CASE("dem: bounce on a triangulated plane equals bounce on a plane", "[dem]
     CHECK(b.v.head<2>().norm() < 1e-9);
     CHECK(b.w.norm() < 1e-6);
   }
+}
+
+TEST_CASE("dem: a fine mesh with many triangles under the contact still acts like a plane",
+          "[dem][mesh]") {
+  // h = 0.05 mm: about 90 triangles intersect the sphere at the largest overlap (18 um, contact
+  // circle of 0.19 mm radius); only the face under the centre carries the contact.
+  const Bounce ref = bounce(false, 0.0, 0.0);
+  for (const auto& pt : {std::pair{0.0, 0.0}, std::pair{0.0123e-3, 0.0371e-3}}) {
+    const Bounce b = bounce(true, pt.first, pt.second, 160);
+    INFO("impact at (" << pt.first << ", " << pt.second << "): v_z " << b.v.z() << " plane "
+                       << ref.v.z() << "; F_max " << b.force_max << " plane " << ref.force_max);
+    CHECK(std::abs(b.v.z() - ref.v.z()) <= 1e-6 * std::abs(ref.v.z()));
+    CHECK(std::abs(b.force_max - ref.force_max) <= 1e-6 * ref.force_max);
+  }
+}
+
+TEST_CASE("dem: a fine folded mesh acts like its planes: V-groove (two faces), ridge (one edge)",
+          "[dem][mesh]") {
+  // h = 0.05 mm. In the groove the sphere touches the two faces whose planes it overlaps; the
+  // edges and vertices of the triangles around them, also within reach, are not contacts. On
+  // the ridge it touches the ridge edge only (overlap and normal of a horizontal plane).
+  const double z_groove = std::sqrt(2.0) * (R + 1e-5);
+  const Bounce groove_ref = bounce_in_planes_groove(z_groove);
+  REQUIRE(groove_ref.v.z() > 0.0);
+  const Bounce groove = bounce(true, 0.0, 0.0123e-3, 160, 1.0, z_groove);
+  INFO("groove: v_z " << groove.v.z() << " planes " << groove_ref.v.z() << "; F_max "
+                      << groove.force_max << " planes " << groove_ref.force_max);
+  CHECK(std::abs(groove.v.z() - groove_ref.v.z()) <= 1e-6 * std::abs(groove_ref.v.z()));
+  CHECK(std::abs(groove.force_max - groove_ref.force_max) <= 1e-6 * groove_ref.force_max);
+
+  const Bounce ref = bounce(false, 0.0, 0.0);
+  const Bounce ridge = bounce(true, 0.0, 0.0123e-3, 160, -1.0);
+  INFO("ridge: v_z " << ridge.v.z() << " plane " << ref.v.z() << "; F_max " << ridge.force_max
+                     << " plane " << ref.force_max);
+  CHECK(std::abs(ridge.v.z() - ref.v.z()) <= 1e-6 * std::abs(ref.v.z()));
+  CHECK(std::abs(ridge.force_max - ref.force_max) <= 1e-6 * ref.force_max);
+  CHECK(ridge.v.head<2>().norm() < 1e-9);
 }
 
 TEST_CASE("dem: mesh forces are distributed to vertices and balance the particle", "[dem][mesh]") {

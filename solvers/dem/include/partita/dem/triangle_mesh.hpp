@@ -42,6 +42,14 @@ class TriangleMesh {
   /// Closest point of triangle t to p (Ericson, Real-Time Collision Detection, 5.1.5).
   TriangleClosestPoint closest_point(int t, const Eigen::Vector3d& p) const;
 
+  /// Whether the closest point `cp` of triangle t to p, found on an edge or vertex, is also the
+  /// closest point of every other triangle sharing that edge or vertex, i.e. whether p lies in
+  /// the region of the mesh surface that the feature is nearest to. A point over the middle of
+  /// a flat mesh is nearest to one face only; the edges and vertices of the other triangles
+  /// within reach are not contacts. Faces are always local closest points.
+  bool feature_is_local_closest(int t, const TriangleClosestPoint& cp,
+                                const Eigen::Vector3d& p) const;
+
   /// Force exerted by the particles on each triangle / vertex in the last step [N].
   const Eigen::MatrixX3d& triangle_forces() const { return triangle_force_; }
   const Eigen::MatrixX3d& vertex_forces() const { return vertex_force_; }
@@ -58,6 +66,10 @@ class TriangleMesh {
   std::vector<std::array<int, 3>> triangles_;
   std::vector<std::array<int, 3>> triangle_edges_;
   std::vector<std::array<int, 2>> edges_;
+  // The vertex opposite edge e in each triangle that has it: edge_opposite_[edge_opposite_offset_
+  // [e] .. edge_opposite_offset_[e + 1]); the vertices joined to vertex v by an edge, likewise.
+  std::vector<int> edge_opposite_offset_, edge_opposite_;
+  std::vector<int> vertex_neighbor_offset_, vertex_neighbor_;
   Eigen::MatrixX3d triangle_force_;
   Eigen::MatrixX3d vertex_force_;
   int material_ = 0;
