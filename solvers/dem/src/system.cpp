@@ -889,13 +889,42 @@ void System::mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3
     old_key[s] = mesh_slot_key_[base + s];
     old_shear[s] = mesh_slot_shear_[base + s];
   }
+  // A contact keeps its history when its feature stays (same key) and also when it passes to
+  // a neighbouring feature of the same mesh, rolling or sliding across triangle boundaries: an
+  // unmatched old contact whose point (the same material point of the wall, at the current
+  // vertex positions) lies within the new contact radius sqrt(R delta) hands its history on.
+  int from_old[max_mesh_contacts];
+  bool old_taken[max_mesh_contacts] = {};
+  for (int a = 0; a < na; ++a) {
+    const Candidate& k = cand[accepted[a]];
+    from_old[a] = -1;
+    const std::int64_t key = feature_key(k.mesh, k.type, k.feature);
+    for (int s = 0; s < n_old; ++s)
+      if (old_key[s] == key) from_old[a] = s, old_taken[s] = true;
+  }
+  for (int a = 0; a < na; ++a) {
+    if (from_old[a] >= 0) continue;
+    const Candidate& k = cand[accepted[a]];
+    const TriangleMesh& m = meshes_[k.mesh];
+    double best = r * (r - std::sqrt(k.dist2));  // (contact radius)^2
+    for (int s = 0; s < n_old; ++s) {
+      const MeshContactRecord& rec = mesh_records_[base + s];
+      if (old_taken[s] || rec.mesh != k.mesh) continue;
+      const auto& tri = m.triangle(rec.triangle);
+      const Eigen::Vector3d p = rec.barycentric[0] * m.position_[tri[0]] +
+                                rec.barycentric[1] * m.position_[tri[1]] +
+                                rec.barycentric[2] * m.position_[tri[2]];
+      const double d2 = (p - k.cp.point).squaredNorm();
+      if (d2 < best) best = d2, from_old[a] = s;
+    }
+    if (from_old[a] >= 0) old_taken[from_old[a]] = true;
+  }
   for (int a = 0; a < na; ++a) {
     const Candidate& k = cand[accepted[a]];
     const TriangleMesh& m = meshes_[k.mesh];
     const std::int64_t key = feature_key(k.mesh, k.type, k.feature);
-    Eigen::Vector3d shear = Eigen::Vector3d::Zero();
-    for (int s = 0; s < n_old; ++s)
-      if (old_key[s] == key) shear = old_shear[s];
+    Eigen::Vector3d shear =
+        from_old[a] >= 0 ? old_shear[from_old[a]] : Eigen::Vector3d::Zero().eval();
     const auto& tri = m.triangle(k.triangle);
     // wall velocity at the contact point: barycentric interpolation of the vertex velocities
     const Eigen::Vector3d v_wall = k.cp.barycentric[0] * m.velocity_[tri[0]] +

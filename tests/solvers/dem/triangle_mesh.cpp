@@ -5,6 +5,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <numbers>
+
 using namespace partita::dem;
 
 namespace {
@@ -136,6 +138,44 @@ TEST_CASE("dem: a fine folded mesh acts like its planes: V-groove (two faces), r
   CHECK(std::abs(ridge.v.z() - ref.v.z()) <= 1e-6 * std::abs(ref.v.z()));
   CHECK(std::abs(ridge.force_max - ref.force_max) <= 1e-6 * ref.force_max);
   CHECK(ridge.v.head<2>().norm() < 1e-9);
+}
+
+TEST_CASE("dem: rolling down an incline across many triangles equals rolling on a plane",
+          "[dem][mesh]") {
+  // Gravity tilted by 20 degrees over a flat floor; friction 0.5 > 2/7 tan(20 deg), so the
+  // sphere rolls without slipping, a = 5/7 g sin(theta). On a mesh of h = 0.05 mm it crosses
+  // about 10 triangles in 0.02 s: the static friction (tangential history) must pass from
+  // triangle to triangle, or the sphere slips at each crossing.
+  const double theta = 20.0 * std::numbers::pi / 180.0, g = 9.81, duration = 0.02;
+  const auto roll = [&](bool on_mesh, double& time) {
+    System sys = test::single_material(E, NU, RHO, 0.5, 0.5);
+    sys.set_gravity({g * std::sin(theta), 0.0, -g * std::cos(theta)});
+    sys.add_particle({-3e-3, 0.0123e-3, R - 1e-7}, R, 0, {0.0, 0.0, 0.0});
+    if (on_mesh) {
+      Eigen::MatrixX3d v;
+      TriangleMesh::Triangles t;
+      triangulated_plane(4.0 * R, 160, v, t);
+      sys.add_mesh(v, t, 0);
+    } else {
+      sys.add_plane({0, 0, 0}, {0, 0, 1}, 0);
+    }
+    const double dt = 0.1 * sys.rayleigh_time_step();
+    time = 0.0;
+    for (; time < duration; time += dt) sys.step(dt);
+    return std::pair{sys.particles().velocity[0], sys.particles().angular_velocity[0]};
+  };
+  double t_plane = 0.0, t_mesh = 0.0;
+  const auto [v_plane, w_plane] = roll(false, t_plane);
+  const auto [v_mesh, w_mesh] = roll(true, t_mesh);
+  const double v_rolling = 5.0 / 7.0 * g * std::sin(theta) * t_plane;
+  INFO("v_x plane " << v_plane.x() << ", mesh " << v_mesh.x() << ", rolling " << v_rolling
+                    << "; w_y R mesh " << w_mesh.y() * R);
+  REQUIRE(t_mesh == t_plane);
+  // the plane itself: rolling without slip (the first contact bounce costs a little)
+  CHECK(std::abs(v_plane.x() - v_rolling) <= 1e-3 * v_rolling);
+  CHECK(std::abs(w_plane.y() * R - v_plane.x()) <= 1e-3 * v_rolling);
+  CHECK(std::abs(v_mesh.x() - v_plane.x()) <= 1e-6 * v_rolling);
+  CHECK(std::abs(w_mesh.y() - w_plane.y()) <= 1e-6 * std::abs(w_plane.y()));
 }
 
 TEST_CASE("dem: mesh forces are distributed to vertices and balance the particle", "[dem][mesh]") {
