@@ -20,8 +20,8 @@ TEST_CASE("output: every VTK file of a coupled run opens in VTK's readers", "[ap
   // the seed-000 steel case, shortened, on a coarse plate: FE .vtu, particle, STL and interface
   // .vtp files with their data
   const auto run = run_command(
-      quote(PARTITA_EXECUTABLE) + " run " + quote(source + "/cases/uniaxial_compaction/steel.yaml") +
-      " --output " + quote(out.string()) +
+      quote(PARTITA_EXECUTABLE) + " run " +
+      quote(source + "/cases/uniaxial_compaction/steel.yaml") + " --output " + quote(out.string()) +
       " --set 'participants.plate.mesh.box.cells=[6, 6, 1]' --set time.end=0.002"
       " --set output.every=0.0005 --log-level warn");
   INFO(run.output);

@@ -30,7 +30,9 @@ std::string read(const fs::path& p) {
   return s.str();
 }
 
-void touch(const fs::path& p, const std::string& text = "x") { std::ofstream(p) << text; }
+void touch(const fs::path& p, const std::string& text = "x") {
+  std::ofstream(p) << text;
+}
 
 }  // namespace
 

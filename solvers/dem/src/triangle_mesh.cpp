@@ -73,7 +73,8 @@ TriangleMesh::TriangleMesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
   vertex_neighbor_offset_.assign(nv + 1, 0);
   for (const auto& te : triangle_edges_)
     for (int e : te) ++edge_opposite_offset_[e + 1];
-  for (const auto& e : edges_) ++vertex_neighbor_offset_[e[0] + 1], ++vertex_neighbor_offset_[e[1] + 1];
+  for (const auto& e : edges_)
+    ++vertex_neighbor_offset_[e[0] + 1], ++vertex_neighbor_offset_[e[1] + 1];
   for (int e = 0; e < ne; ++e) edge_opposite_offset_[e + 1] += edge_opposite_offset_[e];
   for (int v = 0; v < nv; ++v) vertex_neighbor_offset_[v + 1] += vertex_neighbor_offset_[v];
   edge_opposite_.resize(edge_opposite_offset_[ne]);
