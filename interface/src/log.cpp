@@ -1,6 +1,8 @@
 #include "partita/interface/log.hpp"
 
+#include <cstdlib>
 #include <mutex>
+#include <string_view>
 #include <vector>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -10,9 +12,21 @@
 namespace partita::log {
 
 namespace {
+// The starting level: info, or PARTITA_LOG_LEVEL from the environment when it names a level
+// (the test suite sets warn; a command-line --log-level overrides both).
+spdlog::level::level_enum initial_level() {
+  const char* env = std::getenv("PARTITA_LOG_LEVEL");
+  if (env == nullptr) return spdlog::level::info;
+  try {
+    return parse_level(env);
+  } catch (const Error&) {
+    return spdlog::level::info;  // reported by the first get(), where a logger exists
+  }
+}
 struct State {
   std::mutex mutex;
-  spdlog::level::level_enum level = spdlog::level::info;
+  spdlog::level::level_enum level = initial_level();
+  bool env_reported = false;
   spdlog::sink_ptr sink;
 };
 State& state() {
@@ -30,6 +44,13 @@ std::shared_ptr<spdlog::logger> get(const std::string& module) {
   logger->set_pattern("[%H:%M:%S.%e] [%n] %^%l%$: %v");
   logger->set_level(s.level);
   spdlog::register_logger(logger);
+  if (!s.env_reported) {
+    s.env_reported = true;
+    const char* env = std::getenv("PARTITA_LOG_LEVEL");
+    if (env != nullptr && s.level == spdlog::level::info && std::string_view(env) != "info")
+      logger->warn("PARTITA_LOG_LEVEL='{}' is not a log level (allowed: {}); using info", env,
+                   level_names());
+  }
   return logger;
 }
 
