@@ -2,6 +2,7 @@
 
 #include "partita/coupling/acceleration/aitken.hpp"
 #include "partita/coupling/acceleration/constant_relaxation.hpp"
+#include "partita/coupling/acceleration/iqn_imvj.hpp"
 #include "partita/coupling/acceleration/iqn_ils.hpp"
 #include "partita/coupling/convergence/absolute_convergence.hpp"
 #include "partita/coupling/convergence/relative_convergence.hpp"
@@ -55,6 +56,9 @@ void register_builtin(Registries& r) {
   r.accelerations.add("iqn-ils",
                       "interface quasi-Newton, least-squares inverse Jacobian, QR filter",
                       IqnIls::create, IqnIls::spec());
+  r.accelerations.add("iqn-imvj",
+                      "interface quasi-Newton, multi-vector inverse Jacobian kept across windows",
+                      IqnImvj::create, IqnImvj::spec());
 
   r.convergence_measures.add("absolute", "|x^k - x^(k-1)| <= limit (data unit)",
                              AbsoluteConvergence::create,

@@ -1,0 +1,227 @@
+#include "partita/coupling/acceleration/iqn_imvj.hpp"
+
+#include <cmath>
+#include <string>
+
+#include <Eigen/QR>
+#include <Eigen/SVD>
+
+#include "partita/interface/error.hpp"
+
+namespace partita::coupling {
+
+IqnImvj::IqnImvj(Options options) : options_(options) {
+  if (!(options_.initial_relaxation > 0.0 && options_.initial_relaxation <= 1.0))
+    throw Error("IQN-IMVJ initial relaxation must satisfy 0 < omega <= 1, found " +
+                std::to_string(options_.initial_relaxation));
+  if (options_.max_columns < 1) throw Error("IQN-IMVJ needs max_columns >= 1");
+  if (options_.chunk_size < 1) throw Error("IQN-IMVJ needs chunk_size >= 1");
+  if (!(options_.truncation >= 0.0 && options_.truncation < 1.0))
+    throw Error("IQN-IMVJ truncation must satisfy 0 <= truncation < 1, found " +
+                std::to_string(options_.truncation));
+}
+
+void IqnImvj::reset(Eigen::Index rows) {
+  v_.resize(rows, 0);
+  w_.resize(rows, 0);
+  a_.resize(rows, 0);
+  b_.resize(rows, 0);
+  qr_.reset(rows);
+  qr_weights_.resize(0);
+  windows_since_restart_ = 0;
+}
+
+void IqnImvj::start_window_factorisation(const Eigen::VectorXd& weights) {
+  // The weights are fixed within a window; should they change, refactorise the (few) columns.
+  if (qr_weights_.size() == weights.size() && qr_weights_ == weights && qr_.cols() == v_.cols())
+    return;
+  qr_.reset(v_.rows());
+  qr_weights_ = weights;
+  for (Eigen::Index j = 0; j < v_.cols();) {
+    if (qr_.append(weights.cwiseProduct(v_.col(j)))) {
+      ++j;
+    } else {
+      const Eigen::Index n = v_.cols();
+      v_.middleCols(j, n - j - 1) = v_.rightCols(n - j - 1).eval();
+      w_.middleCols(j, n - j - 1) = w_.rightCols(n - j - 1).eval();
+      v_.conservativeResize(Eigen::NoChange, n - 1);
+      w_.conservativeResize(Eigen::NoChange, n - 1);
+      ++filtered_;
+    }
+  }
+}
+
+void IqnImvj::remove_column(Eigen::Index j) {
+  const Eigen::Index n = v_.cols();
+  if (j + 1 < n) {
+    v_.middleCols(j, n - j - 1) = v_.rightCols(n - j - 1).eval();
+    w_.middleCols(j, n - j - 1) = w_.rightCols(n - j - 1).eval();
+  }
+  v_.conservativeResize(Eigen::NoChange, n - 1);
+  w_.conservativeResize(Eigen::NoChange, n - 1);
+  qr_.delete_column(j);
+}
+
+void IqnImvj::add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                          const Eigen::VectorXd& weights) {
+  const Eigen::VectorXd r = x_tilde - x;
+  if (!first_iteration_ && previous_residual_.size() == r.size()) {
+    const Eigen::VectorXd dv = r - previous_residual_;
+    if (qr_.insert_column(0, weights.cwiseProduct(dv))) {
+      const Eigen::Index n = v_.cols();
+      Eigen::MatrixXd v(r.size(), n + 1), w(r.size(), n + 1);
+      v.col(0) = dv;
+      w.col(0) = x_tilde - previous_x_tilde_;
+      if (n > 0) {
+        v.rightCols(n) = v_;
+        w.rightCols(n) = w_;
+      }
+      v_.swap(v);
+      w_.swap(w);
+    } else {
+      ++filtered_;  // zero, or dependent on the columns in to rounding
+    }
+    while (v_.cols() > options_.max_columns) remove_column(v_.cols() - 1);
+    if (options_.filter == Filter::qr2) {
+      for (Eigen::Index j = 0; j < qr_.cols();) {
+        if (std::abs(qr_.diagonal(j)) < options_.filter_limit * qr_.column_norm(j)) {
+          remove_column(j);
+          ++filtered_;
+        } else {
+          ++j;
+        }
+      }
+    }
+  }
+  previous_residual_ = r;
+  previous_x_tilde_ = x_tilde;
+}
+
+Eigen::VectorXd IqnImvj::apply_previous_jacobian(const Eigen::VectorXd& y) const {
+  if (a_.cols() == 0) return Eigen::VectorXd::Zero(y.size());
+  return a_ * (b_.transpose() * y);
+}
+
+void IqnImvj::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                         const Eigen::VectorXd& weights, Eigen::VectorXd& next) {
+  if (v_.rows() != x.size()) reset(x.size());  // the data changed size: start over
+  start_window_factorisation(weights);
+  add_columns(x, x_tilde, weights);
+  first_iteration_ = false;
+  const Eigen::VectorXd r = x_tilde - x;
+  if (v_.cols() == 0 && a_.cols() == 0) {
+    // no model yet: x_{k+1} = x_k + omega_0 r_k
+    next = x + options_.initial_relaxation * r;
+    return;
+  }
+  // x_{k+1} = H(x_k) + W c - J_prev (r_k + V c),  c = argmin |D (V c + r_k)|
+  Eigen::VectorXd rest = r;
+  next = x_tilde;
+  if (v_.cols() > 0) {
+    const Eigen::VectorXd c = qr_.solve(-weights.cwiseProduct(r));
+    next += w_ * c;
+    rest += v_ * c;
+  }
+  if (a_.cols() > 0) next -= a_ * (b_.transpose() * rest);
+}
+
+void IqnImvj::window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                               const Eigen::VectorXd& weights) {
+  // The converged iteration's differences belong to this window's secants too.
+  if (v_.rows() != x.size()) reset(x.size());
+  start_window_factorisation(weights);
+  add_columns(x, x_tilde, weights);
+  first_iteration_ = true;
+  const Eigen::Index m = v_.cols();
+  if (m > 0) {
+    // J_prev <- J_prev + (W - J_prev V) Z,  Z^T = D^2 V (V^T D^2 V)^{-1} = D Q R^{-T}
+    Eigen::MatrixXd w_tilde = w_;
+    if (a_.cols() > 0) w_tilde -= a_ * (b_.transpose() * v_);
+    const Eigen::MatrixXd z_t =
+        weights.asDiagonal() *
+        qr_.r().triangularView<Eigen::Upper>().solve(qr_.q().transpose()).transpose();
+    const Eigen::Index p = a_.cols();
+    a_.conservativeResize(Eigen::NoChange, p + m);
+    b_.conservativeResize(Eigen::NoChange, p + m);
+    a_.rightCols(m) = w_tilde;
+    b_.rightCols(m) = z_t;
+  }
+  v_.resize(x.size(), 0);
+  w_.resize(x.size(), 0);
+  qr_.reset(x.size());
+  qr_weights_.resize(0);
+  if (++windows_since_restart_ >= options_.chunk_size) restart();
+}
+
+void IqnImvj::restart() {
+  windows_since_restart_ = 0;
+  if (a_.cols() == 0) return;
+  ++restarts_;
+  if (options_.restart == Restart::zero) {
+    a_.resize(a_.rows(), 0);
+    b_.resize(b_.rows(), 0);
+    return;
+  }
+  // A B^T = Qa (Ra Rb^T) Qb^T with thin QRs; Ra Rb^T = U S V^T (p x p); keep s_i > tau s_0.
+  const Eigen::Index rows = a_.rows(), p = a_.cols();
+  const Eigen::Index k = std::min(rows, p);
+  Eigen::HouseholderQR<Eigen::MatrixXd> qa(a_), qb(b_);
+  const Eigen::MatrixXd ra = qa.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd rb = qb.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(ra * rb.transpose(),
+                                        Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd& s = svd.singularValues();
+  Eigen::Index keep = 0;
+  while (keep < s.size() && s(keep) > options_.truncation * s(0) && s(keep) > 0.0) ++keep;
+  const Eigen::MatrixXd q_a = qa.householderQ() * Eigen::MatrixXd::Identity(rows, k);
+  const Eigen::MatrixXd q_b = qb.householderQ() * Eigen::MatrixXd::Identity(rows, k);
+  a_ = q_a * (svd.matrixU().leftCols(keep) * s.head(keep).asDiagonal());
+  b_ = q_b * svd.matrixV().leftCols(keep);
+}
+
+std::shared_ptr<const config::Spec> IqnImvj::spec() {
+  auto s = std::make_shared<config::Spec>(
+      "iqn-imvj",
+      "interface quasi-Newton, inverse Jacobian from a multi-vector update carried across "
+      "windows (Lindner et al. 2015; restarts after Scheufele & Mehl 2017)");
+  s->string("type", "the acceleration's name").required();
+  s->real("initial_relaxation",
+          "relaxation factor of the first iteration, before any Jacobian information")
+      .min(0.0, true)
+      .max(1.0)
+      .def(0.1);
+  s->integer("max_columns", "most columns of one window in V and W (oldest dropped first)")
+      .min(1)
+      .def(50);
+  s->choice("filter", "filter of nearly dependent columns", {"none", "qr2"}).def("qr2");
+  s->real("filter_limit", "limit of the filter (stricter than IQN-ILS's: secants stay in J)")
+      .positive()
+      .def(1e-2);
+  s->choice("restart",
+            "every chunk_size windows: svd keeps the truncated SVD of the Jacobian, zero drops it",
+            {"svd", "zero"})
+      .def("svd");
+  s->integer("chunk_size", "windows between restarts").min(1).def(8);
+  s->real("truncation", "svd restart: singular values below this times the largest are dropped")
+      .non_negative()
+      .max(1.0, true)
+      .def(1e-4);
+  s->strings("data",
+             "the data fields to accelerate (default: what the last participant in order writes, "
+             "or every exchange for parallel schemes)");
+  return s;
+}
+
+std::unique_ptr<Acceleration> IqnImvj::create(const config::Node& node) {
+  Options o;
+  o.initial_relaxation = node.real("initial_relaxation");
+  o.max_columns = static_cast<int>(node.integer("max_columns"));
+  o.filter = node.string("filter") == "none" ? Filter::none : Filter::qr2;
+  o.filter_limit = node.real("filter_limit");
+  o.restart = node.string("restart") == "zero" ? Restart::zero : Restart::svd;
+  o.chunk_size = static_cast<int>(node.integer("chunk_size"));
+  o.truncation = node.real("truncation");
+  return std::make_unique<IqnImvj>(o);
+}
+
+}  // namespace partita::coupling
