@@ -45,9 +45,7 @@ std::shared_ptr<const config::Spec> Aitken::spec() {
       .min(0.0, true)
       .max(1.0)
       .def(0.5);
-  s->strings("data",
-             "the data fields to accelerate (default: what the last participant in order writes, "
-             "or every exchange for parallel schemes)");
+  declare_accelerated_data(*s);
   return s;
 }
 

@@ -21,9 +21,7 @@ std::shared_ptr<const config::Spec> ConstantRelaxation::spec() {
       std::make_shared<config::Spec>("constant", "constant under-relaxation x + omega (H(x) - x)");
   s->string("type", "the acceleration's name").required();
   s->real("relaxation", "the relaxation factor omega").range(0.0, 1.0).min(0.0, true).def(0.5);
-  s->strings("data",
-             "the data fields to accelerate (default: what the last participant in order writes, "
-             "or every exchange for parallel schemes)");
+  declare_accelerated_data(*s);
   return s;
 }
 

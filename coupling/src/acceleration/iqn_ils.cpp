@@ -193,9 +193,7 @@ std::shared_ptr<const config::Spec> IqnIls::spec() {
   s->integer("reused_windows", "past windows whose columns are kept").non_negative().def(8);
   s->choice("filter", "filter of nearly dependent columns", {"none", "qr1", "qr2"}).def("qr2");
   s->real("filter_limit", "limit of the filter").positive().def(1e-3);
-  s->strings("data",
-             "the data fields to accelerate (default: what the last participant in order writes, "
-             "or every exchange for parallel schemes)");
+  declare_accelerated_data(*s);
   return s;
 }
 

@@ -206,9 +206,7 @@ std::shared_ptr<const config::Spec> IqnImvj::spec() {
       .non_negative()
       .max(1.0, true)
       .def(1e-4);
-  s->strings("data",
-             "the data fields to accelerate (default: what the last participant in order writes, "
-             "or every exchange for parallel schemes)");
+  declare_accelerated_data(*s);
   return s;
 }
 

@@ -16,7 +16,14 @@
 
 #include <Eigen/Core>
 
+namespace partita::config {
+class Spec;
+}
+
 namespace partita::coupling {
+
+/// Declares the key every acceleration takes: `data`, the fields it accelerates.
+void declare_accelerated_data(config::Spec& spec);
 
 class Acceleration {
  public:
