@@ -1,15 +1,27 @@
 // partita: the command line. A thin main over the libraries:
-//   partita run CASE.yaml [--output DIR] [--threads N] [--log-level L]
+//   partita run CASE.yaml [--output DIR] [--threads N] [--log-level L] [--resume DIR]
 //   partita check CASE.yaml
 //   partita list
 //   partita docs [NAME]
-// Exit status 0 on success; 1 with one clear message on any user error; 2 on usage errors.
+// Exit status 0 on success; 1 with one clear message on any user error; 2 on usage errors;
+// 128 + N when signal N (SIGINT 130, SIGTERM 143) stopped a run (after a restart file).
 
+#include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <vector>
+
+#include <atomic>
+#include <csignal>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
@@ -17,17 +29,34 @@
 #include <omp.h>
 #endif
 
+#include "partita/adapters/mesh_files.hpp"
 #include "partita/adapters/register_all.hpp"
 #include "partita/coupling/case_run.hpp"
 #include "partita/coupling/registries.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
-#include "partita/interface/stl.hpp"
 #include "partita/interface/version.hpp"
 
 namespace {
 
 using partita::coupling::Registries;
+
+// SIGINT / SIGTERM: the run finishes its window, writes a restart file, flushes its CSV files and
+// returns; a second signal of the same kind ends the process at once (SA_RESETHAND).
+std::atomic<int> g_stop_signal{0};
+
+extern "C" void on_stop_signal(int signal) {
+  g_stop_signal.store(signal);
+}
+
+void install_stop_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
 
 Registries make_registries() {
   Registries r;
@@ -46,21 +75,28 @@ void for_each_registry(const Registries& r, F&& f) {
   f("convergence measures", r.convergence_measures);
 }
 
-// `partita check FILE.stl`: read and validate a triangle mesh, print what it holds.
-int check_stl(const std::string& file) {
-  const partita::Mesh m = partita::read_stl(file, "mesh");
-  const auto box = m.bounding_box();
-  std::cout << "partita check: " << file << " is a valid STL: " << m.num_triangles()
-            << " triangles, " << m.size() << " distinct vertices, area " << m.total_area()
-            << " m^2 (if in metres), bounding box [" << box.min.transpose() << "] .. ["
-            << box.max.transpose() << "]\n";
-  return 0;
+// Run a program with an argument vector, no shell in between (nothing in an argument is ever
+// interpreted: a quote or a ';' in a case name is just a character), standard output discarded.
+// Returns the exit status, or -1 if it could not be started or ended by a signal.
+int run_program(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (rc != 0) return -1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-bool is_stl(const std::string& file) {
-  std::string ext = std::filesystem::path(file).extension().string();
-  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".stl";
+std::string python_interpreter() {
+  return std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
 }
 
 // PNG plots of the run's CSV time series, drawn by the bundled matplotlib script. A missing
@@ -71,15 +107,14 @@ void plot_csv_files(const std::filesystem::path& dir) {
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().extension() == ".csv") csvs.push_back(e.path().string());
   if (csvs.empty()) return;
+  std::sort(csvs.begin(), csvs.end());
   fs::path script = PARTITA_PLOT_SCRIPT;
   if (!fs::exists(script))
     script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_monitors.py";
   if (!fs::exists(script)) return;
-  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  std::string cmd = python + " '" + script.string() + "'";
-  for (const auto& c : csvs) cmd += " '" + c + "'";
-  cmd += " >/dev/null";
-  if (std::system(cmd.c_str()) != 0)
+  std::vector<std::string> args = {python_interpreter(), script.string()};
+  args.insert(args.end(), csvs.begin(), csvs.end());
+  if (run_program(args) != 0)
     partita::log::get("app")->warn(
         "plotting the CSV files failed (is python3-matplotlib installed?)");
   else
@@ -89,12 +124,9 @@ void plot_csv_files(const std::filesystem::path& dir) {
 // The case's post-processing scripts (output.scripts), with the output folder as argument.
 void run_scripts(const std::vector<std::filesystem::path>& scripts,
                  const std::filesystem::path& dir) {
-  const std::string python =
-      std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   for (const auto& s : scripts) {
-    const std::string cmd = python + " '" + s.string() + "' '" + dir.string() + "'";
     partita::log::get("app")->info("post-processing: {}", s.filename().string());
-    if (std::system(cmd.c_str()) != 0)
+    if (run_program({python_interpreter(), s.string(), dir.string()}) != 0)
       partita::log::get("app")->warn("post-processing script {} failed", s.string());
   }
 }
@@ -128,6 +160,14 @@ int docs(const Registries& r, const std::string& name) {
         std::cout << e.spec->docs(2);
       else
         std::cout << "  (no parameters)\n";
+      if (!e.quantities.empty()) {
+        std::cout << "  monitor quantities (for monitors: - {quantities: [participant.NAME]}):\n";
+        std::size_t w = 0;
+        for (const auto& q : e.quantities) w = std::max(w, q.name.size());
+        for (const auto& q : e.quantities)
+          std::cout << "    " << q.name << std::string(w + 2 - q.name.size(), ' ') << "["
+                    << (q.unit.empty() ? "-" : q.unit) << "] " << q.doc << "\n";
+      }
     }
   });
   if (!found)
@@ -160,13 +200,18 @@ int main(int argc, char** argv) {
   run->add_option("--log-level", log_level,
                   "Log level: trace, debug, info, warn, error, critical, off");
   std::vector<std::string> overrides;
+  std::string resume_dir;
+  run->add_option("--resume", resume_dir,
+                  "Continue the run whose output folder this is from its newest restart file "
+                  "(DIR/restart/w<window>.bin), bit for bit; time.end may be raised with --set");
   run->add_option("--set", overrides,
                   "Change a value of the case: KEY.PATH=VALUE (e.g. time.end=0.01, "
                   "participants.plate.loads[0].pressure='20 kPa'); repeatable")
       ->take_all();
-  auto* check =
-      app.add_subcommand("check", "Validate a case completely without running it (or an STL file)");
-  check->add_option("case", case_file, "The case file (YAML), or an STL mesh (.stl)")->required();
+  auto* check = app.add_subcommand(
+      "check", "Validate a case completely without running it, or a mesh file (.stl, .msh)");
+  check->add_option("case", case_file, "The case file (YAML), or a mesh file (.stl, Gmsh .msh)")
+      ->required();
   check->add_option("--log-level", log_level, "Log level");
   check
       ->add_option("--set", overrides,
@@ -193,6 +238,8 @@ int main(int argc, char** argv) {
     partita::coupling::RunOptions options;
     options.output_dir = output_dir;
     options.overrides = overrides;
+    options.resume_dir = resume_dir;
+    options.stop_signal = &g_stop_signal;
 #ifdef _OPENMP
     options.threads = threads > 0 ? threads : omp_get_num_procs();
     omp_set_num_threads(options.threads);
@@ -200,15 +247,28 @@ int main(int argc, char** argv) {
     options.threads = threads > 0 ? threads : 1;
 #endif
     if (app.got_subcommand("check")) {
-      if (is_stl(case_file)) return check_stl(case_file);
+      if (const auto mesh = partita::adapters::describe_mesh_file(case_file)) {
+        std::cout << "partita check: " << *mesh << "\n";
+        return 0;
+      }
       options.check_only = true;
       partita::coupling::CaseRun c(case_file, registries, options);
       std::cout << "partita check: " << case_file << " is valid\n";
       return 0;
     }
     partita::coupling::CaseRun c(case_file, registries, options);
+    install_stop_handlers();
     c.run();
     plot_csv_files(c.output_dir());
+    if (const int signal = c.summary().stopped_by_signal; signal != 0) {
+      std::cout << "partita run: stopped by signal " << signal << " after window "
+                << c.summary().windows << "; output in " << c.output_dir().string() << "/";
+      if (!c.summary().last_restart.empty())
+        std::cout << "; continue with: partita run " << case_file << " --resume "
+                  << c.output_dir().string();
+      std::cout << "\n";
+      return 128 + signal;
+    }
     run_scripts(c.scripts(), c.output_dir());
     std::cout << "partita run: finished; output in " << c.output_dir().string()
               << "/ (CSV time series and their "

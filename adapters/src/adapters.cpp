@@ -15,22 +15,48 @@ namespace partita::adapters {
 
 void register_all(coupling::Registries& r) {
 #ifdef PARTITA_HAVE_DEM
-  r.solvers.add("dem",
-                "native DEM: Hertz-Mindlin spheres, walls, STL meshes as coupling interfaces",
-                DemAdapter::create, DemAdapter::spec());
+  r.solvers.add(
+      "dem", "native DEM: Hertz-Mindlin spheres, walls, STL meshes as coupling interfaces",
+      DemAdapter::create, DemAdapter::spec(),
+      {{"kinetic_energy", "J", "translational plus rotational kinetic energy of the particles"},
+       {"particles", "", "number of particles"},
+       {"contacts_per_particle", "", "mean number of particle-particle contacts"},
+       {"<mesh>.force_x", "N", "total contact force of the particles on a mesh, x"},
+       {"<mesh>.force_y", "N", "... y"},
+       {"<mesh>.force_z", "N", "... z"},
+       {"<wall>.force_x", "N", "total contact force of the particles on a plane wall, x"},
+       {"<wall>.force_y", "N", "... y"},
+       {"<wall>.force_z", "N", "... z"}});
 #endif
 #ifdef PARTITA_HAVE_FEM
-  r.solvers.add("fem",
-                "native linear-elastic FEM: Hex8/Hex20/Tet4/Tet10, static or Newmark transient",
-                FemAdapter::create, FemAdapter::spec());
+  r.solvers.add(
+      "fem", "native linear-elastic FEM: Hex8/Hex20/Tet4/Tet10, static or Newmark transient",
+      FemAdapter::create, FemAdapter::spec(),
+      {{"<interface>.force_x", "N",
+        "total force the interface received (tractions times areas plus nodal forces), x"},
+       {"<interface>.force_y", "N", "... y"},
+       {"<interface>.force_z", "N", "... z"},
+       {"static_reaction_x", "N",
+        "minus the sum of the applied loads (gravity included): what the interfaces must "
+        "carry in static equilibrium, x"},
+       {"static_reaction_y", "N", "... y"},
+       {"static_reaction_z", "N", "... z"},
+       {"max_displacement", "m", "largest nodal displacement magnitude"},
+       {"kinetic_energy", "J", "1/2 v^T M v"},
+       {"strain_energy", "J", "1/2 u^T K u"}});
 #endif
 #ifdef PARTITA_HAVE_TUBE1D
   r.solvers.add("tube1d-fluid",
                 "1D elastic tube: quasi-1D incompressible flow (writes pressure, reads area)",
-                TubeFluidAdapter::create, TubeFluidAdapter::spec());
+                TubeFluidAdapter::create, TubeFluidAdapter::spec(),
+                {{"inlet_pressure", "Pa", "pressure in the first cell"},
+                 {"outlet_pressure", "Pa", "pressure in the last cell"},
+                 {"inlet_velocity", "m/s", "velocity in the first cell"}});
   r.solvers.add("tube1d-solid",
                 "1D elastic tube: tube law a(p) (reads pressure, writes cross_section_area)",
-                TubeSolidAdapter::create, TubeSolidAdapter::spec());
+                TubeSolidAdapter::create, TubeSolidAdapter::spec(),
+                {{"mid_area", "m^2", "cross-section area at the middle of the tube"},
+                 {"max_area", "m^2", "largest cross-section area"}});
 #endif
   (void)r;
 }

@@ -1,6 +1,7 @@
 #include "partita/coupling/case_run.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <set>
@@ -16,11 +17,10 @@ namespace partita::coupling {
 
 namespace fs = std::filesystem;
 
-struct CaseRun::Monitor {
-  std::string name;
-  std::vector<std::pair<Participant*, std::string>> quantities;
-  CsvSeries csv;
-};
+namespace {
+// Above this many windows a run is almost surely a typing error in time.window or time.end.
+constexpr double kWindowWarning = 1e8;
+}  // namespace
 
 // ---------------------------------------------------------------------------------------------
 // Schema
@@ -42,8 +42,10 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
   exchange->string("from", "sender as participant.mesh").required();
   exchange->string("to", "receiver as participant.mesh").required();
   exchange
-      ->any("mapper", "mapper name or {type: name, options}; known: " +
-                          join_names(registries.mappers.names()))
+      ->any("mapper",
+            "a mapper name, or a map {type: name, <the mapper's own keys>} (partita docs NAME "
+            "lists them; e.g. {type: rbf, support_radius: 2 mm}); known: " +
+                join_names(registries.mappers.names()))
       .def("nearest-neighbor");
   exchange->choice("constraint",
                    "override the constraint that the data kind implies (intensive: consistent, "
@@ -77,8 +79,10 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
                  "types: " +
                      join_names(registries.convergence_measures.names()),
                  nullptr);
-  coupling->any("acceleration", "implicit schemes: {type, options}; known: " +
-                                    join_names(registries.accelerations.names()));
+  coupling->any("acceleration",
+                "implicit schemes: {type: name, <the acceleration's own keys>} (partita docs "
+                "NAME lists them; e.g. {type: iqn-ils, initial_relaxation: 0.1}); known: " +
+                    join_names(registries.accelerations.names()));
   coupling->integer("max_iterations", "implicit schemes: most iterations per window")
       .min(1)
       .def(100);
@@ -88,6 +92,13 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
                "window with a warning",
                {"error", "accept"})
       .def("accept");
+  coupling
+      ->real("balance_tolerance",
+             "warn when an exchange's total (a force's sum, or a traction's or other field's "
+             "integral over point weights) arrives after mapping off by more than this fraction "
+             "of what was sent (audit columns in coupling.csv)")
+      .positive()
+      .def(0.01);
 
   auto monitor =
       std::make_shared<Spec>("monitor", "a CSV time series DIR/<name>.csv of solver quantities");
@@ -100,6 +111,18 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
       .positive();
   output->boolean("interface", "also write the interface meshes with their exchanged data (.vtp)")
       .def(true);
+  auto restart = std::make_shared<Spec>(
+      "restart",
+      "restart files DIR/restart/w<window>.bin; continue with partita run CASE --resume DIR");
+  restart->integer("every_windows", "windows between restart files").min(1);
+  restart->real("every_minutes", "wall-clock minutes between restart files").positive();
+  restart->integer("keep", "newest restart files kept (older ones are removed)").min(1).def(2);
+  restart->boolean("at_end", "also write one after the last window (to extend the run later)")
+      .def(true);
+  output->section(
+      "restart",
+      "restart files (a run stopped by SIGINT/SIGTERM writes one whether declared or not)",
+      restart);
   output->strings("scripts",
                   "post-processing scripts of the case folder, run by `partita run` after the last "
                   "window with the output folder as argument (e.g. plots of the final state)");
@@ -131,6 +154,33 @@ std::pair<std::string, std::string> split_dot(const config::Node& n, const char*
   return {s.substr(0, dot), s.substr(dot + 1)};
 }
 
+// What a restart file must come from: the same participants and coupling (the time and output
+// sections may change, e.g. a later end time). FNV-1a of their YAML text.
+std::uint64_t case_identity(const config::Node& root) {
+  std::string text = root.string("case");
+  for (const char* key : {"participants", "coupling"}) {
+    YAML::Emitter e;
+    e << root[key].yaml();
+    text += std::string("\n") + key + ":\n" + e.c_str();
+  }
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+// A case name becomes a folder name (out/<case>/) and part of file names: a plain name only.
+void check_plain_name(const config::Node& n, const std::string& name, const std::string& what) {
+  const bool bad_char = std::any_of(name.begin(), name.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return !(std::isalnum(u) || c == '-' || c == '_' || c == '.' || c == '+');
+  });
+  if (name.empty() || bad_char || name == "." || name == ".." || name.front() == '.')
+    n.fail(what +
+           " is used in folder and file names, so it must be a plain name: letters, digits, "
+           "'-', '_', '.', '+', not starting with '.' (no '/', no spaces, no quotes); found '" +
+           name + "'");
+}
+
 }  // namespace
 
 Participant* CaseRun::participant(const std::string& name) const {
@@ -144,16 +194,54 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
   const config::Node root =
       config::Node::load_file(case_file, options_.overrides).validated(case_spec(registries));
   name_ = root.string("case");
+  check_plain_name(root["case"], name_, "the case name");
   case_dir_ = fs::absolute(case_file).parent_path();
   output_dir_ =
       options_.output_dir.empty() ? fs::current_path() / "out" / name_ : options_.output_dir;
+  if (!options_.resume_dir.empty()) {
+    if (!options_.output_dir.empty() &&
+        fs::weakly_canonical(options_.output_dir) != fs::weakly_canonical(options_.resume_dir))
+      throw Error("--resume " + options_.resume_dir.string() +
+                  " continues in that folder; leave out --output (" + options_.output_dir.string() +
+                  ")");
+    output_dir_ = options_.resume_dir;
+  }
+  identity_ = case_identity(root);
 
   const config::Node time = root["time"];
   window_size_ = time.real("window");
-  window_count_ = time.has("windows") ? time.integer("windows")
-                                      : TimeWindow::count_to(time.real("end"), window_size_);
+  if (time.has("windows")) {
+    window_count_ = time.integer("windows");
+  } else {
+    try {
+      window_count_ = TimeWindow::count_to(time.real("end"), window_size_);
+    } catch (const Error& e) {
+      time["end"].fail(e.what());
+    }
+    if (window_size_ > time.real("end"))
+      log::get("coupling")
+          ->warn(
+              "{}: time.window ({:.6g} s) is longer than time.end ({:.6g} s): the run makes one "
+              "window "
+              "and ends at t = {:.6g} s",
+              time["window"].location().str(), window_size_, time.real("end"), window_size_);
+  }
+  if (static_cast<double>(window_count_) > kWindowWarning)
+    log::get("coupling")
+        ->warn(
+            "{}: {} windows of {:.6g} s is more than {:.0e}: at a microsecond per window that is "
+            "over "
+            "a day of run time; check time.window and time.end",
+            time.location().str(), window_count_, window_size_, kWindowWarning);
   if (root.has("output") && root["output"].has("every"))
     output_every_ = root["output"].real("every");
+  if (root.has("output") && root["output"].has("restart")) {
+    const config::Node r = root["output"]["restart"];
+    if (r.has("every_windows")) restart_every_windows_ = r.integer("every_windows");
+    if (r.has("every_minutes")) restart_every_seconds_ = 60.0 * r.real("every_minutes");
+    restart_keep_ = static_cast<int>(r.integer("keep"));
+    restart_at_end_ = r.boolean("at_end");
+  }
   if (root.has("output") && root["output"].has("scripts"))
     for (const config::Node& sn : root["output"]["scripts"].items()) {
       const fs::path script = case_dir_ / sn.as_string();
@@ -175,6 +263,16 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
   scheme_ = entry.factory(ctx);
 
   build_monitors(root);
+
+  if (root.has("output") && root["output"].has("restart") && !restart_blocker().empty())
+    root["output"]["restart"].fail(restart_blocker() + "; remove output.restart");
+  balance_tolerance_ = coupling.real("balance_tolerance");
+  for (const auto& e : exchanges_) {
+    const bool extensive = e->spec().kind == DataKind::extensive;
+    const bool weighted = e->from().find_mesh(e->from_mesh())->mesh.has_weights() &&
+                          e->to().find_mesh(e->to_mesh())->mesh.has_weights();
+    if (extensive || weighted) audited_.push_back(e.get());
+  }
 }
 
 CaseRun::~CaseRun() = default;
@@ -249,6 +347,7 @@ void CaseRun::build_participants(const config::Node& root) {
     if (name.find('.') != std::string::npos)
       pn.fail("a participant name may not contain '.', found '" + name +
               "' (meshes are named participant.mesh)");
+    check_plain_name(pn, name, "a participant name");
     if (!pn.is_map() || !pn.has("solver"))
       pn.fail("participant '" + name + "' needs 'solver: <name>'; known solvers: " +
               join_names(registries_.solvers.names()));
@@ -276,6 +375,9 @@ void CaseRun::build_participants(const config::Node& root) {
     participants_.push_back(std::make_unique<Participant>(name, std::move(solver), s));
     if (participants_.back()->solver().meshes().empty())
       pn.fail("solver '" + entry.name + "' of participant '" + name + "' exposes no coupling mesh");
+    for (const auto& m : participants_.back()->solver().meshes())
+      check_plain_name(pn, m.mesh.name(),
+                       "the mesh name '" + m.mesh.name() + "' of '" + name + "'");
   }
 }
 
@@ -407,8 +509,12 @@ void CaseRun::write_output(int frame, double time) {
   for (auto& p : participants_) {
     OutputFrame f{vtk, p->name(), frame, time};
     p->solver().write_output(f);  // counted as output time, not the participant's
-    for (const auto& [series, file] : p->solver().output_files())
+    for (const auto& [series, file] : p->solver().output_files()) {
+      if (fs::path(file).has_parent_path() || file.empty() || file.front() == '.')
+        throw Error("participant '" + p->name() + "' wrote the output file '" + file +
+                    "', which is not a plain file name inside " + vtk.string());
       pvd(p->name() + "_" + series).add(time, file);
+    }
     // interface meshes with their exchanged data
     for (const auto& im : p->solver().meshes()) {
       VtkArrays arrays;
@@ -434,14 +540,23 @@ void CaseRun::run() {
   if (options_.check_only) return;
   auto logger = log::get("coupling");
   Stopwatch wall;
+  const bool resume = !options_.resume_dir.empty();
+  fs::path resume_file;
+  if (resume) {
+    resume_file = newest_restart_file();
+    if (const std::string why = restart_blocker(); !why.empty())
+      throw Error("cannot resume from " + resume_file.string() + ": " + why);
+  }
   fs::create_directories(output_dir_ / "vtk");
-  if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
-    logger->info("removed {} VTK files of an earlier run from {}", removed,
-                 (output_dir_ / "vtk").string());
+  if (!resume)
+    if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
+      logger->info("removed {} VTK files of an earlier run from {}", removed,
+                   (output_dir_ / "vtk").string());
 
   std::vector<std::pair<std::string, std::string>> columns = {{"time", "s"}, {"iterations", ""}};
   for (const auto& c : scheme_->residual_columns()) columns.push_back(c);
-  CsvSeries coupling_csv(output_dir_ / "coupling.csv", "window", "", columns);
+  for (const Exchange* e : audited_) columns.emplace_back("imbalance " + e->label(), "");
+  coupling_csv_ = CsvSeries(output_dir_ / "coupling.csv", "window", "", columns);
   for (auto& m : monitors_) {
     std::vector<std::pair<std::string, std::string>> mc;
     for (const auto& [p, q] : m.quantities) {
@@ -457,8 +572,17 @@ void CaseRun::run() {
   for (const auto& m : monitors_)
     for (const auto& [p, q] : m.quantities) wanted[p].push_back(q);
   std::map<Participant*, std::vector<MonitorValue>> values;
-  auto record_monitors = [&](double t) {
-    for (const auto& [p, names] : wanted) values[p] = p->solver().monitor_values(names);
+  auto record_monitors = [&](double t, std::int64_t window) {
+    for (const auto& [p, names] : wanted) {
+      values[p] = p->solver().monitor_values(names);
+      for (const auto& mv : values[p])
+        if (!std::isfinite(mv.value))
+          throw Error(fmt::format(
+              "window {} (t = {:.6g} s): participant '{}' reports {} = {} {}: the run is "
+              "diverging; reduce time.window or the substep size, add damping, or check the "
+              "materials and loads",
+              window, t, p->name(), mv.name, mv.value, mv.unit));
+    }
     for (auto& m : monitors_) {
       std::vector<double> row;
       for (const auto& [p, q] : m.quantities) {
@@ -471,12 +595,27 @@ void CaseRun::run() {
     }
   };
   auto flush_all = [&] {
-    coupling_csv.flush();
+    coupling_csv_.flush();
     for (auto& m : monitors_) m.csv.flush();
   };
 
+  Progress progress;
+  progress.next_output = output_every_;
+  if (resume) {
+    read_restart_file(resume_file, progress);
+    summary_.resumed_from = progress.windows_done;
+    if (progress.windows_done >= window_count_)
+      throw Error(fmt::format(
+          "{}: the restart point is window {} (t = {:.6g} s), and the case ends there (window "
+          "{}): nothing to continue; raise time.end, e.g. --set time.end={:.6g}",
+          resume_file.string(), progress.windows_done,
+          static_cast<double>(progress.windows_done) * window_size_, window_count_,
+          2.0 * static_cast<double>(progress.windows_done) * window_size_));
+  }
+
   logger->info(
-      "case '{}': {} windows of {:.6g} s to t = {:.6g} s, scheme {}, participants {}; output in {}",
+      "case '{}': {} windows of {:.6g} s to t = {:.6g} s, scheme {}, participants {}; output in "
+      "{}{}",
       name_, window_count_, window_size_, static_cast<double>(window_count_) * window_size_,
       scheme_->name(),
       [&] {
@@ -484,35 +623,70 @@ void CaseRun::run() {
         for (auto& p : participants_) n.push_back(p->name());
         return join_names(n);
       }(),
-      output_dir_.string());
+      output_dir_.string(),
+      resume ? fmt::format("; resumed after window {} from {}", progress.windows_done,
+                           resume_file.filename().string())
+             : std::string());
 
-  ProgressLine progress(window_count_);
-  int frame = 0;
-  double next_output = output_every_;
-  Stopwatch since_flush;
+  const std::string blocker = restart_blocker();
+  ProgressLine progress_line(window_count_);
+  Stopwatch since_flush, since_restart;
   double flush_interval = 2.0;  // [s]
+  bool warned_imbalance = false;
   try {
-    scheme_->initialize();
-    record_monitors(0.0);
-    write_output(frame++, 0.0);
+    if (!resume) {
+      scheme_->initialize();
+      check_window(0, 0.0);
+      record_monitors(0.0, 0);
+      write_output(progress.frame++, 0.0);
+    }
     TimeWindow window(window_size_, 0, 1);
-    for (std::int64_t n = 0; n < window_count_; ++n) {
+    for (std::int64_t n = progress.windows_done; n < window_count_; ++n) {
       window = TimeWindow(window_size_, n, 1);
       const WindowReport r = scheme_->advance(window);
       const double t = window.end();
+      progress.windows_done = n + 1;
       summary_.windows = n + 1;
       summary_.iterations += r.iterations;
       summary_.max_window_iterations = std::max(summary_.max_window_iterations, r.iterations);
       if (!r.converged) ++summary_.unconverged_windows;
+      check_window(n + 1, t);
       std::vector<double> row = {t, static_cast<double>(r.iterations)};
       row.insert(row.end(), r.residuals.begin(), r.residuals.end());
-      coupling_csv.record(static_cast<double>(n + 1), row);
-      record_monitors(t);
+      const std::vector<double> imbalance = audit_balance();
+      row.insert(row.end(), imbalance.begin(), imbalance.end());
+      for (std::size_t i = 0; i < imbalance.size(); ++i)
+        if (imbalance[i] > balance_tolerance_) {
+          ++summary_.imbalance_warnings;
+          if (!warned_imbalance)
+            logger->warn(
+                "window {} (t = {:.6g} s): exchange {} arrives off by {:.3g} of what was sent "
+                "(coupling.balance_tolerance {:.3g}); the mapper does not conserve its total: use "
+                "a conservative constraint or mapper (area-balanced for tractions); further "
+                "windows are counted in the summary",
+                n + 1, t, audited_[i]->label(), imbalance[i], balance_tolerance_);
+          warned_imbalance = true;
+        }
+      coupling_csv_.record(static_cast<double>(n + 1), row);
+      record_monitors(t, n + 1);
       const bool last = n + 1 == window_count_;
-      if ((output_every_ > 0.0 && t >= next_output - 1e-9 * window_size_) || last) {
-        write_output(frame++, t);
-        while (output_every_ > 0.0 && next_output <= t + 1e-9 * window_size_)
-          next_output = static_cast<double>(frame) * output_every_;
+      if ((output_every_ > 0.0 && t >= progress.next_output - 1e-9 * window_size_) || last) {
+        write_output(progress.frame++, t);
+        while (output_every_ > 0.0 && progress.next_output <= t + 1e-9 * window_size_)
+          progress.next_output = static_cast<double>(progress.frame) * output_every_;
+      }
+      const int signal = options_.stop_signal ? options_.stop_signal->load() : 0;
+      const bool restart_due =
+          (restart_every_windows_ > 0 && (n + 1) % restart_every_windows_ == 0) ||
+          (restart_every_seconds_ > 0.0 && since_restart.seconds() >= restart_every_seconds_) ||
+          (last && restart_at_end_) || signal != 0;
+      if (restart_due) {
+        if (blocker.empty()) {
+          write_restart_file(progress);
+          since_restart.restart();
+        } else if (signal != 0) {
+          logger->warn("no restart file: {}", blocker);
+        }
       }
       // CSV files are rewritten whole at each flush (always complete on disk): flush every 2 s,
       // or less often once a flush takes longer than 2 % of the interval (very long runs)
@@ -522,16 +696,25 @@ void CaseRun::run() {
         flush_interval = std::max(2.0, 50.0 * flush_clock.seconds());
         since_flush.restart();
       }
-      progress.update(n + 1, t, r.iterations);
+      progress_line.update(n + 1, t, r.iterations);
+      if (signal != 0) {
+        summary_.stopped_by_signal = signal;
+        progress_line.finish();
+        logger->warn("stopped by signal {} after window {} (t = {:.6g} s){}", signal, n + 1, t,
+                     summary_.last_restart.empty()
+                         ? std::string()
+                         : "; continue with: partita run CASE --resume " + output_dir_.string());
+        break;
+      }
     }
   } catch (...) {
-    progress.finish();
+    progress_line.finish();
     flush_all();  // the complete rows so far stay readable
     throw;
   }
-  progress.finish();
+  progress_line.finish();
   flush_all();
-  coupling_csv.close();
+  coupling_csv_.close();
   for (auto& m : monitors_) m.csv.close();
   for (auto& p : participants_) {
     Stopwatch sc;
@@ -555,14 +738,17 @@ void CaseRun::run() {
   logger->info(
       "summary: {} windows, {} iterations (mean {:.2f}, max {}{}); wall {:.3f} s = {}mapping "
       "{:.3f} s, "
-      "output {:.3f} s, core {:.3f} s",
+      "output {:.3f} s, core {:.3f} s{}",
       summary_.windows, summary_.iterations, summary_.mean_iterations(),
       summary_.max_window_iterations,
       summary_.unconverged_windows
           ? fmt::format(", {} windows at max_iterations", summary_.unconverged_windows)
           : std::string(),
       summary_.wall_seconds, parts, summary_.mapping_seconds, summary_.output_seconds,
-      summary_.core_seconds);
+      summary_.core_seconds,
+      summary_.imbalance_warnings
+          ? fmt::format("; {} windows with an exchange off balance", summary_.imbalance_warnings)
+          : std::string());
 }
 
 }  // namespace partita::coupling

@@ -1,6 +1,9 @@
 #include "partita/coupling/exchange.hpp"
 
+#include <fmt/format.h>
+
 #include "partita/coupling/stopwatch.hpp"
+#include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -84,6 +87,26 @@ void Exchange::initialize(const Eigen::MatrixXd& initial) {
   previous_ = initial;
   transmit();
   start_ = end_;
+}
+
+void Exchange::write_state(BinaryWriter& out) const {
+  out.section("exchange " + label());
+  for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) out.write(*m);
+}
+
+void Exchange::read_state(BinaryReader& in) {
+  in.expect_section("exchange " + label());
+  for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) in.read(*m);
+  const Eigen::Index sender = from_points_;
+  const Eigen::Index receiver = to_.participant->find_mesh(to_.mesh)->mesh.size();
+  for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_})
+    if (m->rows() != sender || m->cols() != spec_.components)
+      in.fail(fmt::format("{} x {} values of {} (the sender's mesh)", sender, spec_.components,
+                          label()));
+  for (const Eigen::MatrixXd* m : {&start_, &end_})
+    if (m->rows() != receiver || m->cols() != spec_.components)
+      in.fail(fmt::format("{} x {} values of {} (the receiver's mesh)", receiver, spec_.components,
+                          label()));
 }
 
 }  // namespace partita::coupling

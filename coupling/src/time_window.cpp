@@ -4,6 +4,8 @@
 #include <limits>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -46,8 +48,16 @@ double tolerant_ceil(double x) {
 std::int64_t TimeWindow::count_to(double end, double size) {
   if (!(size > 0.0))
     throw Error("time window size must be positive, found " + std::to_string(size));
-  if (!(end > 0.0)) throw Error("end time must be positive, found " + std::to_string(end));
-  return static_cast<std::int64_t>(std::max(1.0, tolerant_ceil(end / size)));
+  if (!(end > 0.0) || !std::isfinite(end))
+    throw Error("end time must be a positive finite number, found " + std::to_string(end));
+  const double n = std::max(1.0, tolerant_ceil(end / size));
+  // Window times are n * size with n an integer held exactly in a double: at most 2^53 windows.
+  if (!(n <= max_windows))
+    throw Error(fmt::format(
+        "an end time of {:.6g} s in windows of {:.6g} s needs {:.6g} windows, more than the {:.6g} "
+        "(2^53) a run can count exactly; use a larger window or an earlier end",
+        end, size, n, max_windows));
+  return static_cast<std::int64_t>(n);
 }
 
 int TimeWindow::substeps_for(double size, double max_step) {

@@ -85,6 +85,12 @@ void CsvSeries::flush() {
   flushed_size_ = text_.size();
 }
 
+void CsvSeries::restore_text(std::string text) {
+  text_ = std::move(text);
+  flushed_size_ = 0;
+  flush();
+}
+
 void CsvSeries::close() {
   flush();
   path_.clear();
@@ -95,6 +101,15 @@ PvdSeries::PvdSeries(std::filesystem::path path) : path_(std::move(path)) {}
 
 void PvdSeries::add(double time, const std::string& file) {
   entries_.emplace_back(time, file);
+  write();
+}
+
+void PvdSeries::restore_entries(std::vector<std::pair<double, std::string>> entries) {
+  entries_ = std::move(entries);
+  write();
+}
+
+void PvdSeries::write() const {
   std::ostringstream s;
   s << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
        "byte_order=\"LittleEndian\">\n"

@@ -66,6 +66,13 @@ std::shared_ptr<Spec> make_spec() {
       .range(0.3, 1.0, true)
       .def(0.5);
   generate->integer("seed", "random seed (same seed, same packing)").min(0).def(1);
+  generate
+      ->real("max_particles",
+             "refuse a packing estimated (box volume x (1 - porosity) / mean particle volume) "
+             "above this many particles (a typing error in the box or diameters); raise it for "
+             "larger runs")
+      .positive()
+      .def(5.0e6);
 
   auto particles =
       std::make_shared<Spec>("particles", "the particles: generated or read from a file");
@@ -139,6 +146,12 @@ std::shared_ptr<Spec> make_spec() {
       .min(0.0, true)
       .def(0.2);
   s->real("skin", "Verlet skin (default: 10 % of the largest radius)").unit("m").non_negative();
+  s->real("lost_margin",
+          "a particle farther than this outside the domain's bounding box (particles at the "
+          "start, walls of type box, meshes) stops the run as lost (default: the box's largest "
+          "edge)")
+      .unit("m")
+      .positive();
   s->integer("sort_interval",
              "renumber the particles in cell order at the first step and every N-th "
              "neighbour-list build (keeps neighbours close in memory; 0: never)")
@@ -250,6 +263,33 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
                                              : dem::PackingSpec::Basis::number;
       ps.porosity = g.real("porosity");
       ps.seed = static_cast<std::uint64_t>(g.integer("seed"));
+      // N = (1 - porosity) V_box / V_mean, V_mean the mean particle volume of the distribution
+      // (by number: sum f_i V_i / sum f_i; by mass = by volume: 1 / sum (f_i / sum f) / V_i).
+      {
+        const double pi = 3.14159265358979323846;
+        double fsum = 0.0, by_number = 0.0, inverse = 0.0;
+        for (std::size_t i = 0; i < ps.diameters.size(); ++i) fsum += ps.fractions[i];
+        for (std::size_t i = 0; i < ps.diameters.size(); ++i) {
+          const double v = pi / 6.0 * std::pow(ps.diameters[i], 3);
+          by_number += ps.fractions[i] / fsum * v;
+          inverse += ps.fractions[i] / fsum / v;
+        }
+        const double v_mean = ps.basis == dem::PackingSpec::Basis::mass ? 1.0 / inverse : by_number;
+        const Eigen::Vector3d size = ps.hi - ps.lo;
+        const double estimate = (1.0 - ps.porosity) * size.prod() / v_mean;
+        const double limit = g.real("max_particles");
+        if (!(estimate <= limit))
+          g.fail(fmt::format(
+              "this box ({:.4g} x {:.4g} x {:.4g} m) filled to porosity {:.3g} holds about {:.3g} "
+              "particles, more than max_particles = {:.3g}; check the box size and diameters "
+              "(units: a box of 5012 m instead of 0.05 m is a typical slip), or raise "
+              "max_particles",
+              size.x(), size.y(), size.z(), ps.porosity, estimate, limit));
+        if (estimate > 1e5)
+          log::get("adapters")
+              ->info("dem '{}': generating about {:.3g} particles (this may take a while)", name_,
+                     estimate);
+      }
       dem::Packing packing;
       try {
         packing = dem::PackingGenerator::generate(ps);
@@ -290,6 +330,8 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
                                                    kFaces.begin()));
         const Eigen::Vector3d lo = w["box"].vec3("origin");
         wall.id = system_.add_box(lo, lo + w["box"].vec3("size"), mid, faces);
+        domain_lo_ = domain_lo_.cwiseMin(lo);
+        domain_hi_ = domain_hi_.cwiseMax(lo + w["box"].vec3("size"));
         if (v.norm() > 0) system_.set_wall_velocity(wall.id, v);
       }
       walls_.push_back(wall);
@@ -343,6 +385,19 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
       }
     // Validate the set-up now (interactions of every pair in use, the Rayleigh step).
     (void)system_.rayleigh_time_step();
+
+    // The domain whose bounding box a particle must not leave by more than lost_margin.
+    for (const auto& p : system_.particles().position) {
+      domain_lo_ = domain_lo_.cwiseMin(p);
+      domain_hi_ = domain_hi_.cwiseMax(p);
+    }
+    for (const auto& m : meshes_dem_)
+      for (Eigen::Index i = 0; i < m.reference.rows(); ++i) {
+        domain_lo_ = domain_lo_.cwiseMin(m.reference.row(i).transpose());
+        domain_hi_ = domain_hi_.cwiseMax(m.reference.row(i).transpose());
+      }
+    lost_margin_ =
+        c.has("lost_margin") ? c.real("lost_margin") : (domain_hi_ - domain_lo_).maxCoeff();
   } catch (const dem::Error& e) {
     c.fail(std::string("DEM model of participant '") + context.name + "': " + e.what());
   }
@@ -430,6 +485,28 @@ void DemAdapter::write_output(const OutputFrame& frame) {
     system_.write_mesh_vtp(m.id, (frame.vtk_directory / mfile).string());
     files_.emplace_back(m.name, mfile);
   }
+}
+
+std::string DemAdapter::check_state() const {
+  const dem::Particles& p = system_.particles();
+  for (std::size_t i = 0; i < p.position.size(); ++i) {
+    if (!p.position[i].allFinite() || !p.velocity[i].allFinite())
+      return fmt::format(
+          "particle {} has a non-finite position or velocity: the DEM step is unstable; lower "
+          "time_step_fraction (now {:.3g}) or check the materials and the coupled loads",
+          p.id[i], time_step_fraction_);
+    const Eigen::Vector3d& x = p.position[i];
+    const double out = std::max((domain_lo_ - x).maxCoeff(), (x - domain_hi_).maxCoeff());
+    if (out > lost_margin_)
+      return fmt::format(
+          "particle {} is lost: at ({:.4g}, {:.4g}, {:.4g}) m it lies {:.3g} m outside the "
+          "domain [{:.4g} {:.4g} {:.4g}] .. [{:.4g} {:.4g} {:.4g}] m (lost_margin {:.3g} m); a "
+          "wall or mesh lets particles through (an open face, an overlap too large for the time "
+          "step) or the run is diverging",
+          p.id[i], x.x(), x.y(), x.z(), out, domain_lo_.x(), domain_lo_.y(), domain_lo_.z(),
+          domain_hi_.x(), domain_hi_.y(), domain_hi_.z(), lost_margin_);
+  }
+  return {};
 }
 
 std::vector<MonitorValue> DemAdapter::monitors() const {

@@ -39,6 +39,7 @@ class DemAdapter : public Solver {
   void restore_checkpoint() override;
   void write_output(const OutputFrame& frame) override;
   std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
+  std::string check_state() const override;
   std::vector<MonitorValue> monitors() const override;
 
   static std::shared_ptr<const config::Spec> spec();
@@ -68,6 +69,10 @@ class DemAdapter : public Solver {
   std::vector<Wall> walls_;
   std::vector<InterfaceMesh> meshes_;
   std::vector<std::pair<std::string, std::string>> files_;
+  // the domain's bounding box (particles at the start, box walls, meshes) and the margin
+  Eigen::Vector3d domain_lo_ = Eigen::Vector3d::Constant(1e300);
+  Eigen::Vector3d domain_hi_ = Eigen::Vector3d::Constant(-1e300);
+  double lost_margin_ = 0.0;
 };
 
 }  // namespace partita::adapters

@@ -224,6 +224,14 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     options.rayleigh_alpha = an["rayleigh"].real("alpha");
     options.rayleigh_beta = an["rayleigh"].real("beta");
     solver_ = std::make_unique<fem::Solver>(std::move(model), options);
+    {
+      Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+      for (const auto& x : solver_->mesh().nodes()) {
+        lo = lo.cwiseMin(x);
+        hi = hi.cwiseMax(x);
+      }
+      model_size_ = (hi - lo).norm();
+    }
 
     const auto ifaces = c["interfaces"].items();
     if (ifaces.empty())
@@ -347,6 +355,86 @@ void FemAdapter::restore_checkpoint() {
   if (!has_checkpoint_)
     throw Error("fem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   solver_->restore_state(checkpoint_);
+}
+
+std::string FemAdapter::check_state() const {
+  const Eigen::VectorXd& u = solver_->displacement();
+  if (!u.allFinite())
+    return "the displacement has non-finite values: the structural step failed; check the "
+           "loads, constraints (a free rigid-body motion) and the coupled forces";
+  const double d = solver_->max_displacement();
+  if (d > model_size_)
+    return fmt::format(
+        "a node moved {:.3g} m, more than the model's size ({:.3g} m, the diagonal of its "
+        "bounding box): the run is diverging or the structure is not held; check the "
+        "constraints, loads and the coupled forces (an undamped soft plate: add analysis.rayleigh "
+        "damping or a smaller time.window)",
+        d, model_size_);
+  return {};
+}
+
+void FemAdapter::write_restart(BinaryWriter& out) const {
+  const fem::SolverState s = solver_->save_state();
+  out.section("fem");
+  out.write(s.time);
+  out.write(static_cast<std::uint64_t>(s.steps));
+  out.write(s.displacement);
+  out.write(s.velocity);
+  out.write(s.acceleration);
+  out.write(s.external_force);
+  out.write(static_cast<std::uint8_t>(s.acceleration_valid));
+  out.write(s.external_work);
+  out.write(s.coupling_force);
+  out.write(static_cast<std::uint64_t>(s.face_tractions.size()));
+  for (const auto& [face, t] : s.face_tractions) {
+    out.write(face);
+    out.write(t);
+  }
+  std::vector<std::uint64_t> nodes(s.nodal_force_nodes.begin(), s.nodal_force_nodes.end());
+  out.write(nodes);
+  out.write(s.nodal_forces);
+  out.section("fem interfaces");
+  for (const auto& i : interfaces_) {
+    out.write(i.nodal_forces);
+    out.write(i.tractions);
+    out.write(static_cast<std::uint8_t>(i.has_forces));
+    out.write(static_cast<std::uint8_t>(i.has_tractions));
+  }
+}
+
+void FemAdapter::read_restart(BinaryReader& in) {
+  fem::SolverState s = solver_->save_state();  // the shapes to compare with
+  const Eigen::Index dofs = s.displacement.size();
+  in.expect_section("fem");
+  in.read(s.time);
+  s.steps = static_cast<std::size_t>(in.get<std::uint64_t>());
+  in.read(s.displacement);
+  in.read(s.velocity);
+  in.read(s.acceleration);
+  in.read(s.external_force);
+  s.acceleration_valid = in.get<std::uint8_t>() != 0;
+  in.read(s.external_work);
+  in.read(s.coupling_force);
+  s.face_tractions.clear();
+  const auto faces = in.get<std::uint64_t>();
+  for (std::uint64_t k = 0; k < faces; ++k) {
+    const std::string face = in.get_string();
+    in.read(s.face_tractions[face]);
+  }
+  std::vector<std::uint64_t> nodes;
+  in.read(nodes);
+  s.nodal_force_nodes.assign(nodes.begin(), nodes.end());
+  in.read(s.nodal_forces);
+  for (const Eigen::VectorXd* v : {&s.displacement, &s.velocity, &s.acceleration})
+    if (v->size() != dofs) in.fail(std::to_string(dofs) + " degrees of freedom (the same mesh)");
+  in.expect_section("fem interfaces");
+  for (auto& i : interfaces_) {
+    in.read(i.nodal_forces);
+    in.read(i.tractions);
+    i.has_forces = in.get<std::uint8_t>() != 0;
+    i.has_tractions = in.get<std::uint8_t>() != 0;
+  }
+  solver_->restore_state(s);
 }
 
 void FemAdapter::write_output(const OutputFrame& frame) {

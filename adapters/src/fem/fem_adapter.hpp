@@ -35,6 +35,10 @@ class FemAdapter : public Solver {
   void restore_checkpoint() override;
   void write_output(const OutputFrame& frame) override;
   std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
+  std::string check_state() const override;
+  bool supports_restart() const override { return true; }
+  void write_restart(BinaryWriter& out) const override;
+  void read_restart(BinaryReader& in) override;
   std::vector<MonitorValue> monitors() const override;
   std::vector<MonitorValue> monitor_values(const std::vector<std::string>& names) const override;
 
@@ -65,6 +69,7 @@ class FemAdapter : public Solver {
   std::vector<InterfaceMesh> meshes_;
   std::vector<std::pair<std::string, std::string>> files_;
   Eigen::Vector3d applied_per_unit_ = Eigen::Vector3d::Zero();
+  double model_size_ = 0.0;  // diagonal of the mesh's bounding box [m]
 };
 
 }  // namespace partita::adapters

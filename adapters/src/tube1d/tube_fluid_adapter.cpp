@@ -54,6 +54,28 @@ void TubeFluidAdapter::write_output(const OutputFrame& frame) {
   files_ = {{"tube", file}};
 }
 
+void TubeFluidAdapter::write_restart(BinaryWriter& out) const {
+  const auto& s = flow_.state();
+  out.section("tube1d-fluid");
+  out.write(s.velocity);
+  out.write(s.pressure);
+  out.write(s.area);
+  out.write(s.time);
+}
+
+void TubeFluidAdapter::read_restart(BinaryReader& in) {
+  in.expect_section("tube1d-fluid");
+  tube1d::TubeFlow::State s;
+  in.read(s.velocity);
+  in.read(s.pressure);
+  in.read(s.area);
+  in.read(s.time);
+  const Eigen::Index n = flow_.state().pressure.size();
+  if (s.velocity.size() != n || s.pressure.size() != n || s.area.size() != n)
+    in.fail(std::to_string(n) + " node values of the tube (same cells as the case)");
+  flow_.set_state(s);
+}
+
 std::vector<MonitorValue> TubeFluidAdapter::monitors() const {
   const auto& p = flow_.pressure();
   return {{"inlet_pressure", "Pa", p(0)},

@@ -45,6 +45,26 @@ void TubeSolidAdapter::write_output(const OutputFrame& frame) {
   files_ = {{"wall", file}};
 }
 
+void TubeSolidAdapter::write_restart(BinaryWriter& out) const {
+  out.section("tube1d-solid");
+  out.write(Eigen::VectorXd(wall_.pressure()));
+  out.write(Eigen::VectorXd(wall_.area()));
+  out.write(wall_.time());
+}
+
+void TubeSolidAdapter::read_restart(BinaryReader& in) {
+  in.expect_section("tube1d-solid");
+  Eigen::VectorXd p, a;
+  double t = 0.0;
+  in.read(p);
+  in.read(a);
+  in.read(t);
+  if (p.size() != wall_.pressure().size() || a.size() != wall_.area().size())
+    in.fail(std::to_string(wall_.area().size()) +
+            " node values of the tube (same cells as the case)");
+  wall_.set_state(p, a, t);
+}
+
 std::vector<MonitorValue> TubeSolidAdapter::monitors() const {
   const auto& a = wall_.area();
   return {{"mid_area", "m^2", a(a.size() / 2)}, {"max_area", "m^2", a.maxCoeff()}};

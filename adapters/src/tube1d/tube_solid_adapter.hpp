@@ -23,6 +23,9 @@ class TubeSolidAdapter : public Solver {
   void save_checkpoint() override { checkpoint_ = wall_; }
   void restore_checkpoint() override { wall_ = checkpoint_; }
   void write_output(const OutputFrame& frame) override;
+  bool supports_restart() const override { return true; }
+  void write_restart(BinaryWriter& out) const override;
+  void read_restart(BinaryReader& in) override;
   std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
   std::vector<MonitorValue> monitors() const override;
 

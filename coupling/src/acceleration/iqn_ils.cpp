@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -206,6 +207,37 @@ std::unique_ptr<Acceleration> IqnIls::create(const config::Node& node) {
   o.filter = f == "qr1" ? Filter::qr1 : f == "qr2" ? Filter::qr2 : Filter::none;
   o.filter_limit = node.real("filter_limit");
   return std::make_unique<IqnIls>(o);
+}
+
+void IqnIls::write_state(BinaryWriter& out) const {
+  out.section("iqn-ils");
+  out.write(v_);
+  out.write(w_);
+  out.write(std::vector<int>(window_columns_.begin(), window_columns_.end()));
+  out.write(previous_residual_);
+  out.write(previous_x_tilde_);
+  out.write(static_cast<std::uint8_t>(first_iteration_));
+  qr_.write_state(out);
+  out.write(qr_weights_);
+  out.write(filtered_);
+  out.write(rebuilds_);
+}
+
+void IqnIls::read_state(BinaryReader& in) {
+  in.expect_section("iqn-ils");
+  in.read(v_);
+  in.read(w_);
+  std::vector<int> counts;
+  in.read(counts);
+  window_columns_.assign(counts.begin(), counts.end());
+  in.read(previous_residual_);
+  in.read(previous_x_tilde_);
+  first_iteration_ = in.get<std::uint8_t>() != 0;
+  qr_.read_state(in);
+  in.read(qr_weights_);
+  in.read(filtered_);
+  in.read(rebuilds_);
+  if (v_.cols() != w_.cols() || v_.rows() != w_.rows()) in.fail("V and W of equal shape");
 }
 
 }  // namespace partita::coupling

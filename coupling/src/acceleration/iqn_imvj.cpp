@@ -6,6 +6,7 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
+#include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -220,6 +221,38 @@ std::unique_ptr<Acceleration> IqnImvj::create(const config::Node& node) {
   o.chunk_size = static_cast<int>(node.integer("chunk_size"));
   o.truncation = node.real("truncation");
   return std::make_unique<IqnImvj>(o);
+}
+
+void IqnImvj::write_state(BinaryWriter& out) const {
+  out.section("iqn-imvj");
+  out.write(v_);
+  out.write(w_);
+  qr_.write_state(out);
+  out.write(qr_weights_);
+  out.write(previous_residual_);
+  out.write(previous_x_tilde_);
+  out.write(static_cast<std::uint8_t>(first_iteration_));
+  out.write(a_);
+  out.write(b_);
+  out.write(windows_since_restart_);
+  out.write(restarts_);
+  out.write(filtered_);
+}
+
+void IqnImvj::read_state(BinaryReader& in) {
+  in.expect_section("iqn-imvj");
+  in.read(v_);
+  in.read(w_);
+  qr_.read_state(in);
+  in.read(qr_weights_);
+  in.read(previous_residual_);
+  in.read(previous_x_tilde_);
+  first_iteration_ = in.get<std::uint8_t>() != 0;
+  in.read(a_);
+  in.read(b_);
+  in.read(windows_since_restart_);
+  in.read(restarts_);
+  in.read(filtered_);
 }
 
 }  // namespace partita::coupling

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "partita/interface/binary_io.hpp"
+
 namespace partita::coupling {
 
 namespace {
@@ -98,6 +100,18 @@ Eigen::VectorXd QrFactorization::solve(const Eigen::VectorXd& b) const {
   const Eigen::VectorXd qtb = q_.transpose() * b;
   // back substitution R c = Q^T b
   return r_.triangularView<Eigen::Upper>().solve(qtb);
+}
+
+void QrFactorization::write_state(BinaryWriter& out) const {
+  out.write(q_);
+  out.write(r_);
+}
+
+void QrFactorization::read_state(BinaryReader& in) {
+  in.read(q_);
+  in.read(r_);
+  if (q_.cols() != r_.cols() || r_.rows() != r_.cols())
+    in.fail("a QR factorisation of matching size");
 }
 
 }  // namespace partita::coupling

@@ -1,5 +1,7 @@
 #include "partita/coupling/coupling_scheme.hpp"
 
+#include "partita/interface/binary_io.hpp"
+
 namespace partita::coupling {
 
 CouplingScheme::CouplingScheme(std::vector<Participant*> participants,
@@ -49,6 +51,16 @@ void CouplingScheme::send_outputs(const Participant& p) {
     e->sent() = e->combined();
     e->transmit();
   }
+}
+
+void CouplingScheme::write_state(BinaryWriter& out) const {
+  out.section("scheme " + name());
+  for (const Exchange* e : exchanges_) e->write_state(out);
+}
+
+void CouplingScheme::read_state(BinaryReader& in) {
+  in.expect_section("scheme " + name());
+  for (Exchange* e : exchanges_) e->read_state(in);
 }
 
 }  // namespace partita::coupling

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "partita/coupling/registries.hpp"
+#include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
@@ -168,6 +169,20 @@ WindowReport ImplicitScheme::run_window(const TimeWindow& window) {
     }
     for (Participant* p : participants_) p->restore_checkpoint();
   }
+}
+
+void ImplicitScheme::write_state(BinaryWriter& out) const {
+  CouplingScheme::write_state(out);
+  out.write(std::string(acceleration_ ? acceleration_->name() : "none"));
+  if (acceleration_) acceleration_->write_state(out);
+}
+
+void ImplicitScheme::read_state(BinaryReader& in) {
+  CouplingScheme::read_state(in);
+  const std::string stored = in.get_string();
+  const std::string mine = acceleration_ ? acceleration_->name() : "none";
+  if (stored != mine) in.fail("the acceleration '" + mine + "', found '" + stored + "'");
+  if (acceleration_) acceleration_->read_state(in);
 }
 
 namespace {

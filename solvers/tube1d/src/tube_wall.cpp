@@ -38,4 +38,14 @@ void TubeWall::advance(double dt) {
   time_ += dt;
 }
 
+void TubeWall::set_state(const Eigen::VectorXd& pressure, const Eigen::VectorXd& area,
+                         double time) {
+  set_pressure(pressure);
+  if (area.size() != area_.size())
+    throw std::invalid_argument("tube1d wall: area has " + std::to_string(area.size()) +
+                                " values, expected " + std::to_string(area_.size()));
+  area_ = area;
+  time_ = time;
+}
+
 }  // namespace partita::tube1d

@@ -24,8 +24,16 @@
 //     on_max_iterations: accept                  # or error
 //   monitors:
 //     - {name: outlet, quantities: [fluid.outlet_pressure, solid.outlet_area]}
-//   output: {every: 0.1}
+//   output: {every: 0.1, restart: {every_windows: 100}}
+//
+// Restart files: DIR/restart/w<window>.bin hold the complete state after a window (every
+// participant's solver, the exchanges' values, the acceleration's history, the CSV rows and
+// the VTK series so far); `partita run CASE --resume DIR` continues from the newest one bit for
+// bit. Between windows the run checks every exchanged field and monitor for non-finite values
+// and asks each solver for its own health check (stops with a diagnosis), and audits the
+// balance of each exchange (what was sent against what arrived after mapping, coupling.csv).
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -47,6 +55,12 @@ struct RunOptions {
   bool check_only = false;  ///< validate and build everything, write nothing, run nothing
   /// "key.path[i].key=YAML value" assignments applied to the case file before validation.
   std::vector<std::string> overrides;
+  /// Continue the run whose output folder this is from its newest restart file (the output
+  /// goes to the same folder).
+  std::filesystem::path resume_dir;
+  /// Set (to the signal number) by a signal handler: the run finishes the current window,
+  /// writes a restart file, flushes every CSV and returns (summary().stopped_by_signal).
+  const std::atomic<int>* stop_signal = nullptr;
 };
 
 /// What run() measured.
@@ -59,7 +73,11 @@ struct RunSummary {
   std::vector<std::pair<std::string, double>> participant_seconds;
   double mapping_seconds = 0.0;
   double output_seconds = 0.0;
-  double core_seconds = 0.0;  ///< the rest: scheme, acceleration, time interpolation
+  double core_seconds = 0.0;           ///< the rest: scheme, acceleration, time interpolation
+  std::int64_t resumed_from = -1;      ///< windows done by the restart file resumed (-1: none)
+  int stopped_by_signal = 0;           ///< the signal that stopped the run early (0: none)
+  std::filesystem::path last_restart;  ///< the newest restart file written (empty: none)
+  long imbalance_warnings = 0;         ///< windows where an exchange's balance exceeded the limit
   double mean_iterations() const {
     return windows > 0 ? static_cast<double>(iterations) / windows : 0.0;
   }
@@ -89,11 +107,29 @@ class CaseRun {
   Participant* participant(const std::string& name) const;
 
  private:
-  struct Monitor;
+  struct Monitor {
+    std::string name;
+    std::vector<std::pair<Participant*, std::string>> quantities;
+    CsvSeries csv;
+  };
+  // What run() carries from window to window besides the solvers (restart files keep it).
+  struct Progress {
+    std::int64_t windows_done = 0;
+    int frame = 0;
+    double next_output = 0.0;
+  };
   void build_participants(const config::Node& root);
   void build_exchanges(const config::Node& coupling);
   void build_monitors(const config::Node& root);
   void write_output(int frame, double time);
+
+  // Restart files and run-time checks (case_run_restart.cpp)
+  void write_restart_file(const Progress& progress);
+  void read_restart_file(const std::filesystem::path& file, Progress& progress);
+  std::filesystem::path newest_restart_file() const;
+  void check_window(std::int64_t window, double time);
+  std::vector<double> audit_balance();
+  std::string restart_blocker() const;  // why restart files cannot be written ("": they can)
 
   const Registries& registries_;
   RunOptions options_;
@@ -110,6 +146,16 @@ class CaseRun {
   std::vector<std::pair<std::string, PvdSeries>> pvds_;  // series name -> .pvd
   PvdSeries& pvd(const std::string& series);
   RunSummary summary_;
+  CsvSeries coupling_csv_;
+  // restart files
+  std::uint64_t identity_ = 0;  // hash of the case's participants and coupling sections
+  std::int64_t restart_every_windows_ = 0;
+  double restart_every_seconds_ = 0.0;
+  int restart_keep_ = 2;
+  bool restart_at_end_ = false;
+  // the balance audit: exchanges audited and the relative imbalance that warns
+  std::vector<const Exchange*> audited_;
+  double balance_tolerance_ = 0.01;
 };
 
 /// The case file's schema (for validation and `partita docs`).

@@ -24,6 +24,11 @@
 #include "partita/coupling/participant.hpp"
 #include "partita/interface/solver.hpp"
 
+namespace partita {
+class BinaryWriter;
+class BinaryReader;
+}  // namespace partita
+
 namespace partita::coupling {
 
 enum class ReaderSees { constant, linear };
@@ -81,6 +86,11 @@ class Exchange {
 
   /// Initial data: combined = sent = previous = initial, transmitted, start = end.
   void initialize(const Eigen::MatrixXd& initial);
+
+  /// Restart files: the values carried between windows (sent, combined, previous, start, end).
+  void write_state(BinaryWriter& out) const;
+  /// Throws partita::Error if the stored values do not fit this exchange's meshes.
+  void read_state(BinaryReader& in);
 
   /// Wall time spent mapping [s].
   double mapping_seconds() const { return mapping_seconds_; }

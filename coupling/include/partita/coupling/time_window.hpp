@@ -53,7 +53,9 @@ class TimeWindow {
 
   /// Number of windows of `size` needed to reach `end`: ceil(end / size), where a ratio within
   /// 1e-9 (relative) of a whole number counts as that number (0.3 / 0.1 gives 3, not 4).
+  /// Throws partita::Error for a count above max_windows (2^53: window times are exact products).
   static std::int64_t count_to(double end, double size);
+  static constexpr double max_windows = 9007199254740992.0;  // 2^53
   /// Substeps for a window of `size` with steps no longer than `max_step`: ceil(size / max_step)
   /// with the same tolerance; 1 when max_step is infinite. Throws if max_step <= 0.
   static int substeps_for(double size, double max_step);

@@ -53,6 +53,10 @@ class CsvSeries {
   void close();
   bool is_open() const { return !path_.empty(); }
   const std::filesystem::path& path() const { return path_; }
+  /// The whole CSV text so far, header included (restart files keep it).
+  const std::string& text() const { return text_; }
+  /// Replace the text by one text() returned (a resumed run), and write it to the file.
+  void restore_text(std::string text);
 
  private:
   std::filesystem::path path_;
@@ -69,8 +73,12 @@ class PvdSeries {
   /// `file` relative to the .pvd's folder.
   void add(double time, const std::string& file);
   const std::filesystem::path& path() const { return path_; }
+  const std::vector<std::pair<double, std::string>>& entries() const { return entries_; }
+  /// Replace the entries (a resumed run) and rewrite the .pvd.
+  void restore_entries(std::vector<std::pair<double, std::string>> entries);
 
  private:
+  void write() const;
   std::filesystem::path path_;
   std::vector<std::pair<double, std::string>> entries_;
 };

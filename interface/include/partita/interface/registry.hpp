@@ -14,6 +14,24 @@
 
 namespace partita {
 
+/// One documented output quantity. `name` may start with a placeholder in angle brackets for a
+/// family of names ("<mesh>.force_z": one per mesh); quantity_matches() applies it.
+struct QuantityDoc {
+  std::string name;
+  std::string unit;  ///< SI unit; empty for a pure number
+  std::string doc;
+};
+
+/// Whether a reported quantity name is one that `d` documents ("<x>" matches any text but '.').
+inline bool quantity_matches(const QuantityDoc& d, std::string_view name) {
+  if (d.name.empty() || d.name.front() != '<') return d.name == name;
+  const auto close = d.name.find('>');
+  if (close == std::string::npos) return false;
+  const std::string_view rest = std::string_view(d.name).substr(close + 1);
+  if (name.size() <= rest.size() || name.substr(name.size() - rest.size()) != rest) return false;
+  return name.substr(0, name.size() - rest.size()).find('.') == std::string_view::npos;
+}
+
 template <class Factory>
 class Registry {
  public:
@@ -22,6 +40,8 @@ class Registry {
     std::string doc;  ///< one line
     Factory factory;
     std::shared_ptr<const config::Spec> spec;  ///< its parameters (may be null)
+    /// What it reports (a solver's monitor quantities), listed on its `partita docs` page.
+    std::vector<QuantityDoc> quantities;
   };
 
   /// `kind` names what is registered ("solver", "mapper", ...) for messages.
@@ -29,9 +49,11 @@ class Registry {
 
   /// Add an entry; a duplicate name is an error.
   void add(std::string name, std::string doc, Factory factory,
-           std::shared_ptr<const config::Spec> spec = nullptr) {
+           std::shared_ptr<const config::Spec> spec = nullptr,
+           std::vector<QuantityDoc> quantities = {}) {
     if (contains(name)) throw Error(kind_ + " '" + name + "' is registered twice");
-    entries_.push_back(Entry{std::move(name), std::move(doc), std::move(factory), std::move(spec)});
+    entries_.push_back(Entry{std::move(name), std::move(doc), std::move(factory), std::move(spec),
+                             std::move(quantities)});
   }
 
   bool contains(std::string_view name) const { return find(name) != nullptr; }

@@ -18,7 +18,9 @@
 //          advance(dt_k)             — one step of its own physics, dt_k <= stable_time_step()
 //          write(mesh, data, values) for each field it sends (the core combines substeps)
 //        (implicit schemes, not converged) restore_checkpoint() and repeat the window
-//      after an accepted window: monitors(); write_output() when an output time is reached.
+//      after an accepted window: monitors(); write_output() when an output time is reached;
+//      write_restart() when a restart point is due (or, in a resumed run, read_restart() once
+//      instead of the initial write() of step 3).
 //   5. finalize() — once, after the last window (close files, print summaries).
 //
 // read() may be called several times before one advance(); the last call for a field wins.
@@ -34,7 +36,9 @@
 
 #include <Eigen/Core>
 
+#include "partita/interface/binary_io.hpp"
 #include "partita/interface/config.hpp"
+#include "partita/interface/error.hpp"
 #include "partita/interface/mesh.hpp"
 
 namespace partita {
@@ -103,6 +107,20 @@ class Solver {
   virtual void save_checkpoint() = 0;
   virtual void restore_checkpoint() = 0;
 
+  /// Restart files (`partita run CASE --resume DIR`). Called between windows only, after the
+  /// solver was built from the same case: write_restart() writes everything that evolves (what
+  /// save_checkpoint() keeps, plus anything read() set that the next window does not set again);
+  /// read_restart() in a new process returns the solver to that state, so that the run goes on
+  /// bit for bit as if it had never stopped. A solver that cannot returns false from
+  /// supports_restart() (the defaults below); runs with it then write no restart files.
+  virtual bool supports_restart() const { return false; }
+  virtual void write_restart(BinaryWriter& out) const {
+    throw Error("this solver does not support restart files");
+  }
+  virtual void read_restart(BinaryReader& in) {
+    throw Error("this solver does not support restart files");
+  }
+
   /// Write VTK files for this frame under frame.vtk_directory (the core keeps the .pvd series
   /// from what add_output_file() was told).
   virtual void write_output(const OutputFrame& frame) {}
@@ -124,6 +142,11 @@ class Solver {
         if (v.name == n) out.push_back(v);
     return out;
   }
+
+  /// A cheap check of the state after each accepted window: a diagnosis (what is wrong, where,
+  /// what to change) when it is no longer physical (non-finite values, particles lost from the
+  /// domain, displacements larger than the model), else "". The core stops the run with it.
+  virtual std::string check_state() const { return {}; }
 
   /// Once after the last window.
   virtual void finalize() {}

@@ -19,6 +19,10 @@
 namespace partita::config {
 class Spec;
 }
+namespace partita {
+class BinaryWriter;
+class BinaryReader;
+}  // namespace partita
 
 namespace partita::coupling {
 
@@ -36,6 +40,10 @@ class Acceleration {
                                 const Eigen::VectorXd& weights) = 0;
   /// Registered name, for messages and the summary.
   virtual std::string name() const = 0;
+  /// Restart files: everything carried from window to window (between windows only), so that a
+  /// resumed run iterates bit for bit as one that never stopped. Stateless: nothing.
+  virtual void write_state(BinaryWriter& out) const {}
+  virtual void read_state(BinaryReader& in) {}
 };
 
 }  // namespace partita::coupling

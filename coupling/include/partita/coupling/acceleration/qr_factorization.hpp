@@ -18,6 +18,11 @@
 
 #include <Eigen/Core>
 
+namespace partita {
+class BinaryWriter;
+class BinaryReader;
+}  // namespace partita
+
 namespace partita::coupling {
 
 class QrFactorization {
@@ -49,6 +54,9 @@ class QrFactorization {
   double r_norm() const { return r_.norm(); }
   const Eigen::MatrixXd& q() const { return q_; }
   const Eigen::MatrixXd& r() const { return r_; }
+  /// Restart files: Q and R as they are.
+  void write_state(BinaryWriter& out) const;
+  void read_state(BinaryReader& in);
 
  private:
   Eigen::MatrixXd q_;  // rows x cols

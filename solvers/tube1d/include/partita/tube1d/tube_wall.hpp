@@ -25,6 +25,8 @@ class TubeWall {
   const Eigen::VectorXd& pressure() const { return pressure_; }
   double time() const { return time_; }
   void set_time(double t) { time_ = t; }
+  /// The whole state at once (restart files): pressure and area at the nodes, time.
+  void set_state(const Eigen::VectorXd& pressure, const Eigen::VectorXd& area, double time);
 
   /// The tube law a(p) and its inverse p(a).
   double area_of(double p) const;

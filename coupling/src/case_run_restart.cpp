@@ -1,0 +1,247 @@
+// CaseRun: restart files, the run-time checks after each window and the balance audit.
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "partita/coupling/case_run.hpp"
+#include "partita/coupling/stopwatch.hpp"
+#include "partita/interface/binary_io.hpp"
+#include "partita/interface/error.hpp"
+#include "partita/interface/log.hpp"
+
+namespace partita::coupling {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kMagic = "partita restart file";
+constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kByteOrder = 0x01020304u;
+
+// DIR/restart/w000000001234.bin -> 1234; -1 for other names.
+std::int64_t window_of(const fs::path& p) {
+  const std::string n = p.filename().string();
+  if (n.size() != 17 || n[0] != 'w' || p.extension() != ".bin") return -1;
+  std::int64_t w = 0;
+  for (std::size_t i = 1; i < 13; ++i) {
+    if (n[i] < '0' || n[i] > '9') return -1;
+    w = 10 * w + (n[i] - '0');
+  }
+  return w;
+}
+
+std::vector<std::pair<std::int64_t, fs::path>> restart_files(const fs::path& dir) {
+  std::vector<std::pair<std::int64_t, fs::path>> files;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (const std::int64_t w = window_of(e.path()); w >= 0 && e.is_regular_file())
+      files.emplace_back(w, e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// Sum (extensive data) or integral over the point weights (intensive data) of each component,
+// and the same of the magnitudes (the scale the imbalance is measured against).
+std::pair<Eigen::VectorXd, double> total(const Eigen::MatrixXd& v, const Mesh& mesh,
+                                         bool extensive) {
+  Eigen::VectorXd t = Eigen::VectorXd::Zero(v.cols());
+  double scale = 0.0;
+  for (Eigen::Index i = 0; i < v.rows(); ++i) {
+    const double w = extensive ? 1.0 : mesh.weights()(i);
+    t += w * v.row(i).transpose();
+    scale += std::abs(w) * v.row(i).norm();
+  }
+  return {t, scale};
+}
+
+}  // namespace
+
+std::string CaseRun::restart_blocker() const {
+  for (const auto& p : participants_)
+    if (!p->solver().supports_restart())
+      return "participant '" + p->name() + "' has a solver that cannot write restart files";
+  return {};
+}
+
+fs::path CaseRun::newest_restart_file() const {
+  const fs::path dir = output_dir_ / "restart";
+  if (!fs::is_directory(output_dir_))
+    throw Error("--resume " + output_dir_.string() +
+                ": no such folder (give a run's output folder)");
+  const auto files = restart_files(dir);
+  if (files.empty())
+    throw Error("--resume " + output_dir_.string() + ": no restart file in " + dir.string() +
+                " (a run writes them with output.restart: {every_windows: N}, at its end, or "
+                "when stopped by SIGINT/SIGTERM)");
+  return files.back().second;
+}
+
+void CaseRun::write_restart_file(const Progress& progress) {
+  Stopwatch clock;
+  const fs::path dir = output_dir_ / "restart";
+  fs::create_directories(dir);
+  const fs::path path = dir / fmt::format("w{:012d}.bin", progress.windows_done);
+  {
+    AtomicFile file(path, /*binary=*/true);
+    BinaryWriter out(file.stream());
+    out.write(std::string(kMagic));
+    out.write(kVersion);
+    out.write(kByteOrder);
+    out.write(name_);
+    out.write(identity_);
+    out.write(window_size_);
+    out.write(progress.windows_done);
+    out.write(progress.frame);
+    out.write(progress.next_output);
+    out.write(static_cast<std::int64_t>(summary_.iterations));
+    out.write(static_cast<std::int64_t>(summary_.unconverged_windows));
+    out.write(summary_.max_window_iterations);
+    out.write(static_cast<std::int64_t>(summary_.imbalance_warnings));
+    out.section("csv");
+    out.write(coupling_csv_.text());
+    out.write(static_cast<std::uint64_t>(monitors_.size()));
+    for (const auto& m : monitors_) {
+      out.write(m.name);
+      out.write(m.csv.text());
+    }
+    out.section("vtk");
+    out.write(static_cast<std::uint64_t>(pvds_.size()));
+    for (const auto& [series, pvd] : pvds_) {
+      out.write(series);
+      out.write(static_cast<std::uint64_t>(pvd.entries().size()));
+      for (const auto& [t, f] : pvd.entries()) {
+        out.write(t);
+        out.write(f);
+      }
+    }
+    scheme_->write_state(out);
+    out.write(static_cast<std::uint64_t>(participants_.size()));
+    for (const auto& p : participants_) {
+      out.section("participant " + p->name());
+      p->solver().write_restart(out);
+    }
+    out.section("end");
+    file.commit();
+  }
+  summary_.last_restart = path;
+  // keep the newest restart_keep_ files
+  auto files = restart_files(dir);
+  for (std::size_t i = 0; i + static_cast<std::size_t>(restart_keep_) < files.size(); ++i) {
+    std::error_code ec;
+    fs::remove(files[i].second, ec);
+  }
+  summary_.output_seconds += clock.seconds();
+  log::get("coupling")->debug("restart file {} ({:.3f} s)", path.string(), clock.seconds());
+}
+
+void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw Error("cannot read restart file " + path.string());
+  BinaryReader in(file, path.string());
+  std::string magic;
+  try {
+    in.read(magic);
+  } catch (const Error&) {
+  }
+  if (magic != kMagic) throw Error(path.string() + " is not a partita restart file");
+  const auto version = in.get<std::uint32_t>();
+  const auto order = in.get<std::uint32_t>();
+  if (order != kByteOrder)
+    throw Error(path.string() + " was written on a machine of another byte order");
+  if (version != kVersion)
+    throw Error(
+        fmt::format("{} has restart format version {}; this partita reads version {} "
+                    "(resume with the partita that wrote it)",
+                    path.string(), version, kVersion));
+  const std::string name = in.get_string();
+  const auto identity = in.get<std::uint64_t>();
+  if (name != name_ || identity != identity_)
+    throw Error(fmt::format(
+        "{} was written by {} whose participants or coupling differ from this case '{}': a run "
+        "resumes only with the same participants and coupling sections (time and output may "
+        "change)",
+        path.string(), name == name_ ? "a version of the case" : "case '" + name + "'", name_));
+  const auto window = in.get<double>();
+  if (window != window_size_)
+    throw Error(fmt::format("{} was written with time.window = {:.17g} s; this case has {:.17g} s",
+                            path.string(), window, window_size_));
+  in.read(progress.windows_done);
+  in.read(progress.frame);
+  in.read(progress.next_output);
+  summary_.iterations = static_cast<long>(in.get<std::int64_t>());
+  summary_.unconverged_windows = static_cast<long>(in.get<std::int64_t>());
+  in.read(summary_.max_window_iterations);
+  summary_.imbalance_warnings = static_cast<long>(in.get<std::int64_t>());
+  summary_.windows = progress.windows_done;
+  in.expect_section("csv");
+  coupling_csv_.restore_text(in.get_string());
+  const auto monitors = in.get<std::uint64_t>();
+  if (monitors != monitors_.size())
+    in.fail(fmt::format("{} monitors (found {})", monitors_.size(), monitors));
+  for (auto& m : monitors_) {
+    if (in.get_string() != m.name) in.fail("the monitor '" + m.name + "'");
+    m.csv.restore_text(in.get_string());
+  }
+  in.expect_section("vtk");
+  const auto series = in.get<std::uint64_t>();
+  for (std::uint64_t i = 0; i < series; ++i) {
+    const std::string s = in.get_string();
+    const auto n = in.get<std::uint64_t>();
+    std::vector<std::pair<double, std::string>> entries;
+    for (std::uint64_t k = 0; k < n; ++k) {
+      const double t = in.get<double>();
+      entries.emplace_back(t, in.get_string());
+    }
+    pvd(s).restore_entries(std::move(entries));
+  }
+  scheme_->read_state(in);
+  const auto participants = in.get<std::uint64_t>();
+  if (participants != participants_.size())
+    in.fail(fmt::format("{} participants (found {})", participants_.size(), participants));
+  for (auto& p : participants_) {
+    in.expect_section("participant " + p->name());
+    p->solver().read_restart(in);
+  }
+  in.expect_section("end");
+}
+
+void CaseRun::check_window(std::int64_t window, double time) {
+  for (const auto& e : exchanges_) {
+    const Exchange& x = *e;
+    for (const bool sent : {true, false}) {
+      const Eigen::MatrixXd* side = sent ? &x.sent() : &x.received();
+      if (side->allFinite()) continue;
+      const Eigen::Index bad = side->size() - side->array().isFinite().count();
+      throw Error(fmt::format(
+          "window {} (t = {:.6g} s): {} {} non-finite values ({} of {}) of '{}' on {}.{}: the "
+          "run is diverging; reduce time.window or the substep size, add damping, or check the "
+          "materials and loads of '{}'",
+          window, time, sent ? "participant '" + e->from().name() + "' sent" : "the mapping gave",
+          "", bad, side->size(), e->data(), sent ? e->from().name() : e->to().name(),
+          sent ? e->from_mesh() : e->to_mesh(), e->from().name()));
+    }
+  }
+  for (const auto& p : participants_)
+    if (const std::string why = p->solver().check_state(); !why.empty())
+      throw Error(fmt::format("window {} (t = {:.6g} s): participant '{}': {}", window, time,
+                              p->name(), why));
+}
+
+std::vector<double> CaseRun::audit_balance() {
+  std::vector<double> out;
+  out.reserve(audited_.size());
+  for (const Exchange* e : audited_) {
+    const bool extensive = e->spec().kind == DataKind::extensive;
+    const auto [ts, ss] = total(e->sent(), e->from().find_mesh(e->from_mesh())->mesh, extensive);
+    const auto [tr, sr] = total(e->received(), e->to().find_mesh(e->to_mesh())->mesh, extensive);
+    const double scale = std::max(ss, sr);
+    out.push_back(scale > 0.0 ? (tr - ts).norm() / scale : 0.0);
+  }
+  return out;
+}
+
+}  // namespace partita::coupling

@@ -1,0 +1,163 @@
+#pragma once
+// Binary state streams for restart files. Values are written in the machine's own byte order
+// (restart files are for continuing a run on the same kind of machine, as LAMMPS's binary
+// restart files are); the file's header records the order and a reader refuses another one.
+//
+//   BinaryWriter w(stream);                BinaryReader r(stream, "out/run/restart/w000100.bin");
+//   w.section("exchange");                 r.expect_section("exchange");
+//   w.write(matrix);                       r.read(matrix);
+//
+// Every read is checked: a truncated stream, a section name that differs from the one expected
+// or a size that cannot fit what remains gives partita::Error naming the source and what was
+// expected, never a crash or a silently wrong state.
+
+#include <cstdint>
+#include <cstring>
+#include <istream>
+#include <ostream>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "partita/interface/error.hpp"
+
+namespace partita {
+
+class BinaryWriter {
+ public:
+  explicit BinaryWriter(std::ostream& out) : out_(out) {}
+
+  template <class T>
+  requires std::is_arithmetic_v<T>
+  void write(T v) { out_.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
+  void write(const std::string& s) {
+    write(static_cast<std::uint64_t>(s.size()));
+    out_.write(s.data(), static_cast<std::streamsize>(s.size()));
+  }
+  template <class T>
+  requires std::is_arithmetic_v<T>
+  void write(const std::vector<T>& v) {
+    write(static_cast<std::uint64_t>(v.size()));
+    out_.write(reinterpret_cast<const char*>(v.data()),
+               static_cast<std::streamsize>(v.size() * sizeof(T)));
+  }
+  /// Any dense Eigen matrix or vector of doubles (rows, cols, column-major values).
+  template <class Derived>
+  void write(const Eigen::PlainObjectBase<Derived>& m) {
+    static_assert(std::is_same_v<typename Derived::Scalar, double>, "doubles only");
+    write(static_cast<std::int64_t>(m.rows()));
+    write(static_cast<std::int64_t>(m.cols()));
+    out_.write(reinterpret_cast<const char*>(m.data()),
+               static_cast<std::streamsize>(m.size() * static_cast<Eigen::Index>(sizeof(double))));
+  }
+  /// A named marker; the reader checks it (catches a reader and writer out of step).
+  void section(const std::string& name) { write("§" + name); }
+  /// Raw bytes of a nested stream (a solver's own format), length first.
+  void bytes(const std::string& b) { write(b); }
+
+  bool good() const { return static_cast<bool>(out_); }
+
+ private:
+  std::ostream& out_;
+};
+
+class BinaryReader {
+ public:
+  /// `source` names the stream in messages (a file name).
+  BinaryReader(std::istream& in, std::string source) : in_(in), source_(std::move(source)) {}
+
+  template <class T>
+  requires std::is_arithmetic_v<T>
+  void read(T& v) { raw(&v, sizeof(T), "a number"); }
+  template <class T>
+  requires std::is_arithmetic_v<T> T get() {
+    T v{};
+    read(v);
+    return v;
+  }
+  void read(std::string& s) {
+    const std::uint64_t n = count(1, "a text");
+    s.resize(n);
+    raw(s.data(), n, "a text");
+  }
+  std::string get_string() {
+    std::string s;
+    read(s);
+    return s;
+  }
+  template <class T>
+  requires std::is_arithmetic_v<T>
+  void read(std::vector<T>& v) {
+    const std::uint64_t n = count(sizeof(T), "a list");
+    v.resize(n);
+    raw(v.data(), n * sizeof(T), "a list");
+  }
+  template <class Derived>
+  void read(Eigen::PlainObjectBase<Derived>& m) {
+    static_assert(std::is_same_v<typename Derived::Scalar, double>, "doubles only");
+    const auto rows = get<std::int64_t>();
+    const auto cols = get<std::int64_t>();
+    if (rows < 0 || cols < 0 || (rows > 0 && cols > (INT64_MAX / 8) / rows))
+      fail("a matrix of " + std::to_string(rows) + " x " + std::to_string(cols) + " values");
+    if ((Derived::RowsAtCompileTime != Eigen::Dynamic && rows != Derived::RowsAtCompileTime) ||
+        (Derived::ColsAtCompileTime != Eigen::Dynamic && cols != Derived::ColsAtCompileTime))
+      fail("a matrix of another shape than " + std::to_string(rows) + " x " + std::to_string(cols));
+    check_remaining(static_cast<std::uint64_t>(rows * cols) * sizeof(double), "a matrix");
+    m.resize(rows, cols);
+    raw(m.data(), static_cast<std::size_t>(rows * cols) * sizeof(double), "a matrix");
+  }
+  /// Check the next marker is `name` (written by BinaryWriter::section).
+  void expect_section(const std::string& name) {
+    std::string s;
+    read(s);
+    if (s != "§" + name)
+      fail("the section '" + name + "', found " +
+           (s.rfind("§", 0) == 0 ? "'" + s.substr(std::string("§").size()) + "'"
+                                 : std::string("other data")));
+  }
+  std::string bytes() { return get_string(); }
+
+  const std::string& source() const { return source_; }
+  /// Throw "<source>: restart data ends or differs where <what> was expected".
+  [[noreturn]] void fail(const std::string& what) const {
+    throw Error(source_ + ": restart data is damaged or from another case: expected " + what +
+                " at byte " + std::to_string(position()));
+  }
+
+ private:
+  long long position() const { return static_cast<long long>(in_.tellg()); }
+  void raw(void* p, std::size_t n, const char* what) {
+    if (n == 0) return;
+    in_.read(static_cast<char*>(p), static_cast<std::streamsize>(n));
+    if (static_cast<std::size_t>(in_.gcount()) != n) {
+      in_.clear();
+      throw Error(source_ + ": restart data is truncated: " + what + " of " + std::to_string(n) +
+                  " bytes is cut off");
+    }
+  }
+  std::uint64_t count(std::size_t item, const char* what) {
+    const auto n = get<std::uint64_t>();
+    if (item > 0 && n > UINT64_MAX / item) fail(std::string(what) + " of sensible length");
+    check_remaining(n * item, what);
+    return n;
+  }
+  // A length must fit in what is left of the stream (a damaged length never allocates).
+  void check_remaining(std::uint64_t n, const char* what) {
+    const auto here = in_.tellg();
+    if (here < 0) return;  // not seekable: the read itself checks
+    in_.seekg(0, std::ios::end);
+    const auto end = in_.tellg();
+    in_.seekg(here);
+    if (end >= here && n > static_cast<std::uint64_t>(end - here))
+      throw Error(source_ + ": restart data is truncated or damaged: " + what + " of " +
+                  std::to_string(n) + " bytes is announced, " +
+                  std::to_string(static_cast<long long>(end - here)) + " remain");
+  }
+
+  std::istream& in_;
+  std::string source_;
+};
+
+}  // namespace partita
