@@ -218,8 +218,9 @@ TEST_CASE("SIGINT: the window ends, CSV files are complete, a restart file conti
   fs::remove_all(dir);
 }
 
-TEST_CASE("no shell: a script name with quotes and ';' is one argument, nothing else runs",
-          "[app][security]") {
+TEST_CASE(
+    "no shell: a script name with quotes and a semicolon is one argument and runs nothing else",
+    "[app][security]") {
   const fs::path dir = scratch("shell");
   const std::string script = "post'; touch pwned; echo '.py";
   std::ofstream(dir / script) << "import sys, pathlib\n"

@@ -167,6 +167,10 @@ Mesh rectangle(const Node& g, const std::string& name) {
   const auto size = g.reals("size");
   const auto cells = g.integers("cells");
   const long nx = cells[0], ny = cells[1];
+  if (2.0 * static_cast<double>(nx) * static_cast<double>(ny) > 2.0e7)
+    g["cells"].fail(
+        fmt::format("{} x {} cells make {:.3g} triangles, more than 2e7; check the counts", nx, ny,
+                    2.0 * static_cast<double>(nx) * static_cast<double>(ny)));
   Mesh::Points p((nx + 1) * (ny + 1), 3);
   for (long j = 0; j <= ny; ++j)
     for (long i = 0; i <= nx; ++i)

@@ -131,12 +131,23 @@ void require_name(const Node& n, const std::string& name, const std::vector<std:
            did_you_mean(name, known));
 }
 
+// The largest generated box mesh accepted (a typing error beyond it would exhaust the memory).
+constexpr double kMaxBoxCells = 2.0e7;
+
 fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
   if (m.has("box")) {
     fem::BoxSpec b;
     b.origin = m["box"].vec3("origin");
     b.size = m["box"].vec3("size");
     const auto cells = m["box"].integers("cells");
+    // Counts are checked as reals first: a product of three longs can wrap.
+    const double total = static_cast<double>(cells[0]) * static_cast<double>(cells[1]) *
+                         static_cast<double>(cells[2]);
+    if (total > kMaxBoxCells)
+      m["box"]["cells"].fail(fmt::format(
+          "{} x {} x {} = {:.3g} cells is more than {:.0e}, far beyond what one machine can solve "
+          "(about 3 x 10^5 degrees of freedom take a minute to factorise); check the counts",
+          cells[0], cells[1], cells[2], total, kMaxBoxCells));
     b.cells = {static_cast<int>(cells[0]), static_cast<int>(cells[1]), static_cast<int>(cells[2])};
     const std::string e = m.string("element");
     b.element = e == "hex8"    ? fem::ElementType::Hex8
