@@ -359,7 +359,12 @@ void CaseRun::build_participants(const config::Node& root) {
       validated = pn.validated(spec);
     }
     SolverContext ctx{name, validated, case_dir_, output_dir_, options_.threads};
+    log::get("coupling")->debug("setting up participant '{}' ({})", name, entry.name);
+    Stopwatch setup;
     std::unique_ptr<Solver> solver = entry.factory(ctx);
+    if (setup.seconds() > 1.0)
+      log::get("coupling")->info("set-up of participant '{}' ({}): {:.1f} s", name, entry.name,
+                                 setup.seconds());
     if (!solver) pn.fail("solver '" + entry.name + "' could not be built");
     Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
     // A fixed number of substeps must not exceed the solver's stable time step.
@@ -449,7 +454,12 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
                                                                : Constraint::consistent;
     std::unique_ptr<Mapper> mapper =
         create_mapper(registries_.mappers, MapperContext{item["mapper"], constraint});
+    Stopwatch setup;
     mapper->compute(from.mesh->mesh, to.mesh->mesh);
+    if (setup.seconds() > 1.0)
+      log::get("coupling")->info("set-up of the mapping of '{}' {}.{} -> {}.{}: {:.1f} s", data,
+                                 from.p->name(), from.mesh->mesh.name(), to.p->name(),
+                                 to.mesh->mesh.name(), setup.seconds());
     const ReaderSees rsee =
         item.string("reader_sees") == "constant" ? ReaderSees::constant : ReaderSees::linear;
     const WriterCombines wc =
