@@ -223,7 +223,7 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         an.string("mass") == "lumped" ? fem::MassType::Lumped : fem::MassType::Consistent;
     options.rayleigh_alpha = an["rayleigh"].real("alpha");
     options.rayleigh_beta = an["rayleigh"].real("beta");
-    solver_ = std::make_unique<fem::Solver>(std::move(model), options);
+    solver_ = std::make_unique<fem::StructuralSolver>(std::move(model), options);
 
     const auto ifaces = c["interfaces"].items();
     if (ifaces.empty())
