@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "partita/fem/box_mesher.hpp"
-#include "partita/fem/solver.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
 using Clock = std::chrono::steady_clock;
@@ -124,7 +124,7 @@ void bench(const Options& opt, std::array<int, 3> cells) {
   // static
   {
     const auto t0 = Clock::now();
-    Solver s(model);
+    StructuralSolver s(model);
     const double t_setup = since(t0);
     const auto t1 = Clock::now();
     s.solve_static();
@@ -143,7 +143,7 @@ void bench(const Options& opt, std::array<int, 3> cells) {
   SolverOptions so;
   so.mass = opt.lumped ? MassType::Lumped : MassType::Consistent;
   const auto t0 = Clock::now();
-  Solver s(model, so);
+  StructuralSolver s(model, so);
   double rmin = 1e300, rmax = -1e300, rmean = 0.0, rlast = 0.0;
   double first_step = 0.0, later_steps = 0.0;
   for (int k = 0; k < opt.steps; ++k) {

@@ -1,7 +1,11 @@
 #include "fem_adapter.hpp"
 
 #include <fmt/format.h>
+#include <sstream>
 #include <algorithm>
+
+#include "partita/fem/error.hpp"
+#include "partita/fem/state_io.hpp"
 
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -234,7 +238,7 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         an.string("mass") == "lumped" ? fem::MassType::Lumped : fem::MassType::Consistent;
     options.rayleigh_alpha = an["rayleigh"].real("alpha");
     options.rayleigh_beta = an["rayleigh"].real("beta");
-    solver_ = std::make_unique<fem::Solver>(std::move(model), options);
+    solver_ = std::make_unique<fem::StructuralSolver>(std::move(model), options);
     {
       Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
       for (const auto& x : solver_->mesh().nodes()) {
@@ -385,25 +389,10 @@ std::string FemAdapter::check_state() const {
 }
 
 void FemAdapter::write_restart(BinaryWriter& out) const {
-  const fem::SolverState s = solver_->save_state();
   out.section("fem");
-  out.write(s.time);
-  out.write(static_cast<std::uint64_t>(s.steps));
-  out.write(s.displacement);
-  out.write(s.velocity);
-  out.write(s.acceleration);
-  out.write(s.external_force);
-  out.write(static_cast<std::uint8_t>(s.acceleration_valid));
-  out.write(s.external_work);
-  out.write(s.coupling_force);
-  out.write(static_cast<std::uint64_t>(s.face_tractions.size()));
-  for (const auto& [face, t] : s.face_tractions) {
-    out.write(face);
-    out.write(t);
-  }
-  std::vector<std::uint64_t> nodes(s.nodal_force_nodes.begin(), s.nodal_force_nodes.end());
-  out.write(nodes);
-  out.write(s.nodal_forces);
+  std::ostringstream state;
+  fem::write_state(state, solver_->save_state());  // the solver's own versioned format
+  out.bytes(state.str());
   out.section("fem interfaces");
   for (const auto& i : interfaces_) {
     out.write(i.nodal_forces);
@@ -414,28 +403,15 @@ void FemAdapter::write_restart(BinaryWriter& out) const {
 }
 
 void FemAdapter::read_restart(BinaryReader& in) {
-  fem::SolverState s = solver_->save_state();  // the shapes to compare with
-  const Eigen::Index dofs = s.displacement.size();
   in.expect_section("fem");
-  in.read(s.time);
-  s.steps = static_cast<std::size_t>(in.get<std::uint64_t>());
-  in.read(s.displacement);
-  in.read(s.velocity);
-  in.read(s.acceleration);
-  in.read(s.external_force);
-  s.acceleration_valid = in.get<std::uint8_t>() != 0;
-  in.read(s.external_work);
-  in.read(s.coupling_force);
-  s.face_tractions.clear();
-  const auto faces = in.get<std::uint64_t>();
-  for (std::uint64_t k = 0; k < faces; ++k) {
-    const std::string face = in.get_string();
-    in.read(s.face_tractions[face]);
+  std::istringstream bytes(in.bytes());
+  fem::SolverState s;
+  try {
+    s = fem::read_state(bytes);
+  } catch (const fem::Error& e) {
+    throw Error(in.source() + ": the FE state of '" + name_ + "': " + e.what());
   }
-  std::vector<std::uint64_t> nodes;
-  in.read(nodes);
-  s.nodal_force_nodes.assign(nodes.begin(), nodes.end());
-  in.read(s.nodal_forces);
+  const Eigen::Index dofs = solver_->displacement().size();
   for (const Eigen::VectorXd* v : {&s.displacement, &s.velocity, &s.acceleration})
     if (v->size() != dofs) in.fail(std::to_string(dofs) + " degrees of freedom (the same mesh)");
   in.expect_section("fem interfaces");

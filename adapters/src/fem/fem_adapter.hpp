@@ -62,7 +62,7 @@ class FemAdapter : public Solver {
 
   std::string name_;
   bool transient_ = true;
-  std::unique_ptr<fem::Solver> solver_;
+  std::unique_ptr<fem::StructuralSolver> solver_;
   fem::SolverState checkpoint_;
   bool has_checkpoint_ = false;
   std::vector<Interface> interfaces_;

@@ -12,27 +12,6 @@ namespace {
 
 using StrainMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxElementDofs>;
 
-// Physical gradients dN/dx (n x 3) and det J at reference point xi.
-// J_ij = dx_j/dxi_i = sum_a dN_a/dxi_i x_aj;  dN_a/dx = J^-1 dN_a/dxi.
-double physical_gradients(ElementType type, const ElementCoordinates& x, const Vec3& xi,
-                          ShapeVector& n, ShapeGradient& dndx) {
-  ShapeGradient dn;
-  shape_functions(type, xi, n, dn);
-  const Mat3 j = dn.transpose() * x;
-  const double det = j.determinant();
-  if (!(det > 0.0)) {
-    std::ostringstream msg;
-    msg << to_string(type) << " element with non-positive Jacobian determinant " << det
-        << " at reference point (" << xi.transpose()
-        << "): the element is inverted or degenerate (check node order and positions; first node "
-           "at ("
-        << x.row(0) << "))";
-    throw Error(msg.str());
-  }
-  dndx = dn * j.inverse().transpose();
-  return det;
-}
-
 // B (6 x 3n): strain = B u_e, rows xx yy zz xy yz zx (engineering shears).
 void strain_matrix(const ShapeGradient& g, StrainMatrix& b) {
   const auto n = g.rows();
@@ -53,6 +32,32 @@ void strain_matrix(const ShapeGradient& g, StrainMatrix& b) {
 }
 
 }  // namespace
+
+double physical_gradients(ElementType type, const ElementCoordinates& x, const Vec3& xi,
+                          ShapeVector& n, ShapeGradient& dndx) {
+  ShapeGradient dn;
+  shape_functions(type, xi, n, dn);
+  const Mat3 j = dn.transpose() * x;
+  const double det = j.determinant();
+  if (!(det > 0.0)) {
+    std::ostringstream msg;
+    msg << to_string(type) << " element with non-positive Jacobian determinant " << det
+        << " at reference point (" << xi.transpose()
+        << "): the element is inverted or degenerate (check node order and positions; first node "
+           "at ("
+        << x.row(0) << "))";
+    throw Error(msg.str());
+  }
+  dndx = dn * j.inverse().transpose();
+  return det;
+}
+
+ElementCoordinates element_coordinates(const Mesh& mesh, const Element& e) {
+  const int n = node_count(e.type);
+  ElementCoordinates x(n, 3);
+  for (int a = 0; a < n; ++a) x.row(a) = mesh.node(e.nodes[a]).transpose();
+  return x;
+}
 
 void ElementIntegrator::stiffness(ElementType type, const ElementCoordinates& x, const Matrix6& d,
                                   ElementMatrix& ke) const {

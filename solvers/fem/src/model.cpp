@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "partita/fem/error.hpp"
+#include "partita/fem/linear_elastic_law.hpp"
 
 namespace partita::fem {
 
@@ -10,16 +11,47 @@ Model::Model(Mesh mesh, const Material& material) : mesh_(std::move(mesh)) {
   mesh_.validate();
   material.validate();
   materials_.assign(std::max<std::size_t>(1, mesh_.region_names().size()), material);
+  laws_.assign(materials_.size(), nullptr);
 }
 
 void Model::set_material(const Material& material) {
   material.validate();
   std::fill(materials_.begin(), materials_.end(), material);
+  std::fill(laws_.begin(), laws_.end(), nullptr);
 }
 
 void Model::set_material(const std::string& region, const Material& material) {
   material.validate();
-  materials_.at(static_cast<std::size_t>(mesh_.region(region))) = material;
+  const auto r = static_cast<std::size_t>(mesh_.region(region));
+  materials_.at(r) = material;
+  laws_.at(r) = nullptr;
+}
+
+void Model::set_material_law(std::shared_ptr<const MaterialLaw> law) {
+  if (!law) throw Error("set_material_law: null law");
+  if (const auto* linear = dynamic_cast<const LinearElasticLaw*>(law.get())) {
+    set_material(linear->material());
+    return;
+  }
+  std::fill(laws_.begin(), laws_.end(), law);
+}
+
+void Model::set_material_law(const std::string& region, std::shared_ptr<const MaterialLaw> law) {
+  if (!law) throw Error("set_material_law('" + region + "'): null law");
+  if (const auto* linear = dynamic_cast<const LinearElasticLaw*>(law.get())) {
+    set_material(region, linear->material());
+    return;
+  }
+  laws_.at(static_cast<std::size_t>(mesh_.region(region))) = std::move(law);
+}
+
+bool Model::is_linear() const {
+  return std::all_of(laws_.begin(), laws_.end(), [](const auto& l) { return l == nullptr; });
+}
+
+double Model::density(int region) const {
+  const auto* law = material_law(region);
+  return law != nullptr ? law->density() : material(region).density;
 }
 
 void Model::check_component(int component) const {

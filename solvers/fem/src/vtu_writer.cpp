@@ -46,7 +46,7 @@ void write_array(std::ostream& out, const char* name, int components, const doub
 
 }  // namespace
 
-void write_vtu(const std::string& path, const Solver& solver) {
+void write_vtu(const std::string& path, const StructuralSolver& solver) {
   const Mesh& mesh = solver.mesh();
   const std::string tmp = path + ".tmp";
   {
@@ -87,7 +87,7 @@ void write_vtu(const std::string& path, const Solver& solver) {
     // VTK symmetric tensors: XX YY ZZ XY YZ XZ (same as partita's Voigt order)
     const MatrixX6 s = solver.nodal_stress();
     write_array(out, "stress", 6, s.data(), 6 * n);
-    const Eigen::VectorXd vm = Solver::von_mises(s);
+    const Eigen::VectorXd vm = StructuralSolver::von_mises(s);
     write_array(out, "von_mises", 1, vm.data(), n);
     out << "      </PointData>\n"
         << "      <CellData>\n"

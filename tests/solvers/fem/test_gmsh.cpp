@@ -6,7 +6,7 @@
 
 #include "fem_test_helpers.hpp"
 #include "partita/fem/gmsh_reader.hpp"
-#include "partita/fem/solver.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
 
@@ -59,7 +59,7 @@ TEST_CASE("fem gmsh import of committed meshes", "[fem][gmsh]") {
                             [g, c](const Vec3& x, double) { return g.row(c).dot(x); });
     }
     model.add_pressure("top", 0.0);
-    Solver s(model);
+    StructuralSolver s(model);
     s.solve_static();
     double err = 0.0;
     for (std::size_t i = 0; i < mesh.num_nodes(); ++i)

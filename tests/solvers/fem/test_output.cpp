@@ -19,7 +19,7 @@ TEST_CASE("fem vtu output for every element type", "[fem][output]") {
     Model model(make_box_mesh({Vec3::Zero(), Vec3(1, 0.2, 0.2), {4, 1, 1}, type}));
     model.fix("xmin");
     model.add_pressure("zmax", 1e5);
-    Solver s(model);
+    StructuralSolver s(model);
     s.solve_static();
     const auto path = (dir / ("out_" + std::string(to_string(type)) + ".vtu")).string();
     write_vtu(path, s);
@@ -41,11 +41,12 @@ TEST_CASE("fem vtu output for every element type", "[fem][output]") {
     CHECK(s.strain_energy() > 0.0);
     CHECK(s.kinetic_energy() == 0.0);
     CHECK(s.reaction("xmin")[2] == Approx(1e5 * 0.2).epsilon(1e-9));
-    const Eigen::VectorXd vm = Solver::von_mises(s.nodal_stress());
+    const Eigen::VectorXd vm = StructuralSolver::von_mises(s.nodal_stress());
     CHECK(vm.minCoeff() >= 0.0);
     CHECK(vm.maxCoeff() > 0.0);
   }
-  CHECK_THROWS_AS(write_vtu("/nonexistent/dir/out.vtu", Solver(Model(make_box_mesh({})))), Error);
+  CHECK_THROWS_AS(write_vtu("/nonexistent/dir/out.vtu", StructuralSolver(Model(make_box_mesh({})))),
+                  Error);
 }
 
 TEST_CASE("fem hex8 incompatible modes: no volumetric locking at nu = 0.45", "[fem][static]") {
@@ -56,7 +57,7 @@ TEST_CASE("fem hex8 incompatible modes: no volumetric locking at nu = 0.45", "[f
     m.set_hex8_formulation(f);
     m.fix("xmin");
     m.add_traction("xmax", Vec3(0, 0, -100.0));
-    Solver s(m);
+    StructuralSolver s(m);
     s.solve_static();
     double sum = 0.0;
     for (auto n : s.mesh().node_set("xmax")) sum -= s.displacement(n)[2];

@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "fem_test_helpers.hpp"
-#include "partita/fem/solver.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
 
@@ -33,7 +33,7 @@ void run_patch(ElementType type, Hex8Formulation formulation) {
     model.prescribe_field("boundary", c,
                           [g, c](const Vec3& x, double) { return kU0[c] + g.row(c).dot(x); });
   }
-  Solver solver(model);
+  StructuralSolver solver(model);
   solver.solve_static();
   double err = 0.0, umax = 0.0;
   for (std::size_t i = 0; i < mesh.num_nodes(); ++i) {

@@ -5,7 +5,7 @@
 #include <numbers>
 
 #include "fem_test_helpers.hpp"
-#include "partita/fem/solver.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
 
@@ -28,7 +28,7 @@ struct Cantilever {
     return m;
   }
   // mean tip deflection (positive down)
-  static double tip(const Solver& s) {
+  static double tip(const StructuralSolver& s) {
     double sum = 0.0;
     const auto& nodes = s.mesh().node_set("xmax");
     for (auto n : nodes) sum += s.displacement(n)[2];
@@ -38,7 +38,7 @@ struct Cantilever {
 
 double cantilever_ratio(ElementType type, std::array<int, 3> cells, Hex8Formulation f) {
   Cantilever c;
-  Solver s(c.model(type, cells, f));
+  StructuralSolver s(c.model(type, cells, f));
   s.solve_static();
   const double ratio = Cantilever::tip(s) / c.beam_deflection();
   // the clamp carries the load
@@ -90,7 +90,7 @@ TEST_CASE("fem seed plate under 10 kPa: support reactions equal p A", "[fem][sta
     model.fix("lateral", {0, 1});
     model.fix("corners", {2});
     model.add_pressure("zmax", p);
-    Solver s(model);
+    StructuralSolver s(model);
     s.solve_static();
     const Vec3 r = s.reaction("corners");
     INFO(to_string(type) << " corner reaction z = " << r[2] << " N");
@@ -115,7 +115,7 @@ TEST_CASE("fem thick-walled cylinder under internal pressure (Lame, plane strain
   model.fix("zmin", {2});  // plane strain
   model.fix("zmax", {2});
   model.add_pressure("xmin", p);  // inner wall
-  Solver s(model);
+  StructuralSolver s(model);
   s.solve_static();
   // u(r) = (1+nu) p a^2 / (E (b^2 - a^2)) ((1 - 2 nu) r + b^2 / r)
   const double ua = (1 + nu) * p * a * a / (e * (b * b - a * a)) * ((1 - 2 * nu) * a + b * b / a);

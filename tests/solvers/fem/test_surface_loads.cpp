@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "fem_test_helpers.hpp"
-#include "partita/fem/solver.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
 
@@ -25,7 +25,7 @@ TEST_CASE("fem face quadrature points integrate area and normals", "[fem][surfac
   for (auto type : {ElementType::Hex8, ElementType::Hex20, ElementType::Tet4, ElementType::Tet10}) {
     Model model(make_box_mesh({Vec3(1, 2, 3), Vec3(0.5, 0.25, 0.2), {3, 2, 2}, type}));
     model.fix("xmin");
-    Solver s(model);
+    StructuralSolver s(model);
     const std::vector<std::pair<std::string, Vec3>> faces = {
         {"xmin", Vec3(-0.05, 0, 0)}, {"xmax", Vec3(0.05, 0, 0)},   {"ymin", Vec3(0, -0.1, 0)},
         {"ymax", Vec3(0, 0.1, 0)},   {"zmin", Vec3(0, 0, -0.125)}, {"zmax", Vec3(0, 0, 0.125)}};
@@ -66,7 +66,7 @@ TEST_CASE("fem uniform traction at quadrature points equals the pressure load", 
     with_pressure.add_pressure("zmax", p);
     Model plain(mesh);
     plain.fix("zmin");
-    Solver a(with_pressure), b(plain);
+    StructuralSolver a(with_pressure), b(plain);
     const auto qps = b.face_quadrature_points("zmax");
     MatrixX3 t(static_cast<Eigen::Index>(qps.size()), 3);
     for (std::size_t q = 0; q < qps.size(); ++q)
@@ -93,7 +93,7 @@ TEST_CASE("fem uniform traction at quadrature points equals the pressure load", 
 TEST_CASE("fem nodal forces on face nodes keep their sum", "[fem][surface]") {
   Model model(make_box_mesh({Vec3::Zero(), Vec3(1, 1, 0.1), {4, 4, 1}, ElementType::Hex20}));
   model.fix("zmin");
-  Solver s(model);
+  StructuralSolver s(model);
   const auto nodes = s.mesh().face_nodes("zmax");
   test::Lcg rng(3);
   MatrixX3 f(static_cast<Eigen::Index>(nodes.size()), 3);

@@ -5,7 +5,7 @@
 #include <numbers>
 
 #include "fem_test_helpers.hpp"
-#include "partita/fem/solver.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
 
@@ -30,14 +30,14 @@ double beam_period() {
          (1.8751 * 1.8751 * std::sqrt(kE * i / (kRho * a * std::pow(kL, 4))));
 }
 
-double tip(const Solver& s) {
+double tip(const StructuralSolver& s) {
   double sum = 0.0;
   for (auto n : s.mesh().node_set("xmax")) sum += s.displacement(n)[2];
   return sum / static_cast<double>(s.mesh().node_set("xmax").size());
 }
 
 // Period from successive upward zero crossings of the tip deflection.
-double measured_period(Solver& s, double dt, int steps) {
+double measured_period(StructuralSolver& s, double dt, int steps) {
   std::vector<double> crossings;
   double prev = tip(s);
   for (int k = 0; k < steps; ++k) {
@@ -57,7 +57,7 @@ TEST_CASE("fem cantilever free vibration: first period vs beam theory", "[fem][t
   for (auto mass : {MassType::Consistent, MassType::Lumped}) {
     SolverOptions opt;
     opt.mass = mass;
-    Solver s(released_cantilever(), opt);
+    StructuralSolver s(released_cantilever(), opt);
     s.solve_static();
     const double period = measured_period(s, t_beam / 200, 700);
     INFO((mass == MassType::Consistent ? "consistent" : "lumped")
@@ -69,7 +69,7 @@ TEST_CASE("fem cantilever free vibration: first period vs beam theory", "[fem][t
 
 TEST_CASE("fem undamped average-acceleration Newmark conserves energy",
           "[fem][transient][energy]") {
-  Solver s(released_cantilever(ElementType::Hex8));
+  StructuralSolver s(released_cantilever(ElementType::Hex8));
   s.solve_static();
   const double e0 = s.kinetic_energy() + s.strain_energy() - s.external_work();
   REQUIRE(e0 > 0.0);
@@ -89,7 +89,7 @@ TEST_CASE("fem undamped average-acceleration Newmark conserves energy",
             Material{kE, 0.3, kRho});
     m.fix("xmin");
     m.add_traction("xmax", Vec3(0, 0, -kP / (kH * kH)));
-    Solver s2(m);
+    StructuralSolver s2(m);
     double w = 0.0;
     for (int k = 0; k < 200; ++k) {
       s2.step(beam_period() / 50);
@@ -104,7 +104,7 @@ TEST_CASE("fem Rayleigh damping dissipates energy", "[fem][transient]") {
   SolverOptions opt;
   opt.rayleigh_alpha = 20.0;
   opt.rayleigh_beta = 1e-5;
-  Solver s(released_cantilever(ElementType::Hex8), opt);
+  StructuralSolver s(released_cantilever(ElementType::Hex8), opt);
   s.solve_static();
   const double e0 = s.strain_energy();
   double prev = e0;
@@ -120,7 +120,7 @@ TEST_CASE("fem Rayleigh damping dissipates energy", "[fem][transient]") {
 TEST_CASE("fem save and restore give bit-identical continuations", "[fem][transient][state]") {
   Model m = released_cantilever(ElementType::Hex20);
   m.prescribe("xmin", 0, [](double t) { return 1e-6 * std::sin(1000 * t); });
-  Solver s(m);
+  StructuralSolver s(m);
   const auto qps = s.face_quadrature_points("zmax");
   MatrixX3 t = MatrixX3::Zero(static_cast<Eigen::Index>(qps.size()), 3);
   t.col(2).setConstant(-1e3);
@@ -165,7 +165,7 @@ TEST_CASE("fem transient plate oscillates about the static reaction", "[fem][tra
   model.fix("lateral", {0, 1});
   model.fix("corners", {2});
   model.add_pressure("zmax", p);
-  Solver s(model);
+  StructuralSolver s(model);
   double rmin = 1e300, rmax = -1e300, mean = 0.0;
   const int n = 400;
   for (int k = 0; k < n; ++k) {
@@ -183,8 +183,8 @@ TEST_CASE("fem transient plate oscillates about the static reaction", "[fem][tra
 
 TEST_CASE("fem steps that differ in the last bits reuse one factorisation", "[fem][transient]") {
   // A coupling advances by t_(k+1) - t_k of absolute times: the sizes differ by rounding only.
-  Solver a(released_cantilever(ElementType::Hex8));
-  Solver b(released_cantilever(ElementType::Hex8));
+  StructuralSolver a(released_cantilever(ElementType::Hex8));
+  StructuralSolver b(released_cantilever(ElementType::Hex8));
   const double dt = beam_period() / 50, t0 = 0.3;
   double max_relative_change = 0.0;
   for (int k = 0; k < 200; ++k) {

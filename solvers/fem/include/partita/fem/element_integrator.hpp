@@ -2,6 +2,8 @@
 #include "partita/fem/element_type.hpp"
 #include "partita/fem/face_type.hpp"
 #include "partita/fem/hex8_formulation.hpp"
+#include "partita/fem/mesh.hpp"
+#include "partita/fem/shape_functions.hpp"
 #include "partita/fem/types.hpp"
 
 namespace partita::fem {
@@ -11,6 +13,14 @@ using ElementMatrix =
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxElementDofs, kMaxElementDofs>;
 using ElementVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementDofs, 1>;
 using ElementStresses = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, kMaxElementNodes, 6>;
+
+// Node coordinates (n x 3) of element e in its node order.
+ElementCoordinates element_coordinates(const Mesh& mesh, const Element& e);
+// Shape functions n and physical gradients dN/dx (n x 3) at reference point xi; returns det J.
+// J_ij = dx_j/dxi_i = sum_a dN_a/dxi_i x_aj;  dN_a/dx = J^-1 dN_a/dxi. Throws Error when
+// det J <= 0 (inverted or degenerate element).
+double physical_gradients(ElementType type, const ElementCoordinates& x, const Vec3& xi,
+                          ShapeVector& n, ShapeGradient& dndx);
 
 // Element matrices of one element at a time (dof order: node-major, x y z per node).
 // x holds the element's node coordinates (n x 3) in the element's node order.

@@ -14,7 +14,7 @@ enum class LoadKind {
 
 // A load defined with the model: its magnitude times amplitude(t) (1 when empty).
 // The coupling inputs (tractions at quadrature points, nodal forces) are not Loads: they are
-// set on the Solver between steps.
+// set on the StructuralSolver between steps.
 struct Load {
   LoadKind kind = LoadKind::Pressure;
   std::string target;

@@ -1,4 +1,5 @@
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -6,13 +7,14 @@
 #include "partita/fem/hex8_formulation.hpp"
 #include "partita/fem/load.hpp"
 #include "partita/fem/material.hpp"
+#include "partita/fem/material_law.hpp"
 #include "partita/fem/mesh.hpp"
 
 namespace partita::fem {
 
-// What is computed: mesh + material(s) + Dirichlet conditions + model loads. A Solver takes a
-// copy, so change a Model before building its Solver. Names are checked when they are given
-// (Error listing the known sets / faces / regions).
+// What is computed: mesh + material(s) + Dirichlet conditions + model loads. A StructuralSolver
+// takes a copy, so change a Model before building its StructuralSolver. Names are checked when they
+// are given (Error listing the known sets / faces / regions).
 class Model {
  public:
   explicit Model(Mesh mesh, const Material& material = {});
@@ -25,6 +27,17 @@ class Model {
   const Material& material(int region) const {
     return materials_.at(static_cast<std::size_t>(region));
   }
+  // A constitutive law (neo-hooke, j2-plasticity, ...) for every region / one region. A
+  // LinearElasticLaw is stored as its Material (the linear path); set_material() replaces a law.
+  void set_material_law(std::shared_ptr<const MaterialLaw> law);
+  void set_material_law(const std::string& region, std::shared_ptr<const MaterialLaw> law);
+  // The law of a region, or nullptr when the region is linear elastic (material(region)).
+  const MaterialLaw* material_law(int region) const {
+    return laws_.at(static_cast<std::size_t>(region)).get();
+  }
+  // True when every region is linear elastic: the solver's factorise-once path applies.
+  bool is_linear() const;
+  double density(int region) const;
   void set_hex8_formulation(Hex8Formulation f) { hex8_ = f; }
   Hex8Formulation hex8_formulation() const { return hex8_; }
 
@@ -48,6 +61,7 @@ class Model {
   void check_component(int component) const;
   Mesh mesh_;
   std::vector<Material> materials_;
+  std::vector<std::shared_ptr<const MaterialLaw>> laws_;  // per region; nullptr: linear elastic
   Hex8Formulation hex8_ = Hex8Formulation::IncompatibleModes;
   std::vector<DirichletCondition> dirichlet_;
   std::vector<Load> loads_;

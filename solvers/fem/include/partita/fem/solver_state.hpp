@@ -8,9 +8,9 @@
 
 namespace partita::fem {
 
-// Everything that evolves in a Solver: kinematics, time, the coupling loads that are set, the
-// energy bookkeeping. Solver::restore_state(save_state()) then continuing gives bit-identical
-// results.
+// Everything that evolves in a StructuralSolver: kinematics, time, the coupling loads that are set,
+// the energy bookkeeping. StructuralSolver::restore_state(save_state()) then continuing gives
+// bit-identical results.
 struct SolverState {
   double time = 0.0;
   std::size_t steps = 0;
@@ -18,6 +18,8 @@ struct SolverState {
   Eigen::VectorXd external_force;  // F(time) used by the last solve
   bool acceleration_valid = false;
   double external_work = 0.0;
+  double damping_work = 0.0;
+  std::vector<double> material_state;  // committed quadrature-point history (nonlinear path)
   Eigen::VectorXd coupling_force;
   std::map<std::string, MatrixX3> face_tractions;
   std::vector<std::size_t> nodal_force_nodes;

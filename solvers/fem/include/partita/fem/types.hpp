@@ -10,6 +10,8 @@ using Mat3 = Eigen::Matrix3d;
 // Voigt vectors are ordered xx, yy, zz, xy, yz, zx; strains carry engineering shears.
 using Voigt = Eigen::Matrix<double, 6, 1>;
 using Matrix6 = Eigen::Matrix<double, 6, 6>;
+// Fourth-order tensors acting on 3x3 tensors, flattened row-major: A(3 i + J, 3 k + L).
+using Matrix9 = Eigen::Matrix<double, 9, 9>;
 // N x 3 arrays (one row per point / node), row-major so that a row is contiguous.
 using MatrixX3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 // N x 6 arrays of Voigt stresses.

@@ -6,25 +6,42 @@
 #include <string>
 #include <vector>
 
+#include "partita/fem/central_difference_integrator.hpp"
+#include "partita/fem/dof_partition.hpp"
 #include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/face_mesh.hpp"
 #include "partita/fem/face_quadrature_point.hpp"
 #include "partita/fem/model.hpp"
+#include "partita/fem/newmark_integrator.hpp"
+#include "partita/fem/nonlinear_operator.hpp"
 #include "partita/fem/solver_options.hpp"
 #include "partita/fem/solver_state.hpp"
 #include "partita/fem/solver_timings.hpp"
+#include "partita/fem/static_integrator.hpp"
+#include "partita/fem/structural_system.hpp"
 
 namespace partita::fem {
 
-// Static and transient (Newmark) small-strain linear elasticity on a Model.
+// Static and transient structural analysis of a Model.
+//
+// Two paths, chosen from the model:
+//   linear (every region linear elastic, Model::is_linear()): K is assembled once (Hex8 with
+//     incompatible modes) and factorised once per dt; static = one solve, Newmark = one
+//     right-hand side and one pair of triangular solves per step.
+//   nonlinear (a region has a MaterialLaw: neo-hooke, j2-plasticity, ...): a NonlinearOperator
+//     (f_int and K_t element by element, quadrature-point history), a StaticIntegrator (Newton
+//     with load stepping and cut-back) and a NewmarkIntegrator (Newton per step, cut-back).
+//   SolverOptions::integrator = CentralDifference selects explicit dynamics on either path
+//     (lumped mass; stable_time_step() gives the largest stable step).
 //
 // Dofs are node-major: dof 3 i + c is component c of node i. Dirichlet dofs are eliminated
 // (partitioned: free f / constrained c), so a factorisation depends on dt and on which dofs
 // are constrained, never on the prescribed values or loads.
 //
 // Call order:
-//   1. Solver solver(model, options);            assembles K (and M on first transient use)
+//   1. StructuralSolver solver(model, options);            assembles K (and M on first transient
+//   use)
 //   2. (coupling set-up) face_mesh(face), face_quadrature_points(face): geometry in the
 //      reference configuration; quadrature points are ordered by surface element, then by
 //      the face rule's points.
@@ -41,12 +58,12 @@ namespace partita::fem {
 //   provides it. The effective matrix
 //   K + gamma/(beta dt) C + 1/(beta dt^2) M is factorised on the first step and whenever dt
 //   changes; otherwise each step is one right-hand side and one pair of triangular solves.
-class Solver {
+class StructuralSolver final : private StructuralSystem {
  public:
-  explicit Solver(Model model, SolverOptions options = {});
-  ~Solver();
-  Solver(const Solver&) = delete;
-  Solver& operator=(const Solver&) = delete;
+  explicit StructuralSolver(Model model, SolverOptions options = {});
+  ~StructuralSolver() override;
+  StructuralSolver(const StructuralSolver&) = delete;
+  StructuralSolver& operator=(const StructuralSolver&) = delete;
 
   const Model& model() const { return model_; }
   const Mesh& mesh() const { return model_.mesh(); }
@@ -68,19 +85,24 @@ class Solver {
   // --- analyses ---
   // K u = F(time()) with the prescribed values at time(); velocity = acceleration = 0.
   void solve_static();
-  // One Newmark step from time() to time() + dt.
+  // One step from time() to time() + dt: Newmark (linear or Newton) or central difference.
   void step(double dt);
+  // Largest stable explicit step estimate: min over elements of l_e / c_d, l_e the element
+  // size (hexahedra: smallest distance between opposite face centres; tetrahedra: smallest
+  // height; quadratic elements: half of that), c_d = sqrt((lambda + 2 mu) / rho) of its
+  // material. Exact (2 / omega_max) for a Hex8 bar in uniaxial strain with lumped mass.
+  double stable_time_step() const;
   // Quasi-static step: time() += dt, then solve_static() with the loads at the new time.
   void step_static(double dt);
-  double time() const { return time_; }
+  double time() const { return kin_.time; }
   std::size_t step_count() const { return steps_; }
 
   // --- results ---
-  const Eigen::VectorXd& displacement() const { return u_; }
-  const Eigen::VectorXd& velocity() const { return v_; }
-  const Eigen::VectorXd& acceleration() const { return a_; }
+  const Eigen::VectorXd& displacement() const { return kin_.u; }
+  const Eigen::VectorXd& velocity() const { return kin_.v; }
+  const Eigen::VectorXd& acceleration() const { return kin_.a; }
   Vec3 displacement(std::size_t node) const {
-    return u_.segment<3>(3 * static_cast<Eigen::Index>(node));
+    return kin_.u.segment<3>(3 * static_cast<Eigen::Index>(node));
   }
   MatrixX3 displacements(const std::vector<std::size_t>& nodes) const;
   // Sum over the set's nodes of the nodal residual K u + C v + M a - F [N]: the force the
@@ -91,21 +113,34 @@ class Solver {
   MatrixX6 nodal_stress() const;
   static Eigen::VectorXd von_mises(const MatrixX6& stress);
   // F(time()): model loads at time() plus coupling loads [N per dof].
-  const Eigen::VectorXd& external_force() const { return f_; }
+  const Eigen::VectorXd& external_force() const { return kin_.f; }
 
   // --- scalar monitors ---
-  double kinetic_energy() const;                           // 1/2 v^T M v
-  double strain_energy() const;                            // 1/2 u^T K u
-  double external_work() const { return external_work_; }  // sum 1/2 (F_n + F_n+1).(u_n+1 - u_n)
-  double max_displacement() const;                         // max over nodes of |u|
-  Vec3 total_coupling_force() const;                       // sum of the coupling loads [N]
-  Vec3 total_external_force() const;                       // sum of F(time()) [N]
+  double kinetic_energy() const;  // 1/2 v^T M v
+  double strain_energy() const;   // 1/2 u^T K u (linear), int W dV (nonlinear)
+  double plastic_work() const;    // int w_p dV of the committed history
+  double damping_work() const { return kin_.damping_work; }  // sum dt v.C v
+  double external_work() const {
+    return kin_.external_work;
+  }  // sum 1/2 (F_n + F_n+1).(u_n+1 - u_n)
+  // external work - (strain + kinetic + plastic + damping) [J]: zero for an exact energy
+  // balance (prescribed displacements do work through the reactions, not counted here).
+  double energy_balance() const;
+  double max_displacement() const;    // max over nodes of |u|
+  Vec3 total_coupling_force() const;  // sum of the coupling loads [N]
+  Vec3 total_external_force() const;  // sum of F(time()) [N]
 
   // --- state ---
   SolverState save_state() const;
   void restore_state(const SolverState& state);
 
   const SolverTimings& timings() const { return timings_; }
+  // Per quadrature point of the nonlinear path (empty on the linear path): equivalent plastic
+  // strain and Cauchy stress (Voigt) at the current state.
+  Eigen::VectorXd equivalent_plastic_strain() const;
+  // Newton reports of the last nonlinear static solve / Newmark step.
+  const std::vector<NewtonReport>& static_reports() const { return static_.reports(); }
+  const NewtonReport& newmark_report() const { return newmark_.last_report(); }
 
  private:
   using Factorisation = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
@@ -126,8 +161,16 @@ class Solver {
   void evaluate_external_force(double t, Eigen::VectorXd& f) const;
   void prescribed_values(double t, Eigen::VectorXd& uc) const;
   void initialise_acceleration();
+  void refresh_internal_force();
+  // StructuralSystem (what the integrators see)
+  const DofPartition& dofs() const override { return dofs_; }
+  InternalForceOperator& internal_forces() override { return *operator_; }
+  const SparseMatrix& mass() override;
+  bool lumped_mass() const override { return options_.mass == MassType::Lumped; }
+  double mass_damping() const override { return options_.rayleigh_alpha; }
+  void external_force(double t, Eigen::VectorXd& f) const override;
+  void apply_prescribed(double t, Eigen::VectorXd& u) const override;
   void factorise_dynamic(double dt);
-  void partition(const SparseMatrix& a, SparseMatrix& aff, SparseMatrix& afc) const;
 
   Model model_;
   SolverOptions options_;
@@ -135,8 +178,7 @@ class Solver {
   std::size_t ndof_ = 0;
 
   // dof partition
-  std::vector<Eigen::Index> free_index_;  // -1 for constrained dofs
-  std::vector<Eigen::Index> free_dofs_, constrained_dofs_;
+  DofPartition dofs_;
   std::vector<SpaceTimeFunction> constrained_value_;  // per constrained dof (empty: zero)
 
   // matrices (full and partitioned)
@@ -154,15 +196,18 @@ class Solver {
   Eigen::VectorXd coupling_force_;
 
   // state
-  double time_ = 0.0;
   std::size_t steps_ = 0;
-  Eigen::VectorXd u_, v_, a_, f_;
+  Kinematics kin_;
+  std::unique_ptr<InternalForceOperator> operator_;
+  NonlinearOperator* nonlinear_ = nullptr;  // operator_ on the nonlinear path
+  StaticIntegrator static_;
+  NewmarkIntegrator newmark_;
+  CentralDifferenceIntegrator central_;
   bool acceleration_valid_ = false;
   struct Work {  // vectors of a dynamic step, kept between steps
     Eigen::VectorXd f1, pm, pc, rhs, uc, rf, uf, u1, a1;
   };
   Work work_;
-  double external_work_ = 0.0;
 
   SolverTimings timings_;
 };

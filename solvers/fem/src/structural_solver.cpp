@@ -1,14 +1,16 @@
-#include "partita/fem/solver.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 #include <Eigen/Dense>
 #include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "block_assembler.hpp"
 #include "partita/fem/error.hpp"
+#include "partita/fem/linear_elastic_operator.hpp"
 #include "partita/fem/quadrature.hpp"
 #include "partita/fem/shape_functions.hpp"
 
@@ -20,50 +22,68 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-ElementCoordinates coordinates(const Mesh& mesh, const Element& e) {
-  const int n = node_count(e.type);
-  ElementCoordinates x(n, 3);
-  for (int a = 0; a < n; ++a) x.row(a) = mesh.node(e.nodes[a]).transpose();
-  return x;
-}
-
 double amplitude_at(const TimeFunction& f, double t) {
   return f ? f(t) : 1.0;
 }
 
 }  // namespace
 
-Solver::Solver(Model model, SolverOptions options)
-    : model_(std::move(model)), options_(options), integrator_(model_.hex8_formulation()) {
+StructuralSolver::StructuralSolver(Model model, SolverOptions options)
+    : model_(std::move(model)),
+      options_(options),
+      integrator_(model_.hex8_formulation()),
+      static_(options_.newton),
+      newmark_(options_.newmark_beta, options_.newmark_gamma, options_.newton) {
   if (!(options_.newmark_beta > 0.0) || !(options_.newmark_gamma > 0.0)) {
     throw Error("Newmark parameters must be > 0 (beta = 1/4, gamma = 1/2 is the default)");
   }
   if (options_.rayleigh_alpha < 0.0 || options_.rayleigh_beta < 0.0) {
     throw Error("Rayleigh damping coefficients must be >= 0");
   }
+  if (options_.integrator == Integrator::CentralDifference && options_.mass != MassType::Lumped) {
+    throw Error("the central-difference integrator needs a lumped mass (mass: lumped)");
+  }
+  if (!model_.is_linear() && options_.rayleigh_beta != 0.0) {
+    throw Error(
+        "stiffness-proportional Rayleigh damping (beta) is only available for linear-elastic "
+        "models; use mass-proportional damping (alpha) with nonlinear materials");
+  }
   ndof_ = 3 * mesh().num_nodes();
   const auto n = static_cast<Eigen::Index>(ndof_);
-  u_ = Eigen::VectorXd::Zero(n);
-  v_ = Eigen::VectorXd::Zero(n);
-  a_ = Eigen::VectorXd::Zero(n);
-  f_ = Eigen::VectorXd::Zero(n);
+  kin_.u = Eigen::VectorXd::Zero(n);
+  kin_.v = Eigen::VectorXd::Zero(n);
+  kin_.a = Eigen::VectorXd::Zero(n);
+  kin_.f = Eigen::VectorXd::Zero(n);
+  kin_.f_int = Eigen::VectorXd::Zero(n);
   coupling_force_ = Eigen::VectorXd::Zero(n);
   setup_dofs();
-  assemble_stiffness();
+  if (model_.is_linear()) {
+    assemble_stiffness();
+    operator_ = std::make_unique<LinearElasticOperator>(k_);
+  } else {
+    const auto t0 = Clock::now();
+    auto op = std::make_unique<NonlinearOperator>(model_);
+    nonlinear_ = op.get();
+    operator_ = std::move(op);
+    timings_.assembly += seconds_since(t0);
+  }
   assemble_loads();
   // Start from rest with the prescribed values of t = 0.
   Eigen::VectorXd uc;
   prescribed_values(0.0, uc);
-  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k)
-    u_[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
-  evaluate_external_force(0.0, f_);
+  for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
+    kin_.u[dofs_.constrained_dofs()[k]] = uc[static_cast<Eigen::Index>(k)];
+  evaluate_external_force(0.0, kin_.f);
+  if (nonlinear_ != nullptr || options_.integrator == Integrator::CentralDifference) {
+    refresh_internal_force();
+  }
 }
 
-Solver::~Solver() = default;
+StructuralSolver::~StructuralSolver() = default;
 
 // ---------------------------------------------------------------- setup and assembly
 
-void Solver::setup_dofs() {
+void StructuralSolver::setup_dofs() {
   std::vector<char> constrained(ndof_, 0);
   std::vector<SpaceTimeFunction> value(ndof_);
   for (const auto& bc : model_.dirichlet_conditions()) {
@@ -73,43 +93,12 @@ void Solver::setup_dofs() {
       value[dof] = bc.value;
     }
   }
-  free_index_.assign(ndof_, -1);
-  for (std::size_t d = 0; d < ndof_; ++d) {
-    if (constrained[d]) {
-      constrained_dofs_.push_back(static_cast<Eigen::Index>(d));
-      constrained_value_.push_back(value[d]);
-    } else {
-      free_index_[d] = static_cast<Eigen::Index>(free_dofs_.size());
-      free_dofs_.push_back(static_cast<Eigen::Index>(d));
-    }
-  }
+  dofs_ = DofPartition(constrained);
+  for (auto d : dofs_.constrained_dofs())
+    constrained_value_.push_back(value[static_cast<std::size_t>(d)]);
 }
 
-void Solver::partition(const SparseMatrix& a, SparseMatrix& aff, SparseMatrix& afc) const {
-  // Free dofs keep their relative order, so columns and rows stay sorted.
-  const auto nf = static_cast<Eigen::Index>(free_dofs_.size());
-  const auto nc = static_cast<Eigen::Index>(constrained_dofs_.size());
-  auto extract = [&](const std::vector<Eigen::Index>& cols, Eigen::Index ncols, SparseMatrix& out) {
-    std::vector<int> outer(static_cast<std::size_t>(ncols) + 1, 0), inner;
-    std::vector<double> values;
-    for (std::size_t k = 0; k < cols.size(); ++k) {
-      for (SparseMatrix::InnerIterator it(a, cols[k]); it; ++it) {
-        const Eigen::Index r = free_index_[static_cast<std::size_t>(it.row())];
-        if (r >= 0) {
-          inner.push_back(static_cast<int>(r));
-          values.push_back(it.value());
-        }
-      }
-      outer[k + 1] = static_cast<int>(inner.size());
-    }
-    out = Eigen::Map<SparseMatrix>(nf, ncols, static_cast<Eigen::Index>(inner.size()), outer.data(),
-                                   inner.data(), values.data());
-  };
-  extract(free_dofs_, nf, aff);
-  extract(constrained_dofs_, nc, afc);
-}
-
-void Solver::assemble_stiffness() {
+void StructuralSolver::assemble_stiffness() {
   const auto t0 = Clock::now();
   const BlockAssembler assembler(mesh());
   k_ = assembler.make_matrix();
@@ -120,15 +109,15 @@ void Solver::assemble_stiffness() {
   }
   // K = sum_e A_e^T K_e A_e
   for (const auto& e : mesh().elements()) {
-    integrator_.stiffness(e.type, coordinates(mesh(), e), d[static_cast<std::size_t>(e.region)],
-                          ke);
+    integrator_.stiffness(e.type, element_coordinates(mesh(), e),
+                          d[static_cast<std::size_t>(e.region)], ke);
     assembler.add(k_, e.node_span(), ke);
   }
-  partition(k_, k_ff_, k_fc_);
+  dofs_.split(k_, k_ff_, k_fc_);
   timings_.assembly += seconds_since(t0);
 }
 
-void Solver::assemble_mass() {
+void StructuralSolver::assemble_mass() {
   if (mass_ready_) return;
   const auto t0 = Clock::now();
   if (options_.mass == MassType::Consistent) {
@@ -137,7 +126,7 @@ void Solver::assemble_mass() {
     ElementMatrix me;
     // M = sum_e A_e^T M_e A_e
     for (const auto& e : mesh().elements()) {
-      integrator_.consistent_mass(e.type, coordinates(mesh(), e), model_.material(e.region).density,
+      integrator_.consistent_mass(e.type, element_coordinates(mesh(), e), model_.density(e.region),
                                   me);
       assembler.add(m_, e.node_span(), me);
     }
@@ -145,7 +134,7 @@ void Solver::assemble_mass() {
     Eigen::VectorXd diag = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ndof_));
     Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
     for (const auto& e : mesh().elements()) {
-      integrator_.lumped_mass(e.type, coordinates(mesh(), e), model_.material(e.region).density, m);
+      integrator_.lumped_mass(e.type, element_coordinates(mesh(), e), model_.density(e.region), m);
       for (int a = 0; a < node_count(e.type); ++a) {
         diag.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a])).array() += m[a];
       }
@@ -155,12 +144,12 @@ void Solver::assemble_mass() {
     for (Eigen::Index i = 0; i < diag.size(); ++i) m_.insert(i, i) = diag[i];
     m_.makeCompressed();
   }
-  partition(m_, m_ff_, m_fc_);
+  dofs_.split(m_, m_ff_, m_fc_);
   mass_ready_ = true;
   timings_.assembly += seconds_since(t0);
 }
 
-void Solver::assemble_loads() {
+void StructuralSolver::assemble_loads() {
   const auto t0 = Clock::now();
   const auto n = static_cast<Eigen::Index>(ndof_);
   for (const auto& load : model_.loads()) {
@@ -187,8 +176,8 @@ void Solver::assemble_loads() {
       case LoadKind::Gravity: {
         ElementVector fe;
         for (const auto& e : mesh().elements()) {
-          integrator_.body_force(e.type, coordinates(mesh(), e),
-                                 model_.material(e.region).density * load.vector, fe);
+          integrator_.body_force(e.type, element_coordinates(mesh(), e),
+                                 model_.density(e.region) * load.vector, fe);
           for (int a = 0; a < node_count(e.type); ++a) {
             f.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a])) += fe.segment<3>(3 * a);
           }
@@ -203,7 +192,8 @@ void Solver::assemble_loads() {
 
 // ---------------------------------------------------------------- faces and coupling loads
 
-std::vector<FaceQuadraturePoint> Solver::face_quadrature_points(const std::string& face) const {
+std::vector<FaceQuadraturePoint> StructuralSolver::face_quadrature_points(
+    const std::string& face) const {
   std::vector<FaceQuadraturePoint> out;
   const auto& elements = mesh().face(face);
   FaceShapeVector n;
@@ -228,7 +218,8 @@ std::vector<FaceQuadraturePoint> Solver::face_quadrature_points(const std::strin
   return out;
 }
 
-const Solver::FaceOperator& Solver::face_operator(const std::string& face) const {
+const StructuralSolver::FaceOperator& StructuralSolver::face_operator(
+    const std::string& face) const {
   auto it = face_operators_.find(face);
   if (it != face_operators_.end()) return it->second;
   FaceOperator op;
@@ -252,7 +243,7 @@ const Solver::FaceOperator& Solver::face_operator(const std::string& face) const
   return face_operators_.emplace(face, std::move(op)).first->second;
 }
 
-FaceMesh Solver::face_mesh(const std::string& face) const {
+FaceMesh StructuralSolver::face_mesh(const std::string& face) const {
   FaceMesh fm;
   fm.nodes = mesh().face_nodes(face);
   std::unordered_map<std::size_t, int> local;
@@ -293,8 +284,8 @@ FaceMesh Solver::face_mesh(const std::string& face) const {
   return fm;
 }
 
-void Solver::set_face_tractions_at_quadrature_points(const std::string& face,
-                                                     const MatrixX3& tractions) {
+void StructuralSolver::set_face_tractions_at_quadrature_points(const std::string& face,
+                                                               const MatrixX3& tractions) {
   const auto& op = face_operator(face);
   if (static_cast<std::size_t>(tractions.rows()) != op.num_qp) {
     throw Error("set_face_tractions_at_quadrature_points('" + face + "'): the face has " +
@@ -308,7 +299,8 @@ void Solver::set_face_tractions_at_quadrature_points(const std::string& face,
   update_coupling_force();
 }
 
-void Solver::set_nodal_forces(const std::vector<std::size_t>& nodes, const MatrixX3& forces) {
+void StructuralSolver::set_nodal_forces(const std::vector<std::size_t>& nodes,
+                                        const MatrixX3& forces) {
   if (static_cast<std::size_t>(forces.rows()) != nodes.size()) {
     throw Error("set_nodal_forces: " + std::to_string(nodes.size()) + " nodes but " +
                 std::to_string(forces.rows()) + " force rows");
@@ -325,14 +317,14 @@ void Solver::set_nodal_forces(const std::vector<std::size_t>& nodes, const Matri
   update_coupling_force();
 }
 
-void Solver::clear_coupling_loads() {
+void StructuralSolver::clear_coupling_loads() {
   face_tractions_.clear();
   nodal_force_nodes_.clear();
   nodal_forces_.resize(0, 3);
   update_coupling_force();
 }
 
-void Solver::update_coupling_force() {
+void StructuralSolver::update_coupling_force() {
   coupling_force_.setZero();
   // f_a = sum_q N_a(x_q) t_q w_q over every face with tractions
   for (const auto& [face, t] : face_tractions_) {
@@ -348,7 +340,7 @@ void Solver::update_coupling_force() {
   }
 }
 
-void Solver::evaluate_external_force(double t, Eigen::VectorXd& f) const {
+void StructuralSolver::evaluate_external_force(double t, Eigen::VectorXd& f) const {
   // F(t) = sum_l amplitude_l(t) F_l + F_coupling
   f = coupling_force_;
   for (std::size_t l = 0; l < load_vectors_.size(); ++l) {
@@ -357,11 +349,11 @@ void Solver::evaluate_external_force(double t, Eigen::VectorXd& f) const {
   }
 }
 
-void Solver::prescribed_values(double t, Eigen::VectorXd& uc) const {
-  uc.resize(static_cast<Eigen::Index>(constrained_dofs_.size()));
-  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k) {
+void StructuralSolver::prescribed_values(double t, Eigen::VectorXd& uc) const {
+  uc.resize(static_cast<Eigen::Index>(dofs_.constrained_dofs().size()));
+  for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k) {
     const auto& g = constrained_value_[k];
-    const auto dof = static_cast<std::size_t>(constrained_dofs_[k]);
+    const auto dof = static_cast<std::size_t>(dofs_.constrained_dofs()[k]);
     uc[static_cast<Eigen::Index>(k)] = g ? g(mesh().node(dof / 3), t) : 0.0;
   }
 }
@@ -384,8 +376,16 @@ void check_factorisation(
 }
 }  // namespace
 
-void Solver::solve_static() {
+void StructuralSolver::solve_static() {
   const auto t0 = Clock::now();
+  if (nonlinear_ != nullptr) {
+    static_.solve(*this, kin_, kin_.time);
+    refresh_internal_force();
+    acceleration_valid_ = true;
+    ++timings_.solves;
+    timings_.solve += seconds_since(t0);
+    return;
+  }
   if (!static_factor_) {
     static_factor_ = std::make_unique<Factorisation>();
     static_factor_->compute(k_ff_);
@@ -394,43 +394,49 @@ void Solver::solve_static() {
     timings_.factorisation += seconds_since(t0);
   }
   const auto t1 = Clock::now();
-  evaluate_external_force(time_, f_);
+  evaluate_external_force(kin_.time, kin_.f);
   Eigen::VectorXd uc;
-  prescribed_values(time_, uc);
+  prescribed_values(kin_.time, uc);
   // K_ff u_f = F_f - K_fc u_c
-  Eigen::VectorXd rhs(static_cast<Eigen::Index>(free_dofs_.size()));
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
-    rhs[static_cast<Eigen::Index>(k)] = f_[free_dofs_[k]];
+  Eigen::VectorXd rhs(static_cast<Eigen::Index>(dofs_.free_dofs().size()));
+  for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
+    rhs[static_cast<Eigen::Index>(k)] = kin_.f[dofs_.free_dofs()[k]];
   if (uc.size() > 0 && uc.cwiseAbs().maxCoeff() > 0.0) rhs -= k_fc_ * uc;
   const Eigen::VectorXd uf = static_factor_->solve(rhs);
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
-    u_[free_dofs_[k]] = uf[static_cast<Eigen::Index>(k)];
-  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k)
-    u_[constrained_dofs_[k]] = uc[static_cast<Eigen::Index>(k)];
-  v_.setZero();
-  a_.setZero();
+  for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
+    kin_.u[dofs_.free_dofs()[k]] = uf[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
+    kin_.u[dofs_.constrained_dofs()[k]] = uc[static_cast<Eigen::Index>(k)];
+  kin_.v.setZero();
+  kin_.a.setZero();
   acceleration_valid_ = true;
   ++timings_.solves;
   timings_.solve += seconds_since(t1);
 }
 
-void Solver::step_static(double dt) {
+void StructuralSolver::step_static(double dt) {
   if (!(dt > 0.0))
     throw Error("step_static: the time step must be positive, got " + std::to_string(dt));
-  time_ += dt;
+  kin_.time += dt;
   ++steps_;
   solve_static();
 }
 
-void Solver::initialise_acceleration() {
+void StructuralSolver::initialise_acceleration() {
   // M_ff a_f = F_f - (K u + C v)_f   (prescribed accelerations taken as zero)
-  evaluate_external_force(time_, f_);
-  Eigen::VectorXd r = f_ - k_ * u_;
-  if (options_.rayleigh_alpha != 0.0) r -= options_.rayleigh_alpha * (m_ * v_);
-  if (options_.rayleigh_beta != 0.0) r -= options_.rayleigh_beta * (k_ * v_);
-  Eigen::VectorXd rf(static_cast<Eigen::Index>(free_dofs_.size()));
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
-    rf[static_cast<Eigen::Index>(k)] = r[free_dofs_[k]];
+  evaluate_external_force(kin_.time, kin_.f);
+  Eigen::VectorXd r;
+  if (nonlinear_ == nullptr) {
+    r = kin_.f - k_ * kin_.u;
+  } else {
+    refresh_internal_force();
+    r = kin_.f - kin_.f_int;
+  }
+  if (options_.rayleigh_alpha != 0.0) r -= options_.rayleigh_alpha * (m_ * kin_.v);
+  if (options_.rayleigh_beta != 0.0) r -= options_.rayleigh_beta * (k_ * kin_.v);
+  Eigen::VectorXd rf(static_cast<Eigen::Index>(dofs_.free_dofs().size()));
+  for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
+    rf[static_cast<Eigen::Index>(k)] = r[dofs_.free_dofs()[k]];
   Eigen::VectorXd af;
   if (options_.mass == MassType::Lumped) {
     af = rf.cwiseQuotient(Eigen::VectorXd(m_ff_.diagonal()));
@@ -447,13 +453,13 @@ void Solver::initialise_acceleration() {
                   std::to_string(cg.error()) + "); is the density > 0 everywhere?");
     }
   }
-  a_.setZero();
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
-    a_[free_dofs_[k]] = af[static_cast<Eigen::Index>(k)];
+  kin_.a.setZero();
+  for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
+    kin_.a[dofs_.free_dofs()[k]] = af[static_cast<Eigen::Index>(k)];
   acceleration_valid_ = true;
 }
 
-void Solver::factorise_dynamic(double dt) {
+void StructuralSolver::factorise_dynamic(double dt) {
   const auto t0 = Clock::now();
   const double beta = options_.newmark_beta, gamma = options_.newmark_gamma;
   const double c0 = 1.0 / (beta * dt * dt), c1 = gamma / (beta * dt);
@@ -473,10 +479,26 @@ void Solver::factorise_dynamic(double dt) {
   timings_.factorisation += seconds_since(t0);
 }
 
-void Solver::step(double dt) {
+void StructuralSolver::step(double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt))
     throw Error("step(dt): dt must be > 0, got " + std::to_string(dt));
   assemble_mass();
+  if (options_.integrator == Integrator::CentralDifference || nonlinear_ != nullptr) {
+    const auto t0 = Clock::now();
+    if (options_.integrator == Integrator::CentralDifference) {
+      if (!acceleration_valid_) central_.initialise(*this, kin_);
+      acceleration_valid_ = true;
+      central_.step(*this, kin_, dt);
+    } else {
+      if (!acceleration_valid_) initialise_acceleration();
+      newmark_.step(*this, kin_, dt);
+      refresh_internal_force();
+    }
+    ++steps_;
+    ++timings_.solves;
+    timings_.solve += seconds_since(t0);
+    return;
+  }
   if (!acceleration_valid_) initialise_acceleration();
   // A coupling hands over substeps as differences of absolute times, equal only to the last few
   // bits: a step within a relative 1e-9 of the factorised one reuses K_eff (and integrates with
@@ -487,16 +509,16 @@ void Solver::step(double dt) {
   const double beta = options_.newmark_beta, gamma = options_.newmark_gamma;
   const double c0 = 1.0 / (beta * h * h), c1 = gamma / (beta * h), c2 = 1.0 / (beta * h);
   const double c3 = 0.5 / beta - 1.0, c4 = gamma / beta - 1.0, c5 = h * (0.5 * gamma / beta - 1.0);
-  const double t1 = time_ + dt;
+  const double t1 = kin_.time + dt;
 
   // work vectors are members: no allocation once sized
   Work& w = work_;
   evaluate_external_force(t1, w.f1);
   // K_eff u1 = F1 + M (c0 u + c2 v + c3 a) + C (c1 u + c4 v + c5 a)
-  w.pm = c0 * u_ + c2 * v_ + c3 * a_;
+  w.pm = c0 * kin_.u + c2 * kin_.v + c3 * kin_.a;
   w.rhs = w.f1;
   if (options_.rayleigh_alpha != 0.0 || options_.rayleigh_beta != 0.0) {
-    w.pc = c1 * u_ + c4 * v_ + c5 * a_;
+    w.pc = c1 * kin_.u + c4 * kin_.v + c5 * kin_.a;
     w.pm += options_.rayleigh_alpha * w.pc;
     w.rhs.noalias() += m_ * w.pm;
     if (options_.rayleigh_beta != 0.0) {
@@ -507,25 +529,25 @@ void Solver::step(double dt) {
     w.rhs.noalias() += m_ * w.pm;
   }
   prescribed_values(t1, w.uc);
-  w.rf.resize(static_cast<Eigen::Index>(free_dofs_.size()));
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
-    w.rf[static_cast<Eigen::Index>(k)] = w.rhs[free_dofs_[k]];
+  w.rf.resize(static_cast<Eigen::Index>(dofs_.free_dofs().size()));
+  for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
+    w.rf[static_cast<Eigen::Index>(k)] = w.rhs[dofs_.free_dofs()[k]];
   if (w.uc.size() > 0 && w.uc.cwiseAbs().maxCoeff() > 0.0) w.rf.noalias() -= keff_fc_ * w.uc;
   w.uf = dynamic_factor_->solve(w.rf);
 
-  w.u1.resize(u_.size());
-  for (std::size_t k = 0; k < free_dofs_.size(); ++k)
-    w.u1[free_dofs_[k]] = w.uf[static_cast<Eigen::Index>(k)];
-  for (std::size_t k = 0; k < constrained_dofs_.size(); ++k)
-    w.u1[constrained_dofs_[k]] = w.uc[static_cast<Eigen::Index>(k)];
+  w.u1.resize(kin_.u.size());
+  for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
+    w.u1[dofs_.free_dofs()[k]] = w.uf[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
+    w.u1[dofs_.constrained_dofs()[k]] = w.uc[static_cast<Eigen::Index>(k)];
   // a1 = c0 (u1 - u) - c2 v - c3 a;  v1 = v + h ((1 - gamma) a + gamma a1)
-  w.a1 = c0 * (w.u1 - u_) - c2 * v_ - c3 * a_;
-  v_ += h * ((1.0 - gamma) * a_ + gamma * w.a1);
-  external_work_ += 0.5 * (f_ + w.f1).dot(w.u1 - u_);
-  u_.swap(w.u1);
-  a_.swap(w.a1);
-  f_.swap(w.f1);
-  time_ = t1;
+  w.a1 = c0 * (w.u1 - kin_.u) - c2 * kin_.v - c3 * kin_.a;
+  kin_.v += h * ((1.0 - gamma) * kin_.a + gamma * w.a1);
+  kin_.external_work += 0.5 * (kin_.f + w.f1).dot(w.u1 - kin_.u);
+  kin_.u.swap(w.u1);
+  kin_.a.swap(w.a1);
+  kin_.f.swap(w.f1);
+  kin_.time = t1;
   ++steps_;
   ++timings_.solves;
   timings_.solve += seconds_since(t0);
@@ -533,38 +555,60 @@ void Solver::step(double dt) {
 
 // ---------------------------------------------------------------- results
 
-MatrixX3 Solver::displacements(const std::vector<std::size_t>& nodes) const {
+MatrixX3 StructuralSolver::displacements(const std::vector<std::size_t>& nodes) const {
   MatrixX3 d(static_cast<Eigen::Index>(nodes.size()), 3);
   for (std::size_t k = 0; k < nodes.size(); ++k)
     d.row(static_cast<Eigen::Index>(k)) = displacement(nodes.at(k)).transpose();
   return d;
 }
 
-Vec3 Solver::reaction(const std::string& node_set) const {
+Vec3 StructuralSolver::reaction(const std::string& node_set) const {
   const auto& nodes = mesh().node_set(node_set);
-  // r = K u + C v + M a - F
-  Eigen::VectorXd r = k_ * u_ - f_;
+  // r = K u + C v + M a - F  (nonlinear or explicit: f_int(u) for K u)
+  Eigen::VectorXd r =
+      (nonlinear_ != nullptr || options_.integrator == Integrator::CentralDifference)
+          ? Eigen::VectorXd(kin_.f_int - kin_.f)
+          : Eigen::VectorXd(k_ * kin_.u - kin_.f);
   if (mass_ready_) {
-    r += m_ * a_;
-    if (options_.rayleigh_alpha != 0.0) r += options_.rayleigh_alpha * (m_ * v_);
-    if (options_.rayleigh_beta != 0.0) r += options_.rayleigh_beta * (k_ * v_);
+    r += m_ * kin_.a;
+    if (options_.rayleigh_alpha != 0.0) r += options_.rayleigh_alpha * (m_ * kin_.v);
+    if (options_.rayleigh_beta != 0.0) r += options_.rayleigh_beta * (k_ * kin_.v);
   }
   Vec3 sum = Vec3::Zero();
   for (auto n : nodes) sum += r.segment<3>(3 * static_cast<Eigen::Index>(n));
   return sum;
 }
 
-MatrixX6 Solver::nodal_stress() const {
+MatrixX6 StructuralSolver::nodal_stress() const {
   MatrixX6 s = MatrixX6::Zero(static_cast<Eigen::Index>(mesh().num_nodes()), 6);
   Eigen::VectorXd count = Eigen::VectorXd::Zero(s.rows());
+  if (nonlinear_ != nullptr) {
+    // nonlinear path: each element's mean Cauchy stress over its quadrature points, averaged
+    // over the elements that share a node
+    const auto& offsets = nonlinear_->element_qp_offsets();
+    const auto& sigma = nonlinear_->cauchy_stress();
+    for (std::size_t e = 0; e < mesh().num_elements(); ++e) {
+      const auto q0 = static_cast<Eigen::Index>(offsets[e]);
+      const auto nq = static_cast<Eigen::Index>(offsets[e + 1] - offsets[e]);
+      const Eigen::Matrix<double, 1, 6> mean = sigma.middleRows(q0, nq).colwise().mean();
+      for (auto node : mesh().elements()[e].node_span()) {
+        s.row(static_cast<Eigen::Index>(node)) += mean;
+        count[static_cast<Eigen::Index>(node)] += 1.0;
+      }
+    }
+    for (Eigen::Index i = 0; i < s.rows(); ++i) {
+      if (count[i] > 0) s.row(i) /= count[i];
+    }
+    return s;
+  }
   ElementStresses se;
   ElementVector ue;
   for (const auto& e : mesh().elements()) {
     const int n = node_count(e.type);
     ue.resize(3 * n);
     for (int a = 0; a < n; ++a)
-      ue.segment<3>(3 * a) = u_.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a]));
-    integrator_.stresses_at_nodes(e.type, coordinates(mesh(), e),
+      ue.segment<3>(3 * a) = kin_.u.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a]));
+    integrator_.stresses_at_nodes(e.type, element_coordinates(mesh(), e),
                                   model_.material(e.region).elasticity_matrix(), ue, se);
     for (int a = 0; a < n; ++a) {
       const auto i = static_cast<Eigen::Index>(e.nodes[a]);
@@ -578,7 +622,7 @@ MatrixX6 Solver::nodal_stress() const {
   return s;
 }
 
-Eigen::VectorXd Solver::von_mises(const MatrixX6& s) {
+Eigen::VectorXd StructuralSolver::von_mises(const MatrixX6& s) {
   Eigen::VectorXd vm(s.rows());
   // sigma_vm = sqrt(1/2 ((sx-sy)^2 + (sy-sz)^2 + (sz-sx)^2) + 3 (txy^2 + tyz^2 + tzx^2))
   for (Eigen::Index i = 0; i < s.rows(); ++i) {
@@ -589,39 +633,118 @@ Eigen::VectorXd Solver::von_mises(const MatrixX6& s) {
   return vm;
 }
 
-double Solver::kinetic_energy() const {
-  return mass_ready_ ? 0.5 * v_.dot(m_ * v_) : 0.0;
+double StructuralSolver::kinetic_energy() const {
+  return mass_ready_ ? 0.5 * kin_.v.dot(m_ * kin_.v) : 0.0;
 }
-double Solver::strain_energy() const {
-  return 0.5 * u_.dot(k_ * u_);
+double StructuralSolver::strain_energy() const {
+  if (nonlinear_ != nullptr) return nonlinear_->strain_energy();
+  return 0.5 * kin_.u.dot(k_ * kin_.u);
 }
 
-double Solver::max_displacement() const {
+double StructuralSolver::plastic_work() const {
+  return operator_->plastic_work();
+}
+
+double StructuralSolver::energy_balance() const {
+  // W_ext - (W_strain + E_kin + W_plastic + W_damping)
+  return external_work() - (strain_energy() + kinetic_energy() + plastic_work() + damping_work());
+}
+
+Eigen::VectorXd StructuralSolver::equivalent_plastic_strain() const {
+  return nonlinear_ != nullptr ? nonlinear_->equivalent_plastic_strain() : Eigen::VectorXd();
+}
+
+double StructuralSolver::stable_time_step() const {
+  double dt = std::numeric_limits<double>::infinity();
+  for (const auto& e : mesh().elements()) {
+    const ElementCoordinates x = element_coordinates(mesh(), e);
+    double length = std::numeric_limits<double>::infinity();
+    if (e.type == ElementType::Hex8 || e.type == ElementType::Hex20) {
+      // smallest distance between the centres of opposite faces (corner nodes)
+      static constexpr int kFaces[3][2][4] = {
+          {{0, 3, 7, 4}, {1, 2, 6, 5}}, {{0, 1, 5, 4}, {3, 2, 6, 7}}, {{0, 1, 2, 3}, {4, 5, 6, 7}}};
+      for (const auto& pair : kFaces) {
+        Vec3 c0 = Vec3::Zero(), c1 = Vec3::Zero();
+        for (int k = 0; k < 4; ++k) {
+          c0 += 0.25 * x.row(pair[0][k]).transpose();
+          c1 += 0.25 * x.row(pair[1][k]).transpose();
+        }
+        length = std::min(length, (c1 - c0).norm());
+      }
+    } else {
+      // smallest height 3 V / (largest face area) of the corner tetrahedron
+      const Vec3 p0 = x.row(0), p1 = x.row(1), p2 = x.row(2), p3 = x.row(3);
+      const double volume = std::abs((p1 - p0).cross(p2 - p0).dot(p3 - p0)) / 6.0;
+      const double area =
+          0.5 * std::max({(p1 - p0).cross(p2 - p0).norm(), (p1 - p0).cross(p3 - p0).norm(),
+                          (p2 - p0).cross(p3 - p0).norm(), (p2 - p1).cross(p3 - p1).norm()});
+      length = 3.0 * volume / area;
+    }
+    if (e.type == ElementType::Hex20 || e.type == ElementType::Tet10) length *= 0.5;
+    const auto* law = model_.material_law(e.region);
+    double c = 0.0;
+    if (law != nullptr) {
+      c = law->dilatational_wave_speed();
+    } else {
+      const Material& m = model_.material(e.region);
+      const auto lame = lame_constants(m.youngs_modulus, m.poisson_ratio);
+      c = std::sqrt((lame.lambda + 2.0 * lame.mu) / m.density);
+    }
+    // dt_e = l_e / c_d
+    dt = std::min(dt, length / c);
+  }
+  return dt;
+}
+
+void StructuralSolver::refresh_internal_force() {
+  operator_->evaluate(kin_.u, kin_.f_int, nullptr);
+}
+
+const SparseMatrix& StructuralSolver::mass() {
+  assemble_mass();
+  return m_;
+}
+
+void StructuralSolver::external_force(double t, Eigen::VectorXd& f) const {
+  evaluate_external_force(t, f);
+}
+
+void StructuralSolver::apply_prescribed(double t, Eigen::VectorXd& u) const {
+  Eigen::VectorXd uc;
+  prescribed_values(t, uc);
+  for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
+    u[dofs_.constrained_dofs()[k]] = uc[static_cast<Eigen::Index>(k)];
+}
+
+double StructuralSolver::max_displacement() const {
   double m = 0.0;
-  for (Eigen::Index i = 0; i + 2 < u_.size(); i += 3) m = std::max(m, u_.segment<3>(i).norm());
+  for (Eigen::Index i = 0; i + 2 < kin_.u.size(); i += 3)
+    m = std::max(m, kin_.u.segment<3>(i).norm());
   return m;
 }
 
-Vec3 Solver::total_coupling_force() const {
+Vec3 StructuralSolver::total_coupling_force() const {
   return coupling_force_.reshaped(3, coupling_force_.size() / 3).rowwise().sum();
 }
 
-Vec3 Solver::total_external_force() const {
-  return f_.reshaped(3, f_.size() / 3).rowwise().sum();
+Vec3 StructuralSolver::total_external_force() const {
+  return kin_.f.reshaped(3, kin_.f.size() / 3).rowwise().sum();
 }
 
 // ---------------------------------------------------------------- state
 
-SolverState Solver::save_state() const {
+SolverState StructuralSolver::save_state() const {
   SolverState s;
-  s.time = time_;
+  s.time = kin_.time;
   s.steps = steps_;
-  s.displacement = u_;
-  s.velocity = v_;
-  s.acceleration = a_;
-  s.external_force = f_;
+  s.displacement = kin_.u;
+  s.velocity = kin_.v;
+  s.acceleration = kin_.a;
+  s.external_force = kin_.f;
   s.acceleration_valid = acceleration_valid_;
-  s.external_work = external_work_;
+  s.external_work = kin_.external_work;
+  s.damping_work = kin_.damping_work;
+  s.material_state = operator_->committed_state();
   s.coupling_force = coupling_force_;
   s.face_tractions = face_tractions_;
   s.nodal_force_nodes = nodal_force_nodes_;
@@ -629,7 +752,7 @@ SolverState Solver::save_state() const {
   return s;
 }
 
-void Solver::restore_state(const SolverState& s) {
+void StructuralSolver::restore_state(const SolverState& s) {
   const auto n = static_cast<Eigen::Index>(ndof_);
   if (s.displacement.size() != n || s.velocity.size() != n || s.acceleration.size() != n ||
       s.external_force.size() != n || s.coupling_force.size() != n) {
@@ -637,18 +760,23 @@ void Solver::restore_state(const SolverState& s) {
                 " dofs but this solver has " + std::to_string(ndof_) +
                 " (state of another model?)");
   }
-  time_ = s.time;
+  kin_.time = s.time;
   steps_ = s.steps;
-  u_ = s.displacement;
-  v_ = s.velocity;
-  a_ = s.acceleration;
-  f_ = s.external_force;
+  kin_.u = s.displacement;
+  kin_.v = s.velocity;
+  kin_.a = s.acceleration;
+  kin_.f = s.external_force;
   acceleration_valid_ = s.acceleration_valid;
-  external_work_ = s.external_work;
+  kin_.external_work = s.external_work;
+  kin_.damping_work = s.damping_work;
+  operator_->set_committed_state(s.material_state);
   coupling_force_ = s.coupling_force;
   face_tractions_ = s.face_tractions;
   nodal_force_nodes_ = s.nodal_force_nodes;
   nodal_forces_ = s.nodal_forces;
+  if (nonlinear_ != nullptr || options_.integrator == Integrator::CentralDifference) {
+    refresh_internal_force();
+  }
 }
 
 }  // namespace partita::fem

@@ -1,0 +1,30 @@
+#pragma once
+#include <utility>
+#include <vector>
+
+namespace partita::fem {
+
+// Isotropic hardening: the uniaxial yield stress sigma_y(alpha) as a function of the equivalent
+// plastic strain alpha = int sqrt(2/3) |d eps_p|.
+//   linear(sigma_y0, H):  sigma_y = sigma_y0 + H alpha  (H >= 0)
+//   tabulated({(alpha_i, sigma_i)}): piecewise linear through the points; alpha_0 = 0, alpha
+//     strictly increasing, sigma non-decreasing (no softening); constant beyond the last point.
+// Throws Error on a negative or zero initial yield stress, H < 0, a table with fewer than one
+// point, not starting at alpha = 0, not strictly increasing in strain or decreasing in stress.
+class HardeningCurve {
+ public:
+  static HardeningCurve linear(double initial_yield_stress, double hardening_modulus);
+  static HardeningCurve tabulated(std::vector<std::pair<double, double>> points);
+
+  double yield_stress(double alpha) const;  // sigma_y(alpha) [Pa]
+  double slope(double alpha) const;         // H(alpha) = d sigma_y / d alpha [Pa]
+  double initial_yield_stress() const;
+
+ private:
+  HardeningCurve() = default;
+  bool linear_ = true;
+  double sigma0_ = 0.0, h_ = 0.0;
+  std::vector<std::pair<double, double>> points_;
+};
+
+}  // namespace partita::fem

@@ -1,0 +1,41 @@
+#pragma once
+#include "partita/fem/hardening_curve.hpp"
+#include "partita/fem/material_law.hpp"
+
+namespace partita::fem {
+
+// Small-strain J2 (von Mises) plasticity with isotropic hardening, associative flow, backward
+// Euler radial return and the consistent (algorithmic) tangent (Simo & Hughes, Computational
+// Inelasticity, 1998, Box 3.2 and eq. 3.3.13):
+//   eps = sym(F - I), s_tr = 2 G dev(eps - eps_p_n), f = |s_tr| - sqrt(2/3) sigma_y(alpha_n)
+//   f <= 0: elastic;  else solve |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg) = 0,
+//   n = s_tr / |s_tr|, s = s_tr - 2 G dg n, eps_p += dg n, alpha += sqrt(2/3) dg,
+//   C_ep = K 1(x)1 + 2 G theta I_dev - 2 G theta_bar n(x)n,
+//   theta = 1 - 2 G dg / |s_tr|, theta_bar = 1 / (1 + H / (3 G)) - (1 - theta).
+// History per point (8 values): eps_p (xx yy zz xy yz zx, tensor components), alpha, plastic
+// work w_p = sum sigma_n+1 : d eps_p (per reference volume). W = 1/2 (eps - eps_p) : C : (eps -
+// eps_p) is the stored elastic energy (hardening energy is counted in the plastic work).
+class J2PlasticityLaw final : public MaterialLaw {
+ public:
+  J2PlasticityLaw(double youngs_modulus, double poisson_ratio, double density,
+                  HardeningCurve hardening);
+
+  std::string_view name() const override { return "j2-plasticity"; }
+  double density() const override { return density_; }
+  double dilatational_wave_speed() const override;
+  double bulk_modulus() const override { return bulk_; }
+  int state_size() const override { return 8; }
+  void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
+                MaterialResponse& response) const override;
+  double plastic_work_density(std::span<const double> state) const override { return state[7]; }
+  double equivalent_plastic_strain(std::span<const double> state) const override {
+    return state[6];
+  }
+  const HardeningCurve& hardening() const { return hardening_; }
+
+ private:
+  double density_ = 0.0, bulk_ = 0.0, shear_ = 0.0;
+  HardeningCurve hardening_;
+};
+
+}  // namespace partita::fem

@@ -1,0 +1,28 @@
+#pragma once
+#include "partita/fem/material.hpp"
+#include "partita/fem/material_law.hpp"
+
+namespace partita::fem {
+
+// Isotropic linear elasticity at small strain: eps = sym(F - I), sigma = lambda tr(eps) I +
+// 2 mu eps, W = 1/2 eps : C : eps. The structural solver recognises it and keeps the linear
+// path (K assembled and factorised once, Hex8 incompatible modes).
+class LinearElasticLaw final : public MaterialLaw {
+ public:
+  explicit LinearElasticLaw(const Material& material);
+
+  std::string_view name() const override { return "linear-elastic"; }
+  double density() const override { return material_.density; }
+  double dilatational_wave_speed() const override;
+  double bulk_modulus() const override;
+  void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
+                MaterialResponse& response) const override;
+  const Material& material() const { return material_; }
+
+ private:
+  Material material_;
+  LameConstants lame_;
+  Matrix9 c_;
+};
+
+}  // namespace partita::fem

@@ -1,0 +1,54 @@
+#pragma once
+#include <span>
+#include <string_view>
+
+#include "partita/fem/material_response.hpp"
+#include "partita/fem/types.hpp"
+
+namespace partita::fem {
+
+// A constitutive law: stress and tangent from the deformation gradient F and the history of a
+// quadrature point. The law is stateless itself; the operator owns the history.
+//
+// Call order (per quadrature point):
+//   1. initialise_state(committed) once (history at rest)
+//   2. evaluate(F, committed, trial, response) any number of times (Newton iterations,
+//      line search): reads the committed history, writes the trial history, never changes
+//      the committed one
+//   3. on acceptance of a step the operator copies trial -> committed; on rejection it keeps
+//      the committed history and evaluates again.
+// Small-strain laws use eps = sym(F - I) and return sigma as P, so the same operator serves
+// both kinematics.
+class MaterialLaw {
+ public:
+  virtual ~MaterialLaw() = default;
+
+  virtual std::string_view name() const = 0;
+  virtual double density() const = 0;  // rho [kg/m^3] in the reference configuration
+  // Dilatational (P-) wave speed of the undeformed material c_d = sqrt((lambda + 2 mu) / rho).
+  virtual double dilatational_wave_speed() const = 0;
+  // Bulk modulus K = lambda + 2/3 mu at rest [Pa].
+  virtual double bulk_modulus() const = 0;
+
+  // Number of history values per quadrature point (0 for elastic laws).
+  virtual int state_size() const { return 0; }
+  virtual void initialise_state(std::span<double> state) const;
+  virtual void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
+                        MaterialResponse& response) const = 0;
+  // Plastic work per unit reference volume accumulated in a history [J/m^3] (0 if elastic).
+  virtual double plastic_work_density(std::span<const double> state) const;
+  // Equivalent plastic strain of a history (0 if elastic).
+  virtual double equivalent_plastic_strain(std::span<const double> state) const;
+};
+
+// Lame constants from E and nu: lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)).
+struct LameConstants {
+  double lambda = 0.0;
+  double mu = 0.0;
+};
+LameConstants lame_constants(double youngs_modulus, double poisson_ratio);
+
+// C_iJkL = lambda d_iJ d_kL + mu (d_ik d_JL + d_iL d_Jk) as a 9 x 9 matrix.
+Matrix9 isotropic_elasticity_tensor(double lambda, double mu);
+
+}  // namespace partita::fem

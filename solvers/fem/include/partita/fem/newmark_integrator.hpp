@@ -1,0 +1,31 @@
+#pragma once
+#include <vector>
+
+#include "partita/fem/newton_solver.hpp"
+#include "partita/fem/structural_system.hpp"
+
+namespace partita::fem {
+
+// Implicit Newmark for a nonlinear structure, Newton on the displacement u_1 at t + dt:
+//   a_1 = (u_1 - u - dt v) / (beta dt^2) - (1/(2 beta) - 1) a,
+//   v_1 = v + dt ((1 - gamma) a + gamma a_1),
+//   R(u_1) = F_1 - f_int(u_1) - M a_1 - C v_1 = 0 (free dofs),
+//   tangent K_t + (1/(beta dt^2) + alpha gamma/(beta dt)) M.
+// A step whose Newton fails is split in two halves, recursively (max_cutbacks levels); after
+// that it throws Error with the time, the step size and the residual. The history is committed
+// after each accepted (sub)step. Needs a valid acceleration at the start.
+class NewmarkIntegrator {
+ public:
+  NewmarkIntegrator(double beta, double gamma, NewtonOptions options = {});
+  void step(StructuralSystem& system, Kinematics& kin, double dt);
+  const NewtonReport& last_report() const { return last_; }
+
+ private:
+  bool try_step(StructuralSystem& system, Kinematics& kin, double dt);
+  void step_with_cutback(StructuralSystem& system, Kinematics& kin, double dt, int depth);
+  double beta_, gamma_;
+  NewtonSolver newton_;
+  NewtonReport last_;
+};
+
+}  // namespace partita::fem

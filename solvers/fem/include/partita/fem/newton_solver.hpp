@@ -1,0 +1,30 @@
+#pragma once
+#include <Eigen/SparseCholesky>
+#include <memory>
+
+#include "partita/fem/newton_options.hpp"
+#include "partita/fem/newton_report.hpp"
+#include "partita/fem/nonlinear_problem.hpp"
+
+namespace partita::fem {
+
+// Newton-Raphson with a backtracking line search on |R|:
+//   K(x_k) dx = R(x_k),  x_k+1 = x_k + s dx  (s = 1, 1/2, ... while |R| does not decrease),
+// converged on the force norm and the energy norm (NewtonOptions). The tangent is factorised
+// by a sparse LDL^T whose symbolic analysis is kept while the sparsity pattern is unchanged.
+// Never throws for non-convergence: the report says what happened, the caller cuts back.
+class NewtonSolver {
+ public:
+  explicit NewtonSolver(NewtonOptions options = {}) : options_(options) {}
+  const NewtonOptions& options() const { return options_; }
+  // Solves R(x) = 0 from the given x (changed in place; on failure x holds the last iterate).
+  NewtonReport solve(NonlinearProblem& problem, Eigen::VectorXd& x, double reference_force);
+
+ private:
+  using Factorisation = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
+  NewtonOptions options_;
+  std::unique_ptr<Factorisation> factor_;
+  Eigen::Index pattern_nonzeros_ = -1, pattern_size_ = -1;
+};
+
+}  // namespace partita::fem

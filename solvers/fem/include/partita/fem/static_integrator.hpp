@@ -1,0 +1,29 @@
+#pragma once
+#include <vector>
+
+#include "partita/fem/newton_solver.hpp"
+#include "partita/fem/structural_system.hpp"
+
+namespace partita::fem {
+
+// Nonlinear static equilibrium f_int(u) = F on the free dofs, u_c prescribed, by load stepping:
+// from the current state (F_0 = f_int(u_0) on the free dofs, the applied load on the
+// constrained ones; u_c,0) to the target (F(t1), g(t1)) along
+//   F(lambda) = F_0 + lambda (F(t1) - F_0),  u_c(lambda) = u_c,0 + lambda (g(t1) - u_c,0),
+// lambda from 0 to 1 in NewtonOptions::load_steps increments; a failed increment is halved
+// (automatic cut-back), the history committed after each converged one. After max_cutbacks
+// halvings in a row it throws Error naming the load step, lambda, the residual and tolerance.
+class StaticIntegrator {
+ public:
+  explicit StaticIntegrator(NewtonOptions options = {}) : newton_(options) {}
+  // Velocity and acceleration are set to zero; kin.time = t1.
+  void solve(StructuralSystem& system, Kinematics& kin, double t1);
+  // Reports of the Newton solves of the last solve() (converged increments and failures).
+  const std::vector<NewtonReport>& reports() const { return reports_; }
+
+ private:
+  NewtonSolver newton_;
+  std::vector<NewtonReport> reports_;
+};
+
+}  // namespace partita::fem

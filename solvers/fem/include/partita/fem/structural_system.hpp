@@ -1,0 +1,37 @@
+#pragma once
+#include <vector>
+
+#include "partita/fem/dof_partition.hpp"
+#include "partita/fem/internal_force_operator.hpp"
+#include "partita/fem/types.hpp"
+
+namespace partita::fem {
+
+// What a time integrator sees of a structure:
+//   M a + C v + f_int(u) = F(t) on the free dofs,  u = g(t) on the constrained dofs,
+// with C = alpha M (mass-proportional damping). Vectors span all dofs (node-major).
+class StructuralSystem {
+ public:
+  virtual ~StructuralSystem() = default;
+  virtual const DofPartition& dofs() const = 0;
+  virtual InternalForceOperator& internal_forces() = 0;
+  // M over all dofs (assembled on first use); diagonal when lumped.
+  virtual const SparseMatrix& mass() = 0;
+  virtual bool lumped_mass() const = 0;
+  virtual double mass_damping() const = 0;  // alpha of C = alpha M
+  virtual void external_force(double t, Eigen::VectorXd& f) const = 0;
+  // Writes g(t) into the constrained entries of u.
+  virtual void apply_prescribed(double t, Eigen::VectorXd& u) const = 0;
+};
+
+// The evolving kinematic state an integrator advances, and its energy bookkeeping.
+struct Kinematics {
+  double time = 0.0;
+  Eigen::VectorXd u, v, a;
+  Eigen::VectorXd f;           // F(time) of the last solve
+  Eigen::VectorXd f_int;       // f_int(u) (nonlinear path and explicit steps)
+  double external_work = 0.0;  // sum 1/2 (F_n + F_n+1) . (u_n+1 - u_n)
+  double damping_work = 0.0;   // sum dt v_n+1/2 . C v_n+1/2
+};
+
+}  // namespace partita::fem

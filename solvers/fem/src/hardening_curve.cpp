@@ -1,0 +1,86 @@
+#include "partita/fem/hardening_curve.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+#include "partita/fem/error.hpp"
+
+namespace partita::fem {
+
+HardeningCurve HardeningCurve::linear(double sigma0, double h) {
+  if (!(sigma0 > 0.0)) {
+    throw Error("j2-plasticity: the initial yield stress must be > 0 Pa, got " +
+                std::to_string(sigma0));
+  }
+  if (!(h >= 0.0)) {
+    throw Error("j2-plasticity: the hardening modulus must be >= 0 Pa (no softening), got " +
+                std::to_string(h));
+  }
+  HardeningCurve c;
+  c.linear_ = true;
+  c.sigma0_ = sigma0;
+  c.h_ = h;
+  return c;
+}
+
+HardeningCurve HardeningCurve::tabulated(std::vector<std::pair<double, double>> points) {
+  if (points.empty()) {
+    throw Error("j2-plasticity: the hardening table is empty; give (plastic strain, stress) pairs");
+  }
+  if (points.front().first != 0.0) {
+    throw Error("j2-plasticity: the hardening table must start at plastic strain 0, got " +
+                std::to_string(points.front().first));
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!(points[i].second > 0.0)) {
+      std::ostringstream msg;
+      msg << "j2-plasticity: hardening table row " << i << ": yield stress must be > 0 Pa, got "
+          << points[i].second;
+      throw Error(msg.str());
+    }
+    if (i > 0 && !(points[i].first > points[i - 1].first)) {
+      std::ostringstream msg;
+      msg << "j2-plasticity: hardening table row " << i << ": plastic strain " << points[i].first
+          << " is not greater than the previous " << points[i - 1].first
+          << " (the table must be strictly increasing in strain)";
+      throw Error(msg.str());
+    }
+    if (i > 0 && points[i].second < points[i - 1].second) {
+      std::ostringstream msg;
+      msg << "j2-plasticity: hardening table row " << i << ": yield stress " << points[i].second
+          << " is below the previous " << points[i - 1].second << " (softening is not supported)";
+      throw Error(msg.str());
+    }
+  }
+  HardeningCurve c;
+  c.linear_ = false;
+  c.points_ = std::move(points);
+  c.sigma0_ = c.points_.front().second;
+  return c;
+}
+
+double HardeningCurve::yield_stress(double alpha) const {
+  if (linear_) return sigma0_ + h_ * alpha;
+  // piecewise linear: sigma = sigma_i + (sigma_i+1 - sigma_i) (alpha - alpha_i) / (alpha_i+1 -
+  // alpha_i) on [alpha_i, alpha_i+1], sigma_last beyond the table
+  if (alpha >= points_.back().first) return points_.back().second;
+  const auto it = std::upper_bound(points_.begin(), points_.end(), alpha,
+                                   [](double a, const auto& p) { return a < p.first; });
+  const auto& hi = *it;
+  const auto& lo = *(it - 1);
+  return lo.second + (hi.second - lo.second) * (alpha - lo.first) / (hi.first - lo.first);
+}
+
+double HardeningCurve::slope(double alpha) const {
+  if (linear_) return h_;
+  if (alpha >= points_.back().first) return 0.0;
+  const auto it = std::upper_bound(points_.begin(), points_.end(), alpha,
+                                   [](double a, const auto& p) { return a < p.first; });
+  return (it->second - (it - 1)->second) / (it->first - (it - 1)->first);
+}
+
+double HardeningCurve::initial_yield_stress() const {
+  return sigma0_;
+}
+
+}  // namespace partita::fem

@@ -1,0 +1,116 @@
+#include "partita/fem/j2_plasticity_law.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "partita/fem/error.hpp"
+
+namespace partita::fem {
+namespace {
+
+// Symmetric tensor <-> 6 values xx yy zz xy yz zx (tensor components).
+Mat3 unpack(std::span<const double> v) {
+  Mat3 m;
+  m << v[0], v[3], v[5], v[3], v[1], v[4], v[5], v[4], v[2];
+  return m;
+}
+void pack(const Mat3& m, std::span<double> v) {
+  v[0] = m(0, 0);
+  v[1] = m(1, 1);
+  v[2] = m(2, 2);
+  v[3] = m(0, 1);
+  v[4] = m(1, 2);
+  v[5] = m(0, 2);
+}
+
+}  // namespace
+
+J2PlasticityLaw::J2PlasticityLaw(double e, double nu, double rho, HardeningCurve hardening)
+    : density_(rho), hardening_(std::move(hardening)) {
+  if (!(e > 0.0)) {
+    throw Error("j2-plasticity: Young's modulus must be > 0 Pa, got " + std::to_string(e));
+  }
+  if (!(nu > -1.0 && nu < 0.5)) {
+    throw Error("j2-plasticity: Poisson's ratio must lie in (-1, 0.5), got " + std::to_string(nu));
+  }
+  if (!(rho >= 0.0)) {
+    throw Error("j2-plasticity: density must be >= 0 kg/m^3, got " + std::to_string(rho));
+  }
+  const auto lame = lame_constants(e, nu);
+  shear_ = lame.mu;
+  bulk_ = lame.lambda + 2.0 / 3.0 * lame.mu;
+}
+
+double J2PlasticityLaw::dilatational_wave_speed() const {
+  return std::sqrt((bulk_ + 4.0 / 3.0 * shear_) / density_);
+}
+
+void J2PlasticityLaw::evaluate(const Mat3& f, std::span<const double> committed,
+                               std::span<double> trial, MaterialResponse& r) const {
+  const double g = shear_, k = bulk_;
+  const double sqrt23 = std::sqrt(2.0 / 3.0);
+  const Mat3 id = Mat3::Identity();
+  const Mat3 eps = 0.5 * (f + f.transpose()) - id;
+  const Mat3 eps_p_n = unpack(committed.subspan(0, 6));
+  const double alpha_n = committed[6];
+  const double wp_n = committed[7];
+
+  const Mat3 eps_e_tr = eps - eps_p_n;
+  const double tr = eps_e_tr.trace();
+  // s_tr = 2 G dev(eps - eps_p_n)
+  const Mat3 s_tr = 2.0 * g * (eps_e_tr - tr / 3.0 * id);
+  const double s_norm = s_tr.norm();
+  // f_tr = |s_tr| - sqrt(2/3) sigma_y(alpha_n)
+  const double f_tr = s_norm - sqrt23 * hardening_.yield_stress(alpha_n);
+
+  double dg = 0.0, theta = 1.0, theta_bar = 0.0;
+  Mat3 n = Mat3::Zero();
+  if (f_tr > 0.0) {
+    n = s_tr / s_norm;
+    // Solve |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg) = 0 by Newton
+    // (exact in one step for linear hardening; a few steps across table segments).
+    dg = f_tr / (2.0 * g + 2.0 / 3.0 * hardening_.slope(alpha_n));
+    const double scale = hardening_.initial_yield_stress();
+    for (int it = 0;; ++it) {
+      const double alpha = alpha_n + sqrt23 * dg;
+      const double res = s_norm - 2.0 * g * dg - sqrt23 * hardening_.yield_stress(alpha);
+      if (std::abs(res) <= 1e-13 * scale) break;
+      if (it == 50) {
+        std::ostringstream msg;
+        msg << "j2-plasticity: the radial return did not converge (residual " << res
+            << " Pa after 50 iterations)";
+        throw Error(msg.str());
+      }
+      dg += res / (2.0 * g + 2.0 / 3.0 * hardening_.slope(alpha));
+    }
+    theta = 1.0 - 2.0 * g * dg / s_norm;
+    theta_bar = 1.0 / (1.0 + hardening_.slope(alpha_n + sqrt23 * dg) / (3.0 * g)) - (1.0 - theta);
+  }
+  // sigma = K tr(eps_e) I + s_tr - 2 G dg n
+  const Mat3 s = s_tr - 2.0 * g * dg * n;
+  r.stress = k * tr * id + s;
+  // C_ep = K 1(x)1 + 2 G theta (I_sym - 1/3 1(x)1) - 2 G theta_bar n(x)n
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) {
+          const double dij_ab = (i == j && a == b) ? 1.0 : 0.0;
+          const double isym =
+              0.5 * ((i == a && j == b ? 1.0 : 0.0) + (i == b && j == a ? 1.0 : 0.0));
+          r.tangent(3 * i + j, 3 * a + b) = k * dij_ab + 2.0 * g * theta * (isym - dij_ab / 3.0) -
+                                            2.0 * g * theta_bar * n(i, j) * n(a, b);
+        }
+      }
+    }
+  }
+  const Mat3 eps_p = eps_p_n + dg * n;
+  const Mat3 eps_e = eps - eps_p;
+  // W = 1/2 (eps - eps_p) : sigma
+  r.energy_density = 0.5 * (eps_e.array() * r.stress.array()).sum();
+  pack(eps_p, trial.subspan(0, 6));
+  trial[6] = alpha_n + sqrt23 * dg;
+  // w_p += sigma_n+1 : d eps_p = dg s : n
+  trial[7] = wp_n + dg * (s.array() * n.array()).sum();
+}
+
+}  // namespace partita::fem

@@ -1,0 +1,97 @@
+#include "partita/fem/newton_solver.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "partita/fem/error.hpp"
+
+namespace partita::fem {
+
+NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
+                                 double reference_force) {
+  NewtonReport rep;
+  Eigen::VectorXd r, r_trial, dx, x_trial;
+  SparseMatrix k, k_trial;
+  try {
+    problem.residual(x, r, &k);
+  } catch (const Error& e) {
+    rep.failure = std::string("the start is inadmissible: ") + e.what();
+    return rep;
+  }
+  double r_norm = r.norm();
+  rep.residual_norms.push_back(r_norm);
+  rep.reference_force = std::max(reference_force, r_norm);
+  const double force_tol = options_.force_tolerance * rep.reference_force;
+  double energy_0 = -1.0;
+  for (int it = 0;; ++it) {
+    if (!std::isfinite(r_norm)) {
+      rep.failure = "the residual is not finite";
+      return rep;
+    }
+    const bool energy_ok =
+        it == 0 || rep.energy_norms.back() <= options_.energy_tolerance * energy_0;
+    if (r_norm <= force_tol && energy_ok) {
+      rep.converged = true;
+      rep.iterations = it;
+      return rep;
+    }
+    if (it == options_.max_iterations) {
+      std::ostringstream msg;
+      msg << "no convergence in " << it << " iterations (|R| = " << r_norm << ", tolerance "
+          << force_tol << ")";
+      rep.failure = msg.str();
+      rep.iterations = it;
+      return rep;
+    }
+    // K dx = R
+    if (!factor_ || k.nonZeros() != pattern_nonzeros_ || k.rows() != pattern_size_) {
+      factor_ = std::make_unique<Factorisation>();
+      factor_->analyzePattern(k);
+      pattern_nonzeros_ = k.nonZeros();
+      pattern_size_ = k.rows();
+    }
+    factor_->factorize(k);
+    if (factor_->info() != Eigen::Success) {
+      rep.failure = "the tangent matrix could not be factorised (singular)";
+      rep.iterations = it;
+      return rep;
+    }
+    dx = factor_->solve(r);
+    // energy norm |dx . R|
+    const double energy = std::abs(dx.dot(r));
+    if (energy_0 < 0.0) energy_0 = energy;
+    // backtracking line search on |R(x + s dx)|
+    double s = 1.0;
+    bool accepted = false;
+    for (int ls = 0; ls <= options_.max_line_search_steps; ++ls, s *= 0.5) {
+      x_trial = x + s * dx;
+      try {
+        problem.residual(x_trial, r_trial, &k_trial);
+      } catch (const Error&) {
+        continue;  // inadmissible trial (inverted element): shorter step
+      }
+      const double n_trial = r_trial.norm();
+      if (!std::isfinite(n_trial)) continue;
+      // accept a decrease, or the full step when |R| is already at round-off level
+      if (n_trial <= (1.0 - 1e-4 * s) * r_norm || ls == options_.max_line_search_steps ||
+          (s == 1.0 && n_trial <= force_tol)) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      rep.failure = "the line search found no admissible step (elements invert)";
+      rep.iterations = it;
+      return rep;
+    }
+    x.swap(x_trial);
+    r.swap(r_trial);
+    k.swap(k_trial);
+    r_norm = r.norm();
+    rep.residual_norms.push_back(r_norm);
+    rep.energy_norms.push_back(s * energy);
+    rep.step_lengths.push_back(s);
+  }
+}
+
+}  // namespace partita::fem
