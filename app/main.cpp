@@ -36,6 +36,8 @@
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/version.hpp"
+#include "process.hpp"
+#include "sweep_runner.hpp"
 
 namespace {
 
@@ -75,30 +77,6 @@ void for_each_registry(const Registries& r, F&& f) {
   f("convergence measures", r.convergence_measures);
 }
 
-// Run a program with an argument vector, no shell in between (nothing in an argument is ever
-// interpreted: a quote or a ';' in a case name is just a character), standard output discarded.
-// Returns the exit status, or -1 if it could not be started or ended by a signal.
-int run_program(const std::vector<std::string>& args) {
-  std::vector<char*> argv;
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) return -1;
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string python_interpreter() {
-  return std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-}
-
 // PNG plots of the run's CSV time series, drawn by the bundled matplotlib script. A missing
 // python3/matplotlib costs the plots only, never the run.
 void plot_csv_files(const std::filesystem::path& dir) {
@@ -112,9 +90,9 @@ void plot_csv_files(const std::filesystem::path& dir) {
   if (!fs::exists(script))
     script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_monitors.py";
   if (!fs::exists(script)) return;
-  std::vector<std::string> args = {python_interpreter(), script.string()};
+  std::vector<std::string> args = {partita::app::python_interpreter(), script.string()};
   args.insert(args.end(), csvs.begin(), csvs.end());
-  if (run_program(args) != 0)
+  if (partita::app::run_program(args) != 0)
     partita::log::get("app")->warn(
         "plotting the CSV files failed (is python3-matplotlib installed?)");
   else
@@ -126,7 +104,8 @@ void run_scripts(const std::vector<std::filesystem::path>& scripts,
                  const std::filesystem::path& dir) {
   for (const auto& s : scripts) {
     partita::log::get("app")->info("post-processing: {}", s.filename().string());
-    if (run_program({python_interpreter(), s.string(), dir.string()}) != 0)
+    if (partita::app::run_program({partita::app::python_interpreter(), s.string(), dir.string()}) !=
+        0)
       partita::log::get("app")->warn("post-processing script {} failed", s.string());
   }
 }
@@ -201,6 +180,13 @@ int main(int argc, char** argv) {
                   "Log level: trace, debug, info, warn, error, critical, off");
   std::vector<std::string> overrides;
   std::string resume_dir;
+  bool no_sweep = false;
+  int jobs = 1;
+  run->add_flag("--no-sweep", no_sweep,
+                "Run the case as written, ignoring its sweep section (each variant of a sweep "
+                "runs so)");
+  run->add_option("-j,--jobs", jobs, "Variants of a sweep run at once (default 1)")
+      ->check(CLI::PositiveNumber);
   run->add_option("--resume", resume_dir,
                   "Continue the run whose output folder this is from its newest restart file "
                   "(DIR/restart/w<window>.bin), bit for bit; time.end may be raised with --set");
@@ -255,6 +241,18 @@ int main(int argc, char** argv) {
       partita::coupling::CaseRun c(case_file, registries, options);
       std::cout << "partita check: " << case_file << " is valid\n";
       return 0;
+    }
+    if (!no_sweep && resume_dir.empty() && partita::app::has_sweep(case_file, overrides)) {
+      install_stop_handlers();
+      partita::app::SweepOptions so;
+      so.case_file = case_file;
+      so.output_dir = output_dir;
+      so.overrides = overrides;
+      so.jobs = jobs;
+      so.threads = options.threads;
+      so.log_level = log_level;
+      so.stop_signal = &g_stop_signal;
+      return partita::app::run_sweep(registries, so);
     }
     partita::coupling::CaseRun c(case_file, registries, options);
     install_stop_handlers();

@@ -8,8 +8,10 @@
 
 #include <fmt/format.h>
 
+#include "partita/coupling/explicit_scheme.hpp"
 #include "partita/coupling/progress_line.hpp"
 #include "partita/coupling/stopwatch.hpp"
+#include "partita/coupling/sweep.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
@@ -134,9 +136,15 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
             "map of participant name -> {solver: <registered solver>, solver keys...}; solvers: " +
                 join_names(registries.solvers.names()))
       .required();
-  root->section("coupling", "coupling scheme and exchanges", coupling).required();
+  root->section("coupling",
+                "coupling scheme and exchanges (leave it out for a case of one participant: it "
+                "then steps alone, as many steps per window as its stable time step needs)",
+                coupling);
   root->list("monitors", "scalar time series", monitor);
   root->section("output", "VTK output", output);
+  root->section("sweep",
+                "a parametric sweep (partita run runs every variant; see partita docs case)",
+                Sweep::spec());
   return root;
 }
 
@@ -252,21 +260,27 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
 
   build_participants(root);
   const config::Node coupling = root["coupling"];
-  build_exchanges(coupling);
-
-  SchemeContext ctx;
-  ctx.config = coupling;
-  ctx.registries = &registries_;
-  for (auto& p : participants_) ctx.participants.push_back(p.get());
-  for (auto& e : exchanges_) ctx.exchanges.push_back(e.get());
-  const auto& entry = registries_.schemes.get(coupling["scheme"]);
-  scheme_ = entry.factory(ctx);
+  if (root.has("coupling")) {
+    build_exchanges(coupling);
+    SchemeContext ctx;
+    ctx.config = coupling;
+    ctx.registries = &registries_;
+    for (auto& p : participants_) ctx.participants.push_back(p.get());
+    for (auto& e : exchanges_) ctx.exchanges.push_back(e.get());
+    const auto& entry = registries_.schemes.get(coupling["scheme"]);
+    scheme_ = entry.factory(ctx);
+  } else {
+    // A single-solver case: the participant steps through the windows alone (no exchanges).
+    scheme_ = std::make_unique<ExplicitScheme>(std::vector<Participant*>{participants_[0].get()},
+                                               std::vector<Exchange*>{}, true);
+  }
 
   build_monitors(root);
+  if (root.has("sweep")) (void)Sweep(root);  // validates the swept keys, results and plot
 
   if (root.has("output") && root["output"].has("restart") && !restart_blocker().empty())
     root["output"]["restart"].fail(restart_blocker() + "; remove output.restart");
-  balance_tolerance_ = coupling.real("balance_tolerance");
+  if (root.has("coupling")) balance_tolerance_ = coupling.real("balance_tolerance");
   for (const auto& e : exchanges_) {
     const bool extensive = e->spec().kind == DataKind::extensive;
     const bool weighted = e->from().find_mesh(e->from_mesh())->mesh.has_weights() &&
@@ -307,8 +321,14 @@ void CaseRun::build_participants(const config::Node& root) {
       on.fail("the order must list every participant once; missing: " + join_names(missing));
     }
   }
-  if (names.size() < 2)
-    ps.fail("a coupled case needs at least 2 participants, found " + std::to_string(names.size()));
+  const bool coupled = root.has("coupling");
+  if (coupled && names.size() < 2)
+    ps.fail("a coupled case needs at least 2 participants, found " + std::to_string(names.size()) +
+            " (a single-solver case has no coupling section)");
+  if (!coupled && names.size() != 1)
+    ps.fail("a case with " + std::to_string(names.size()) +
+            " participants needs a coupling section (scheme and exchanges); only a case with one "
+            "participant runs without one");
 
   // substeps
   std::map<std::string, Substeps> substeps;
@@ -363,10 +383,11 @@ void CaseRun::build_participants(const config::Node& root) {
     Stopwatch setup;
     std::unique_ptr<Solver> solver = entry.factory(ctx);
     if (setup.seconds() > 1.0)
-      log::get("coupling")->info("set-up of participant '{}' ({}): {:.1f} s", name, entry.name,
-                                 setup.seconds());
+      log::get("coupling")
+          ->info("set-up of participant '{}' ({}): {:.1f} s", name, entry.name, setup.seconds());
     if (!solver) pn.fail("solver '" + entry.name + "' could not be built");
     Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
+    if (!coupled) s.automatic = true;  // alone: as many steps per window as its stability needs
     // A fixed number of substeps must not exceed the solver's stable time step.
     const double stable = solver->stable_time_step();
     if (!s.automatic && window_size_ / s.count > stable * (1.0 + 1e-12)) {
@@ -378,7 +399,7 @@ void CaseRun::build_participants(const config::Node& root) {
           static_cast<long>(std::ceil(window_size_ / stable * (1.0 - 1e-12))), name));
     }
     participants_.push_back(std::make_unique<Participant>(name, std::move(solver), s));
-    if (participants_.back()->solver().meshes().empty())
+    if (coupled && participants_.back()->solver().meshes().empty())
       pn.fail("solver '" + entry.name + "' of participant '" + name + "' exposes no coupling mesh");
     for (const auto& m : participants_.back()->solver().meshes())
       check_plain_name(pn, m.mesh.name(),
@@ -457,9 +478,9 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
     Stopwatch setup;
     mapper->compute(from.mesh->mesh, to.mesh->mesh);
     if (setup.seconds() > 1.0)
-      log::get("coupling")->info("set-up of the mapping of '{}' {}.{} -> {}.{}: {:.1f} s", data,
-                                 from.p->name(), from.mesh->mesh.name(), to.p->name(),
-                                 to.mesh->mesh.name(), setup.seconds());
+      log::get("coupling")
+          ->info("set-up of the mapping of '{}' {}.{} -> {}.{}: {:.1f} s", data, from.p->name(),
+                 from.mesh->mesh.name(), to.p->name(), to.mesh->mesh.name(), setup.seconds());
     const ReaderSees rsee =
         item.string("reader_sees") == "constant" ? ReaderSees::constant : ReaderSees::linear;
     const WriterCombines wc =
