@@ -36,6 +36,9 @@ void register_all(coupling::Registries& r) {
         "total force the interface received (tractions times areas plus nodal forces), x"},
        {"<interface>.force_y", "N", "... y"},
        {"<interface>.force_z", "N", "... z"},
+       {"<interface>.displacement_x", "m", "mean displacement of the interface's nodes, x"},
+       {"<interface>.displacement_y", "m", "... y"},
+       {"<interface>.displacement_z", "m", "... z"},
        {"static_reaction_x", "N",
         "minus the sum of the applied loads (gravity included): what the interfaces must "
         "carry in static equilibrium, x"},

@@ -10,6 +10,7 @@
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/stl.hpp"
+#include "partita/interface/time_table.hpp"
 
 namespace partita::adapters {
 
@@ -98,6 +99,8 @@ std::shared_ptr<Spec> make_spec() {
       .unit("m/s")
       .size(3)
       .def(std::vector<double>{0, 0, 0});
+  wall->any("velocity_table", std::string("the velocity times a factor over time: ") +
+                                  TimeTable::doc() + " (e.g. press, hold and release a lid)");
   wall->one_of({"plane", "box"});
 
   auto grid = std::make_shared<Spec>(
@@ -338,6 +341,11 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
         domain_hi_ = domain_hi_.cwiseMax(lo + w["box"].vec3("size"));
         if (v.norm() > 0) system_.set_wall_velocity(wall.id, v);
       }
+      if (w.has("velocity_table")) {
+        wall.velocity = v;
+        wall.table = TimeTable::from_node(w["velocity_table"]);
+        wall.moving = true;
+      }
       walls_.push_back(wall);
     }
 
@@ -460,6 +468,10 @@ double DemAdapter::stable_time_step() const {
 }
 
 void DemAdapter::advance(double dt) {
+  // walls with a velocity table move with the factor at the middle of the step (exact
+  // displacement where the step lies within one row interval of the table)
+  for (const auto& w : walls_)
+    if (w.moving) system_.set_wall_velocity(w.id, w.velocity * w.table(system_.time() + 0.5 * dt));
   try {
     system_.step(dt);
   } catch (const dem::Error& e) {

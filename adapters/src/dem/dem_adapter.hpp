@@ -22,6 +22,7 @@
 #include "partita/dem/packing_generator.hpp"
 #include "partita/dem/system.hpp"
 #include "partita/interface/solver.hpp"
+#include "partita/interface/time_table.hpp"
 
 namespace partita::adapters {
 
@@ -56,6 +57,9 @@ class DemAdapter : public Solver {
   struct Wall {
     std::string name;
     int id = -1;
+    bool moving = false;                                 // velocity from a table
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // times table(t)
+    TimeTable table;
   };
   /// Index into meshes_dem_ of the coupling mesh `mesh` (vertices or centres); throws if unknown.
   std::size_t find(std::string_view mesh, bool* centres) const;

@@ -1,14 +1,15 @@
 #include "fem_adapter.hpp"
 
 #include <fmt/format.h>
-#include <sstream>
 #include <algorithm>
+#include <sstream>
 
 #include "partita/fem/error.hpp"
 #include "partita/fem/state_io.hpp"
 
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
+#include "partita/interface/time_table.hpp"
 
 namespace partita::adapters {
 
@@ -65,6 +66,8 @@ std::shared_ptr<Spec> make_spec() {
       .unit("s")
       .non_negative()
       .def(0.0);
+  constraint->any("table",
+                  std::string("instead of ramp: the displacement times ") + TimeTable::doc());
   constraint->one_of({"fix", "displacement"});
 
   auto load = std::make_shared<Spec>("load", "a load: pressure or traction on a face, or gravity");
@@ -81,6 +84,7 @@ std::shared_ptr<Spec> make_spec() {
       .unit("s")
       .non_negative()
       .def(0.0);
+  load->any("table", std::string("instead of ramp: the load times ") + TimeTable::doc());
   load->one_of({"pressure", "traction", "gravity"});
 
   auto interface = std::make_shared<Spec>("interface", "a coupling interface on a face");
@@ -111,7 +115,10 @@ std::shared_ptr<Spec> make_spec() {
   s->section("material", "the material", material).required();
   s->list("constraints", "Dirichlet conditions", constraint);
   s->list("loads", "applied loads", load);
-  s->list("interfaces", "coupling interfaces", interface).required();
+  s->list("interfaces",
+          "coupling interfaces (faces whose meshes the coupling can use, and whose mean "
+          "displacement and received force are monitor quantities)",
+          interface);
   s->section("analysis", "analysis type and time integration", analysis);
   return s;
 }
@@ -207,13 +214,24 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         if (!k.has("component")) k.fail("a prescribed displacement needs 'component: x|y|z'");
         const double value = k.real("displacement");
         const double ramp = k.real("ramp");
-        model.prescribe(set, component_index(k["component"]), [value, ramp](double t) {
-          return ramp > 0 ? value * std::min(1.0, t / ramp) : value;
-        });
+        if (k.has("table")) {
+          if (k.has("ramp")) k["table"].fail("give a ramp or a table, not both");
+          const TimeTable table = TimeTable::from_node(k["table"]);
+          model.prescribe(set, component_index(k["component"]),
+                          [value, table](double t) { return value * table(t); });
+        } else {
+          model.prescribe(set, component_index(k["component"]), [value, ramp](double t) {
+            return ramp > 0 ? value * std::min(1.0, t / ramp) : value;
+          });
+        }
       }
     }
     for (const Node& l : c["loads"].items()) {
-      const auto amp = ramp_function(l.real("ramp"));
+      fem::TimeFunction amp = ramp_function(l.real("ramp"));
+      if (l.has("table")) {
+        if (l.has("ramp")) l["table"].fail("give a ramp or a table, not both");
+        amp = [table = TimeTable::from_node(l["table"])](double t) { return table(t); };
+      }
       if (l.has("gravity")) {
         if (l.has("face")) l["face"].fail("gravity acts on the whole body; remove 'face'");
         model.add_gravity(l.vec3("gravity"), amp);
@@ -249,8 +267,6 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     }
 
     const auto ifaces = c["interfaces"].items();
-    if (ifaces.empty())
-      c["interfaces"].fail("at least one interface is needed: [{name: bottom, face: zmin}]");
     for (const Node& i : ifaces) {
       Interface itf;
       itf.name = i.string("name");
@@ -450,6 +466,14 @@ std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::stri
     if (i.has_forces) f += i.nodal_forces.colwise().sum().transpose();
     for (int k = 0; k < 3; ++k)
       m.push_back({i.name + ".force_" + kComponents[static_cast<std::size_t>(k)], "N", f(k)});
+    // Mean displacement of the interface's nodes.
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    const Eigen::VectorXd& u = solver_->displacement();
+    for (const std::size_t n : i.nodes) d += u.segment<3>(3 * static_cast<Eigen::Index>(n));
+    if (!i.nodes.empty()) d /= static_cast<double>(i.nodes.size());
+    for (int k = 0; k < 3; ++k)
+      m.push_back(
+          {i.name + ".displacement_" + kComponents[static_cast<std::size_t>(k)], "m", d(k)});
   }
   // Minus the applied loads (gravity included): what the interfaces carry in static equilibrium.
   const Eigen::Vector3d applied = solver_->total_external_force() - solver_->total_coupling_force();
