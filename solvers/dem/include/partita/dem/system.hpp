@@ -113,6 +113,10 @@ class System {
     sync_particles();
     return store_;
   }
+  /// The store without bringing positions, velocities and angular velocities up to date (while
+  /// stepping they live in packed arrays): for a hook's per-step reading of radii, ids, materials
+  /// and its own arrays at no cost.
+  ParticleStore& store_unsynced() { return store_; }
 
   /// Adds a step hook (breakage, ...), calls its attach(); returns its index.
   int add_hook(std::unique_ptr<StepHook> hook);
