@@ -5,14 +5,17 @@
 // LIGGGHTS: measured in the same invocation when `liggghts` is on PATH, else the recorded figures.
 //
 // usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] [--quick]
-//                        [--vtk DIR] [--no-peer] [--shuffle] [--sort N]
+//                        [--vtk DIR] [--no-peer] [--shuffle] [--sort N] [--breakage]
 // --shuffle numbers the bed's particles in a random order (as a data file written by another code
 // may); --sort N renumbers them in cell order at the first step and every N-th list build
 // (System::set_sort_interval; default 0: the file's order, which is already spatial).
+// --breakage runs every line twice, plain and with the crushing model (Breakage) enabled but
+// nothing breaking (strength far above any contact pressure of the bed), and prints the cost.
 // Physics as the decks dem/liggghts/model.in + bench.in: E = 200 MPa, nu = 0.23, e = 0.5 with
 // LIGGGHTS-style damping, mu = 0.3, Mindlin tangential history, walls x = 0, W, y = 0, W, z = 0
 // of the same material, g = 9.81 m/s^2, dt = 1.9e-6 s, skin 0.5 mm.
 
+#include "partita/dem/breakage.hpp"
 #include "partita/dem/error.hpp"
 #include "partita/dem/lammps_data.hpp"
 #include "partita/dem/parallel.hpp"
@@ -42,8 +45,17 @@ struct Case {
   double liggghts_1, liggghts_2;  // recorded particle-steps/s (RESULTS.md)
 };
 
-System make_system(const LammpsData& d, double width, bool shuffle, int sort_interval) {
+System make_system(const LammpsData& d, double width, bool shuffle, int sort_interval,
+                   bool breakage) {
   System sys;
+  if (breakage) {  // enabled, nothing breaks: the cost of the criterion alone
+    BreakageParameters b;
+    b.limit_strength = 1.0e15;
+    b.reference_size = 4.0e-3;
+    b.weibull_modulus = 3.0;
+    b.comminution_limit = 1.0e-3;
+    sys.add_hook(std::make_unique<Breakage>(b));
+  }
   std::map<double, int> material_of_density;
   for (double rho : d.density)
     if (!material_of_density.count(rho))
@@ -115,7 +127,7 @@ int main(int argc, char** argv) {
   std::string data_dir = dem_dir + "/data";
   std::string which = "all", vtk_dir;
   std::vector<int> threads = {1, 2};
-  bool quick = false, no_peer = false, shuffle = false;
+  bool quick = false, no_peer = false, shuffle = false, breakage = false;
   int sort_interval = 0;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
@@ -144,11 +156,13 @@ int main(int argc, char** argv) {
       shuffle = true;
     } else if (arg == "--sort") {
       sort_interval = std::stoi(next());
+    } else if (arg == "--breakage") {
+      breakage = true;
     } else if (arg == "--vtk") {
       vtk_dir = next();
     } else {
       std::cerr << "usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] "
-                   "[--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N]\n"
+                   "[--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N] [--breakage]\n"
                    "  --no-peer: do not run LIGGGHTS; ratios use the recorded figures\n";
       return arg == "--help" || arg == "-h" ? 0 : 2;
     }
@@ -171,7 +185,7 @@ int main(int argc, char** argv) {
   std::printf(
       "# psteps/s = N x steps / wall seconds of the timed loop; cpu_s = process CPU time of\n"
       "# the loop (with 1 thread, N x steps / cpu_s estimates an unloaded machine)\n");
-  std::printf("%-6s %3s %8s %7s %6s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N",
+  std::printf("%-9s %3s %8s %7s %6s %9s %9s %11s %9s %8s %10s %10s %9s\n", "case", "thr", "N",
               "steps", "builds", "loop_s", "cpu_s", "psteps/s", "cn/atom", "peer_cn", "KE_J",
               "KEtrans_J", "vs_LIGG");
   try {
@@ -180,39 +194,54 @@ int main(int argc, char** argv) {
       const LammpsData data = LammpsData::read(data_dir + "/bed_" + c.name + ".data");
       const long steps = quick ? c.steps / 20 : c.steps;
       for (int nt : threads) {
-        set_num_threads(nt);
-        System sys = make_system(data, c.width, shuffle, sort_interval);
-        const double dt = 1.9e-6;
-        sys.run(warmup, dt);
-        const auto t0 = std::chrono::steady_clock::now();
-        const std::clock_t c0 = std::clock();
-        const long builds0 = sys.neighbor_list().build_count();
-        sys.run(steps, dt);
-        const long builds = sys.neighbor_list().build_count() - builds0;
-        const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
-        const double seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        double ke_trans = 0.0;
-        for (std::size_t i = 0; i < sys.particle_count(); ++i)
-          ke_trans += 0.5 * sys.particles().mass[i] * sys.particles().velocity[i].squaredNorm();
-        const double rate = static_cast<double>(sys.particle_count()) * steps / seconds;
-        const double cn = sys.mean_contacts_per_particle();
-        double peer = nt == 1 ? c.liggghts_1 : c.liggghts_2;
-        const char* peer_kind = "rec";
-        if (liggghts) {
-          const double measured =
-              run_liggghts(dem_dir, c, static_cast<long>(data.size()), nt, steps);
-          if (measured > 0.0) peer = measured, peer_kind = "meas";
-        }
-        std::printf(
-            "%-6s %3d %8zu %7ld %6ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx %s%s\n",
-            c.name.c_str(), nt, sys.particle_count(), steps, builds, seconds, cpu, rate, cn,
-            c.peer_contacts, sys.kinetic_energy(), ke_trans, rate / peer, peer_kind,
-            std::abs(cn / c.peer_contacts - 1.0) > 0.02 ? "  CONTACTS DIFFER >2%" : "");
-        std::fflush(stdout);
-        if (!vtk_dir.empty()) {
-          std::filesystem::create_directories(vtk_dir);
-          sys.write_particles_vtp(vtk_dir + "/bed_" + c.name + ".vtp");
+        double plain_cpu = 0.0, plain_rate = 0.0;
+        for (int with_breakage = 0; with_breakage <= (breakage ? 1 : 0); ++with_breakage) {
+          set_num_threads(nt);
+          System sys = make_system(data, c.width, shuffle, sort_interval, with_breakage == 1);
+          const double dt = 1.9e-6;
+          sys.run(warmup, dt);
+          const auto t0 = std::chrono::steady_clock::now();
+          const std::clock_t c0 = std::clock();
+          const long builds0 = sys.neighbor_list().build_count();
+          sys.run(steps, dt);
+          const long builds = sys.neighbor_list().build_count() - builds0;
+          const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+          const double seconds =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          double ke_trans = 0.0;
+          for (std::size_t i = 0; i < sys.particle_count(); ++i)
+            ke_trans += 0.5 * sys.particles().mass[i] * sys.particles().velocity[i].squaredNorm();
+          const double rate = static_cast<double>(sys.particle_count()) * steps / seconds;
+          const double cn = sys.mean_contacts_per_particle();
+          double peer = nt == 1 ? c.liggghts_1 : c.liggghts_2;
+          const char* peer_kind = "rec";
+          if (liggghts && with_breakage == 0) {
+            const double measured =
+                run_liggghts(dem_dir, c, static_cast<long>(data.size()), nt, steps);
+            if (measured > 0.0) peer = measured, peer_kind = "meas";
+          }
+          const std::string name = c.name + (with_breakage ? "/brk" : "");
+          std::printf(
+              "%-9s %3d %8zu %7ld %6ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx "
+              "%s%s\n",
+              name.c_str(), nt, sys.particle_count(), steps, builds, seconds, cpu, rate, cn,
+              c.peer_contacts, sys.kinetic_energy(), ke_trans, rate / peer, peer_kind,
+              std::abs(cn / c.peer_contacts - 1.0) > 0.02 ? "  CONTACTS DIFFER >2%" : "");
+          if (with_breakage == 0) {
+            plain_cpu = cpu, plain_rate = rate;
+          } else {
+            std::printf(
+                "# %s, %d thread(s): breakage enabled, nothing broken (%lld events): "
+                "%+.1f %% wall time, %+.1f %% CPU time per step\n",
+                c.name.c_str(), nt,
+                static_cast<long long>(static_cast<const Breakage&>(sys.hook(0)).counters().events),
+                100.0 * (plain_rate / rate - 1.0), 100.0 * (cpu / plain_cpu - 1.0));
+          }
+          std::fflush(stdout);
+          if (!vtk_dir.empty() && with_breakage == 0) {
+            std::filesystem::create_directories(vtk_dir);
+            sys.write_particles_vtp(vtk_dir + "/bed_" + c.name + ".vtp");
+          }
         }
       }
     }

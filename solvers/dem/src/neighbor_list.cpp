@@ -1,5 +1,7 @@
 #include "partita/dem/neighbor_list.hpp"
 
+#include "partita/dem/error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -52,30 +54,40 @@ bool NeighborList::needs_rebuild(double max_moved2, const std::vector<PlaneWall>
 }
 
 void NeighborList::renumber(const std::vector<int>& new_of_old) {
-  const int n = static_cast<int>(new_of_old.size());
+  renumber(new_of_old, static_cast<int>(new_of_old.size()));
+}
+
+void NeighborList::renumber(const std::vector<int>& new_of_old, int n) {
   const int rows = static_cast<int>(offsets_.size()) - 1;  // particles added since: no rows
-  if (!valid_ || rows > n) {
+  if (!valid_ || rows > static_cast<int>(new_of_old.size())) {
     clear();
     return;
   }
   // Each pair (i, j) becomes (min(a, b), max(a, b)) with a = new(i), b = new(j); the history is
-  // that of the first particle relative to the second, so it changes sign when they swap.
+  // that of the first particle relative to the second, so it changes sign when they swap. Pairs
+  // with a removed particle are dropped.
   new_offsets_.assign(n + 1, 0);
-  for (int i = 0; i < rows; ++i)
+  for (int i = 0; i < rows; ++i) {
+    if (new_of_old[i] < 0) continue;
     for (int s = offsets_[i]; s < offsets_[i + 1]; ++s)
-      ++new_offsets_[std::min(new_of_old[i], new_of_old[neighbors_[s]]) + 1];
+      if (new_of_old[neighbors_[s]] >= 0)
+        ++new_offsets_[std::min(new_of_old[i], new_of_old[neighbors_[s]]) + 1];
+  }
   for (int i = 0; i < n; ++i) new_offsets_[i + 1] += new_offsets_[i];
-  new_neighbors_.resize(neighbors_.size());
-  new_shear_.resize(neighbors_.size());
+  new_neighbors_.resize(new_offsets_[n]);
+  new_shear_.resize(new_offsets_[n]);
   counts_.assign(n, 0);
-  for (int i = 0; i < rows; ++i)
+  for (int i = 0; i < rows; ++i) {
+    if (new_of_old[i] < 0) continue;
     for (int s = offsets_[i]; s < offsets_[i + 1]; ++s) {
       const int a = new_of_old[i], b = new_of_old[neighbors_[s]];
+      if (b < 0) continue;
       const int row = std::min(a, b);
       const int slot = new_offsets_[row] + counts_[row]++;
       new_neighbors_[slot] = std::max(a, b);
       new_shear_[slot] = a < b ? shear_[s] : Eigen::Vector3d(-shear_[s]);
     }
+  }
   // rows sorted by neighbour (short rows: insertion sort, histories moved along)
   for (int r = 0; r < n; ++r)
     for (int s = new_offsets_[r] + 1; s < new_offsets_[r + 1]; ++s)
@@ -89,6 +101,39 @@ void NeighborList::renumber(const std::vector<int>& new_of_old) {
   // the build positions are only compared with the same particle's: drop them (next build sets
   // them); the lists must be rebuilt before use
   position_at_build_.clear();
+}
+
+void NeighborList::write(BinaryWriter& out) const {
+  out.value(skin_);
+  out.value(builds_);
+  out.value(static_cast<char>(valid_));
+  out.array(offsets_);
+  out.array(neighbors_);
+  out.array(shear_);
+  out.array(touching_);
+  out.array(position_at_build_);
+  out.array(plane_at_build_);
+  out.array(plane_mask_);
+  out.array(mesh_offsets_);
+  out.array(mesh_candidates_);
+}
+
+void NeighborList::read(BinaryReader& in) {
+  in.value(skin_, "neighbour skin");
+  in.value(builds_, "neighbour build count");
+  valid_ = in.value<char>("neighbour list validity") != 0;
+  in.array(offsets_, "neighbour offsets");
+  in.array(neighbors_, "neighbour pairs");
+  in.array(shear_, "pair histories");
+  in.array(touching_, "pair contact flags");
+  in.array(position_at_build_, "positions at the list build");
+  in.array(plane_at_build_, "planes at the list build");
+  in.array(plane_mask_, "plane masks");
+  in.array(mesh_offsets_, "mesh candidate offsets");
+  in.array(mesh_candidates_, "mesh candidates");
+  if (offsets_.empty() || static_cast<std::size_t>(offsets_.back()) != neighbors_.size() ||
+      shear_.size() != neighbors_.size() || touching_.size() != neighbors_.size())
+    throw Error("corrupt state: neighbour list arrays do not agree");
 }
 
 // Calls visit(j) for every j > i within R_i + R_j + skin of i, cells in a fixed order.

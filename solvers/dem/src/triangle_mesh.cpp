@@ -171,4 +171,38 @@ TriangleClosestPoint TriangleMesh::closest_point(int t, const Eigen::Vector3d& p
   return r;
 }
 
+void TriangleMesh::write_state(BinaryWriter& out) const {
+  out.value(static_cast<std::int64_t>(vertex_count()));
+  out.value(static_cast<std::int64_t>(triangle_count()));
+  out.array(position_);
+  out.array(velocity_);
+  out.array(position_last_step_);
+  out.array(position_at_build_);
+  const std::vector<double> tf(triangle_force_.data(),
+                               triangle_force_.data() + triangle_force_.size());
+  const std::vector<double> vf(vertex_force_.data(), vertex_force_.data() + vertex_force_.size());
+  out.array(tf);
+  out.array(vf);
+  out.value(static_cast<char>(velocity_from_motion_));
+}
+
+void TriangleMesh::read_state(BinaryReader& in) {
+  in.expect(static_cast<std::int64_t>(vertex_count()), "mesh vertex count");
+  in.expect(static_cast<std::int64_t>(triangle_count()), "mesh triangle count");
+  in.array(position_, "mesh vertex positions");
+  in.array(velocity_, "mesh vertex velocities");
+  in.array(position_last_step_, "mesh positions of the last step");
+  in.array(position_at_build_, "mesh positions at the list build");
+  std::vector<double> tf, vf;
+  in.array(tf, "mesh triangle forces");
+  in.array(vf, "mesh vertex forces");
+  if (tf.size() != static_cast<std::size_t>(triangle_force_.size()) ||
+      vf.size() != static_cast<std::size_t>(vertex_force_.size()) ||
+      position_.size() != static_cast<std::size_t>(vertex_count()))
+    throw Error("corrupt state: mesh arrays do not match the mesh");
+  std::copy(tf.begin(), tf.end(), triangle_force_.data());
+  std::copy(vf.begin(), vf.end(), vertex_force_.data());
+  velocity_from_motion_ = in.value<char>("mesh velocity mode") != 0;
+}
+
 }  // namespace partita::dem

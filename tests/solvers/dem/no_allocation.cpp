@@ -4,6 +4,7 @@
 
 #include "dem_test_helpers.hpp"
 
+#include "partita/dem/breakage.hpp"
 #include "partita/dem/parallel.hpp"
 #include "partita/dem/system.hpp"
 
@@ -111,4 +112,33 @@ TEST_CASE("dem: renumbering the particles at list builds allocates no memory eit
   INFO(made << " allocations in 400 steps with " << sys.sort_count() - sorts << " renumberings");
   CHECK(sys.sort_count() - sorts >= 2);
   if (PARTITA_COUNT_ALLOCATIONS) CHECK(made == 0);
+}
+
+TEST_CASE("dem: steps with breakage enabled but nothing breaking allocate no memory",
+          "[dem][performance][breakage]") {
+  const int before = max_threads();
+  for (int threads : {1, 2}) {
+    set_num_threads(threads);
+    System sys = drifting_bed(true);
+    BreakageParameters b;
+    b.limit_strength = 1e12;  // far above any contact pressure here
+    b.reference_size = 1e-3;
+    b.weibull_modulus = 3.0;
+    b.comminution_limit = 1e-4;
+    const int hook = sys.add_hook(std::make_unique<Breakage>(b));
+    const double dt = 0.2 * sys.rayleigh_time_step();
+    sys.run(100, dt);  // first steps size the arrays and draw the strengths
+    const long builds = sys.neighbor_list().build_count();
+    const long count = allocations.load();
+    sys.run(400, dt);
+    const long made = allocations.load() - count;
+    const long rebuilt = sys.neighbor_list().build_count() - builds;
+    INFO(threads << " threads: " << made << " allocations in 400 steps with " << rebuilt
+                 << " list rebuilds");
+    CHECK(rebuilt >= 2);
+    CHECK(static_cast<const Breakage&>(sys.hook(hook)).counters().events == 0);
+    CHECK(sys.contact_count() > 0);  // loads were recorded, just below the strengths
+    if (PARTITA_COUNT_ALLOCATIONS) CHECK(made == 0);
+  }
+  set_num_threads(before);
 }

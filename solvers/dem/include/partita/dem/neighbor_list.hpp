@@ -12,6 +12,8 @@
 // Cells are 2 R_max + skin wide (correct for any size distribution; with very wide ones the
 // cells hold many small particles). Vectors are reused: no allocation between rebuilds.
 
+#include "partita/dem/binary_reader.hpp"
+#include "partita/dem/binary_writer.hpp"
 #include "partita/dem/particles.hpp"
 #include "partita/dem/plane_wall.hpp"
 #include "partita/dem/triangle_mesh.hpp"
@@ -50,6 +52,15 @@ class NeighborList {
   /// keeps its history with the sign changed), so that the next build() carries them over. The
   /// lists must be rebuilt before they are used again.
   void renumber(const std::vector<int>& new_of_old);
+  /// Same, where new_of_old[i] < 0 marks a removed particle (its pairs and histories are
+  /// dropped) and `new_count` is the number of particles after the change.
+  void renumber(const std::vector<int>& new_of_old, int new_count);
+  /// Whether the lists were built for the current particles (cleared by renumber()).
+  bool built() const { return valid_ && !position_at_build_.empty(); }
+  /// Writes / reads the lists with their histories and build references (the cell grid is
+  /// scratch of build() and not part of the state).
+  void write(BinaryWriter& out) const;
+  void read(BinaryReader& in);
   /// Planes near particle i (bit k: plane k); all bits set when there are more than 64 planes.
   std::uint64_t plane_mask(std::size_t i) const { return plane_mask_[i]; }
 
@@ -58,6 +69,7 @@ class NeighborList {
 
  private:
   friend class System;
+  friend class ThreadPartition;
 
   struct Grid {
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();

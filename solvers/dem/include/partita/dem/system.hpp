@@ -11,7 +11,14 @@
 //   3. loop: [set_vertex_positions(mesh, X[, V]) / set_wall_velocity()] then step(dt) or
 //      run(n, dt); read monitors (kinetic_energy(), wall_force(), mesh_force(),
 //      triangle_forces(), vertex_forces()) and write output (write_particles_vtp(), ...).
-//   4. implicit coupling: save_state() at the window start, restore_state() to repeat it.
+//   4. implicit coupling: save_state() at the window start, restore_state() to repeat it;
+//      restart files: write_state(ostream) / read_state(istream) (versioned binary, see
+//      SystemState).
+// Particles live in one ParticleStore (store()): every per-particle array, the core ones and
+// those of the contact histories and step hooks, is added, removed, renumbered, saved and
+// restored together; particles keep a stable 64-bit id (particles().id). Models that change the
+// particle set or add forces (breakage, ...) are StepHooks (add_hook()), called at fixed points
+// of every step (see step_hook.hpp).
 // The first step checks that every material pair in use has an interaction and builds the
 // neighbour lists; adding particles, walls or meshes later is allowed (lists are rebuilt and the
 // contact histories of new contacts start at zero).
@@ -20,18 +27,26 @@
 // angular velocity with I = 2/5 m R^2). Forces of a step do not depend on the number of
 // OpenMP threads (set_num_threads()): each particle sums its contacts in a fixed order.
 
+#include "partita/dem/cell_order.hpp"
 #include "partita/dem/contact_model.hpp"
 #include "partita/dem/damping_model.hpp"
 #include "partita/dem/interaction.hpp"
 #include "partita/dem/material.hpp"
+#include "partita/dem/mesh_contact_record.hpp"
 #include "partita/dem/neighbor_list.hpp"
+#include "partita/dem/particle_store.hpp"
 #include "partita/dem/particles.hpp"
 #include "partita/dem/plane_wall.hpp"
+#include "partita/dem/step_hook.hpp"
+#include "partita/dem/step_hook_list.hpp"
 #include "partita/dem/system_state.hpp"
+#include "partita/dem/thread_partition.hpp"
 #include "partita/dem/triangle_mesh.hpp"
 
 #include <cstddef>
 #include <cstdint>
+#include <iosfwd>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -65,8 +80,10 @@ class System {
   void sort_particles();
   long sort_count() const { return sorts_; }
 
-  /// Adds one sphere; returns its index. Throws Error on radius <= 0, unknown material or
-  /// non-finite values. id < 0: the index is used.
+  /// Adds one sphere; returns its index. Between steps, the new particle starts with its weight as
+  /// force (its contacts act from the next force pass) and the others keep theirs. Throws Error on
+  /// radius <= 0, unknown material or non-finite values. id < 0: the next free id
+  /// (ParticleStore::next_id(); the index while no id was given and nothing was removed).
   std::size_t add_particle(const Eigen::Vector3d& position, double radius, int material,
                            const Eigen::Vector3d& velocity = Eigen::Vector3d::Zero(),
                            const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero(),
@@ -76,6 +93,40 @@ class System {
                             const Eigen::Ref<const Eigen::VectorXd>& radii, int material);
   void set_particle_velocity(std::size_t i, const Eigen::Vector3d& velocity,
                              const Eigen::Vector3d& angular_velocity = Eigen::Vector3d::Zero());
+  /// Overrides the mass [kg] and moment of inertia [kg m^2] of particle i (default: from the
+  /// material's density, 2/5 m R^2), e.g. for fragments that carry restored mass.
+  void set_particle_mass(std::size_t i, double mass, double inertia);
+  /// Removes the particles with remove[i] != 0 (one flag per particle); the others keep their
+  /// order, ids and contact histories. The next step rebuilds the lists and recomputes forces.
+  void remove_particles(const std::vector<char>& remove);
+  /// Renumbers the particles: new index k holds old particle order[k] (a permutation); ids,
+  /// every per-particle array and the contact histories follow.
+  void renumber_particles(const std::vector<int>& order);
+  /// Every per-particle array (core and registered). Register arrays with
+  /// store().add_array(); change the particle set only through add_particle() and
+  /// remove_particles().
+  ParticleStore& store() {
+    sync_particles();
+    return store_;
+  }
+  const ParticleStore& store() const {
+    sync_particles();
+    return store_;
+  }
+  /// The store without bringing positions, velocities and angular velocities up to date (while
+  /// stepping they live in packed arrays): for a hook's per-step reading of radii, ids, materials
+  /// and its own arrays at no cost.
+  ParticleStore& store_unsynced() { return store_; }
+
+  /// Adds a step hook (breakage, ...), calls its attach(); returns its index.
+  int add_hook(std::unique_ptr<StepHook> hook);
+  int hook_count() const { return hooks_.size(); }
+  StepHook& hook(int k) { return hooks_[k]; }
+  const StepHook& hook(int k) const { return hooks_[k]; }
+  /// Per particle, the largest contact load F_n (E*/R*)^2 [N Pa^2/m^2] of the last force pass
+  /// (F_n the normal force, E* and R* the contact's effective modulus and radius; a wall's
+  /// R* = R). Recorded only while a hook wants it (StepHook::wants_contact_load()), else empty.
+  const std::vector<double>& contact_load() const { return load_; }
 
   /// An infinite plane through `point`; particles stay on the side `normal` points to.
   /// Returns the wall id.
@@ -89,6 +140,7 @@ class System {
   /// Prescribes the translation velocity of all planes of a wall.
   void set_wall_velocity(int wall, const Eigen::Vector3d& velocity);
   int wall_count() const { return wall_count_; }
+  const std::vector<PlaneWall>& planes() const { return planes_; }
 
   /// A triangle mesh (vertices N x 3, triangles M x 3 vertex indices); returns the mesh id.
   int add_mesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
@@ -113,16 +165,28 @@ class System {
   double time() const { return time_; }
   long step_count() const { return steps_; }
 
+  /// A copy of the complete dynamic state: particles with ids and every registered array,
+  /// contact histories (pairs, planes, meshes), neighbour lists, planes, mesh vertices, forces,
+  /// time, step count and the hooks' state (counters, random-number state).
   SystemState save_state() const;
-  /// Throws Error if the state comes from a system with other particles, walls or meshes.
+  /// Continues from a saved state: stepping on gives bit-identical results to never having left.
+  /// The state may hold another number of particles (breakage, insertion) if it came from this
+  /// system (or a copy of it) or was read from a stream. Throws Error if the state comes from a
+  /// system with other materials, planes, meshes or hooks, or from another system with a
+  /// different particle count.
   void restore_state(const SystemState& state);
+  /// save_state().write(out): the versioned binary format of SystemState (restart files).
+  void write_state(std::ostream& out) const;
+  /// restore_state(SystemState::read(in)) for a system set up alike (materials, interactions,
+  /// walls, meshes, hooks); throws Error on a bad magic, another version or a truncated stream.
+  void read_state(std::istream& in);
 
   // ---- access and monitors ------------------------------------------------------------------
   const Particles& particles() const {
     sync_particles();
-    return particles_;
+    return store_.core();
   }
-  std::size_t particle_count() const { return particles_.size(); }
+  std::size_t particle_count() const { return store_.size(); }
   const ContactModel& contact_model() const { return model_; }
   const NeighborList& neighbor_list() const { return neighbors_; }
   /// Kinetic energy, translational + rotational [J].
@@ -149,12 +213,14 @@ class System {
   void write_mesh_vtp(int mesh, const std::string& path) const;
 
  private:
+  struct PackedParticle;
   void prepare();
   void check_interactions() const;
   void check_mesh(int mesh, const char* what) const;
+  void check_particle(std::size_t i, const char* what) const;
   void resize_histories();
+  void particles_changed();
   // forces at the current positions; kick > 0: then v += kick F/m, omega += kick T/I
-  // packed: packed_ is up to date (else it is filled first)
   // started: the sums were started (start_sums()) by the caller
   void compute_forces(double dt, bool update_history, double kick, bool started);
   void load_packed();
@@ -162,45 +228,57 @@ class System {
   void sync_particles() const;
   void start_sums(int i);
   void rebuild_lists();
-  // Splits the particles into parts of whole blocks, one per thread; returns the count.
   int set_partition();
-  int part_of(int i) const;
-  // Lists the pairs whose j lies in a later part than i (after a rebuild or a new partition).
-  void prepare_cross_pairs();
-  struct PackedParticle;
+  template <bool Load>
   bool pair_force(const PackedParticle& qi, int j, int slot, double dt, bool update_history,
-                  Eigen::Vector3d& force_i, Eigen::Vector3d& torque_i, Eigen::Vector3d& torque_j);
+                  Eigen::Vector3d& force_i, Eigen::Vector3d& torque_i, Eigen::Vector3d& torque_j,
+                  double& load);
   // called inside a parallel region (orphaned omp for)
   void evaluate_forces(double dt, bool update_history, double kick);
+  template <bool Load>
+  void evaluate_forces_impl(double dt, bool update_history, double kick);
   void reduce_wall_and_mesh_forces();
-  void mesh_contacts(int i, double dt, bool update_history, Eigen::Vector3d& force,
-                     Eigen::Vector3d& torque);
+  struct MeshHistory {  // the mesh-contact arrays of the store, fetched once per force pass
+    int* count;
+    std::int64_t* key;
+    Eigen::Vector3d* shear;
+    MeshContactRecord* records;
+  };
+  template <bool Load>
+  void mesh_contacts(int i, const MeshHistory& history, double dt, bool update_history,
+                     Eigen::Vector3d& force, Eigen::Vector3d& torque, double& load);
+  void write_body(BinaryWriter& out) const;
+  void read_body(BinaryReader& in);
 
   ContactModel model_;
-  // position, velocity and angular velocity: packed_ holds them while stepping; particles_ is
-  // brought up to date on demand (mirror_valid_), and packed_ reloaded after a caller's change
-  mutable Particles particles_;
+  // every per-particle array; position, velocity and angular velocity: packed_ holds them while
+  // stepping; the store's copies are brought up to date on demand (mirror_valid_), and packed_
+  // reloaded after a caller's change
+  mutable ParticleStore store_;
+  int h_plane_shear_ = -1;      // N x planes tangential histories with the planes
+  int h_mesh_slot_count_ = -1;  // mesh contacts of each particle (<= max_mesh_contacts)
+  int h_mesh_slot_key_ = -1;    // N x max_mesh_contacts feature keys
+  int h_mesh_slot_shear_ = -1;  // N x max_mesh_contacts tangential histories
+  int h_mesh_records_ = -1;     // N x max_mesh_contacts results of the last force evaluation
   mutable bool mirror_valid_ = true;
   bool packed_valid_ = false;
   std::vector<PlaneWall> planes_;
   std::vector<TriangleMesh> meshes_;
   NeighborList neighbors_;
+  StepHookList hooks_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
   double skin_ = -1.0;
   int wall_count_ = 0;
   double time_ = 0.0;
   long steps_ = 0;
   bool prepared_ = false;
+  bool lists_current_ = false;  // the neighbour lists were built for the current particle set
   bool forces_valid_ = false;
+  bool track_load_ = false;
   double rayleigh_dt_ = 0.0;
+  std::uint64_t identity_ = 0;  // shared by copies; a state remembers the system it came from
+  std::vector<double> load_;    // largest contact load per particle (track_load_)
 
-  // contact histories
-  std::vector<Eigen::Vector3d> plane_shear_;  // N x planes
-  std::vector<std::int64_t> mesh_slot_key_;   // N x max_mesh_contacts
-  std::vector<Eigen::Vector3d> mesh_slot_shear_;
-  std::vector<int> mesh_slot_count_;
-  // per-contact results of the last force evaluation (for deterministic wall/mesh reductions)
-  std::vector<MeshContactRecord> mesh_records_;  // N x max_mesh_contacts
   struct PackedParticle {  // the moving state and what the pair loop reads about a neighbour
     Eigen::Vector3d x;
     double r;
@@ -210,34 +288,15 @@ class System {
     int material;
   };
   std::vector<PackedParticle> packed_;
-  // threads: part t owns particles [partition_[t], partition_[t+1])
-  std::vector<int> partition_;
-  struct CrossPair {  // a listed pair (i, j) with j in a later part than i
-    int i, j, slot;
-  };
-  struct CrossForce {  // its force on i and torques, evaluated before the parts' row loops
-    Eigen::Vector3d force_i, torque_i, torque_j;
-    bool touching = false;
-  };
-  std::vector<CrossPair> cross_pairs_;  // by part of i, then ascending i, j
-  std::vector<int> cross_out_begin_;    // parts + 1
-  std::vector<int> cross_in_;           // indices into cross_pairs_, by part of j
-  std::vector<int> cross_in_begin_;     // parts + 1
-  std::vector<CrossForce> cross_force_;
-  std::vector<int> counts_;
-  bool cross_valid_ = false;
-  // renumbering in cell order (scratch reused: no allocation once sized)
+  ThreadPartition partition_;
+  // renumbering in cell order
   int sort_interval_ = 0;
   int builds_since_sort_ = 0;
   long sorts_ = 0;
-  std::vector<int> sort_key_, sort_order_, sort_new_of_old_, sort_start_;
-  std::vector<Eigen::Vector3d> scratch_vec3_;
-  std::vector<double> scratch_real_;
-  std::vector<int> scratch_int_;
-  std::vector<std::int64_t> scratch_int64_;
-  std::vector<MeshContactRecord> scratch_records_;
+  CellOrder cell_order_;
   std::vector<Eigen::Vector3d> wall_block_force_;  // blocks x planes
   std::vector<Eigen::Vector3d> wall_force_;        // per wall
+  std::vector<int> new_of_old_;  // scratch of remove_particles() / renumber_particles()
 };
 
 }  // namespace partita::dem

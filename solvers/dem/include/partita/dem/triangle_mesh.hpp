@@ -3,6 +3,9 @@
 // Holds vertex positions and velocities, edge topology (to count a contact on a shared edge or
 // vertex once), and the contact forces of the last step per triangle and per vertex.
 
+#include "partita/dem/binary_reader.hpp"
+#include "partita/dem/binary_writer.hpp"
+
 #include <array>
 #include <vector>
 
@@ -54,6 +57,12 @@ class TriangleMesh {
   const Eigen::MatrixX3d& triangle_forces() const { return triangle_force_; }
   const Eigen::MatrixX3d& vertex_forces() const { return vertex_force_; }
   Eigen::Vector3d total_force() const { return triangle_force_.colwise().sum().transpose(); }
+
+  /// Writes / reads what changes while stepping (vertex positions and velocities, the last
+  /// step's and the last list build's positions, forces); the topology is set-up and must match
+  /// (read() throws Error otherwise).
+  void write_state(BinaryWriter& out) const;
+  void read_state(BinaryReader& in);
 
  private:
   friend class System;

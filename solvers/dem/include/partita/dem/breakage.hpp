@@ -1,0 +1,84 @@
+#pragma once
+// Crushable particles (seed 001, eq. 2): a step hook that replaces a particle loaded beyond its
+// strength by fragments inscribed in it, at the end of the step.
+//
+// Criterion (Russell & Muir Wood 2009; Ciantia et al. 2015; seed 001 eq. 2): the Hertzian contact
+// of normal force F, effective modulus E' (1/E' = (1-nu1^2)/E1 + (1-nu2^2)/E2) and radius r'
+// (1/r' = 1/r1 + 1/r2; a plane or mesh: r' = r) has the radius a = (3 F r'/(4 E'))^(1/3); the
+// particle breaks when the mean pressure F/(pi a^2) reaches its strength sigma, i.e. when
+//   F >= [sigma pi (3 r'/(4 E'))^(2/3)]^3 = (9/16) pi^3 sigma^3 (r'/E')^2,
+// checked for every contact of the particle (particle-particle, particle-plane, particle-mesh) as
+//   F (E'/r')^2 >= (9/16) pi^3 sigma^3
+// (the force pass records the left side's largest value per particle: System::contact_load()).
+// Strength with the Weibull size effect: sigma = s sigma_lim,0 (d/d0)^(-3/m), s = 1 without
+// scatter, else s = (-ln U)^(1/m), U uniform in (0, 1] drawn from (seed, particle id): a Weibull
+// law of modulus m with survival exp(-(sigma/sigma_c)^m). A particle's strength is drawn once,
+// when the hook first sees it (fragments: at birth), and kept in the store array
+// "breakage_strength", so it follows the particle and is saved and restored with it.
+// Particles with d < d_min (comminution limit) never break; fragments are breakable.
+//
+// Fragments (FragmentPattern, in a random orientation drawn from (seed, id)): radius R rho_k at
+// x + R Q c_k, material of the parent, velocity v + omega x (R Q c_k) and spin omega (the parent's
+// rigid motion). Radii are reduced by 1e-9 relative so that fragments do not touch each other and
+// overlap every neighbour strictly less than the parent did. Mass: without restoration each
+// fragment has its material's density and the rest of the parent's mass is lost (it carries the
+// momentum m_lost v and the angular momentum (I_p - I_fragments) omega away: counted); with
+// restoration the fragments' masses are scaled by M/M_fragments and each fragment's moment of
+// inertia is raised by an equal share of the parent's I_p = 2/5 M R^2 minus the set's inertia
+// about the parent's centre, so linear and angular momentum and kinetic energy are those of the
+// parent. Particles broken in one step are handled in ascending index; the set changes at the end
+// of the step (the next step rebuilds the lists and the new fragments' contacts act from its force
+// pass). Smaller fragments lower the Rayleigh step: read System::rayleigh_time_step() again.
+
+#include "partita/dem/breakage_counters.hpp"
+#include "partita/dem/breakage_parameters.hpp"
+#include "partita/dem/fragment_pattern.hpp"
+#include "partita/dem/step_hook.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace partita::dem {
+
+class Breakage final : public StepHook {
+ public:
+  /// Throws Error on parameters out of range (m, d0, sigma_lim,0, d_min > 0 and finite).
+  explicit Breakage(const BreakageParameters& parameters);
+
+  std::string name() const override { return "breakage"; }
+  std::unique_ptr<StepHook> clone() const override { return std::make_unique<Breakage>(*this); }
+  void attach(System& system) override;
+  bool wants_contact_load() const override { return true; }
+  void end_of_step(System& system, double dt) override;
+  void write_state(BinaryWriter& out) const override;
+  void read_state(BinaryReader& in) override;
+
+  const BreakageParameters& parameters() const { return parameters_; }
+  const FragmentPattern& pattern() const { return pattern_; }
+  const BreakageCounters& counters() const { return counters_; }
+
+  /// Characteristic strength sigma_lim,0 (d/d0)^(-3/m) of a particle of diameter d [Pa].
+  double characteristic_strength(double diameter) const;
+  /// The strength drawn for the particle with this id and diameter (scatter as declared).
+  double draw_strength(std::int64_t id, double diameter) const;
+  /// The force at which a particle of strength sigma breaks in a contact of E', r' (eq. 2) [N].
+  static double critical_force(double strength, double e_eff, double r_eff);
+  /// Replaces the particles of the given indices (ascending, each < particle_count()) by their
+  /// fragments now, whatever their load (also used by end_of_step()).
+  void break_particles(System& system, const std::vector<std::size_t>& indices);
+
+ private:
+  // elastic (normal Hertz) energy of particle i's contacts at the current positions
+  double contact_energy(const System& system, std::size_t i) const;
+
+  BreakageParameters parameters_;
+  FragmentPattern pattern_;
+  BreakageCounters counters_;
+  int h_strength_ = -1;
+  std::vector<std::size_t> broken_;  // scratch (reserved: no allocation while nothing breaks)
+};
+
+}  // namespace partita::dem

@@ -1,0 +1,21 @@
+#pragma once
+// What the crushing model (Breakage) has done since it was added (monitors). Saved and restored
+// with the System state.
+
+#include <cstdint>
+
+namespace partita::dem {
+
+struct BreakageCounters {
+  std::int64_t events = 0;         ///< particles broken
+  std::int64_t fragments = 0;      ///< fragments created
+  double fragment_mass = 0.0;      ///< mass of the fragments created [kg]
+  double mass_lost = 0.0;          ///< parent mass the fragments do not hold, lost [kg]
+  double mass_restored = 0.0;      ///< the same, given back to the fragments [kg]
+  double energy_released = 0.0;    ///< elastic energy of the parents' contacts minus that of the
+                                   ///< fragments' contacts right after, plus the kinetic energy
+                                   ///< carried away by lost mass [J]
+  double smallest_fragment = 0.0;  ///< smallest fragment diameter so far [m] (0: none yet)
+};
+
+}  // namespace partita::dem

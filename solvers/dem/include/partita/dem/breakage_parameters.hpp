@@ -1,0 +1,26 @@
+#pragma once
+// Parameters of the crushing model (Breakage): seed 001, eq. 2, with the Weibull size effect.
+
+#include "partita/dem/fragment_pattern.hpp"
+
+#include <cstdint>
+
+namespace partita::dem {
+
+struct BreakageParameters {
+  double limit_strength = 0.0;   ///< sigma_lim,0 [Pa] > 0: strength of a particle of size d0
+  double reference_size = 0.0;   ///< d0 [m] > 0
+  double weibull_modulus = 0.0;  ///< m [-] > 0: size effect (d/d0)^(-3/m) and scatter shape
+  /// Per-particle scatter: each particle's strength is drawn from a Weibull law of modulus m
+  /// whose characteristic value (37 % survive it) is sigma_lim,0 (d/d0)^(-3/m); false: every
+  /// particle has exactly that value.
+  bool scatter = true;
+  double comminution_limit = 0.0;  ///< d_min [m] > 0: particles with d < d_min never break
+  FragmentPattern::Kind pattern = FragmentPattern::Kind::apollonian_14;
+  /// false: the mass the inscribed fragments cannot hold is lost (counted); true: it is restored
+  /// (fragments carry the parent's mass and moment of inertia about its centre; counted).
+  bool restore_mass = false;
+  std::uint64_t seed = 1;  ///< strengths and fragment orientations are drawn from (seed, id)
+};
+
+}  // namespace partita::dem

@@ -1,0 +1,21 @@
+#pragma once
+// Result of one particle-mesh contact in the last force evaluation (kept per particle and contact
+// slot, for the deterministic mesh-force reduction, the history hand-over and the energies).
+
+#include <array>
+
+#include <Eigen/Core>
+
+namespace partita::dem {
+
+struct MeshContactRecord {
+  int mesh = 0;
+  int triangle = 0;
+  std::array<double, 3> barycentric{};
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< on the particle [N]
+  double delta = 0.0;                               ///< overlap [m]
+  double r_eff = 0.0;
+  int material = 0;
+};
+
+}  // namespace partita::dem

@@ -1,0 +1,203 @@
+#pragma once
+// One store for every per-particle array (as LAMMPS atom styles do with grow/copy/pack): the
+// core quantities of Particles and any array a component registers (contact histories with
+// walls and meshes, a breakage model's strengths, ...). Each array is registered once with its
+// width (entries per particle) and the value a new particle gets; from then on adding, removing,
+// permuting, copying, writing and reading particles treats all of them together, so no
+// component keeps a parallel array that could fall out of step.
+//
+// Ids: every particle has a stable 64-bit id (Particles::id) that survives renumbering, removal
+// and restart. add() takes the caller's id or, given a negative one, the next free id (one more
+// than the largest id ever held, so an id is never reused within a run).
+//
+// Scratch space is kept between calls: permute() and remove() allocate nothing once the store
+// has had its largest size.
+
+#include "partita/dem/binary_reader.hpp"
+#include "partita/dem/binary_writer.hpp"
+#include "partita/dem/error.hpp"
+#include "partita/dem/particles.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <typeinfo>
+#include <vector>
+
+namespace partita::dem {
+
+class ParticleStore {
+ public:
+  ParticleStore();
+  ParticleStore(const ParticleStore& other);
+  ParticleStore& operator=(const ParticleStore& other);
+  ParticleStore(ParticleStore&&) noexcept = default;
+  ParticleStore& operator=(ParticleStore&&) noexcept = default;
+
+  /// Registers an array of `width` entries of T per particle, filled with `fill` for the particles
+  /// there are and for every particle added later; returns its handle. Names are unique.
+  template <class T>
+  int add_array(const std::string& name, std::size_t width, const T& fill);
+  /// Handle of the array `name`, or -1.
+  int find(const std::string& name) const;
+  template <class T>
+  std::vector<T>& array(int handle);
+  template <class T>
+  const std::vector<T>& array(int handle) const;
+  std::size_t width(int handle) const { return columns_[handle]->width; }
+  /// Changes an array's width, keeping each particle's first min(old, new) entries and filling
+  /// the rest (e.g. a history per wall plane when a plane is added).
+  void set_width(int handle, std::size_t width);
+  int array_count() const { return static_cast<int>(columns_.size()); }
+  const std::string& array_name(int handle) const { return columns_[handle]->name; }
+
+  Particles& core() { return core_; }
+  const Particles& core() const { return core_; }
+  std::size_t size() const { return core_.size(); }
+  void reserve(std::size_t n);
+
+  /// Appends one particle: every array grows by its fill values; the id is `id`, or the next free
+  /// id when id < 0. Returns the new index; the caller sets the core values.
+  std::size_t add(std::int64_t id = -1);
+  /// Removes the particles with remove[i] != 0, keeping the order of the others; new_of_old[i]
+  /// becomes the new index of old particle i, or -1.
+  void remove(const std::vector<char>& remove, std::vector<int>& new_of_old);
+  /// Renumbers: new particle k is old particle order[k] (order is a permutation).
+  void permute(const std::vector<int>& order);
+  /// The id the next add() without an id gets.
+  std::int64_t next_id() const { return next_id_; }
+
+  /// Writes / reads every array (names, widths and contents) and the id counter. read() requires
+  /// the same arrays (names, element sizes) in the same order; it throws Error otherwise.
+  void write(BinaryWriter& out) const;
+  void read(BinaryReader& in);
+
+ private:
+  struct Column {
+    std::string name;
+    std::size_t width = 1;
+    virtual ~Column() = default;
+    virtual std::unique_ptr<Column> clone() const = 0;
+    virtual std::size_t element_size() const = 0;
+    virtual const std::type_info& type() const = 0;
+    virtual std::size_t length(const Particles& core) const = 0;
+    virtual void resize(Particles& core, std::size_t n) = 0;
+    virtual void reserve(Particles& core, std::size_t n) = 0;
+    virtual void compact(Particles& core, const std::vector<int>& new_of_old, std::size_t n) = 0;
+    virtual void permute(Particles& core, const std::vector<int>& order) = 0;
+    virtual void set_width(Particles& core, std::size_t width) = 0;
+    virtual void write(const Particles& core, BinaryWriter& out) const = 0;
+    virtual void read(Particles& core, BinaryReader& in) = 0;
+  };
+  template <class T>
+  struct TypedColumn;
+
+  template <class T>
+  void add_core(const char* name, std::vector<T> Particles::*member, const T& fill);
+
+  Particles core_;
+  std::vector<std::unique_ptr<Column>> columns_;
+  std::int64_t next_id_ = 0;
+};
+
+// ---- implementation of the typed arrays ------------------------------------------------------
+
+template <class T>
+struct ParticleStore::TypedColumn final : Column {
+  std::vector<T> own;                           // the data, unless it is a core array
+  std::vector<T> Particles::*member = nullptr;  // the core array it stands for
+  T fill{};
+  std::vector<T> scratch;
+
+  std::vector<T>& data(Particles& core) { return member ? core.*member : own; }
+  const std::vector<T>& data(const Particles& core) const { return member ? core.*member : own; }
+
+  std::unique_ptr<Column> clone() const override {
+    auto c = std::make_unique<TypedColumn<T>>();
+    c->name = name, c->width = width, c->own = own, c->member = member, c->fill = fill;
+    return c;
+  }
+  std::size_t element_size() const override { return sizeof(T); }
+  const std::type_info& type() const override { return typeid(T); }
+  std::size_t length(const Particles& core) const override { return data(core).size(); }
+  void resize(Particles& core, std::size_t n) override { data(core).resize(n * width, fill); }
+  void reserve(Particles& core, std::size_t n) override { data(core).reserve(n * width); }
+  void compact(Particles& core, const std::vector<int>& new_of_old, std::size_t n) override {
+    std::vector<T>& v = data(core);
+    for (std::size_t i = 0; i < new_of_old.size(); ++i) {
+      const int k = new_of_old[i];
+      if (k < 0 || static_cast<std::size_t>(k) == i) continue;
+      std::copy_n(v.begin() + i * width, width, v.begin() + static_cast<std::size_t>(k) * width);
+    }
+    v.resize(n * width);
+  }
+  void permute(Particles& core, const std::vector<int>& order) override {
+    std::vector<T>& v = data(core);
+    scratch.resize(v.size());
+    for (std::size_t k = 0; k < order.size(); ++k)
+      std::copy_n(v.begin() + static_cast<std::size_t>(order[k]) * width, width,
+                  scratch.begin() + k * width);
+    std::copy(scratch.begin(), scratch.end(), v.begin());
+  }
+  void set_width(Particles& core, std::size_t w) override {
+    std::vector<T>& v = data(core);
+    const std::size_t n = width > 0 ? v.size() / width : core.size();
+    std::vector<T> next(n * w, fill);
+    for (std::size_t i = 0; i < n; ++i)
+      std::copy_n(v.begin() + i * width, std::min(width, w), next.begin() + i * w);
+    v.swap(next);
+    width = w;
+  }
+  void write(const Particles& core, BinaryWriter& out) const override {
+    out.string(name);
+    out.value(static_cast<std::uint64_t>(width));
+    out.value(static_cast<std::uint64_t>(sizeof(T)));
+    out.array(data(core));
+  }
+  void read(Particles& core, BinaryReader& in) override {
+    const std::string found = in.string("a particle array name");
+    if (found != name)
+      throw Error("state does not fit this system: particle array '" + found +
+                  "' in the state where this system has '" + name + "'");
+    width = in.value<std::uint64_t>("particle array width");
+    in.expect(static_cast<std::uint64_t>(sizeof(T)), "particle array element size");
+    in.array(data(core), name.c_str());
+  }
+};
+
+template <class T>
+void ParticleStore::add_core(const char* name, std::vector<T> Particles::*member, const T& fill) {
+  auto c = std::make_unique<TypedColumn<T>>();
+  c->name = name, c->member = member, c->fill = fill;
+  columns_.push_back(std::move(c));
+}
+
+template <class T>
+int ParticleStore::add_array(const std::string& name, std::size_t width, const T& fill) {
+  if (find(name) >= 0) throw Error("particle store: an array named '" + name + "' exists already");
+  auto c = std::make_unique<TypedColumn<T>>();
+  c->name = name, c->width = width, c->fill = fill;
+  c->own.assign(size() * width, fill);
+  columns_.push_back(std::move(c));
+  return static_cast<int>(columns_.size()) - 1;
+}
+
+template <class T>
+std::vector<T>& ParticleStore::array(int handle) {
+  Column& c = *columns_[handle];
+  if (c.type() != typeid(T))
+    throw Error("particle store: array '" + c.name + "' read with another element type");
+  return static_cast<TypedColumn<T>&>(c).data(core_);
+}
+
+template <class T>
+const std::vector<T>& ParticleStore::array(int handle) const {
+  const Column& c = *columns_[handle];
+  if (c.type() != typeid(T))
+    throw Error("particle store: array '" + c.name + "' read with another element type");
+  return static_cast<const TypedColumn<T>&>(c).data(core_);
+}
+
+}  // namespace partita::dem

@@ -1,0 +1,46 @@
+#pragma once
+// A model that acts on a System at fixed points of every step, beside the integrator (as LAMMPS
+// fixes do): breakage now; insertion and deletion regions later. Each hook lives in its own file.
+//
+// Call order within System::step(dt), for the hooks in the order they were added:
+//   1. velocity Verlet first half, forces at t + dt and the second half kick (one fused pass);
+//   2. post_force(system, dt): forces, torques and velocities at t + dt are complete; if the hook
+//      asked for it (wants_contact_load()), System::contact_load() holds each particle's largest
+//      contact load of this pass;
+//   3. time and step count advance;
+//   4. end_of_step(system, dt): the place to change the particle set (System::remove_particles,
+//      System::add_particle): the next step recomputes forces and neighbour lists first.
+// attach(system) is called once by System::add_hook: register per-particle arrays there
+// (System::store().add_array), so that they are added, removed, permuted, saved and restored
+// with the particles. Whatever else a hook changes between steps (counters, random-number
+// state) is written by write_state() and read back by read_state(): System::save_state() and
+// restore_state() include it, so a repeated window or a restart continues bit-identically.
+
+#include "partita/dem/binary_reader.hpp"
+#include "partita/dem/binary_writer.hpp"
+
+#include <memory>
+#include <string>
+
+namespace partita::dem {
+
+class System;
+
+class StepHook {
+ public:
+  virtual ~StepHook() = default;
+  /// Name, written with the state (a state only goes back into a system with the same hooks).
+  virtual std::string name() const = 0;
+  /// A copy for a copied System (its per-particle arrays are copied with the store).
+  virtual std::unique_ptr<StepHook> clone() const = 0;
+  virtual void attach(System& /*system*/) {}
+  /// True: the force pass records per particle the largest contact load
+  /// F_n (E*/R*)^2 (System::contact_load()).
+  virtual bool wants_contact_load() const { return false; }
+  virtual void post_force(System& /*system*/, double /*dt*/) {}
+  virtual void end_of_step(System& /*system*/, double /*dt*/) {}
+  virtual void write_state(BinaryWriter& /*out*/) const {}
+  virtual void read_state(BinaryReader& /*in*/) {}
+};
+
+}  // namespace partita::dem

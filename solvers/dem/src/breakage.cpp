@@ -1,0 +1,227 @@
+#include "partita/dem/breakage.hpp"
+
+#include "partita/dem/error.hpp"
+#include "partita/dem/system.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+namespace partita::dem {
+
+namespace {
+
+constexpr double shrink = 1.0 - 1e-9;  // fragments strictly inside the parent
+
+std::uint64_t mix(std::uint64_t z) {  // SplitMix64 finaliser
+  z += 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// Uniform in (0, 1], stream k of particle `id` under `seed` (counter-based: no state to carry).
+double uniform(std::uint64_t seed, std::int64_t id, std::uint64_t k) {
+  const std::uint64_t z = mix(seed ^ mix(static_cast<std::uint64_t>(id) ^ mix(k)));
+  return (static_cast<double>(z >> 11) + 1.0) * 0x1.0p-53;
+}
+
+void check_positive(double value, const char* what, std::ostringstream& msg) {
+  if (msg.str().empty() && !(value > 0.0 && std::isfinite(value)))
+    msg << "breakage: " << what << " must be finite and > 0, got " << value;
+}
+
+}  // namespace
+
+Breakage::Breakage(const BreakageParameters& p) : parameters_(p), pattern_(p.pattern) {
+  std::ostringstream msg;
+  check_positive(p.limit_strength, "the limit strength sigma_lim,0 [Pa]", msg);
+  check_positive(p.reference_size, "the reference size d0 [m]", msg);
+  check_positive(p.weibull_modulus, "the Weibull modulus m", msg);
+  check_positive(p.comminution_limit, "the comminution limit d_min [m]", msg);
+  if (!msg.str().empty()) throw Error(msg.str());
+  broken_.reserve(64);
+}
+
+void Breakage::attach(System& system) {
+  ParticleStore& store = system.store_unsynced();
+  if (store.find("breakage_strength") >= 0)
+    throw Error("add_hook: a breakage model is attached already (one per system)");
+  h_strength_ = store.add_array<double>("breakage_strength", 1, -1.0);  // -1: not drawn yet
+}
+
+double Breakage::characteristic_strength(double diameter) const {
+  // sigma_lim = sigma_lim,0 (d/d0)^(-3/m)
+  return parameters_.limit_strength *
+         std::pow(diameter / parameters_.reference_size, -3.0 / parameters_.weibull_modulus);
+}
+
+double Breakage::draw_strength(std::int64_t id, double diameter) const {
+  const double sigma_c = characteristic_strength(diameter);
+  if (!parameters_.scatter) return sigma_c;
+  // Weibull, survival P(sigma) = exp(-(sigma/sigma_c)^m): sigma = sigma_c (-ln U)^(1/m)
+  const double u = uniform(parameters_.seed, id, 0);
+  return sigma_c * std::pow(-std::log(u), 1.0 / parameters_.weibull_modulus);
+}
+
+double Breakage::critical_force(double strength, double e_eff, double r_eff) {
+  // F = [sigma pi (3 r'/(4 E'))^(2/3)]^3 = (9/16) pi^3 sigma^3 (r'/E')^2
+  const double pi3 = std::numbers::pi * std::numbers::pi * std::numbers::pi;
+  const double ratio = r_eff / e_eff;
+  return 9.0 / 16.0 * pi3 * strength * strength * strength * ratio * ratio;
+}
+
+void Breakage::end_of_step(System& system, double /*dt*/) {
+  ParticleStore& store = system.store_unsynced();
+  const Particles& p = store.core();
+  std::vector<double>& strength = store.array<double>(h_strength_);
+  const std::vector<double>& load = system.contact_load();
+  const std::size_t n = p.size();
+  if (load.size() != n) return;  // no force pass since the set changed
+  // break when F (E'/r')^2 >= (9/16) pi^3 sigma^3 (eq. 2, see the class comment)
+  const double pi3 = std::numbers::pi * std::numbers::pi * std::numbers::pi;
+  const double k = 9.0 / 16.0 * pi3;
+  const double d_min = parameters_.comminution_limit;
+  broken_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    double s = strength[i];
+    if (s < 0.0) strength[i] = s = draw_strength(p.id[i], 2.0 * p.radius[i]);
+    if (load[i] >= k * s * s * s && 2.0 * p.radius[i] >= d_min) broken_.push_back(i);
+  }
+  if (!broken_.empty()) break_particles(system, broken_);
+}
+
+double Breakage::contact_energy(const System& system, std::size_t i) const {
+  const Particles& p = system.particles();
+  const ContactModel& model = system.contact_model();
+  const Eigen::Vector3d& x = p.position[i];
+  const double r = p.radius[i];
+  // Hertz: 8/15 E* sqrt(R*) delta^(5/2)
+  auto hertz = [](double e_star, double r_eff, double delta) {
+    return 8.0 / 15.0 * e_star * std::sqrt(r_eff) * std::pow(delta, 2.5);
+  };
+  double e = 0.0;
+  for (std::size_t j = 0; j < p.size(); ++j) {
+    if (j == i) continue;
+    const double delta = r + p.radius[j] - (x - p.position[j]).norm();
+    if (delta > 0.0)
+      e += hertz(model.pair(p.material[i], p.material[j]).e_star,
+                 r * p.radius[j] / (r + p.radius[j]), delta);
+  }
+  for (const PlaneWall& w : system.planes()) {
+    const double delta = r - (x - w.point).dot(w.normal);
+    if (delta > 0.0) e += hertz(model.pair(p.material[i], w.material).e_star, r, delta);
+  }
+  for (int m = 0; m < system.mesh_count(); ++m) {  // the nearest triangle of each mesh
+    const TriangleMesh& mesh = system.mesh(m);
+    double d2 = std::numeric_limits<double>::max();
+    for (int t = 0; t < mesh.triangle_count(); ++t)
+      d2 = std::min(d2, (mesh.closest_point(t, x).point - x).squaredNorm());
+    const double delta = r - std::sqrt(d2);
+    if (delta > 0.0) e += hertz(model.pair(p.material[i], mesh.material()).e_star, r, delta);
+  }
+  return e;
+}
+
+void Breakage::break_particles(System& system, const std::vector<std::size_t>& indices) {
+  if (indices.empty()) return;
+  const std::vector<std::size_t> parents = indices;  // (indices may be broken_)
+  const Particles& p = system.particles();
+  const std::size_t n = p.size();
+  struct Fragment {
+    Eigen::Vector3d x, v, w;
+    double r, m, inertia;
+    int material;
+  };
+  std::vector<Fragment> fragments;
+  std::vector<char> remove(n, 0);
+  double released = 0.0;
+  const int nf = pattern_.size();
+  for (std::size_t i : parents) {
+    if (i >= n || remove[i])
+      throw Error("break_particles: bad or repeated index " + std::to_string(i));
+    remove[i] = 1;
+    released += contact_energy(system, i);
+    const double r = p.radius[i], mass = p.mass[i], ip = p.inertia[i];
+    const Eigen::Vector3d x = p.position[i], v = p.velocity[i], w = p.angular_velocity[i];
+    const double rho = system.contact_model().material(p.material[i]).density;
+    // random orientation (Shoemake's uniform quaternion from three uniforms)
+    const double u1 = uniform(parameters_.seed, p.id[i], 1),
+                 u2 = uniform(parameters_.seed, p.id[i], 2),
+                 u3 = uniform(parameters_.seed, p.id[i], 3);
+    const double two_pi = 2.0 * std::numbers::pi;
+    const Eigen::Quaterniond q(
+        std::sqrt(u1) * std::cos(two_pi * u3), std::sqrt(1.0 - u1) * std::sin(two_pi * u2),
+        std::sqrt(1.0 - u1) * std::cos(two_pi * u2), std::sqrt(u1) * std::sin(two_pi * u3));
+    const Eigen::Matrix3d rot = q.normalized().toRotationMatrix();
+    const std::size_t first = fragments.size();
+    double m_f = 0.0, j_f = 0.0, i_s = 0.0;  // fragments' mass, orbital and own inertia
+    for (int k = 0; k < nf; ++k) {
+      Fragment f;
+      const Eigen::Vector3d c = r * (rot * pattern_.centre(k));
+      f.r = shrink * r * pattern_.radius(k);
+      f.x = x + c;
+      f.v = v + w.cross(c);  // the parent's rigid motion
+      f.w = w;
+      f.m = rho * 4.0 / 3.0 * std::numbers::pi * f.r * f.r * f.r;
+      f.inertia = 0.4 * f.m * f.r * f.r;
+      f.material = p.material[i];
+      m_f += f.m;
+      j_f += f.m * 2.0 / 3.0 * c.squaredNorm();  // isotropic second moment: sum m (|c|^2 I - c c^T)
+      i_s += f.inertia;
+      fragments.push_back(f);
+    }
+    const double missing = mass - m_f;
+    const double i_missing = ip - j_f - i_s;  // the lost material's inertia about the centre
+    if (parameters_.restore_mass) {
+      const double scale = mass / m_f;
+      const double extra = std::max(0.0, scale * (ip / scale - j_f - i_s)) / nf;
+      for (std::size_t k = first; k < fragments.size(); ++k) {
+        fragments[k].m *= scale;
+        fragments[k].inertia = fragments[k].inertia * scale + extra;
+      }
+      counters_.mass_restored += missing;
+      counters_.fragment_mass += mass;
+    } else {
+      counters_.mass_lost += missing;
+      counters_.fragment_mass += m_f;
+      released += 0.5 * missing * v.squaredNorm() + 0.5 * i_missing * w.squaredNorm();
+    }
+    ++counters_.events;
+  }
+  system.remove_particles(remove);
+  std::vector<std::size_t> added;
+  added.reserve(fragments.size());
+  for (const Fragment& f : fragments) {
+    const std::size_t k = system.add_particle(f.x, f.r, f.material, f.v, f.w);
+    if (parameters_.restore_mass) system.set_particle_mass(k, f.m, f.inertia);
+    added.push_back(k);
+    const double d = 2.0 * f.r;
+    if (counters_.smallest_fragment == 0.0 || d < counters_.smallest_fragment)
+      counters_.smallest_fragment = d;
+  }
+  ParticleStore& store = system.store_unsynced();
+  std::vector<double>& strength = store.array<double>(h_strength_);
+  for (std::size_t k : added)
+    strength[k] = draw_strength(store.core().id[k], 2.0 * store.core().radius[k]);
+  for (std::size_t k : added) released -= contact_energy(system, k);
+  counters_.fragments += static_cast<std::int64_t>(added.size());
+  counters_.energy_released += released;
+}
+
+void Breakage::write_state(BinaryWriter& out) const {
+  // strengths travel with the particles (store); the draws are counter-based on (seed, id), so
+  // the counters are the model's whole state
+  out.value(parameters_.seed);
+  out.value(counters_);
+}
+
+void Breakage::read_state(BinaryReader& in) {
+  in.expect(parameters_.seed, "the breakage seed");
+  in.value(counters_, "the breakage counters");
+}
+
+}  // namespace partita::dem

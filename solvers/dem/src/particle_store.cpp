@@ -1,0 +1,94 @@
+#include "partita/dem/particle_store.hpp"
+
+namespace partita::dem {
+
+ParticleStore::ParticleStore() {
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  add_core("position", &Particles::position, zero);
+  add_core("velocity", &Particles::velocity, zero);
+  add_core("angular_velocity", &Particles::angular_velocity, zero);
+  add_core("force", &Particles::force, zero);
+  add_core("torque", &Particles::torque, zero);
+  add_core("radius", &Particles::radius, 0.0);
+  add_core("mass", &Particles::mass, 0.0);
+  add_core("inertia", &Particles::inertia, 0.0);
+  add_core("material", &Particles::material, 0);
+  add_core("id", &Particles::id, std::int64_t{-1});
+}
+
+ParticleStore::ParticleStore(const ParticleStore& other)
+    : core_(other.core_), next_id_(other.next_id_) {
+  for (const auto& c : other.columns_) columns_.push_back(c->clone());
+}
+
+ParticleStore& ParticleStore::operator=(const ParticleStore& other) {
+  if (this == &other) return *this;
+  core_ = other.core_;
+  next_id_ = other.next_id_;
+  columns_.clear();
+  for (const auto& c : other.columns_) columns_.push_back(c->clone());
+  return *this;
+}
+
+int ParticleStore::find(const std::string& name) const {
+  for (std::size_t k = 0; k < columns_.size(); ++k)
+    if (columns_[k]->name == name) return static_cast<int>(k);
+  return -1;
+}
+
+void ParticleStore::set_width(int handle, std::size_t width) {
+  if (columns_[handle]->width != width) columns_[handle]->set_width(core_, width);
+}
+
+void ParticleStore::reserve(std::size_t n) {
+  for (auto& c : columns_) c->reserve(core_, n);
+}
+
+std::size_t ParticleStore::add(std::int64_t id) {
+  const std::size_t index = size();
+  for (auto& c : columns_) c->resize(core_, index + 1);
+  if (id < 0) id = next_id_;
+  core_.id[index] = id;
+  next_id_ = std::max(next_id_, id + 1);
+  return index;
+}
+
+void ParticleStore::remove(const std::vector<char>& flag, std::vector<int>& new_of_old) {
+  const std::size_t n = size();
+  if (flag.size() != n)
+    throw Error("particle store: remove() needs one flag per particle, got " +
+                std::to_string(flag.size()) + " for " + std::to_string(n));
+  new_of_old.resize(n);
+  int k = 0;
+  for (std::size_t i = 0; i < n; ++i) new_of_old[i] = flag[i] ? -1 : k++;
+  for (auto& c : columns_) c->compact(core_, new_of_old, static_cast<std::size_t>(k));
+}
+
+void ParticleStore::permute(const std::vector<int>& order) {
+  if (order.size() != size())
+    throw Error("particle store: permute() needs one index per particle, got " +
+                std::to_string(order.size()) + " for " + std::to_string(size()));
+  for (auto& c : columns_) c->permute(core_, order);
+}
+
+void ParticleStore::write(BinaryWriter& out) const {
+  out.value(static_cast<std::uint64_t>(size()));
+  out.value(next_id_);
+  out.value(static_cast<std::uint64_t>(columns_.size()));
+  for (const auto& c : columns_) c->write(core_, out);
+}
+
+void ParticleStore::read(BinaryReader& in) {
+  const auto n = in.value<std::uint64_t>("particle count");
+  in.value(next_id_, "next particle id");
+  in.expect(static_cast<std::uint64_t>(columns_.size()), "number of particle arrays");
+  for (auto& c : columns_) {
+    c->read(core_, in);
+    if (c->length(core_) != n * c->width)
+      throw Error("corrupt state: particle array '" + c->name + "' has " +
+                  std::to_string(c->length(core_)) + " entries for " + std::to_string(n) +
+                  " particles of width " + std::to_string(c->width));
+  }
+}
+
+}  // namespace partita::dem

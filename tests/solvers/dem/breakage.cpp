@@ -1,0 +1,353 @@
+// Crushable granules (seed 001, eq. 2): the breaking force, the comminution limit, conservation
+// at breakage, the Weibull strength scatter, thread independence and repeatable windows.
+
+#include "dem_test_helpers.hpp"
+
+#include "partita/dem/breakage.hpp"
+#include "partita/dem/error.hpp"
+#include "partita/dem/grading.hpp"
+#include "partita/dem/parallel.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+using namespace partita::dem;
+
+namespace {
+
+constexpr double E = 1.0e9, NU = 0.3, RHO = 2500.0;  // granule
+constexpr double E_P = 200.0e9, NU_P = 0.3;          // platens
+
+BreakageParameters parameters(double m, bool scatter = false) {
+  BreakageParameters b;
+  b.limit_strength = 30.0e6;
+  b.reference_size = 2.0e-3;
+  b.weibull_modulus = m;
+  b.scatter = scatter;
+  b.comminution_limit = 0.1e-3;
+  return b;
+}
+
+Breakage& breakage_of(System& sys) {
+  return static_cast<Breakage&>(sys.hook(0));
+}
+const Breakage& breakage_of(const System& sys) {
+  return static_cast<const Breakage&>(sys.hook(0));
+}
+
+// A granule of diameter d resting on a floor z = 0, a top platen touching it and moving down at
+// speed u; no gravity.
+struct Platens {
+  System sys;
+  int top = -1;
+  double u = 0.0;
+  Platens(double d, const BreakageParameters& b, double speed) : u(speed) {
+    const int g = sys.add_material({E, NU, RHO});
+    const int s = sys.add_material({E_P, NU_P, 7850.0});
+    sys.add_interaction(g, g, {0.3, 0.5, 0.0});
+    sys.add_interaction(g, s, {0.3, 0.5, 0.0});
+    sys.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
+    sys.add_plane({0, 0, 0}, {0, 0, 1}, s);
+    top = sys.add_plane({0, 0, d}, {0, 0, -1}, s, {0, 0, -speed});
+    sys.add_hook(std::make_unique<Breakage>(b));
+  }
+};
+
+// Eq. 2 of seed 001, written out: F = [sigma pi (3 r'/(4 E'))^(2/3)]^3 with 1/E' = (1-nu1^2)/E1 +
+// (1-nu2^2)/E2, r' = r against a plane, sigma = sigma_lim,0 (d/d0)^(-3/m).
+double eq2_force(double d, const BreakageParameters& b) {
+  const double e_eff = 1.0 / ((1.0 - NU * NU) / E + (1.0 - NU_P * NU_P) / E_P);
+  const double sigma = b.limit_strength * std::pow(d / b.reference_size, -3.0 / b.weibull_modulus);
+  return std::pow(sigma * std::numbers::pi * std::pow(3.0 * 0.5 * d / (4.0 * e_eff), 2.0 / 3.0), 3);
+}
+
+struct Motion {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero(), l = Eigen::Vector3d::Zero();  // about `centre`
+  double ke = 0.0, mass = 0.0;
+  Motion(const System& s, const Eigen::Vector3d& centre) {
+    const Particles& q = s.particles();
+    for (std::size_t i = 0; i < q.size(); ++i) {
+      p += q.mass[i] * q.velocity[i];
+      l += q.mass[i] * (q.position[i] - centre).cross(q.velocity[i]) +
+           q.inertia[i] * q.angular_velocity[i];
+      ke += 0.5 * q.mass[i] * q.velocity[i].squaredNorm() +
+            0.5 * q.inertia[i] * q.angular_velocity[i].squaredNorm();
+      mass += q.mass[i];
+    }
+  }
+};
+
+}  // namespace
+
+TEST_CASE("dem: a granule between two platens breaks at the force of eq. 2", "[dem][breakage]") {
+  for (double m : {3.0, 10.0})
+    for (double d : {2.0e-3, 4.0e-3}) {
+      const BreakageParameters b = parameters(m);
+      Platens t(d, b, 0.005);
+      const double dt = 0.2 * t.sys.rayleigh_time_step();
+      const double f_c = eq2_force(d, b);
+      double f = 0.0;
+      long steps = 0;
+      for (; steps < 2'000'000 && breakage_of(t.sys).counters().events == 0; ++steps) {
+        t.sys.step(dt);
+        f = t.sys.wall_force(t.top).norm();  // the top platen's force in this step
+      }
+      INFO("m " << m << ", d " << d << ": broke after " << steps << " steps at F = " << f
+                << " N; eq. 2: " << f_c << " N");
+      REQUIRE(breakage_of(t.sys).counters().events == 1);
+      CHECK(f == Approx(f_c).epsilon(0.01));
+      CHECK(t.sys.particle_count() == 14);  // apollonian-14 by default
+    }
+}
+
+TEST_CASE("dem: below the comminution limit a granule never breaks", "[dem][breakage]") {
+  BreakageParameters b = parameters(3.0);
+  const double d = 2.0e-3;
+  b.comminution_limit = 2.5e-3;
+  Platens t(d, b, 0.01);
+  const double dt = 0.2 * t.sys.rayleigh_time_step();
+  const double f_c = eq2_force(d, b);
+  double f = 0.0;
+  for (long s = 0; s < 2'000'000 && f < 3.0 * f_c; ++s) {
+    t.sys.step(dt);
+    f = t.sys.wall_force(t.top).norm();
+  }
+  INFO("F " << f << " N, eq. 2 " << f_c << " N");
+  CHECK(f >= 3.0 * f_c);
+  CHECK(breakage_of(t.sys).counters().events == 0);
+  CHECK(t.sys.particle_count() == 1);
+}
+
+TEST_CASE("dem: breakage conserves momentum and does not create kinetic energy",
+          "[dem][breakage]") {
+  for (const std::string& pattern : FragmentPattern::names())
+    for (bool restore : {false, true}) {
+      BreakageParameters b = parameters(5.0);
+      b.pattern = FragmentPattern::named(pattern).kind();
+      b.restore_mass = restore;
+      System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
+      const double r = 1.5e-3;
+      const Eigen::Vector3d x0(1e-3, -2e-3, 3e-3), v0(0.3, -0.2, 0.5), w0(40.0, -25.0, 60.0);
+      sys.add_particle(x0, r, 0, v0, w0);
+      sys.add_hook(std::make_unique<Breakage>(b));
+      const Motion before(sys, x0);
+      breakage_of(sys).break_particles(sys, {0});
+      const Motion after(sys, x0);
+      const Particles& p = sys.particles();
+      INFO(pattern << (restore ? ", mass restored" : ", mass lost") << ": " << p.size()
+                   << " fragments holding " << after.mass / before.mass << " of the mass");
+      REQUIRE(p.size() == static_cast<std::size_t>(FragmentPattern::named(pattern).size()));
+      // inscribed: inside the parent, not touching each other
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        CHECK((p.position[i] - x0).norm() + p.radius[i] < r);
+        for (std::size_t j = i + 1; j < p.size(); ++j)
+          CHECK((p.position[i] - p.position[j]).norm() > p.radius[i] + p.radius[j]);
+      }
+      const BreakageCounters& c = breakage_of(sys).counters();
+      if (restore) {
+        CHECK(after.mass == Approx(before.mass).epsilon(1e-14));
+        CHECK((after.p - before.p).norm() <= 1e-14 * before.p.norm());
+        CHECK((after.l - before.l).norm() <= 1e-12 * before.l.norm());
+        CHECK(after.ke == Approx(before.ke).epsilon(1e-12));
+        CHECK(c.mass_restored == Approx(before.mass - c.fragment_mass + c.mass_restored));
+      } else {
+        // the lost mass takes its share of the momentum: the fragments keep the parent's velocity
+        // of the centre of mass, and they rotate rigidly with it
+        CHECK(c.mass_lost == Approx(before.mass - after.mass).epsilon(1e-12));
+        CHECK((after.p - after.mass * v0).norm() <= 1e-14 * before.p.norm());
+        Eigen::Vector3d l_rigid = Eigen::Vector3d::Zero();
+        for (std::size_t i = 0; i < p.size(); ++i) {
+          const Eigen::Vector3d c_i = p.position[i] - x0;
+          l_rigid += p.mass[i] * (c_i.squaredNorm() * w0 - c_i * c_i.dot(w0)) + p.inertia[i] * w0;
+        }
+        CHECK((after.l - l_rigid).norm() <= 1e-12 * before.l.norm());
+        CHECK(after.ke <= before.ke);
+      }
+      CHECK(c.events == 1);
+    }
+}
+
+TEST_CASE("dem: kinetic energy after breakage does not exceed kinetic plus released elastic",
+          "[dem][breakage]") {
+  BreakageParameters b = parameters(3.0);
+  b.comminution_limit = 1.0;  // nothing breaks by itself: break by hand at 90 % of the load
+  const double d = 2.0e-3;
+  Platens t(d, b, 0.005);
+  const double dt = 0.2 * t.sys.rayleigh_time_step();
+  while (t.sys.wall_force(t.top).norm() < 0.9 * eq2_force(d, parameters(3.0))) t.sys.step(dt);
+  const double ke0 = t.sys.kinetic_energy(), el0 = t.sys.elastic_energy();
+  breakage_of(t.sys).break_particles(t.sys, {0});
+  const double ke1 = t.sys.kinetic_energy(), el1 = t.sys.elastic_energy();
+  INFO("KE " << ke0 << " -> " << ke1 << " J, elastic " << el0 << " -> " << el1 << " J");
+  CHECK(el1 < el0);  // fragments overlap the platens less than the parent did
+  CHECK(ke1 <= ke0 + (el0 - el1));
+}
+
+TEST_CASE("dem: drawn strengths follow the declared Weibull law (Kolmogorov-Smirnov, 1 %)",
+          "[dem][breakage]") {
+  const int n = 10000;
+  const double critical = 1.628 / std::sqrt(static_cast<double>(n));  // 1 % level, large n
+  for (double m : {3.0, 10.0})
+    for (double d : {2.0e-3, 5.0e-3}) {
+      const BreakageParameters b = parameters(m, true);
+      const Breakage model(b);
+      const double sigma_c = 30.0e6 * std::pow(d / 2.0e-3, -3.0 / m);
+      std::vector<double> s(n);
+      for (int k = 0; k < n; ++k) s[k] = model.draw_strength(k, d);
+      std::sort(s.begin(), s.end());
+      double ks = 0.0;
+      for (int k = 0; k < n; ++k) {
+        const double f = 1.0 - std::exp(-std::pow(s[k] / sigma_c, m));  // Weibull CDF
+        ks = std::max({ks, std::abs(f - static_cast<double>(k) / n),
+                       std::abs(f - static_cast<double>(k + 1) / n)});
+      }
+      INFO("m " << m << ", d " << d << ": D = " << ks << ", critical " << critical);
+      CHECK(ks < critical);
+      CHECK(model.draw_strength(17, d) == Breakage(b).draw_strength(17, d));  // reproducible
+    }
+  BreakageParameters other = parameters(3.0, true);
+  other.seed = 2;
+  CHECK(Breakage(other).draw_strength(17, 2e-3) !=
+        Breakage(parameters(3.0, true)).draw_strength(17, 2e-3));
+}
+
+namespace {
+
+// A bed dropped onto a floor with weak granules: some break on landing.
+System crushing_bed(double box) {
+  System sys;
+  const int m = sys.add_material({1.0e7, 0.3, 2500.0});
+  sys.add_interaction(m, m, {0.4, 0.5, 0.0});
+  sys.set_gravity({0, 0, -9.81});
+  const Packing pk = test::two_size_packing(Eigen::Vector3d(0, 0, 1e-3),
+                                            Eigen::Vector3d(box, box, box), 1.2e-3, 0.8e-3, 0.6, 9);
+  sys.add_particles(pk.positions, pk.radii, m);
+  for (std::size_t i = 0; i < sys.particle_count(); ++i) sys.set_particle_velocity(i, {0, 0, -0.5});
+  sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(box, box, 2 * box), m, 0b011111);
+  BreakageParameters b;
+  b.limit_strength = 0.4e6;
+  b.reference_size = 1e-3;
+  b.weibull_modulus = 3.0;
+  b.comminution_limit = 0.5e-3;
+  sys.add_hook(std::make_unique<Breakage>(b));
+  return sys;
+}
+
+bool same_particles(const System& a, const System& b) {
+  const Particles& p = a.particles();
+  const Particles& q = b.particles();
+  return p.id == q.id && p.position == q.position && p.velocity == q.velocity &&
+         p.angular_velocity == q.angular_velocity && p.force == q.force && p.radius == q.radius &&
+         p.mass == q.mass;
+}
+
+}  // namespace
+
+TEST_CASE("dem: with breakage on, results do not depend on the number of threads",
+          "[dem][breakage][threads]") {
+  auto run = [](int threads) {
+    set_num_threads(threads);
+    System sys = crushing_bed(14e-3);
+    const double dt = 0.2 * sys.rayleigh_time_step();
+    for (int s = 0; s < 400; ++s) sys.step(std::min(dt, 0.2 * sys.rayleigh_time_step()));
+    return sys;
+  };
+  const int before = max_threads();
+  System one = run(1);
+  System two = run(2);
+  set_num_threads(before);
+  const BreakageCounters& c = breakage_of(one).counters();
+  INFO(one.particle_count() << " particles, " << c.events << " breakage events");
+  CHECK(c.events > 0);
+  CHECK(one.particle_count() > 1024);
+  CHECK(same_particles(one, two));
+  CHECK(breakage_of(two).counters().events == c.events);
+  CHECK(breakage_of(two).counters().energy_released == c.energy_released);
+}
+
+TEST_CASE("dem: a repeated window restores the pre-breakage particle set bit for bit",
+          "[dem][breakage][state]") {
+  System sys = crushing_bed(6e-3);
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  sys.run(20, dt);
+  const std::size_t n0 = sys.particle_count();
+  const SystemState saved = sys.save_state();
+  std::stringstream file;
+  sys.write_state(file);
+  const std::int64_t events0 = breakage_of(sys).counters().events;
+  auto window = [&](System& s) {
+    for (int k = 0; k < 600; ++k) s.step(std::min(dt, 0.2 * s.rayleigh_time_step()));
+  };
+  window(sys);
+  REQUIRE(breakage_of(sys).counters().events > events0);
+  const System first = sys;
+  sys.restore_state(saved);
+  CHECK(sys.particle_count() == n0);
+  CHECK(breakage_of(sys).counters().events == events0);
+  window(sys);
+  CHECK(same_particles(sys, first));
+  CHECK(breakage_of(sys).counters().mass_lost == breakage_of(first).counters().mass_lost);
+  // and from a restart file, into a system set up alike
+  System fresh = crushing_bed(6e-3);
+  fresh.read_state(file);
+  window(fresh);
+  CHECK(same_particles(fresh, first));
+}
+
+TEST_CASE("dem: fragments are further breakable and the stable step follows them",
+          "[dem][breakage]") {
+  BreakageParameters b = parameters(3.0);
+  b.pattern = FragmentPattern::Kind::equal_4;
+  b.comminution_limit = 0.5e-3;
+  Platens t(4.0e-3, b, 0.05);
+  const double dt0 = t.sys.rayleigh_time_step();
+  long steps = 0;
+  while (breakage_of(t.sys).counters().events < 2 && steps < 2'000'000) {
+    t.sys.step(0.2 * t.sys.rayleigh_time_step());
+    ++steps;
+  }
+  const BreakageCounters& c = breakage_of(t.sys).counters();
+  INFO(c.events << " events, " << t.sys.particle_count() << " particles, smallest fragment "
+                << c.smallest_fragment);
+  CHECK(c.events >= 2);  // a fragment broke again
+  // Rayleigh step proportional to the smallest radius: equal-4 fragments have 0.4495 R
+  double r_min = 1.0;
+  for (double r : t.sys.particles().radius) r_min = std::min(r_min, r);
+  CHECK(t.sys.rayleigh_time_step() == Approx(dt0 * r_min / 2.0e-3).epsilon(1e-9));
+  CHECK(c.smallest_fragment == Approx(2.0 * r_min));
+}
+
+TEST_CASE("dem: grading is the cumulative mass fraction passing each size", "[dem][breakage]") {
+  System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
+  sys.add_particle({0, 0, 0}, 1e-3, 0);    // d = 2 mm, mass 8 units
+  sys.add_particle({1, 0, 0}, 0.5e-3, 0);  // d = 1 mm, 1 unit each
+  sys.add_particle({2, 0, 0}, 0.5e-3, 0);
+  const auto g = Grading::cumulative(sys.particles());
+  REQUIRE(g.size() == 2);
+  CHECK(g[0].size == 1e-3);
+  CHECK(g[0].passing == Approx(2.0 / 10.0));
+  CHECK(g[1].passing == 1.0);
+  const auto p = Grading::passing(sys.particles(), {0.5e-3, 1.5e-3, 3e-3});
+  CHECK(p[0] == 0.0);
+  CHECK(p[1] == Approx(0.2));
+  CHECK(p[2] == Approx(1.0));
+}
+
+TEST_CASE("dem: breakage parameters out of range are refused", "[dem][breakage][errors]") {
+  for (int k = 0; k < 4; ++k) {
+    BreakageParameters b = parameters(3.0);
+    (k == 0   ? b.limit_strength
+     : k == 1 ? b.reference_size
+     : k == 2 ? b.weibull_modulus
+              : b.comminution_limit) = -1.0;
+    CHECK_THROWS_AS(Breakage(b), Error);
+  }
+  CHECK_THROWS_WITH(FragmentPattern::named("apolonian-14"), Catch::Contains("apollonian-14"));
+  System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
+  sys.add_hook(std::make_unique<Breakage>(parameters(3.0)));
+  CHECK_THROWS_AS(sys.add_hook(std::make_unique<Breakage>(parameters(3.0))), Error);
+}
