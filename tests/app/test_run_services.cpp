@@ -1,6 +1,7 @@
 // Run-level services of `partita run`, driven through the executable as a user would:
 //  - restart files: a run of 2N windows and a run of N windows resumed for N more write
-//    byte-identical CSV and VTK files (implicit IQN-ILS and Aitken on the elastic tube);
+//    byte-identical CSV and VTK files (implicit IQN-ILS, Aitken, IQN-IMVJ on the elastic tube;
+//    explicit and implicit FEM/DEM on the seed-000 cases);
 //  - SIGINT: the run finishes its window, flushes complete CSV files, writes a restart file and
 //    exits with 130; the restart file continues the run;
 //  - no shell: a post-processing script whose name holds quotes and ';' runs as one argument and
@@ -79,30 +80,34 @@ void require_identical_results(const fs::path& a, const fs::path& b) {
   }
 }
 
-void restart_round_trip(const std::string& case_file, const std::string& extra) {
+// A run of 2N windows against N windows with restart files every N/2, resumed for N more.
+// `output.every` is set to N windows so that both runs write frames at the same times.
+void restart_round_trip(const std::string& case_file, double window, int n) {
   const fs::path one = scratch("one"), two = scratch("two");
   const std::string c = quote((kSource / case_file).string());
-  // 40 windows in one go
-  auto r =
-      partita_run("run " + c + " --set time.end=0.4 " + extra + " --output " + quote(one.string()));
+  const std::string every = " --set output.every=" + std::to_string(n * window);
+  const std::string restart = " --set output.restart.every_windows=" + std::to_string(n / 2);
+  auto end = [&](int windows) { return " --set time.end=" + std::to_string(windows * window); };
+  auto r = partita_run("run " + c + end(2 * n) + every + " --output " + quote(one.string()));
   INFO(r.output);
   REQUIRE(r.status == 0);
-  // 20 windows with restart files every 10, then 20 more from the newest
-  r = partita_run("run " + c + " --set time.end=0.2 --set output.restart.every_windows=10 " +
-                  extra + " --output " + quote(two.string()));
+  r = partita_run("run " + c + end(n) + every + restart + " --output " + quote(two.string()));
   INFO(r.output);
   REQUIRE(r.status == 0);
-  REQUIRE(fs::exists(two / "restart" / "w000000000020.bin"));
-  REQUIRE(fs::exists(two / "restart" / "w000000000010.bin"));
-  r = partita_run("run " + c + " --set time.end=0.4 --set output.restart.every_windows=10 " +
-                  extra + " --resume " + quote(two.string()));
+  const auto file = [&](int w) {
+    std::string s = std::to_string(w);
+    return two / "restart" / ("w" + std::string(12 - s.size(), '0') + s + ".bin");
+  };
+  REQUIRE(fs::exists(file(n)));
+  REQUIRE(fs::exists(file(n / 2)));
+  r = partita_run("run " + c + end(2 * n) + every + restart + " --resume " + quote(two.string()));
   INFO(r.output);
   REQUIRE(r.status == 0);
-  CHECK(r.output.find("resumed after window 20") != std::string::npos);
+  CHECK(r.output.find("resumed after window " + std::to_string(n)) != std::string::npos);
   require_identical_results(one, two);
   // keep: 2 (the default): the newest two remain
-  CHECK_FALSE(fs::exists(two / "restart" / "w000000000010.bin"));
-  CHECK(fs::exists(two / "restart" / "w000000000040.bin"));
+  CHECK_FALSE(fs::exists(file(n / 2)));
+  CHECK(fs::exists(file(2 * n)));
   fs::remove_all(one);
   fs::remove_all(two);
 }
@@ -111,13 +116,19 @@ void restart_round_trip(const std::string& case_file, const std::string& extra) 
 
 TEST_CASE("restart: 2N windows equal N windows resumed for N more, bit for bit", "[app][restart]") {
   SECTION("implicit serial, IQN-ILS (tube)") {
-    restart_round_trip("cases/elastic_tube_1d/iqn-ils.yaml", "");
+    restart_round_trip("cases/elastic_tube_1d/iqn-ils.yaml", 0.01, 20);
   }
   SECTION("implicit serial, Aitken (tube)") {
-    restart_round_trip("cases/elastic_tube_1d/aitken.yaml", "");
+    restart_round_trip("cases/elastic_tube_1d/aitken.yaml", 0.01, 20);
   }
   SECTION("implicit, IQN-IMVJ (tube)") {
-    restart_round_trip("cases/elastic_tube_1d/iqn-imvj.yaml", "");
+    restart_round_trip("cases/elastic_tube_1d/iqn-imvj.yaml", 0.01, 20);
+  }
+  SECTION("explicit serial, FEM plate and DEM granules (seed 000, steel)") {
+    restart_round_trip("cases/uniaxial_compaction/steel.yaml", 1.0e-5, 50);
+  }
+  SECTION("implicit serial, IQN-ILS, FEM rubber plate and DEM granules") {
+    restart_round_trip("cases/uniaxial_compaction/rubber-implicit.yaml", 1.0e-5, 20);
   }
 }
 

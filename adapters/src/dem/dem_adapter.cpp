@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <sstream>
 
 #include "partita/dem/error.hpp"
 #include "partita/dem/lammps_data.hpp"
@@ -500,6 +501,24 @@ void DemAdapter::write_output(const OutputFrame& frame) {
     const std::string mfile = fmt::format("{}_{}_{:06d}.vtp", frame.prefix, m.name, frame.index);
     system_.write_mesh_vtp(m.id, (frame.vtk_directory / mfile).string());
     files_.emplace_back(m.name, mfile);
+  }
+}
+
+void DemAdapter::write_restart(BinaryWriter& out) const {
+  out.section("dem");
+  std::ostringstream state;
+  system_.write_state(state);  // the DEM's own versioned format: particles with ids, contact
+                               // histories, walls, mesh vertices, hooks' counters and RNG state
+  out.bytes(state.str());
+}
+
+void DemAdapter::read_restart(BinaryReader& in) {
+  in.expect_section("dem");
+  std::istringstream state(in.bytes());
+  try {
+    system_.read_state(state);
+  } catch (const dem::Error& e) {
+    throw Error(in.source() + ": the DEM state of '" + name_ + "': " + e.what());
   }
 }
 

@@ -41,6 +41,9 @@ class DemAdapter : public Solver {
   void write_output(const OutputFrame& frame) override;
   std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
   std::string check_state() const override;
+  bool supports_restart() const override { return true; }
+  void write_restart(BinaryWriter& out) const override;
+  void read_restart(BinaryReader& in) override;
   std::vector<MonitorValue> monitors() const override;
 
   static std::shared_ptr<const config::Spec> spec();

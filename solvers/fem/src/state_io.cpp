@@ -121,6 +121,7 @@ void write_state(std::ostream& out, const SolverState& s) {
   w.u64(s.nodal_force_nodes.size());
   for (auto n : s.nodal_force_nodes) w.u64(n);
   w.matrix(s.nodal_forces);
+  w.f64(s.factor_dt);
   out.flush();
   if (!out) throw Error("write_state: the stream failed while flushing");
 }
@@ -160,6 +161,7 @@ SolverState read_state(std::istream& in) {
   s.nodal_force_nodes.resize(r.length("nodal force nodes"));
   for (auto& n : s.nodal_force_nodes) n = r.u64("nodal force nodes");
   r.matrix(s.nodal_forces, "nodal forces");
+  s.factor_dt = r.f64("the factorised step size");
   return s;
 }
 

@@ -749,6 +749,7 @@ SolverState StructuralSolver::save_state() const {
   s.face_tractions = face_tractions_;
   s.nodal_force_nodes = nodal_force_nodes_;
   s.nodal_forces = nodal_forces_;
+  s.factor_dt = factor_dt_;
   return s;
 }
 
@@ -774,6 +775,12 @@ void StructuralSolver::restore_state(const SolverState& s) {
   face_tractions_ = s.face_tractions;
   nodal_force_nodes_ = s.nodal_force_nodes;
   nodal_forces_ = s.nodal_forces;
+  // A state from another process (a restart file) carries the step size the factorisation was
+  // made for; the same h gives the same K_eff and the same steps, bit for bit.
+  if (s.factor_dt > 0.0 && s.factor_dt != factor_dt_) {
+    assemble_mass();  // K_eff needs M (assembled lazily at the first step)
+    factorise_dynamic(s.factor_dt);
+  }
   if (nonlinear_ != nullptr || options_.integrator == Integrator::CentralDifference) {
     refresh_internal_force();
   }

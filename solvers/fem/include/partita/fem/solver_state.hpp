@@ -24,6 +24,9 @@ struct SolverState {
   std::map<std::string, MatrixX3> face_tractions;
   std::vector<std::size_t> nodal_force_nodes;
   MatrixX3 nodal_forces;
+  // The step size K_eff was factorised for (-1: none). Steps within 1e-9 of it integrate with
+  // exactly this h, so a restart must factorise for the same h to continue bit for bit.
+  double factor_dt = -1.0;
 };
 
 }  // namespace partita::fem
