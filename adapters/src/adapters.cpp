@@ -20,6 +20,7 @@ void register_all(coupling::Registries& r) {
       DemAdapter::create, DemAdapter::spec(),
       {{"kinetic_energy", "J", "translational plus rotational kinetic energy of the particles"},
        {"particles", "", "number of particles"},
+       {"mass", "kg", "total mass of the particles"},
        {"contacts_per_particle", "", "mean number of particle-particle contacts"},
        {"<mesh>.force_x", "N", "total contact force of the particles on a mesh, x"},
        {"<mesh>.force_y", "N", "... y"},

@@ -362,6 +362,13 @@ void CaseRun::build_participants(const config::Node& root) {
     }
   }
 
+  struct Built {
+    std::string name;
+    config::Node node;
+    std::string solver_name;
+    std::unique_ptr<Solver> solver;
+  };
+  std::vector<Built> built;
   for (const std::string& name : order) {
     const config::Node pn = ps[name];
     if (name.find('.') != std::string::npos)
@@ -386,10 +393,45 @@ void CaseRun::build_participants(const config::Node& root) {
       log::get("coupling")
           ->info("set-up of participant '{}' ({}): {:.1f} s", name, entry.name, setup.seconds());
     if (!solver) pn.fail("solver '" + entry.name + "' could not be built");
+    built.push_back(Built{name, pn, entry.name, std::move(solver)});
+  }
+
+  // Surfaces handed from one participant to another (an FE face as a DEM wall): once every
+  // participant is built, before anyone's meshes() is used for the exchanges.
+  for (auto& b : built)
+    for (const MeshRequest& req : b.solver->mesh_requests()) {
+      const auto dot = req.source.find('.');
+      const std::string pname = req.source.substr(0, dot);
+      const std::string mname = dot == std::string::npos ? "" : req.source.substr(dot + 1);
+      const Built* from = nullptr;
+      for (const auto& other : built)
+        if (other.name == pname) from = &other;
+      if (dot == std::string::npos || !from)
+        req.where.fail("'" + req.source + "' names no participant's mesh (participant.mesh); " +
+                       "participants: " + join_names(names) + did_you_mean(pname, names));
+      if (from == &b) req.where.fail("a participant cannot take a mesh from itself");
+      std::vector<std::string> known;
+      const InterfaceMesh* found = nullptr;
+      for (const auto& m : from->solver->meshes()) {
+        known.push_back(m.mesh.name());
+        if (m.mesh.name() == mname) found = &m;
+      }
+      if (!found)
+        req.where.fail("participant '" + pname + "' has no mesh '" + mname +
+                       "'; its meshes: " + join_names(known) + did_you_mean(mname, known));
+      if (found->mesh.num_triangles() == 0)
+        req.where.fail("mesh '" + req.source +
+                       "' has no triangles (a point set): a surface is needed");
+      b.solver->receive_mesh(req.name, found->mesh);
+    }
+
+  for (auto& b : built) {
+    const std::string& name = b.name;
+    const config::Node& pn = b.node;
     Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
     if (!coupled) s.automatic = true;  // alone: as many steps per window as its stability needs
     // A fixed number of substeps must not exceed the solver's stable time step.
-    const double stable = solver->stable_time_step();
+    const double stable = b.solver->stable_time_step();
     if (!s.automatic && window_size_ / s.count > stable * (1.0 + 1e-12)) {
       const config::Node where = substeps.count(name) ? coupling["substeps"][name] : pn;
       where.fail(fmt::format(
@@ -398,9 +440,10 @@ void CaseRun::build_participants(const config::Node& root) {
           name, window_size_ / s.count, window_size_, s.count, stable, name,
           static_cast<long>(std::ceil(window_size_ / stable * (1.0 - 1e-12))), name));
     }
-    participants_.push_back(std::make_unique<Participant>(name, std::move(solver), s));
+    participants_.push_back(std::make_unique<Participant>(name, std::move(b.solver), s));
     if (coupled && participants_.back()->solver().meshes().empty())
-      pn.fail("solver '" + entry.name + "' of participant '" + name + "' exposes no coupling mesh");
+      pn.fail("solver '" + b.solver_name + "' of participant '" + name +
+              "' exposes no coupling mesh");
     for (const auto& m : participants_.back()->solver().meshes())
       check_plain_name(pn, m.mesh.name(),
                        "the mesh name '" + m.mesh.name() + "' of '" + name + "'");

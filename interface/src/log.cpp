@@ -47,7 +47,13 @@ std::shared_ptr<spdlog::logger> get(const std::string& module) {
   if (!s.env_reported) {
     s.env_reported = true;
     const char* env = std::getenv("PARTITA_LOG_LEVEL");
-    if (env != nullptr && s.level == spdlog::level::info && std::string_view(env) != "info")
+    bool bad = false;
+    try {
+      if (env != nullptr) (void)parse_level(env);
+    } catch (const Error&) {
+      bad = true;
+    }
+    if (bad)
       logger->warn("PARTITA_LOG_LEVEL='{}' is not a log level (allowed: {}); using info", env,
                    level_names());
   }

@@ -122,7 +122,11 @@ std::shared_ptr<Spec> make_spec() {
       .def(1.0);
   mesh->section("rectangle", "generated flat rectangle", grid);
   mesh->string("material", "material name").required();
-  mesh->one_of({"stl", "rectangle"});
+  mesh->string("from",
+               "participant.mesh of another participant (e.g. an FE interface face): its surface, "
+               "handed over at set-up, becomes this contact mesh (follow its displacement through "
+               "an exchange)");
+  mesh->one_of({"stl", "rectangle", "from"});
 
   auto s = std::make_shared<Spec>(
       "dem", "native DEM (solvers/dem): Hertz-Mindlin spheres, planes, triangle meshes");
@@ -357,6 +361,13 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
       for (const auto& other : meshes_dem_)
         if (other.name == cm.name) m["name"].fail("mesh name '" + cm.name + "' is used twice");
       Mesh mesh;
+      if (m.has("from")) {  // built when the core hands the surface over (receive_mesh)
+        for (const auto& r : requests_)
+          if (r.name == cm.name) m["name"].fail("mesh name '" + cm.name + "' is used twice");
+        requests_.push_back(MeshRequest{cm.name, m.string("from"), m["from"]});
+        request_materials_.push_back(material_id(m["material"]));
+        continue;
+      }
       if (m.has("stl")) {
         const std::filesystem::path f = resolve(m.string("stl"));
         try {
@@ -367,22 +378,7 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
       } else {
         mesh = rectangle(m["rectangle"], cm.name);
       }
-      cm.reference = mesh.points();
-      cm.positions = mesh.points();
-      cm.areas = mesh.triangle_areas();
-      cm.id = system_.add_mesh(mesh.points(), mesh.triangles(), material_id(m["material"]));
-      InterfaceMesh vertices;
-      vertices.mesh = mesh;
-      vertices.reads.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});
-      vertices.writes.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
-      InterfaceMesh centres;
-      centres.mesh = Mesh(cm.name + "_centres", mesh.triangle_centroids());
-      centres.mesh.set_weights(cm.areas);  // each centre stands for its triangle's area
-      centres.writes.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
-      centres.writes.push_back(DataSpec{"traction", 3, "Pa", DataKind::intensive});
-      meshes_.push_back(std::move(vertices));
-      meshes_.push_back(std::move(centres));
-      meshes_dem_.push_back(std::move(cm));
+      add_coupling_mesh(cm.name, mesh, material_id(m["material"]));
     }
     // Every pair that can touch needs an interaction: particles with particles, walls and meshes.
     std::vector<int> partners{pm};
@@ -522,6 +518,46 @@ void DemAdapter::read_restart(BinaryReader& in) {
   }
 }
 
+void DemAdapter::add_coupling_mesh(const std::string& name, const Mesh& mesh, int material) {
+  CouplingMesh cm;
+  cm.name = name;
+  cm.reference = mesh.points();
+  cm.positions = mesh.points();
+  cm.areas = mesh.triangle_areas();
+  cm.id = system_.add_mesh(mesh.points(), mesh.triangles(), material);
+  InterfaceMesh vertices;
+  vertices.mesh = Mesh(name, mesh.points(), mesh.triangles());
+  vertices.reads.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});
+  vertices.writes.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
+  InterfaceMesh centres;
+  centres.mesh = Mesh(name + "_centres", mesh.triangle_centroids());
+  centres.mesh.set_weights(cm.areas);  // each centre stands for its triangle's area
+  centres.writes.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
+  centres.writes.push_back(DataSpec{"traction", 3, "Pa", DataKind::intensive});
+  meshes_.push_back(std::move(vertices));
+  meshes_.push_back(std::move(centres));
+  for (Eigen::Index i = 0; i < cm.reference.rows(); ++i) {
+    domain_lo_ = domain_lo_.cwiseMin(cm.reference.row(i).transpose());
+    domain_hi_ = domain_hi_.cwiseMax(cm.reference.row(i).transpose());
+  }
+  meshes_dem_.push_back(std::move(cm));
+}
+
+void DemAdapter::receive_mesh(const std::string& name, const Mesh& mesh) {
+  for (std::size_t k = 0; k < requests_.size(); ++k)
+    if (requests_[k].name == name) {
+      try {
+        add_coupling_mesh(name, mesh, request_materials_[k]);
+      } catch (const dem::Error& e) {
+        requests_[k].where.fail(std::string("cannot use this surface as a contact mesh: ") +
+                                e.what());
+      }
+      if (!lost_margin_given_) lost_margin_ = (domain_hi_ - domain_lo_).maxCoeff();
+      return;
+    }
+  throw Error("dem '" + name_ + "' asked for no mesh '" + name + "'");
+}
+
 std::string DemAdapter::check_state() const {
   const dem::Particles& p = system_.particles();
   for (std::size_t i = 0; i < p.position.size(); ++i) {
@@ -548,6 +584,9 @@ std::vector<MonitorValue> DemAdapter::monitors() const {
   std::vector<MonitorValue> v;
   v.push_back({"kinetic_energy", "J", system_.kinetic_energy()});
   v.push_back({"particles", "", static_cast<double>(system_.particle_count())});
+  double mass = 0.0;
+  for (const double m : system_.particles().mass) mass += m;
+  v.push_back({"mass", "kg", mass});
   v.push_back({"contacts_per_particle", "", system_.mean_contacts_per_particle()});
   const char* xyz[] = {"x", "y", "z"};
   for (const auto& m : meshes_dem_) {

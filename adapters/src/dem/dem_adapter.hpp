@@ -41,6 +41,8 @@ class DemAdapter : public Solver {
   void write_output(const OutputFrame& frame) override;
   std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
   std::string check_state() const override;
+  std::vector<MeshRequest> mesh_requests() const override { return requests_; }
+  void receive_mesh(const std::string& name, const Mesh& mesh) override;
   bool supports_restart() const override { return true; }
   void write_restart(BinaryWriter& out) const override;
   void read_restart(BinaryReader& in) override;
@@ -80,6 +82,11 @@ class DemAdapter : public Solver {
   Eigen::Vector3d domain_lo_ = Eigen::Vector3d::Constant(1e300);
   Eigen::Vector3d domain_hi_ = Eigen::Vector3d::Constant(-1e300);
   double lost_margin_ = 0.0;
+  bool lost_margin_given_ = false;
+  // meshes taken from other participants (meshes: [{from: participant.mesh}]), with materials
+  std::vector<MeshRequest> requests_;
+  std::vector<int> request_materials_;
+  void add_coupling_mesh(const std::string& name, const Mesh& mesh, int material);
 };
 
 }  // namespace partita::adapters

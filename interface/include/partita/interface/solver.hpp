@@ -6,8 +6,9 @@
 //
 //   1. The factory builds the solver from its YAML section (SolverContext); the solver reads
 //      its own inputs and sets up its initial state (time 0).
-//   2. meshes() — called once after construction; the list and the reference coordinates of
-//      its meshes stay fixed for the whole run.
+//   2. mesh_requests() — once after every participant is built; receive_mesh() once per
+//      request with the other participant's mesh. Then meshes() — called once; the list and the
+//      reference coordinates of its meshes stay fixed for the whole run.
 //   3. Once before the first window: write_output(frame 0) and monitors() for t = 0, and the
 //      core asks write() for the initial values of every exchanged field.
 //   4. For every time window [t_n, t_n + Δt]:
@@ -64,6 +65,15 @@ struct InterfaceMesh {
   std::vector<DataSpec> writes;  ///< fields the solver provides through write()
 };
 
+/// A surface a solver takes from another participant at set-up (e.g. an FE face as a DEM wall):
+/// the core hands over that participant's interface mesh (points with triangles, reference
+/// configuration) through Solver::receive_mesh().
+struct MeshRequest {
+  std::string name;    ///< the name the receiving solver gives it
+  std::string source;  ///< "participant.mesh" as the case wrote it
+  config::Node where;  ///< the YAML key, for messages
+};
+
 /// A scalar the solver reports after each accepted window (for monitors / CSV).
 struct MonitorValue {
   std::string name;  ///< e.g. "kinetic_energy", "plate.force_z"
@@ -86,6 +96,13 @@ class Solver {
 
   /// The coupling meshes in the reference configuration, with their readable/writable fields.
   virtual const std::vector<InterfaceMesh>& meshes() const = 0;
+
+  /// Surfaces this solver takes from other participants (default: none).
+  virtual std::vector<MeshRequest> mesh_requests() const { return {}; }
+  /// One requested surface, handed over by the core before meshes() is used.
+  virtual void receive_mesh(const std::string& name, const Mesh& mesh) {
+    throw Error("this solver takes no meshes from other participants (asked for '" + name + "')");
+  }
 
   /// Give the solver the values of a field it receives (N x C on that mesh's points).
   virtual void read(std::string_view mesh, std::string_view data,

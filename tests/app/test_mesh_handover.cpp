@@ -1,0 +1,67 @@
+// An FE face handed to the DEM as a contact surface (meshes: [{from: block.top}]): granules
+// settle onto it inside frictionless DEM side walls (tests/inputs/handover/fe_floor.yaml). At
+// rest the FE face carries the granules' whole weight m g (static equilibrium; the side walls
+// take no vertical force without friction), within 0.5 %; the force the FE side receives equals
+// the force the DEM's particles put on the surface (a conservative exchange), and the horizontal
+// forces on floor and side walls cancel within 0.5 % of the weight.
+
+#include <catch2/catch.hpp>
+
+#include "../support/run_command.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <vector>
+
+namespace fs = std::filesystem;
+using partita::test::quote;
+
+TEST_CASE("mesh hand-over: granules at rest on an FE face load it with their weight",
+          "[app][handover]") {
+  const fs::path dir = fs::temp_directory_path() / ("partita_floor_" + std::to_string(::getpid()));
+  const auto r = partita::test::run_command(
+      quote(PARTITA_EXECUTABLE) + " run " +
+      quote((fs::path(PARTITA_SOURCE_DIR) / "tests/inputs/handover/fe_floor.yaml").string()) +
+      " --output " + quote(dir.string()));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  std::ifstream in(dir / "forces.csv");
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream s(line);
+    for (std::string c; std::getline(s, c, ',');) header.push_back(c.substr(0, c.find(" [")));
+  }
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::stringstream s(line);
+    std::vector<double> row;
+    for (std::string c; std::getline(s, c, ',');) row.push_back(std::stod(c));
+    rows.push_back(row);
+  }
+  REQUIRE(rows.size() > 100);
+  // means over the last 10 % (the bed at rest)
+  std::map<std::string, double> mean;
+  const std::size_t from = rows.size() - rows.size() / 10;
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    double s = 0;
+    for (std::size_t i = from; i < rows.size(); ++i) s += rows[i][c];
+    mean[header[c]] = s / static_cast<double>(rows.size() - from);
+  }
+  const double weight = mean["granules.mass"] * 9.81;
+  REQUIRE(weight > 0.0);
+  INFO("weight " << weight << " N, FE face " << mean["block.top.force_z"] << " N, DEM "
+                 << mean["granules.floor.force_z"] << " N");
+  CHECK(mean["granules.kinetic_energy"] < 1e-4 * weight * 0.01);  // at rest: E_k << m g (1 cm)
+  CHECK(-mean["block.top.force_z"] == Approx(weight).epsilon(0.005));
+  CHECK(mean["block.top.force_z"] == Approx(mean["granules.floor.force_z"]).epsilon(0.005));
+  CHECK(std::abs(mean["granules.floor.force_x"] + mean["granules.sides.force_x"]) < 0.005 * weight);
+  CHECK(std::abs(mean["granules.floor.force_y"] + mean["granules.sides.force_y"]) < 0.005 * weight);
+  fs::remove_all(dir);
+}
