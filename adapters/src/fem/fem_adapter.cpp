@@ -7,8 +7,10 @@
 #include "partita/fem/error.hpp"
 #include "partita/fem/state_io.hpp"
 
+#include "line_probe.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
+#include "partita/interface/output.hpp"
 #include "partita/interface/time_table.hpp"
 
 namespace partita::adapters {
@@ -87,6 +89,15 @@ std::shared_ptr<Spec> make_spec() {
   load->any("table", std::string("instead of ramp: the load times ") + TimeTable::doc());
   load->one_of({"pressure", "traction", "gravity"});
 
+  auto probe = std::make_shared<Spec>(
+      "probe", "a line probe: N points from 'from' to 'to', sampled at every output time");
+  probe->string("name", "file names DIR/probes/<participant>_<name>_<frame>.csv").required();
+  probe->reals("from", "start of the segment").unit("m").size(3).required();
+  probe->reals("to", "end of the segment").unit("m").size(3).required();
+  probe->integer("points", "points along the segment").min(2).def(50);
+  probe->strings("fields", "what to sample (default: displacement)")
+      .choices({"displacement", "stress", "von_mises"});
+
   auto interface = std::make_shared<Spec>("interface", "a coupling interface on a face");
   interface->string("name", "interface name: meshes <name> (nodes) and <name>_quadrature (quadrature points)")
       .required();
@@ -115,6 +126,10 @@ std::shared_ptr<Spec> make_spec() {
   s->section("material", "the material", material).required();
   s->list("constraints", "Dirichlet conditions", constraint);
   s->list("loads", "applied loads", load);
+  s->list("probes",
+          "line probes: one CSV per output time along a segment (s, x, y, z, the fields; the "
+          "stress is the element-averaged nodal stress interpolated)",
+          probe);
   s->list("interfaces",
           "coupling interfaces (faces whose meshes the coupling can use, and whose mean "
           "displacement and received force are monitor quantities)",
@@ -302,6 +317,23 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       meshes_.push_back(std::move(quad));
       interfaces_.push_back(std::move(itf));
     }
+    for (const Node& p : c["probes"].items()) {
+      std::vector<LineProbe::Field> fields;
+      for (const std::string& f :
+           p.has("fields") ? p.strings("fields") : std::vector<std::string>{"displacement"})
+        fields.push_back(f == "stress"      ? LineProbe::Field::stress
+                         : f == "von_mises" ? LineProbe::Field::von_mises
+                                            : LineProbe::Field::displacement);
+      const std::string pname = p.string("name");
+      for (const auto& other : probes_)
+        if (other.name() == pname) p["name"].fail("probe name '" + pname + "' is used twice");
+      try {
+        probes_.emplace_back(pname, solver_->mesh(), p.vec3("from"), p.vec3("to"),
+                             static_cast<int>(p.integer("points")), fields);
+      } catch (const fem::Error& e) {
+        p.fail(e.what());
+      }
+    }
     if (!transient_) solver_->solve_static();
   } catch (const fem::Error& e) {
     c.fail(std::string("FEM model of participant '") + context.name + "': " + e.what());
@@ -444,6 +476,10 @@ void FemAdapter::write_output(const OutputFrame& frame) {
   const std::string file = fmt::format("{}_fem_{:06d}.vtu", frame.prefix, frame.index);
   fem::write_vtu((frame.vtk_directory / file).string(), *solver_);
   files_ = {{"fem", file}};
+  for (const auto& p : probes_)
+    write_file_atomically(frame.vtk_directory.parent_path() / "probes" /
+                              fmt::format("{}_{}_{:06d}.csv", frame.prefix, p.name(), frame.index),
+                          p.csv(*solver_));
 }
 
 std::vector<MonitorValue> FemAdapter::monitors() const {

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "line_probe.hpp"
 #include "partita/fem/fem.hpp"
 #include "partita/interface/solver.hpp"
 
@@ -69,7 +70,8 @@ class FemAdapter : public Solver {
   std::vector<InterfaceMesh> meshes_;
   std::vector<std::pair<std::string, std::string>> files_;
   Eigen::Vector3d applied_per_unit_ = Eigen::Vector3d::Zero();
-  double model_size_ = 0.0;  // diagonal of the mesh's bounding box [m]
+  double model_size_ = 0.0;
+  std::vector<LineProbe> probes_;  // diagonal of the mesh's bounding box [m]
 };
 
 }  // namespace partita::adapters
