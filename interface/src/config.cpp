@@ -274,6 +274,8 @@ void Spec::validate(const Node& node) const {
     const std::string key = it->first.Scalar();
     Node key_node(it->first, nullptr, node.path().empty() ? key : node.path() + "." + key);
     SourceLocation where{node.file(), it->first.Mark().line + 1, it->first.Mark().column + 1};
+    // A key given by --set has no place in the file: say where it came from instead.
+    if (const SourceLocation set = node[key].location(); set.file != node.file()) where = set;
     if (!seen.insert(key).second)
       throw Error(where, key_node.path(), "duplicate key '" + key + "' (each key may appear once)");
     if (!find(key))

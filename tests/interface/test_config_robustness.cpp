@@ -113,3 +113,17 @@ TEST_CASE("config: --set reaches list elements as key[i]; key.i points there",
              Catch::Contains("'loads' is a list; its element 1 is written 'loads[1]'"));
   CHECK_THAT(set_message(yaml, "loads.1=3"), Catch::Contains("'loads[1]'"));
 }
+
+TEST_CASE("config: an unknown key given by --set is reported at the command line",
+          "[interface][config]") {
+  const auto file = std::filesystem::temp_directory_path() / "partita_config_set_key.yaml";
+  std::ofstream(file) << "case: c\nmaterial: {youngs_modulus: 1}\n";
+  std::string m;
+  try {
+    Node::load_file(file, {"material={youngs_modulus: 1, colour: red}"}).validated(spec());
+  } catch (const partita::Error& e) {
+    m = e.what();
+  }
+  CHECK_THAT(m, Catch::StartsWith("command line (--set material=...)") &&
+                    Catch::Contains("unknown key 'colour'"));
+}
