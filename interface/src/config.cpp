@@ -6,6 +6,7 @@
 #include <limits>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 
 namespace partita::config {
 
@@ -438,7 +439,7 @@ class DocumentCheck {
         walk(n[i], path + "[" + std::to_string(i) + "]", depth + 1);
     } else if (n.IsMap()) {
       for (auto it = n.begin(); it != n.end(); ++it) {
-        const YAML::Node& key = it->first;
+        const YAML::Node key = it->first;  // a copy: `it->` yields a temporary
         if (!key.IsScalar()) {
           const std::string what = key.IsSequence() ? "a sequence"
                                    : key.IsMap()    ? "a map"
@@ -462,13 +463,14 @@ class DocumentCheck {
     return m.line >= 0 ? SourceLocation{name_, m.line + 1, m.column + 1} : SourceLocation{name_};
   }
 
-  void check_quotes(const YAML::Node& n, const std::string& path) const {
+  void check_quotes(const YAML::Node& n, const std::string& path) {
     if (!text_ || n.Tag() != "!") return;  // "!": a quoted (non-plain) scalar
     const YAML::Mark m = n.Mark();
     if (m.pos < 0 || static_cast<std::size_t>(m.pos) >= text_->size()) return;
     const auto at = static_cast<std::size_t>(m.pos);
     const char q = (*text_)[at];
     if (q != '"' && q != '\'') return;
+    if (!checked_.insert(at).second) return;  // an alias repeats a scalar: scan its text once
     for (std::size_t i = at + 1; i < text_->size(); ++i) {
       const char c = (*text_)[i];
       if (q == '"' && c == '\\') {
@@ -491,6 +493,7 @@ class DocumentCheck {
   const std::string* text_;
   std::string name_;
   std::size_t visited_ = 0;
+  std::unordered_set<std::size_t> checked_;  // positions of the quoted scalars scanned
 };
 
 }  // namespace
