@@ -339,7 +339,11 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
   if (!text.empty() && text.front() == '+') ++begin;
   auto r = std::from_chars(begin, end, value);
   if (r.ec != std::errc()) {
-    if (why) *why = "not a number";
+    if (why)
+      *why = r.ec == std::errc::result_out_of_range
+                 ? "out of the range of a real number; allowed: a magnitude between about "
+                   "2.2e-308 and 1.8e308"
+                 : "not a number";
     return std::nullopt;
   }
   if (!std::isfinite(value)) {

@@ -57,6 +57,9 @@ TEST_CASE("config: a value infinite after unit conversion is an error", "[interf
   CHECK_FALSE(partita::config::parse_quantity("-1e300 GPa", "Pa", &why));
   CHECK_THAT(why, Catch::Contains("infinite"));
   CHECK(partita::config::parse_quantity("0 GPa", "Pa") == 0.0);
+  // beyond a double as written
+  CHECK_FALSE(partita::config::parse_quantity("1e400", "Pa", &why));
+  CHECK_THAT(why, Catch::Contains("out of the range of a real number"));
 }
 
 TEST_CASE("config: a sequence or a map used as a key is the project's error",
