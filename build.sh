@@ -6,6 +6,10 @@
 #   ./build.sh test [--sanitize]                       install what is missing, build, run ctest
 #                                                      (--sanitize: a second build with
 #                                                       -fsanitize=address,undefined in build-asan/)
+#   ./build.sh fuzz [SECONDS]                          install what is missing, build the libFuzzer
+#                                                      harnesses of tests/fuzz with clang, ASan and
+#                                                      UBSan in build-fuzz/, run each for SECONDS
+#                                                      (default 60) from the seed inputs
 #   ./build.sh deps                                    only install the Debian packages
 #
 # Works on a fresh Debian 12 machine as root or as a user with sudo. Nothing is downloaded but
@@ -16,12 +20,14 @@ cd "$(dirname "$0")"
 PACKAGES=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
           catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib
           python3-vtk9)
+# Only for `./build.sh fuzz`: clang and its runtime libraries (libclang_rt.fuzzer, ASan, UBSan).
+FUZZ_PACKAGES=(clang libclang-rt-dev)
 DEFAULT_CASE=cases/uniaxial_compaction/steel.yaml
 JOBS=${JOBS:-$(nproc)}
 
-install_deps() {
+install_deps() {  # extra packages...
   local missing=()
-  for p in "${PACKAGES[@]}"; do
+  for p in "${PACKAGES[@]}" "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   [ ${#missing[@]} -eq 0 ] && return 0
@@ -72,8 +78,42 @@ case "$cmd" in
       ctest --test-dir build --output-on-failure -j "$JOBS"
     fi
     ;;
+  fuzz)
+    install_deps "${FUZZ_PACKAGES[@]}"
+    seconds=${1:-60}
+    [[ "$seconds" =~ ^[0-9]+$ ]] || { echo "build.sh fuzz: SECONDS must be a whole number, found '$seconds'" >&2; exit 2; }
+    # Release at -O1 with assertions on (no NDEBUG): checks inside the readers count as findings.
+    cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -g" \
+      -DCMAKE_CXX_COMPILER=clang++ -DPARTITA_FUZZ=ON -DPARTITA_BUILD_TESTS=OFF \
+      -DPARTITA_BUILD_BENCH=OFF -DPARTITA_OPENMP=OFF >/dev/null
+    cmake --build build-fuzz -j "$JOBS" --target fuzz_stl fuzz_gmsh fuzz_case
+    # Seeds: the test and case inputs of each kind. The corpus grows in build-fuzz/corpus/NAME;
+    # a finding is written to build-fuzz/findings/ and fails the command (fix it, then add the
+    # input to tests/inputs/bad/ with its expected message).
+    seed() {  # name, find expression...
+      local dir=build-fuzz/corpus/$1; shift
+      mkdir -p "$dir"
+      find tests cases "$@" -exec cp -t "$dir" {} +
+    }
+    seed stl -type f -iname '*.stl'
+    seed gmsh -type f -iname '*.msh'
+    seed case -type f \( -iname '*.yaml' -o -iname '*.yml' \)
+    mkdir -p build-fuzz/findings
+    export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+    status=0
+    for h in stl gmsh case; do
+      echo "build.sh fuzz: fuzz_$h for $seconds s"
+      ./build-fuzz/tests/fuzz/fuzz_$h -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
+        -max_len=65536 -print_final_stats=1 -artifact_prefix="build-fuzz/findings/$h-" \
+        -dict="tests/fuzz/$h.dict" "build-fuzz/corpus/$h" 2>build-fuzz/fuzz_$h.log || status=1
+      grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|Done|==[0-9]+==ERROR|SUMMARY)' \
+        build-fuzz/fuzz_$h.log || true
+      [ $status -eq 0 ] || { tail -n 60 build-fuzz/fuzz_$h.log; ls build-fuzz/findings; }
+    done
+    exit $status
+    ;;
   *)
-    echo "usage: ./build.sh run [CASE.yaml] [options] | ./build.sh test [--sanitize] | ./build.sh deps" >&2
+    echo "usage: ./build.sh run [CASE.yaml] [options] | ./build.sh test [--sanitize] | ./build.sh fuzz [SECONDS] | ./build.sh deps" >&2
     exit 2
     ;;
 esac

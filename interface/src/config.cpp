@@ -3,8 +3,10 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
+#include <unordered_set>
 
 namespace partita::config {
 
@@ -268,9 +270,13 @@ void Spec::validate(const Node& node) const {
   std::set<std::string> seen;
   const std::vector<std::string> allowed = keys();
   for (auto it = node.yaml().begin(); it != node.yaml().end(); ++it) {
-    const std::string key = it->first.as<std::string>();
+    if (!it->first.IsScalar())  // load_string() rejects these; a Node made by hand may hold one
+      node.fail("a key must be a plain name, found " + Node(it->first, nullptr, "").describe());
+    const std::string key = it->first.Scalar();
     Node key_node(it->first, nullptr, node.path().empty() ? key : node.path() + "." + key);
     SourceLocation where{node.file(), it->first.Mark().line + 1, it->first.Mark().column + 1};
+    // A key given by --set has no place in the file: say where it came from instead.
+    if (const SourceLocation set = node[key].location(); set.file != node.file()) where = set;
     if (!seen.insert(key).second)
       throw Error(where, key_node.path(), "duplicate key '" + key + "' (each key may appear once)");
     if (!find(key))
@@ -333,7 +339,11 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
   if (!text.empty() && text.front() == '+') ++begin;
   auto r = std::from_chars(begin, end, value);
   if (r.ec != std::errc()) {
-    if (why) *why = "not a number";
+    if (why)
+      *why = r.ec == std::errc::result_out_of_range
+                 ? "out of the range of a real number; allowed: a magnitude between about "
+                   "2.2e-308 and 1.8e308"
+                 : "not a number";
     return std::nullopt;
   }
   if (!std::isfinite(value)) {
@@ -348,6 +358,15 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
     return std::nullopt;
   }
   if (token == unit) return value;
+  // The value in SI: a finite number may overflow (1e308 GPa) or vanish (1e-320 nm) on the way.
+  const auto converted = [&](double si) -> std::optional<double> {
+    if (std::isfinite(si) && (si != 0.0 || value == 0.0)) return si;
+    if (why)
+      *why = "'" + std::string(text) + "' is " + (std::isfinite(si) ? "zero" : "infinite") +
+             " after conversion to " + std::string(unit) + "; allowed: a magnitude in " +
+             std::string(unit) + " between about 2.2e-308 and 1.8e308";
+    return std::nullopt;
+  };
   static const std::vector<std::pair<std::string, double>> prefixes = {
       {"G", 1e9},  {"M", 1e6},  {"k", 1e3},         {"c", 1e-2},
       {"m", 1e-3}, {"u", 1e-6}, {"\xC2\xB5", 1e-6}, {"n", 1e-9}};
@@ -366,9 +385,9 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
       caret + 1 < base.size())
     power = base[caret + 1] - '0';
   for (const auto& [p, f] : prefixes) {
-    if (token == p + base) return value * std::pow(f, power) * base_factor;
+    if (token == p + base) return converted(value * std::pow(f, power) * base_factor);
   }
-  if (base_factor != 1.0 && token == base) return value * base_factor;
+  if (base_factor != 1.0 && token == base) return converted(value * base_factor);
   if (why)
     *why = "unit '" + std::string(token) + "' is not allowed here; the unit is " +
            std::string(unit) + " (SI prefixes G, M, k, m, u, n may precede it)";
@@ -392,10 +411,102 @@ Node::Node(YAML::Node node, std::shared_ptr<const std::string> file, std::string
       path_(std::move(path)),
       spec_(std::move(spec)) {}
 
+namespace {
+
+// What yaml-cpp accepts but a case file may not hold: keys that are not plain scalars (a sequence
+// or a map used as a key), and a quoted string left open (yaml-cpp ends it at the end of the
+// file, so it swallows every key after it). `text` is the source (null: not checked for quotes).
+class DocumentCheck {
+ public:
+  DocumentCheck(const std::string* text, std::string name) : text_(text), name_(std::move(name)) {}
+
+  void walk(const YAML::Node& n, const std::string& path, int depth = 0) {
+    // Aliases may repeat a node, or nest it in itself ('&a [*a]'): bounds on the size and the
+    // depth keep the walk of such a document short.
+    if (depth > kMaxDepth) {
+      throw Error(where(n), path.size() > 60 ? path.substr(0, 60) + "..." : path,
+                  "values nested more than " + std::to_string(kMaxDepth) +
+                      " levels deep (an alias '*name' inside its own anchor '&name'?); allowed: "
+                      "at most " +
+                      std::to_string(kMaxDepth) + " levels");
+    }
+    if (++visited_ > kMaxNodes) {
+      throw Error(where(n), path,
+                  "the document holds more than " + std::to_string(kMaxNodes) +
+                      " values (aliases '*name' repeating an anchor '&name'?); allowed: a case "
+                      "of at most that size");
+    }
+    if (n.IsScalar()) {
+      check_quotes(n, path);
+    } else if (n.IsSequence()) {
+      for (std::size_t i = 0; i < n.size(); ++i)
+        walk(n[i], path + "[" + std::to_string(i) + "]", depth + 1);
+    } else if (n.IsMap()) {
+      for (auto it = n.begin(); it != n.end(); ++it) {
+        const YAML::Node key = it->first;  // a copy: `it->` yields a temporary
+        if (!key.IsScalar()) {
+          const std::string what = key.IsSequence() ? "a sequence"
+                                   : key.IsMap()    ? "a map"
+                                                    : "an empty (null) key";
+          throw Error(where(key), path,
+                      "a key must be a plain name, found " + what +
+                          " used as a key (e.g. '[a, b]: ...' or '? ...'); write 'name: value'");
+        }
+        check_quotes(key, path);
+        walk(it->second, path.empty() ? key.Scalar() : path + "." + key.Scalar(), depth + 1);
+      }
+    }
+  }
+
+ private:
+  static constexpr std::size_t kMaxNodes = 1'000'000;
+  static constexpr int kMaxDepth = 100;
+
+  SourceLocation where(const YAML::Node& n) const {
+    const YAML::Mark m = n.Mark();
+    return m.line >= 0 ? SourceLocation{name_, m.line + 1, m.column + 1} : SourceLocation{name_};
+  }
+
+  void check_quotes(const YAML::Node& n, const std::string& path) {
+    if (!text_ || n.Tag() != "!") return;  // "!": a quoted (non-plain) scalar
+    const YAML::Mark m = n.Mark();
+    if (m.pos < 0 || static_cast<std::size_t>(m.pos) >= text_->size()) return;
+    const auto at = static_cast<std::size_t>(m.pos);
+    const char q = (*text_)[at];
+    if (q != '"' && q != '\'') return;
+    if (!checked_.insert(at).second) return;  // an alias repeats a scalar: scan its text once
+    for (std::size_t i = at + 1; i < text_->size(); ++i) {
+      const char c = (*text_)[i];
+      if (q == '"' && c == '\\') {
+        ++i;  // an escaped character
+      } else if (c == q) {
+        if (q == '\'' && i + 1 < text_->size() && (*text_)[i + 1] == '\'') {
+          ++i;  // '' is a quote inside single quotes
+        } else {
+          return;
+        }
+      }
+    }
+    throw Error(where(n), path,
+                std::string("unterminated quoted string: the ") + q +
+                    " opened here is never closed, so the string runs to the end of the file "
+                    "and swallows every key after it; add the closing " +
+                    q);
+  }
+
+  const std::string* text_;
+  std::string name_;
+  std::size_t visited_ = 0;
+  std::unordered_set<std::size_t> checked_;  // positions of the quoted scalars scanned
+};
+
+}  // namespace
+
 Node Node::load_string(const std::string& text, const std::string& name) {
   auto file = std::make_shared<const std::string>(name);
   try {
     YAML::Node root = YAML::Load(text);
+    DocumentCheck(&text, name).walk(root, "");
     Node n(root, file, "");
     n.fallback_ = SourceLocation{name, 1, 1};
     return n;
@@ -472,6 +583,10 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
       if (end == std::string::npos) end = path.size();
       const std::string key = path.substr(i, end - i);
       if (key.empty()) throw Error("--set '" + a + "': empty key in the path");
+      if (cur.IsSequence() && key.find_first_not_of("0123456789") == std::string::npos)
+        throw Error("--set '" + a + "': '" + walked + "' is a list; its element " + key +
+                    " is written '" + walked + "[" + key +
+                    "]' (list indices go in brackets, e.g. participants.plate.loads[0].pressure)");
       if (cur.IsDefined() && !cur.IsNull() && !cur.IsMap())
         throw Error("--set '" + a + "': '" + walked + "' is not a map, it cannot have key '" + key +
                     "'");
@@ -484,6 +599,7 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
       chain.push_back(cur[key]);
     }
   }
+  DocumentCheck(nullptr, "command line (--set)").walk(n.node_, "");
   n.overridden_ = std::make_shared<const std::vector<std::string>>(std::move(overridden));
   return n;
 }
@@ -623,6 +739,10 @@ long Node::as_integer() const {
   const char* b = s.data();
   if (!s.empty() && s[0] == '+') ++b;
   auto r = std::from_chars(b, s.data() + s.size(), v);
+  if (r.ec == std::errc::result_out_of_range)
+    fail("integer " + describe() +
+         " is out of range; allowed: " + std::to_string(std::numeric_limits<long>::min()) + " to " +
+         std::to_string(std::numeric_limits<long>::max()));
   if (r.ec != std::errc() || r.ptr != s.data() + s.size())
     fail("expected an integer, found " + describe() +
          (is_number_text(s) ? " (a whole number is required)" : ""));

@@ -104,16 +104,17 @@ TEST_CASE("fem gmsh import: malformed files are clear errors", "[fem][gmsh]") {
   CHECK_THROWS_WITH(read_gmsh(missing_node),
                     Catch::Contains("missing.msh:19:") && Catch::Contains("node 9"));
 
-  const auto garbage =
-      write_temp("garbage.msh",
-                 std::string(kHeader) + "$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n0 0 0\n1 zero 0\n");
+  const auto garbage = write_temp(
+      "garbage.msh", std::string(kHeader) +
+                         "$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n3\n4\n0 0 0\n1 zero 0\n0 1 0\n0 0 1\n");
   CHECK_THROWS_WITH(read_gmsh(garbage),
                     Catch::Contains("garbage.msh:12:") && Catch::Contains("node coordinates"));
 
   const auto truncated =
       write_temp("truncated.msh", std::string(kHeader) + "$Nodes\n1 4 1 4\n3 1 0 4\n1\n2\n");
+  // (4 nodes announced, fewer bytes left than 4 nodes take: found at the header)
   CHECK_THROWS_WITH(read_gmsh(truncated),
-                    Catch::Contains("truncated.msh:") && Catch::Contains("unexpected end of file"));
+                    Catch::Contains("truncated.msh:5:") && Catch::Contains("file ends too soon"));
 
   const auto no_volume =
       write_temp("novolume.msh", std::string(kHeader) + kNodes +
