@@ -410,6 +410,8 @@ void StructuralSolver::solve_static() {
   kin_.v.setZero();
   kin_.a.setZero();
   acceleration_valid_ = true;
+  // the explicit path's reactions use f_int(u)
+  if (options_.integrator == Integrator::CentralDifference) refresh_internal_force();
   ++timings_.solves;
   timings_.solve += seconds_since(t1);
 }
@@ -652,6 +654,19 @@ double StructuralSolver::energy_balance() const {
 
 Eigen::VectorXd StructuralSolver::equivalent_plastic_strain() const {
   return nonlinear_ != nullptr ? nonlinear_->equivalent_plastic_strain() : Eigen::VectorXd();
+}
+
+Eigen::VectorXd StructuralSolver::element_equivalent_plastic_strain() const {
+  if (nonlinear_ == nullptr) return {};
+  const auto& offsets = nonlinear_->element_qp_offsets();
+  const Eigen::VectorXd& q = nonlinear_->equivalent_plastic_strain();
+  Eigen::VectorXd out(static_cast<Eigen::Index>(mesh().num_elements()));
+  for (std::size_t e = 0; e < mesh().num_elements(); ++e) {
+    const auto q0 = static_cast<Eigen::Index>(offsets[e]);
+    out[static_cast<Eigen::Index>(e)] =
+        q.segment(q0, static_cast<Eigen::Index>(offsets[e + 1] - offsets[e])).mean();
+  }
+  return out;
 }
 
 double StructuralSolver::stable_time_step() const {

@@ -138,6 +138,8 @@ class StructuralSolver final : private StructuralSystem {
   // Per quadrature point of the nonlinear path (empty on the linear path): equivalent plastic
   // strain and Cauchy stress (Voigt) at the current state.
   Eigen::VectorXd equivalent_plastic_strain() const;
+  // Mean over each element's quadrature points (one value per element; empty when linear).
+  Eigen::VectorXd element_equivalent_plastic_strain() const;
   // Newton reports of the last nonlinear static solve / Newmark step.
   const std::vector<NewtonReport>& static_reports() const { return static_.reports(); }
   const NewtonReport& newmark_report() const { return newmark_.last_report(); }
