@@ -751,7 +751,7 @@ void StructuralSolver::external_force(double t, Eigen::VectorXd& f) const {
 }
 
 void StructuralSolver::apply_prescribed(double t, Eigen::VectorXd& u) const {
-  Eigen::VectorXd uc;
+  Eigen::VectorXd& uc = prescribed_work_;  // sized once: no allocation per explicit step
   prescribed_values(t, uc);
   for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
     u[dofs_.constrained_dofs()[k]] = uc[static_cast<Eigen::Index>(k)];

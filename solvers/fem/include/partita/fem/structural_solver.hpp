@@ -188,7 +188,8 @@ class StructuralSolver final : private StructuralSystem {
   bool mass_ready_ = false;
   std::unique_ptr<Factorisation> static_factor_, dynamic_factor_;
   double factor_dt_ = -1.0;
-  mutable double stable_step_ = -1.0;  // cached stable_time_step()
+  mutable double stable_step_ = -1.0;        // cached stable_time_step()
+  mutable Eigen::VectorXd prescribed_work_;  // apply_prescribed()'s buffer
 
   // loads
   std::vector<Eigen::VectorXd> load_vectors_;  // per model load, at unit amplitude
