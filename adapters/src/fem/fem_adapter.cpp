@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <algorithm>
 #include <sstream>
+#include <limits>
 
 #include "partita/fem/error.hpp"
 #include "partita/fem/state_io.hpp"
@@ -52,10 +53,42 @@ std::shared_ptr<Spec> make_spec() {
       .def("incompatible-modes");
   mesh->one_of({"box", "gmsh"});
 
-  auto material = std::make_shared<Spec>("material", "isotropic linear-elastic material");
+  auto hardening_point =
+      std::make_shared<Spec>("hardening_point", "a point of the hardening curve");
+  hardening_point->real("plastic_strain", "equivalent plastic strain (first point: 0)")
+      .non_negative()
+      .required();
+  hardening_point->real("yield_stress", "uniaxial yield stress there")
+      .unit("Pa")
+      .positive()
+      .required();
+  auto material = std::make_shared<Spec>(
+      "material", "isotropic material: linear elastic, compressible Neo-Hooke or J2 plasticity");
+  material
+      ->choice("model",
+               "linear-elastic (small strain, the fast linear path), neo-hooke (compressible, "
+               "finite strain, W = mu/2 (tr C - 3) - mu ln J + lambda/2 ln^2 J), "
+               "neo-hooke-decoupled (W = mu/2 (I1_bar - 3) + kappa/4 (J^2 - 1 - 2 ln J)), "
+               "j2-plasticity (small strain, isotropic hardening) or j2-plasticity-finite-strain "
+               "(multiplicative, logarithmic strains)",
+               {"linear-elastic", "neo-hooke", "neo-hooke-decoupled", "j2-plasticity",
+                "j2-plasticity-finite-strain"})
+      .def("linear-elastic");
   material->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
   material->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
   material->real("density", "mass density rho").unit("kg/m^3").positive().required();
+  material->real("yield_stress", "j2-plasticity: initial uniaxial yield stress")
+      .unit("Pa")
+      .positive();
+  material
+      ->real("hardening_modulus", "j2-plasticity: linear isotropic hardening d sigma_y / d eps_p")
+      .unit("Pa")
+      .non_negative()
+      .def(0.0);
+  material->list("hardening_table",
+                 "j2-plasticity: tabulated hardening instead of yield_stress and hardening_modulus "
+                 "(piecewise linear, flat beyond the last point)",
+                 hardening_point);
 
   auto constraint = std::make_shared<Spec>("constraint", "a Dirichlet condition on a node set");
   constraint->string("set", "node set (box: all, xmin ... zmax; Gmsh: physical group names)")
@@ -117,11 +150,41 @@ std::shared_ptr<Spec> make_spec() {
   analysis->section("newmark", "Newmark parameters", newmark);
   analysis->choice("mass", "mass matrix", {"consistent", "lumped"}).def("consistent");
   analysis->section("rayleigh", "Rayleigh damping", rayleigh);
+  analysis
+      ->choice("integrator",
+               "transient time integration: newmark (implicit) or central-difference (explicit, "
+               "needs mass: lumped; the coupling's auto substeps use its stable step)",
+               {"newmark", "central-difference"})
+      .def("newmark");
+  analysis
+      ->real("stable_step_factor",
+             "central-difference: the step offered to the coupling is this times the element "
+             "estimate l_e / c_d")
+      .range(0.0, 1.0)
+      .def(0.9);
+  auto nonlinear = std::make_shared<Spec>(
+      "nonlinear", "Newton iterations of neo-hooke and j2-plasticity (static and Newmark)");
+  nonlinear->integer("max_iterations", "Newton iterations per load or time step").min(1).def(25);
+  nonlinear->real("force_tolerance", "converged when |R| <= this * max(|F|, |R_0|)")
+      .positive()
+      .def(1e-8);
+  nonlinear->real("energy_tolerance", "and |du . R| <= this * (first iteration's)")
+      .positive()
+      .def(1e-14);
+  nonlinear->integer("load_steps", "static: increments from the current state to the target")
+      .min(1)
+      .def(1);
+  nonlinear->integer("max_cutbacks", "halvings of a failed load or time step before giving up")
+      .min(0)
+      .def(8);
+  nonlinear->integer("line_search_steps", "backtracking halvings of a Newton step").min(0).def(6);
+  analysis->section("nonlinear", "Newton solver of the nonlinear materials", nonlinear);
 
   auto s =
       std::make_shared<Spec>("fem",
-                             "native linear-elastic FEM (solvers/fem): Hex8 (incompatible modes), "
-                             "Hex20, Tet4, Tet10; static or Newmark transient");
+                             "native FEM (solvers/fem): Hex8 (incompatible modes), Hex20, Tet4, "
+                             "Tet10; linear elastic, Neo-Hooke or J2 plasticity; static, Newmark "
+                             "or central-difference transient");
   s->section("mesh", "the mesh", mesh).required();
   s->section("material", "the material", material).required();
   s->list("constraints", "Dirichlet conditions", constraint);
@@ -159,6 +222,35 @@ void require_name(const Node& n, const std::string& name, const std::vector<std:
 
 // The largest generated box mesh accepted (a typing error beyond it would exhaust the memory).
 constexpr double kMaxBoxCells = 2.0e7;
+// The law of material: {model: ...}; nullptr for linear-elastic (the Material path).
+std::shared_ptr<const fem::MaterialLaw> build_law(const Node& mat) {
+  const std::string model = mat.string("model");
+  const double e = mat.real("youngs_modulus"), nu = mat.real("poisson_ratio");
+  const double rho = mat.real("density");
+  if (model == "neo-hooke") return std::make_shared<fem::NeoHookeLaw>(e, nu, rho);
+  if (model == "neo-hooke-decoupled")
+    return std::make_shared<fem::DecoupledNeoHookeLaw>(e, nu, rho);
+  if (model != "j2-plasticity" && model != "j2-plasticity-finite-strain") return nullptr;
+  const auto make = [&](fem::HardeningCurve curve) -> std::shared_ptr<const fem::MaterialLaw> {
+    if (model == "j2-plasticity")
+      return std::make_shared<fem::J2PlasticityLaw>(e, nu, rho, std::move(curve));
+    return std::make_shared<fem::FiniteStrainJ2Law>(e, nu, rho, std::move(curve));
+  };
+  if (mat.has("hardening_table")) {
+    if (mat.has("yield_stress"))
+      mat["yield_stress"].fail(
+          "give either yield_stress (and hardening_modulus) or hardening_table");
+    std::vector<std::pair<double, double>> points;
+    for (const Node& p : mat["hardening_table"].items())
+      points.emplace_back(p.real("plastic_strain"), p.real("yield_stress"));
+    return make(fem::HardeningCurve::tabulated(points));
+  }
+  if (!mat.has("yield_stress"))
+    mat.fail(model +
+             " needs 'yield_stress' (and optionally 'hardening_modulus') or "
+             "'hardening_table'");
+  return make(fem::HardeningCurve::linear(mat.real("yield_stress"), mat.real("hardening_modulus")));
+}
 
 fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
   if (m.has("box")) {
@@ -212,6 +304,7 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     fem::Material material{mat.real("youngs_modulus"), mat.real("poisson_ratio"),
                            mat.real("density")};
     fem::Model model(std::move(mesh), material);
+    if (auto law = build_law(mat)) model.set_material_law(std::move(law));
     model.set_hex8_formulation(c["mesh"].string("hex8") == "full"
                                    ? fem::Hex8Formulation::Full
                                    : fem::Hex8Formulation::IncompatibleModes);
@@ -271,6 +364,19 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         an.string("mass") == "lumped" ? fem::MassType::Lumped : fem::MassType::Consistent;
     options.rayleigh_alpha = an["rayleigh"].real("alpha");
     options.rayleigh_beta = an["rayleigh"].real("beta");
+    if (an.string("integrator") == "central-difference") {
+      if (options.mass != fem::MassType::Lumped)
+        an["integrator"].fail("central-difference needs 'mass: lumped'");
+      options.integrator = fem::Integrator::CentralDifference;
+    }
+    stable_step_factor_ = an.real("stable_step_factor");
+    const Node nl = an["nonlinear"];
+    options.newton.max_iterations = static_cast<int>(nl.integer("max_iterations"));
+    options.newton.force_tolerance = nl.real("force_tolerance");
+    options.newton.energy_tolerance = nl.real("energy_tolerance");
+    options.newton.load_steps = static_cast<int>(nl.integer("load_steps"));
+    options.newton.max_cutbacks = static_cast<int>(nl.integer("max_cutbacks"));
+    options.newton.max_line_search_steps = static_cast<int>(nl.integer("line_search_steps"));
     solver_ = std::make_unique<fem::StructuralSolver>(std::move(model), options);
     {
       Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -409,6 +515,12 @@ void FemAdapter::advance(double dt) {
   }
 }
 
+double FemAdapter::stable_time_step() const {
+  if (!transient_ || solver_->options().integrator != fem::Integrator::CentralDifference)
+    return std::numeric_limits<double>::infinity();
+  return stable_step_factor_ * solver_->stable_time_step();
+}
+
 void FemAdapter::save_checkpoint() {
   checkpoint_ = solver_->save_state();
   has_checkpoint_ = true;
@@ -519,6 +631,10 @@ std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::stri
   m.push_back({"max_displacement", "m", solver_->max_displacement()});
   if (wanted("kinetic_energy")) m.push_back({"kinetic_energy", "J", solver_->kinetic_energy()});
   if (wanted("strain_energy")) m.push_back({"strain_energy", "J", solver_->strain_energy()});
+  if (wanted("plastic_work")) m.push_back({"plastic_work", "J", solver_->plastic_work()});
+  if (wanted("external_work")) m.push_back({"external_work", "J", solver_->external_work()});
+  if (wanted("damping_work")) m.push_back({"damping_work", "J", solver_->damping_work()});
+  if (wanted("energy_balance")) m.push_back({"energy_balance", "J", solver_->energy_balance()});
   if (names.empty()) return m;
   std::vector<MonitorValue> out;
   for (auto& v : m)

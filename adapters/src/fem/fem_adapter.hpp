@@ -1,8 +1,9 @@
 #pragma once
 // Adapter of the native FEM solver (solvers/fem) to the Solver contract.
 //
-// YAML (see spec() or `partita docs fem`): mesh (structured box or Gmsh file), material,
-// constraints, loads, interfaces, analysis (static or Newmark transient).
+// YAML (see spec() or `partita docs fem`): mesh (structured box or Gmsh file), material
+// (model: linear-elastic | neo-hooke | j2-plasticity), constraints, loads, interfaces, analysis
+// (static or transient; integrator: newmark | central-difference; nonlinear: Newton options).
 //
 // For each interface {name: N, face: F} it exposes two meshes:
 //   N             the face's nodes (with the face triangulated): writes "displacement" [m],
@@ -11,7 +12,9 @@
 //                 route: tractions at the quadrature points, integrated with the face rule)
 // Monitors: N.force_x|y|z (total interface force received [N]), static_reaction_z (the force the
 // interfaces must carry for static equilibrium: minus the sum of the applied loads, gravity
-// included [N]), max_displacement [m], kinetic_energy, strain_energy [J].
+// included [N]), max_displacement [m], kinetic_energy, strain_energy, plastic_work,
+// external_work, damping_work, energy_balance (external - strain - kinetic - plastic - damping)
+// [J].
 
 #include <memory>
 #include <string>
@@ -30,6 +33,7 @@ class FemAdapter : public Solver {
   const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
   void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) override;
   void write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) override;
+  double stable_time_step() const override;
   void advance(double dt) override;
   double time() const override { return solver_->time(); }
   void save_checkpoint() override;
@@ -63,6 +67,7 @@ class FemAdapter : public Solver {
 
   std::string name_;
   bool transient_ = true;
+  double stable_step_factor_ = 0.9;
   std::unique_ptr<fem::StructuralSolver> solver_;
   fem::SolverState checkpoint_;
   bool has_checkpoint_ = false;

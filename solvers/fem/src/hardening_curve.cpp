@@ -1,6 +1,7 @@
 #include "partita/fem/hardening_curve.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "partita/fem/error.hpp"
@@ -81,6 +82,25 @@ double HardeningCurve::slope(double alpha) const {
 
 double HardeningCurve::initial_yield_stress() const {
   return sigma0_;
+}
+
+double HardeningCurve::return_map_increment(double g, double trial_norm, double alpha_n) const {
+  const double sqrt23 = std::sqrt(2.0 / 3.0);
+  const double f_tr = trial_norm - sqrt23 * yield_stress(alpha_n);
+  double dg = f_tr / (2.0 * g + 2.0 / 3.0 * slope(alpha_n));
+  for (int it = 0;; ++it) {
+    const double alpha = alpha_n + sqrt23 * dg;
+    // r(dg) = |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg)
+    const double res = trial_norm - 2.0 * g * dg - sqrt23 * yield_stress(alpha);
+    if (std::abs(res) <= 1e-13 * sigma0_) return dg;
+    if (it == 50) {
+      std::ostringstream msg;
+      msg << "j2-plasticity: the radial return did not converge (residual " << res
+          << " Pa after 50 iterations)";
+      throw Error(msg.str());
+    }
+    dg += res / (2.0 * g + 2.0 / 3.0 * slope(alpha));
+  }
 }
 
 }  // namespace partita::fem

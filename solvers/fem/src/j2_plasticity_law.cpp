@@ -1,41 +1,15 @@
 #include "partita/fem/j2_plasticity_law.hpp"
 
 #include <cmath>
-#include <sstream>
 
 #include "partita/fem/error.hpp"
+#include "symmetric_storage.hpp"
 
 namespace partita::fem {
-namespace {
-
-// Symmetric tensor <-> 6 values xx yy zz xy yz zx (tensor components).
-Mat3 unpack(std::span<const double> v) {
-  Mat3 m;
-  m << v[0], v[3], v[5], v[3], v[1], v[4], v[5], v[4], v[2];
-  return m;
-}
-void pack(const Mat3& m, std::span<double> v) {
-  v[0] = m(0, 0);
-  v[1] = m(1, 1);
-  v[2] = m(2, 2);
-  v[3] = m(0, 1);
-  v[4] = m(1, 2);
-  v[5] = m(0, 2);
-}
-
-}  // namespace
 
 J2PlasticityLaw::J2PlasticityLaw(double e, double nu, double rho, HardeningCurve hardening)
     : density_(rho), hardening_(std::move(hardening)) {
-  if (!(e > 0.0)) {
-    throw Error("j2-plasticity: Young's modulus must be > 0 Pa, got " + std::to_string(e));
-  }
-  if (!(nu > -1.0 && nu < 0.5)) {
-    throw Error("j2-plasticity: Poisson's ratio must lie in (-1, 0.5), got " + std::to_string(nu));
-  }
-  if (!(rho >= 0.0)) {
-    throw Error("j2-plasticity: density must be >= 0 kg/m^3, got " + std::to_string(rho));
-  }
+  validate_isotropic_constants("j2-plasticity", e, nu, rho);
   const auto lame = lame_constants(e, nu);
   shear_ = lame.mu;
   bulk_ = lame.lambda + 2.0 / 3.0 * lame.mu;
@@ -51,7 +25,7 @@ void J2PlasticityLaw::evaluate(const Mat3& f, std::span<const double> committed,
   const double sqrt23 = std::sqrt(2.0 / 3.0);
   const Mat3 id = Mat3::Identity();
   const Mat3 eps = 0.5 * (f + f.transpose()) - id;
-  const Mat3 eps_p_n = unpack(committed.subspan(0, 6));
+  const Mat3 eps_p_n = unpack_symmetric(committed.subspan(0, 6));
   const double alpha_n = committed[6];
   const double wp_n = committed[7];
 
@@ -67,22 +41,8 @@ void J2PlasticityLaw::evaluate(const Mat3& f, std::span<const double> committed,
   Mat3 n = Mat3::Zero();
   if (f_tr > 0.0) {
     n = s_tr / s_norm;
-    // Solve |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg) = 0 by Newton
-    // (exact in one step for linear hardening; a few steps across table segments).
-    dg = f_tr / (2.0 * g + 2.0 / 3.0 * hardening_.slope(alpha_n));
-    const double scale = hardening_.initial_yield_stress();
-    for (int it = 0;; ++it) {
-      const double alpha = alpha_n + sqrt23 * dg;
-      const double res = s_norm - 2.0 * g * dg - sqrt23 * hardening_.yield_stress(alpha);
-      if (std::abs(res) <= 1e-13 * scale) break;
-      if (it == 50) {
-        std::ostringstream msg;
-        msg << "j2-plasticity: the radial return did not converge (residual " << res
-            << " Pa after 50 iterations)";
-        throw Error(msg.str());
-      }
-      dg += res / (2.0 * g + 2.0 / 3.0 * hardening_.slope(alpha));
-    }
+    // Solve |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg) = 0
+    dg = hardening_.return_map_increment(g, s_norm, alpha_n);
     theta = 1.0 - 2.0 * g * dg / s_norm;
     theta_bar = 1.0 / (1.0 + hardening_.slope(alpha_n + sqrt23 * dg) / (3.0 * g)) - (1.0 - theta);
   }
@@ -107,10 +67,12 @@ void J2PlasticityLaw::evaluate(const Mat3& f, std::span<const double> committed,
   const Mat3 eps_e = eps - eps_p;
   // W = 1/2 (eps - eps_p) : sigma
   r.energy_density = 0.5 * (eps_e.array() * r.stress.array()).sum();
-  pack(eps_p, trial.subspan(0, 6));
+  pack_symmetric(eps_p, trial.subspan(0, 6));
   trial[6] = alpha_n + sqrt23 * dg;
-  // w_p += sigma_n+1 : d eps_p = dg s : n
-  trial[7] = wp_n + dg * (s.array() * n.array()).sum();
+  // w_p += 1/2 (sigma_n + sigma_n+1) : d eps_p,  d eps_p = dg n
+  const Mat3 sigma_n = unpack_symmetric(committed.subspan(8, 6));
+  trial[7] = wp_n + 0.5 * dg * ((sigma_n + r.stress).array() * n.array()).sum();
+  pack_symmetric(r.stress, trial.subspan(8, 6));
 }
 
 }  // namespace partita::fem

@@ -1,6 +1,10 @@
 #include "partita/fem/material_law.hpp"
 
 #include <algorithm>
+#include <sstream>
+#include <string>
+
+#include "partita/fem/error.hpp"
 
 namespace partita::fem {
 
@@ -14,6 +18,29 @@ double MaterialLaw::plastic_work_density(std::span<const double>) const {
 
 double MaterialLaw::equivalent_plastic_strain(std::span<const double>) const {
   return 0.0;
+}
+
+void validate_isotropic_constants(std::string_view law, double e, double nu, double rho) {
+  const std::string name(law);
+  if (!(e > 0.0)) {
+    throw Error(name + ": Young's modulus must be > 0 Pa, got " + std::to_string(e));
+  }
+  if (!(nu > -1.0 && nu < 0.5)) {
+    throw Error(name + ": Poisson's ratio must lie in (-1, 0.5), got " + std::to_string(nu) +
+                " (the law is compressible: nu >= 0.5 makes the bulk modulus infinite; use "
+                "e.g. 0.45-0.49)");
+  }
+  if (!(rho >= 0.0)) {
+    throw Error(name + ": density must be >= 0 kg/m^3, got " + std::to_string(rho));
+  }
+}
+
+void require_positive_jacobian(std::string_view law, double j) {
+  if (j > 0.0) return;
+  std::ostringstream msg;
+  msg << law << ": deformation gradient with det F = " << j
+      << " <= 0 (material inverted); reduce the load or time step";
+  throw Error(msg.str());
 }
 
 LameConstants lame_constants(double e, double nu) {

@@ -1,23 +1,13 @@
 #include "partita/fem/neo_hooke_law.hpp"
 
 #include <cmath>
-#include <sstream>
 
 #include "partita/fem/error.hpp"
 
 namespace partita::fem {
 
 NeoHookeLaw::NeoHookeLaw(double e, double nu, double rho) : density_(rho) {
-  if (!(e > 0.0)) {
-    throw Error("neo-hooke: Young's modulus must be > 0 Pa, got " + std::to_string(e));
-  }
-  if (!(nu > -1.0 && nu < 0.5)) {
-    throw Error("neo-hooke: Poisson's ratio must lie in (-1, 0.5), got " + std::to_string(nu) +
-                " (this law is compressible: nu >= 0.5 makes lambda infinite; use e.g. 0.45-0.49)");
-  }
-  if (!(rho >= 0.0)) {
-    throw Error("neo-hooke: density must be >= 0 kg/m^3, got " + std::to_string(rho));
-  }
+  validate_isotropic_constants("neo-hooke", e, nu, rho);
   lame_ = lame_constants(e, nu);
 }
 
@@ -32,12 +22,7 @@ double NeoHookeLaw::bulk_modulus() const {
 void NeoHookeLaw::evaluate(const Mat3& f, std::span<const double>, std::span<double>,
                            MaterialResponse& r) const {
   const double j = f.determinant();
-  if (!(j > 0.0)) {
-    std::ostringstream msg;
-    msg << "neo-hooke: deformation gradient with det F = " << j
-        << " <= 0 (material inverted); reduce the load or time step";
-    throw Error(msg.str());
-  }
+  require_positive_jacobian("neo-hooke", j);
   const double mu = lame_.mu, lambda = lame_.lambda;
   const double log_j = std::log(j);
   const Mat3 finv = f.inverse();

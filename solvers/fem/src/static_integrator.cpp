@@ -1,5 +1,6 @@
 #include "partita/fem/static_integrator.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "partita/fem/error.hpp"
@@ -40,10 +41,12 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
   // free dofs (so lambda = 0 is exact even for a state that is not an equilibrium of F_0),
   // the applied F_0 on the constrained ones.
   Eigen::VectorXd f0 = kin.f;
+  double internal_scale = 0.0;  // |f_int(u_0)| over all dofs: the loads and the reactions
   {
     Eigen::VectorXd f_int;
     system.internal_forces().evaluate(u0, f_int, nullptr);
     for (auto d : dofs.free_dofs()) f0[d] = f_int[d];
+    internal_scale = f_int.norm();
   }
   const int steps = std::max(1, newton_.options().load_steps);
   double lambda = 0.0, increment = 1.0 / steps;
@@ -58,8 +61,9 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
     for (auto d : dofs.constrained_dofs()) u_trial[d] = u0[d] + next * (u_target[d] - u0[d]);
     dofs.gather_free(u_trial, x);
     StaticProblem problem(system, f_lambda, u_trial);
-    // reference force: the applied loads and what the supports carry, |F| + |f_int(u_c only)|
-    const double reference = std::max(f_lambda.norm(), 1e-300);
+    // force scale of the convergence test: the applied loads or the internal forces of the
+    // start (reactions included), whichever is larger
+    const double reference = std::max({f_lambda.norm(), internal_scale, 1e-300});
     NewtonReport rep = newton_.solve(problem, x, reference);
     reports_.push_back(rep);
     if (rep.converged) {

@@ -1,6 +1,7 @@
 #include "partita/fem/structural_solver.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
 #include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
 #include <chrono>
@@ -410,6 +411,8 @@ void StructuralSolver::solve_static() {
   kin_.v.setZero();
   kin_.a.setZero();
   acceleration_valid_ = true;
+  // the explicit path's reactions use f_int(u)
+  if (options_.integrator == Integrator::CentralDifference) refresh_internal_force();
   ++timings_.solves;
   timings_.solve += seconds_since(t1);
 }
@@ -654,46 +657,84 @@ Eigen::VectorXd StructuralSolver::equivalent_plastic_strain() const {
   return nonlinear_ != nullptr ? nonlinear_->equivalent_plastic_strain() : Eigen::VectorXd();
 }
 
+Eigen::VectorXd StructuralSolver::element_equivalent_plastic_strain() const {
+  if (nonlinear_ == nullptr) return {};
+  const auto& offsets = nonlinear_->element_qp_offsets();
+  const Eigen::VectorXd& q = nonlinear_->equivalent_plastic_strain();
+  Eigen::VectorXd out(static_cast<Eigen::Index>(mesh().num_elements()));
+  for (std::size_t e = 0; e < mesh().num_elements(); ++e) {
+    const auto q0 = static_cast<Eigen::Index>(offsets[e]);
+    out[static_cast<Eigen::Index>(e)] =
+        q.segment(q0, static_cast<Eigen::Index>(offsets[e + 1] - offsets[e])).mean();
+  }
+  return out;
+}
+
 double StructuralSolver::stable_time_step() const {
-  double dt = std::numeric_limits<double>::infinity();
+  if (stable_step_ > 0.0) return stable_step_;
+  // Element eigenvalue bound (Irons 1970; Hughes, The Finite Element Method, 2000, section
+  // 9.3): with a lumped mass, omega_max^2 of the mesh <= max_e lambda_max(M_e^-1 K_e), K_e and M_e
+  // restricted to the element's free dofs (a constrained dof is zero in every mode). K_e is the
+  // element stiffness at rest: the linear-elastic one (Hex8 as the path integrates it) or, for
+  // a law, the elasticity tensor of its tangent at F = I. dt_crit = 2 / omega_max.
+  const ElementIntegrator full(Hex8Formulation::Full);
+  std::vector<Matrix6> d_region;
+  for (std::size_t r = 0; r < std::max<std::size_t>(1, mesh().region_names().size()); ++r) {
+    const auto* law = model_.material_law(static_cast<int>(r));
+    if (law == nullptr) {
+      d_region.push_back(model_.material(static_cast<int>(r)).elasticity_matrix());
+      continue;
+    }
+    std::vector<double> state(static_cast<std::size_t>(law->state_size()));
+    std::vector<double> trial(state.size());
+    law->initialise_state(state);
+    MaterialResponse at_rest;
+    law->evaluate(Mat3::Identity(), state, trial, at_rest);
+    // Voigt D_ab = C_ijkl with a = (i, j), b = (k, l): xx yy zz xy yz zx
+    static constexpr int kPair[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+    Matrix6 d;
+    for (int a = 0; a < 6; ++a) {
+      for (int b = 0; b < 6; ++b) {
+        d(a, b) = at_rest.tangent(3 * kPair[a][0] + kPair[a][1], 3 * kPair[b][0] + kPair[b][1]);
+      }
+    }
+    d_region.push_back(d);
+  }
+  std::vector<char> is_free(ndof_, 0);
+  for (auto dof : dofs_.free_dofs()) is_free[static_cast<std::size_t>(dof)] = 1;
+  double omega2 = 0.0;
+  ElementMatrix ke;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
+  std::vector<int> free_local;
   for (const auto& e : mesh().elements()) {
     const ElementCoordinates x = element_coordinates(mesh(), e);
-    double length = std::numeric_limits<double>::infinity();
-    if (e.type == ElementType::Hex8 || e.type == ElementType::Hex20) {
-      // smallest distance between the centres of opposite faces (corner nodes)
-      static constexpr int kFaces[3][2][4] = {
-          {{0, 3, 7, 4}, {1, 2, 6, 5}}, {{0, 1, 5, 4}, {3, 2, 6, 7}}, {{0, 1, 2, 3}, {4, 5, 6, 7}}};
-      for (const auto& pair : kFaces) {
-        Vec3 c0 = Vec3::Zero(), c1 = Vec3::Zero();
-        for (int k = 0; k < 4; ++k) {
-          c0 += 0.25 * x.row(pair[0][k]).transpose();
-          c1 += 0.25 * x.row(pair[1][k]).transpose();
-        }
-        length = std::min(length, (c1 - c0).norm());
+    const auto& d = d_region[static_cast<std::size_t>(e.region)];
+    (nonlinear_ != nullptr ? full : integrator_).stiffness(e.type, x, d, ke);
+    integrator_.lumped_mass(e.type, x, model_.density(e.region), m);
+    free_local.clear();
+    for (int a = 0; a < node_count(e.type); ++a) {
+      for (int c = 0; c < 3; ++c) {
+        if (is_free[3 * e.nodes[a] + static_cast<std::size_t>(c)]) free_local.push_back(3 * a + c);
       }
-    } else {
-      // smallest height 3 V / (largest face area) of the corner tetrahedron
-      const Vec3 p0 = x.row(0), p1 = x.row(1), p2 = x.row(2), p3 = x.row(3);
-      const double volume = std::abs((p1 - p0).cross(p2 - p0).dot(p3 - p0)) / 6.0;
-      const double area =
-          0.5 * std::max({(p1 - p0).cross(p2 - p0).norm(), (p1 - p0).cross(p3 - p0).norm(),
-                          (p2 - p0).cross(p3 - p0).norm(), (p2 - p1).cross(p3 - p1).norm()});
-      length = 3.0 * volume / area;
     }
-    if (e.type == ElementType::Hex20 || e.type == ElementType::Tet10) length *= 0.5;
-    const auto* law = model_.material_law(e.region);
-    double c = 0.0;
-    if (law != nullptr) {
-      c = law->dilatational_wave_speed();
-    } else {
-      const Material& m = model_.material(e.region);
-      const auto lame = lame_constants(m.youngs_modulus, m.poisson_ratio);
-      c = std::sqrt((lame.lambda + 2.0 * lame.mu) / m.density);
+    if (free_local.empty()) continue;
+    // lambda_max of M^-1/2 K M^-1/2 on the free dofs
+    const auto nf = static_cast<Eigen::Index>(free_local.size());
+    Eigen::MatrixXd a(nf, nf);
+    for (Eigen::Index i = 0; i < nf; ++i) {
+      for (Eigen::Index j = 0; j < nf; ++j) {
+        const int li = free_local[static_cast<std::size_t>(i)];
+        const int lj = free_local[static_cast<std::size_t>(j)];
+        a(i, j) = ke(li, lj) / std::sqrt(m[li / 3] * m[lj / 3]);
+      }
     }
-    // dt_e = l_e / c_d
-    dt = std::min(dt, length / c);
+    omega2 =
+        std::max(omega2, Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a, Eigen::EigenvaluesOnly)
+                             .eigenvalues()
+                             .maxCoeff());
   }
-  return dt;
+  stable_step_ = omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
+  return stable_step_;
 }
 
 void StructuralSolver::refresh_internal_force() {
@@ -710,7 +751,7 @@ void StructuralSolver::external_force(double t, Eigen::VectorXd& f) const {
 }
 
 void StructuralSolver::apply_prescribed(double t, Eigen::VectorXd& u) const {
-  Eigen::VectorXd uc;
+  Eigen::VectorXd& uc = prescribed_work_;  // sized once: no allocation per explicit step
   prescribed_values(t, uc);
   for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
     u[dofs_.constrained_dofs()[k]] = uc[static_cast<Eigen::Index>(k)];

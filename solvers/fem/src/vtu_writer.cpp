@@ -93,7 +93,14 @@ void write_vtu(const std::string& path, const StructuralSolver& solver) {
         << "      <CellData>\n"
         << "        <DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">\n";
     for (const auto& e : mesh.elements()) out << "          " << e.region << '\n';
-    out << "        </DataArray>\n      </CellData>\n"
+    out << "        </DataArray>\n";
+    // nonlinear path: element mean of the equivalent plastic strain
+    const Eigen::VectorXd eqps = solver.element_equivalent_plastic_strain();
+    if (eqps.size() > 0) {
+      write_array(out, "equivalent_plastic_strain", 1, eqps.data(),
+                  static_cast<std::size_t>(eqps.size()));
+    }
+    out << "      </CellData>\n"
         << "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
     if (!out) throw Error(tmp + ": write failed");
   }

@@ -2,9 +2,15 @@
 // Shared helpers of the nonlinear FEM tests (not a test file itself).
 #include <Eigen/Dense>
 #include <functional>
+#include <memory>
+#include <sstream>
+#include <string>
 
 #include "fem_test_helpers.hpp"
 #include "partita/fem/internal_force_operator.hpp"
+#include "partita/fem/model.hpp"
+#include "partita/fem/newton_report.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 namespace partita::fem::test {
 
@@ -28,6 +34,78 @@ inline double tangent_fd_error(InternalForceOperator& op, const Eigen::VectorXd&
     worst = std::max(worst, (kdu - fd).norm() / kdu.norm());
   }
   return worst;
+}
+
+// Box (2 x 1 x depth, 2 x 2 x 2 cells of `type`) with its interior nodes moved randomly by up to
+// 15 % of a cell, with one law everywhere.
+inline Model distorted_box(ElementType type, double depth, std::shared_ptr<const MaterialLaw> law,
+                           unsigned long long seed) {
+  BoxSpec spec{Vec3::Zero(), Vec3(2.0, 1.0, depth), {2, 2, 2}, type};
+  Mesh mesh = make_box_mesh(spec);
+  distort_interior(mesh, spec, 0.15, seed);
+  Model m(std::move(mesh));
+  m.set_material_law(std::move(law));
+  return m;
+}
+
+// u = (F0 - I) X + a random perturbation of 0.01: a large, non-symmetric, non-homogeneous
+// deformation (F0 = [1.3 0.2 0; 0 0.9 0.1; 0.05 0 1.1]).
+inline Eigen::VectorXd large_deformation(const Mesh& mesh, unsigned long long seed) {
+  Mat3 f0;
+  f0 << 1.3, 0.2, 0.0, 0.0, 0.9, 0.1, 0.05, 0.0, 1.1;
+  Lcg rng(seed);
+  Eigen::VectorXd u(3 * static_cast<Eigen::Index>(mesh.num_nodes()));
+  for (std::size_t n = 0; n < mesh.num_nodes(); ++n) {
+    u.segment<3>(3 * static_cast<Eigen::Index>(n)) =
+        (f0 - Mat3::Identity()) * mesh.node(n) + 0.01 * Vec3(rng.next(), rng.next(), rng.next());
+  }
+  return u;
+}
+
+// Pairs (r_k, r_k+1) of relative residuals with lo < r_k < 1e-2 (the asymptotic range, above
+// the accuracy floor lo) that violate quadratic convergence r_k+1 <= 10 r_k^2, and how many
+// pairs were checked.
+struct QuadraticCheck {
+  int checked = 0;
+  int violations = 0;
+};
+inline QuadraticCheck check_quadratic(const NewtonReport& rep, double lo) {
+  QuadraticCheck c;
+  const auto& r = rep.residual_norms;
+  for (std::size_t k = 0; k + 1 < r.size(); ++k) {
+    const double a = r[k] / rep.reference_force, b = r[k + 1] / rep.reference_force;
+    if (a < 1e-2 && a > lo) {
+      ++c.checked;
+      if (!(b <= 10.0 * a * a)) ++c.violations;
+    }
+  }
+  return c;
+}
+
+// Cantilever 10 x 1 x 1 (10 x 2 x 2 Hex20) of `law`, clamped at x = 0, its end x = 10 pushed
+// down by `tip` in `steps` load steps: the Newton report of the last step, the largest
+// equivalent plastic strain and the relative residual sequence as text.
+struct BendingRun {
+  NewtonReport report;
+  double max_plastic_strain = 0.0;
+  std::string residuals;
+};
+inline BendingRun plastic_bending(std::shared_ptr<const MaterialLaw> law, double tip,
+                                  double force_tolerance, int steps) {
+  Model m(make_box_mesh({Vec3::Zero(), Vec3(10.0, 1.0, 1.0), {10, 2, 2}, ElementType::Hex20}));
+  m.set_material_law(std::move(law));
+  m.fix("xmin");
+  m.prescribe("xmax", 2, [tip](double t) { return -tip * t; });
+  SolverOptions opt;
+  opt.newton.force_tolerance = force_tolerance;
+  opt.newton.load_steps = steps;
+  StructuralSolver s(std::move(m), opt);
+  s.step_static(1.0);
+  BendingRun run{s.static_reports().back(), s.equivalent_plastic_strain().maxCoeff(), ""};
+  std::ostringstream seq;
+  for (double r : run.report.residual_norms) seq << r / run.report.reference_force << " ";
+  run.residuals = seq.str();
+  return run;
 }
 
 // Root of a monotone scalar function on [lo, hi] by bisection to round-off.

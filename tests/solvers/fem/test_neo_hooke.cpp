@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "nonlinear_test_helpers.hpp"
+#include "partita/fem/decoupled_neo_hooke_law.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/neo_hooke_law.hpp"
 #include "partita/fem/nonlinear_operator.hpp"
@@ -97,22 +98,9 @@ TEST_CASE("neo-hooke uniaxial stretch by Newton: lateral stretch and force vs cl
 TEST_CASE("neo-hooke tangent equals finite differences of the internal force",
           "[fem][nonlinear][neo-hooke]") {
   for (auto type : {ElementType::Hex8, ElementType::Hex20, ElementType::Tet10}) {
-    BoxSpec spec{Vec3::Zero(), Vec3(2.0, 1.0, 0.5), {2, 2, 2}, type};
-    Mesh mesh = make_box_mesh(spec);
-    test::distort_interior(mesh, spec, 0.15, 7);
-    Model m(std::move(mesh));
-    m.set_material_law(std::make_shared<NeoHookeLaw>(kE, kNu, kRho));
+    Model m = test::distorted_box(type, 0.5, std::make_shared<NeoHookeLaw>(kE, kNu, kRho), 7);
     NonlinearOperator op(m);
-    // a large homogeneous deformation F0 plus a random perturbation
-    Mat3 f0;
-    f0 << 1.3, 0.2, 0.0, 0.0, 0.9, 0.1, 0.05, 0.0, 1.1;
-    test::Lcg rng(3);
-    Eigen::VectorXd u(3 * static_cast<Eigen::Index>(m.mesh().num_nodes()));
-    for (std::size_t n = 0; n < m.mesh().num_nodes(); ++n) {
-      const Vec3 x = m.mesh().node(n);
-      u.segment<3>(3 * static_cast<Eigen::Index>(n)) =
-          (f0 - Mat3::Identity()) * x + 0.01 * Vec3(rng.next(), rng.next(), rng.next());
-    }
+    const Eigen::VectorXd u = test::large_deformation(m.mesh(), 3);
     // central differences: error O(h^2) ~ 1e-10, round-off ~ 1e-16 / h ~ 1e-10
     CHECK(test::tangent_fd_error(op, u, 1e-6, 4, 11) < 1e-6);
   }
@@ -130,4 +118,27 @@ TEST_CASE("neo-hooke rejects nu >= 0.5 and other bad input", "[fem][nonlinear][n
   Mat3 f = Mat3::Identity();
   f(2, 2) = -0.5;
   CHECK_THROWS_WITH(law.evaluate(f, {}, {}, r), Catch::Contains("det F"));
+}
+
+TEST_CASE("decoupled neo-hooke: tangent equals finite differences; simple shear closed form",
+          "[fem][nonlinear][neo-hooke]") {
+  Model m = test::distorted_box(ElementType::Hex20, 0.5,
+                                std::make_shared<DecoupledNeoHookeLaw>(kE, kNu, kRho), 7);
+  NonlinearOperator op(m);
+  const Eigen::VectorXd u = test::large_deformation(m.mesh(), 3);
+  CHECK(test::tangent_fd_error(op, u, 1e-6, 4, 11) < 1e-6);
+  // simple shear (J = 1, b_bar = b): sigma = mu dev(b): sigma_xy = mu gamma,
+  // sigma_xx = 2/3 mu gamma^2, sigma_yy = sigma_zz = -1/3 mu gamma^2 (Holzapfel 2000, 6.5)
+  DecoupledNeoHookeLaw law(kE, kNu, kRho);
+  const double gamma = 0.7;
+  Mat3 f = Mat3::Identity();
+  f(0, 1) = gamma;
+  MaterialResponse r;
+  law.evaluate(f, {}, {}, r);
+  const Mat3 sigma = r.stress * f.transpose();
+  CHECK(std::abs(sigma(0, 1) - law.mu() * gamma) <= 1e-10 * law.mu());
+  CHECK(std::abs(sigma(0, 0) - 2.0 / 3.0 * law.mu() * gamma * gamma) <= 1e-10 * law.mu());
+  CHECK(std::abs(sigma(1, 1) + 1.0 / 3.0 * law.mu() * gamma * gamma) <= 1e-10 * law.mu());
+  CHECK(std::abs(sigma(2, 2) + 1.0 / 3.0 * law.mu() * gamma * gamma) <= 1e-10 * law.mu());
+  CHECK_THROWS_WITH(DecoupledNeoHookeLaw(kE, 0.5, kRho), Catch::Contains("nu >= 0.5"));
 }

@@ -1,7 +1,9 @@
 #pragma once
 // Everything of partita::fem in one include.
 #include "partita/fem/box_mesher.hpp"
+#include "partita/fem/decoupled_neo_hooke_law.hpp"
 #include "partita/fem/error.hpp"
+#include "partita/fem/finite_strain_j2_law.hpp"
 #include "partita/fem/gmsh_reader.hpp"
 #include "partita/fem/hardening_curve.hpp"
 #include "partita/fem/j2_plasticity_law.hpp"

@@ -19,6 +19,11 @@ class HardeningCurve {
   double yield_stress(double alpha) const;  // sigma_y(alpha) [Pa]
   double slope(double alpha) const;         // H(alpha) = d sigma_y / d alpha [Pa]
   double initial_yield_stress() const;
+  // The plastic multiplier dg of a radial return: the root of
+  //   trial_norm - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg) = 0
+  // (trial_norm = |s_tr| > sqrt(2/3) sigma_y(alpha_n)), by Newton (exact in one step for linear
+  // hardening, a few steps across table segments). Throws Error if it does not converge.
+  double return_map_increment(double shear_modulus, double trial_norm, double alpha_n) const;
 
  private:
   HardeningCurve() = default;

@@ -12,9 +12,11 @@ namespace partita::fem {
 //   n = s_tr / |s_tr|, s = s_tr - 2 G dg n, eps_p += dg n, alpha += sqrt(2/3) dg,
 //   C_ep = K 1(x)1 + 2 G theta I_dev - 2 G theta_bar n(x)n,
 //   theta = 1 - 2 G dg / |s_tr|, theta_bar = 1 / (1 + H / (3 G)) - (1 - theta).
-// History per point (8 values): eps_p (xx yy zz xy yz zx, tensor components), alpha, plastic
-// work w_p = sum sigma_n+1 : d eps_p (per reference volume). W = 1/2 (eps - eps_p) : C : (eps -
-// eps_p) is the stored elastic energy (hardening energy is counted in the plastic work).
+// History per point (14 values): eps_p (xx yy zz xy yz zx, tensor components), alpha, plastic
+// work w_p = sum 1/2 (sigma_n + sigma_n+1) : d eps_p (per reference volume; trapezoidal like the
+// external work, so a proportional path with linear hardening balances exactly), sigma (xx yy
+// zz xy yz zx). W = 1/2 (eps - eps_p) : C : (eps - eps_p) is the stored elastic energy (the
+// hardening energy is part of the plastic work).
 class J2PlasticityLaw final : public MaterialLaw {
  public:
   J2PlasticityLaw(double youngs_modulus, double poisson_ratio, double density,
@@ -24,7 +26,7 @@ class J2PlasticityLaw final : public MaterialLaw {
   double density() const override { return density_; }
   double dilatational_wave_speed() const override;
   double bulk_modulus() const override { return bulk_; }
-  int state_size() const override { return 8; }
+  int state_size() const override { return 14; }
   void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
                 MaterialResponse& response) const override;
   double plastic_work_density(std::span<const double> state) const override { return state[7]; }

@@ -48,6 +48,13 @@ struct LameConstants {
 };
 LameConstants lame_constants(double youngs_modulus, double poisson_ratio);
 
+// Throws Error("<law>: ...") unless E > 0, -1 < nu < 0.5 and rho >= 0 (the rule, the value
+// found and, for nu, that a compressible law needs nu < 0.5).
+void validate_isotropic_constants(std::string_view law, double youngs_modulus, double poisson_ratio,
+                                  double density);
+// Throws Error("<law>: deformation gradient with det F = j <= 0 ...") unless j > 0.
+void require_positive_jacobian(std::string_view law, double j);
+
 // C_iJkL = lambda d_iJ d_kL + mu (d_ik d_JL + d_iL d_Jk) as a 9 x 9 matrix.
 Matrix9 isotropic_elasticity_tensor(double lambda, double mu);
 
