@@ -206,6 +206,7 @@ int System::add_hook(std::unique_ptr<StepHook> hook) {
   hooks_[k].attach(*this);
   track_load_ = track_load_ || hooks_[k].wants_contact_load();
   forces_valid_ = false;
+  prepared_ = false;  // sizes the load array (the lists stay)
   return k;
 }
 
