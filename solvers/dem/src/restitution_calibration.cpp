@@ -85,7 +85,7 @@ double RestitutionCalibration::damping_ratio(double e, bool no_tension) {
 double RestitutionCalibration::time_step_fraction(double e) {
   check_restitution(e);
   // measured worst relative error over v = 0.01..3 m/s, pairs and walls (see the header)
-  if (e < 0.15) return 0.025;
+  if (e < 0.15) return 0.02;
   if (e < 0.2) return 0.05;
   if (e < 0.9) return 0.1;
   return 0.2;
