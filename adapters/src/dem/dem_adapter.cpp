@@ -3,10 +3,13 @@
 #include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <sstream>
 
+#include "partita/dem/breakage.hpp"
 #include "partita/dem/error.hpp"
+#include "partita/dem/grading.hpp"
 #include "partita/dem/lammps_data.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -128,6 +131,45 @@ std::shared_ptr<Spec> make_spec() {
                "an exchange)");
   mesh->one_of({"stl", "rectangle", "from"});
 
+  auto breakage = std::make_shared<Spec>(
+      "breakage",
+      "crushable particles (seed 001, eq. 2): a particle breaks when a contact's mean Hertz "
+      "pressure reaches its strength sigma = sigma_lim,0 (d/d0)^(-3/m) (times a Weibull scatter)");
+  breakage->real("limit_strength", "limit strength sigma_lim,0 of a particle of size d0")
+      .unit("Pa")
+      .positive()
+      .required();
+  breakage->real("reference_size", "reference diameter d0 of the limit strength")
+      .unit("m")
+      .positive()
+      .required();
+  breakage->real("weibull_modulus", "Weibull modulus m (size effect and scatter)")
+      .positive()
+      .required();
+  breakage
+      ->choice("scatter",
+               "per-particle strength: weibull (drawn, modulus m, reproducible from the seed) or "
+               "none (every particle at sigma_lim,0 (d/d0)^(-3/m))",
+               {"weibull", "none"})
+      .def("weibull");
+  breakage->real("comminution_limit", "d_min: particles with a smaller diameter never break")
+      .unit("m")
+      .positive()
+      .required();
+  breakage
+      ->choice("pattern",
+               "fragments inscribed in the broken particle: equal-4 (tetrahedron, 36 % of the "
+               "mass), equal-6 (octahedron, 43 %), apollonian-14 (6 + 8, 52 %)",
+               dem::FragmentPattern::names())
+      .def("apollonian-14");
+  breakage
+      ->choice("mass",
+               "the mass the fragments cannot hold: lost (counted) or restored to the fragments "
+               "(counted)",
+               {"lost", "restored"})
+      .def("lost");
+  breakage->integer("seed", "seed of the strengths and fragment orientations").min(0).def(1);
+
   auto s = std::make_shared<Spec>(
       "dem", "native DEM (solvers/dem): Hertz-Mindlin spheres, planes, triangle meshes");
   s->any("materials",
@@ -165,6 +207,7 @@ std::shared_ptr<Spec> make_spec() {
              "neighbour-list build (keeps neighbours close in memory; 0: never)")
       .min(0)
       .def(10);
+  s->section("breakage", "crushable particles (off when absent)", breakage);
   return s;
 }
 
@@ -392,6 +435,7 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
                                "', which can touch; add {pair: [" + na + ", " + nb +
                                "], friction: 0.3, restitution: 0.5}");
       }
+    if (c.has("breakage")) add_breakage(c["breakage"]);
     // Validate the set-up now (interactions of every pair in use, the Rayleigh step).
     (void)system_.rayleigh_time_step();
 
@@ -415,6 +459,31 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
           "dem '{}': {} particles, {} walls, {} meshes, Rayleigh step {:.3e} s, time step {:.3e} s",
           name_, system_.particle_count(), walls_.size(), meshes_dem_.size(),
           system_.rayleigh_time_step(), stable_time_step());
+}
+
+void DemAdapter::add_breakage(const config::Node& b) {
+  dem::BreakageParameters p;
+  p.limit_strength = b.real("limit_strength");
+  p.reference_size = b.real("reference_size");
+  p.weibull_modulus = b.real("weibull_modulus");
+  p.scatter = b.string("scatter") == "weibull";
+  p.comminution_limit = b.real("comminution_limit");
+  p.pattern = dem::FragmentPattern::named(b.string("pattern")).kind();
+  p.restore_mass = b.string("mass") == "restored";
+  p.seed = static_cast<std::uint64_t>(b.integer("seed"));
+  breakage_ = system_.add_hook(std::make_unique<dem::Breakage>(p));
+  double d_max = 0.0;
+  for (double r : system_.particles().radius) d_max = std::max(d_max, 2.0 * r);
+  if (p.comminution_limit > d_max)
+    log::get("adapters")
+        ->warn(
+            "dem '{}': breakage.comminution_limit {:.4g} m is above the largest particle "
+            "diameter {:.4g} m: nothing can break",
+            name_, p.comminution_limit, d_max);
+}
+
+const dem::Breakage* DemAdapter::breakage() const {
+  return breakage_ < 0 ? nullptr : &static_cast<const dem::Breakage&>(system_.hook(breakage_));
 }
 
 std::size_t DemAdapter::find(std::string_view mesh, bool* centres) const {
@@ -469,6 +538,15 @@ void DemAdapter::advance(double dt) {
   // displacement where the step lies within one row interval of the table)
   for (const auto& w : walls_)
     if (w.moving) system_.set_wall_velocity(w.id, w.velocity * w.table(system_.time() + 0.5 * dt));
+  // Fragments lower the stable step; `auto` substeps follow it (stable_time_step() is asked
+  // before every window), a fixed count that has become too coarse stops here.
+  if (breakage_ >= 0 && dt > stable_time_step() * (1.0 + 1e-12))
+    throw Error(fmt::format(
+        "dem '{}' at t = {:.6g} s: the step {:.4g} s is above the stable step {:.4g} s of the "
+        "smallest particle after breakage; give the participant's substeps as auto, or multiply "
+        "the substep count by at least {} (or lower time_step_fraction)",
+        name_, system_.time(), dt, stable_time_step(),
+        static_cast<long>(std::ceil(dt / stable_time_step() * (1.0 - 1e-12)))));
   try {
     system_.step(dt);
   } catch (const dem::Error& e) {
@@ -498,6 +576,20 @@ void DemAdapter::write_output(const OutputFrame& frame) {
     system_.write_mesh_vtp(m.id, (frame.vtk_directory / mfile).string());
     files_.emplace_back(m.name, mfile);
   }
+  if (breakage_ >= 0) write_grading(frame);
+}
+
+// Grading at each output time: rows time, diameter, mass fraction passing, appended to
+// DIR/<participant>_grading.csv (DIR the run's output folder, the parent of vtk/).
+void DemAdapter::write_grading(const OutputFrame& frame) const {
+  const std::filesystem::path file =
+      frame.vtk_directory.parent_path() / (frame.prefix + "_grading.csv");
+  const bool header = frame.index == 0 || !std::filesystem::exists(file);
+  std::ofstream out(file, header ? std::ios::trunc : std::ios::app);
+  if (!out) throw Error("dem '" + name_ + "': cannot write the grading to " + file.string());
+  if (header) out << "time_s,diameter_m,passing\n";
+  for (const dem::Grading::Point& g : dem::Grading::cumulative(system_.particles()))
+    out << fmt::format("{:.9g},{:.9g},{:.9g}\n", frame.time, g.size, g.passing);
 }
 
 void DemAdapter::write_restart(BinaryWriter& out) const {
@@ -596,6 +688,16 @@ std::vector<MonitorValue> DemAdapter::monitors() const {
   for (const auto& w : walls_) {
     const Eigen::Vector3d f = system_.wall_force(w.id);
     for (int k = 0; k < 3; ++k) v.push_back({w.name + ".force_" + xyz[k], "N", f(k)});
+  }
+  if (const dem::Breakage* b = breakage()) {
+    const dem::BreakageCounters& c = b->counters();
+    v.push_back({"breakage.events", "", static_cast<double>(c.events)});
+    v.push_back({"breakage.fragments", "", static_cast<double>(c.fragments)});
+    v.push_back({"breakage.fragment_mass", "kg", c.fragment_mass});
+    v.push_back({"breakage.mass_lost", "kg", c.mass_lost});
+    v.push_back({"breakage.mass_restored", "kg", c.mass_restored});
+    v.push_back({"breakage.energy_released", "J", c.energy_released});
+    v.push_back({"stable_time_step", "s", stable_time_step()});
   }
   return v;
 }

@@ -13,12 +13,17 @@
 //   M_centres  the triangle centroids: writes "force" [N] per triangle and "traction" [Pa] =
 //              force / triangle area (the seed's route, Algorithm 1 of seed 000)
 // Monitors: kinetic_energy [J], M.force_x|y|z [N] (force of the particles on mesh M),
-// <wall>.force_x|y|z [N], particles, contacts_per_particle.
+// <wall>.force_x|y|z [N], particles, contacts_per_particle; with `breakage`: breakage.events,
+// .fragments, .fragment_mass [kg], .mass_lost [kg], .mass_restored [kg], .energy_released [J],
+// stable_time_step [s] (it falls as fragments appear; `auto` substeps follow it), and the grading
+// (cumulative mass passing per size) appended to <output>/<participant>_grading.csv at each
+// output time.
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "partita/dem/breakage.hpp"
 #include "partita/dem/packing_generator.hpp"
 #include "partita/dem/system.hpp"
 #include "partita/interface/solver.hpp"
@@ -68,6 +73,9 @@ class DemAdapter : public Solver {
   };
   /// Index into meshes_dem_ of the coupling mesh `mesh` (vertices or centres); throws if unknown.
   std::size_t find(std::string_view mesh, bool* centres) const;
+  void add_breakage(const config::Node& breakage);
+  const dem::Breakage* breakage() const;  ///< nullptr when off
+  void write_grading(const OutputFrame& frame) const;
 
   std::string name_;
   dem::System system_;
@@ -87,6 +95,7 @@ class DemAdapter : public Solver {
   std::vector<MeshRequest> requests_;
   std::vector<int> request_materials_;
   void add_coupling_mesh(const std::string& name, const Mesh& mesh, int material);
+  int breakage_ = -1;  // hook index of the breakage model, -1: off
 };
 
 }  // namespace partita::adapters

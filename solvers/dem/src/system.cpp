@@ -4,6 +4,7 @@
 
 #include "partita/dem/error.hpp"
 #include "partita/dem/parallel.hpp"
+#include "partita/dem/restitution_calibration.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -205,6 +206,7 @@ int System::add_hook(std::unique_ptr<StepHook> hook) {
   hooks_[k].attach(*this);
   track_load_ = track_load_ || hooks_[k].wants_contact_load();
   forces_valid_ = false;
+  prepared_ = false;  // sizes the load array (the lists stay)
   return k;
 }
 
@@ -343,6 +345,21 @@ double System::rayleigh_time_step() const {
                           (0.1631 * m.poisson_ratio + 0.8766));
   }
   return dt;
+}
+
+double System::time_step_fraction() const {
+  check_interactions();
+  std::vector<bool> used(model_.material_count(), false), partner(model_.material_count(), false);
+  for (int m : store_.core().material) used[m] = partner[m] = true;
+  for (const PlaneWall& p : planes_) partner[p.material] = true;
+  for (const TriangleMesh& m : meshes_) partner[m.material()] = true;
+  double f = 0.2;
+  for (int a = 0; a < model_.material_count(); ++a)
+    for (int b = 0; b < model_.material_count(); ++b)
+      if (used[a] && partner[b])
+        f = std::min(
+            f, RestitutionCalibration::time_step_fraction(model_.interaction(a, b).restitution));
+  return f;
 }
 
 void System::check_interactions() const {

@@ -107,6 +107,10 @@ void System::write_body(BinaryWriter& w) const {
   w.value(static_cast<std::int32_t>(wall_count_));
   w.value(static_cast<std::int64_t>(planes_.size()));
   w.value(static_cast<std::int64_t>(meshes_.size()));
+  for (const TriangleMesh& m : meshes_) {
+    w.value(static_cast<std::int64_t>(m.vertex_count()));
+    w.value(static_cast<std::int64_t>(m.triangle_count()));
+  }
   w.value(static_cast<std::int32_t>(hooks_.size()));
   for (int k = 0; k < hooks_.size(); ++k) w.string(hooks_[k].name());
   // particles with every registered array (histories with planes and meshes included)
@@ -126,12 +130,18 @@ void System::write_body(BinaryWriter& w) const {
   w.value(end_tag);
 }
 
+// The set-up is checked first (nothing is changed when the state does not fit); a body that is
+// inconsistent further on (corrupt data) throws with the system partly overwritten.
 void System::read_body(BinaryReader& r) {
   r.expect(body_tag, "the body tag");
   r.expect(static_cast<std::int32_t>(model_.material_count()), "the number of materials");
   r.expect(static_cast<std::int32_t>(wall_count_), "the number of walls");
   r.expect(static_cast<std::int64_t>(planes_.size()), "the number of planes");
   r.expect(static_cast<std::int64_t>(meshes_.size()), "the number of meshes");
+  for (const TriangleMesh& m : meshes_) {
+    r.expect(static_cast<std::int64_t>(m.vertex_count()), "a mesh's vertex count");
+    r.expect(static_cast<std::int64_t>(m.triangle_count()), "a mesh's triangle count");
+  }
   r.expect(static_cast<std::int32_t>(hooks_.size()), "the number of step hooks");
   for (int k = 0; k < hooks_.size(); ++k) {
     const std::string name = r.string("a step hook name");

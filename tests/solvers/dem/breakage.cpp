@@ -321,6 +321,35 @@ TEST_CASE("dem: fragments are further breakable and the stable step follows them
   CHECK(c.smallest_fragment == Approx(2.0 * r_min));
 }
 
+TEST_CASE("dem: a breakage model added after the first steps takes over at once",
+          "[dem][breakage]") {
+  const BreakageParameters b = parameters(3.0);
+  const double d = 2.0e-3;
+  Platens with(d, b, 0.005);  // hook from the start
+  // the same set-up without the hook
+  System plain;
+  const int g = plain.add_material({E, NU, RHO});
+  const int s = plain.add_material({E_P, NU_P, 7850.0});
+  plain.add_interaction(g, g, {0.3, 0.5, 0.0});
+  plain.add_interaction(g, s, {0.3, 0.5, 0.0});
+  plain.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
+  plain.add_plane({0, 0, 0}, {0, 0, 1}, s);
+  const int top = plain.add_plane({0, 0, d}, {0, 0, -1}, s, {0, 0, -0.005});
+  const double dt = 0.2 * plain.rayleigh_time_step();
+  plain.run(50, dt);
+  with.sys.run(50, dt);
+  plain.add_hook(std::make_unique<Breakage>(b));
+  long steps = 50;
+  while (breakage_of(plain).counters().events == 0 && steps < 2'000'000) {
+    plain.step(dt);
+    with.sys.step(dt);
+    ++steps;
+  }
+  CHECK(breakage_of(plain).counters().events == 1);
+  CHECK(breakage_of(with.sys).counters().events == 1);  // the same step
+  CHECK(plain.wall_force(top).norm() == Approx(eq2_force(d, b)).epsilon(0.01));
+}
+
 TEST_CASE("dem: grading is the cumulative mass fraction passing each size", "[dem][breakage]") {
   System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
   sys.add_particle({0, 0, 0}, 1e-3, 0);    // d = 2 mm, mass 8 units

@@ -262,6 +262,23 @@ TEST_CASE("dem: a state stream with a bad magic, another version or cut short is
     std::stringstream s(bytes);
     CHECK_THROWS_WITH(other.read_state(s), Catch::Contains("does not fit"));
   }
+  {  // a second mesh of another size: refused before anything changes
+    Eigen::MatrixX3d v3(3, 3), v4(4, 3);
+    v3 << 0, 0, -1, 1, 0, -1, 0, 1, -1;
+    v4 << 0, 0, -1, 1, 0, -1, 0, 1, -1, 1, 1, -1;
+    TriangleMesh::Triangles t1(1, 3), t2(2, 3);
+    t1 << 0, 1, 2;
+    t2 << 0, 1, 2, 1, 3, 2;
+    System three = bed(), four = bed();
+    three.add_mesh(v3, t1, 0);
+    four.add_mesh(v4, t2, 0);
+    three.run(10, 0.2 * three.rayleigh_time_step());
+    std::stringstream s;
+    three.write_state(s);
+    CHECK_THROWS_WITH(four.read_state(s), Catch::Contains("vertex count"));
+    CHECK(four.particles().position == bed().particles().position);  // unchanged
+    CHECK(four.time() == 0.0);
+  }
   std::stringstream s(bytes);
   CHECK_NOTHROW(sys.read_state(s));
 }

@@ -56,6 +56,10 @@ class ContactModel {
   /// Throws Error naming `what` if id is not a material id.
   void check_material(int id, const std::string& what) const;
   bool has_interaction(int a, int b) const;
+  /// The interaction of materials a and b (valid when has_interaction(a, b)).
+  const Interaction& interaction(int a, int b) const {
+    return interactions_[a * material_count() + b];
+  }
 
   /// Recomputes the pair table (restitution calibration) after changes; cheap when unchanged.
   void update();

@@ -158,6 +158,11 @@ class System {
   /// Rayleigh time step of the smallest particle: pi R sqrt(rho/G)/(0.1631 nu + 0.8766),
   /// minimised over particles. Throws Error when there are no particles.
   double rayleigh_time_step() const;
+  /// The fraction of rayleigh_time_step() at which the restitution of every interaction in use
+  /// (particles with particles, planes and meshes) is realised to 1 %
+  /// (RestitutionCalibration::time_step_fraction(), smallest over the interactions; 0.2 when
+  /// all are elastic). Throws Error when a pair in use has no interaction.
+  double time_step_fraction() const;
   /// One velocity-Verlet step. Throws Error if dt <= 0 or dt > rayleigh_time_step(), or if a
   /// material pair in use has no interaction.
   void step(double dt);

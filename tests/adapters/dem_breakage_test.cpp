@@ -1,0 +1,124 @@
+// The DEM adapter's breakage keys: validation (ranges, pattern names with "did you mean"),
+// monitors, the stable step that falls as fragments appear, a fixed step that has become too
+// coarse, and the grading CSV.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "partita/adapters/register_all.hpp"
+#include "partita/coupling/registries.hpp"
+
+using namespace partita;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string dem_yaml(const std::string& breakage) {
+  return "solver: dem\n"
+         "materials: {glass: {youngs_modulus: 200 MPa, poisson_ratio: 0.23, density: 400},\n"
+         "            steel: {youngs_modulus: 250 GPa, poisson_ratio: 0.3, density: 7850}}\n"
+         "interactions: [{pair: [glass, glass]}, {pair: [glass, steel], friction: 0.1}]\n"
+         "particles: {material: glass, generate: {box: {origin: [0, 0, 0], size: [0.01, 0.01, "
+         "0.01]},\n"
+         "            diameters: [2.5 mm, 2.0 mm], porosity: 0.55, seed: 3}}\n"
+         "walls: [{box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.02]}, open: [zmax], material: "
+         "steel}]\n"
+         "meshes: [{name: plate, rectangle: {origin: [0, 0, 0.0102], size: [0.01, 0.01], cells: "
+         "[4, 4]}, material: steel}]\n" +
+         breakage;
+}
+
+std::unique_ptr<Solver> make(const std::string& yaml, const fs::path& out) {
+  coupling::Registries r;
+  coupling::register_builtin(r);
+  adapters::register_all(r);
+  const auto& e = r.solvers.get("dem");
+  config::Node n = config::Node::load_string(yaml, "dem.yaml");
+  auto spec = std::make_shared<config::Spec>(*e.spec);
+  if (!spec->find("solver")) spec->string("solver", "name").required();
+  SolverContext ctx{"p", n.validated(spec), fs::path(PARTITA_SOURCE_DIR), out, 1};
+  return e.factory(ctx);
+}
+
+double monitor(const Solver& s, const std::string& name) {
+  for (const auto& m : s.monitors())
+    if (m.name == name) return m.value;
+  FAIL("no monitor " << name);
+  return 0.0;
+}
+
+}  // namespace
+
+TEST_CASE("dem adapter: breakage keys are validated", "[adapters][dem][breakage]") {
+  const fs::path out = fs::temp_directory_path() / "partita_dem_breakage_keys";
+  const std::string ok =
+      "breakage: {limit_strength: 1 MPa, reference_size: 2 mm, weibull_modulus: 3, "
+      "comminution_limit: 1 mm";
+  CHECK_NOTHROW(make(dem_yaml(ok + "}\n"), out));
+  for (const char* bad : {"weibull_modulus: 0", "weibull_modulus: -3"}) {
+    std::string y = ok + "}\n";
+    y.replace(y.find("weibull_modulus: 3"), 18, bad);
+    CHECK_THROWS_WITH(make(dem_yaml(y), out), Catch::Contains("weibull_modulus"));
+  }
+  for (const char* key : {"limit_strength", "reference_size", "comminution_limit"}) {
+    std::string y = ok + "}\n";
+    const auto at = y.find(key);
+    const auto end = y.find_first_of(",}", at);
+    y.replace(at, end - at, std::string(key) + ": -1");
+    INFO(y);
+    CHECK_THROWS_WITH(make(dem_yaml(y), out), Catch::Contains(key));
+  }
+  CHECK_THROWS_WITH(make(dem_yaml(ok + ", pattern: apolonian-14}\n"), out),
+                    Catch::Contains("apollonian-14"));
+  CHECK_THROWS_WITH(make(dem_yaml(ok + ", mass: kept}\n"), out), Catch::Contains("restored"));
+  // d_min above every particle: accepted (a warning says nothing can break)
+  std::string big = ok + "}\n";
+  big.replace(big.find("comminution_limit: 1 mm"), 23, "comminution_limit: 5 mm");
+  auto s = make(dem_yaml(big), out);
+  for (int k = 0; k < 200; ++k) s->advance(s->stable_time_step());
+  CHECK(monitor(*s, "breakage.events") == 0.0);
+}
+
+TEST_CASE("dem adapter: fragments lower the stable step; monitors and the grading follow",
+          "[adapters][dem][breakage]") {
+  const fs::path out = fs::temp_directory_path() / "partita_dem_breakage_run";
+  fs::create_directories(out / "vtk");
+  // weak granules: they break when the bed lands on the floor
+  auto s = make(dem_yaml("breakage: {limit_strength: 0.2 MPa, reference_size: 2 mm, "
+                       "weibull_modulus: 3, comminution_limit: 0.5 mm, pattern: equal-4}\n"),
+                out);
+  s->write_output(OutputFrame{out / "vtk", "p", 0, s->time()});
+  const double dt0 = s->stable_time_step();
+  const double n0 = monitor(*s, "particles");
+  int steps = 0;
+  while (monitor(*s, "breakage.events") == 0.0 && steps < 50000) {
+    s->advance(s->stable_time_step());
+    ++steps;
+  }
+  INFO(steps << " steps, " << monitor(*s, "breakage.events") << " events");
+  REQUIRE(monitor(*s, "breakage.events") > 0.0);
+  const double events = monitor(*s, "breakage.events");
+  CHECK(monitor(*s, "particles") == n0 + 3.0 * events);  // equal-4: one parent, four fragments
+  CHECK(monitor(*s, "breakage.mass_lost") > 0.0);
+  CHECK(monitor(*s, "breakage.fragments") == 4.0 * events);
+  // equal-4 fragments are 0.4495 of the parent's radius: the Rayleigh step falls alike
+  CHECK(s->stable_time_step() < 0.5 * dt0);
+  CHECK(monitor(*s, "stable_time_step") == s->stable_time_step());
+  // a step above the new stable one stops with the remedy
+  CHECK_THROWS_WITH(s->advance(dt0), Catch::Contains("substeps"));
+  s->write_output(OutputFrame{out / "vtk", "p", 1, s->time()});
+  std::ifstream csv(out / "p_grading.csv");
+  std::stringstream text;
+  text << csv.rdbuf();
+  const std::string t = text.str();
+  CHECK(t.rfind("time_s,diameter_m,passing\n", 0) == 0);
+  // both frames end with 1 passing the largest size
+  std::size_t ones = 0;
+  for (std::size_t at = t.find(",1\n"); at != std::string::npos; at = t.find(",1\n", at + 1))
+    ++ones;
+  CHECK(ones == 2);
+  fs::remove_all(out);
+}
