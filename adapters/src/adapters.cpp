@@ -21,6 +21,13 @@ void register_all(coupling::Registries& r) {
       {{"kinetic_energy", "J", "translational plus rotational kinetic energy of the particles"},
        {"particles", "", "number of particles"},
        {"mass", "kg", "total mass of the particles"},
+       {"breakage.events", "", "particles broken so far (with breakage on)"},
+       {"breakage.fragments", "", "fragments created so far"},
+       {"breakage.fragment_mass", "kg", "mass of the fragments created so far"},
+       {"breakage.mass_lost", "kg", "parent mass the inscribed fragments do not hold, lost"},
+       {"breakage.mass_restored", "kg", "the same, given back to the fragments (mass option)"},
+       {"breakage.energy_released", "J", "elastic contact energy released at breakage"},
+       {"stable_time_step", "s", "the DEM's stable step now (falls as fragments appear)"},
        {"contacts_per_particle", "", "mean number of particle-particle contacts"},
        {"<mesh>.force_x", "N", "total contact force of the particles on a mesh, x"},
        {"<mesh>.force_y", "N", "... y"},
@@ -47,7 +54,12 @@ void register_all(coupling::Registries& r) {
        {"static_reaction_z", "N", "... z"},
        {"max_displacement", "m", "largest nodal displacement magnitude"},
        {"kinetic_energy", "J", "1/2 v^T M v"},
-       {"strain_energy", "J", "1/2 u^T K u"}});
+       {"strain_energy", "J", "stored elastic energy (1/2 u^T K u when linear)"},
+       {"plastic_work", "J", "work dissipated by plastic flow"},
+       {"external_work", "J", "work of the applied and coupled loads"},
+       {"damping_work", "J", "work dissipated by Rayleigh damping"},
+       {"energy_balance", "J",
+        "external work - (strain + kinetic + plastic + damping): zero for an exact balance"}});
 #endif
 #ifdef PARTITA_HAVE_TUBE1D
   r.solvers.add("tube1d-fluid",
