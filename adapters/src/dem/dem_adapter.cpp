@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -345,6 +346,18 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
               ->info("dem '{}': generating about {:.3g} particles (this may take a while)", name_,
                      estimate);
       }
+      // progress of a long generation, every 5 s
+      auto clock = std::chrono::steady_clock::now();
+      ps.progress = [&, name = name_](int sweep, double overlap) {
+        const auto now = std::chrono::steady_clock::now();
+        if (now - clock < std::chrono::seconds(5)) return;
+        clock = now;
+        log::get("adapters")
+            ->info(
+                "dem '{}': generating the packing: sweep {}, largest overlap {:.3g} R_min "
+                "(target {:.3g})",
+                name, sweep, overlap, ps.max_overlap);
+      };
       dem::Packing packing;
       try {
         packing = dem::PackingGenerator::generate(ps);

@@ -133,6 +133,7 @@ Packing PackingGenerator::generate(const PackingSpec& spec) {
           }
       dx[i] = d;
     }
+    if (spec.progress) spec.progress(sweep, worst / r_min);
     if (worst <= bound) break;
     for (int i = 0; i < n; ++i) {
       x[i] += dx[i];

@@ -13,6 +13,7 @@
 // thread parts depend on it).
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -30,6 +31,9 @@ struct PackingSpec {
   std::uint64_t seed = 1;
   double max_overlap = 0.01;  ///< largest allowed overlap as a fraction of the smallest radius
   int max_sweeps = 20000;
+  /// Called after every relaxation sweep with the sweep number and the largest overlap as a
+  /// fraction of the smallest radius (progress of long generations); may be empty.
+  std::function<void(int sweep, double overlap)> progress;
 };
 
 struct Packing {
