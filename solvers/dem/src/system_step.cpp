@@ -2,6 +2,7 @@
 #include "partita/dem/system.hpp"
 
 #include "partita/dem/error.hpp"
+#include "partita/dem/mesh_contacts.hpp"
 #include "partita/dem/parallel.hpp"
 
 #include <algorithm>
@@ -14,11 +15,6 @@ namespace partita::dem {
 namespace {
 
 constexpr int block_size = ThreadPartition::block_size;
-
-std::int64_t feature_key(int mesh, int type, int index) {
-  return (static_cast<std::int64_t>(mesh) << 40) | (static_cast<std::int64_t>(type) << 36) |
-         static_cast<std::int64_t>(index);
-}
 
 }  // namespace
 
@@ -231,10 +227,10 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   const int parts = tp.parts();
   std::vector<Eigen::Vector3d>& plane_shear = store_.array<Eigen::Vector3d>(h_plane_shear_);
   double* load = Load ? load_.data() : nullptr;
-  const MeshHistory mesh_history{store_.array<int>(h_mesh_slot_count_).data(),
-                                 store_.array<std::int64_t>(h_mesh_slot_key_).data(),
-                                 store_.array<Eigen::Vector3d>(h_mesh_slot_shear_).data(),
-                                 store_.array<MeshContactRecord>(h_mesh_records_).data()};
+  const MeshContacts::History mesh_history{store_.array<int>(h_mesh_slot_count_).data(),
+                                           store_.array<std::int64_t>(h_mesh_slot_key_).data(),
+                                           store_.array<Eigen::Vector3d>(h_mesh_slot_shear_).data(),
+                                           store_.array<MeshContactRecord>(h_mesh_records_).data()};
   const int np = static_cast<int>(planes_.size());
   const bool have_meshes = !meshes_.empty();
   if (parts > 1) {  // the cross pairs, shared evenly among the threads
@@ -328,7 +324,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         }
         if (have_meshes) {  // own accumulators: f and t keep their registers
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
-          mesh_contacts<Load>(i, mesh_history, dt, update_history, fm, tm, load_i);
+          const MeshContacts::Particle q{qi.x, qi.r, qi.v, qi.m, qi.w, qi.material};
+          MeshContacts::evaluate<Load>(i, q, nl, meshes_, model_, mesh_history, dt, update_history,
+                                       fm, tm, load_i);
           f += fm;
           t += tm;
         }
@@ -348,213 +346,15 @@ void System::reduce_wall_and_mesh_forces() {
   const int n = static_cast<int>(store_.size());
   const int np = static_cast<int>(planes_.size());
   const int blocks = (n + block_size - 1) / block_size;
-  const bool have_meshes = !meshes_.empty();
   // Wall totals (fixed order: blocks, then planes).
   for (Eigen::Vector3d& w : wall_force_) w.setZero();
   for (int b = 0; b < blocks; ++b)
     for (int k = 0; k < np; ++k)
       wall_force_[planes_[k].wall] += wall_block_force_[static_cast<std::size_t>(b) * np + k];
-  // Mesh forces: particles in order, each contact's reaction on its triangle, shared among the
-  // triangle's vertices with the barycentric weights of the contact point.
-  if (!have_meshes) return;
-  for (TriangleMesh& m : meshes_) {
-    m.triangle_force_.setZero();
-    m.vertex_force_.setZero();
-  }
-  const std::vector<int>& slot_count = store_.array<int>(h_mesh_slot_count_);
-  const std::vector<MeshContactRecord>& records = store_.array<MeshContactRecord>(h_mesh_records_);
-  for (int i = 0; i < n; ++i) {
-    for (int c = 0; c < slot_count[i]; ++c) {
-      const MeshContactRecord& rec = records[static_cast<std::size_t>(i) * max_mesh_contacts + c];
-      TriangleMesh& m = meshes_[rec.mesh];
-      m.triangle_force_.row(rec.triangle) -= rec.force.transpose();
-      const auto& tri = m.triangle(rec.triangle);
-      for (int k = 0; k < 3; ++k)
-        m.vertex_force_.row(tri[k]) -= rec.barycentric[k] * rec.force.transpose();
-    }
-  }
-}
-
-// Contacts of particle i with the meshes, each counted once:
-//  - candidates: triangles whose closest point is within R (face, edge or vertex feature) and
-//    is a local closest point of the mesh surface (an edge or vertex only where no triangle
-//    sharing it comes nearer: on a fine flat mesh only the face under the centre touches);
-//  - accepted in the order faces, edges, vertices (then by distance): a face always; an edge
-//    only if no accepted face has it as an edge; a vertex only if no accepted face or edge has
-//    it; and any contact only if its normal differs from all accepted ones (a sphere cannot
-//    touch two surfaces with the same normal: coplanar neighbours sharing the point).
-template <bool Load>
-void System::mesh_contacts(int i, const MeshHistory& h, double dt, bool update_history,
-                           Eigen::Vector3d& f, Eigen::Vector3d& t, double& load) {
-  struct Candidate {
-    int mesh, triangle, type, feature;
-    TriangleClosestPoint cp;
-    double dist2;
-    Eigen::Vector3d normal;
-  };
-  // Order of preference: faces, edges, vertices, then by distance (the order of acceptance).
-  const auto before = [](const Candidate& a, const Candidate& b) {
-    if (a.type != b.type) return a.type < b.type;
-    if (a.dist2 != b.dist2) return a.dist2 < b.dist2;
-    if (a.mesh != b.mesh) return a.mesh < b.mesh;
-    return a.triangle < b.triangle;
-  };
-  // At most max_candidates touching triangles are kept: when more touch (a fine mesh under a
-  // large sphere), the least preferred one gives way, so the faces and the nearest features
-  // always take part.
-  constexpr int max_candidates = 32;
-  Candidate cand[max_candidates + 1];
-  int nc = 0;
-  int worst = -1;  // index of the least preferred kept candidate once the array is full
-  const PackedParticle& q = packed_[i];
-  const NeighborList& nl = neighbors_;
-  const Eigen::Vector3d& x = q.x;
-  const double r = q.r;
-  for (int k = nl.mesh_offsets_[i]; k < nl.mesh_offsets_[i + 1]; ++k) {
-    const MeshCandidate mc = nl.mesh_candidates_[k];
-    const TriangleMesh& m = meshes_[mc.mesh];
-    Candidate& c = cand[nc];  // cand[max_candidates] is scratch once the array is full
-    c.cp = m.closest_point(mc.triangle, x);
-    c.dist2 = (x - c.cp.point).squaredNorm();
-    if (c.dist2 >= r * r || !m.feature_is_local_closest(mc.triangle, c.cp, x)) continue;
-    c.mesh = mc.mesh;
-    c.triangle = mc.triangle;
-    c.type = c.cp.feature;
-    c.feature = c.type == TriangleClosestPoint::face ? mc.triangle
-                : c.type == TriangleClosestPoint::edge
-                    ? m.triangle_edges(mc.triangle)[c.cp.local_index]
-                    : m.triangle(mc.triangle)[c.cp.local_index];
-    const double dist = std::sqrt(c.dist2);
-    if (dist > 1e-12 * r) {
-      c.normal = (x - c.cp.point) / dist;
-    } else {
-      const auto& tri = m.triangle(mc.triangle);
-      c.normal = (m.position_[tri[1]] - m.position_[tri[0]])
-                     .cross(m.position_[tri[2]] - m.position_[tri[0]])
-                     .normalized();
-    }
-    if (nc < max_candidates) {
-      ++nc;
-      continue;
-    }
-    if (worst < 0) {
-      worst = 0;
-      for (int w = 1; w < max_candidates; ++w)
-        if (before(cand[worst], cand[w])) worst = w;
-    }
-    if (before(c, cand[worst])) {
-      cand[worst] = c;
-      worst = 0;
-      for (int w = 1; w < max_candidates; ++w)
-        if (before(cand[worst], cand[w])) worst = w;
-    }
-  }
-  std::sort(cand, cand + nc, before);
-  int accepted[max_mesh_contacts];
-  int na = 0;
-  constexpr double same_normal = 1.0 - 5.0e-5;  // about 0.6 degrees
-  for (int c = 0; c < nc; ++c) {
-    const Candidate& k = cand[c];
-    bool keep = true;
-    for (int a = 0; a < na && keep; ++a) {
-      const Candidate& acc = cand[accepted[a]];
-      if (acc.normal.dot(k.normal) > same_normal) keep = false;
-      if (acc.mesh != k.mesh) continue;
-      if (acc.type == k.type && acc.feature == k.feature) keep = false;
-      const TriangleMesh& m = meshes_[k.mesh];
-      if (k.type == TriangleClosestPoint::edge && acc.type == TriangleClosestPoint::face) {
-        for (int e : m.triangle_edges(acc.triangle)) keep = keep && e != k.feature;
-      } else if (k.type == TriangleClosestPoint::vertex) {
-        if (acc.type == TriangleClosestPoint::face)
-          for (int v : m.triangle(acc.triangle)) keep = keep && v != k.feature;
-        else if (acc.type == TriangleClosestPoint::edge)
-          for (int v : m.edge(acc.feature)) keep = keep && v != k.feature;
-      }
-    }
-    if (keep && na < max_mesh_contacts) accepted[na++] = c;
-  }
-  // Histories: the previous step's slots of particle i, matched by feature key.
-  int* const slot_count = h.count;
-  std::int64_t* const slot_key = h.key;
-  Eigen::Vector3d* const slot_shear = h.shear;
-  MeshContactRecord* const records = h.records;
-  const std::size_t base = static_cast<std::size_t>(i) * max_mesh_contacts;
-  std::int64_t old_key[max_mesh_contacts];
-  Eigen::Vector3d old_shear[max_mesh_contacts];
-  const int n_old = slot_count[i];
-  for (int s = 0; s < n_old; ++s) {
-    old_key[s] = slot_key[base + s];
-    old_shear[s] = slot_shear[base + s];
-  }
-  // A contact keeps its history when its feature stays (same key) and also when it passes to
-  // a neighbouring feature of the same mesh, rolling or sliding across triangle boundaries: an
-  // unmatched old contact whose point (the same material point of the wall, at the current
-  // vertex positions) lies within the new contact radius sqrt(R delta) hands its history on.
-  int from_old[max_mesh_contacts];
-  bool old_taken[max_mesh_contacts] = {};
-  for (int a = 0; a < na; ++a) {
-    const Candidate& k = cand[accepted[a]];
-    from_old[a] = -1;
-    const std::int64_t key = feature_key(k.mesh, k.type, k.feature);
-    for (int s = 0; s < n_old; ++s)
-      if (old_key[s] == key) from_old[a] = s, old_taken[s] = true;
-  }
-  for (int a = 0; a < na; ++a) {
-    if (from_old[a] >= 0) continue;
-    const Candidate& k = cand[accepted[a]];
-    const TriangleMesh& m = meshes_[k.mesh];
-    double best = r * (r - std::sqrt(k.dist2));  // (contact radius)^2
-    for (int s = 0; s < n_old; ++s) {
-      const MeshContactRecord& rec = records[base + s];
-      if (old_taken[s] || rec.mesh != k.mesh) continue;
-      const auto& tri = m.triangle(rec.triangle);
-      const Eigen::Vector3d p = rec.barycentric[0] * m.position_[tri[0]] +
-                                rec.barycentric[1] * m.position_[tri[1]] +
-                                rec.barycentric[2] * m.position_[tri[2]];
-      const double d2 = (p - k.cp.point).squaredNorm();
-      if (d2 < best) best = d2, from_old[a] = s;
-    }
-    if (from_old[a] >= 0) old_taken[from_old[a]] = true;
-  }
-  for (int a = 0; a < na; ++a) {
-    const Candidate& k = cand[accepted[a]];
-    const TriangleMesh& m = meshes_[k.mesh];
-    const std::int64_t key = feature_key(k.mesh, k.type, k.feature);
-    Eigen::Vector3d shear =
-        from_old[a] >= 0 ? old_shear[from_old[a]] : Eigen::Vector3d::Zero().eval();
-    const auto& tri = m.triangle(k.triangle);
-    // wall velocity at the contact point: barycentric interpolation of the vertex velocities
-    const Eigen::Vector3d v_wall = k.cp.barycentric[0] * m.velocity_[tri[0]] +
-                                   k.cp.barycentric[1] * m.velocity_[tri[1]] +
-                                   k.cp.barycentric[2] * m.velocity_[tri[2]];
-    const double delta = r - std::sqrt(k.dist2);
-    const double cr = r - 0.5 * delta;
-    const PairParameters& pp = model_.pair(q.material, m.material());
-    Eigen::Vector3d fw, ft;
-    const double fn = hertz_mindlin(pp, delta, r, q.m, k.normal, q.v - v_wall, cr * q.w, shear, dt,
-                                    update_history, fw, ft);
-    f += fw;
-    t -= cr * k.normal.cross(ft);
-    if (pp.rolling_friction > 0.0) {
-      const double wn = q.w.norm();
-      if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * r / wn) * q.w;
-    }
-    if constexpr (Load) {  // mesh: R* = R
-      const double kw = pp.e_star / r;
-      load = std::max(load, fn * kw * kw);
-    }
-    slot_key[base + a] = key;
-    slot_shear[base + a] = shear;
-    MeshContactRecord& rec = records[base + a];
-    rec.mesh = k.mesh;
-    rec.triangle = k.triangle;
-    rec.barycentric = k.cp.barycentric;
-    rec.force = fw;
-    rec.delta = delta;
-    rec.r_eff = r;
-    rec.material = m.material();
-  }
-  slot_count[i] = na;
+  // Mesh forces: particles in order (MeshContacts::reduce).
+  if (meshes_.empty()) return;
+  MeshContacts::reduce(n, store_.array<int>(h_mesh_slot_count_).data(),
+                       store_.array<MeshContactRecord>(h_mesh_records_).data(), meshes_);
 }
 
 }  // namespace partita::dem

@@ -70,6 +70,7 @@ class NeighborList {
  private:
   friend class System;
   friend class ThreadPartition;
+  friend class MeshContacts;
 
   struct Grid {
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();

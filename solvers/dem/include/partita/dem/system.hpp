@@ -33,6 +33,7 @@
 #include "partita/dem/interaction.hpp"
 #include "partita/dem/material.hpp"
 #include "partita/dem/mesh_contact_record.hpp"
+#include "partita/dem/mesh_contacts.hpp"
 #include "partita/dem/neighbor_list.hpp"
 #include "partita/dem/particle_store.hpp"
 #include "partita/dem/particles.hpp"
@@ -58,7 +59,7 @@ class System {
  public:
   /// Contacts one particle keeps with mesh features (faces, edges, vertices) at a time; further
   /// ones (only in extreme geometries) are ignored.
-  static constexpr int max_mesh_contacts = 8;
+  static constexpr int max_mesh_contacts = MeshContacts::max_contacts;
 
   System();
 
@@ -243,15 +244,6 @@ class System {
   template <bool Load>
   void evaluate_forces_impl(double dt, bool update_history, double kick);
   void reduce_wall_and_mesh_forces();
-  struct MeshHistory {  // the mesh-contact arrays of the store, fetched once per force pass
-    int* count;
-    std::int64_t* key;
-    Eigen::Vector3d* shear;
-    MeshContactRecord* records;
-  };
-  template <bool Load>
-  void mesh_contacts(int i, const MeshHistory& history, double dt, bool update_history,
-                     Eigen::Vector3d& force, Eigen::Vector3d& torque, double& load);
   void write_body(BinaryWriter& out) const;
   void read_body(BinaryReader& in);
 

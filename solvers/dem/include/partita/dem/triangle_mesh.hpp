@@ -67,6 +67,7 @@ class TriangleMesh {
  private:
   friend class System;
   friend class NeighborList;
+  friend class MeshContacts;
 
   std::vector<Eigen::Vector3d> position_;
   std::vector<Eigen::Vector3d> velocity_;
