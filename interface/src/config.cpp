@@ -470,8 +470,10 @@ class DocumentCheck {
   void check_quotes(const YAML::Node& n, const std::string& path) {
     if (!text_ || n.Tag() != "!") return;  // "!": a quoted (non-plain) scalar
     const YAML::Mark m = n.Mark();
-    if (m.pos < 0 || static_cast<std::size_t>(m.pos) >= text_->size()) return;
-    const auto at = static_cast<std::size_t>(m.pos);
+    // yaml-cpp counts positions in bytes after a UTF-8 byte order mark, if any
+    const std::size_t bom = text_->rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+    if (m.pos < 0 || static_cast<std::size_t>(m.pos) + bom >= text_->size()) return;
+    const auto at = static_cast<std::size_t>(m.pos) + bom;
     const char q = (*text_)[at];
     if (q != '"' && q != '\'') return;
     if (!checked_.insert(at).second) return;  // an alias repeats a scalar: scan its text once

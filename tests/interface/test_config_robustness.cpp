@@ -89,6 +89,13 @@ TEST_CASE("config: an unterminated quoted string is reported where it starts",
   CHECK(message_of("case: \"a \\\" b\"\ncount: 2\n").empty());
   CHECK(message_of("case: 'it''s'\ncount: 2\n").empty());
   CHECK(message_of("case: \"two\n  lines\"\ncount: 2\n").empty());
+  // after a byte order mark and multi-byte characters
+  CHECK_THAT(message_of("\xEF\xBB\xBF"
+                        "case: \"\xC2\xB5\ncount: 2\n"),
+             Catch::Contains("unterminated quoted string"));
+  CHECK(message_of("\xEF\xBB\xBF"
+                   "count: 1\ncase: \"\xC2\xB5\"\n")
+            .empty());
 }
 
 TEST_CASE("config: aliases cannot make the document endless", "[interface][config]") {
