@@ -107,7 +107,7 @@ case "$cmd" in
     status=0
     for h in stl gmsh case; do
       echo "build.sh fuzz: fuzz_$h for $seconds s"
-      ./build-fuzz/tests/fuzz/fuzz_$h -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
+      ./build-fuzz/tests/fuzz/fuzz_$h -seed="${FUZZ_SEED:-1}" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
         -max_len=65536 -print_final_stats=1 -artifact_prefix="build-fuzz/findings/$h-" \
         -dict="tests/fuzz/$h.dict" "build-fuzz/corpus/$h" 2>build-fuzz/fuzz_$h.log || status=1
       grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|Done|==[0-9]+==ERROR|SUMMARY)' \

@@ -191,7 +191,8 @@ int main(int argc, char** argv) {
                   "Continue the run whose output folder this is from its newest restart file "
                   "(DIR/restart/w<window>.bin), bit for bit; time.end may be raised with --set");
   run->add_option("--set", overrides,
-                  "Change a value of the case: KEY.PATH=VALUE (e.g. time.end=0.01, "
+                  "Change a value of the case: KEY.PATH=VALUE with map keys joined by dots and "
+                  "list elements as key[i] (e.g. time.end=0.01, "
                   "participants.plate.loads[0].pressure='20 kPa'); repeatable")
       ->take_all();
   auto* check = app.add_subcommand(
@@ -201,7 +202,8 @@ int main(int argc, char** argv) {
   check->add_option("--log-level", log_level, "Log level");
   check
       ->add_option("--set", overrides,
-                   "Change a value of the case before checking it: KEY.PATH=VALUE")
+                   "Change a value of the case before checking it: KEY.PATH=VALUE (list elements "
+                   "as key[i])")
       ->take_all();
   app.add_subcommand(
       "list", "List every registered solver, mapper, scheme, acceleration and convergence measure");

@@ -20,7 +20,8 @@ std::shared_ptr<const config::Spec> scheme_spec(const std::string& name, const s
   if (implicit) {
     s->list("convergence", "convergence measures (all must hold)", nullptr).required();
     s->any("acceleration",
-           "acceleration of the fixed-point iteration (a name or {type: ..., options})");
+           "acceleration of the fixed-point iteration: a name, or {type: name, <its own keys>} "
+           "(partita docs NAME lists them)");
     s->integer("max_iterations", "most iterations per window").min(1).def(100);
     s->choice("on_max_iterations", "what happens at max_iterations", {"error", "accept"})
         .def("accept");
