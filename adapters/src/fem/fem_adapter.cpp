@@ -159,7 +159,7 @@ std::shared_ptr<Spec> make_spec() {
   analysis
       ->real("stable_step_factor",
              "central-difference: the step offered to the coupling is this times the element "
-             "estimate l_e / c_d")
+             "estimate (the element eigenvalue bound)")
       .range(0.0, 1.0)
       .def(0.9);
   auto nonlinear = std::make_shared<Spec>(
