@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Overlay one monitor column of every variant of a partita sweep in one PNG.
 
-Usage: plot_sweep.py OUT.png COLUMN LABEL FILE.csv [LABEL FILE.csv ...]
+Usage: plot_sweep.py [--x XCOLUMN] [--x-scale F] [--y-scale F] OUT.png COLUMN LABEL FILE.csv [...]
 COLUMN is the column's name without its unit ("granules.plate.force_z"); each FILE.csv is the
 variant's monitor CSV (first column: time). Variants whose file or column is missing are left
 out. The PNG is written under a temporary name and renamed.
@@ -16,6 +16,16 @@ def main(argv):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    x_column, x_scale, y_scale = "", 1.0, 1.0
+    while len(argv) > 1 and argv[1].startswith("--"):
+        key, value = argv[1], argv[2]
+        if key == "--x":
+            x_column = value
+        elif key == "--x-scale":
+            x_scale = float(value)
+        elif key == "--y-scale":
+            y_scale = float(value)
+        argv = argv[:1] + argv[3:]
     out, column = argv[1], argv[2]
     fig, ax = plt.subplots(figsize=(7, 4.2), dpi=120)
     xlabel, ylabel, drawn = "time [s]", column, 0
@@ -32,9 +42,15 @@ def main(argv):
         if column not in names:
             continue
         c = names.index(column)
-        xlabel, ylabel = header[0], header[c]
+        xc = names.index(x_column) if x_column in names else 0
+        xlabel, ylabel = header[xc], header[c]
+        if x_scale != 1.0:
+            xlabel += " x %g" % x_scale
+        if y_scale != 1.0:
+            ylabel += " x %g" % y_scale
         data = [r for r in rows[1:] if len(r) == len(header)]
-        ax.plot([float(r[0]) for r in data], [float(r[c]) for r in data], lw=1.3, label=label)
+        ax.plot([x_scale * float(r[xc]) for r in data], [y_scale * float(r[c]) for r in data],
+                lw=1.3, label=label)
         drawn += 1
     if drawn == 0:
         return 1

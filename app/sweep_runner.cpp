@@ -126,8 +126,16 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
     fs::path script = PARTITA_SWEEP_PLOT_SCRIPT;
     if (!fs::exists(script))
       script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_sweep.py";
-    std::vector<std::string> args = {python_interpreter(), script.string(),
-                                     (dir / "sweep.png").string(), sweep.plot_column()};
+    std::vector<std::string> args = {python_interpreter(),
+                                     script.string(),
+                                     "--x",
+                                     sweep.plot_x(),
+                                     "--x-scale",
+                                     fmt::format("{}", sweep.plot_x_scale()),
+                                     "--y-scale",
+                                     fmt::format("{}", sweep.plot_y_scale()),
+                                     (dir / "sweep.png").string(),
+                                     sweep.plot_column()};
     for (std::size_t k = 0; k < variants.size(); ++k)
       if (status[k] == "ok") {
         args.push_back(variants[k].folder);

@@ -1,5 +1,7 @@
 #include "partita/coupling/participant.hpp"
 
+#include <fmt/format.h>
+
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/coupling/time_window.hpp"
 #include "partita/interface/error.hpp"
@@ -21,8 +23,17 @@ const InterfaceMesh* Participant::find_mesh(std::string_view mesh) const {
 }
 
 int Participant::substeps(double window_size) const {
-  if (!substeps_.automatic) return substeps_.count;
   const double stable = solver_->stable_time_step();
+  if (!substeps_.automatic) {
+    // The stable step may fall during a run (a DEM whose granules break into smaller ones).
+    if (window_size / substeps_.count > stable * (1.0 + 1e-12))
+      throw Error(fmt::format(
+          "participant '{}': its stable time step has fallen to {:.4g} s, below the {:.4g} s of "
+          "coupling.substeps.{} = {}; use substeps: {{{}: {}}} or more, or {{{}: auto}}",
+          name_, stable, window_size / substeps_.count, name_, substeps_.count, name_,
+          TimeWindow::substeps_for(window_size, stable), name_));
+    return substeps_.count;
+  }
   if (!(stable > 0.0))
     throw Error("participant '" + name_ + "': stable_time_step() returned " +
                 std::to_string(stable) +

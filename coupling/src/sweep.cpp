@@ -29,6 +29,10 @@ std::shared_ptr<const config::Spec> Sweep::spec() {
   auto plot = std::make_shared<Spec>("plot", "sweep.png: one monitor column of every variant");
   plot->string("monitor", "a declared monitor").required();
   plot->string("column", "participant.quantity of that monitor").required();
+  plot->string("x", "participant.quantity of that monitor on the x axis (default: time)");
+  plot->real("x_scale", "factor on the x values (e.g. -1000: a downward displacement in mm)")
+      .def(1.0);
+  plot->real("y_scale", "factor on the y values").def(1.0);
   auto s = std::make_shared<Spec>(
       "sweep",
       "run the case once per combination of values, each into DIR/<label>=<value>/ (partita run "
@@ -157,6 +161,17 @@ Sweep::Sweep(const config::Node& root) {
     check_column(sw["plot"]);
     plot_monitor_ = sw["plot"].string("monitor");
     plot_column_ = sw["plot"].string("column");
+    if (sw["plot"].has("x")) {
+      const std::string x = sw["plot"].string("x");
+      const auto it = std::find(monitors.begin(), monitors.end(), plot_monitor_);
+      const auto& cols = columns[static_cast<std::size_t>(it - monitors.begin())];
+      if (std::find(cols.begin(), cols.end(), x) == cols.end())
+        sw["plot"]["x"].fail("monitor '" + plot_monitor_ + "' has no column '" + x + "'; it has " +
+                             join_names(cols) + did_you_mean(x, cols));
+      plot_x_ = x;
+    }
+    plot_x_scale_ = sw["plot"].real("x_scale");
+    plot_y_scale_ = sw["plot"].real("y_scale");
   }
 
   // full factorial, the first parameter slowest

@@ -58,6 +58,10 @@ class Sweep {
   /// The monitor and column overlaid in sweep.png ("" when no plot is declared).
   const std::string& plot_monitor() const { return plot_monitor_; }
   const std::string& plot_column() const { return plot_column_; }
+  /// The x column of the plot ("": the monitor's time) and the scale factors of x and y.
+  const std::string& plot_x() const { return plot_x_; }
+  double plot_x_scale() const { return plot_x_scale_; }
+  double plot_y_scale() const { return plot_y_scale_; }
 
   /// A result of one finished variant, read from its monitor CSV in `variant_dir`; NaN when the
   /// file or column is missing or has no rows.
@@ -71,7 +75,8 @@ class Sweep {
   std::vector<Parameter> parameters_;
   std::vector<Result> results_;
   std::vector<Variant> variants_;
-  std::string plot_monitor_, plot_column_;
+  std::string plot_monitor_, plot_column_, plot_x_;
+  double plot_x_scale_ = 1.0, plot_y_scale_ = 1.0;
 };
 
 }  // namespace partita::coupling
