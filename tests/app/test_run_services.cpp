@@ -280,3 +280,21 @@ TEST_CASE("a diverging run stops with a diagnosis, non-zero, with finite numbers
   }
   fs::remove_all(dir);
 }
+
+TEST_CASE("a fixed substep count that breakage makes too coarse stops naming the key",
+          "[app][divergence]") {
+  // The confined compression with crushing: 6 DEM substeps per window are stable for the
+  // initial granules (time step 1.9e-6 s, window 1e-5 s); the fragments of the first breakage
+  // (at about 21.5 ms) need smaller steps, and the run must stop before the next window.
+  const fs::path dir = scratch("substeps");
+  const auto r = partita_run(
+      "run " + quote((kSource / "cases/confined_compression/confined_compression.yaml").string()) +
+      " --no-sweep --set time.end=0.03 --set coupling.substeps.granules=6 --output " +
+      quote(dir.string()));
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK_FALSE(r.signalled);
+  CHECK(r.output.find("coupling.substeps.granules = 6") != std::string::npos);
+  CHECK(r.output.find("or {granules: auto}") != std::string::npos);
+  fs::remove_all(dir);
+}
