@@ -7,7 +7,7 @@ namespace partita::fem {
 // Finite-strain J2 plasticity: multiplicative split F = F_e F_p, Hencky (logarithmic) elastic
 // strains, exponential-map return in principal space (Eterovic & Bathe, IJNME 30 (1990)
 // 1099-1114; Simo, CMAME 99 (1992) 61-112; de Souza Neto, Peric & Owen, Computational Methods
-// for Plasticity, 2008, Box 14.3):
+// for Plasticity, 2008, chapter 14):
 //   b_e_tr = F C_p_n^-1 F^T = sum lambda_a^2 n_a n_a,  eps_tr = ln(lambda_a) (principal),
 //   the small-strain radial return (J2PlasticityLaw, same hardening) on eps_tr gives the
 //   principal Kirchhoff stresses tau_a and eps_e; b_e = sum exp(2 eps_e,a) n_a n_a,

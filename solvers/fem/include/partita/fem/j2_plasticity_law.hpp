@@ -6,7 +6,7 @@ namespace partita::fem {
 
 // Small-strain J2 (von Mises) plasticity with isotropic hardening, associative flow, backward
 // Euler radial return and the consistent (algorithmic) tangent (Simo & Hughes, Computational
-// Inelasticity, 1998, Box 3.2 and eq. 3.3.13):
+// Inelasticity, 1998, chapter 3: the radial return of Box 3.1 and its consistent tangent):
 //   eps = sym(F - I), s_tr = 2 G dev(eps - eps_p_n), f = |s_tr| - sqrt(2/3) sigma_y(alpha_n)
 //   f <= 0: elastic;  else solve |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg) = 0,
 //   n = s_tr / |s_tr|, s = s_tr - 2 G dg n, eps_p += dg n, alpha += sqrt(2/3) dg,
