@@ -543,7 +543,15 @@ void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
 }
 
 double DemAdapter::stable_time_step() const {
-  return time_step_fraction_ * system_.rayleigh_time_step();
+  // dt_R is a minimum over the particles (O(N) square roots): recomputed only when the particle
+  // set changed (breakage adds fragments), not at every step that asks for it.
+  // (Restoring a checkpoint or a restart file resets stable_for_count_.)
+  if (system_.particle_count() != stable_for_count_ || time_step_fraction_ != stable_fraction_) {
+    stable_ = time_step_fraction_ * system_.rayleigh_time_step();
+    stable_for_count_ = system_.particle_count();
+    stable_fraction_ = time_step_fraction_;
+  }
+  return stable_;
 }
 
 void DemAdapter::advance(double dt) {
@@ -577,6 +585,7 @@ void DemAdapter::restore_checkpoint() {
   if (!has_checkpoint_)
     throw Error("dem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   system_.restore_state(checkpoint_);
+  stable_for_count_ = kNoCount;
 }
 
 void DemAdapter::write_output(const OutputFrame& frame) {
@@ -618,6 +627,7 @@ void DemAdapter::read_restart(BinaryReader& in) {
   std::istringstream state(in.bytes());
   try {
     system_.read_state(state);
+    stable_for_count_ = kNoCount;
   } catch (const dem::Error& e) {
     throw Error(in.source() + ": the DEM state of '" + name_ + "': " + e.what());
   }

@@ -90,6 +90,11 @@ class DemAdapter : public Solver {
   Eigen::Vector3d domain_lo_ = Eigen::Vector3d::Constant(1e300);
   Eigen::Vector3d domain_hi_ = Eigen::Vector3d::Constant(-1e300);
   double lost_margin_ = 0.0;
+  // stable_time_step() cached for the particle count it was computed for
+  static constexpr std::size_t kNoCount = static_cast<std::size_t>(-1);
+  mutable double stable_ = 0.0;
+  mutable std::size_t stable_for_count_ = kNoCount;
+  mutable double stable_fraction_ = -1.0;
   bool lost_margin_given_ = false;
   // meshes taken from other participants (meshes: [{from: participant.mesh}]), with materials
   std::vector<MeshRequest> requests_;
