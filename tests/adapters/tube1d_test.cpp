@@ -56,7 +56,7 @@ std::unique_ptr<Solver> make(const coupling::Registries& r, const std::string& s
 
 }  // namespace
 
-TEST_CASE("Tube adapters follow the Solver contract; checkpoint/restore is bit-identical",
+TEST_CASE("Tube adapters follow the Solver contract, checkpoint/restore is bit-identical",
           "[adapters][tube1d]") {
   const auto r = registries();
   for (const char* name : {"tube1d-fluid", "tube1d-solid"}) {

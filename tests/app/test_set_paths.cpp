@@ -8,7 +8,7 @@
 
 using partita::test::quote;
 
-TEST_CASE("cli: --set on a list element is key[i]; key.i points to key[i]", "[app][cli]") {
+TEST_CASE("cli: --set on a list element is key[i], key.i points to key[i]", "[app][cli]") {
   const std::string exe = quote(PARTITA_EXECUTABLE);
   const std::string c =
       quote(std::string(PARTITA_SOURCE_DIR) + "/cases/uniaxial_compaction/steel.yaml");

@@ -52,7 +52,7 @@ std::vector<std::string> csv_lines(const fs::path& p) {
 
 }  // namespace
 
-TEST_CASE("sweep: variants differ only in the swept value; the summary has one row each",
+TEST_CASE("sweep: variants differ only in the swept value, the summary has one row each",
           "[app][sweep]") {
   const fs::path dir = scratch("plain");
   const auto r = run("--jobs 2 --output " + quote(dir.string()));

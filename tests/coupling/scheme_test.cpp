@@ -181,7 +181,7 @@ TEST_CASE("Subcycling: linear interpolation reproduces a linear-in-time input at
 }
 
 TEST_CASE(
-    "Subcycling: averaging a constant output returns it exactly; last returns the last substep",
+    "Subcycling: averaging a constant output returns it exactly, last returns the last substep",
     "[coupling][scheme][subcycling]") {
   for (int m : {3, 7, 1000}) {
     Setup s(m, ReaderSees::linear, WriterCombines::average);

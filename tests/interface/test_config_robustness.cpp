@@ -115,7 +115,7 @@ TEST_CASE("config: an integer out of range says so", "[interface][config]") {
              Catch::Contains("key 'count'") && Catch::Contains("is out of range"));
 }
 
-TEST_CASE("config: --set reaches list elements as key[i]; key.i points there",
+TEST_CASE("config: --set reaches list elements as key[i], key.i points there",
           "[interface][config]") {
   const std::string yaml = "case: c\nloads: [{p: 1}, {p: 2}]\n";
   CHECK(set_message(yaml, "loads[1].p=3").empty());

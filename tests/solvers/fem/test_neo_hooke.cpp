@@ -120,7 +120,7 @@ TEST_CASE("neo-hooke rejects nu >= 0.5 and other bad input", "[fem][nonlinear][n
   CHECK_THROWS_WITH(law.evaluate(f, {}, {}, r), Catch::Contains("det F"));
 }
 
-TEST_CASE("decoupled neo-hooke: tangent equals finite differences; simple shear closed form",
+TEST_CASE("decoupled neo-hooke: tangent equals finite differences, simple shear closed form",
           "[fem][nonlinear][neo-hooke]") {
   Model m = test::distorted_box(ElementType::Hex20, 0.5,
                                 std::make_shared<DecoupledNeoHookeLaw>(kE, kNu, kRho), 7);

@@ -9,7 +9,7 @@
 using namespace partita::tube1d;
 
 TEST_CASE(
-    "Tube law: a(p) and p(a) are inverse; dp/da at a0 gives the wave speed c^2 = E / (2 rho r0)",
+    "Tube law: a(p) and p(a) are inverse, dp/da at a0 gives the wave speed c^2 = E / (2 rho r0)",
     "[tube1d]") {
   TubeParameters prm;
   prm.density = 1.3;
