@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kMagic = "partita restart file";
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: the energy audit
 constexpr std::uint32_t kByteOrder = 0x01020304u;
 
 // DIR/restart/w000000001234.bin -> 1234; -1 for other names.
@@ -101,6 +101,14 @@ void CaseRun::write_restart_file(const Progress& progress) {
     out.write(static_cast<std::int64_t>(summary_.unconverged_windows));
     out.write(summary_.max_window_iterations);
     out.write(static_cast<std::int64_t>(summary_.imbalance_warnings));
+    out.section("energy audit");
+    out.write(static_cast<std::int64_t>(summary_.energy_warnings));
+    for (const auto& p : energy_pairs_) {
+      out.write(p.last_a);
+      out.write(p.last_b);
+      out.write(p.passed);
+      out.write(p.over);
+    }
     out.section("csv");
     out.write(coupling_csv_.text());
     out.write(static_cast<std::uint64_t>(monitors_.size()));
@@ -176,6 +184,14 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
   summary_.unconverged_windows = static_cast<long>(in.get<std::int64_t>());
   in.read(summary_.max_window_iterations);
   summary_.imbalance_warnings = static_cast<long>(in.get<std::int64_t>());
+  in.expect_section("energy audit");
+  summary_.energy_warnings = static_cast<long>(in.get<std::int64_t>());
+  for (auto& p : energy_pairs_) {
+    in.read(p.last_a);
+    in.read(p.last_b);
+    in.read(p.passed);
+    in.read(p.over);
+  }
   summary_.windows = progress.windows_done;
   in.expect_section("csv");
   coupling_csv_.restore_text(in.get_string());
@@ -242,6 +258,13 @@ std::vector<double> CaseRun::audit_balance() {
     out.push_back(scale > 0.0 ? (tr - ts).norm() / scale : 0.0);
   }
   return out;
+}
+
+CaseRun::EnergyAudit CaseRun::audit_energy(const EnergyPair& pair) const {
+  EnergyAudit a;
+  for (const auto& m : pair.a_meshes) a.on_a += pair.a->solver().interface_work(m).value_or(0.0);
+  for (const auto& m : pair.b_meshes) a.on_b += pair.b->solver().interface_work(m).value_or(0.0);
+  return a;
 }
 
 }  // namespace partita::coupling

@@ -8,8 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "partita/adapters/register_all.hpp"
-#include "partita/coupling/registries.hpp"
+#include "../support/adapter_solver.hpp"
 
 using namespace partita;
 namespace fs = std::filesystem;
@@ -32,23 +31,10 @@ std::string dem_yaml(const std::string& breakage) {
 }
 
 std::unique_ptr<Solver> make(const std::string& yaml, const fs::path& out) {
-  coupling::Registries r;
-  coupling::register_builtin(r);
-  adapters::register_all(r);
-  const auto& e = r.solvers.get("dem");
-  config::Node n = config::Node::load_string(yaml, "dem.yaml");
-  auto spec = std::make_shared<config::Spec>(*e.spec);
-  if (!spec->find("solver")) spec->string("solver", "name").required();
-  SolverContext ctx{"p", n.validated(spec), fs::path(PARTITA_SOURCE_DIR), out, 1};
-  return e.factory(ctx);
+  return test::make_solver("dem", yaml, fs::path(PARTITA_SOURCE_DIR), out);
 }
 
-double monitor(const Solver& s, const std::string& name) {
-  for (const auto& m : s.monitors())
-    if (m.name == name) return m.value;
-  FAIL("no monitor " << name);
-  return 0.0;
-}
+double monitor(const Solver& s, const std::string& name) { return test::monitor_value(s, name); }
 
 }  // namespace
 

@@ -281,6 +281,39 @@ TEST_CASE("a diverging run stops with a diagnosis, non-zero, with finite numbers
   fs::remove_all(dir);
 }
 
+TEST_CASE("the undamped rubber plate stops at the energy audit, non-zero, with finite files",
+          "[app][divergence][energy]") {
+  // Seed 000's rubber plate without its Rayleigh damping: the explicit coupling (the plate sees
+  // the granules' traction one window late) feeds the soft plate's mesh-scale modes, the contact
+  // forces grow to many times the load, and both sides receive positive work through the
+  // interface: energy that the coupling creates (a lossless interface creates none). Nothing is
+  // non-finite, no particle is lost and the plate stays within its size, so only the energy
+  // audit can see it.
+  const fs::path dir = scratch("energy");
+  const auto r = partita_run(
+      "run " + quote((kSource / "cases/uniaxial_compaction/rubber.yaml").string()) +
+      " --set time.end=0.006 --set participants.plate.analysis.rayleigh.beta=0 --set "
+      "output.scripts=[] --output " +
+      quote(dir.string()));
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK_FALSE(r.signalled);
+  CHECK(r.output.find("the coupling between 'granules' and 'plate' has created") !=
+        std::string::npos);
+  CHECK(r.output.find("coupling.energy_tolerance") != std::string::npos);
+  const std::string c = read_all(dir / "coupling.csv");
+  CHECK(c.find("energy created granules-plate [J]") != std::string::npos);
+  CHECK(c.find("nan") == std::string::npos);
+  CHECK(lines(dir / "coupling.csv") >= 21);
+  // the same plate with its damping passes the audit over the same windows
+  const auto ok = partita_run(
+      "run " + quote((kSource / "cases/uniaxial_compaction/rubber.yaml").string()) +
+      " --set time.end=0.006 --set output.scripts=[] --output " + quote((dir / "damped").string()));
+  INFO(ok.output);
+  CHECK(ok.status == 0);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("a fixed substep count that breakage makes too coarse stops naming the key",
           "[app][divergence]") {
   // The confined compression with crushing: 6 DEM substeps per window are stable for the

@@ -11,7 +11,10 @@
 //              velocity follows from the motion), writes "force" [N] (contact forces distributed
 //              to the vertices by barycentric weights: the conservative route)
 //   M_centres  the triangle centroids: writes "force" [N] per triangle and "traction" [Pa] =
-//              force / triangle area (the seed's route, Algorithm 1 of seed 000)
+//              force / triangle area (the seed's route, Algorithm 1 of seed 000); a triangle's
+//              force is lumped from its vertices' (continuous as contacts cross triangle edges:
+//              see dem::TriangleMesh::triangle_forces)
+// interface_work(M or M_centres): the work the motion of M did on the particles (energy audit).
 // Monitors: kinetic_energy [J], M.force_x|y|z [N] (force of the particles on mesh M),
 // <wall>.force_x|y|z [N], particles, contacts_per_particle; with `breakage`: breakage.events,
 // .fragments, .fragment_mass [kg], .mass_lost [kg], .mass_restored [kg], .energy_released [J],
@@ -52,6 +55,7 @@ class DemAdapter : public Solver {
   void write_restart(BinaryWriter& out) const override;
   void read_restart(BinaryReader& in) override;
   std::vector<MonitorValue> monitors() const override;
+  std::optional<double> interface_work(std::string_view mesh) const override;
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);
@@ -63,6 +67,15 @@ class DemAdapter : public Solver {
     Eigen::MatrixX3d reference;  // vertex positions, reference configuration
     Eigen::VectorXd areas;       // triangle areas (reference) [m^2]
     Eigen::MatrixX3d positions;  // current vertex positions (work array)
+    // The interface energy audit (Solver::interface_work): the work the moving mesh did on the
+    // particles since t = 0, -sum_v 1/2 (f_v,k + f_v,k+1) . (x_v,k+1 - x_v,k) over the steps,
+    // with f_v the contact forces on the vertices (barycentric: exact for the linear motion of
+    // each triangle), and the vertex positions and forces at the end of the last step.
+    struct Work {
+      double work = 0.0;          // [J]
+      Eigen::MatrixX3d position;  // x_v,k
+      Eigen::MatrixX3d force;     // f_v,k
+    } audit, audit_checkpoint;
   };
   struct Wall {
     std::string name;

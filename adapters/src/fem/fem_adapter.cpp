@@ -504,6 +504,7 @@ void FemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
 }
 
 void FemAdapter::advance(double dt) {
+  u_before_ = solver_->displacement();  // (no allocation after the first step: same size)
   try {
     if (transient_)
       solver_->step(dt);
@@ -513,6 +514,34 @@ void FemAdapter::advance(double dt) {
     throw Error("fem '" + name_ + "' at t = " + fmt::format("{:.6g}", solver_->time()) +
                 " s: " + e.what());
   }
+  // the work of each interface's loads over this step: 1/2 (f_k + f_k+1) . du
+  du_ = solver_->displacement() - u_before_;
+  for (auto& i : interfaces_) {
+    Interface::Work& a = i.audit;
+    double w = 0.0;
+    if (i.has_tractions) {
+      w += solver_->face_traction_work(i.face, i.tractions, du_);
+      if (a.tractions.rows() == i.tractions.rows())
+        w += solver_->face_traction_work(i.face, a.tractions, du_);
+      a.tractions = i.tractions;
+    }
+    if (i.has_forces) {
+      const bool previous = a.forces.rows() == i.nodal_forces.rows();
+      for (std::size_t k = 0; k < i.nodes.size(); ++k) {
+        const auto r = static_cast<Eigen::Index>(k);
+        const auto d = du_.segment<3>(3 * static_cast<Eigen::Index>(i.nodes[k]));
+        w += i.nodal_forces.row(r).dot(d);
+        if (previous) w += a.forces.row(r).dot(d);
+      }
+      a.forces = i.nodal_forces;
+    }
+    a.work += 0.5 * w;
+  }
+}
+
+std::optional<double> FemAdapter::interface_work(std::string_view mesh) const {
+  bool quadrature = false;
+  return interfaces_[find_interface(mesh, &quadrature)].audit.work;
 }
 
 double FemAdapter::stable_time_step() const {
@@ -523,6 +552,7 @@ double FemAdapter::stable_time_step() const {
 
 void FemAdapter::save_checkpoint() {
   checkpoint_ = solver_->save_state();
+  for (auto& i : interfaces_) i.audit_checkpoint = i.audit;
   has_checkpoint_ = true;
 }
 
@@ -530,6 +560,7 @@ void FemAdapter::restore_checkpoint() {
   if (!has_checkpoint_)
     throw Error("fem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   solver_->restore_state(checkpoint_);
+  for (auto& i : interfaces_) i.audit = i.audit_checkpoint;
 }
 
 std::string FemAdapter::check_state() const {
@@ -560,6 +591,12 @@ void FemAdapter::write_restart(BinaryWriter& out) const {
     out.write(static_cast<std::uint8_t>(i.has_forces));
     out.write(static_cast<std::uint8_t>(i.has_tractions));
   }
+  out.section("fem interface work");
+  for (const auto& i : interfaces_) {
+    out.write(i.audit.work);
+    out.write(i.audit.forces);
+    out.write(i.audit.tractions);
+  }
 }
 
 void FemAdapter::read_restart(BinaryReader& in) {
@@ -580,6 +617,12 @@ void FemAdapter::read_restart(BinaryReader& in) {
     in.read(i.tractions);
     i.has_forces = in.get<std::uint8_t>() != 0;
     i.has_tractions = in.get<std::uint8_t>() != 0;
+  }
+  in.expect_section("fem interface work");
+  for (auto& i : interfaces_) {
+    i.audit.work = in.get<double>();
+    in.read(i.audit.forces);
+    in.read(i.audit.tractions);
   }
   solver_->restore_state(s);
 }

@@ -46,6 +46,7 @@ class FemAdapter : public Solver {
   void read_restart(BinaryReader& in) override;
   std::vector<MonitorValue> monitors() const override;
   std::vector<MonitorValue> monitor_values(const std::vector<std::string>& names) const override;
+  std::optional<double> interface_work(std::string_view mesh) const override;
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);
@@ -60,6 +61,14 @@ class FemAdapter : public Solver {
     Eigen::MatrixX3d tractions;      // last "traction" read
     bool has_forces = false;
     bool has_tractions = false;
+    // The interface energy audit (Solver::interface_work): the work of the received loads on the
+    // displacements since t = 0, sum over steps of 1/2 (f_k + f_k+1) . (u_k+1 - u_k) (the
+    // trapezoidal rule of Newmark's energy balance), and the loads of the last step.
+    struct Work {
+      double work = 0.0;           // [J]
+      Eigen::MatrixX3d forces;     // nodal forces of the last step (empty: none)
+      Eigen::MatrixX3d tractions;  // tractions of the last step (empty: none)
+    } audit, audit_checkpoint;
   };
   /// Index into interfaces_ of the coupling mesh `mesh` (nodes or quadrature); throws if unknown.
   std::size_t find_interface(std::string_view mesh, bool* quadrature) const;
@@ -72,6 +81,7 @@ class FemAdapter : public Solver {
   fem::SolverState checkpoint_;
   bool has_checkpoint_ = false;
   std::vector<Interface> interfaces_;
+  Eigen::VectorXd u_before_, du_;  // displacement before a step and its increment (work arrays)
   std::vector<InterfaceMesh> meshes_;
   std::vector<std::pair<std::string, std::string>> files_;
   Eigen::Vector3d applied_per_unit_ = Eigen::Vector3d::Zero();

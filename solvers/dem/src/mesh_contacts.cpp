@@ -205,24 +205,29 @@ template void MeshContacts::evaluate<true>(int, const Particle&, const NeighborL
                                            const History&, double, bool, Eigen::Vector3d&,
                                            Eigen::Vector3d&, double&);
 
-// Each contact's reaction on its triangle, shared among the triangle's vertices with the
-// barycentric weights of the contact point; particles in order (a fixed summation order).
+// Each contact's reaction shared among its triangle's vertices with the barycentric weights of
+// the contact point, particles in order (a fixed summation order); then each triangle's force
+// from its vertices' (each vertex's force shared equally among its triangles): continuous as a
+// contact moves across triangles, sums preserved (see TriangleMesh::triangle_forces).
 void MeshContacts::reduce(int n, const int* slot_count, const MeshContactRecord* records,
                           std::vector<TriangleMesh>& meshes) {
-  for (TriangleMesh& m : meshes) {
-    m.triangle_force_.setZero();
-    m.vertex_force_.setZero();
-  }
+  for (TriangleMesh& m : meshes) m.vertex_force_.setZero();
   for (int i = 0; i < n; ++i) {
     for (int c = 0; c < slot_count[i]; ++c) {
       const MeshContactRecord& rec = records[static_cast<std::size_t>(i) * max_contacts + c];
       TriangleMesh& m = meshes[rec.mesh];
-      m.triangle_force_.row(rec.triangle) -= rec.force.transpose();
       const auto& tri = m.triangle(rec.triangle);
       for (int k = 0; k < 3; ++k)
         m.vertex_force_.row(tri[k]) -= rec.barycentric[k] * rec.force.transpose();
     }
   }
+  for (TriangleMesh& m : meshes)
+    for (int t = 0; t < m.triangle_count(); ++t) {
+      const auto& tri = m.triangle(t);
+      m.triangle_force_.row(t) = m.vertex_share_[tri[0]] * m.vertex_force_.row(tri[0]) +
+                                 m.vertex_share_[tri[1]] * m.vertex_force_.row(tri[1]) +
+                                 m.vertex_share_[tri[2]] * m.vertex_force_.row(tri[2]);
+    }
 }
 
 }  // namespace partita::dem

@@ -65,6 +65,11 @@ TriangleMesh::TriangleMesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
   }
   triangle_force_ = Eigen::MatrixX3d::Zero(triangle_count(), 3);
   vertex_force_ = Eigen::MatrixX3d::Zero(nv, 3);
+  vertex_share_.assign(nv, 0.0);
+  for (const auto& tri : triangles_)
+    for (int v : tri) vertex_share_[v] += 1.0;
+  for (double& s : vertex_share_)
+    if (s > 0.0) s = 1.0 / s;
 
   // Topology for the local-closest test: opposite vertices of each edge, neighbours of each
   // vertex (compressed rows).

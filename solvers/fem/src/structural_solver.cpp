@@ -325,6 +325,19 @@ void StructuralSolver::clear_coupling_loads() {
   update_coupling_force();
 }
 
+double StructuralSolver::face_traction_work(const std::string& face, const MatrixX3& tractions,
+                                            const Eigen::VectorXd& du) const {
+  const auto& op = face_operator(face);
+  if (static_cast<std::size_t>(tractions.rows()) != op.num_qp || du.size() != coupling_force_.size())
+    throw Error("face_traction_work('" + face + "'): " + std::to_string(op.num_qp) +
+                " tractions and " + std::to_string(coupling_force_.size()) + " dofs expected");
+  double w = 0.0;
+  for (std::size_t k = 0; k < op.node.size(); ++k)
+    w += op.coefficient[k] * tractions.row(static_cast<Eigen::Index>(op.qp[k]))
+                                 .dot(du.segment<3>(3 * static_cast<Eigen::Index>(op.node[k])));
+  return w;
+}
+
 void StructuralSolver::update_coupling_force() {
   coupling_force_.setZero();
   // f_a = sum_q N_a(x_q) t_q w_q over every face with tractions

@@ -78,6 +78,7 @@ struct RunSummary {
   int stopped_by_signal = 0;           ///< the signal that stopped the run early (0: none)
   std::filesystem::path last_restart;  ///< the newest restart file written (empty: none)
   long imbalance_warnings = 0;         ///< windows where an exchange's balance exceeded the limit
+  long energy_warnings = 0;            ///< windows where the coupling created too much energy
   double mean_iterations() const {
     return windows > 0 ? static_cast<double>(iterations) / windows : 0.0;
   }
@@ -156,6 +157,27 @@ class CaseRun {
   // the balance audit: exchanges audited and the relative imbalance that warns
   std::vector<const Exchange*> audited_;
   double balance_tolerance_ = 0.01;
+  // the energy audit: two participants that read from each other, each with the meshes it reads
+  // the other's data on (where its solver reports Solver::interface_work)
+  struct EnergyPair {
+    std::string label;  // "a-b"
+    Participant* a = nullptr;
+    Participant* b = nullptr;
+    std::vector<std::string> a_meshes, b_meshes;
+    // since t = 0: the work on each side at the last accepted window and the work that passed
+    // (sum over windows of |change on a| + |change on b|: the scale of the audit)
+    double last_a = 0.0, last_b = 0.0, passed = 0.0;
+    std::int64_t over = 0;  // windows in a row above the tolerance
+  };
+  std::vector<EnergyPair> energy_pairs_;
+  // work done on a and on b through their interface [J], and what it adds up to
+  struct EnergyAudit {
+    double on_a = 0.0, on_b = 0.0;
+    double created() const { return on_a + on_b; }
+  };
+  EnergyAudit audit_energy(const EnergyPair& pair) const;
+  double energy_tolerance_ = 0.5;  // created / passed that stops the run (or warns)
+  bool energy_stop_ = true;
 };
 
 /// The case file's schema (for validation and `partita docs`).

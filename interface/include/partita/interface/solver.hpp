@@ -31,6 +31,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -164,6 +165,17 @@ class Solver {
   /// what to change) when it is no longer physical (non-finite values, particles lost from the
   /// domain, displacements larger than the model), else "". The core stops the run with it.
   virtual std::string check_state() const { return {}; }
+
+  /// The interface energy audit: the work [J] done on this solver, from t = 0 to the end of its
+  /// last step, by what it reads on `mesh` (received loads: their work on its own displacements;
+  /// a received motion: the work the moving boundary does on the solver's bodies), integrated
+  /// with the trapezoidal rule over its own steps, restored with checkpoints and restart files.
+  /// nullopt where the solver does not track it (the default). The core pairs the meshes two
+  /// participants read from each other: a lossless interface does no net work, so the sum over
+  /// both sides is the energy the coupling itself creates (see docs/coupling.md).
+  virtual std::optional<double> interface_work(std::string_view mesh) const {
+    return std::nullopt;
+  }
 
   /// Once after the last window.
   virtual void finalize() {}

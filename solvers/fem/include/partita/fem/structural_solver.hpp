@@ -81,6 +81,10 @@ class StructuralSolver final : private StructuralSystem {
   // One force [N] per listed node; replaces all earlier nodal forces.
   void set_nodal_forces(const std::vector<std::size_t>& nodes, const MatrixX3& forces);
   void clear_coupling_loads();
+  // sum_q w_q t_q . du(x_q) = f(t) . du: the work of tractions t (one row per quadrature point of
+  // the face, as above) over the displacement increment du (all dofs) (interface energy audit).
+  double face_traction_work(const std::string& face, const MatrixX3& tractions,
+                            const Eigen::VectorXd& du) const;
 
   // --- analyses ---
   // K u = F(time()) with the prescribed values at time(); velocity = acceleration = 0.
