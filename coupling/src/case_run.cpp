@@ -698,7 +698,9 @@ void CaseRun::run() {
   std::map<Participant*, std::vector<MonitorValue>> values;
   auto record_monitors = [&](double t, std::int64_t window) {
     for (const auto& [p, names] : wanted) {
+      Stopwatch clock;  // the solver computes its quantities: its time, not the core's
       values[p] = p->solver().monitor_values(names);
+      p->add_seconds(clock.seconds());
       for (const auto& mv : values[p])
         if (!std::isfinite(mv.value))
           throw Error(fmt::format(

@@ -48,14 +48,9 @@ std::vector<std::pair<std::int64_t, fs::path>> restart_files(const fs::path& dir
 // and the same of the magnitudes (the scale the imbalance is measured against).
 std::pair<Eigen::VectorXd, double> total(const Eigen::MatrixXd& v, const Mesh& mesh,
                                          bool extensive) {
-  Eigen::VectorXd t = Eigen::VectorXd::Zero(v.cols());
-  double scale = 0.0;
-  for (Eigen::Index i = 0; i < v.rows(); ++i) {
-    const double w = extensive ? 1.0 : mesh.weights()(i);
-    t += w * v.row(i).transpose();
-    scale += std::abs(w) * v.row(i).norm();
-  }
-  return {t, scale};
+  if (extensive) return {v.colwise().sum().transpose(), v.rowwise().norm().sum()};
+  const Eigen::VectorXd& w = mesh.weights();
+  return {v.transpose() * w, (v.rowwise().norm().array() * w.array().abs()).sum()};
 }
 
 }  // namespace
@@ -241,10 +236,14 @@ void CaseRun::check_window(std::int64_t window, double time) {
           sent ? e->from_mesh() : e->to_mesh(), e->from().name()));
     }
   }
-  for (const auto& p : participants_)
-    if (const std::string why = p->solver().check_state(); !why.empty())
+  for (const auto& p : participants_) {
+    Stopwatch clock;  // the solver's own work: its time, not the core's
+    const std::string why = p->solver().check_state();
+    p->add_seconds(clock.seconds());
+    if (!why.empty())
       throw Error(fmt::format("window {} (t = {:.6g} s): participant '{}': {}", window, time,
                               p->name(), why));
+  }
 }
 
 std::vector<double> CaseRun::audit_balance() {
