@@ -45,10 +45,10 @@ TEST_CASE("particle file: a settled run's final state restarts the same particle
   const fs::path settled = dir / "settle" / "granules.data";
   REQUIRE(fs::exists(settled));
   CHECK(!fs::exists(settled.string() + ".tmp"));
-  r = partita::test::run_command(
-      quote(PARTITA_EXECUTABLE) + " run " + quote((inputs / "restart.yaml").string()) +
-      " --output " + quote((dir / "restart").string()) + " --set " +
-      quote("participants.granules.particles.file=" + settled.string()));
+  r = partita::test::run_command(quote(PARTITA_EXECUTABLE) + " run " +
+                                 quote((inputs / "restart.yaml").string()) + " --output " +
+                                 quote((dir / "restart").string()) + " --set " +
+                                 quote("participants.granules.particles.file=" + settled.string()));
   INFO(r.output);
   REQUIRE(r.status == 0);
   const fs::path again = dir / "restart" / "particles" / "granules_000000.data";

@@ -13,7 +13,7 @@
 namespace partita::test {
 
 struct MonitorCsv {
-  std::vector<std::string> header;         ///< column names without their " [unit]"
+  std::vector<std::string> header;        ///< column names without their " [unit]"
   std::vector<std::vector<double>> rows;  ///< one per line after the header
 
   static MonitorCsv read(const std::filesystem::path& file) {
@@ -36,7 +36,8 @@ struct MonitorCsv {
   std::map<std::string, double> mean_over_last(double fraction) const {
     std::map<std::string, double> mean;
     if (rows.empty()) return mean;
-    std::size_t count = static_cast<std::size_t>(fraction * static_cast<double>(rows.size()) + 1e-9);
+    std::size_t count =
+        static_cast<std::size_t>(fraction * static_cast<double>(rows.size()) + 1e-9);
     if (count == 0) count = 1;
     const std::size_t from = rows.size() - count;
     for (std::size_t c = 0; c < header.size(); ++c) {

@@ -391,8 +391,8 @@ DemAdapter::DemAdapter(const SolverContext& context)
       const double rho = system_.contact_model().material(pm).density;
       for (std::size_t i = 0; i < d.size(); ++i) {
         const double r = d.diameter[i] / 2;
-        const std::size_t k =
-            system_.add_particle(d.position[i], r, pm, d.velocity[i], d.angular_velocity[i], d.id[i]);
+        const std::size_t k = system_.add_particle(d.position[i], r, pm, d.velocity[i],
+                                                   d.angular_velocity[i], d.id[i]);
         if (d.density[i] != rho) {  // the file's density sets the mass (as add_particle would)
           const double m = d.density[i] * 4.0 / 3.0 * std::numbers::pi * r * r * r;
           system_.set_particle_mass(k, m, 0.4 * m * r * r);
@@ -638,7 +638,8 @@ void DemAdapter::write_particles_file(const std::filesystem::path& file) const {
     density.push_back(system_.contact_model().material(m).density);
   try {
     dem::LammpsData::of(system_.particles(), density)
-        .write(file.string(), fmt::format("partita DEM '{}' at t = {:.17g} s", name_, system_.time()));
+        .write(file.string(),
+               fmt::format("partita DEM '{}' at t = {:.17g} s", name_, system_.time()));
   } catch (const dem::Error& e) {
     throw Error("dem '" + name_ + "': " + e.what());
   }

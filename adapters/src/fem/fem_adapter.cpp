@@ -31,7 +31,10 @@ std::shared_ptr<Spec> make_spec() {
                              "box (also inner)");
   box->reals("origin", "lower corner").unit("m").size(3).required();
   box->reals("size", "edge lengths").unit("m").size(3).min(0.0, true).required();
-  box->integers("cells", "cells along x, y, z (hollow box: across the cavity)").size(3).min(1).required();
+  box->integers("cells", "cells along x, y, z (hollow box: across the cavity)")
+      .size(3)
+      .min(1)
+      .required();
   box->real("wall_thickness",
             "a closed hollow box: walls of this thickness around an empty cavity (> 0 and < half "
             "the smallest edge); adds the face and node set 'inner' (the cavity's whole surface, "
@@ -291,7 +294,8 @@ fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
       if (hollow_total > kMaxBoxCells)
         m["box"]["wall_cells"].fail(fmt::format(
             "{} cells through the wall make {:.3g} cells in all, more than {:.0e}; check the "
-            "counts", b.wall_cells, hollow_total, kMaxBoxCells));
+            "counts",
+            b.wall_cells, hollow_total, kMaxBoxCells));
     } else if (m["box"].has("wall_cells")) {
       m["box"]["wall_cells"].fail("wall_cells applies to a hollow box only: add wall_thickness");
     }

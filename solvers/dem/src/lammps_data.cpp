@@ -115,7 +115,8 @@ void LammpsData::write(const std::string& path, const std::string& title) const 
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
-  if (ec) throw Error("LAMMPS data: cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+  if (ec)
+    throw Error("LAMMPS data: cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
 }
 
 LammpsData LammpsData::read(const std::string& path) {

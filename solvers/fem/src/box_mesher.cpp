@@ -40,7 +40,8 @@ Axis make_axis(const BoxSpec& spec, int d) {
       x = o + t * static_cast<double>(g) / (2.0 * static_cast<double>(a.wall));
     } else if (g <= 2 * (a.cells - a.wall)) {
       x = o + t +
-          (s - 2 * t) * static_cast<double>(g - 2 * a.wall) / (2.0 * static_cast<double>(spec.cells[d]));
+          (s - 2 * t) * static_cast<double>(g - 2 * a.wall) /
+              (2.0 * static_cast<double>(spec.cells[d]));
     } else {
       x = o + s - t * static_cast<double>(2 * a.cells - g) / (2.0 * static_cast<double>(a.wall));
     }
@@ -55,8 +56,7 @@ class Lattice {
  public:
   Lattice(const std::array<Axis, 3>& axes, Mesh& mesh) : axes_(axes), mesh_(mesh) {}
   std::size_t node(const GridIndex& g) {
-    const long key =
-        g[0] + (2L * axes_[0].cells + 1) * (g[1] + (2L * axes_[1].cells + 1) * g[2]);
+    const long key = g[0] + (2L * axes_[0].cells + 1) * (g[1] + (2L * axes_[1].cells + 1) * g[2]);
     auto [it, inserted] = ids_.try_emplace(key, 0);
     if (inserted) {
       Vec3 x;
@@ -141,9 +141,8 @@ Mesh make_box_mesh(const BoxSpec& spec) {
       const auto local = local_face_nodes(type, f);
       for (int d = 0; d < 3; ++d) {
         const long g0 = lattice.index(el.nodes[local[0]])[d];
-        const bool flat = std::all_of(local.begin(), local.end(), [&](int a) {
-          return lattice.index(el.nodes[a])[d] == g0;
-        });
+        const bool flat = std::all_of(local.begin(), local.end(),
+                                      [&](int a) { return lattice.index(el.nodes[a])[d] == g0; });
         if (!flat || (g0 != 2 * cell[d] && g0 != 2 * cell[d] + 2)) continue;
         const int upper = g0 == 2 * cell[d] + 2 ? 1 : 0;
         GridIndex across = cell;

@@ -18,8 +18,8 @@ TEST_CASE("dem: a written particle file reads back bit for bit", "[dem][io]") {
   sys.add_interaction(0, other, {0.4, 0.5, 0.0});
   sys.add_interaction(other, other, {0.4, 0.5, 0.0});
   sys.set_gravity({0, 0, -9.81});
-  const Packing pk = test::two_size_packing(Eigen::Vector3d::Zero(), Eigen::Vector3d(8e-3, 8e-3, 8e-3),
-                                            1.3e-3, 0.7e-3, 0.6, 3);
+  const Packing pk = test::two_size_packing(
+      Eigen::Vector3d::Zero(), Eigen::Vector3d(8e-3, 8e-3, 8e-3), 1.3e-3, 0.7e-3, 0.6, 3);
   sys.add_particles(pk.positions, pk.radii, 0);
   sys.add_particle({4e-3, 4e-3, 12e-3}, 0.9e-3, other, {0.1, -0.2, 0.3}, {1.0, 2.0, -3.0}, 1000);
   sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(8e-3, 8e-3, 16e-3), 0);
@@ -54,7 +54,8 @@ TEST_CASE("dem: a written particle file reads back bit for bit", "[dem][io]") {
   }
   const double r = p.radius[2];
   CHECK(d.density[2] == Approx(1.37 * 2500.0).epsilon(1e-14));
-  CHECK(d.density[2] * 4.0 / 3.0 * std::numbers::pi * r * r * r == Approx(p.mass[2]).epsilon(1e-15));
+  CHECK(d.density[2] * 4.0 / 3.0 * std::numbers::pi * r * r * r ==
+        Approx(p.mass[2]).epsilon(1e-15));
   // the velocities are those of a bed in motion, not zero (else the check above says little)
   double v_max = 0.0;
   for (const auto& v : p.velocity) v_max = std::max(v_max, v.norm());

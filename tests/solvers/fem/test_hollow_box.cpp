@@ -63,9 +63,9 @@ TEST_CASE("hollow box: outer and inner faces enclose the walls' volume", "[fem][
     // the inner surface alone is closed and bounds the cavity: 1/3 int x . n dA = -V_cavity
     CHECK(inner.area_normal.norm() < 1e-12);
     CHECK(inner.x_dot_n / 3.0 == Approx(-cavity.prod()).epsilon(1e-12));
-    CHECK(inner.area == Approx(2 * (cavity.x() * cavity.y() + cavity.y() * cavity.z() +
-                                    cavity.z() * cavity.x()))
-                            .epsilon(1e-12));
+    CHECK(inner.area ==
+          Approx(2 * (cavity.x() * cavity.y() + cavity.y() * cavity.z() + cavity.z() * cavity.x()))
+              .epsilon(1e-12));
     // each inner side: its area, normal into the cavity, at its plane
     for (int side = 0; side < 6; ++side) {
       const int d = side / 2;
@@ -75,7 +75,8 @@ TEST_CASE("hollow box: outer and inner faces enclose the walls' volume", "[fem][
       CHECK(r.area == Approx(a).epsilon(1e-12));
       CHECK(r.area_normal[d] == Approx(sign * a).epsilon(1e-12));
       const double plane = side % 2 == 0 ? o[d] + t : o[d] + size[d] - t;
-      for (const auto& q : s.face_quadrature_points("inner_" + kSides[static_cast<std::size_t>(side)]))
+      for (const auto& q :
+           s.face_quadrature_points("inner_" + kSides[static_cast<std::size_t>(side)]))
         CHECK(q.position[d] == Approx(plane).epsilon(1e-12));
     }
     // the outer faces are those of the solid box: area of each side
