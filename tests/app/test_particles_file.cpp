@@ -60,5 +60,29 @@ TEST_CASE("particle file: a settled run's final state restarts the same particle
   // the later frames and the end of the restarted run are written too
   CHECK(fs::exists(dir / "restart" / "particles" / "granules_000002.data"));
   CHECK(fs::exists(dir / "restart" / "granules.data"));
+
+  // The file's densities set the masses: read with a material of another density (1000), the
+  // particles keep the file's 2500 kg/m^3 (written back as mass / volume).
+  r = partita::test::run_command(
+      quote(PARTITA_EXECUTABLE) + " run " + quote((inputs / "restart.yaml").string()) +
+      " --output " + quote((dir / "density").string()) + " --set " +
+      quote("participants.granules.particles.file=" + settled.string()) + " --set " +
+      quote("participants.granules.materials.glass.density=1000"));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  std::ifstream in(dir / "density" / "particles" / "granules_000000.data");
+  std::string line;
+  bool atoms = false;
+  int count = 0;
+  while (std::getline(in, line)) {
+    if (line.rfind("Atoms", 0) == 0) atoms = true;
+    if (line.rfind("Velocities", 0) == 0) break;
+    std::istringstream row(line);
+    double id = 0, type = 0, diameter = 0, density = 0;
+    if (!atoms || !(row >> id >> type >> diameter >> density)) continue;
+    CHECK(density == Approx(2500.0).epsilon(1e-14));
+    ++count;
+  }
+  CHECK(count > 50);
   fs::remove_all(dir);
 }
