@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "../support/monitor_csv.hpp"
 #include "../support/run_command.hpp"
 
 #include <unistd.h>
@@ -30,30 +31,9 @@ TEST_CASE("mesh hand-over: granules at rest on an FE face load it with their wei
       " --output " + quote(dir.string()));
   INFO(r.output);
   REQUIRE(r.status == 0);
-  std::ifstream in(dir / "forces.csv");
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  {
-    std::stringstream s(line);
-    for (std::string c; std::getline(s, c, ',');) header.push_back(c.substr(0, c.find(" [")));
-  }
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::stringstream s(line);
-    std::vector<double> row;
-    for (std::string c; std::getline(s, c, ',');) row.push_back(std::stod(c));
-    rows.push_back(row);
-  }
-  REQUIRE(rows.size() > 100);
-  // means over the last 10 % (the bed at rest)
-  std::map<std::string, double> mean;
-  const std::size_t from = rows.size() - rows.size() / 10;
-  for (std::size_t c = 0; c < header.size(); ++c) {
-    double s = 0;
-    for (std::size_t i = from; i < rows.size(); ++i) s += rows[i][c];
-    mean[header[c]] = s / static_cast<double>(rows.size() - from);
-  }
+  const auto csv = partita::test::MonitorCsv::read(dir / "forces.csv");
+  REQUIRE(csv.rows.size() > 100);
+  auto mean = csv.mean_over_last(0.1);  // the bed at rest
   const double weight = mean["granules.mass"] * 9.81;
   REQUIRE(weight > 0.0);
   INFO("weight " << weight << " N, FE face " << mean["block.top.force_z"] << " N, DEM "

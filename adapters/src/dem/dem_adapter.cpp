@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <sstream>
 
 #include "partita/dem/breakage.hpp"
@@ -86,7 +87,9 @@ std::shared_ptr<Spec> make_spec() {
   particles->section("generate", "generate a packing", generate);
   particles->string(
       "file",
-      "LAMMPS data file (id type diameter density x y z [+ Velocities]), relative to the case");
+      "LAMMPS data file (id type diameter density x y z [+ Velocities]), relative to the case; "
+      "each particle's mass follows the file's density where it differs from the material's "
+      "(e.g. the final state a DEM run wrote with output: {particles_file: end})");
   particles->one_of({"generate", "file"});
 
   auto plane = std::make_shared<Spec>("plane", "an infinite plane");
@@ -209,6 +212,16 @@ std::shared_ptr<Spec> make_spec() {
       .min(0)
       .def(10);
   s->section("breakage", "crushable particles (off when absent)", breakage);
+  auto output = std::make_shared<Spec>("output", "files of this participant beyond the VTK series");
+  output
+      ->choice("particles_file",
+               "the particles as a LAMMPS data file that particles: {file: ...} reads back bit "
+               "for bit (positions, velocities, diameters, densities): none, end (DIR/"
+               "<participant>.data after the last window, or where a signal stopped the run) or "
+               "every-output (also DIR/particles/<participant>_<frame>.data at each output time)",
+               {"none", "end", "every-output"})
+      .def("none");
+  s->section("output", "participant output", output);
   return s;
 }
 
@@ -257,7 +270,8 @@ std::unique_ptr<Solver> DemAdapter::create(const SolverContext& context) {
   return std::make_unique<DemAdapter>(context);
 }
 
-DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
+DemAdapter::DemAdapter(const SolverContext& context)
+    : name_(context.name), output_dir_(context.output_dir) {
   const Node& c = context.config;
   auto resolve = [&](const std::filesystem::path& f) {
     return f.is_relative() ? context.case_dir / f : f;
@@ -299,6 +313,7 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
     if (c.has("skin")) system_.set_skin(c.real("skin"));
     system_.set_sort_interval(static_cast<int>(c.integer("sort_interval")));
     time_step_fraction_ = c.real("time_step_fraction");
+    particles_file_ = c["output"].string("particles_file");
 
     // Particles.
     const Node pn = c["particles"];
@@ -373,9 +388,16 @@ DemAdapter::DemAdapter(const SolverContext& context) : name_(context.name) {
       if (!std::filesystem::exists(f))
         pn["file"].fail("particle file '" + f.string() + "' does not exist");
       const dem::LammpsData d = dem::LammpsData::read(f.string());
-      for (std::size_t i = 0; i < d.size(); ++i)
-        system_.add_particle(d.position[i], d.diameter[i] / 2, pm, d.velocity[i],
-                             d.angular_velocity[i], d.id[i]);
+      const double rho = system_.contact_model().material(pm).density;
+      for (std::size_t i = 0; i < d.size(); ++i) {
+        const double r = d.diameter[i] / 2;
+        const std::size_t k = system_.add_particle(d.position[i], r, pm, d.velocity[i],
+                                                   d.angular_velocity[i], d.id[i]);
+        if (d.density[i] != rho) {  // the file's density sets the mass (as add_particle would)
+          const double m = d.density[i] * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+          system_.set_particle_mass(k, m, 0.4 * m * r * r);
+        }
+      }
     }
 
     // Walls.
@@ -617,6 +639,28 @@ void DemAdapter::write_output(const OutputFrame& frame) {
     files_.emplace_back(m.name, mfile);
   }
   if (breakage_ >= 0) write_grading(frame);
+  if (particles_file_ == "every-output") {
+    const std::filesystem::path dir = frame.vtk_directory.parent_path() / "particles";
+    std::filesystem::create_directories(dir);
+    write_particles_file(dir / fmt::format("{}_{:06d}.data", frame.prefix, frame.index));
+  }
+}
+
+void DemAdapter::finalize() {
+  if (particles_file_ != "none") write_particles_file(output_dir_ / (name_ + ".data"));
+}
+
+void DemAdapter::write_particles_file(const std::filesystem::path& file) const {
+  std::vector<double> density;
+  for (int m = 0; m < system_.contact_model().material_count(); ++m)
+    density.push_back(system_.contact_model().material(m).density);
+  try {
+    dem::LammpsData::of(system_.particles(), density)
+        .write(file.string(),
+               fmt::format("partita DEM '{}' at t = {:.17g} s", name_, system_.time()));
+  } catch (const dem::Error& e) {
+    throw Error("dem '" + name_ + "': " + e.what());
+  }
 }
 
 // Grading at each output time: rows time, diameter, mass fraction passing, appended to

@@ -20,7 +20,9 @@
 // .fragments, .fragment_mass [kg], .mass_lost [kg], .mass_restored [kg], .energy_released [J],
 // stable_time_step [s] (it falls as fragments appear; `auto` substeps follow it), and the grading
 // (cumulative mass passing per size) appended to <output>/<participant>_grading.csv at each
-// output time.
+// output time. With output: {particles_file: end | every-output} the particles are written as a
+// LAMMPS data file that particles: {file: ...} reads back bit for bit: <output>/<participant>.data
+// at finalize() (and <output>/particles/<participant>_<frame>.data at each output time).
 
 #include <memory>
 #include <string>
@@ -56,6 +58,7 @@ class DemAdapter : public Solver {
   void read_restart(BinaryReader& in) override;
   std::vector<MonitorValue> monitors() const override;
   std::optional<double> interface_work(std::string_view mesh) const override;
+  void finalize() override;
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);
@@ -89,8 +92,12 @@ class DemAdapter : public Solver {
   void add_breakage(const config::Node& breakage);
   const dem::Breakage* breakage() const;  ///< nullptr when off
   void write_grading(const OutputFrame& frame) const;
+  /// The particles as a LAMMPS data file (dem::LammpsData), written atomically.
+  void write_particles_file(const std::filesystem::path& file) const;
 
   std::string name_;
+  std::filesystem::path output_dir_;
+  std::string particles_file_ = "none";  // output.particles_file: none, end, every-output
   dem::System system_;
   double time_step_fraction_ = 0.2;
   dem::SystemState checkpoint_;

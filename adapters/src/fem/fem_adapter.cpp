@@ -27,10 +27,21 @@ std::shared_ptr<Spec> make_spec() {
   auto box =
       std::make_shared<Spec>("box",
                              "a structured box mesh with faces and node sets xmin, xmax, ymin, "
-                             "ymax, zmin, zmax and all");
+                             "ymax, zmin, zmax and all; with wall_thickness a closed hollow "
+                             "box (also inner)");
   box->reals("origin", "lower corner").unit("m").size(3).required();
   box->reals("size", "edge lengths").unit("m").size(3).min(0.0, true).required();
-  box->integers("cells", "cells along x, y, z").size(3).min(1).required();
+  box->integers("cells", "cells along x, y, z (hollow box: across the cavity)")
+      .size(3)
+      .min(1)
+      .required();
+  box->real("wall_thickness",
+            "a closed hollow box: walls of this thickness around an empty cavity (> 0 and < half "
+            "the smallest edge); adds the face and node set 'inner' (the cavity's whole surface, "
+            "normals into the cavity) and faces inner_xmin ... inner_zmax")
+      .unit("m")
+      .positive();
+  box->integer("wall_cells", "hollow box: cells through the wall thickness").min(1).def(1);
 
   auto mesh =
       std::make_shared<Spec>("mesh", "the finite element mesh: a box or a Gmsh 4.1 ASCII file");
@@ -267,6 +278,27 @@ fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
           "(about 3 x 10^5 degrees of freedom take a minute to factorise); check the counts",
           cells[0], cells[1], cells[2], total, kMaxBoxCells));
     b.cells = {static_cast<int>(cells[0]), static_cast<int>(cells[1]), static_cast<int>(cells[2])};
+    if (m["box"].has("wall_thickness")) {
+      b.wall_thickness = m["box"].real("wall_thickness");
+      b.wall_cells = static_cast<int>(m["box"].integer("wall_cells"));
+      const double half = 0.5 * b.size.minCoeff();
+      if (!(b.wall_thickness < half))
+        m["box"]["wall_thickness"].fail(fmt::format(
+            "a wall thickness of {:.4g} m leaves no cavity in a box whose smallest edge is {:.4g} "
+            "m; allowed: 0 < wall_thickness < {:.4g} m (half the smallest edge)",
+            b.wall_thickness, b.size.minCoeff(), half));
+      const double walls = static_cast<double>(b.wall_cells) * 2.0;
+      const double hollow_total = (static_cast<double>(cells[0]) + walls) *
+                                  (static_cast<double>(cells[1]) + walls) *
+                                  (static_cast<double>(cells[2]) + walls);
+      if (hollow_total > kMaxBoxCells)
+        m["box"]["wall_cells"].fail(fmt::format(
+            "{} cells through the wall make {:.3g} cells in all, more than {:.0e}; check the "
+            "counts",
+            b.wall_cells, hollow_total, kMaxBoxCells));
+    } else if (m["box"].has("wall_cells")) {
+      m["box"]["wall_cells"].fail("wall_cells applies to a hollow box only: add wall_thickness");
+    }
     const std::string e = m.string("element");
     b.element = e == "hex8"    ? fem::ElementType::Hex8
                 : e == "hex20" ? fem::ElementType::Hex20

@@ -1,9 +1,14 @@
 #include "partita/dem/lammps_data.hpp"
 
 #include "partita/dem/error.hpp"
+#include "partita/dem/particles.hpp"
 
+#include <array>
 #include <cctype>
+#include <charconv>
+#include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 #include <unordered_map>
 
@@ -19,7 +24,100 @@ std::string strip(const std::string& line) {
   return s.substr(b, e - b + 1);
 }
 
+// Appends x in its shortest form that reads back as the same double.
+void put(std::string& out, double x) {
+  std::array<char, 32> buf{};
+  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), x);
+  out.append(buf.data(), r.ptr);
+}
+
+void put(std::string& out, std::int64_t x) {
+  std::array<char, 24> buf{};
+  const auto r = std::to_chars(buf.data(), buf.data() + buf.size(), x);
+  out.append(buf.data(), r.ptr);
+}
+
 }  // namespace
+
+LammpsData LammpsData::of(const Particles& p, const std::vector<double>& material_density) {
+  LammpsData d;
+  const std::size_t n = p.size();
+  d.box_lo = Eigen::Vector3d::Constant(n ? 1e300 : 0.0);
+  d.box_hi = Eigen::Vector3d::Constant(n ? -1e300 : 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = p.radius[i];
+    const double volume = 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    const double rho = material_density.at(static_cast<std::size_t>(p.material[i]));
+    // the same expression as System::add_particle(): equal masses mean the material's density
+    const double m_material = rho * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+    d.id.push_back(p.id[i]);
+    d.type.push_back(p.material[i] + 1);
+    d.diameter.push_back(2.0 * r);
+    d.density.push_back(p.mass[i] == m_material ? rho : p.mass[i] / volume);
+    d.position.push_back(p.position[i]);
+    d.velocity.push_back(p.velocity[i]);
+    d.angular_velocity.push_back(p.angular_velocity[i]);
+    d.box_lo = d.box_lo.cwiseMin(p.position[i] - Eigen::Vector3d::Constant(r));
+    d.box_hi = d.box_hi.cwiseMax(p.position[i] + Eigen::Vector3d::Constant(r));
+  }
+  return d;
+}
+
+void LammpsData::write(const std::string& path, const std::string& title) const {
+  std::string out;
+  out.reserve(200 * (size() + 1));
+  out += title.substr(0, title.find('\n'));
+  out += "\n\n";
+  put(out, static_cast<std::int64_t>(size()));
+  out += " atoms\n";
+  int types = 1;
+  for (int t : type) types = std::max(types, t);
+  put(out, static_cast<std::int64_t>(types));
+  out += " atom types\n";
+  const char* axes[] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    put(out, box_lo[k]);
+    out += ' ';
+    put(out, box_hi[k]);
+    out += std::string(" ") + axes[k] + "lo " + axes[k] + "hi\n";
+  }
+  out += "\nAtoms # sphere: id type diameter density x y z (SI units)\n\n";
+  for (std::size_t i = 0; i < size(); ++i) {
+    put(out, id[i]);
+    out += ' ';
+    put(out, static_cast<std::int64_t>(type[i]));
+    for (double v : {diameter[i], density[i], position[i].x(), position[i].y(), position[i].z()}) {
+      out += ' ';
+      put(out, v);
+    }
+    out += '\n';
+  }
+  out += "\nVelocities # id vx vy vz wx wy wz (m/s, rad/s)\n\n";
+  for (std::size_t i = 0; i < size(); ++i) {
+    put(out, id[i]);
+    for (int k = 0; k < 3; ++k) {
+      out += ' ';
+      put(out, velocity[i][k]);
+    }
+    for (int k = 0; k < 3; ++k) {
+      out += ' ';
+      put(out, angular_velocity[i][k]);
+    }
+    out += '\n';
+  }
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw Error("LAMMPS data: cannot write '" + tmp + "'");
+    f.write(out.data(), static_cast<std::streamsize>(out.size()));
+    f.close();
+    if (!f) throw Error("LAMMPS data: writing '" + tmp + "' failed (disk full?)");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec)
+    throw Error("LAMMPS data: cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+}
 
 LammpsData LammpsData::read(const std::string& path) {
   std::ifstream in(path);
@@ -78,6 +176,7 @@ LammpsData LammpsData::read(const std::string& path) {
       if (!(is >> id >> type >> dia >> rho >> x >> y >> z))
         fail("expected 'id type diameter density x y z'");
       if (!(dia > 0.0)) fail("diameter must be > 0");
+      if (!(rho > 0.0)) fail("density must be > 0");
       if (index_of.count(id)) fail("atom id " + std::to_string(id) + " appears twice");
       index_of[id] = d.id.size();
       d.id.push_back(id);
