@@ -47,10 +47,11 @@ std::shared_ptr<Spec> make_spec() {
       .def("hex8");
   mesh->choice(
           "hex8",
-          "Hex8 formulation: incompatible modes (linear path: no shear or volumetric locking), "
-          "plain full integration (the nonlinear path's default: locks in bending and for nu -> "
-          "0.5) or f-bar (nonlinear path only: F_bar = (J_bar/J)^(1/3) F, no volumetric locking, "
-          "still stiff in bending of thin plates)",
+          "Hex8 formulation: incompatible modes (linear path: no shear or volumetric locking; "
+          "the nonlinear path has no incompatible modes and integrates such a Hex8 plainly), "
+          "full (plain 2x2x2: locks in bending and for nu -> 0.5) or f-bar (nonlinear path "
+          "only: F_bar = (J_bar/J)^(1/3) F, no volumetric locking, still stiff in bending of "
+          "thin plates)",
           {"incompatible-modes", "full", "f-bar"})
       .def("incompatible-modes");
   mesh->one_of({"box", "gmsh"});
@@ -141,7 +142,11 @@ std::shared_ptr<Spec> make_spec() {
   auto newmark = std::make_shared<Spec>("newmark", "Newmark parameters");
   newmark->real("beta", "beta (1/4: average acceleration)").positive().max(0.5).def(0.25);
   newmark->real("gamma", "gamma (1/2: no numerical damping)").min(0.5).max(1.0).def(0.5);
-  auto rayleigh = std::make_shared<Spec>("rayleigh", "Rayleigh damping C = alpha M + beta K");
+  auto rayleigh = std::make_shared<Spec>(
+      "rayleigh",
+      "Rayleigh damping C = alpha M + beta K0, K0 the stiffness at rest (nonlinear materials: "
+      "the tangent at u = 0); beta lowers the central-difference stable step to (2/omega_max)"
+      "(sqrt(1 + xi^2) - xi), xi = beta omega_max / 2");
   rayleigh->real("alpha", "mass-proportional coefficient").unit("1/s").non_negative().def(0.0);
   rayleigh->real("beta", "stiffness-proportional coefficient").unit("s").non_negative().def(0.0);
   auto analysis = std::make_shared<Spec>("analysis", "static or transient analysis");
