@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 #include <algorithm>
-#include <sstream>
 #include <limits>
+#include <sstream>
 
 #include "partita/fem/error.hpp"
 #include "partita/fem/state_io.hpp"
@@ -45,14 +45,13 @@ std::shared_ptr<Spec> make_spec() {
   mesh->choice("element", "element type of the box mesh (Gmsh files carry their own)",
                {"hex8", "hex20", "tet4", "tet10"})
       .def("hex8");
-  mesh->choice(
-          "hex8",
-          "Hex8 formulation: incompatible modes (linear path: no shear or volumetric locking; "
-          "the nonlinear path has no incompatible modes and integrates such a Hex8 plainly), "
-          "full (plain 2x2x2: locks in bending and for nu -> 0.5) or f-bar (nonlinear path "
-          "only: F_bar = (J_bar/J)^(1/3) F, no volumetric locking, still stiff in bending of "
-          "thin plates)",
-          {"incompatible-modes", "full", "f-bar"})
+  mesh->choice("hex8",
+               "Hex8 formulation: incompatible modes (linear path: no shear or volumetric locking; "
+               "the nonlinear path has no incompatible modes and integrates such a Hex8 plainly), "
+               "full (plain 2x2x2: locks in bending and for nu -> 0.5) or f-bar (nonlinear path "
+               "only: F_bar = (J_bar/J)^(1/3) F, no volumetric locking, still stiff in bending of "
+               "thin plates)",
+               {"incompatible-modes", "full", "f-bar"})
       .def("incompatible-modes");
   mesh->one_of({"box", "gmsh"});
 

@@ -62,10 +62,9 @@ TEST_CASE("nonlinear Newmark: energy of a Neo-Hooke bar bounded over 40 periods,
   // vanishes at least as dt^2 and, in a conservative oscillation, cancels over a period
   // instead of accumulating: bounded, no drift.
   const EnergyRun coarse = released_bar(50), fine = released_bar(100);
-  INFO("T/50: worst " << coarse.worst << " (first 5 periods " << coarse.first_periods
-                      << ", last 5 " << coarse.last_periods << "); T/100: worst " << fine.worst
-                      << " (first " << fine.first_periods << ", last " << fine.last_periods
-                      << ")");
+  INFO("T/50: worst " << coarse.worst << " (first 5 periods " << coarse.first_periods << ", last 5 "
+                      << coarse.last_periods << "); T/100: worst " << fine.worst << " (first "
+                      << fine.first_periods << ", last " << fine.last_periods << ")");
   CHECK(fine.worst < 1e-2);
   CHECK(coarse.worst / fine.worst > 4.0);  // a discretisation error of order >= 2
   for (const EnergyRun& r : {coarse, fine}) {
