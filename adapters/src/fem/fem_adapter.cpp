@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 #include <algorithm>
-#include <limits>
 #include <sstream>
+#include <limits>
 
 #include "partita/fem/error.hpp"
 #include "partita/fem/state_io.hpp"
