@@ -38,7 +38,9 @@ void register_all(coupling::Registries& r) {
 #endif
 #ifdef PARTITA_HAVE_FEM
   r.solvers.add(
-      "fem", "native linear-elastic FEM: Hex8/Hex20/Tet4/Tet10, static or Newmark transient",
+      "fem",
+      "native FEM: Hex8/Hex20/Tet4/Tet10; linear elastic, Neo-Hooke or J2 plasticity; static, "
+      "Newmark or central-difference transient",
       FemAdapter::create, FemAdapter::spec(),
       {{"<interface>.force_x", "N",
         "total force the interface received (tractions times areas plus nodal forces), x"},
@@ -59,7 +61,9 @@ void register_all(coupling::Registries& r) {
        {"external_work", "J", "work of the applied and coupled loads"},
        {"damping_work", "J", "work dissipated by Rayleigh damping"},
        {"energy_balance", "J",
-        "external work - (strain + kinetic + plastic + damping): zero for an exact balance"}});
+        "external work - (strain + kinetic + plastic + damping): zero for an exact balance"},
+       {"newton_iterations", "",
+        "Newton iterations of the last step (nonlinear materials; 0 on the linear path)"}});
 #endif
 #ifdef PARTITA_HAVE_TUBE1D
   r.solvers.add("tube1d-fluid",

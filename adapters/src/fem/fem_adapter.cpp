@@ -56,11 +56,13 @@ std::shared_ptr<Spec> make_spec() {
   mesh->choice("element", "element type of the box mesh (Gmsh files carry their own)",
                {"hex8", "hex20", "tet4", "tet10"})
       .def("hex8");
-  mesh->choice(
-          "hex8",
-          "Hex8 formulation: incompatible modes (no shear or volumetric locking) or plain full "
-          "integration",
-          {"incompatible-modes", "full"})
+  mesh->choice("hex8",
+               "Hex8 formulation: incompatible modes (linear path: no shear or volumetric locking; "
+               "the nonlinear path has no incompatible modes and integrates such a Hex8 plainly), "
+               "full (plain 2x2x2: locks in bending and for nu -> 0.5) or f-bar (nonlinear path "
+               "only: F_bar = (J_bar/J)^(1/3) F, no volumetric locking, still stiff in bending of "
+               "thin plates)",
+               {"incompatible-modes", "full", "f-bar"})
       .def("incompatible-modes");
   mesh->one_of({"box", "gmsh"});
 
@@ -150,7 +152,11 @@ std::shared_ptr<Spec> make_spec() {
   auto newmark = std::make_shared<Spec>("newmark", "Newmark parameters");
   newmark->real("beta", "beta (1/4: average acceleration)").positive().max(0.5).def(0.25);
   newmark->real("gamma", "gamma (1/2: no numerical damping)").min(0.5).max(1.0).def(0.5);
-  auto rayleigh = std::make_shared<Spec>("rayleigh", "Rayleigh damping C = alpha M + beta K");
+  auto rayleigh = std::make_shared<Spec>(
+      "rayleigh",
+      "Rayleigh damping C = alpha M + beta K0, K0 the stiffness at rest (nonlinear materials: "
+      "the tangent at u = 0); beta lowers the central-difference stable step to (2/omega_max)"
+      "(sqrt(1 + xi^2) - xi), xi = beta omega_max / 2");
   rayleigh->real("alpha", "mass-proportional coefficient").unit("1/s").non_negative().def(0.0);
   rayleigh->real("beta", "stiffness-proportional coefficient").unit("s").non_negative().def(0.0);
   auto analysis = std::make_shared<Spec>("analysis", "static or transient analysis");
@@ -189,6 +195,13 @@ std::shared_ptr<Spec> make_spec() {
       .min(0)
       .def(8);
   nonlinear->integer("line_search_steps", "backtracking halvings of a Newton step").min(0).def(6);
+  nonlinear
+      ->choice("line_search",
+               "what a line-search step must lower: residual (|R|) or energy (|R| or the energy "
+               "slope |du . R| to 0.8 of the step's start: needed near incompressibility, "
+               "nu > ~0.45, where full Newton steps raise |R|)",
+               {"residual", "energy"})
+      .def("residual");
   analysis->section("nonlinear", "Newton solver of the nonlinear materials", nonlinear);
 
   auto s =
@@ -254,7 +267,11 @@ std::shared_ptr<const fem::MaterialLaw> build_law(const Node& mat) {
     std::vector<std::pair<double, double>> points;
     for (const Node& p : mat["hardening_table"].items())
       points.emplace_back(p.real("plastic_strain"), p.real("yield_stress"));
-    return make(fem::HardeningCurve::tabulated(points));
+    try {
+      return make(fem::HardeningCurve::tabulated(points));
+    } catch (const fem::Error& error) {
+      mat["hardening_table"].fail(error.what());  // at the table's line, not the participant's
+    }
   }
   if (!mat.has("yield_stress"))
     mat.fail(model +
@@ -337,9 +354,15 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
                            mat.real("density")};
     fem::Model model(std::move(mesh), material);
     if (auto law = build_law(mat)) model.set_material_law(std::move(law));
-    model.set_hex8_formulation(c["mesh"].string("hex8") == "full"
-                                   ? fem::Hex8Formulation::Full
-                                   : fem::Hex8Formulation::IncompatibleModes);
+    const std::string hex8 = c["mesh"].string("hex8");
+    model.set_hex8_formulation(hex8 == "full"    ? fem::Hex8Formulation::Full
+                               : hex8 == "f-bar" ? fem::Hex8Formulation::FBar
+                                                 : fem::Hex8Formulation::IncompatibleModes);
+    if (hex8 == "f-bar" && model.is_linear())
+      c["mesh"]["hex8"].fail(
+          "hex8: f-bar is an element of the nonlinear path; with material model linear-elastic "
+          "use hex8: incompatible-modes (the default, which does not lock), or choose a "
+          "nonlinear material.model");
     const auto sets = model.mesh().node_set_names();
     const auto faces = model.mesh().face_names();
 
@@ -409,6 +432,7 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     options.newton.load_steps = static_cast<int>(nl.integer("load_steps"));
     options.newton.max_cutbacks = static_cast<int>(nl.integer("max_cutbacks"));
     options.newton.max_line_search_steps = static_cast<int>(nl.integer("line_search_steps"));
+    options.newton.energy_line_search = nl.string("line_search") == "energy";
     solver_ = std::make_unique<fem::StructuralSolver>(std::move(model), options);
     {
       Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -710,6 +734,7 @@ std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::stri
   if (wanted("external_work")) m.push_back({"external_work", "J", solver_->external_work()});
   if (wanted("damping_work")) m.push_back({"damping_work", "J", solver_->damping_work()});
   if (wanted("energy_balance")) m.push_back({"energy_balance", "J", solver_->energy_balance()});
+  m.push_back({"newton_iterations", "", static_cast<double>(solver_->newton_iterations())});
   if (names.empty()) return m;
   std::vector<MonitorValue> out;
   for (auto& v : m)

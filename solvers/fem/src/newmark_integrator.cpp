@@ -7,7 +7,7 @@
 namespace partita::fem {
 namespace {
 
-// R(u_1) = F_1 - f_int(u_1) - M (a_1 + alpha v_1) on the free dofs, with
+// R(u_1) = F_1 - f_int(u_1) - M (a_1 + alpha v_1) - beta_R K0 v_1 on the free dofs, with
 // a_1 = c0 (u_1 - u) - c2 v - c3 a and v_1 = v + dt ((1 - gamma) a + gamma a_1).
 class NewmarkProblem final : public NonlinearProblem {
  public:
@@ -26,12 +26,18 @@ class NewmarkProblem final : public NonlinearProblem {
     s_.dofs().scatter_free(x, u1_);
     s_.internal_forces().evaluate(u1_, f_int_, k != nullptr ? &k_full_ : nullptr);
     velocity_acceleration(v1_, a1_);
-    const double alpha = s_.mass_damping();
+    const double alpha = s_.mass_damping(), beta_r = s_.stiffness_damping();
     const SparseMatrix& m = s_.mass();
-    s_.dofs().gather_free(f1_ - f_int_ - m * (a1_ + alpha * v1_), r);
+    if (beta_r == 0.0) {
+      s_.dofs().gather_free(f1_ - f_int_ - m * (a1_ + alpha * v1_), r);
+    } else {
+      s_.dofs().gather_free(
+          f1_ - f_int_ - m * (a1_ + alpha * v1_) - beta_r * (s_.damping_stiffness() * v1_), r);
+    }
     if (k == nullptr) return;
-    // K = K_t + (c0 + alpha gamma c2) M
+    // K = K_t + (c0 + alpha gamma c2) M + beta_R gamma c2 K0   (d v_1 / d u_1 = gamma c2)
     k_full_ += (c0_ + alpha * gamma_ * c2_) * m;
+    if (beta_r != 0.0) k_full_ += (beta_r * gamma_ * c2_) * s_.damping_stiffness();
     s_.dofs().split(k_full_, *k, k_fc_);
   }
 
@@ -58,6 +64,7 @@ bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, doub
   system.dofs().gather_free(u1, x);
   NewmarkProblem problem(system, kin, f1, u1, beta_, gamma_, dt);
   last_ = newton_.solve(problem, x, std::max(f1.norm(), 1e-300));
+  step_iterations_ += last_.iterations;
   if (!last_.converged) return false;
   system.dofs().scatter_free(x, u1);
   Eigen::VectorXd f_int, v1, a1;
@@ -66,7 +73,12 @@ bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, doub
   problem.velocity_acceleration(v1, a1);
   // prescribed dofs: Newmark velocity and acceleration of the prescribed motion
   const Eigen::VectorXd v_mid = 0.5 * (kin.v + v1);
+  // dt v_mid . C v_mid: exact for average acceleration (the mean of the equations at n and
+  // n+1 times u_1 - u = dt v_mid)
   kin.damping_work += dt * system.mass_damping() * v_mid.dot(system.mass() * v_mid);
+  if (system.stiffness_damping() != 0.0)
+    kin.damping_work +=
+        dt * system.stiffness_damping() * v_mid.dot(system.damping_stiffness() * v_mid);
   kin.external_work += 0.5 * (kin.f + f1).dot(u1 - kin.u);
   kin.u = u1;
   kin.v = v1;
@@ -93,6 +105,7 @@ void NewmarkIntegrator::step_with_cutback(StructuralSystem& system, Kinematics& 
 }
 
 void NewmarkIntegrator::step(StructuralSystem& system, Kinematics& kin, double dt) {
+  step_iterations_ = 0;
   step_with_cutback(system, kin, dt, 0);
 }
 

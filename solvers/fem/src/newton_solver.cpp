@@ -11,7 +11,7 @@ NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
                                  double reference_force) {
   NewtonReport rep;
   Eigen::VectorXd r, r_trial, dx, x_trial;
-  SparseMatrix k, k_trial;
+  SparseMatrix k;
   try {
     problem.residual(x, r, &k);
   } catch (const Error& e) {
@@ -23,6 +23,7 @@ NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
   rep.reference_force = std::max(reference_force, r_norm);
   const double force_tol = options_.force_tolerance * rep.reference_force;
   double energy_0 = -1.0;
+  bool k_current = true;  // k is the tangent at x (trial points are evaluated without it)
   for (int it = 0;; ++it) {
     if (!std::isfinite(r_norm)) {
       rep.failure = "the residual is not finite";
@@ -34,6 +35,12 @@ NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
       rep.converged = true;
       rep.iterations = it;
       return rep;
+    }
+    if (!k_current) {
+      // the tangent at the accepted point, only when another iteration needs it (the residual
+      // is the same; the last, converged evaluation skips the tangent)
+      problem.residual(x, r, &k);
+      k_current = true;
     }
     if (it == options_.max_iterations) {
       std::ostringstream msg;
@@ -60,21 +67,24 @@ NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
     // energy norm |dx . R|
     const double energy = std::abs(dx.dot(r));
     if (energy_0 < 0.0) energy_0 = energy;
-    // backtracking line search on |R(x + s dx)|
+    // backtracking line search: accept s where |R(x + s dx)| decreases or (energy line search,
+    // see NewtonOptions) where the energy slope along dx, g(s) = dx . R(x + s dx), has fallen
+    // to 0.8 |g(0)|
     double s = 1.0;
     bool accepted = false;
     for (int ls = 0; ls <= options_.max_line_search_steps; ++ls, s *= 0.5) {
       x_trial = x + s * dx;
       try {
-        problem.residual(x_trial, r_trial, &k_trial);
+        problem.residual(x_trial, r_trial, nullptr);
       } catch (const Error&) {
         continue;  // inadmissible trial (inverted element): shorter step
       }
       const double n_trial = r_trial.norm();
       if (!std::isfinite(n_trial)) continue;
       // accept a decrease, or the full step when |R| is already at round-off level
-      if (n_trial <= (1.0 - 1e-4 * s) * r_norm || ls == options_.max_line_search_steps ||
-          (s == 1.0 && n_trial <= force_tol)) {
+      if (n_trial <= (1.0 - 1e-4 * s) * r_norm ||
+          (options_.energy_line_search && std::abs(dx.dot(r_trial)) <= 0.8 * energy) ||
+          ls == options_.max_line_search_steps || (s == 1.0 && n_trial <= force_tol)) {
         accepted = true;
         break;
       }
@@ -86,7 +96,7 @@ NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
     }
     x.swap(x_trial);
     r.swap(r_trial);
-    k.swap(k_trial);
+    k_current = false;
     r_norm = r.norm();
     rep.residual_norms.push_back(r_norm);
     rep.energy_norms.push_back(s * energy);

@@ -44,10 +44,10 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
   if (options_.integrator == Integrator::CentralDifference && options_.mass != MassType::Lumped) {
     throw Error("the central-difference integrator needs a lumped mass (mass: lumped)");
   }
-  if (!model_.is_linear() && options_.rayleigh_beta != 0.0) {
+  if (model_.is_linear() && model_.hex8_formulation() == Hex8Formulation::FBar) {
     throw Error(
-        "stiffness-proportional Rayleigh damping (beta) is only available for linear-elastic "
-        "models; use mass-proportional damping (alpha) with nonlinear materials");
+        "the F-bar Hex8 is an element of the nonlinear path (neo-hooke, j2-plasticity, ...); a "
+        "linear-elastic model uses the incompatible-mode Hex8, which does not lock");
   }
   ndof_ = 3 * mesh().num_nodes();
   const auto n = static_cast<Eigen::Index>(ndof_);
@@ -66,6 +66,12 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
     auto op = std::make_unique<NonlinearOperator>(model_);
     nonlinear_ = op.get();
     operator_ = std::move(op);
+    if (options_.rayleigh_beta != 0.0) {
+      // K0 = K_t(u = 0) with the initial history, symmetrised: the damping stiffness
+      Eigen::VectorXd f0;
+      operator_->evaluate(Eigen::VectorXd::Zero(n), f0, &k0_);
+      k0_ = 0.5 * (SparseMatrix(k0_.transpose()) + k0_);
+    }
     timings_.assembly += seconds_since(t0);
   }
   assemble_loads();
@@ -392,6 +398,7 @@ void check_factorisation(
 
 void StructuralSolver::solve_static() {
   const auto t0 = Clock::now();
+  last_was_static_ = true;
   if (nonlinear_ != nullptr) {
     static_.solve(*this, kin_, kin_.time);
     refresh_internal_force();
@@ -448,8 +455,7 @@ void StructuralSolver::initialise_acceleration() {
     refresh_internal_force();
     r = kin_.f - kin_.f_int;
   }
-  if (options_.rayleigh_alpha != 0.0) r -= options_.rayleigh_alpha * (m_ * kin_.v);
-  if (options_.rayleigh_beta != 0.0) r -= options_.rayleigh_beta * (k_ * kin_.v);
+  add_damping_force(kin_.v, -1.0, r);
   Eigen::VectorXd rf(static_cast<Eigen::Index>(dofs_.free_dofs().size()));
   for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
     rf[static_cast<Eigen::Index>(k)] = r[dofs_.free_dofs()[k]];
@@ -499,6 +505,7 @@ void StructuralSolver::step(double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt))
     throw Error("step(dt): dt must be > 0, got " + std::to_string(dt));
   assemble_mass();
+  last_was_static_ = false;
   if (options_.integrator == Integrator::CentralDifference || nonlinear_ != nullptr) {
     const auto t0 = Clock::now();
     if (options_.integrator == Integrator::CentralDifference) {
@@ -587,8 +594,7 @@ Vec3 StructuralSolver::reaction(const std::string& node_set) const {
           : Eigen::VectorXd(k_ * kin_.u - kin_.f);
   if (mass_ready_) {
     r += m_ * kin_.a;
-    if (options_.rayleigh_alpha != 0.0) r += options_.rayleigh_alpha * (m_ * kin_.v);
-    if (options_.rayleigh_beta != 0.0) r += options_.rayleigh_beta * (k_ * kin_.v);
+    add_damping_force(kin_.v, 1.0, r);
   }
   Vec3 sum = Vec3::Zero();
   for (auto n : nodes) sum += r.segment<3>(3 * static_cast<Eigen::Index>(n));
@@ -664,6 +670,16 @@ double StructuralSolver::plastic_work() const {
 double StructuralSolver::energy_balance() const {
   // W_ext - (W_strain + E_kin + W_plastic + W_damping)
   return external_work() - (strain_energy() + kinetic_energy() + plastic_work() + damping_work());
+}
+
+int StructuralSolver::newton_iterations() const {
+  if (nonlinear_ == nullptr) return 0;
+  if (last_was_static_) {
+    int n = 0;
+    for (const auto& r : static_.reports()) n += r.iterations;
+    return n;
+  }
+  return options_.integrator == Integrator::Newmark ? newmark_.step_iterations() : 0;
 }
 
 Eigen::VectorXd StructuralSolver::equivalent_plastic_strain() const {
@@ -747,7 +763,21 @@ double StructuralSolver::stable_time_step() const {
                              .maxCoeff());
   }
   stable_step_ = omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
+  if (omega2 > 0.0 && options_.rayleigh_beta > 0.0) {
+    // dt <= (2 / omega)(sqrt(1 + xi^2) - xi), xi = beta omega / 2: decreasing in omega, so the
+    // bound on omega_max bounds the step
+    const double xi = 0.5 * options_.rayleigh_beta * std::sqrt(omega2);
+    stable_step_ *= std::sqrt(1.0 + xi * xi) - xi;
+  }
   return stable_step_;
+}
+
+void StructuralSolver::add_damping_force(const Eigen::VectorXd& v, double sign,
+                                         Eigen::VectorXd& r) const {
+  // r += sign (alpha M + beta K0) v
+  if (options_.rayleigh_alpha != 0.0) r += (sign * options_.rayleigh_alpha) * (m_ * v);
+  if (options_.rayleigh_beta != 0.0)
+    r += (sign * options_.rayleigh_beta) * ((nonlinear_ != nullptr ? k0_ : k_) * v);
 }
 
 void StructuralSolver::refresh_internal_force() {

@@ -7,6 +7,7 @@
 #include "partita/fem/box_mesher.hpp"
 #include "partita/fem/element_topology.hpp"
 #include "partita/fem/mesh.hpp"
+#include "partita/fem/structural_solver.hpp"
 
 namespace partita::fem::test {
 
@@ -60,6 +61,25 @@ inline void distort_interior(Mesh& mesh, const BoxSpec& spec, double amount,
     mesh.set_node(i, x);
   }
   straighten_edges(mesh);
+}
+
+// Explicit stability probe of a rod along x: one step of dt under random axial nodal forces
+// (random initial accelerations), then `steps` free steps; true when the motion grew beyond
+// 1e3 times its size after the kick (unstable) or stopped being finite.
+inline bool axial_kick_grows(StructuralSolver& s, double dt, int steps) {
+  Lcg rng(1);
+  std::vector<std::size_t> nodes;
+  MatrixX3 f(static_cast<Eigen::Index>(s.mesh().num_nodes()), 3);
+  for (std::size_t i = 0; i < s.mesh().num_nodes(); ++i) {
+    nodes.push_back(i);
+    f.row(static_cast<Eigen::Index>(i)) = Vec3(1e3 * rng.next(), 0, 0).transpose();
+  }
+  s.set_nodal_forces(nodes, f);
+  s.step(dt);
+  s.clear_coupling_loads();
+  const double u0 = s.max_displacement();
+  for (int k = 0; k < steps; ++k) s.step(dt);
+  return !s.displacement().allFinite() || !(s.max_displacement() < 1e3 * u0);
 }
 
 }  // namespace partita::fem::test

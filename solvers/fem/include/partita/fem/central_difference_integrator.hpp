@@ -5,8 +5,9 @@ namespace partita::fem {
 
 // Explicit central differences with a lumped (diagonal) mass, in velocity-Verlet form:
 //   v_1/2 = v + dt/2 a,   u_1 = u + dt v_1/2  (u_c = g(t + dt)),
-//   M a_1 + C v_1 = F_1 - f_int(u_1),  v_1 = v_1/2 + dt/2 a_1
-//   => a_1 = (M^-1 (F_1 - f_int(u_1)) - alpha v_1/2) / (1 + alpha dt/2)  per free dof;
+//   M a_1 + alpha M v_1 + beta K0 v_1/2 = F_1 - f_int(u_1),  v_1 = v_1/2 + dt/2 a_1
+//   => a_1 = (M^-1 (F_1 - f_int(u_1) - beta K0 v_1/2) - alpha v_1/2) / (1 + alpha dt/2)
+//   per free dof (the mass-proportional part implicit, the stiffness-proportional one lagged);
 // prescribed dofs: v_1 = (u_1 - u) / dt, a_1 = 0. The history is committed every step.
 // Stable for dt <= 2 / omega_max (see StructuralSolver::stable_time_step()). The state at full
 // steps (u, v, a) is all it needs: restoring it continues bit-identically.
@@ -17,7 +18,7 @@ class CentralDifferenceIntegrator {
   void initialise(StructuralSystem& system, Kinematics& kin);
 
  private:
-  Eigen::VectorXd v_half_, f1_, u1_, m_;
+  Eigen::VectorXd v_half_, f1_, u1_, m_, cv_;
 };
 
 }  // namespace partita::fem

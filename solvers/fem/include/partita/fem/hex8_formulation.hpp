@@ -10,6 +10,11 @@ namespace partita::fem {
 //     per element (the "QM6" element). Removes shear locking in bending and volumetric locking
 //     up to nu ~ 0.49.
 //   Full: plain 2x2x2 Gauss (locks in bending; as CalculiX's C3D8), for comparison.
-enum class Hex8Formulation { IncompatibleModes, Full };
+//   FBar: the nonlinear path's Hex8 against volumetric locking: F_bar = (J_bar / J)^(1/3) F at
+//     each of the 2x2x2 points (de Souza Neto, Peric, Dutko & Owen 1996, with the element's
+//     volume ratio J_bar = v / V in place of det F at the centre), internal force and tangent
+//     the derivatives of int W(F_bar) dV (see NonlinearOperator). The linear path rejects it
+//     (its incompatible-mode Hex8 does not lock).
+enum class Hex8Formulation { IncompatibleModes, Full, FBar };
 
 }  // namespace partita::fem

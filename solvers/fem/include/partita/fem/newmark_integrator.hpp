@@ -9,8 +9,8 @@ namespace partita::fem {
 // Implicit Newmark for a nonlinear structure, Newton on the displacement u_1 at t + dt:
 //   a_1 = (u_1 - u - dt v) / (beta dt^2) - (1/(2 beta) - 1) a,
 //   v_1 = v + dt ((1 - gamma) a + gamma a_1),
-//   R(u_1) = F_1 - f_int(u_1) - M a_1 - C v_1 = 0 (free dofs),
-//   tangent K_t + (1/(beta dt^2) + alpha gamma/(beta dt)) M.
+//   R(u_1) = F_1 - f_int(u_1) - M a_1 - C v_1 = 0 (free dofs), C = alpha M + beta_R K0,
+//   tangent K_t + (1/(beta dt^2) + alpha gamma/(beta dt)) M + beta_R gamma/(beta dt) K0.
 // A step whose Newton fails is split in two halves, recursively (max_cutbacks levels); after
 // that it throws Error with the time, the step size and the residual. The history is committed
 // after each accepted (sub)step. Needs a valid acceleration at the start.
@@ -19,6 +19,8 @@ class NewmarkIntegrator {
   NewmarkIntegrator(double beta, double gamma, NewtonOptions options = {});
   void step(StructuralSystem& system, Kinematics& kin, double dt);
   const NewtonReport& last_report() const { return last_; }
+  // Newton iterations of the last step(), summed over its cut-back substeps and failed tries.
+  int step_iterations() const { return step_iterations_; }
 
  private:
   bool try_step(StructuralSystem& system, Kinematics& kin, double dt);
@@ -26,6 +28,7 @@ class NewmarkIntegrator {
   double beta_, gamma_;
   NewtonSolver newton_;
   NewtonReport last_;
+  int step_iterations_ = 0;
 };
 
 }  // namespace partita::fem

@@ -11,6 +11,13 @@ struct NewtonOptions {
   double energy_tolerance = 1e-14;
   // Backtracking line search: halve the step while |R(x + s dx)| > (1 - 1e-4 s) |R(x)|.
   int max_line_search_steps = 6;
+  // Also accept a step where the energy slope along dx has fallen, |dx . R(x + s dx)| <=
+  // 0.8 |dx . R(x)| (Crisfield's line-search tolerance). Nearly incompressible solids need it:
+  // there the full Newton step of an increment raises |R| (dominated by the stiff volumetric
+  // part) while it lowers the energy, and the |R| test alone halves it into linear convergence
+  // (Cook's membrane at nu = 0.499: hundreds of cut-backs without, 8 iterations per load step
+  // with it). Off by default: it changes the path of the iterates of existing analyses.
+  bool energy_line_search = false;
   // Static analyses: the load (from the current state to the target) in this many equal
   // increments; a failed increment is halved, at most max_cutbacks times in a row.
   // Implicit dynamics: a failed time step is split in two, at most max_cutbacks levels deep.

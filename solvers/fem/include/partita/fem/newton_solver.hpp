@@ -12,6 +12,8 @@ namespace partita::fem {
 //   K(x_k) dx = R(x_k),  x_k+1 = x_k + s dx  (s = 1, 1/2, ... while |R| does not decrease),
 // converged on the force norm and the energy norm (NewtonOptions). The tangent is factorised
 // by a sparse LDL^T whose symbolic analysis is kept while the sparsity pattern is unchanged.
+// Trial points of the line search are evaluated without the tangent; it is computed at the
+// accepted point only when another iteration follows (the converged one never needs it).
 // Never throws for non-convergence: the report says what happened, the caller cuts back.
 class NewtonSolver {
  public:

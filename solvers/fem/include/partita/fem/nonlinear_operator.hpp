@@ -3,6 +3,7 @@
 #include <memory>
 #include <vector>
 
+#include "partita/fem/element_integrator.hpp"
 #include "partita/fem/internal_force_operator.hpp"
 #include "partita/fem/material_law.hpp"
 #include "partita/fem/model.hpp"
@@ -16,9 +17,25 @@ class BlockAssembler;
 //   K_(a i)(b k) = int_Omega0 dN_a/dX_J A_iJkL dN_b/dX_L dV.
 // Small-strain laws return sigma(sym(F - I)) as P, which makes this the linear-geometry
 // operator for them. Quadrature: the full (stiffness) rule of each element (Hex8 2x2x2, Hex20
-// 3x3x3, Tet4 1, Tet10 4 points); plain displacement elements (no incompatible modes, no
-// F-bar): use Hex20 or Tet10 for bending of thin parts and for near-incompressible flow.
+// 3x3x3, Tet4 1, Tet10 4 points). Plain displacement elements unless the model's Hex8
+// formulation is FBar; plain Hex8 locks in bending of thin parts and near-incompressible flow.
 // Regions without a law use a LinearElasticLaw of their Material.
+//
+// F-bar Hex8 (Hex8Formulation::FBar): at each point F_bar = (J_bar / J)^(1/3) F, J = det F,
+// J_bar = (1/V) int J dV the element's volume ratio (de Souza Neto, Peric, Dutko & Owen 1996,
+// Int. J. Solids Struct. 33, 3277-3296, use det F at the centre; the volume ratio makes a
+// homogeneous deformation exact on distorted elements too: the patch test). The isochoric part
+// of F_bar is that of F; its volume change is the element's mean: the volumetric energy sees
+// one dilatation per element (no volumetric locking). Internal force and tangent are the first
+// and second derivatives of Pi = int W(F_bar) dV (a variational form of F-bar), with
+//   d F_bar = s (d F + F (x) (d ln J_bar - d ln J) / 3),  s = (J_bar / J)^(1/3):
+//   f = int B_bar^T P_bar dV,  K = int B_bar^T A B_bar + s (e c^T + c e^T
+//        + (F : P_bar)(e e^T + (H_bar - H) / 3)) dV,
+// e = (d ln J_bar - d ln J) / 3, c = dF/du^T P_bar, H = d^2 ln J, H_bar = d^2 ln J_bar.
+// For a hyperelastic law K is the Hessian of Pi: symmetric, so the LDL^T Newton solver applies
+// unchanged, and the work of f_int is stored as int W(F_bar) dV (the energy balance closes).
+// de Souza Neto's own form, int sigma(F_bar) : grad_x(dv) dv, has an unsymmetric tangent and no
+// potential; it would need an LU factorisation and an energy monitor of its own.
 class NonlinearOperator final : public InternalForceOperator {
  public:
   explicit NonlinearOperator(const Model& model);
@@ -32,6 +49,7 @@ class NonlinearOperator final : public InternalForceOperator {
   void set_committed_state(const std::vector<double>& state) override;
 
   std::size_t num_quadrature_points() const { return weight_.size(); }
+  bool fbar_hex8() const { return fbar_hex8_; }
   // Per quadrature point, at the last evaluate(): Cauchy stress sigma = P F^T / J (Voigt xx yy
   // zz xy yz zx) and the equivalent plastic strain of the trial history.
   const MatrixX6& cauchy_stress() const { return cauchy_; }
@@ -40,7 +58,15 @@ class NonlinearOperator final : public InternalForceOperator {
   const std::vector<std::size_t>& element_qp_offsets() const { return qp_offset_; }
 
  private:
+  using ElementDisplacements = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
+  // One element's fe and, when ke != nullptr, ke (zeroed by the caller); adds to the energy,
+  // writes the points' stresses and trial history. Plain: the element's own rule; F-bar: Hex8.
+  void evaluate_plain(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
+                      ElementMatrix* ke);
+  void evaluate_fbar(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
+                     ElementMatrix* ke);
   const Mesh& mesh_;
+  bool fbar_hex8_ = false;
   std::vector<std::shared_ptr<const MaterialLaw>> region_laws_;
   std::vector<const MaterialLaw*> element_law_;
   std::vector<std::size_t> qp_offset_;        // per element

@@ -15,9 +15,14 @@ struct SolverOptions {
   double newmark_beta = 0.25;
   double newmark_gamma = 0.5;
   MassType mass = MassType::Consistent;
-  // Rayleigh damping C = alpha M + beta K.
+  // Rayleigh damping C = alpha M + beta K0. K0 is the stiffness at rest: the assembled K on the
+  // linear path, the tangent of the nonlinear operator at u = 0 with the initial history on the
+  // nonlinear path (symmetrised). A constant K0 keeps the damping force linear in v, so the
+  // Newmark tangent gains a constant beta gamma / (beta_N dt) K0 and the damping work
+  // dt v_mid . C v_mid is exact for average acceleration; a current-tangent K_t(u) would make
+  // the damping depend on the deformation (and vanish or turn negative where K_t softens).
   double rayleigh_alpha = 0.0;
-  double rayleigh_beta = 0.0;  // linear path only (the nonlinear path rejects it)
+  double rayleigh_beta = 0.0;
   Integrator integrator = Integrator::Newmark;
   // Newton, load stepping and cut-back of the nonlinear path.
   NewtonOptions newton;

@@ -91,10 +91,14 @@ class StructuralSolver final : private StructuralSystem {
   void solve_static();
   // One step from time() to time() + dt: Newmark (linear or Newton) or central difference.
   void step(double dt);
-  // Largest stable explicit step (lumped mass, undamped): 2 / omega_max with omega_max bounded
-  // by the largest element eigenfrequency (element eigenvalue theorem), the elements' K and M
-  // at rest restricted to their free dofs. Never above the true limit of the linearised mesh;
-  // measured 0.66-1.0 of the observed limit (see README). Computed once and cached.
+  // Largest stable explicit step (lumped mass): 2 / omega_max with omega_max bounded by the
+  // largest element eigenfrequency (element eigenvalue theorem), the elements' K and M at rest
+  // restricted to their free dofs. Never above the true limit of the linearised mesh; measured
+  // 0.66-1.0 of the observed limit (see README). With stiffness-proportional damping (beta > 0,
+  // its force lagged by half a step) the limit is (2 / omega_max)(sqrt(1 + xi^2) - xi) with
+  // xi = beta omega_max / 2 (Belytschko, Liu & Moran, Nonlinear Finite Elements for Continua
+  // and Structures, 2000, chapter 6); mass-proportional damping is integrated implicitly and
+  // does not lower it. Computed once and cached.
   double stable_time_step() const;
   // Quasi-static step: time() += dt, then solve_static() with the loads at the new time.
   void step_static(double dt);
@@ -147,6 +151,9 @@ class StructuralSolver final : private StructuralSystem {
   // Newton reports of the last nonlinear static solve / Newmark step.
   const std::vector<NewtonReport>& static_reports() const { return static_.reports(); }
   const NewtonReport& newmark_report() const { return newmark_.last_report(); }
+  // Newton iterations of the last step() or solve_static() of the nonlinear path (all load
+  // steps, cut-backs and failed tries); 0 on the linear path and for central difference.
+  int newton_iterations() const;
 
  private:
   using Factorisation = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
@@ -174,6 +181,10 @@ class StructuralSolver final : private StructuralSystem {
   const SparseMatrix& mass() override;
   bool lumped_mass() const override { return options_.mass == MassType::Lumped; }
   double mass_damping() const override { return options_.rayleigh_alpha; }
+  double stiffness_damping() const override { return options_.rayleigh_beta; }
+  const SparseMatrix& damping_stiffness() override { return nonlinear_ != nullptr ? k0_ : k_; }
+  // r += sign C v with C = alpha M + beta K0 (M assembled).
+  void add_damping_force(const Eigen::VectorXd& v, double sign, Eigen::VectorXd& r) const;
   void external_force(double t, Eigen::VectorXd& f) const override;
   void apply_prescribed(double t, Eigen::VectorXd& u) const override;
   void factorise_dynamic(double dt);
@@ -189,6 +200,7 @@ class StructuralSolver final : private StructuralSystem {
 
   // matrices (full and partitioned)
   SparseMatrix k_, m_, k_ff_, k_fc_, m_ff_, m_fc_, keff_fc_;
+  SparseMatrix k0_;  // nonlinear path with rayleigh_beta > 0: K0 of C = alpha M + beta K0
   bool mass_ready_ = false;
   std::unique_ptr<Factorisation> static_factor_, dynamic_factor_;
   double factor_dt_ = -1.0;
@@ -212,7 +224,8 @@ class StructuralSolver final : private StructuralSystem {
   NewmarkIntegrator newmark_;
   CentralDifferenceIntegrator central_;
   bool acceleration_valid_ = false;
-  struct Work {  // vectors of a dynamic step, kept between steps
+  bool last_was_static_ = false;  // newton_iterations(): of solve_static() or of step()
+  struct Work {                   // vectors of a dynamic step, kept between steps
     Eigen::VectorXd f1, pm, pc, rhs, uc, rf, uf, u1, a1;
   };
   Work work_;

@@ -9,7 +9,8 @@ namespace partita::fem {
 
 // What a time integrator sees of a structure:
 //   M a + C v + f_int(u) = F(t) on the free dofs,  u = g(t) on the constrained dofs,
-// with C = alpha M (mass-proportional damping). Vectors span all dofs (node-major).
+// with Rayleigh damping C = alpha M + beta K0, K0 the tangent stiffness at rest (u = 0, initial
+// history): a constant, linear damping (see SolverOptions). Vectors span all dofs (node-major).
 class StructuralSystem {
  public:
   virtual ~StructuralSystem() = default;
@@ -18,7 +19,10 @@ class StructuralSystem {
   // M over all dofs (assembled on first use); diagonal when lumped.
   virtual const SparseMatrix& mass() = 0;
   virtual bool lumped_mass() const = 0;
-  virtual double mass_damping() const = 0;  // alpha of C = alpha M
+  virtual double mass_damping() const = 0;       // alpha of C = alpha M + beta K0
+  virtual double stiffness_damping() const = 0;  // beta of C = alpha M + beta K0
+  // K0 over all dofs (the tangent at rest, symmetric); only asked for when beta != 0.
+  virtual const SparseMatrix& damping_stiffness() = 0;
   virtual void external_force(double t, Eigen::VectorXd& f) const = 0;
   // Writes g(t) into the constrained entries of u.
   virtual void apply_prescribed(double t, Eigen::VectorXd& u) const = 0;
