@@ -80,6 +80,7 @@ class DemAdapter : public Solver {
   std::string name_;
   dem::System system_;
   double time_step_fraction_ = 0.2;
+  bool time_step_fraction_auto_ = false;  // not given: from the restitutions in use
   dem::SystemState checkpoint_;
   bool has_checkpoint_ = false;
   std::vector<CouplingMesh> meshes_dem_;
