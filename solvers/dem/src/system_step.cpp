@@ -167,12 +167,15 @@ void System::compute_forces(double dt, bool update_history, double kick, bool st
 // each once, into its cross_force, then added by both owners in the same place of their sums.
 void System::evaluate_forces(double dt, bool update_history, double kick) {
   if (track_load_)
-    evaluate_forces_impl<true>(dt, update_history, kick);
+    if (h_load_limit_ >= 0)
+      evaluate_forces_impl<true, true>(dt, update_history, kick);
+    else
+      evaluate_forces_impl<true, false>(dt, update_history, kick);
   else
-    evaluate_forces_impl<false>(dt, update_history, kick);
+    evaluate_forces_impl<false, false>(dt, update_history, kick);
 }
 
-template <bool Load>
+template <bool Load, bool Limit>
 void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   Particles& p = store_.core();
   const NeighborList& nl = neighbors_;
@@ -187,8 +190,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   Eigen::Vector3d* const pair_shear = neighbors_.shear_.data();  // the pairs' histories
   char* const pair_touching = neighbors_.touching_.data();
   double* load = Load ? load_.data() : nullptr;
-  const double* load_limit =
-      Load && h_load_limit_ >= 0 ? store_.array<double>(h_load_limit_).data() : nullptr;
+  const double* load_limit = Limit ? store_.array<double>(h_load_limit_).data() : nullptr;
   const MeshContacts::History mesh_history{store_.array<int>(h_mesh_slot_count_).data(),
                                            store_.array<std::int64_t>(h_mesh_slot_key_).data(),
                                            store_.array<Eigen::Vector3d>(h_mesh_slot_shear_).data(),
@@ -268,7 +270,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         torque[i] = t;
         if constexpr (Load) {  // (i's load is complete: the pairs (k, i), k < i, came first)
           load[i] = load_i;
-          if (load_limit && load_i >= load_limit[i]) reached = true;
+          if constexpr (Limit) reached |= load_i >= load_limit[i];
         }
         if (kick > 0.0) {  // (no other row reads particle i any more in this pass)
           qi.v += (kick / qi.m) * f;

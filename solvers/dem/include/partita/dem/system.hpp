@@ -246,7 +246,8 @@ class System {
   int set_partition();
   // called inside a parallel region (orphaned omp for)
   void evaluate_forces(double dt, bool update_history, double kick);
-  template <bool Load>
+  // Load: record the contact loads; Limit: compare them with a hook's limits
+  template <bool Load, bool Limit>
   void evaluate_forces_impl(double dt, bool update_history, double kick);
   void reduce_wall_and_mesh_forces();  // wall totals and mesh forces of the last pass
   void start_load_pass(int parts);
