@@ -8,9 +8,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "../support/adapter_solver.hpp"
+#include "dem_adapter_support.hpp"
 
 using namespace partita;
+using partita::test::monitor;
 namespace fs = std::filesystem;
 
 namespace {
@@ -30,12 +31,6 @@ std::string dem_yaml(const std::string& breakage) {
          breakage;
 }
 
-std::unique_ptr<Solver> make(const std::string& yaml, const fs::path& out) {
-  return test::make_solver("dem", yaml, fs::path(PARTITA_SOURCE_DIR), out);
-}
-
-double monitor(const Solver& s, const std::string& name) { return test::monitor_value(s, name); }
-
 }  // namespace
 
 TEST_CASE("dem adapter: breakage keys are validated", "[adapters][dem][breakage]") {
@@ -43,11 +38,11 @@ TEST_CASE("dem adapter: breakage keys are validated", "[adapters][dem][breakage]
   const std::string ok =
       "breakage: {limit_strength: 1 MPa, reference_size: 2 mm, weibull_modulus: 3, "
       "comminution_limit: 1 mm";
-  CHECK_NOTHROW(make(dem_yaml(ok + "}\n"), out));
+  CHECK_NOTHROW(test::make_dem(dem_yaml(ok + "}\n"), out));
   for (const char* bad : {"weibull_modulus: 0", "weibull_modulus: -3"}) {
     std::string y = ok + "}\n";
     y.replace(y.find("weibull_modulus: 3"), 18, bad);
-    CHECK_THROWS_WITH(make(dem_yaml(y), out), Catch::Contains("weibull_modulus"));
+    CHECK_THROWS_WITH(test::make_dem(dem_yaml(y), out), Catch::Contains("weibull_modulus"));
   }
   for (const char* key : {"limit_strength", "reference_size", "comminution_limit"}) {
     std::string y = ok + "}\n";
@@ -55,15 +50,15 @@ TEST_CASE("dem adapter: breakage keys are validated", "[adapters][dem][breakage]
     const auto end = y.find_first_of(",}", at);
     y.replace(at, end - at, std::string(key) + ": -1");
     INFO(y);
-    CHECK_THROWS_WITH(make(dem_yaml(y), out), Catch::Contains(key));
+    CHECK_THROWS_WITH(test::make_dem(dem_yaml(y), out), Catch::Contains(key));
   }
-  CHECK_THROWS_WITH(make(dem_yaml(ok + ", pattern: apolonian-14}\n"), out),
+  CHECK_THROWS_WITH(test::make_dem(dem_yaml(ok + ", pattern: apolonian-14}\n"), out),
                     Catch::Contains("apollonian-14"));
-  CHECK_THROWS_WITH(make(dem_yaml(ok + ", mass: kept}\n"), out), Catch::Contains("restored"));
+  CHECK_THROWS_WITH(test::make_dem(dem_yaml(ok + ", mass: kept}\n"), out), Catch::Contains("restored"));
   // d_min above every particle: accepted (a warning says nothing can break)
   std::string big = ok + "}\n";
   big.replace(big.find("comminution_limit: 1 mm"), 23, "comminution_limit: 5 mm");
-  auto s = make(dem_yaml(big), out);
+  auto s = test::make_dem(dem_yaml(big), out);
   for (int k = 0; k < 200; ++k) s->advance(s->stable_time_step());
   CHECK(monitor(*s, "breakage.events") == 0.0);
 }
@@ -73,7 +68,7 @@ TEST_CASE("dem adapter: fragments lower the stable step, monitors and the gradin
   const fs::path out = fs::temp_directory_path() / "partita_dem_breakage_run";
   fs::create_directories(out / "vtk");
   // weak granules: they break when the bed lands on the floor
-  auto s = make(dem_yaml("breakage: {limit_strength: 0.2 MPa, reference_size: 2 mm, "
+  auto s = test::make_dem(dem_yaml("breakage: {limit_strength: 0.2 MPa, reference_size: 2 mm, "
                          "weibull_modulus: 3, comminution_limit: 0.5 mm, pattern: equal-4}\n"),
                 out);
   s->write_output(OutputFrame{out / "vtk", "p", 0, s->time()});

@@ -100,6 +100,7 @@ class DemAdapter : public Solver {
   std::string particles_file_ = "none";  // output.particles_file: none, end, every-output
   dem::System system_;
   double time_step_fraction_ = 0.2;
+  bool time_step_fraction_auto_ = false;  // not given: from the restitutions in use
   dem::SystemState checkpoint_;
   bool has_checkpoint_ = false;
   std::vector<CouplingMesh> meshes_dem_;

@@ -51,6 +51,18 @@ void Breakage::attach(System& system) {
   if (store.find("breakage_strength") >= 0)
     throw Error("add_hook: a breakage model is attached already (one per system)");
   h_strength_ = store.add_array<double>("breakage_strength", 1, -1.0);  // -1: not drawn yet
+  // -1: below any load (>= 0), so a new particle makes the next force pass report a reached
+  // limit and end_of_step() draws its strength
+  h_limit_ = store.add_array<double>("breakage_load_limit", 1, -1.0);
+}
+
+void Breakage::set_limit(System& system, std::size_t i, double strength) const {
+  ParticleStore& store = system.store_unsynced();
+  const double pi3 = std::numbers::pi * std::numbers::pi * std::numbers::pi;
+  store.array<double>(h_limit_)[i] =
+      2.0 * store.core().radius[i] >= parameters_.comminution_limit
+          ? 9.0 / 16.0 * pi3 * strength * strength * strength
+          : std::numeric_limits<double>::infinity();
 }
 
 double Breakage::characteristic_strength(double diameter) const {
@@ -81,15 +93,16 @@ void Breakage::end_of_step(System& system, double /*dt*/) {
   const std::vector<double>& load = system.contact_load();
   const std::size_t n = p.size();
   if (load.size() != n) return;  // no force pass since the set changed
-  // break when F (E'/r')^2 >= (9/16) pi^3 sigma^3 (eq. 2, see the class comment)
-  const double pi3 = std::numbers::pi * std::numbers::pi * std::numbers::pi;
-  const double k = 9.0 / 16.0 * pi3;
-  const double d_min = parameters_.comminution_limit;
+  if (!system.contact_load_reached()) return;  // (every load below its limit)
+  // break when F (E'/r')^2 >= (9/16) pi^3 sigma^3 (eq. 2, see the class comment), d >= d_min
+  const std::vector<double>& limit = store.array<double>(h_limit_);
   broken_.clear();
   for (std::size_t i = 0; i < n; ++i) {
-    double s = strength[i];
-    if (s < 0.0) strength[i] = s = draw_strength(p.id[i], 2.0 * p.radius[i]);
-    if (load[i] >= k * s * s * s && 2.0 * p.radius[i] >= d_min) broken_.push_back(i);
+    if (strength[i] < 0.0) {
+      strength[i] = draw_strength(p.id[i], 2.0 * p.radius[i]);
+      set_limit(system, i, strength[i]);
+    }
+    if (load[i] >= limit[i]) broken_.push_back(i);
   }
   if (!broken_.empty()) break_particles(system, broken_);
 }
@@ -205,8 +218,10 @@ void Breakage::break_particles(System& system, const std::vector<std::size_t>& i
   }
   ParticleStore& store = system.store_unsynced();
   std::vector<double>& strength = store.array<double>(h_strength_);
-  for (std::size_t k : added)
+  for (std::size_t k : added) {
     strength[k] = draw_strength(store.core().id[k], 2.0 * store.core().radius[k]);
+    set_limit(system, k, strength[k]);
+  }
   for (std::size_t k : added) released -= contact_energy(system, k);
   counters_.fragments += static_cast<std::int64_t>(added.size());
   counters_.energy_released += released;

@@ -17,12 +17,6 @@ namespace partita::dem {
 
 namespace {
 
-std::string vec_str(const Eigen::Vector3d& v) {
-  std::ostringstream s;
-  s << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return s.str();
-}
-
 std::uint64_t new_identity() {
   static std::atomic<std::uint64_t> next{1};
   return next.fetch_add(1, std::memory_order_relaxed);
@@ -33,7 +27,7 @@ std::uint64_t new_identity() {
 System::System() : identity_(new_identity()) {
   neighbors_.clear();
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
-  h_plane_shear_ = store_.add_array<Eigen::Vector3d>("plane_shear", 0, zero);
+  walls_.attach(store_);
   h_mesh_slot_count_ = store_.add_array<int>("mesh_slot_count", 1, 0);
   h_mesh_slot_key_ =
       store_.add_array<std::int64_t>("mesh_slot_key", max_mesh_contacts, std::int64_t{-1});
@@ -93,8 +87,8 @@ std::size_t System::add_particle(const Eigen::Vector3d& x, double radius, int ma
   }
   if (!x.allFinite() || !v.allFinite() || !w.allFinite()) {
     std::ostringstream msg;
-    msg << "add_particle " << index << ": position " << vec_str(x) << ", velocity " << vec_str(v)
-        << " and angular velocity " << vec_str(w) << " must be finite";
+    msg << "add_particle " << index << ": position " << vector_text(x) << ", velocity " << vector_text(v)
+        << " and angular velocity " << vector_text(w) << " must be finite";
     throw Error(msg.str());
   }
   model_.check_material(material, "add_particle " + std::to_string(index));
@@ -205,6 +199,13 @@ int System::add_hook(std::unique_ptr<StepHook> hook) {
   const int k = hooks_.add(std::move(hook));
   hooks_[k].attach(*this);
   track_load_ = track_load_ || hooks_[k].wants_contact_load();
+  if (const int h = hooks_[k].contact_load_limit(); h >= 0) {
+    if (h_load_limit_ >= 0)
+      throw Error("add_hook: '" + hooks_[k].name() +
+                  "' brings contact load limits and another hook has them already (one per "
+                  "system)");
+    h_load_limit_ = h;
+  }
   forces_valid_ = false;
   prepared_ = false;  // sizes the load array (the lists stay)
   return k;
@@ -213,47 +214,17 @@ int System::add_hook(std::unique_ptr<StepHook> hook) {
 int System::add_plane(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, int material,
                       const Eigen::Vector3d& velocity) {
   model_.check_material(material, "add_plane");
-  if (!(normal.norm() > 0.0) || !normal.allFinite() || !point.allFinite() ||
-      !velocity.allFinite()) {
-    throw Error("add_plane: need a finite point and velocity and a non-zero normal, got point " +
-                vec_str(point) + ", normal " + vec_str(normal));
-  }
-  PlaneWall plane;
-  plane.point = point;
-  plane.normal = normal.normalized();
-  plane.velocity = velocity;
-  plane.material = material;
-  plane.wall = wall_count_;
-  planes_.push_back(plane);
-  wall_force_.assign(wall_count_ + 1, Eigen::Vector3d::Zero());
+  const int wall = walls_.add_plane(point, normal, material, velocity);
   prepared_ = false;
   lists_current_ = false;
   forces_valid_ = false;
-  return wall_count_++;
+  return wall;
 }
 
 int System::add_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int material,
                     unsigned faces) {
   model_.check_material(material, "add_box");
-  if (!((hi - lo).array() > 0.0).all()) {
-    throw Error("add_box: need lo < hi in every direction, got lo " + vec_str(lo) + ", hi " +
-                vec_str(hi));
-  }
-  if ((faces & 0b111111u) == 0u) throw Error("add_box: the face mask selects no face");
-  const int wall = wall_count_;
-  for (int k = 0; k < 6; ++k) {
-    if (!(faces & (1u << k))) continue;
-    const int axis = k / 2;
-    PlaneWall plane;
-    plane.normal = Eigen::Vector3d::Zero();
-    plane.normal[axis] = (k % 2 == 0) ? 1.0 : -1.0;
-    plane.point = (k % 2 == 0) ? lo : hi;
-    plane.material = material;
-    plane.wall = wall;
-    planes_.push_back(plane);
-  }
-  ++wall_count_;
-  wall_force_.assign(wall_count_, Eigen::Vector3d::Zero());
+  const int wall = walls_.add_box(lo, hi, material, faces);
   prepared_ = false;
   lists_current_ = false;
   forces_valid_ = false;
@@ -261,13 +232,7 @@ int System::add_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int ma
 }
 
 void System::set_wall_velocity(int wall, const Eigen::Vector3d& velocity) {
-  if (wall < 0 || wall >= wall_count_) {
-    std::ostringstream msg;
-    msg << "set_wall_velocity: unknown wall id " << wall << "; ids are 0.." << wall_count_ - 1;
-    throw Error(msg.str());
-  }
-  for (PlaneWall& p : planes_)
-    if (p.wall == wall) p.velocity = velocity;
+  walls_.set_velocity(wall, velocity);
 }
 
 int System::add_mesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
@@ -351,7 +316,7 @@ double System::time_step_fraction() const {
   check_interactions();
   std::vector<bool> used(model_.material_count(), false), partner(model_.material_count(), false);
   for (int m : store_.core().material) used[m] = partner[m] = true;
-  for (const PlaneWall& p : planes_) partner[p.material] = true;
+  for (const PlaneWall& p : walls_.planes()) partner[p.material] = true;
   for (const TriangleMesh& m : meshes_) partner[m.material()] = true;
   double f = 0.2;
   for (int a = 0; a < model_.material_count(); ++a)
@@ -365,7 +330,7 @@ double System::time_step_fraction() const {
 void System::check_interactions() const {
   std::vector<bool> used(model_.material_count(), false), used_wall(model_.material_count(), false);
   for (int m : store_.core().material) used[m] = true;
-  for (const PlaneWall& p : planes_) used_wall[p.material] = true;
+  for (const PlaneWall& p : walls_.planes()) used_wall[p.material] = true;
   for (const TriangleMesh& m : meshes_) used_wall[m.material()] = true;
   for (int a = 0; a < model_.material_count(); ++a) {
     if (!used[a]) continue;
@@ -381,12 +346,7 @@ void System::check_interactions() const {
 
 void System::resize_histories() {
   const std::size_t n = store_.size();
-  const std::size_t np = planes_.size();
-  store_.set_width(h_plane_shear_, np);
-  wall_block_force_.assign(
-      ((n + ThreadPartition::block_size - 1) / ThreadPartition::block_size) * np,
-      Eigen::Vector3d::Zero());
-  wall_force_.resize(wall_count_, Eigen::Vector3d::Zero());
+  walls_.resize(store_, n);
   if (track_load_) load_.resize(n, 0.0);
 }
 
@@ -439,7 +399,7 @@ void System::reorder_particles() {
 
 void System::rebuild_lists() {
   sync_particles();
-  neighbors_.build(store_.core(), planes_, meshes_);
+  neighbors_.build(store_.core(), walls_.planes(), meshes_);
   partition_.invalidate();
   lists_current_ = true;
 }

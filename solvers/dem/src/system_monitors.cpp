@@ -32,7 +32,8 @@ double System::elastic_energy() const {
   sync_particles();
   const_cast<ContactModel&>(model_).update();
   const Particles& p = store_.core();
-  const std::vector<Eigen::Vector3d>& plane_shear = store_.array<Eigen::Vector3d>(h_plane_shear_);
+  const std::vector<Eigen::Vector3d>& plane_shear = walls_.shear(store_);
+  const std::vector<PlaneWall>& planes = walls_.planes();
   const std::vector<int>& slot_count = store_.array<int>(h_mesh_slot_count_);
   const std::vector<Eigen::Vector3d>& slot_shear =
       store_.array<Eigen::Vector3d>(h_mesh_slot_shear_);
@@ -56,13 +57,13 @@ double System::elastic_energy() const {
     for (int i = 0; i < n; ++i)
       for (int j = i + 1; j < n; ++j) e += pair_energy(i, j, no_shear);
   }
-  const std::size_t np = planes_.size();
+  const std::size_t np = planes.size();
   const bool have_shear = plane_shear.size() == p.size() * np;
   for (int i = 0; i < n; ++i)
     for (std::size_t k = 0; k < np; ++k) {
-      const double delta = p.radius[i] - (p.position[i] - planes_[k].point).dot(planes_[k].normal);
+      const double delta = p.radius[i] - (p.position[i] - planes[k].point).dot(planes[k].normal);
       if (delta <= 0.0) continue;
-      e += hertz_elastic_energy(model_.pair(p.material[i], planes_[k].material), delta, p.radius[i],
+      e += hertz_elastic_energy(model_.pair(p.material[i], planes[k].material), delta, p.radius[i],
                                 have_shear ? plane_shear[i * np + k] : no_shear);
     }
   for (int i = 0; i < n; ++i)
@@ -75,14 +76,7 @@ double System::elastic_energy() const {
   return e;
 }
 
-Eigen::Vector3d System::wall_force(int wall) const {
-  if (wall < 0 || wall >= wall_count_) {
-    std::ostringstream msg;
-    msg << "wall_force: unknown wall id " << wall << "; ids are 0.." << wall_count_ - 1;
-    throw Error(msg.str());
-  }
-  return wall_force_[wall];
-}
+Eigen::Vector3d System::wall_force(int wall) const { return walls_.wall_force(wall); }
 
 Eigen::Vector3d System::mesh_force(int mesh) const {
   check_mesh(mesh, "mesh_force");

@@ -104,8 +104,8 @@ void System::write_body(BinaryWriter& w) const {
   w.value(body_tag);
   // set-up that the state must fit
   w.value(static_cast<std::int32_t>(model_.material_count()));
-  w.value(static_cast<std::int32_t>(wall_count_));
-  w.value(static_cast<std::int64_t>(planes_.size()));
+  w.value(static_cast<std::int32_t>(walls_.wall_count()));
+  w.value(static_cast<std::int64_t>(walls_.planes().size()));
   w.value(static_cast<std::int64_t>(meshes_.size()));
   for (const TriangleMesh& m : meshes_) {
     w.value(static_cast<std::int64_t>(m.vertex_count()));
@@ -115,10 +115,10 @@ void System::write_body(BinaryWriter& w) const {
   for (int k = 0; k < hooks_.size(); ++k) w.string(hooks_[k].name());
   // particles with every registered array (histories with planes and meshes included)
   store_.write(w);
-  w.array(planes_);
+  walls_.write(w);
   for (const TriangleMesh& m : meshes_) m.write_state(w);
   neighbors_.write(w);
-  w.array(wall_force_);
+  walls_.write_forces(w);
   w.value(time_);
   w.value(static_cast<std::int64_t>(steps_));
   w.value(skin_);
@@ -135,8 +135,8 @@ void System::write_body(BinaryWriter& w) const {
 void System::read_body(BinaryReader& r) {
   r.expect(body_tag, "the body tag");
   r.expect(static_cast<std::int32_t>(model_.material_count()), "the number of materials");
-  r.expect(static_cast<std::int32_t>(wall_count_), "the number of walls");
-  r.expect(static_cast<std::int64_t>(planes_.size()), "the number of planes");
+  r.expect(static_cast<std::int32_t>(walls_.wall_count()), "the number of walls");
+  r.expect(static_cast<std::int64_t>(walls_.planes().size()), "the number of planes");
   r.expect(static_cast<std::int64_t>(meshes_.size()), "the number of meshes");
   for (const TriangleMesh& m : meshes_) {
     r.expect(static_cast<std::int64_t>(m.vertex_count()), "a mesh's vertex count");
@@ -150,10 +150,10 @@ void System::read_body(BinaryReader& r) {
                   name + "' in the state, '" + hooks_[k].name() + "' here");
   }
   store_.read(r);
-  r.array(planes_, "the planes");
+  walls_.read(r);
   for (TriangleMesh& m : meshes_) m.read_state(r);
   neighbors_.read(r);
-  r.array(wall_force_, "the wall forces");
+  walls_.read_forces(r);
   r.value(time_, "the time");
   steps_ = static_cast<long>(r.value<std::int64_t>("the step count"));
   r.value(skin_, "the skin");

@@ -51,9 +51,10 @@ void System::step(double dt) {
   const bool have_build = x_build.size() == p.size();
   double moved2 = 0.0;  // largest squared displacement since the last neighbour build
   bool rebuild = !have_build;
-  for (PlaneWall& w : planes_) w.point += dt * w.velocity;
+  walls_.advance(dt);
   const int parts = set_partition();
   partition_.prepare_cross_pairs(neighbors_);  // for the current lists (a rebuild below: its own)
+  start_load_pass(parts);
   // One parallel region for the whole step unless the lists need a rebuild: velocity Verlet,
   // first half (v += dt/2 F/m, x += dt v, omega += dt/2 T/I on packed_, F = m g, T = 0), then the
   // forces at t + dt and the second half (v += dt/2 F/m, omega += dt/2 T/I) particle by particle
@@ -74,7 +75,7 @@ void System::step(double dt) {
       }
     }
     // moved2 is complete after the loop's barrier; every thread reaches the same decision
-    const bool rebuild_here = !have_build || neighbors_.needs_rebuild(moved2, planes_, meshes_);
+    const bool rebuild_here = !have_build || neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_);
     if (!rebuild_here) evaluate_forces(dt, true, half);
 #pragma omp master
     rebuild = rebuild_here;
@@ -135,10 +136,16 @@ void System::start_sums(int i) {
   if (track_load_) load_[i] = 0.0;
 }
 
+// Clears the per-part flags of the load limits (no allocation once sized).
+void System::start_load_pass(int parts) {
+  load_reached_.assign(h_load_limit_ >= 0 ? static_cast<std::size_t>(parts) : 0, 0);
+}
+
 void System::compute_forces(double dt, bool update_history, double kick, bool started) {
   if (!packed_valid_) load_packed();
   const int parts = set_partition();
   partition_.prepare_cross_pairs(neighbors_);
+  start_load_pass(parts);
 #pragma omp parallel if (parts > 1) num_threads(parts)
   {
     if (!started) {
@@ -151,60 +158,6 @@ void System::compute_forces(double dt, bool update_history, double kick, bool st
   reduce_wall_and_mesh_forces();
 }
 
-// Hertz-Mindlin force of the pair in slot s (i < j): F on i, the torques on i and j. Returns
-// false (and settles the history) when the spheres do not overlap. Torques T_i = -cr_i n x F_t,
-// T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
-// T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
-// Load: also the contact load F_n (E*/R*)^2 (breakage criterion, System::contact_load()).
-template <bool Load>
-PARTITA_DEM_INLINE bool System::pair_force(const PackedParticle& qi, int j, int s, double dt,
-                                           bool update_history, Eigen::Vector3d& fij,
-                                           Eigen::Vector3d& ti, Eigen::Vector3d& tj, double& load) {
-  NeighborList& nl = neighbors_;
-  const PackedParticle& qj = packed_[j];
-  const Eigen::Vector3d d = qi.x - qj.x;
-  const double ri = qi.r, rj = qj.r;
-  const double rsum = ri + rj;
-  const double r2 = d.squaredNorm();
-  if (r2 >= rsum * rsum) {
-    if (nl.touching_[s]) {
-      nl.touching_[s] = 0;
-      nl.shear_[s].setZero();
-    }
-    return false;
-  }
-  nl.touching_[s] = 1;
-  const double r = std::sqrt(r2);
-  const Eigen::Vector3d nrm = r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
-  const double delta = rsum - r;
-  const double mi = qi.m, mj = qj.m;
-  const PairParameters& pp = model_.pair(qi.material, qj.material);
-  const double r_eff = ri * rj / rsum;
-  const double m_eff = mi * mj / (mi + mj);
-  const double cri = ri - 0.5 * delta, crj = rj - 0.5 * delta;
-  const Eigen::Vector3d w_arm = cri * qi.w + crj * qj.w;
-  Eigen::Vector3d ft;
-  const double fn = hertz_mindlin(pp, delta, r_eff, m_eff, nrm, qi.v - qj.v, w_arm, nl.shear_[s],
-                                  dt, update_history, fij, ft);
-  if constexpr (Load) {
-    const double k = pp.e_star / r_eff;
-    load = fn * k * k;
-  }
-  const Eigen::Vector3d c = nrm.cross(ft);
-  ti = -cri * c;
-  tj = -crj * c;
-  if (pp.rolling_friction > 0.0) {
-    const Eigen::Vector3d w_rel = qi.w - qj.w;
-    const double wn = w_rel.norm();
-    if (wn > 0.0) {
-      const Eigen::Vector3d tr = (-pp.rolling_friction * std::abs(fn) * r_eff / wn) * w_rel;
-      ti += tr;
-      tj -= tr;
-    }
-  }
-  return true;
-}
-
 // Called inside a parallel region. Each particle's force is a sum in a fixed order, whatever the
 // number of threads: F_i = m_i g (start_sums()) + the pairs (k, i), k < i, in ascending k + the
 // pairs (i, j), j > i, in ascending j + planes + meshes. Rows are processed in ascending i, so the
@@ -214,24 +167,35 @@ PARTITA_DEM_INLINE bool System::pair_force(const PackedParticle& qi, int j, int 
 // each once, into its cross_force, then added by both owners in the same place of their sums.
 void System::evaluate_forces(double dt, bool update_history, double kick) {
   if (track_load_)
-    evaluate_forces_impl<true>(dt, update_history, kick);
+    if (h_load_limit_ >= 0)
+      evaluate_forces_impl<true, true>(dt, update_history, kick);
+    else
+      evaluate_forces_impl<true, false>(dt, update_history, kick);
   else
-    evaluate_forces_impl<false>(dt, update_history, kick);
+    evaluate_forces_impl<false, false>(dt, update_history, kick);
 }
 
-template <bool Load>
+template <bool Load, bool Limit>
 void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   Particles& p = store_.core();
   const NeighborList& nl = neighbors_;
   ThreadPartition& tp = partition_;
   const int parts = tp.parts();
-  std::vector<Eigen::Vector3d>& plane_shear = store_.array<Eigen::Vector3d>(h_plane_shear_);
+  const WallContacts::Pass walls = walls_.pass(store_);
+  // Raw pointers, taken once: the loops keep them in registers (a vector's data pointer would be
+  // reloaded after every store through the char touching flags, which may alias it).
+  PackedParticle* const packed = packed_.data();
+  Eigen::Vector3d* const force = p.force.data();
+  Eigen::Vector3d* const torque = p.torque.data();
+  Eigen::Vector3d* const pair_shear = neighbors_.shear_.data();  // the pairs' histories
+  char* const pair_touching = neighbors_.touching_.data();
   double* load = Load ? load_.data() : nullptr;
+  const double* load_limit = Limit ? store_.array<double>(h_load_limit_).data() : nullptr;
   const MeshContacts::History mesh_history{store_.array<int>(h_mesh_slot_count_).data(),
                                            store_.array<std::int64_t>(h_mesh_slot_key_).data(),
                                            store_.array<Eigen::Vector3d>(h_mesh_slot_shear_).data(),
                                            store_.array<MeshContactRecord>(h_mesh_records_).data()};
-  const int np = static_cast<int>(planes_.size());
+  const int np = walls.np;
   const bool have_meshes = !meshes_.empty();
   if (parts > 1) {  // the cross pairs, shared evenly among the threads
     const int n_cross = static_cast<int>(tp.cross_pairs.size());
@@ -239,33 +203,34 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     for (int k = 0; k < n_cross; ++k) {
       const ThreadPartition::CrossPair& c = tp.cross_pairs[k];
       ThreadPartition::CrossForce& cf = tp.cross_force[k];
-      cf.touching = pair_force<Load>(packed_[c.i], c.j, c.slot, dt, update_history, cf.force_i,
-                                     cf.torque_i, cf.torque_j, cf.load);
+      cf.touching = PairContacts::force<Load>(model_, packed[c.i], packed[c.j], pair_shear[c.slot],
+                                              pair_touching[c.slot], dt, update_history,
+                                              cf.force_i, cf.torque_i, cf.torque_j, cf.load);
     }
   }
 #pragma omp for schedule(static, 1)
   for (int part = 0; part < parts; ++part) {
+    bool reached = false;  // a particle's load reached its limit (load_limit)
     // pairs (k, i) from earlier parts, ascending k
     for (int k = tp.cross_in_begin[part]; k < tp.cross_in_begin[part + 1]; ++k) {
       const int c = tp.cross_in[k];
       const ThreadPartition::CrossForce& cf = tp.cross_force[c];
       if (!cf.touching) continue;
       const int j = tp.cross_pairs[c].j;
-      p.force[j] -= cf.force_i;
-      p.torque[j] += cf.torque_j;
+      force[j] -= cf.force_i;
+      torque[j] += cf.torque_j;
       if constexpr (Load) load[j] = std::max(load[j], cf.load);
     }
     int cross = tp.cross_out_begin[part];
     const int lo = tp.begin(part), hi = tp.begin(part + 1);
     for (int b = lo / block_size; b * block_size < hi; ++b) {
       // plane forces summed per block of particles, then over blocks (fixed order)
-      Eigen::Vector3d* block_wall = wall_block_force_.data() + static_cast<std::size_t>(b) * np;
-      for (int k = 0; k < np; ++k) block_wall[k].setZero();
+      Eigen::Vector3d* block_wall = walls.start_block(b);
       const int i_end = std::min(hi, (b + 1) * block_size);
       for (int i = b * block_size; i < i_end; ++i) {
-        PackedParticle& qi = packed_[i];
-        Eigen::Vector3d f = p.force[i];
-        Eigen::Vector3d t = p.torque[i];
+        PackedParticle& qi = packed[i];
+        Eigen::Vector3d f = force[i];
+        Eigen::Vector3d t = torque[i];
         double load_i = Load ? load[i] : 0.0;
         for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
           const int j = nl.neighbors_[s];
@@ -279,49 +244,20 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           }
           Eigen::Vector3d fij, ti, tj;
           double lij = 0.0;
-          if (!pair_force<Load>(qi, j, s, dt, update_history, fij, ti, tj, lij)) continue;
+          if (!PairContacts::force<Load>(model_, qi, packed[j], pair_shear[s], pair_touching[s], dt,
+                                         update_history, fij, ti, tj, lij))
+            continue;
           f += fij;
           t += ti;
-          p.force[j] -= fij;
-          p.torque[j] += tj;
+          force[j] -= fij;
+          torque[j] += tj;
           if constexpr (Load) {
             load_i = std::max(load_i, lij);
             load[j] = std::max(load[j], lij);
           }
         }
-        // Planes near i: overlap delta = R - (x - x_w).n_w, R* = R, m* = m.
-        const double ri = qi.r;
-        std::uint64_t mask = np <= 64 ? nl.plane_mask_[i] : 0;
-        for (int k = 0; k < np; ++k) {
-          if (np <= 64) {  // jump to the next plane near i
-            if (mask == 0) break;
-            k = std::countr_zero(mask);
-            mask &= mask - 1;
-          }
-          const PlaneWall& w = planes_[k];
-          Eigen::Vector3d& shear = plane_shear[static_cast<std::size_t>(i) * np + k];
-          const double delta = ri - (qi.x - w.point).dot(w.normal);
-          if (delta <= 0.0) {
-            shear.setZero();
-            continue;
-          }
-          const PairParameters& pp = model_.pair(qi.material, w.material);
-          const double cr = ri - 0.5 * delta;
-          Eigen::Vector3d fw, ft;
-          const double fn = hertz_mindlin(pp, delta, ri, qi.m, w.normal, qi.v - w.velocity,
-                                          cr * qi.w, shear, dt, update_history, fw, ft);
-          f += fw;
-          t -= cr * w.normal.cross(ft);
-          if (pp.rolling_friction > 0.0) {
-            const double wn = qi.w.norm();
-            if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * ri / wn) * qi.w;
-          }
-          if constexpr (Load) {  // wall: R* = R
-            const double kw = pp.e_star / ri;
-            load_i = std::max(load_i, fn * kw * kw);
-          }
-          block_wall[k] -= fw;
-        }
+        walls.add_forces<Load>(i, qi, np <= 64 ? nl.plane_mask_[i] : 0, model_, dt,
+                               update_history, f, t, load_i, block_wall);
         if (have_meshes) {  // own accumulators: f and t keep their registers
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
           const MeshContacts::Particle q{qi.x, qi.r, qi.v, qi.m, qi.w, qi.material};
@@ -330,27 +266,25 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           f += fm;
           t += tm;
         }
-        p.force[i] = f;
-        p.torque[i] = t;
-        if constexpr (Load) load[i] = load_i;
+        force[i] = f;
+        torque[i] = t;
+        if constexpr (Load) {  // (i's load is complete: the pairs (k, i), k < i, came first)
+          load[i] = load_i;
+          if constexpr (Limit) reached |= load_i >= load_limit[i];
+        }
         if (kick > 0.0) {  // (no other row reads particle i any more in this pass)
           qi.v += (kick / qi.m) * f;
           qi.w += (kick / p.inertia[i]) * t;
         }
       }
     }
+    if (reached) load_reached_[part] = 1;
   }
 }
 
 void System::reduce_wall_and_mesh_forces() {
   const int n = static_cast<int>(store_.size());
-  const int np = static_cast<int>(planes_.size());
-  const int blocks = (n + block_size - 1) / block_size;
-  // Wall totals (fixed order: blocks, then planes).
-  for (Eigen::Vector3d& w : wall_force_) w.setZero();
-  for (int b = 0; b < blocks; ++b)
-    for (int k = 0; k < np; ++k)
-      wall_force_[planes_[k].wall] += wall_block_force_[static_cast<std::size_t>(b) * np + k];
+  walls_.reduce(n);
   // Mesh forces: particles in order (MeshContacts::reduce).
   if (meshes_.empty()) return;
   MeshContacts::reduce(n, store_.array<int>(h_mesh_slot_count_).data(),

@@ -380,3 +380,57 @@ TEST_CASE("dem: breakage parameters out of range are refused", "[dem][breakage][
   sys.add_hook(std::make_unique<Breakage>(parameters(3.0)));
   CHECK_THROWS_AS(sys.add_hook(std::make_unique<Breakage>(parameters(3.0))), Error);
 }
+
+namespace {
+
+// A hook with a load limit per particle (as Breakage has), the same for every particle.
+class LimitHook final : public StepHook {
+ public:
+  explicit LimitHook(double limit) : limit_(limit) {}
+  std::string name() const override { return "limit"; }
+  std::unique_ptr<StepHook> clone() const override { return std::make_unique<LimitHook>(*this); }
+  void attach(System& system) override {
+    h_ = system.store_unsynced().add_array<double>("test_load_limit", 1, limit_);
+  }
+  bool wants_contact_load() const override { return true; }
+  int contact_load_limit() const override { return h_; }
+  void end_of_step(System& system, double) override { reached_ = system.contact_load_reached(); }
+  bool reached_ = false;
+
+ private:
+  double limit_;
+  int h_ = -1;
+};
+
+}  // namespace
+
+TEST_CASE("dem: the force pass reports a contact load that reaches a hook's limit",
+          "[dem][breakage]") {
+  // A sphere at rest on a plane under gravity: the contact force is its weight m g (static
+  // equilibrium), so its load is m g (E*/R)^2 (wall: R* = R). The other particles are far away
+  // and touch nothing (their loads are 0). A limit 1 % above the load is not reached, 1 % below
+  // it is; so is a limit of 0 (>= includes a load of 0) and not one of +infinity.
+  const double r = 1e-3, g = 9.81;
+  const double e_star = 1.0 / (2.0 * (1.0 - NU * NU) / E);
+  const double load = test::sphere_mass(r, RHO) * g * (e_star / r) * (e_star / r);
+  for (int threads : {1, 2})
+    for (double factor : {1.01, 0.99, 0.0, HUGE_VAL}) {
+      set_num_threads(threads);
+      System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
+      sys.set_gravity({0, 0, -g});
+      const int k = sys.add_hook(std::make_unique<LimitHook>(factor * load));
+      // rows of spheres apart (enough for two parts) and one resting on the floor
+      sys.add_particle({0, 0, r}, r, 0);
+      for (int i = 1; i < 2100; ++i) sys.add_particle({0.01 * i, 0, 0.5}, r, 0);
+      sys.add_plane({0, 0, 0}, {0, 0, 1}, 0);
+      const double dt = 0.2 * sys.rayleigh_time_step();
+      for (int s = 0; s < 3000; ++s) sys.step(dt);  // settles (e = 0.5)
+      // the far particles fall freely: give them no time to reach the floor
+      INFO(threads << " thread(s), limit " << factor << " x the load; load "
+                   << sys.contact_load()[0] << ", m g (E*/R)^2 " << load);
+      REQUIRE(sys.contact_load()[0] == Approx(load).epsilon(1e-3));
+      const bool reached = static_cast<const LimitHook&>(sys.hook(k)).reached_;
+      CHECK(reached == (factor <= 0.99));
+    }
+  set_num_threads(1);
+}

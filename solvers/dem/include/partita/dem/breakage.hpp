@@ -14,7 +14,10 @@
 // scatter, else s = (-ln U)^(1/m), U uniform in (0, 1] drawn from (seed, particle id): a Weibull
 // law of modulus m with survival exp(-(sigma/sigma_c)^m). A particle's strength is drawn once,
 // when the hook first sees it (fragments: at birth), and kept in the store array
-// "breakage_strength", so it follows the particle and is saved and restored with it.
+// "breakage_strength", so it follows the particle and is saved and restored with it. The load at
+// which it breaks is kept beside it ("breakage_load_limit"): the force pass compares each load
+// with it as the load is completed (System::contact_load_reached()), so a step in which nothing
+// breaks costs no pass over the particles here (issue 13: at most 5 % on a large bed).
 // Particles with d < d_min (comminution limit) never break; fragments are breakable.
 //
 // Fragments (FragmentPattern, in a random orientation drawn from (seed, id)): radius R rho_k at
@@ -52,6 +55,7 @@ class Breakage final : public StepHook {
   std::unique_ptr<StepHook> clone() const override { return std::make_unique<Breakage>(*this); }
   void attach(System& system) override;
   bool wants_contact_load() const override { return true; }
+  int contact_load_limit() const override { return h_limit_; }
   void end_of_step(System& system, double dt) override;
   void write_state(BinaryWriter& out) const override;
   void read_state(BinaryReader& in) override;
@@ -77,7 +81,12 @@ class Breakage final : public StepHook {
   BreakageParameters parameters_;
   FragmentPattern pattern_;
   BreakageCounters counters_;
+  // load limit (9/16) pi^3 sigma^3 per particle (infinite below d_min; -1: strength not drawn
+  // yet): the force pass compares each load with it, end_of_step() looks at the particles only
+  // when one reached it
+  void set_limit(System& system, std::size_t i, double strength) const;
   int h_strength_ = -1;
+  int h_limit_ = -1;
   std::vector<std::size_t> broken_;  // scratch (reserved: no allocation while nothing breaks)
 };
 

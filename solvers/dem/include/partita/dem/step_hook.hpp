@@ -37,6 +37,14 @@ class StepHook {
   /// True: the force pass records per particle the largest contact load
   /// F_n (E*/R*)^2 (System::contact_load()).
   virtual bool wants_contact_load() const { return false; }
+  /// With wants_contact_load(): the handle of a per-particle store array (double, width 1) of
+  /// load limits, or -1. The force pass compares each particle's load with its limit as the load
+  /// is completed (in the threads' own loops: no extra pass, no barrier) and
+  /// System::contact_load_reached() says whether any particle reached its limit, so a hook that
+  /// acts on a few particles need not look at every particle at every step. New particles take
+  /// the array's default; one below 0 makes them count as reached (the hook then sets their
+  /// limits). One hook per system may have limits.
+  virtual int contact_load_limit() const { return -1; }
   virtual void post_force(System& /*system*/, double /*dt*/) {}
   virtual void end_of_step(System& /*system*/, double /*dt*/) {}
   virtual void write_state(BinaryWriter& /*out*/) const {}

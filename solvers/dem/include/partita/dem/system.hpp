@@ -35,6 +35,8 @@
 #include "partita/dem/mesh_contact_record.hpp"
 #include "partita/dem/mesh_contacts.hpp"
 #include "partita/dem/neighbor_list.hpp"
+#include "partita/dem/packed_particle.hpp"
+#include "partita/dem/pair_contacts.hpp"
 #include "partita/dem/particle_store.hpp"
 #include "partita/dem/particles.hpp"
 #include "partita/dem/plane_wall.hpp"
@@ -43,6 +45,7 @@
 #include "partita/dem/system_state.hpp"
 #include "partita/dem/thread_partition.hpp"
 #include "partita/dem/triangle_mesh.hpp"
+#include "partita/dem/wall_contacts.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -128,6 +131,13 @@ class System {
   /// (F_n the normal force, E* and R* the contact's effective modulus and radius; a wall's
   /// R* = R). Recorded only while a hook wants it (StepHook::wants_contact_load()), else empty.
   const std::vector<double>& contact_load() const { return load_; }
+  /// True when, in the last force pass, some particle's contact load reached its limit in the
+  /// hook's limit array (StepHook::contact_load_limit()); false without such a hook.
+  bool contact_load_reached() const {
+    for (char c : load_reached_)
+      if (c) return true;
+    return false;
+  }
 
   /// An infinite plane through `point`; particles stay on the side `normal` points to.
   /// Returns the wall id.
@@ -140,8 +150,8 @@ class System {
               unsigned faces = 0b111111);
   /// Prescribes the translation velocity of all planes of a wall.
   void set_wall_velocity(int wall, const Eigen::Vector3d& velocity);
-  int wall_count() const { return wall_count_; }
-  const std::vector<PlaneWall>& planes() const { return planes_; }
+  int wall_count() const { return walls_.wall_count(); }
+  const std::vector<PlaneWall>& planes() const { return walls_.planes(); }
 
   /// A triangle mesh (vertices N x 3, triangles M x 3 vertex indices); returns the mesh id.
   int add_mesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
@@ -219,7 +229,6 @@ class System {
   void write_mesh_vtp(int mesh, const std::string& path) const;
 
  private:
-  struct PackedParticle;
   void prepare();
   void check_interactions() const;
   void check_mesh(int mesh, const char* what) const;
@@ -235,15 +244,13 @@ class System {
   void start_sums(int i);
   void rebuild_lists();
   int set_partition();
-  template <bool Load>
-  bool pair_force(const PackedParticle& qi, int j, int slot, double dt, bool update_history,
-                  Eigen::Vector3d& force_i, Eigen::Vector3d& torque_i, Eigen::Vector3d& torque_j,
-                  double& load);
   // called inside a parallel region (orphaned omp for)
   void evaluate_forces(double dt, bool update_history, double kick);
-  template <bool Load>
+  // Load: record the contact loads; Limit: compare them with a hook's limits
+  template <bool Load, bool Limit>
   void evaluate_forces_impl(double dt, bool update_history, double kick);
-  void reduce_wall_and_mesh_forces();
+  void reduce_wall_and_mesh_forces();  // wall totals and mesh forces of the last pass
+  void start_load_pass(int parts);
   void write_body(BinaryWriter& out) const;
   void read_body(BinaryReader& in);
 
@@ -252,20 +259,18 @@ class System {
   // stepping; the store's copies are brought up to date on demand (mirror_valid_), and packed_
   // reloaded after a caller's change
   mutable ParticleStore store_;
-  int h_plane_shear_ = -1;      // N x planes tangential histories with the planes
   int h_mesh_slot_count_ = -1;  // mesh contacts of each particle (<= max_mesh_contacts)
   int h_mesh_slot_key_ = -1;    // N x max_mesh_contacts feature keys
   int h_mesh_slot_shear_ = -1;  // N x max_mesh_contacts tangential histories
   int h_mesh_records_ = -1;     // N x max_mesh_contacts results of the last force evaluation
   mutable bool mirror_valid_ = true;
   bool packed_valid_ = false;
-  std::vector<PlaneWall> planes_;
+  WallContacts walls_;  // planes, their histories and wall forces
   std::vector<TriangleMesh> meshes_;
   NeighborList neighbors_;
   StepHookList hooks_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
   double skin_ = -1.0;
-  int wall_count_ = 0;
   double time_ = 0.0;
   long steps_ = 0;
   bool prepared_ = false;
@@ -275,24 +280,16 @@ class System {
   double rayleigh_dt_ = 0.0;
   std::uint64_t identity_ = 0;  // shared by copies; a state remembers the system it came from
   std::vector<double> load_;    // largest contact load per particle (track_load_)
+  int h_load_limit_ = -1;       // a hook's per-particle load limits (store array) or -1
+  std::vector<char> load_reached_;  // per part: a load reached its limit in the last pass
 
-  struct PackedParticle {  // the moving state and what the pair loop reads about a neighbour
-    Eigen::Vector3d x;
-    double r;
-    Eigen::Vector3d v;
-    double m;
-    Eigen::Vector3d w;
-    int material;
-  };
-  std::vector<PackedParticle> packed_;
+  std::vector<PackedParticle> packed_;  // the moving state while stepping
   ThreadPartition partition_;
   // renumbering in cell order
   int sort_interval_ = 0;
   int builds_since_sort_ = 0;
   long sorts_ = 0;
   CellOrder cell_order_;
-  std::vector<Eigen::Vector3d> wall_block_force_;  // blocks x planes
-  std::vector<Eigen::Vector3d> wall_force_;        // per wall
   std::vector<int> new_of_old_;  // scratch of remove_particles() / renumber_particles()
 };
 

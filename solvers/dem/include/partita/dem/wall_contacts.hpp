@@ -1,0 +1,145 @@
+#pragma once
+// Contacts of the spheres with rigid planes (walls): the planes, grouped into walls, their
+// per-particle tangential histories (a store array, so they follow the particles), the force
+// kernel and the wall totals.
+//
+// A particle i touches plane k where delta = R - (x - x_k).n_k > 0; the Hertz-Mindlin law with
+// R* = R, m* = m (hertz_mindlin()), torque -cr n x F_t (cr = R - delta/2) and rolling
+// resistance -mu_r F_n R w/|w|. The force on each plane is summed per block of
+// ThreadPartition::block_size particles by the thread that owns the block, then over the blocks in
+// a fixed order (reduce()), so the wall totals do not depend on the number of threads.
+
+#include "partita/dem/binary_reader.hpp"
+#include "partita/dem/binary_writer.hpp"
+#include "partita/dem/contact_model.hpp"
+#include "partita/dem/packed_particle.hpp"
+#include "partita/dem/particle_store.hpp"
+#include "partita/dem/plane_wall.hpp"
+
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace partita::dem {
+
+class WallContacts {
+ public:
+  /// Registers the tangential histories (one per particle and plane) in the store.
+  void attach(ParticleStore& store);
+
+  /// A plane (unit normal into the particle side) as a wall of its own; returns the wall id.
+  /// Throws Error on a zero or non-finite normal or a non-finite point or velocity.
+  int add_plane(const Eigen::Vector3d& point, const Eigen::Vector3d& normal, int material,
+                const Eigen::Vector3d& velocity);
+  /// The inside of the box [lo, hi], faces selected by bit k of `faces` (-x, +x, -y, +y, -z,
+  /// +z); returns the wall id. Throws Error unless lo < hi and some face is selected.
+  int add_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int material, unsigned faces);
+  /// Translation velocity of every plane of a wall; throws Error on an unknown wall id.
+  void set_velocity(int wall, const Eigen::Vector3d& velocity);
+  /// Moves the planes by dt times their velocities.
+  void advance(double dt) {
+    for (PlaneWall& w : planes_) w.point += dt * w.velocity;
+  }
+
+  int wall_count() const { return wall_count_; }
+  const std::vector<PlaneWall>& planes() const { return planes_; }
+  /// The force the particles exerted on a wall in the last force pass; throws Error on an
+  /// unknown id.
+  Eigen::Vector3d wall_force(int wall) const;
+  /// The histories (N x planes().size(), particle-major).
+  const std::vector<Eigen::Vector3d>& shear(const ParticleStore& store) const {
+    return store.array<Eigen::Vector3d>(h_shear_);
+  }
+
+  /// Sizes the histories and the block sums for n particles (no allocation when unchanged).
+  void resize(ParticleStore& store, std::size_t n);
+  /// Wall totals from the block sums of n particles (fixed order: blocks, then planes).
+  void reduce(std::size_t n);
+
+  /// What one force pass reads and writes, taken once per pass: raw pointers and the plane
+  /// count, which the kernel's loop keeps in registers (a member vector's size would be reloaded
+  /// after every store through the pair histories' char flags, which may alias it).
+  struct Pass {
+    const PlaneWall* planes;
+    int np;
+    Eigen::Vector3d* shear;        // N x np histories
+    Eigen::Vector3d* block_force;  // blocks x np sums
+
+    /// The sums of block b, zeroed: the kernel adds each plane's reaction there.
+    Eigen::Vector3d* start_block(int b) const {
+      Eigen::Vector3d* s = block_force + static_cast<std::size_t>(b) * np;
+      for (int k = 0; k < np; ++k) s[k].setZero();
+      return s;
+    }
+    /// Forces of the planes near particle i (bit k of `mask`: plane k; every plane when there
+    /// are more than 64) added to f and t, their reactions to `block`; Load: the largest contact
+    /// load F_n (E*/R)^2 into load.
+    template <bool Load>
+    PARTITA_DEM_INLINE void add_forces(int i, const PackedParticle& qi, std::uint64_t mask,
+                                       const ContactModel& model, double dt, bool update_history,
+                                       Eigen::Vector3d& f, Eigen::Vector3d& t, double& load,
+                                       Eigen::Vector3d* block) const;
+  };
+  Pass pass(ParticleStore& store) {
+    return Pass{planes_.data(), static_cast<int>(planes_.size()),
+                store.array<Eigen::Vector3d>(h_shear_).data(), block_force_.data()};
+  }
+
+  /// The planes (positions move) / the wall totals, for System's state.
+  void write(BinaryWriter& out) const;
+  void read(BinaryReader& in);
+  void write_forces(BinaryWriter& out) const;
+  void read_forces(BinaryReader& in);
+
+ private:
+  std::vector<PlaneWall> planes_;
+  int wall_count_ = 0;
+  int h_shear_ = -1;                          // store array: N x planes tangential histories
+  std::vector<Eigen::Vector3d> block_force_;  // blocks x planes
+  std::vector<Eigen::Vector3d> wall_force_;   // per wall
+};
+
+template <bool Load>
+PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(int i, const PackedParticle& qi,
+                                                       std::uint64_t mask,
+                                                       const ContactModel& model, double dt,
+                                                       bool update_history, Eigen::Vector3d& f,
+                                                       Eigen::Vector3d& t, double& load,
+                                                       Eigen::Vector3d* block) const {
+  const double ri = qi.r;
+  for (int k = 0; k < np; ++k) {
+    if (np <= 64) {  // jump to the next plane near i
+      if (mask == 0) break;
+      k = std::countr_zero(mask);
+      mask &= mask - 1;
+    }
+    const PlaneWall& w = planes[k];
+    Eigen::Vector3d& sh = shear[static_cast<std::size_t>(i) * np + k];
+    const double delta = ri - (qi.x - w.point).dot(w.normal);
+    if (delta <= 0.0) {
+      sh.setZero();
+      continue;
+    }
+    const PairParameters& pp = model.pair(qi.material, w.material);
+    const double cr = ri - 0.5 * delta;
+    Eigen::Vector3d fw, ft;
+    const double fn = hertz_mindlin(pp, delta, ri, qi.m, w.normal, qi.v - w.velocity, cr * qi.w,
+                                    sh, dt, update_history, fw, ft);
+    f += fw;
+    t -= cr * w.normal.cross(ft);
+    if (pp.rolling_friction > 0.0) {
+      const double wn = qi.w.norm();
+      if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * ri / wn) * qi.w;
+    }
+    if constexpr (Load) {  // wall: R* = R
+      const double kw = pp.e_star / ri;
+      load = std::max(load, fn * kw * kw);
+    }
+    block[k] -= fw;
+  }
+}
+
+}  // namespace partita::dem

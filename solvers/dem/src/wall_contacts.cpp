@@ -1,0 +1,99 @@
+#include "partita/dem/wall_contacts.hpp"
+
+#include "partita/dem/error.hpp"
+#include "partita/dem/thread_partition.hpp"
+
+#include <sstream>
+
+namespace partita::dem {
+
+void WallContacts::attach(ParticleStore& store) {
+  h_shear_ = store.add_array<Eigen::Vector3d>("plane_shear", 0, Eigen::Vector3d::Zero());
+}
+
+int WallContacts::add_plane(const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                            int material, const Eigen::Vector3d& velocity) {
+  if (!(normal.norm() > 0.0) || !normal.allFinite() || !point.allFinite() ||
+      !velocity.allFinite()) {
+    throw Error("add_plane: need a finite point and velocity and a non-zero normal, got point " +
+                vector_text(point) + ", normal " + vector_text(normal));
+  }
+  PlaneWall plane;
+  plane.point = point;
+  plane.normal = normal.normalized();
+  plane.velocity = velocity;
+  plane.material = material;
+  plane.wall = wall_count_;
+  planes_.push_back(plane);
+  wall_force_.assign(wall_count_ + 1, Eigen::Vector3d::Zero());
+  return wall_count_++;
+}
+
+int WallContacts::add_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int material,
+                          unsigned faces) {
+  if (!((hi - lo).array() > 0.0).all()) {
+    throw Error("add_box: need lo < hi in every direction, got lo " + vector_text(lo) + ", hi " +
+                vector_text(hi));
+  }
+  if ((faces & 0b111111u) == 0u) throw Error("add_box: the face mask selects no face");
+  const int wall = wall_count_;
+  for (int k = 0; k < 6; ++k) {
+    if (!(faces & (1u << k))) continue;
+    const int axis = k / 2;
+    PlaneWall plane;
+    plane.normal = Eigen::Vector3d::Zero();
+    plane.normal[axis] = (k % 2 == 0) ? 1.0 : -1.0;
+    plane.point = (k % 2 == 0) ? lo : hi;
+    plane.material = material;
+    plane.wall = wall;
+    planes_.push_back(plane);
+  }
+  ++wall_count_;
+  wall_force_.assign(wall_count_, Eigen::Vector3d::Zero());
+  return wall;
+}
+
+void WallContacts::set_velocity(int wall, const Eigen::Vector3d& velocity) {
+  if (wall < 0 || wall >= wall_count_) {
+    std::ostringstream msg;
+    msg << "set_wall_velocity: unknown wall id " << wall << "; ids are 0.." << wall_count_ - 1;
+    throw Error(msg.str());
+  }
+  for (PlaneWall& p : planes_)
+    if (p.wall == wall) p.velocity = velocity;
+}
+
+Eigen::Vector3d WallContacts::wall_force(int wall) const {
+  if (wall < 0 || wall >= wall_count_) {
+    std::ostringstream msg;
+    msg << "wall_force: unknown wall id " << wall << "; ids are 0.." << wall_count_ - 1;
+    throw Error(msg.str());
+  }
+  return wall_force_[wall];
+}
+
+void WallContacts::resize(ParticleStore& store, std::size_t n) {
+  const std::size_t np = planes_.size();
+  store.set_width(h_shear_, np);
+  block_force_.assign(((n + ThreadPartition::block_size - 1) / ThreadPartition::block_size) * np,
+                      Eigen::Vector3d::Zero());
+  wall_force_.resize(wall_count_, Eigen::Vector3d::Zero());
+}
+
+void WallContacts::reduce(std::size_t n) {
+  const std::size_t np = planes_.size();
+  const std::size_t blocks = (n + ThreadPartition::block_size - 1) / ThreadPartition::block_size;
+  for (Eigen::Vector3d& w : wall_force_) w.setZero();
+  for (std::size_t b = 0; b < blocks; ++b)
+    for (std::size_t k = 0; k < np; ++k) wall_force_[planes_[k].wall] += block_force_[b * np + k];
+}
+
+void WallContacts::write(BinaryWriter& out) const { out.array(planes_); }
+
+void WallContacts::read(BinaryReader& in) { in.array(planes_, "the planes"); }
+
+void WallContacts::write_forces(BinaryWriter& out) const { out.array(wall_force_); }
+
+void WallContacts::read_forces(BinaryReader& in) { in.array(wall_force_, "the wall forces"); }
+
+}  // namespace partita::dem
