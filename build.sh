@@ -4,13 +4,14 @@
 #   ./build.sh run [CASE.yaml] [partita run options]   install what is missing, build, run a case
 #                                                      (default: the seed-000 steel plate case)
 #   ./build.sh test [--sanitize]                       install what is missing, build, run ctest
-#                                                      (--sanitize: a second build with
-#                                                       -fsanitize=address,undefined in build-asan/)
+#                                                      (--sanitize: a clang build with ASan, UBSan
+#                                                       and libFuzzer instrumentation in build-asan/,
+#                                                       the suite without the tests tagged [slow])
 #   ./build.sh fuzz [SECONDS]                          install what is missing, build the libFuzzer
-#                                                      harnesses of tests/fuzz with clang, ASan and
-#                                                      UBSan in build-fuzz/, run each for SECONDS
+#                                                      harnesses of tests/fuzz in that same
+#                                                      build-asan/, run each for SECONDS
 #                                                      (default 60) from the seed inputs
-#                                                      (FUZZ_CXXFLAGS: optimisation, default -O0)
+#                                                      (SANITIZE_CXXFLAGS: optimisation, default -O1)
 #   ./build.sh deps                                    only install the Debian packages
 #
 # Works on a fresh Debian 12 machine as root or as a user with sudo. Nothing is downloaded but
@@ -21,8 +22,9 @@ cd "$(dirname "$0")"
 PACKAGES=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
           catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib
           python3-vtk9)
-# Only for `./build.sh fuzz`: clang and its runtime libraries (libclang_rt.fuzzer, ASan, UBSan).
-FUZZ_PACKAGES=(clang libclang-rt-dev)
+# Only for `./build.sh test --sanitize` and `./build.sh fuzz`: clang and its runtime libraries
+# (libclang_rt.fuzzer, ASan, UBSan).
+SANITIZE_PACKAGES=(clang libclang-rt-dev)
 DEFAULT_CASE=cases/uniaxial_compaction/steel.yaml
 JOBS=${JOBS:-$(nproc)}
 
@@ -48,6 +50,19 @@ configure_and_build() {  # dir, extra cmake args...
   cmake --build "$dir" -j "$JOBS"
 }
 
+# The sanitized build (build-asan/): clang, ASan + UBSan, libFuzzer coverage in every module, so
+# one build serves the sanitized suite and the fuzz harnesses. Assertions on (no NDEBUG): checks
+# inside the readers count as findings. -O1: the suite runs about ten times slower than Release.
+# OpenMP off (clang's runtime is another package; races are a ThreadSanitizer matter).
+configure_sanitized() {  # targets...
+  install_deps "${SANITIZE_PACKAGES[@]}"
+  cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    "-DCMAKE_CXX_FLAGS_RELEASE=${SANITIZE_CXXFLAGS:--O1 -gline-tables-only}" \
+    -DCMAKE_CXX_COMPILER=clang++ -DPARTITA_FUZZ=ON -DPARTITA_BUILD_BENCH=OFF -DPARTITA_OPENMP=OFF >/dev/null
+  cmake --build build-asan -j "$JOBS" "$@"
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+}
+
 cmd=${1:-run}
 [ $# -gt 0 ] && shift
 case "$cmd" in
@@ -68,11 +83,7 @@ case "$cmd" in
     # `run`: a run alone on the machine is faster with the default, spinning, policy.)
     export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
     if [ "${1:-}" = "--sanitize" ]; then
-      # Sanitizers: -O1 with assertions on (no NDEBUG), benchmarks not built; ASan's leak checker on.
-      # (-O1 builds in about 4.5 min on 2 cores and runs the suite in about 2 min.)
-      configure_and_build build-asan -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O1" \
-        -DPARTITA_SANITIZE=ON -DPARTITA_BUILD_BENCH=OFF
-      export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+      configure_sanitized
       ctest --test-dir build-asan --output-on-failure -j "$JOBS"
     else
       configure_and_build build -DCMAKE_BUILD_TYPE=Release
@@ -80,39 +91,31 @@ case "$cmd" in
     fi
     ;;
   fuzz)
-    install_deps "${FUZZ_PACKAGES[@]}"
     seconds=${1:-60}
     [[ "$seconds" =~ ^[0-9]+$ ]] || { echo "build.sh fuzz: SECONDS must be a whole number, found '$seconds'" >&2; exit 2; }
-    # Assertions on (no NDEBUG): checks inside the readers count as findings. -O0 by default: the
-    # build (every module, for the case harness) takes about 40 % of the CPU time of -O1, which
-    # matters more in CI than the speed of a 45-s run; FUZZ_CXXFLAGS="-O1 -g" for long campaigns.
-    cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=Release \
-      "-DCMAKE_CXX_FLAGS_RELEASE=${FUZZ_CXXFLAGS:--O0 -gline-tables-only}" \
-      -DCMAKE_CXX_COMPILER=clang++ -DPARTITA_FUZZ=ON -DPARTITA_BUILD_TESTS=OFF \
-      -DPARTITA_BUILD_BENCH=OFF -DPARTITA_OPENMP=OFF >/dev/null
-    cmake --build build-fuzz -j "$JOBS" --target fuzz_stl fuzz_gmsh fuzz_case
-    # Seeds: the test and case inputs of each kind. The corpus grows in build-fuzz/corpus/NAME;
-    # a finding is written to build-fuzz/findings/ and fails the command (fix it, then add the
-    # input to tests/inputs/bad/ with its expected message).
+    configure_sanitized --target fuzz_stl fuzz_gmsh fuzz_case
+    # Seeds: the test and case inputs of each kind, named after their paths (two cases may each
+    # have a checks.yaml). The corpus grows in build-asan/fuzz/corpus/NAME; a finding is written to
+    # build-asan/fuzz/findings/ and fails the command (fix it, then add the input to
+    # tests/inputs/bad/ with its expected message).
     seed() {  # name, find expression...
-      local dir=build-fuzz/corpus/$1; shift
+      local dir=build-asan/fuzz/corpus/$1 f; shift
       mkdir -p "$dir"
-      find tests cases "$@" -exec cp -t "$dir" {} +
+      while IFS= read -r -d '' f; do cp -f "$f" "$dir/${f//\//_}"; done < <(find tests cases "$@" -print0)
     }
     seed stl -type f -iname '*.stl'
     seed gmsh -type f -iname '*.msh'
     seed case -type f \( -iname '*.yaml' -o -iname '*.yml' \)
-    mkdir -p build-fuzz/findings
-    export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+    mkdir -p build-asan/fuzz/findings
     status=0
     for h in stl gmsh case; do
       echo "build.sh fuzz: fuzz_$h for $seconds s"
-      ./build-fuzz/tests/fuzz/fuzz_$h -seed="${FUZZ_SEED:-1}" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
-        -max_len=65536 -print_final_stats=1 -artifact_prefix="build-fuzz/findings/$h-" \
-        -dict="tests/fuzz/$h.dict" "build-fuzz/corpus/$h" 2>build-fuzz/fuzz_$h.log || status=1
+      ./build-asan/tests/fuzz/fuzz_$h -seed="${FUZZ_SEED:-1}" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
+        -max_len=65536 -print_final_stats=1 -artifact_prefix="build-asan/fuzz/findings/$h-" \
+        -dict="tests/fuzz/$h.dict" "build-asan/fuzz/corpus/$h" 2>build-asan/fuzz/fuzz_$h.log || status=1
       grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|Done|==[0-9]+==ERROR|SUMMARY)' \
-        build-fuzz/fuzz_$h.log || true
-      [ $status -eq 0 ] || { tail -n 60 build-fuzz/fuzz_$h.log; ls build-fuzz/findings; }
+        build-asan/fuzz/fuzz_$h.log || true
+      [ $status -eq 0 ] || { tail -n 60 build-asan/fuzz/fuzz_$h.log; ls build-asan/fuzz/findings; }
     done
     exit $status
     ;;

@@ -110,7 +110,7 @@ TEST_CASE(
 }
 
 TEST_CASE("Elastic tube (t = 1): IQN-IMVJ converges in every window and carries the Jacobian on",
-          "[adapters][tube1d][case]") {
+          "[adapters][tube1d][case][slow]") {
   // Without information from past windows (IQN-ILS, reused_windows 0) every window starts its
   // model from nothing; IMVJ starts from the previous windows' Jacobian, so it must need clearly
   // fewer iterations over the whole run (the tube's 100 windows, about 0.3 s each way).

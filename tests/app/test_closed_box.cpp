@@ -45,7 +45,7 @@ fs::path run_input(const std::string& input, const std::string& tag,
 }  // namespace
 
 TEST_CASE("closed FE box: granules at rest inside load it with their weight",
-          "[app][handover][hollow]") {
+          "[app][handover][hollow][slow]") {
   // Hex8 (6 x 6 x 6 cells across the cavity): the inner surface's Quad4 faces make 2 triangles
   // each; Hex20 (3 x 3 x 3 cells, for the test's time): Quad8 faces, 6 triangles each
   const std::string element = GENERATE(as<std::string>{}, "hex8", "hex20");
@@ -72,7 +72,7 @@ TEST_CASE("closed FE box: granules at rest inside load it with their weight",
 }
 
 TEST_CASE("closed FE box: very stiff walls load each face as rigid DEM walls do",
-          "[app][handover][hollow]") {
+          "[app][handover][hollow][slow]") {
   const fs::path fe = run_input("rigid_fe.yaml", "rigid_fe");
   const fs::path dem = run_input("rigid_dem.yaml", "rigid_dem");
   auto f = MonitorCsv::read(fe / "forces.csv").mean_over_last(0.1);

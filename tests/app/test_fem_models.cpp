@@ -111,7 +111,7 @@ TEST_CASE("fem adapter: material.model neo-hooke, a bar in uniaxial stress, clos
 }
 
 TEST_CASE("fem adapter: material.model neo-hooke-decoupled and f-bar hex8, closed form",
-          "[app][fem-models]") {
+          "[app][fem-models][slow]") {
   // W = mu/2 (I1_bar - 3) + kappa/4 (J^2 - 1 - 2 ln J), I1_bar = J^(-2/3) (l1^2 + 2 l2^2):
   // P_i = mu J^(-2/3) (l_i - I1 / (3 l_i)) + kappa/2 (J^2 - 1) / l_i
   const double mu = kE / (2 * (1 + kNu)), kappa = kE / (3 * (1 - 2 * kNu));
@@ -133,7 +133,7 @@ TEST_CASE("fem adapter: material.model neo-hooke-decoupled and f-bar hex8, close
 }
 
 TEST_CASE("fem adapter: material.model j2-plasticity and j2-plasticity-finite-strain, 1D models",
-          "[app][fem-models]") {
+          "[app][fem-models][slow]") {
   const double e = 200e9, nu = 0.3, sy = 250e6, h = 2e9, t = 300e6;
   const std::vector<std::string> steel = {"participants.bar.material.youngs_modulus=200 GPa",
                                           "participants.bar.material.poisson_ratio=0.3",
@@ -165,7 +165,7 @@ TEST_CASE("fem adapter: material.model j2-plasticity and j2-plasticity-finite-st
 }
 
 TEST_CASE("fem adapter: analysis.integrator newmark and central-difference on neo-hooke",
-          "[app][fem-models]") {
+          "[app][fem-models][slow]") {
   // rod_release.yaml with a Neo-Hooke rod (nu = 0, strain 5e-6: its linear limit), the load
   // ramped over 2 ms (5 periods: no vibration left), held to 3 ms and released: held
   // elongation F L / (E A) = 2.5e-6 m, then free vibration with T1 = 4 L / c = 0.4 ms

@@ -17,7 +17,7 @@
 namespace fs = std::filesystem;
 using partita::test::quote;
 
-TEST_CASE("load table: a released rod vibrates with its first axial period", "[app][time-table]") {
+TEST_CASE("load table: a released rod vibrates with its first axial period", "[app][time-table][slow]") {
   const fs::path dir = fs::temp_directory_path() / ("partita_rod_" + std::to_string(::getpid()));
   const auto r = partita::test::run_command(
       quote(PARTITA_EXECUTABLE) + " run " +

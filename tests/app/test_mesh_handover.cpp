@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 using partita::test::quote;
 
 TEST_CASE("mesh hand-over: granules at rest on an FE face load it with their weight",
-          "[app][handover]") {
+          "[app][handover][slow]") {
   const fs::path dir = fs::temp_directory_path() / ("partita_floor_" + std::to_string(::getpid()));
   const auto r = partita::test::run_command(
       quote(PARTITA_EXECUTABLE) + " run " +

@@ -33,7 +33,7 @@ std::string body(const fs::path& f) {
 }  // namespace
 
 TEST_CASE("particle file: a settled run's final state restarts the same particles bit for bit",
-          "[app][particles-file]") {
+          "[app][particles-file][slow]") {
   const fs::path inputs = fs::path(PARTITA_SOURCE_DIR) / "tests/inputs/particles_file";
   const fs::path dir = fs::temp_directory_path() / ("partita_settle_" + std::to_string(::getpid()));
   fs::remove_all(dir);

@@ -114,7 +114,7 @@ void restart_round_trip(const std::string& case_file, double window, int n) {
 
 }  // namespace
 
-TEST_CASE("restart: 2N windows equal N windows resumed for N more, bit for bit", "[app][restart]") {
+TEST_CASE("restart: 2N windows equal N windows resumed for N more, bit for bit", "[app][restart][slow]") {
   SECTION("implicit serial, IQN-ILS (tube)") {
     restart_round_trip("cases/elastic_tube_1d/iqn-ils.yaml", 0.01, 20);
   }

@@ -53,7 +53,7 @@ std::vector<std::string> csv_lines(const fs::path& p) {
 }  // namespace
 
 TEST_CASE("sweep: variants differ only in the swept value, the summary has one row each",
-          "[app][sweep]") {
+          "[app][sweep][slow]") {
   const fs::path dir = scratch("plain");
   const auto r = run("--jobs 2 --output " + quote(dir.string()));
   INFO(r.output);
@@ -92,7 +92,7 @@ TEST_CASE("sweep: variants differ only in the swept value, the summary has one r
   fs::remove_all(dir);
 }
 
-TEST_CASE("sweep: two jobs at once write the same files as one", "[app][sweep]") {
+TEST_CASE("sweep: two jobs at once write the same files as one", "[app][sweep][slow]") {
   const fs::path one = scratch("jobs1"), two = scratch("jobs2");
   REQUIRE(run("--jobs 1 --output " + quote(one.string())).status == 0);
   REQUIRE(run("--jobs 2 --output " + quote(two.string())).status == 0);
@@ -106,7 +106,7 @@ TEST_CASE("sweep: two jobs at once write the same files as one", "[app][sweep]")
   fs::remove_all(two);
 }
 
-TEST_CASE("sweep: a failing variant is reported and the others go on", "[app][sweep]") {
+TEST_CASE("sweep: a failing variant is reported and the others go on", "[app][sweep][slow]") {
   const fs::path dir = scratch("failing");
   // 2 cells is below the tube's minimum of 3: that variant stops at set-up
   const auto r = partita::test::run_command(

@@ -13,7 +13,7 @@ namespace fs = std::filesystem;
 using partita::test::quote;
 using partita::test::run_command;
 
-TEST_CASE("output: every VTK file of a coupled run opens in VTK's readers", "[app][output]") {
+TEST_CASE("output: every VTK file of a coupled run opens in VTK's readers", "[app][output][slow]") {
   const fs::path out = fs::temp_directory_path() / "partita_test_vtk_output";
   fs::remove_all(out);
   const std::string source = PARTITA_SOURCE_DIR;

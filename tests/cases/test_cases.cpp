@@ -102,7 +102,7 @@ void compare(const YAML::Node& check, double value, const std::string& what,
 
 }  // namespace
 
-TEST_CASE("cases: shortened runs meet their reference values", "[cases]") {
+TEST_CASE("cases: shortened runs meet their reference values", "[cases][slow]") {
   const fs::path root = fs::path(PARTITA_SOURCE_DIR) / "cases";
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   int runs = 0;

@@ -405,7 +405,7 @@ class LimitHook final : public StepHook {
 }  // namespace
 
 TEST_CASE("dem: the force pass reports a contact load that reaches a hook's limit",
-          "[dem][breakage]") {
+          "[dem][breakage][slow]") {
   // A sphere at rest on a plane under gravity: the contact force is its weight m g (static
   // equilibrium), so its load is m g (E*/R)^2 (wall: R* = R). The other particles are far away
   // and touch nothing (their loads are 0). A limit 1 % above the load is not reached, 1 % below

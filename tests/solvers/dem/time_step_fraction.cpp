@@ -40,7 +40,7 @@ double realised(double e, double v, bool wall, double fraction = -1.0) {
 }  // namespace
 
 TEST_CASE("dem: the default time step realises the restitution to 1 % for 0.1 <= e <= 1",
-          "[dem][physics]") {
+          "[dem][physics][slow]") {
   for (double e : {0.1, 0.15, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0}) {
     double worst = 0.0;
     for (double v : {0.01, 0.1, 1.0, 3.0, 10.0})

@@ -104,7 +104,7 @@ TEST_CASE("dem: bounce on a triangulated plane equals bounce on a plane", "[dem]
 }
 
 TEST_CASE("dem: a fine mesh with many triangles under the contact still acts like a plane",
-          "[dem][mesh]") {
+          "[dem][mesh][slow]") {
   // h = 0.05 mm: about 90 triangles intersect the sphere at the largest overlap (18 um, contact
   // circle of 0.19 mm radius); only the face under the centre carries the contact.
   const Bounce ref = bounce(false, 0.0, 0.0);
@@ -118,7 +118,7 @@ TEST_CASE("dem: a fine mesh with many triangles under the contact still acts lik
 }
 
 TEST_CASE("dem: a fine folded mesh acts like its planes: V-groove (two faces), ridge (one edge)",
-          "[dem][mesh]") {
+          "[dem][mesh][slow]") {
   // h = 0.05 mm. In the groove the sphere touches the two faces whose planes it overlaps; the
   // edges and vertices of the triangles around them, also within reach, are not contacts. On
   // the ridge it touches the ridge edge only (overlap and normal of a horizontal plane).
@@ -141,7 +141,7 @@ TEST_CASE("dem: a fine folded mesh acts like its planes: V-groove (two faces), r
 }
 
 TEST_CASE("dem: rolling down an incline across many triangles equals rolling on a plane",
-          "[dem][mesh]") {
+          "[dem][mesh][slow]") {
   // Gravity tilted by 20 degrees over a flat floor; friction 0.5 > 2/7 tan(20 deg), so the
   // sphere rolls without slipping, a = 5/7 g sin(theta). On a mesh of h = 0.05 mm it crosses
   // about 10 triangles in 0.02 s: the static friction (tangential history) must pass from

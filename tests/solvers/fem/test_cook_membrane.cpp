@@ -63,7 +63,7 @@ double cook_tip_displacement(ElementType type, int n, double nu = 0.3,
 }  // namespace
 
 TEST_CASE("cook's membrane, Neo-Hooke, Hex8: the published Q1 tip displacements per mesh",
-          "[fem][nonlinear][neo-hooke][cook]") {
+          "[fem][nonlinear][neo-hooke][cook][slow]") {
   // {elements per edge, published Q1 tip y-displacement [mm], 2 decimals}
   const std::vector<std::pair<int, double>> published = {{1, 5.15},  {2, 8.72},   {4, 12.02},
                                                          {8, 13.61}, {16, 14.13}, {32, 14.28}};
@@ -78,7 +78,7 @@ TEST_CASE("cook's membrane, Neo-Hooke, Hex8: the published Q1 tip displacements 
 }
 
 TEST_CASE("cook's membrane, Neo-Hooke, Hex20: converges to the published 14.33 mm",
-          "[fem][nonlinear][neo-hooke][cook]") {
+          "[fem][nonlinear][neo-hooke][cook][slow]") {
   double previous_error = 1e9;
   for (int n : {2, 4, 8}) {
     const double tip = cook_tip_displacement(ElementType::Hex20, n);
@@ -92,7 +92,7 @@ TEST_CASE("cook's membrane, Neo-Hooke, Hex20: converges to the published 14.33 m
 }
 
 TEST_CASE("cook's membrane, nu = 0.499: F-bar Hex8 near Hex20, plain Hex8 locks",
-          "[fem][nonlinear][neo-hooke][cook][fbar]") {
+          "[fem][nonlinear][neo-hooke][cook][fbar][slow]") {
   // Nearly incompressible (kappa / mu = 1000): the plain 2x2x2 Hex8 must keep eight volumes
   // per element nearly constant and locks; the F-bar Hex8 keeps one (the element's mean
   // dilatation). Reference: Hex20 (3x3x3, converging from below: 12.24, 12.88, 13.11 mm at 4,

@@ -139,7 +139,7 @@ TEST_CASE("explicit: stable_time_step() within 5 % of the observed stability lim
 }
 
 TEST_CASE("explicit: stable_time_step() is never above the observed limit of a 3D block",
-          "[fem][explicit]") {
+          "[fem][explicit][slow]") {
   // 4 x 4 x 4 cube clamped on one face. In 3D the highest modes are not the 1D P-wave: the
   // element-size estimate l / c_d was measured 16 % (Hex8, nu = 0.45) to 100 % (Hex20) above
   // the observed limit; the element eigenvalue bound must stay below it.

@@ -84,7 +84,7 @@ TEST_CASE("finite-strain j2: a rigid rotation after plastic flow rotates the str
 }
 
 TEST_CASE("finite-strain j2: Newton converges quadratically in plastic bending",
-          "[fem][nonlinear][j2][finite-strain]") {
+          "[fem][nonlinear][j2][finite-strain][slow]") {
   const test::BendingRun run = test::plastic_bending(
       std::make_shared<FiniteStrainJ2Law>(kE, kNu, kRho, HardeningCurve::linear(kSy, kE / 50.0)),
       0.5, 1e-9, 4);

@@ -56,7 +56,7 @@ EnergyRun released_bar(int per_period) {
 }  // namespace
 
 TEST_CASE("nonlinear Newmark: energy of a Neo-Hooke bar bounded over 40 periods, no drift",
-          "[fem][nonlinear][neo-hooke][energy]") {
+          "[fem][nonlinear][neo-hooke][energy][slow]") {
   // Average acceleration conserves KE + 1/2 u^T K u exactly for a linear system. For a
   // nonlinear one each step replaces int f_int . du by the trapezoidal rule: an error that
   // vanishes at least as dt^2 and, in a conservative oscillation, cancels over a period

@@ -55,7 +55,7 @@ bool carries(double factor, Hex8Formulation hex8) {
 }  // namespace
 
 TEST_CASE("thick cylinder, perfect plasticity: F-bar Hex8 collapses at Hill's limit pressure",
-          "[fem][nonlinear][j2][fbar]") {
+          "[fem][nonlinear][j2][fbar][slow]") {
   // Measured: F-bar carries p_lim itself (the whole wall plastic, eqps 2e-4 to 4e-3) and fails
   // from 1.005 p_lim on (the discrete limit within 0.5 %).
   CHECK(carries(0.99, Hex8Formulation::FBar));
