@@ -22,8 +22,7 @@ void NeighborList::clear() {
   valid_ = false;
   offsets_.assign(1, 0);
   neighbors_.clear();
-  shear_.clear();
-  touching_.clear();
+  slot_source_.clear();
   plane_mask_.clear();
   mesh_offsets_.assign(1, 0);
   mesh_candidates_.clear();
@@ -63,9 +62,9 @@ void NeighborList::renumber(const std::vector<int>& new_of_old, int n) {
     clear();
     return;
   }
-  // Each pair (i, j) becomes (min(a, b), max(a, b)) with a = new(i), b = new(j); the history is
-  // that of the first particle relative to the second, so it changes sign when they swap. Pairs
-  // with a removed particle are dropped.
+  // Each pair (i, j) becomes (min(a, b), max(a, b)) with a = new(i), b = new(j); its source
+  // remembers the old slot and whether a > b (a history of the first particle relative to the
+  // second changes sign). Pairs with a removed particle are dropped.
   new_offsets_.assign(n + 1, 0);
   for (int i = 0; i < rows; ++i) {
     if (new_of_old[i] < 0) continue;
@@ -75,7 +74,7 @@ void NeighborList::renumber(const std::vector<int>& new_of_old, int n) {
   }
   for (int i = 0; i < n; ++i) new_offsets_[i + 1] += new_offsets_[i];
   new_neighbors_.resize(new_offsets_[n]);
-  new_shear_.resize(new_offsets_[n]);
+  slot_source_.resize(new_offsets_[n]);
   counts_.assign(n, 0);
   for (int i = 0; i < rows; ++i) {
     if (new_of_old[i] < 0) continue;
@@ -85,32 +84,32 @@ void NeighborList::renumber(const std::vector<int>& new_of_old, int n) {
       const int row = std::min(a, b);
       const int slot = new_offsets_[row] + counts_[row]++;
       new_neighbors_[slot] = std::max(a, b);
-      new_shear_[slot] = a < b ? shear_[s] : Eigen::Vector3d(-shear_[s]);
+      slot_source_[slot] = {s, a > b};
     }
   }
-  // rows sorted by neighbour (short rows: insertion sort, histories moved along)
+  // rows sorted by neighbour (short rows: insertion sort, sources moved along)
   for (int r = 0; r < n; ++r)
     for (int s = new_offsets_[r] + 1; s < new_offsets_[r + 1]; ++s)
       for (int t = s; t > new_offsets_[r] && new_neighbors_[t - 1] > new_neighbors_[t]; --t) {
         std::swap(new_neighbors_[t - 1], new_neighbors_[t]);
-        std::swap(new_shear_[t - 1], new_shear_[t]);
+        std::swap(slot_source_[t - 1], slot_source_[t]);
       }
   offsets_.swap(new_offsets_);
   neighbors_.swap(new_neighbors_);
-  shear_.swap(new_shear_);
   // the build positions are only compared with the same particle's: drop them (next build sets
   // them); the lists must be rebuilt before use
   position_at_build_.clear();
 }
 
-void NeighborList::write(BinaryWriter& out) const {
+void NeighborList::write_rows(BinaryWriter& out) const {
   out.value(skin_);
   out.value(builds_);
   out.value(static_cast<char>(valid_));
   out.array(offsets_);
   out.array(neighbors_);
-  out.array(shear_);
-  out.array(touching_);
+}
+
+void NeighborList::write_build_references(BinaryWriter& out) const {
   out.array(position_at_build_);
   out.array(plane_at_build_);
   out.array(plane_mask_);
@@ -118,22 +117,23 @@ void NeighborList::write(BinaryWriter& out) const {
   out.array(mesh_candidates_);
 }
 
-void NeighborList::read(BinaryReader& in) {
+void NeighborList::read_rows(BinaryReader& in) {
   in.value(skin_, "neighbour skin");
   in.value(builds_, "neighbour build count");
   valid_ = in.value<char>("neighbour list validity") != 0;
   in.array(offsets_, "neighbour offsets");
   in.array(neighbors_, "neighbour pairs");
-  in.array(shear_, "pair histories");
-  in.array(touching_, "pair contact flags");
+  if (offsets_.empty() || static_cast<std::size_t>(offsets_.back()) != neighbors_.size())
+    throw Error("corrupt state: neighbour list arrays do not agree");
+  slot_source_.clear();  // the per-pair state comes with the state
+}
+
+void NeighborList::read_build_references(BinaryReader& in) {
   in.array(position_at_build_, "positions at the list build");
   in.array(plane_at_build_, "planes at the list build");
   in.array(plane_mask_, "plane masks");
   in.array(mesh_offsets_, "mesh candidate offsets");
   in.array(mesh_candidates_, "mesh candidates");
-  if (offsets_.empty() || static_cast<std::size_t>(offsets_.back()) != neighbors_.size() ||
-      shear_.size() != neighbors_.size() || touching_.size() != neighbors_.size())
-    throw Error("corrupt state: neighbour list arrays do not agree");
 }
 
 // Calls visit(j) for every j > i within R_i + R_j + skin of i, cells in a fixed order.
@@ -213,7 +213,7 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   }
   for (int i = 0; i < n; ++i) new_offsets_[i + 1] += new_offsets_[i];
   new_neighbors_.resize(new_offsets_[n]);
-  new_shear_.resize(new_offsets_[n]);
+  slot_source_.resize(new_offsets_[n]);
   // rows of the previous build (particles added since then have none)
   const int old_n = valid_ ? std::min(n, static_cast<int>(offsets_.size()) - 1) : 0;
 #pragma omp parallel for schedule(dynamic, 64) if (n >= 1024)
@@ -222,19 +222,16 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
     int k = 0;
     visit_pairs(p, i, [&](int j) { row[k++] = j; });
     std::sort(row, row + k);
-    // carry the tangential history of pairs that were already listed (both rows sorted)
+    // the old slots of pairs that were already listed (both rows sorted)
     int o = i < old_n ? offsets_[i] : 0;
     const int o_end = i < old_n ? offsets_[i + 1] : 0;
     for (int m = 0; m < k; ++m) {
       while (o < o_end && neighbors_[o] < row[m]) ++o;
-      new_shear_[new_offsets_[i] + m] =
-          (o < o_end && neighbors_[o] == row[m]) ? shear_[o] : Eigen::Vector3d::Zero();
+      slot_source_[new_offsets_[i] + m] = {(o < o_end && neighbors_[o] == row[m]) ? o : -1, false};
     }
   }
   offsets_.swap(new_offsets_);
   neighbors_.swap(new_neighbors_);
-  shear_.swap(new_shear_);
-  touching_.assign(neighbors_.size(), 1);  // the next evaluation settles forces and histories
 
   position_at_build_ = p.position;
   // Planes within R + skin of each particle.

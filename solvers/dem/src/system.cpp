@@ -71,7 +71,7 @@ void System::set_skin(double skin) {
 void System::particles_changed() {
   prepared_ = false;
   lists_current_ = false;
-  packed_valid_ = false;
+  verlet_.invalidate();
   partition_.invalidate();
 }
 
@@ -138,7 +138,7 @@ void System::set_particle_velocity(std::size_t i, const Eigen::Vector3d& v,
   store_.core().velocity[i] = v;
   store_.core().angular_velocity[i] = w;
   forces_valid_ = false;
-  packed_valid_ = false;
+  verlet_.invalidate();
 }
 
 void System::set_particle_mass(std::size_t i, double mass, double inertia) {
@@ -153,7 +153,7 @@ void System::set_particle_mass(std::size_t i, double mass, double inertia) {
   store_.core().mass[i] = mass;
   store_.core().inertia[i] = inertia;
   forces_valid_ = false;
-  packed_valid_ = false;
+  verlet_.invalidate();
 }
 
 void System::remove_particles(const std::vector<char>& remove) {
@@ -168,6 +168,7 @@ void System::remove_particles(const std::vector<char>& remove) {
   store_.remove(remove, new_of_old_);
   // pair histories follow their particles; the lists are rebuilt before the next use
   neighbors_.renumber(new_of_old_, static_cast<int>(store_.size()));
+  pairs_follow_lists();
   particles_changed();
 }
 
@@ -188,7 +189,8 @@ void System::renumber_particles(const std::vector<int>& order) {
   }
   store_.permute(order);
   neighbors_.renumber(new_of_old_);
-  packed_valid_ = false;
+  pairs_follow_lists();
+  verlet_.invalidate();
   partition_.invalidate();
   prepared_ = false;
   lists_current_ = false;
@@ -384,15 +386,16 @@ void System::sort_particles() {
   if (prepared_) rebuild_lists();
 }
 
-// Every per-particle array (the store) is permuted alike and the pair histories are renumbered
-// for the next build.
+// Every per-particle array (the store) is permuted alike and the pair histories follow the
+// renumbered rows (the next build finds them there).
 void System::reorder_particles() {
   sync_particles();
   builds_since_sort_ = 0;
   if (!cell_order_.compute(store_.core(), skin_)) return;
   store_.permute(cell_order_.order());
   neighbors_.renumber(cell_order_.new_of_old());
-  packed_valid_ = false;
+  pairs_follow_lists();
+  verlet_.invalidate();
   partition_.invalidate();
   ++sorts_;
 }
@@ -400,6 +403,7 @@ void System::reorder_particles() {
 void System::rebuild_lists() {
   sync_particles();
   neighbors_.build(store_.core(), walls_.planes(), meshes_);
+  pairs_follow_lists();
   partition_.invalidate();
   lists_current_ = true;
 }

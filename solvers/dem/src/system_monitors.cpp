@@ -52,7 +52,7 @@ double System::elastic_energy() const {
   if (lists_current_ && nl.offsets_.size() == p.size() + 1) {
     for (int i = 0; i < n; ++i)
       for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s)
-        e += pair_energy(i, nl.neighbors_[s], nl.shear_[s]);
+        e += pair_energy(i, nl.neighbors_[s], pairs_.shear(s));
   } else {  // before the first step: no lists yet, all pairs (no tangential history either)
     for (int i = 0; i < n; ++i)
       for (int j = i + 1; j < n; ++j) e += pair_energy(i, j, no_shear);

@@ -86,8 +86,7 @@ void System::restore_state(const SystemState& s) {
   std::istringstream in(s.body_, std::ios::binary);
   BinaryReader r(in);
   read_body(r);
-  mirror_valid_ = true;
-  packed_valid_ = false;
+  verlet_.store_replaced();
   partition_.invalidate();
   prepared_ = false;  // time step and scratch for the restored particle set; lists come with it
 }
@@ -117,7 +116,11 @@ void System::write_body(BinaryWriter& w) const {
   store_.write(w);
   walls_.write(w);
   for (const TriangleMesh& m : meshes_) m.write_state(w);
-  neighbors_.write(w);
+  // the lists, the pairs' histories between their rows and build references (format version 1:
+  // where the neighbour list wrote them when it held them)
+  neighbors_.write_rows(w);
+  pairs_.write(w);
+  neighbors_.write_build_references(w);
   walls_.write_forces(w);
   w.value(time_);
   w.value(static_cast<std::int64_t>(steps_));
@@ -152,7 +155,9 @@ void System::read_body(BinaryReader& r) {
   store_.read(r);
   walls_.read(r);
   for (TriangleMesh& m : meshes_) m.read_state(r);
-  neighbors_.read(r);
+  neighbors_.read_rows(r);
+  pairs_.read(r, neighbors_.pair_count());
+  neighbors_.read_build_references(r);
   walls_.read_forces(r);
   r.value(time_, "the time");
   steps_ = static_cast<long>(r.value<std::int64_t>("the step count"));

@@ -1,4 +1,5 @@
-// System: the step (velocity Verlet), the force pass (pairs, planes, meshes) and the reductions.
+// System: the step (orchestrating the VelocityVerlet integrator), the force pass (pairs, planes,
+// meshes) and the reductions.
 #include "partita/dem/system.hpp"
 
 #include "partita/dem/error.hpp"
@@ -35,7 +36,7 @@ void System::step(double dt) {
         << "rayleigh_time_step())";
     throw Error(msg.str());
   }
-  if (!packed_valid_) load_packed();
+  if (!verlet_.loaded()) verlet_.load(store_.core());
   if (!forces_valid_) {
     compute_forces(dt, false, 0.0, false);
     forces_valid_ = true;
@@ -55,22 +56,21 @@ void System::step(double dt) {
   const int parts = set_partition();
   partition_.prepare_cross_pairs(neighbors_);  // for the current lists (a rebuild below: its own)
   start_load_pass(parts);
-  // One parallel region for the whole step unless the lists need a rebuild: velocity Verlet,
-  // first half (v += dt/2 F/m, x += dt v, omega += dt/2 T/I on packed_, F = m g, T = 0), then the
-  // forces at t + dt and the second half (v += dt/2 F/m, omega += dt/2 T/I) particle by particle
-  // as each total is complete. With a rebuild the region
-  // ends after the first half and the (parallel) build and force evaluation follow. Every loop
-  // runs over the same parts (thread t: part t), so a particle's data stays in one core's cache.
+  const VelocityVerlet::Pass verlet = verlet_.pass(p);
+  // One parallel region for the whole step unless the lists need a rebuild: the integrator's
+  // first half (VelocityVerlet: v += dt/2 F/m, x += dt v, omega += dt/2 T/I), the start of the
+  // force sums (F = m g, T = 0), then the forces at t + dt and the integrator's kick
+  // (v += dt/2 F/m, omega += dt/2 T/I) particle by particle as each total is complete. With a
+  // rebuild the region ends after the first half and the (parallel) build and force evaluation
+  // follow. Every loop runs over the same parts (thread t: part t), so a particle's data stays in
+  // one core's cache.
 #pragma omp parallel if (parts > 1) num_threads(parts)
   {
 #pragma omp for schedule(static, 1) reduction(max : moved2)
     for (int part = 0; part < parts; ++part) {
       for (int i = partition_.begin(part); i < partition_.begin(part + 1); ++i) {
-        PackedParticle& q = packed_[i];
-        q.v += (half / q.m) * p.force[i];
-        q.x += dt * q.v;
-        q.w += (half / p.inertia[i]) * p.torque[i];
-        if (have_build) moved2 = std::max(moved2, (q.x - x_build[i]).squaredNorm());
+        const Eigen::Vector3d& x = verlet.first_half(i, dt, half);
+        if (have_build) moved2 = std::max(moved2, (x - x_build[i]).squaredNorm());
         start_sums(i);
       }
     }
@@ -87,7 +87,7 @@ void System::step(double dt) {
   } else {
     reduce_wall_and_mesh_forces();
   }
-  mirror_valid_ = false;
+  verlet_.moved();
   for (TriangleMesh& m : meshes_) m.position_last_step_ = m.position_;
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].post_force(*this, dt);
   time_ += dt;
@@ -101,37 +101,10 @@ void System::run(long steps, double dt) {
 
 // ---- forces -----------------------------------------------------------------------------------
 
-// Positions, velocities and angular velocities live in packed_ while stepping (with what the pair
-// loop reads about a neighbour: 96 bytes per particle, 2 cache lines instead of one per array);
-// the store's arrays mirror them for the caller, copied on demand.
-void System::load_packed() {
-  const Particles& p = store_.core();
-  const int n = static_cast<int>(p.size());
-  packed_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    PackedParticle& q = packed_[i];
-    q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
-    q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
-  }
-  packed_valid_ = true;
-  mirror_valid_ = true;
-}
-
-void System::sync_particles() const {
-  if (mirror_valid_) return;
-  Particles& p = store_.core();
-  for (std::size_t i = 0; i < packed_.size(); ++i) {
-    p.position[i] = packed_[i].x;
-    p.velocity[i] = packed_[i].v;
-    p.angular_velocity[i] = packed_[i].w;
-  }
-  mirror_valid_ = true;
-}
-
 // Starts the force sums of a step: F = m g, T = 0.
 void System::start_sums(int i) {
   Particles& p = store_.core();
-  p.force[i] = packed_[i].m * gravity_;
+  p.force[i] = verlet_.particle(i).m * gravity_;
   p.torque[i].setZero();
   if (track_load_) load_[i] = 0.0;
 }
@@ -142,7 +115,7 @@ void System::start_load_pass(int parts) {
 }
 
 void System::compute_forces(double dt, bool update_history, double kick, bool started) {
-  if (!packed_valid_) load_packed();
+  if (!verlet_.loaded()) verlet_.load(store_.core());
   const int parts = set_partition();
   partition_.prepare_cross_pairs(neighbors_);
   start_load_pass(parts);
@@ -184,11 +157,11 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   const WallContacts::Pass walls = walls_.pass(store_);
   // Raw pointers, taken once: the loops keep them in registers (a vector's data pointer would be
   // reloaded after every store through the char touching flags, which may alias it).
-  PackedParticle* const packed = packed_.data();
+  const VelocityVerlet::Pass verlet = verlet_.pass(p);
+  const PairContacts::Pass pairs = pairs_.pass();
+  PackedParticle* const packed = verlet.packed;
   Eigen::Vector3d* const force = p.force.data();
   Eigen::Vector3d* const torque = p.torque.data();
-  Eigen::Vector3d* const pair_shear = neighbors_.shear_.data();  // the pairs' histories
-  char* const pair_touching = neighbors_.touching_.data();
   double* load = Load ? load_.data() : nullptr;
   const double* load_limit = Limit ? store_.array<double>(h_load_limit_).data() : nullptr;
   const MeshContacts::History mesh_history{store_.array<int>(h_mesh_slot_count_).data(),
@@ -203,9 +176,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     for (int k = 0; k < n_cross; ++k) {
       const ThreadPartition::CrossPair& c = tp.cross_pairs[k];
       ThreadPartition::CrossForce& cf = tp.cross_force[k];
-      cf.touching = PairContacts::force<Load>(model_, packed[c.i], packed[c.j], pair_shear[c.slot],
-                                              pair_touching[c.slot], dt, update_history,
-                                              cf.force_i, cf.torque_i, cf.torque_j, cf.load);
+      cf.touching = pairs.force<Load>(c.slot, model_, packed[c.i], packed[c.j], dt,
+                                      update_history, cf.force_i, cf.torque_i, cf.torque_j,
+                                      cf.load);
     }
   }
 #pragma omp for schedule(static, 1)
@@ -228,7 +201,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       Eigen::Vector3d* block_wall = walls.start_block(b);
       const int i_end = std::min(hi, (b + 1) * block_size);
       for (int i = b * block_size; i < i_end; ++i) {
-        PackedParticle& qi = packed[i];
+        const PackedParticle& qi = packed[i];
         Eigen::Vector3d f = force[i];
         Eigen::Vector3d t = torque[i];
         double load_i = Load ? load[i] : 0.0;
@@ -244,8 +217,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           }
           Eigen::Vector3d fij, ti, tj;
           double lij = 0.0;
-          if (!PairContacts::force<Load>(model_, qi, packed[j], pair_shear[s], pair_touching[s], dt,
-                                         update_history, fij, ti, tj, lij))
+          if (!pairs.force<Load>(s, model_, qi, packed[j], dt, update_history, fij, ti, tj, lij))
             continue;
           f += fij;
           t += ti;
@@ -272,10 +244,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           load[i] = load_i;
           if constexpr (Limit) reached |= load_i >= load_limit[i];
         }
-        if (kick > 0.0) {  // (no other row reads particle i any more in this pass)
-          qi.v += (kick / qi.m) * f;
-          qi.w += (kick / p.inertia[i]) * t;
-        }
+        // the integrator's closing kick (no other row reads particle i any more in this pass)
+        if (kick > 0.0) verlet.kick(i, kick, f, t);
       }
     }
     if (reached) load_reached_[part] = 1;

@@ -3,7 +3,9 @@
 //
 // Particle pairs: a half list in compressed rows (pairs (i, j) with j > i, j ascending), cut-off
 // R_i + R_j + skin, so that it stays valid until some particle has moved more than skin/2 since
-// the build. Each pair slot carries its tangential history (moved to the new slot at a rebuild).
+// the build. The per-pair state (tangential histories, contact flags) is not kept here: its owner
+// (PairContacts) holds one entry per slot and follows the slot mapping that build() and
+// renumber() leave in slot_sources().
 // Particle-triangle candidates: triangles are binned into the same cells (box grown by
 // R_max + skin), each particle keeps the triangles within R + skin; valid until a particle or a
 // mesh vertex has moved more than skin/2.
@@ -33,9 +35,18 @@ struct MeshCandidate {
 
 class NeighborList {
  public:
+  /// Where the pair in a slot was before the last build() or renumber(): its old slot (-1: the
+  /// pair was not listed) and whether its order (i < j) flipped, so that a history of i relative
+  /// to j changes sign.
+  struct SlotSource {
+    int slot = -1;
+    bool flipped = false;
+  };
+
   void set_skin(double skin) { skin_ = skin; }
   double skin() const { return skin_; }
-  /// Forgets the lists (next needs_rebuild() is true); histories are dropped.
+  /// Forgets the lists (next needs_rebuild() is true); slot_sources() becomes empty (per-pair
+  /// state is dropped by the owner's follow()).
   void clear();
   /// True when a particle or mesh vertex moved more than skin/2 since the last build.
   bool needs_rebuild(const Particles& particles, const std::vector<PlaneWall>& planes,
@@ -44,23 +55,31 @@ class NeighborList {
   /// caller's integration loop).
   bool needs_rebuild(double max_moved2, const std::vector<PlaneWall>& planes,
                      const std::vector<TriangleMesh>& meshes) const;
-  /// Rebuilds cells and lists, carrying the tangential histories of surviving pairs over.
+  /// Rebuilds cells and lists; slot_sources() maps each new slot to the pair's old slot (pairs
+  /// of the previous build that are still listed).
   void build(const Particles& particles, const std::vector<PlaneWall>& planes,
              std::vector<TriangleMesh>& meshes);
   /// After the caller renumbered the particles (old index i is now new_of_old[i]): rewrites the
-  /// pair rows and their tangential histories in the new numbering (a pair whose order flips
-  /// keeps its history with the sign changed), so that the next build() carries them over. The
-  /// lists must be rebuilt before they are used again.
+  /// pair rows in the new numbering (slot_sources(): a pair's old slot and whether its order
+  /// flipped), so that the next build() finds the pairs again. The lists must be rebuilt before
+  /// they are used again.
   void renumber(const std::vector<int>& new_of_old);
-  /// Same, where new_of_old[i] < 0 marks a removed particle (its pairs and histories are
-  /// dropped) and `new_count` is the number of particles after the change.
+  /// Same, where new_of_old[i] < 0 marks a removed particle (its pairs are dropped) and `new_count` is the number of particles after the change.
   void renumber(const std::vector<int>& new_of_old, int new_count);
   /// Whether the lists were built for the current particles (cleared by renumber()).
   bool built() const { return valid_ && !position_at_build_.empty(); }
-  /// Writes / reads the lists with their histories and build references (the cell grid is
-  /// scratch of build() and not part of the state).
-  void write(BinaryWriter& out) const;
-  void read(BinaryReader& in);
+  /// The slot mapping of the last build() or renumber() (one entry per slot; empty after
+  /// clear()). The owner of per-pair state follows it before the next build() or renumber().
+  const std::vector<SlotSource>& slot_sources() const { return slot_source_; }
+  /// Writes / reads the lists in two parts, the rows (skin, build count, validity, offsets,
+  /// neighbours) and the build references (positions and planes at the build, plane masks, mesh
+  /// candidates); the state format has the pairs' histories between them (System). The cell
+  /// grid is scratch of build() and not part of the state. read_rows() throws Error when the
+  /// offsets and neighbours do not agree.
+  void write_rows(BinaryWriter& out) const;
+  void write_build_references(BinaryWriter& out) const;
+  void read_rows(BinaryReader& in);
+  void read_build_references(BinaryReader& in);
   /// Planes near particle i (bit k: plane k); all bits set when there are more than 64 planes.
   std::uint64_t plane_mask(std::size_t i) const { return plane_mask_[i]; }
 
@@ -91,16 +110,14 @@ class NeighborList {
   bool valid_ = false;
   Grid grid_;
   std::vector<int> cell_start_, cell_items_, particle_cell_;
-  // half list (compressed rows) with per-pair history and force buffers
+  // half list (compressed rows)
   std::vector<int> offsets_, neighbors_;
-  std::vector<Eigen::Vector3d> shear_;
-  std::vector<char> touching_;  // overlap > 0 in the last force evaluation
+  std::vector<SlotSource> slot_source_;  // per slot: where the pair was before the last change
   std::vector<Eigen::Vector3d> position_at_build_;
   std::vector<Eigen::Vector3d> plane_at_build_;
   std::vector<std::uint64_t> plane_mask_;
   // scratch reused between builds
   std::vector<int> new_offsets_, new_neighbors_, counts_;
-  std::vector<Eigen::Vector3d> new_shear_;
   // particle-triangle candidates
   std::vector<int> tri_cell_start_;
   std::vector<MeshCandidate> tri_cell_items_;

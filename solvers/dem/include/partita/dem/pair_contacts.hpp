@@ -1,15 +1,26 @@
 #pragma once
-// Contacts between two spheres: the force kernel of one listed pair (Hertz-Mindlin with the
-// tangential history, torques, rolling resistance and the contact load of the breakage
-// criterion). The per-pair state, the tangential history and the touching flag, lives in the
-// slot of the pair in the neighbour list (NeighborList moves it to the pair's new slot at a
-// rebuild and renumbers it with the particles); the material-pair parameters in the
-// ContactModel's table. Inline: the force pass keeps the compiler's whole view of the loop.
+// Contacts between two spheres: the per-pair state and the force kernel of one listed pair
+// (Hertz-Mindlin with the tangential history, torques, rolling resistance and the contact load of
+// the breakage criterion).
+//
+// PairContacts owns the per-pair state, one entry per slot of the neighbour list's half list
+// (slot s: the pair (i, nl.neighbors_[s])): the tangential spring (shear) and whether the spheres
+// overlapped in the last force pass (touching). The neighbour list owns the slots; after each of
+// its build() and renumber() calls follow(lists.slot_sources()) moves every history to its
+// pair's new slot (a pair whose order flipped keeps its history with the sign changed; a new pair
+// starts at zero) and marks every slot touching, so that the next force pass settles forces and
+// histories. No allocation once sized. The material-pair parameters live in the ContactModel's
+// table. The kernel is inline: the force pass keeps the compiler's whole view of the loop.
 
+#include "partita/dem/binary_reader.hpp"
+#include "partita/dem/binary_writer.hpp"
 #include "partita/dem/contact_model.hpp"
+#include "partita/dem/neighbor_list.hpp"
 #include "partita/dem/packed_particle.hpp"
 
 #include <cmath>
+#include <cstddef>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -18,6 +29,38 @@ namespace partita::dem {
 
 class PairContacts {
  public:
+  /// Moves the per-pair state to the slots of the neighbour list's last build() or renumber()
+  /// (sources[k]: where slot k's pair was); every slot is marked touching.
+  void follow(const std::vector<NeighborList::SlotSource>& sources);
+  std::size_t slot_count() const { return shear_.size(); }
+  /// The tangential history of the pair in slot s.
+  const Eigen::Vector3d& shear(std::size_t s) const { return shear_[s]; }
+
+  /// What one force pass reads and writes, taken once per pass (raw pointers the loops keep in
+  /// registers: a member vector's data pointer would be reloaded after every store through the
+  /// char flags, which may alias it).
+  struct Pass {
+    Eigen::Vector3d* shear;
+    char* touching;
+
+    /// The kernel (force()) for the pair in slot s.
+    template <bool Load>
+    PARTITA_DEM_INLINE bool force(int s, const ContactModel& model, const PackedParticle& qi,
+                                  const PackedParticle& qj, double dt, bool update_history,
+                                  Eigen::Vector3d& fij, Eigen::Vector3d& ti, Eigen::Vector3d& tj,
+                                  double& load) const {
+      return PairContacts::force<Load>(model, qi, qj, shear[s], touching[s], dt, update_history,
+                                       fij, ti, tj, load);
+    }
+  };
+  Pass pass() { return Pass{shear_.data(), touching_.data()}; }
+
+  /// Writes / reads the histories and flags (in the state format, between the neighbour list's
+  /// rows and its build references: see System::write_body()). read() throws Error when their
+  /// number is not `slots` (the neighbour list's pair count).
+  void write(BinaryWriter& out) const;
+  void read(BinaryReader& in, std::size_t slots);
+
   /// Force of the pair (i, j) on i and the torques on i and j; false (and the history settled:
   /// zeroed once the spheres part) when they do not overlap. Torques T_i = -cr_i n x F_t,
   /// T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
@@ -72,6 +115,11 @@ class PairContacts {
     }
     return true;
   }
+
+ private:
+  std::vector<Eigen::Vector3d> shear_;  // per slot: tangential spring
+  std::vector<char> touching_;          // per slot: overlap > 0 in the last force pass
+  std::vector<Eigen::Vector3d> new_shear_;  // scratch of follow()
 };
 
 }  // namespace partita::dem

@@ -24,8 +24,19 @@
 // contact histories of new contacts start at zero).
 //
 // Integration: velocity Verlet (v += dt/2 F/m; x += dt v; forces; v += dt/2 F/m, same for the
-// angular velocity with I = 2/5 m R^2). Forces of a step do not depend on the number of
-// OpenMP threads (set_num_threads()): each particle sums its contacts in a fixed order.
+// angular velocity with I = 2/5 m R^2; VelocityVerlet). Forces of a step do not depend on the
+// number of OpenMP threads (set_num_threads()): each particle sums its contacts in a fixed order.
+//
+// System orchestrates; the data is owned by (see solvers/dem/README.md, "Class map"):
+//   ParticleStore   every per-particle array (core arrays, wall and mesh histories, hooks' arrays)
+//   VelocityVerlet  the packed moving state while stepping and its mirror into the store
+//   NeighborList    cells, the pair half list (slots), plane masks, mesh candidates
+//   PairContacts    per pair slot: tangential history and touching flag
+//   WallContacts    planes, walls, wall forces (histories: a store array)
+//   MeshContacts    the mesh contact kernel and reduction (histories: store arrays)
+//   ThreadPartition parts of the particles per thread, cross pairs and their forces
+//   CellOrder       renumbering in cell order
+//   StepHookList    the step hooks (breakage, ...)
 
 #include "partita/dem/cell_order.hpp"
 #include "partita/dem/contact_model.hpp"
@@ -45,6 +56,7 @@
 #include "partita/dem/system_state.hpp"
 #include "partita/dem/thread_partition.hpp"
 #include "partita/dem/triangle_mesh.hpp"
+#include "partita/dem/velocity_verlet.hpp"
 #include "partita/dem/wall_contacts.hpp"
 
 #include <cstddef>
@@ -238,9 +250,10 @@ class System {
   // forces at the current positions; kick > 0: then v += kick F/m, omega += kick T/I
   // started: the sums were started (start_sums()) by the caller
   void compute_forces(double dt, bool update_history, double kick, bool started);
-  void load_packed();
   void reorder_particles();
-  void sync_particles() const;
+  void sync_particles() const { verlet_.sync(store_.core()); }
+  // the neighbour list's slots changed (build, renumber): the pair histories follow
+  void pairs_follow_lists() { pairs_.follow(neighbors_.slot_sources()); }
   void start_sums(int i);
   void rebuild_lists();
   int set_partition();
@@ -255,19 +268,19 @@ class System {
   void read_body(BinaryReader& in);
 
   ContactModel model_;
-  // every per-particle array; position, velocity and angular velocity: packed_ holds them while
-  // stepping; the store's copies are brought up to date on demand (mirror_valid_), and packed_
-  // reloaded after a caller's change
+  // every per-particle array; position, velocity and angular velocity: verlet_ holds them while
+  // stepping; the store's copies are brought up to date on demand (sync_particles()), and the
+  // packed copy reloaded after a caller's change (verlet_.invalidate())
   mutable ParticleStore store_;
+  VelocityVerlet verlet_;
   int h_mesh_slot_count_ = -1;  // mesh contacts of each particle (<= max_mesh_contacts)
   int h_mesh_slot_key_ = -1;    // N x max_mesh_contacts feature keys
   int h_mesh_slot_shear_ = -1;  // N x max_mesh_contacts tangential histories
   int h_mesh_records_ = -1;     // N x max_mesh_contacts results of the last force evaluation
-  mutable bool mirror_valid_ = true;
-  bool packed_valid_ = false;
   WallContacts walls_;  // planes, their histories and wall forces
   std::vector<TriangleMesh> meshes_;
   NeighborList neighbors_;
+  PairContacts pairs_;  // per pair slot of neighbors_: tangential histories, touching flags
   StepHookList hooks_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
   double skin_ = -1.0;
@@ -283,7 +296,6 @@ class System {
   int h_load_limit_ = -1;       // a hook's per-particle load limits (store array) or -1
   std::vector<char> load_reached_;  // per part: a load reached its limit in the last pass
 
-  std::vector<PackedParticle> packed_;  // the moving state while stepping
   ThreadPartition partition_;
   // renumbering in cell order
   int sort_interval_ = 0;

@@ -1,0 +1,27 @@
+// VelocityVerlet: loading the packed state from the particle store and mirroring it back.
+#include "partita/dem/velocity_verlet.hpp"
+
+namespace partita::dem {
+
+void VelocityVerlet::load(const Particles& p) {
+  const int n = static_cast<int>(p.size());
+  packed_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    PackedParticle& q = packed_[i];
+    q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
+    q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
+  }
+  loaded_ = true;
+  mirror_current_ = true;
+}
+
+void VelocityVerlet::copy_back(Particles& p) const {
+  for (std::size_t i = 0; i < packed_.size(); ++i) {
+    p.position[i] = packed_[i].x;
+    p.velocity[i] = packed_[i].v;
+    p.angular_velocity[i] = packed_[i].w;
+  }
+  mirror_current_ = true;
+}
+
+}  // namespace partita::dem
