@@ -50,6 +50,8 @@ std::string to_string(FillOrdering ordering) {
       return "auto";
     case FillOrdering::Metis:
       return "metis";
+    case FillOrdering::Nesdis:
+      return "nesdis";
     case FillOrdering::Amd:
       return "amd";
   }
@@ -92,7 +94,10 @@ class EigenLdlt final : public SparseFactorisation::Impl {
     x = ldlt_.solve(b);
   }
   double factor_nonzeros() const override {
-    return factorised_ ? static_cast<double>(ldlt_.matrixL().nestedExpression().nonZeros()) : 0.0;
+    // L is stored without its unit diagonal
+    return factorised_ ? static_cast<double>(ldlt_.matrixL().nestedExpression().nonZeros() +
+                                             ldlt_.rows())
+                       : 0.0;
   }
 
  private:
@@ -110,10 +115,22 @@ class Cholmod final : public SparseFactorisation::Impl {
     cholmod_start(&c_);
     c_.print = 0;  // no output: failures are reported through factorize()'s result
     c_.supernodal = CHOLMOD_SUPERNODAL;
-    // One ordering, no trial of others: METIS (nested dissection) measured best on the plates
-    // (bench/README.md, FEM). CHOLMOD's METIS is deterministic (fixed seed).
+    // One ordering, no trial of others (CHOLMOD's default tries AMD, then METIS when AMD's
+    // fill is high): NESDIS measured best on the plates (bench/README.md, FEM). METIS runs
+    // with a fixed seed, so the ordering and the factor are the same in every run.
     c_.nmethods = 1;
-    c_.method[0].ordering = ordering == FillOrdering::Amd ? CHOLMOD_AMD : CHOLMOD_METIS;
+    switch (ordering) {
+      case FillOrdering::Amd:
+        c_.method[0].ordering = CHOLMOD_AMD;
+        break;
+      case FillOrdering::Metis:
+        c_.method[0].ordering = CHOLMOD_METIS;
+        break;
+      case FillOrdering::Automatic:
+      case FillOrdering::Nesdis:
+        c_.method[0].ordering = CHOLMOD_NESDIS;
+        break;
+    }
     c_.postorder = 1;
     c_.quick_return_if_not_posdef = 1;
   }

@@ -15,9 +15,11 @@ namespace partita::fem {
 //   Automatic  Cholmod when built in, else EigenLdlt.
 // Both factorise the symmetric matrix's lower triangle and agree to round-off.
 enum class LinearSolver { Automatic, Cholmod, EigenLdlt };
-// CHOLMOD's fill-reducing ordering: METIS nested dissection or AMD (approximate minimum degree).
-// Automatic is the measured better one on the plate meshes (bench_fem_plate, see bench/README).
-enum class FillOrdering { Automatic, Metis, Amd };
+// CHOLMOD's fill-reducing ordering: Metis (METIS_NodeND nested dissection), Nesdis (CHOLMOD's
+// own nested dissection: METIS edge separators, then constrained minimum degree on the parts),
+// or Amd (approximate minimum degree). Automatic = Nesdis, the smallest factor and the fastest
+// factorisation and solve on the plates of bench_fem_plate (figures in bench/README.md).
+enum class FillOrdering { Automatic, Metis, Nesdis, Amd };
 
 // Whether this build has CHOLMOD (PARTITA_CHOLMOD).
 bool cholmod_available();
@@ -57,7 +59,7 @@ class SparseFactorisation {
   // x = A^-1 b with the last successful factorisation. No allocation once x and the
   // backend's work space are sized (the first call of a given size sizes them).
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
-  // Nonzeros of the factor L (0 before the first factorize()).
+  // Nonzeros of the factor L, its diagonal included (0 before the first factorize()).
   double factor_nonzeros() const;
 
   struct Impl;  // the backend (defined in linear_solver.cpp)
