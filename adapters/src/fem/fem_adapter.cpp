@@ -182,8 +182,8 @@ std::shared_ptr<Spec> make_spec() {
   analysis
       ->choice("linear_solver",
                "sparse direct solver of static solves, Newmark's K_eff and Newton's tangents: "
-               "cholmod (SuiteSparse's supernodal Cholesky, METIS ordering; only in a build "
-               "with CHOLMOD), eigen-ldlt (Eigen's simplicial LDL^T, AMD ordering), or auto "
+               "cholmod (SuiteSparse's supernodal Cholesky, NESDIS nested-dissection ordering; "
+               "only in a build with CHOLMOD), eigen-ldlt (Eigen's simplicial LDL^T, AMD ordering), or auto "
                "(cholmod when built in, else eigen-ldlt); both agree to round-off",
                {"auto", "cholmod", "eigen-ldlt"})
       .def("auto");

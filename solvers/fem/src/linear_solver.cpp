@@ -95,9 +95,9 @@ class EigenLdlt final : public SparseFactorisation::Impl {
   }
   double factor_nonzeros() const override {
     // L is stored without its unit diagonal
-    return factorised_ ? static_cast<double>(ldlt_.matrixL().nestedExpression().nonZeros() +
-                                             ldlt_.rows())
-                       : 0.0;
+    return factorised_
+               ? static_cast<double>(ldlt_.matrixL().nestedExpression().nonZeros() + ldlt_.rows())
+               : 0.0;
   }
 
  private:
@@ -164,7 +164,8 @@ class Cholmod final : public SparseFactorisation::Impl {
       throw Error("CHOLMOD: out of memory in the factorisation");
     bool positive_definite = ok && c_.status != CHOLMOD_NOT_POSDEF && l_->minor >= l_->n;
     // (min_i L_ii / max_i L_ii)^2 = min d / max d of the equivalent L D L^T
-    if (positive_definite && !indefinite_ok_) positive_definite = cholmod_rcond(l_, &c_) > kMinPivotRatio;
+    if (positive_definite && !indefinite_ok_)
+      positive_definite = cholmod_rcond(l_, &c_) > kMinPivotRatio;
     use_fallback_ = !positive_definite && indefinite_ok_;
     if (use_fallback_) {
       // not positive definite (a Newton tangent past a limit point): L D L^T without pivoting

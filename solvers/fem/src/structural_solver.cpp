@@ -408,7 +408,8 @@ void StructuralSolver::solve_static() {
     return;
   }
   if (!static_factor_) {
-    static_factor_ = std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
+    static_factor_ =
+        std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
     static_factor_->analyze(k_ff_);
     factorise_or_throw(*static_factor_, k_ff_, "static stiffness matrix K_ff");
     timings_.factor_nonzeros = static_factor_->factor_nonzeros();
@@ -494,7 +495,8 @@ void StructuralSolver::factorise_dynamic(double dt) {
   keff_fc_ = sk * k_fc_ + sm * m_fc_;
   // symbolic analysis once (the pattern of K_eff does not depend on dt), numeric per dt
   if (!dynamic_factor_) {
-    dynamic_factor_ = std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
+    dynamic_factor_ =
+        std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
     dynamic_factor_->analyze(keff_ff);
   }
   factorise_or_throw(*dynamic_factor_, keff_ff, "effective matrix K_eff");

@@ -146,8 +146,8 @@ TEST_CASE("linear solver: a plate free to move rigidly is a clear error with eit
     free_z.fix("lateral", {0, 1});
     free_z.add_pressure("zmax", 10e3);
     StructuralSolver s(std::move(free_z), with_solver(solver));
-    CHECK_THROWS_WITH(s.solve_static(), Catch::Contains("singular or indefinite") &&
-                                            Catch::Contains("rigid-body"));
+    CHECK_THROWS_WITH(s.solve_static(),
+                      Catch::Contains("singular or indefinite") && Catch::Contains("rigid-body"));
   }
 }
 
