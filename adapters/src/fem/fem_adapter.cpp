@@ -183,8 +183,9 @@ std::shared_ptr<Spec> make_spec() {
       ->choice("linear_solver",
                "sparse direct solver of static solves, Newmark's K_eff and Newton's tangents: "
                "cholmod (SuiteSparse's supernodal Cholesky, NESDIS nested-dissection ordering; "
-               "only in a build with CHOLMOD), eigen-ldlt (Eigen's simplicial LDL^T, AMD ordering), or auto "
-               "(cholmod when built in, else eigen-ldlt); both agree to round-off",
+               "only in a build with CHOLMOD), eigen-ldlt (Eigen's simplicial LDL^T, AMD "
+               "ordering), or auto (cholmod when built in, else eigen-ldlt); both agree to "
+               "round-off",
                {"auto", "cholmod", "eigen-ldlt"})
       .def("auto");
   auto nonlinear = std::make_shared<Spec>(
