@@ -20,9 +20,13 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 
+# libsuitesparse-dev: CHOLMOD, the FEM's supernodal sparse Cholesky (optional: without it the
+# build falls back to Eigen's solver). libopenblas0-serial: the BLAS CHOLMOD's supernodes run on
+# (Debian's reference BLAS makes the factorisation about 4x slower); single-threaded, so the
+# results do not depend on the thread count and restarts stay bit-identical.
 PACKAGES=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
           catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib
-          python3-vtk9)
+          python3-vtk9 libsuitesparse-dev libopenblas0-serial)
 # Only for `./build.sh test --sanitize` and `./build.sh fuzz`: clang and its runtime libraries
 # (libclang_rt.fuzzer, ASan, UBSan).
 SANITIZE_PACKAGES=(clang libclang-rt-dev)

@@ -7,12 +7,20 @@
 // figures of shared/bench/peers/RESULTS.md (0.155 s/increment at 20x20x2, 2.28 s at 40x40x4).
 //
 // usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] [--lumped] [--no-ccx]
-//                        [--peers DIR]
-// Timings are wall-clock on a possibly shared machine: read them with that caveat.
+//                        [--peers DIR] [--backends
+//                        eigen-ldlt,cholmod-nesdis,cholmod-metis,cholmod-amd]
+//                        [--no-static]   (transient only: the large plates)
+// Each mesh is solved with every linear solver built in (Eigen's SimplicialLDLT + AMD; CHOLMOD
+// supernodal with NESDIS, METIS and AMD orderings), and the summary prints their factorisation and
+// step times as ratios to the first one listed, and to CalculiX. Timings are wall-clock on a
+// possibly shared machine: read them with that caveat.
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -21,6 +29,7 @@
 #include <vector>
 
 #include "partita/fem/box_mesher.hpp"
+#include "partita/fem/linear_solver.hpp"
 #include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
@@ -37,6 +46,8 @@ struct Options {
   int steps = 100;
   double dt = 1e-6;
   bool qm6 = false, lumped = false, ccx = true;
+  std::vector<std::string> backends;  // empty: all built in
+  bool with_static = true;
   std::string peers = PARTITA_PEERS_DIR;
 };
 
@@ -113,6 +124,89 @@ double run_ccx(const Options& opt, std::array<int, 3> c) {
   return wall / opt.steps;
 }
 
+struct Backend {
+  std::string name;  // eigen-ldlt, cholmod-metis, cholmod-amd
+  LinearSolver solver;
+  FillOrdering ordering;
+};
+
+std::vector<Backend> all_backends() {
+  std::vector<Backend> b = {{"eigen-ldlt", LinearSolver::EigenLdlt, FillOrdering::Automatic}};
+  if (cholmod_available()) {
+    b.push_back({"cholmod-nesdis", LinearSolver::Cholmod, FillOrdering::Nesdis});
+    b.push_back({"cholmod-metis", LinearSolver::Cholmod, FillOrdering::Metis});
+    b.push_back({"cholmod-amd", LinearSolver::Cholmod, FillOrdering::Amd});
+  }
+  return b;
+}
+
+struct Result {
+  double static_factorisation = 0.0, nnz_l = 0.0, per_step = 0.0, amortised = 0.0;
+  double per_step_cpu = 0.0;  // process CPU time per steady step (less noisy when shared)
+  double transient_factorisation = 0.0;
+  Eigen::VectorXd u_static, u_transient;
+};
+
+Result bench_backend(const Options& opt, const Model& model, const Backend& b) {
+  Result res;
+  // static
+  if (opt.with_static) {
+    SolverOptions so;
+    so.linear_solver = b.solver;
+    so.fill_ordering = b.ordering;
+    const auto t0 = Clock::now();
+    StructuralSolver s(model, so);
+    const double t_setup = since(t0);
+    const auto t1 = Clock::now();
+    s.solve_static();
+    const double t_solve = since(t1);
+    const Vec3 r = s.reaction("corners");
+    res.static_factorisation = s.timings().factorisation;
+    res.nnz_l = s.timings().factor_nonzeros;
+    res.u_static = s.displacement();
+    std::printf(
+        "  [%s] static: %zu dofs, set-up (assembly) %.3f s, factorise + solve %.3f s "
+        "(factorisation %.3f s, nnz(L) %.3g), Rz = %.9f N (p A = 4 N)\n",
+        b.name.c_str(), s.num_dofs(), t_setup, t_solve, res.static_factorisation, res.nnz_l, r[2]);
+  }
+  // transient
+  SolverOptions so;
+  so.mass = opt.lumped ? MassType::Lumped : MassType::Consistent;
+  so.linear_solver = b.solver;
+  so.fill_ordering = b.ordering;
+  const auto t0 = Clock::now();
+  StructuralSolver s(model, so);
+  double rmin = 1e300, rmax = -1e300, rlast = 0.0;
+  double first_step = 0.0, later_steps = 0.0, later_cpu = 0.0;
+  for (int k = 0; k < opt.steps; ++k) {
+    const auto ts = Clock::now();
+    const std::clock_t cs = std::clock();
+    s.step(opt.dt);
+    if (k > 0) later_cpu += static_cast<double>(std::clock() - cs) / CLOCKS_PER_SEC;
+    (k == 0 ? first_step : later_steps) += since(ts);
+    const double r = s.reaction("corners")[2];
+    rmin = std::min(rmin, r);
+    rmax = std::max(rmax, r);
+    rlast = r;
+  }
+  const double total = since(t0);
+  const auto& tm = s.timings();
+  res.per_step = opt.steps > 1 ? later_steps / (opt.steps - 1) : first_step;
+  res.per_step_cpu = opt.steps > 1 ? later_cpu / (opt.steps - 1) : 0.0;
+  res.amortised = (tm.assembly + tm.factorisation + tm.solve) / opt.steps;
+  res.transient_factorisation = tm.factorisation;
+  res.nnz_l = tm.factor_nonzeros;
+  res.u_transient = s.displacement();
+  std::printf(
+      "  [%s] transient (%s mass, dt = %g s, %d steps): assembly K+M %.3f s, K_eff factorised "
+      "%zu x in %.3f s, per step %.2f ms (steady), first step %.3f s, total %.3f s; corner Rz "
+      "min %.3f max %.3f last %.3f N\n",
+      b.name.c_str(), opt.lumped ? "lumped" : "consistent", opt.dt, opt.steps, tm.assembly,
+      tm.factorisations, tm.factorisation, 1e3 * res.per_step, first_step, total, rmin, rmax,
+      rlast);
+  return res;
+}
+
 void bench(const Options& opt, std::array<int, 3> cells) {
   const std::string tag =
       std::to_string(cells[0]) + "x" + std::to_string(cells[1]) + "x" + std::to_string(cells[2]);
@@ -121,53 +215,14 @@ void bench(const Options& opt, std::array<int, 3> cells) {
               cells[0] * cells[1] * cells[2]);
   const Model model = plate_model(cells, opt.qm6);
 
-  // static
-  {
-    const auto t0 = Clock::now();
-    StructuralSolver s(model);
-    const double t_setup = since(t0);
-    const auto t1 = Clock::now();
-    s.solve_static();
-    const double t_solve = since(t1);
-    const Vec3 r = s.reaction("corners");
-    std::printf(
-        "  static: %zu dofs, set-up (assembly) %.3f s, factorise + solve %.3f s (factorisation "
-        "%.3f s), "
-        "total %.3f s\n",
-        s.num_dofs(), t_setup, t_solve, s.timings().factorisation, t_setup + t_solve);
-    std::printf("  static corner reaction: Rz = %.9f N (p A = 4 N), Rx = %.2e, Ry = %.2e\n", r[2],
-                r[0], r[1]);
+  std::vector<Backend> backends;
+  for (const auto& b : all_backends()) {
+    if (opt.backends.empty() ||
+        std::find(opt.backends.begin(), opt.backends.end(), b.name) != opt.backends.end())
+      backends.push_back(b);
   }
-
-  // transient
-  SolverOptions so;
-  so.mass = opt.lumped ? MassType::Lumped : MassType::Consistent;
-  const auto t0 = Clock::now();
-  StructuralSolver s(model, so);
-  double rmin = 1e300, rmax = -1e300, rmean = 0.0, rlast = 0.0;
-  double first_step = 0.0, later_steps = 0.0;
-  for (int k = 0; k < opt.steps; ++k) {
-    const auto ts = Clock::now();
-    s.step(opt.dt);
-    (k == 0 ? first_step : later_steps) += since(ts);
-    const double r = s.reaction("corners")[2];
-    rmin = std::min(rmin, r);
-    rmax = std::max(rmax, r);
-    rmean += r / opt.steps;
-    rlast = r;
-  }
-  const double total = since(t0);
-  const auto& tm = s.timings();
-  const double per_step = opt.steps > 1 ? later_steps / (opt.steps - 1) : first_step;
-  const double amortised = (tm.assembly + tm.factorisation + tm.solve) / opt.steps;
-  std::printf(
-      "  transient (%s mass, dt = %g s, %d steps): assembly K+M %.3f s, factorisations %zu in %.3f "
-      "s "
-      "(K_eff once), per step %.2f ms (steady), first step %.3f s, total %.3f s incl. reactions\n",
-      opt.lumped ? "lumped" : "consistent", opt.dt, opt.steps, tm.assembly, tm.factorisations,
-      tm.factorisation, 1e3 * per_step, first_step, total);
-  std::printf("  transient corner reaction Rz: min %.3f max %.3f mean %.3f last %.3f N\n", rmin,
-              rmax, rmean, rlast);
+  std::vector<Result> results;
+  for (const auto& b : backends) results.push_back(bench_backend(opt, model, b));
 
   const std::map<std::string, double> recorded = {{"20x20x2", 0.155}, {"40x40x4", 2.28}};
   double ccx = -1.0;
@@ -175,18 +230,41 @@ void bench(const Options& opt, std::array<int, 3> cells) {
   std::string source = "live";
   if (ccx < 0.0) {
     const auto it = recorded.find(tag);
-    if (it == recorded.end()) {
-      std::printf("  no CalculiX figure for this mesh (ccx not on PATH, none recorded)\n");
-      return;
+    if (it != recorded.end()) {
+      ccx = it->second;
+      source = "recorded, RESULTS.md";
     }
-    ccx = it->second;
-    source = "recorded, RESULTS.md";
+  }
+  // summary: ratios to the first backend (eigen-ldlt when listed) and to CalculiX
+  std::printf("  %-14s %12s %10s %10s %9s %16s %12s %10s\n", "backend", "factorise s", "nnz(L)",
+              "step ms", "(cpu ms)", "vs " /* first */, "ccx/partita", "|du|/|u|");
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const auto& r = results[i];
+    const auto& r0 = results.front();
+    const double du =
+        opt.with_static ? (r.u_static - r0.u_static).norm() / r0.u_static.norm() : 0.0;
+    const double dv = (r.u_transient - r0.u_transient).norm() / r0.u_transient.norm();
+    char vs[64], cx[32];
+    const double f0 = opt.with_static ? r0.static_factorisation : r0.transient_factorisation;
+    const double f = opt.with_static ? r.static_factorisation : r.transient_factorisation;
+    std::snprintf(vs, sizeof vs, "%.1fx/%.1fx/%.1fx", f0 / f, r0.per_step / r.per_step,
+                  r0.per_step_cpu / r.per_step_cpu);
+    if (ccx > 0.0)
+      std::snprintf(cx, sizeof cx, "%.0fx", ccx / r.per_step);
+    else
+      std::snprintf(cx, sizeof cx, "-");
+    std::printf("  %-14s %12.3f %10.3g %10.2f %9.2f %16s %12s %10.1e\n", backends[i].name.c_str(),
+                f, r.nnz_l, 1e3 * r.per_step, 1e3 * r.per_step_cpu, vs, cx, std::max(du, dv));
   }
   std::printf(
-      "  CalculiX %.3f s/increment (%s): ratio ccx/partita = %.0fx per steady step, %.0fx "
-      "amortised "
-      "(assembly + factorisations + %d steps)\n",
-      ccx, source.c_str(), ccx / per_step, ccx / amortised, opt.steps);
+      "  (factorise: of K (static) or, with --no-static, of K_eff; vs: speed-up over %s of "
+      "that factorisation / of the steady step (wall) / (CPU); |du|/|u|: largest "
+      "relative difference of the static and final transient displacements to it)\n",
+      backends.front().name.c_str());
+  if (ccx > 0.0)
+    std::printf("  CalculiX %.3f s/increment (%s, 1 thread)\n", ccx, source.c_str());
+  else
+    std::printf("  no CalculiX figure for this mesh (ccx not on PATH, none recorded)\n");
 }
 
 }  // namespace
@@ -212,9 +290,17 @@ int main(int argc, char** argv) {
         opt.ccx = false;
       else if (a == "--peers")
         opt.peers = value();
-      else if (a == "-h" || a == "--help") {
+      else if (a == "--no-static")
+        opt.with_static = false;
+      else if (a == "--backends") {
+        std::stringstream list(value());
+        std::string name;
+        while (std::getline(list, name, ',')) opt.backends.push_back(name);
+      } else if (a == "-h" || a == "--help") {
         std::cout << "usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] "
-                     "[--lumped] [--no-ccx] [--peers DIR]\n";
+                     "[--lumped] [--no-ccx] [--peers DIR] [--backends "
+                     "eigen-ldlt,cholmod-nesdis,cholmod-metis,cholmod-amd] "
+                     "[--no-static]\n";
         return 0;
       } else {
         std::array<int, 3> c{};

@@ -179,6 +179,15 @@ std::shared_ptr<Spec> make_spec() {
              "estimate (the element eigenvalue bound)")
       .range(0.0, 1.0)
       .def(0.9);
+  analysis
+      ->choice("linear_solver",
+               "sparse direct solver of static solves, Newmark's K_eff and Newton's tangents: "
+               "cholmod (SuiteSparse's supernodal Cholesky, NESDIS nested-dissection ordering; "
+               "only in a build with CHOLMOD), eigen-ldlt (Eigen's simplicial LDL^T, AMD "
+               "ordering), or auto (cholmod when built in, else eigen-ldlt); both agree to "
+               "round-off",
+               {"auto", "cholmod", "eigen-ldlt"})
+      .def("auto");
   auto nonlinear = std::make_shared<Spec>(
       "nonlinear", "Newton iterations of neo-hooke and j2-plasticity (static and Newmark)");
   nonlinear->integer("max_iterations", "Newton iterations per load or time step").min(1).def(25);
@@ -425,6 +434,16 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       options.integrator = fem::Integrator::CentralDifference;
     }
     stable_step_factor_ = an.real("stable_step_factor");
+    const std::string linear_solver = an.string("linear_solver");
+    if (linear_solver == "cholmod") {
+      if (!fem::cholmod_available())
+        an["linear_solver"].fail(
+            "'cholmod' is not built into this partita (configure with libsuitesparse-dev "
+            "installed and -DPARTITA_CHOLMOD=ON); allowed here: auto, eigen-ldlt");
+      options.linear_solver = fem::LinearSolver::Cholmod;
+    } else if (linear_solver == "eigen-ldlt") {
+      options.linear_solver = fem::LinearSolver::EigenLdlt;
+    }
     const Node nl = an["nonlinear"];
     options.newton.max_iterations = static_cast<int>(nl.integer("max_iterations"));
     options.newton.force_tolerance = nl.real("force_tolerance");

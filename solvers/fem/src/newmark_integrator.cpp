@@ -53,8 +53,9 @@ class NewmarkProblem final : public NonlinearProblem {
 
 }  // namespace
 
-NewmarkIntegrator::NewmarkIntegrator(double beta, double gamma, NewtonOptions options)
-    : beta_(beta), gamma_(gamma), newton_(options) {}
+NewmarkIntegrator::NewmarkIntegrator(double beta, double gamma, NewtonOptions options,
+                                     LinearSolver linear_solver, FillOrdering ordering)
+    : beta_(beta), gamma_(gamma), newton_(options, linear_solver, ordering) {}
 
 bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, double dt) {
   const double t1 = kin.time + dt;

@@ -51,19 +51,21 @@ NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
       return rep;
     }
     // K dx = R
-    if (!factor_ || k.nonZeros() != pattern_nonzeros_ || k.rows() != pattern_size_) {
-      factor_ = std::make_unique<Factorisation>();
-      factor_->analyzePattern(k);
+    // symbolic analysis once per sparsity pattern, numeric factorisation per iteration
+    if (!factor_)
+      factor_ = std::make_unique<SparseFactorisation>(
+          linear_solver_, ordering_, SparseFactorisation::Matrix::SymmetricIndefiniteAllowed);
+    if (k.nonZeros() != pattern_nonzeros_ || k.rows() != pattern_size_) {
+      factor_->analyze(k);
       pattern_nonzeros_ = k.nonZeros();
       pattern_size_ = k.rows();
     }
-    factor_->factorize(k);
-    if (factor_->info() != Eigen::Success) {
+    if (!factor_->factorize(k)) {
       rep.failure = "the tangent matrix could not be factorised (singular)";
       rep.iterations = it;
       return rep;
     }
-    dx = factor_->solve(r);
+    factor_->solve(r, dx);
     // energy norm |dx . R|
     const double energy = std::abs(dx.dot(r));
     if (energy_0 < 0.0) energy_0 = energy;

@@ -33,13 +33,19 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
     : model_(std::move(model)),
       options_(options),
       integrator_(model_.hex8_formulation()),
-      static_(options_.newton),
-      newmark_(options_.newmark_beta, options_.newmark_gamma, options_.newton) {
+      static_(options_.newton, options_.linear_solver, options_.fill_ordering),
+      newmark_(options_.newmark_beta, options_.newmark_gamma, options_.newton,
+               options_.linear_solver, options_.fill_ordering) {
   if (!(options_.newmark_beta > 0.0) || !(options_.newmark_gamma > 0.0)) {
     throw Error("Newmark parameters must be > 0 (beta = 1/4, gamma = 1/2 is the default)");
   }
   if (options_.rayleigh_alpha < 0.0 || options_.rayleigh_beta < 0.0) {
     throw Error("Rayleigh damping coefficients must be >= 0");
+  }
+  if (resolve(options_.linear_solver) == LinearSolver::Cholmod && !cholmod_available()) {
+    throw Error(
+        "linear solver 'cholmod': this build of partita has no CHOLMOD (configure with "
+        "libsuitesparse-dev installed and -DPARTITA_CHOLMOD=ON); use 'eigen-ldlt' or 'auto'");
   }
   if (options_.integrator == Integrator::CentralDifference && options_.mass != MassType::Lumped) {
     throw Error("the central-difference integrator needs a lumped mass (mass: lumped)");
@@ -381,14 +387,8 @@ void StructuralSolver::prescribed_values(double t, Eigen::VectorXd& uc) const {
 // ---------------------------------------------------------------- analyses
 
 namespace {
-void check_factorisation(
-    const Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>& f,
-    const char* what) {
-  if (f.info() != Eigen::Success) {
-    throw Error(std::string(what) + ": factorisation failed (singular matrix)");
-  }
-  const auto d = f.vectorD();
-  if (d.size() > 0 && !(d.minCoeff() > 1e-14 * d.cwiseAbs().maxCoeff())) {
+void factorise_or_throw(SparseFactorisation& f, const SparseMatrix& a, const char* what) {
+  if (!f.factorize(a)) {
     throw Error(std::string(what) +
                 " is singular or indefinite: the Dirichlet conditions do not prevent rigid-body "
                 "motion (fix more components) or an element is inverted");
@@ -408,9 +408,11 @@ void StructuralSolver::solve_static() {
     return;
   }
   if (!static_factor_) {
-    static_factor_ = std::make_unique<Factorisation>();
-    static_factor_->compute(k_ff_);
-    check_factorisation(*static_factor_, "static stiffness matrix K_ff");
+    static_factor_ =
+        std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
+    static_factor_->analyze(k_ff_);
+    factorise_or_throw(*static_factor_, k_ff_, "static stiffness matrix K_ff");
+    timings_.factor_nonzeros = static_factor_->factor_nonzeros();
     ++timings_.factorisations;
     timings_.factorisation += seconds_since(t0);
   }
@@ -423,7 +425,8 @@ void StructuralSolver::solve_static() {
   for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
     rhs[static_cast<Eigen::Index>(k)] = kin_.f[dofs_.free_dofs()[k]];
   if (uc.size() > 0 && uc.cwiseAbs().maxCoeff() > 0.0) rhs -= k_fc_ * uc;
-  const Eigen::VectorXd uf = static_factor_->solve(rhs);
+  Eigen::VectorXd uf;
+  static_factor_->solve(rhs, uf);
   for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
     kin_.u[dofs_.free_dofs()[k]] = uf[static_cast<Eigen::Index>(k)];
   for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
@@ -490,12 +493,14 @@ void StructuralSolver::factorise_dynamic(double dt) {
   const double sm = c0 + c1 * options_.rayleigh_alpha;
   const SparseMatrix keff_ff = sk * k_ff_ + sm * m_ff_;
   keff_fc_ = sk * k_fc_ + sm * m_fc_;
+  // symbolic analysis once (the pattern of K_eff does not depend on dt), numeric per dt
   if (!dynamic_factor_) {
-    dynamic_factor_ = std::make_unique<Factorisation>();
-    dynamic_factor_->analyzePattern(keff_ff);
+    dynamic_factor_ =
+        std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
+    dynamic_factor_->analyze(keff_ff);
   }
-  dynamic_factor_->factorize(keff_ff);
-  check_factorisation(*dynamic_factor_, "effective matrix K_eff");
+  factorise_or_throw(*dynamic_factor_, keff_ff, "effective matrix K_eff");
+  timings_.factor_nonzeros = dynamic_factor_->factor_nonzeros();
   factor_dt_ = dt;
   ++timings_.factorisations;
   timings_.factorisation += seconds_since(t0);
@@ -556,7 +561,7 @@ void StructuralSolver::step(double dt) {
   for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
     w.rf[static_cast<Eigen::Index>(k)] = w.rhs[dofs_.free_dofs()[k]];
   if (w.uc.size() > 0 && w.uc.cwiseAbs().maxCoeff() > 0.0) w.rf.noalias() -= keff_fc_ * w.uc;
-  w.uf = dynamic_factor_->solve(w.rf);
+  dynamic_factor_->solve(w.rf, w.uf);
 
   w.u1.resize(kin_.u.size());
   for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)

@@ -8,6 +8,7 @@
 #include "partita/fem/hardening_curve.hpp"
 #include "partita/fem/j2_plasticity_law.hpp"
 #include "partita/fem/linear_elastic_law.hpp"
+#include "partita/fem/linear_solver.hpp"
 #include "partita/fem/model.hpp"
 #include "partita/fem/neo_hooke_law.hpp"
 #include "partita/fem/state_io.hpp"

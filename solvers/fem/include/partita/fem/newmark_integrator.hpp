@@ -16,7 +16,9 @@ namespace partita::fem {
 // after each accepted (sub)step. Needs a valid acceleration at the start.
 class NewmarkIntegrator {
  public:
-  NewmarkIntegrator(double beta, double gamma, NewtonOptions options = {});
+  NewmarkIntegrator(double beta, double gamma, NewtonOptions options = {},
+                    LinearSolver linear_solver = LinearSolver::Automatic,
+                    FillOrdering ordering = FillOrdering::Automatic);
   void step(StructuralSystem& system, Kinematics& kin, double dt);
   const NewtonReport& last_report() const { return last_; }
   // Newton iterations of the last step(), summed over its cut-back substeps and failed tries.

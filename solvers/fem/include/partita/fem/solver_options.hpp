@@ -1,5 +1,6 @@
 #pragma once
 
+#include "partita/fem/linear_solver.hpp"
 #include "partita/fem/newton_options.hpp"
 
 namespace partita::fem {
@@ -26,6 +27,11 @@ struct SolverOptions {
   Integrator integrator = Integrator::Newmark;
   // Newton, load stepping and cut-back of the nonlinear path.
   NewtonOptions newton;
+  // The sparse direct solver of static solves, Newmark's K_eff and Newton's tangents:
+  // Automatic = CHOLMOD (supernodal) when built in, else Eigen's SimplicialLDLT.
+  // Cholmod in a build without it: StructuralSolver throws Error. The ordering is CHOLMOD's.
+  LinearSolver linear_solver = LinearSolver::Automatic;
+  FillOrdering fill_ordering = FillOrdering::Automatic;
 };
 
 }  // namespace partita::fem

@@ -10,6 +10,7 @@ struct SolverTimings {
   double solve = 0.0;          // right-hand sides, triangular solves, updates
   std::size_t factorisations = 0;
   std::size_t solves = 0;
+  double factor_nonzeros = 0.0;  // nonzeros of the last linear-path factor L (fill-in measure)
 };
 
 }  // namespace partita::fem

@@ -15,7 +15,10 @@ namespace partita::fem {
 // halvings in a row it throws Error naming the load step, lambda, the residual and tolerance.
 class StaticIntegrator {
  public:
-  explicit StaticIntegrator(NewtonOptions options = {}) : newton_(options) {}
+  explicit StaticIntegrator(NewtonOptions options = {},
+                            LinearSolver linear_solver = LinearSolver::Automatic,
+                            FillOrdering ordering = FillOrdering::Automatic)
+      : newton_(options, linear_solver, ordering) {}
   // Velocity and acceleration are set to zero; kin.time = t1.
   void solve(StructuralSystem& system, Kinematics& kin, double t1);
   // Reports of the Newton solves of the last solve() (converged increments and failures).

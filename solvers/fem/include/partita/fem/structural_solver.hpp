@@ -1,5 +1,4 @@
 #pragma once
-#include <Eigen/SparseCholesky>
 #include <cstddef>
 #include <map>
 #include <memory>
@@ -12,6 +11,7 @@
 #include "partita/fem/error.hpp"
 #include "partita/fem/face_mesh.hpp"
 #include "partita/fem/face_quadrature_point.hpp"
+#include "partita/fem/linear_solver.hpp"
 #include "partita/fem/model.hpp"
 #include "partita/fem/newmark_integrator.hpp"
 #include "partita/fem/nonlinear_operator.hpp"
@@ -156,7 +156,7 @@ class StructuralSolver final : private StructuralSystem {
   int newton_iterations() const;
 
  private:
-  using Factorisation = Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>>;
+  using Factorisation = SparseFactorisation;
   // Face load operator: f[node] += coefficient * t_q for each (node, qp, coefficient).
   struct FaceOperator {
     std::vector<std::size_t> node;

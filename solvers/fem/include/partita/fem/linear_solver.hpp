@@ -1,0 +1,73 @@
+#pragma once
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "partita/fem/types.hpp"
+
+namespace partita::fem {
+
+// The sparse direct solver of the implicit paths (static, Newmark, Newton):
+//   Cholmod    SuiteSparse's CHOLMOD, supernodal LL^T (dense BLAS kernels on supernodes) with a
+//              fill-reducing ordering (FillOrdering); only when partita was built with it
+//              (CMake option PARTITA_CHOLMOD, on when CHOLMOD is found);
+//   EigenLdlt  Eigen's SimplicialLDLT with AMD: always there, one column at a time;
+//   Automatic  Cholmod when built in, else EigenLdlt.
+// Both factorise the symmetric matrix's lower triangle and agree to round-off.
+enum class LinearSolver { Automatic, Cholmod, EigenLdlt };
+// CHOLMOD's fill-reducing ordering: Metis (METIS_NodeND nested dissection), Nesdis (CHOLMOD's
+// own nested dissection: METIS edge separators, then constrained minimum degree on the parts),
+// or Amd (approximate minimum degree). Automatic = Nesdis, the smallest factor and the fastest
+// factorisation and solve on the plates of bench_fem_plate (figures in bench/README.md).
+enum class FillOrdering { Automatic, Metis, Nesdis, Amd };
+
+// Whether this build has CHOLMOD (PARTITA_CHOLMOD).
+bool cholmod_available();
+// Automatic resolved for this build.
+LinearSolver resolve(LinearSolver solver);
+// "auto", "cholmod", "eigen-ldlt" (the names the FEM adapter accepts).
+std::string to_string(LinearSolver solver);
+std::string to_string(FillOrdering ordering);
+
+// A symmetric positive definite sparse factorisation A = L D L^T (or L L^T) with its symbolic
+// analysis kept: analyze() once per sparsity pattern, factorize() whenever the values change,
+// solve() as often as needed. Only the lower triangle of A is read (the upper may be stored).
+// Throws Error for a backend that is not built in. Deterministic: the same matrix gives the
+// same factor and the same solutions, bit for bit (restart files rely on it).
+class SparseFactorisation {
+ public:
+  // SymmetricPositiveDefinite: factorize() fails unless A is numerically positive definite.
+  // SymmetricIndefiniteAllowed (Newton's tangents, which may lose definiteness): an L D L^T
+  // without pivoting that fails only on a zero pivot; CHOLMOD's L L^T then falls back to
+  // Eigen's L D L^T for a matrix that is not positive definite.
+  enum class Matrix { SymmetricPositiveDefinite, SymmetricIndefiniteAllowed };
+  explicit SparseFactorisation(LinearSolver solver = LinearSolver::Automatic,
+                               FillOrdering ordering = FillOrdering::Automatic,
+                               Matrix kind = Matrix::SymmetricPositiveDefinite);
+  ~SparseFactorisation();
+  SparseFactorisation(const SparseFactorisation&) = delete;
+  SparseFactorisation& operator=(const SparseFactorisation&) = delete;
+
+  LinearSolver solver() const { return solver_; }  // resolved: never Automatic
+  // Symbolic analysis (ordering, elimination tree, supernodes) of A's pattern.
+  void analyze(const SparseMatrix& a);
+  // Numeric factorisation of A with the analysed pattern (analyze() first, or again when the
+  // pattern changed). Returns false when A is not numerically positive definite: a pivot <= 0
+  // or min pivot <= 1e-14 max pivot (rigid-body motion not prevented, an inverted element);
+  // with SymmetricIndefiniteAllowed only for a zero pivot.
+  bool factorize(const SparseMatrix& a);
+  // x = A^-1 b with the last successful factorisation. No allocation once x and the
+  // backend's work space are sized (the first call of a given size sizes them).
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  // Nonzeros of the factor L, its diagonal included (0 before the first factorize()).
+  double factor_nonzeros() const;
+
+  struct Impl;  // the backend (defined in linear_solver.cpp)
+
+ private:
+  LinearSolver solver_;
+  std::unique_ptr<Impl> impl_;
+  bool empty_ = false;  // a 0 x 0 matrix
+};
+
+}  // namespace partita::fem

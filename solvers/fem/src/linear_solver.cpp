@@ -1,0 +1,277 @@
+#include "partita/fem/linear_solver.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <cstring>
+
+#include "partita/fem/error.hpp"
+
+#ifdef PARTITA_HAS_CHOLMOD
+#include <cholmod.h>
+#endif
+
+namespace partita::fem {
+
+// Below this ratio of the smallest to the largest pivot d_i of A = L D L^T (for L L^T: the
+// squared diagonal of L) the matrix counts as singular: rigid-body motion left free gives
+// pivots at round-off level, ~1e-16 of the largest.
+namespace {
+constexpr double kMinPivotRatio = 1e-14;
+}
+
+bool cholmod_available() {
+#ifdef PARTITA_HAS_CHOLMOD
+  return true;
+#else
+  return false;
+#endif
+}
+
+LinearSolver resolve(LinearSolver solver) {
+  if (solver != LinearSolver::Automatic) return solver;
+  return cholmod_available() ? LinearSolver::Cholmod : LinearSolver::EigenLdlt;
+}
+
+std::string to_string(LinearSolver solver) {
+  switch (solver) {
+    case LinearSolver::Automatic:
+      return "auto";
+    case LinearSolver::Cholmod:
+      return "cholmod";
+    case LinearSolver::EigenLdlt:
+      return "eigen-ldlt";
+  }
+  return "?";
+}
+
+std::string to_string(FillOrdering ordering) {
+  switch (ordering) {
+    case FillOrdering::Automatic:
+      return "auto";
+    case FillOrdering::Metis:
+      return "metis";
+    case FillOrdering::Nesdis:
+      return "nesdis";
+    case FillOrdering::Amd:
+      return "amd";
+  }
+  return "?";
+}
+
+struct SparseFactorisation::Impl {
+  virtual ~Impl() = default;
+  virtual void analyze(const SparseMatrix& a) = 0;
+  virtual bool factorize(const SparseMatrix& a) = 0;
+  virtual void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
+  virtual double factor_nonzeros() const = 0;
+};
+
+namespace {
+
+// ---------------------------------------------------------------- Eigen's SimplicialLDLT
+
+class EigenLdlt final : public SparseFactorisation::Impl {
+ public:
+  explicit EigenLdlt(bool indefinite_ok) : indefinite_ok_(indefinite_ok) {}
+  void analyze(const SparseMatrix& a) override {
+    ldlt_.analyzePattern(a);
+    analysed_ = true;
+  }
+  bool factorize(const SparseMatrix& a) override {
+    if (!analysed_) analyze(a);
+    ldlt_.factorize(a);
+    factorised_ = false;
+    if (ldlt_.info() != Eigen::Success) return false;
+    const auto d = ldlt_.vectorD();
+    if (!indefinite_ok_ && d.size() > 0 &&
+        !(d.minCoeff() > kMinPivotRatio * d.cwiseAbs().maxCoeff()))
+      return false;
+    factorised_ = true;
+    return true;
+  }
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override {
+    if (!factorised_) throw Error("SparseFactorisation::solve: no successful factorisation");
+    x = ldlt_.solve(b);
+  }
+  double factor_nonzeros() const override {
+    // L is stored without its unit diagonal
+    return factorised_
+               ? static_cast<double>(ldlt_.matrixL().nestedExpression().nonZeros() + ldlt_.rows())
+               : 0.0;
+  }
+
+ private:
+  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+  bool indefinite_ok_;
+  bool analysed_ = false, factorised_ = false;
+};
+
+#ifdef PARTITA_HAS_CHOLMOD
+// ---------------------------------------------------------------- CHOLMOD, supernodal L L^T
+
+class Cholmod final : public SparseFactorisation::Impl {
+ public:
+  Cholmod(FillOrdering ordering, bool indefinite_ok) : indefinite_ok_(indefinite_ok) {
+    cholmod_start(&c_);
+    c_.print = 0;  // no output: failures are reported through factorize()'s result
+    c_.supernodal = CHOLMOD_SUPERNODAL;
+    // One ordering, no trial of others (CHOLMOD's default tries AMD, then METIS when AMD's
+    // fill is high): NESDIS measured best on the plates (bench/README.md, FEM). METIS runs
+    // with a fixed seed, so the ordering and the factor are the same in every run.
+    c_.nmethods = 1;
+    switch (ordering) {
+      case FillOrdering::Amd:
+        c_.method[0].ordering = CHOLMOD_AMD;
+        break;
+      case FillOrdering::Metis:
+        c_.method[0].ordering = CHOLMOD_METIS;
+        break;
+      case FillOrdering::Automatic:
+      case FillOrdering::Nesdis:
+        c_.method[0].ordering = CHOLMOD_NESDIS;
+        break;
+    }
+    c_.postorder = 1;
+    c_.quick_return_if_not_posdef = 1;
+  }
+  ~Cholmod() override {
+    cholmod_free_factor(&l_, &c_);
+    cholmod_free_dense(&x_, &c_);
+    cholmod_free_dense(&y_, &c_);
+    cholmod_free_dense(&e_, &c_);
+    cholmod_finish(&c_);
+  }
+  Cholmod(const Cholmod&) = delete;
+  Cholmod& operator=(const Cholmod&) = delete;
+
+  void analyze(const SparseMatrix& a) override {
+    cholmod_free_factor(&l_, &c_);
+    cholmod_sparse view = lower_view(a);
+    l_ = cholmod_analyze(&view, &c_);
+    if (l_ == nullptr || c_.status < CHOLMOD_OK) {
+      throw Error("CHOLMOD: the symbolic analysis failed (status " + std::to_string(c_.status) +
+                  (c_.status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "") + ")");
+    }
+    factorised_ = false;
+    fallback_.reset();
+  }
+  bool factorize(const SparseMatrix& a) override {
+    if (l_ == nullptr || static_cast<Eigen::Index>(l_->n) != a.rows()) analyze(a);
+    cholmod_sparse view = lower_view(a);
+    factorised_ = false;
+    const int ok = cholmod_factorize(&view, l_, &c_);
+    if (c_.status == CHOLMOD_OUT_OF_MEMORY)
+      throw Error("CHOLMOD: out of memory in the factorisation");
+    bool positive_definite = ok && c_.status != CHOLMOD_NOT_POSDEF && l_->minor >= l_->n;
+    // (min_i L_ii / max_i L_ii)^2 = min d / max d of the equivalent L D L^T
+    if (positive_definite && !indefinite_ok_)
+      positive_definite = cholmod_rcond(l_, &c_) > kMinPivotRatio;
+    use_fallback_ = !positive_definite && indefinite_ok_;
+    if (use_fallback_) {
+      // not positive definite (a Newton tangent past a limit point): L D L^T without pivoting
+      if (!fallback_) fallback_ = std::make_unique<EigenLdlt>(true);
+      return fallback_->factorize(a);
+    }
+    factorised_ = positive_definite;
+    return factorised_;
+  }
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override {
+    if (use_fallback_) {
+      fallback_->solve(b, x);
+      return;
+    }
+    if (!factorised_) throw Error("SparseFactorisation::solve: no successful factorisation");
+    cholmod_dense rhs{};
+    rhs.nrow = rhs.d = rhs.nzmax = static_cast<std::size_t>(b.size());
+    rhs.ncol = 1;
+    rhs.x = const_cast<double*>(b.data());
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    // x_, y_, e_ are allocated on the first call and reused while the size is the same
+    if (!cholmod_solve2(CHOLMOD_A, l_, &rhs, nullptr, &x_, nullptr, &y_, &e_, &c_)) {
+      throw Error("CHOLMOD: the solve failed (status " + std::to_string(c_.status) + ")");
+    }
+    x.resize(b.size());
+    std::memcpy(x.data(), x_->x, sizeof(double) * static_cast<std::size_t>(b.size()));
+  }
+  double factor_nonzeros() const override {
+    if (use_fallback_) return fallback_->factor_nonzeros();
+    return factorised_ ? c_.lnz : 0.0;
+  }
+
+ private:
+  // A view of A for CHOLMOD (no copy): symmetric, lower triangle used (stype -1: the upper
+  // triangle, when stored, is ignored).
+  static cholmod_sparse lower_view(const SparseMatrix& a) {
+    cholmod_sparse s{};
+    s.nrow = static_cast<std::size_t>(a.rows());
+    s.ncol = static_cast<std::size_t>(a.cols());
+    s.nzmax = static_cast<std::size_t>(a.nonZeros());
+    s.p = const_cast<int*>(a.outerIndexPtr());
+    s.i = const_cast<int*>(a.innerIndexPtr());
+    s.x = const_cast<double*>(a.valuePtr());
+    s.nz = a.isCompressed() ? nullptr : const_cast<int*>(a.innerNonZeroPtr());
+    s.packed = a.isCompressed() ? 1 : 0;
+    s.sorted = 1;  // Eigen keeps the inner indices of a column sorted
+    s.stype = -1;
+    s.itype = CHOLMOD_INT;
+    s.xtype = CHOLMOD_REAL;
+    s.dtype = CHOLMOD_DOUBLE;
+    return s;
+  }
+
+  cholmod_common c_{};
+  cholmod_factor* l_ = nullptr;
+  cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;
+  bool indefinite_ok_;
+  bool factorised_ = false;
+  bool use_fallback_ = false;
+  std::unique_ptr<EigenLdlt> fallback_;  // Eigen's L D L^T of an indefinite matrix
+};
+#endif
+
+}  // namespace
+
+SparseFactorisation::SparseFactorisation(LinearSolver solver, FillOrdering ordering, Matrix kind)
+    : solver_(resolve(solver)) {
+  const bool indefinite_ok = kind == Matrix::SymmetricIndefiniteAllowed;
+  if (solver_ == LinearSolver::Cholmod) {
+#ifdef PARTITA_HAS_CHOLMOD
+    impl_ = std::make_unique<Cholmod>(ordering, indefinite_ok);
+#else
+    (void)ordering;
+    throw Error(
+        "linear solver 'cholmod': this build of partita has no CHOLMOD (configure with "
+        "libsuitesparse-dev installed and -DPARTITA_CHOLMOD=ON); use 'eigen-ldlt' or 'auto'");
+#endif
+  } else {
+    impl_ = std::make_unique<EigenLdlt>(indefinite_ok);
+  }
+}
+
+SparseFactorisation::~SparseFactorisation() = default;
+
+void SparseFactorisation::analyze(const SparseMatrix& a) {
+  if (a.rows() != a.cols()) throw Error("SparseFactorisation: the matrix is not square");
+  if (a.rows() > 0) impl_->analyze(a);
+}
+
+bool SparseFactorisation::factorize(const SparseMatrix& a) {
+  if (a.rows() != a.cols()) throw Error("SparseFactorisation: the matrix is not square");
+  empty_ = a.rows() == 0;  // every dof constrained: nothing to factorise
+  return empty_ || impl_->factorize(a);
+}
+
+void SparseFactorisation::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  if (empty_) {
+    x.resize(0);
+    return;
+  }
+  impl_->solve(b, x);
+}
+
+double SparseFactorisation::factor_nonzeros() const {
+  return impl_->factor_nonzeros();
+}
+
+}  // namespace partita::fem
