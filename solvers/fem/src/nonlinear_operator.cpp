@@ -1,5 +1,7 @@
 #include "partita/fem/nonlinear_operator.hpp"
 
+#include <exception>
+
 #include <array>
 #include <cmath>
 
@@ -89,34 +91,75 @@ void NonlinearOperator::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_in
     std::fill(k->valuePtr(), k->valuePtr() + k->nonZeros(), 0.0);
   }
   energy_ = 0.0;
-  ElementVector fe;
-  ElementMatrix ke;
-  ElementDisplacements ue;
+  // Elements are evaluated a chunk at a time, the chunk's elements in parallel (each writes only
+  // its own quadrature points and its own slot of the chunk buffers), then added to f_int and K
+  // serially in element order: the sums are the same, bit for bit, on any number of threads.
+  constexpr std::size_t kChunk = 1024;
   const auto& elements = mesh_.elements();
-  for (std::size_t e = 0; e < elements.size(); ++e) {
-    const Element& el = elements[e];
-    const int nn = node_count(el.type);
-    ue.resize(nn, 3);
-    for (int a = 0; a < nn; ++a) {
-      ue.row(a) = u.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])).transpose();
+  const std::size_t ne = elements.size();
+  if (chunk_fe_.size() < std::min(ne, kChunk)) {
+    chunk_fe_.resize(std::min(ne, kChunk));
+    chunk_ke_.resize(std::min(ne, kChunk));
+    chunk_energy_.resize(std::min(ne, kChunk));
+  }
+  for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
+    const long n = static_cast<long>(std::min(ne - c0, kChunk));
+    // A material law may throw (a radial return that does not converge: the Newton solver cuts
+    // the step back); an exception cannot leave a parallel region, so the one of the first
+    // element that threw is kept and rethrown after it, as the serial loop would have thrown it.
+    std::exception_ptr error;
+    long error_at = n;
+#pragma omp parallel for schedule(static) if (n >= 32)
+    for (long i = 0; i < n; ++i) {
+      try {
+        evaluate_chunk_element(c0, i, u, k != nullptr);
+      } catch (...) {
+#pragma omp critical(partita_fem_operator_error)
+        if (i < error_at) {
+          error_at = i;
+          error = std::current_exception();
+        }
+      }
     }
-    fe.setZero(3 * nn);
-    if (k != nullptr) ke.setZero(3 * nn, 3 * nn);
-    if (fbar_hex8_ && el.type == ElementType::Hex8) {
-      evaluate_fbar(e, ue, fe, k != nullptr ? &ke : nullptr);
-    } else {
-      evaluate_plain(e, ue, fe, k != nullptr ? &ke : nullptr);
+    if (error) std::rethrow_exception(error);
+    for (long i = 0; i < n; ++i) {
+      const Element& el = elements[c0 + static_cast<std::size_t>(i)];
+      const int nn = node_count(el.type);
+      const ElementVector& fe = chunk_fe_[static_cast<std::size_t>(i)];
+      // f_int = sum_e A_e^T f_e
+      for (int a = 0; a < nn; ++a) {
+        f_int.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])) += fe.segment<3>(3 * a);
+      }
+      if (k != nullptr) assembler_->add(*k, el.node_span(), chunk_ke_[static_cast<std::size_t>(i)]);
+      energy_ += chunk_energy_[static_cast<std::size_t>(i)];
     }
-    // f_int = sum_e A_e^T f_e
-    for (int a = 0; a < nn; ++a) {
-      f_int.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])) += fe.segment<3>(3 * a);
-    }
-    if (k != nullptr) assembler_->add(*k, el.node_span(), ke);
+  }
+}
+
+void NonlinearOperator::evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u,
+                                               bool tangent) {
+  const std::size_t e = c0 + static_cast<std::size_t>(i);
+  const Element& el = mesh_.elements()[e];
+  const int nn = node_count(el.type);
+  ElementDisplacements ue(nn, 3);
+  for (int a = 0; a < nn; ++a) {
+    ue.row(a) = u.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])).transpose();
+  }
+  ElementVector& fe = chunk_fe_[static_cast<std::size_t>(i)];
+  ElementMatrix& ke = chunk_ke_[static_cast<std::size_t>(i)];
+  double& energy = chunk_energy_[static_cast<std::size_t>(i)];
+  energy = 0.0;
+  fe.setZero(3 * nn);
+  if (tangent) ke.setZero(3 * nn, 3 * nn);
+  if (fbar_hex8_ && el.type == ElementType::Hex8) {
+    evaluate_fbar(e, ue, fe, tangent ? &ke : nullptr, energy);
+  } else {
+    evaluate_plain(e, ue, fe, tangent ? &ke : nullptr, energy);
   }
 }
 
 void NonlinearOperator::evaluate_plain(std::size_t e, const ElementDisplacements& ue,
-                                       ElementVector& fe, ElementMatrix* ke) {
+                                       ElementVector& fe, ElementMatrix* ke, double& energy) {
   const Element& el = mesh_.elements()[e];
   const int nn = node_count(el.type);
   const MaterialLaw& law = *element_law_[e];
@@ -130,7 +173,7 @@ void NonlinearOperator::evaluate_plain(std::size_t e, const ElementDisplacements
     law.evaluate(f, std::span<const double>(committed_).subspan(s0, ns),
                  std::span<double>(trial_).subspan(s0, ns), resp);
     const double w = weight_[q];
-    energy_ += resp.energy_density * w;
+    energy += resp.energy_density * w;
     // f_a,i += P_iJ dN_a/dX_J w
     const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3> pg =
         g * (resp.stress.transpose() * w);
@@ -146,7 +189,7 @@ void NonlinearOperator::evaluate_plain(std::size_t e, const ElementDisplacements
 }
 
 void NonlinearOperator::evaluate_fbar(std::size_t e, const ElementDisplacements& ue,
-                                      ElementVector& fe, ElementMatrix* ke) {
+                                      ElementVector& fe, ElementMatrix* ke, double& energy) {
   using Vec24 = Eigen::Matrix<double, 24, 1>;
   using Mat24 = Eigen::Matrix<double, 24, 24>;
   constexpr int kPoints = 8;
@@ -211,7 +254,7 @@ void NonlinearOperator::evaluate_fbar(std::size_t e, const ElementDisplacements&
     law.evaluate(fb, std::span<const double>(committed_).subspan(s0, ns),
                  std::span<double>(trial_).subspan(s0, ns), resp);
     const double w = weight_[qp];
-    energy_ += resp.energy_density * w;
+    energy += resp.energy_density * w;
     const Mat3 sigma = resp.stress * fb.transpose() / fb.determinant();
     const auto qi = static_cast<Eigen::Index>(qp);
     cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);

@@ -59,12 +59,20 @@ class NonlinearOperator final : public InternalForceOperator {
 
  private:
   using ElementDisplacements = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
-  // One element's fe and, when ke != nullptr, ke (zeroed by the caller); adds to the energy,
-  // writes the points' stresses and trial history. Plain: the element's own rule; F-bar: Hex8.
+  // One element's fe and, when ke != nullptr, ke (zeroed by the caller); adds its strain energy
+  // to `energy`, writes the points' stresses and trial history (its own points only: elements
+  // may be evaluated concurrently). Plain: the element's own rule; F-bar: Hex8.
   void evaluate_plain(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
-                      ElementMatrix* ke);
+                      ElementMatrix* ke, double& energy);
   void evaluate_fbar(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
-                     ElementMatrix* ke);
+                     ElementMatrix* ke, double& energy);
+  // Element c0 + i into slot i of the chunk buffers (ke only when `tangent`).
+  void evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u, bool tangent);
+  // Per-element results of one chunk of elements (evaluate() computes a chunk in parallel and
+  // adds it to f_int and K in element order): sized once, reused.
+  std::vector<ElementVector> chunk_fe_;
+  std::vector<ElementMatrix> chunk_ke_;
+  std::vector<double> chunk_energy_;
   const Mesh& mesh_;
   bool fbar_hex8_ = false;
   std::vector<std::shared_ptr<const MaterialLaw>> region_laws_;
