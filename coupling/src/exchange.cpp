@@ -22,6 +22,8 @@ Exchange::Exchange(std::string data, End from, End to, DataSpec spec,
   const InterfaceMesh* tm = to_.participant->find_mesh(to_.mesh);
   if (!fm || !tm) throw Error("exchange " + label() + ": unknown mesh");
   from_points_ = fm->mesh.size();
+  source_mesh_ = &fm->mesh;
+  target_mesh_ = &tm->mesh;
   if (!mapper_ && fm->mesh.size() != tm->mesh.size())
     throw Error("exchange " + label() +
                 ": without a mapper the meshes need the same number of points (" +
@@ -42,10 +44,7 @@ void Exchange::check_shape(const Eigen::MatrixXd& values, const char* what) cons
                 "' x components)");
 }
 
-void Exchange::begin_collect() {
-  accumulated_.setZero(from_points_, spec_.components);
-  collected_ = 0;
-}
+void Exchange::begin_collect() { collected_ = 0; }
 
 void Exchange::collect(const Eigen::MatrixXd& values) {
   check_shape(values, "wrote");
@@ -59,7 +58,12 @@ void Exchange::collect(const Eigen::MatrixXd& values) {
 
 void Exchange::finish_collect() {
   // average: f_{n+1} = 1/m Σ_{k=1..m} f_{n,k} (the running mean);  last: f_{n+1} = f_{n,m}
-  combined_ = accumulated_;
+  if (collected_ == 0) {
+    combined_.setZero(from_points_, spec_.components);
+    return;
+  }
+  // The next begin_collect()/collect() overwrite accumulated_ whole: swap instead of a copy.
+  combined_.swap(accumulated_);
 }
 
 void Exchange::transmit() {
@@ -98,7 +102,7 @@ void Exchange::read_state(BinaryReader& in) {
   in.expect_section("exchange " + label());
   for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) in.read(*m);
   const Eigen::Index sender = from_points_;
-  const Eigen::Index receiver = to_.participant->find_mesh(to_.mesh)->mesh.size();
+  const Eigen::Index receiver = target_mesh_->size();
   for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_})
     if (m->rows() != sender || m->cols() != spec_.components)
       in.fail(fmt::format("{} x {} values of {} (the sender's mesh)", sender, spec_.components,

@@ -129,7 +129,8 @@ class CaseRun {
   void read_restart_file(const std::filesystem::path& file, Progress& progress);
   std::filesystem::path newest_restart_file() const;
   void check_window(std::int64_t window, double time);
-  std::vector<double> audit_balance();
+  /// Per audited exchange: |received total - sent total| / scale (into imbalance_).
+  const std::vector<double>& audit_balance();
   std::string restart_blocker() const;  // why restart files cannot be written ("": they can)
 
   const Registries& registries_;
@@ -157,6 +158,9 @@ class CaseRun {
   // the balance audit: exchanges audited and the relative imbalance that warns
   std::vector<const Exchange*> audited_;
   double balance_tolerance_ = 0.01;
+  std::vector<double> imbalance_;  // audit_balance()'s result and scratch space, kept between
+  Eigen::VectorXd audit_sent_, audit_received_;  // windows (no allocation per window)
+  Eigen::ArrayXd audit_norm2_;
   // the energy audit: two participants that read from each other, each with the meshes it reads
   // the other's data on (where its solver reports Solver::interface_work)
   struct EnergyPair {

@@ -56,10 +56,14 @@ class Exchange {
   ReaderSees reader_sees() const { return reader_sees_; }
   WriterCombines writer_combines() const { return writer_combines_; }
   const Mapper* mapper() const { return mapper_.get(); }
+  /// The sender's and the receiver's interface meshes (fixed for the run, see Solver::meshes()).
+  const Mesh& source_mesh() const { return *source_mesh_; }
+  const Mesh& target_mesh() const { return *target_mesh_; }
   /// "pressure fluid.nodes -> solid.nodes" for messages.
   std::string label() const;
 
   // --- sender side ------------------------------------------------------------------------
+  // Called every substep: no allocation once the arrays have their sizes (first window).
   void begin_collect();
   /// The writer's values after one substep (checked: points x components).
   void collect(const Eigen::MatrixXd& values);
@@ -105,6 +109,8 @@ class Exchange {
   ReaderSees reader_sees_;
   WriterCombines writer_combines_;
   Eigen::Index from_points_ = 0;
+  const Mesh* source_mesh_ = nullptr;
+  const Mesh* target_mesh_ = nullptr;
 
   Eigen::MatrixXd accumulated_, combined_, sent_, previous_;
   int collected_ = 0;
