@@ -740,12 +740,16 @@ void CaseRun::run() {
         }
         monitor_row.push_back(c.at < got.size() ? got[c.at].value : std::nan(""));
       }
+      Stopwatch csv_clock;  // formatting the row: output time, not the core's
       monitors_[mi].csv.record(t, monitor_row);
+      summary_.output_seconds += csv_clock.seconds();
     }
   };
   auto flush_all = [&] {
+    Stopwatch clock;
     coupling_csv_.flush();
     for (auto& m : monitors_) m.csv.flush();
+    summary_.output_seconds += clock.seconds();
   };
 
   Progress progress;
@@ -843,7 +847,9 @@ void CaseRun::run() {
                 n + 1, t, audited_[i]->label(), imbalance[i], balance_tolerance_);
           warned_imbalance = true;
         }
+      Stopwatch csv_clock;
       coupling_csv_.record(static_cast<double>(n + 1), row);
+      summary_.output_seconds += csv_clock.seconds();
       record_monitors(t, n + 1);
       const bool last = n + 1 == window_count_;
       if ((output_every_ > 0.0 && t >= progress.next_output - 1e-9 * window_size_) || last) {
@@ -890,8 +896,10 @@ void CaseRun::run() {
   }
   progress_line.finish();
   flush_all();
+  Stopwatch close_clock;
   coupling_csv_.close();
   for (auto& m : monitors_) m.csv.close();
+  summary_.output_seconds += close_clock.seconds();
   for (auto& p : participants_) {
     Stopwatch sc;
     p->solver().finalize();

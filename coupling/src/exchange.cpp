@@ -75,13 +75,11 @@ void Exchange::transmit() {
   mapping_seconds_ += s.seconds();
 }
 
-void Exchange::read_at(double fraction, Eigen::MatrixXd& out) const {
-  if (reader_sees_ == ReaderSees::constant || fraction >= 1.0) {
-    out = end_;
-    return;
-  }
+const Eigen::MatrixXd& Exchange::read_at(double fraction, Eigen::MatrixXd& scratch) const {
+  if (reader_sees_ == ReaderSees::constant || fraction >= 1.0) return end_;
   // d_{n,k} = d_n + (k/m) (d_{n+1} - d_n)
-  out = start_ + fraction * (end_ - start_);
+  scratch = start_ + fraction * (end_ - start_);
+  return scratch;
 }
 
 void Exchange::initialize(const Eigen::MatrixXd& initial) {

@@ -35,8 +35,7 @@ void CouplingScheme::run_participant(Participant& p, const TimeWindow& window) {
     for (std::size_t i = 0; i < exchanges_.size(); ++i) {
       Exchange* e = exchanges_[i];
       if (&e->to() != &p) continue;
-      e->read_at(fraction, read_buffers_[i]);
-      p.read(e->to_mesh(), e->data(), read_buffers_[i]);
+      p.read(e->to_mesh(), e->data(), e->read_at(fraction, read_buffers_[i]));
     }
     p.advance(w.next_substep_size());
     w.advance_substep();

@@ -81,8 +81,9 @@ class Exchange {
   void transmit();
 
   // --- receiver side ----------------------------------------------------------------------
-  /// The value the receiver sees after the fraction s = k/m of the window.
-  void read_at(double fraction, Eigen::MatrixXd& out) const;
+  /// The value the receiver sees after the fraction s = k/m of the window: received() itself
+  /// where that is the value (no copy), else the interpolation written into `scratch`.
+  const Eigen::MatrixXd& read_at(double fraction, Eigen::MatrixXd& scratch) const;
   /// The newest mapped value d_{n+1}.
   const Eigen::MatrixXd& received() const { return end_; }
   /// d_n = d_{n+1}: the window is accepted.
