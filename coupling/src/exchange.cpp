@@ -68,6 +68,10 @@ void Exchange::finish_collect() {
 
 void Exchange::transmit() {
   Stopwatch s;
+  if (start_is_end_) {
+    start_.swap(end_);  // d_n keeps the accepted value; end_'s storage is overwritten below
+    start_is_end_ = false;
+  }
   if (mapper_)
     mapper_->map(sent_, end_);
   else
@@ -76,7 +80,7 @@ void Exchange::transmit() {
 }
 
 const Eigen::MatrixXd& Exchange::read_at(double fraction, Eigen::MatrixXd& scratch) const {
-  if (reader_sees_ == ReaderSees::constant || fraction >= 1.0) return end_;
+  if (reader_sees_ == ReaderSees::constant || fraction >= 1.0 || start_is_end_) return end_;
   // d_{n,k} = d_n + (k/m) (d_{n+1} - d_n)
   scratch = start_ + fraction * (end_ - start_);
   return scratch;
@@ -88,17 +92,20 @@ void Exchange::initialize(const Eigen::MatrixXd& initial) {
   sent_ = initial;
   previous_ = initial;
   transmit();
-  start_ = end_;
+  start_is_end_ = true;  // start = end
 }
 
 void Exchange::write_state(BinaryWriter& out) const {
   out.section("exchange " + label());
-  for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) out.write(*m);
+  for (const Eigen::MatrixXd* m :
+       {&combined_, &sent_, &previous_, start_is_end_ ? &end_ : &start_, &end_})
+    out.write(*m);
 }
 
 void Exchange::read_state(BinaryReader& in) {
   in.expect_section("exchange " + label());
   for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) in.read(*m);
+  start_is_end_ = false;
   const Eigen::Index sender = from_points_;
   const Eigen::Index receiver = target_mesh_->size();
   for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_})

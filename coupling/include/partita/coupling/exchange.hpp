@@ -86,8 +86,9 @@ class Exchange {
   const Eigen::MatrixXd& read_at(double fraction, Eigen::MatrixXd& scratch) const;
   /// The newest mapped value d_{n+1}.
   const Eigen::MatrixXd& received() const { return end_; }
-  /// d_n = d_{n+1}: the window is accepted.
-  void accept_window() { start_ = end_; }
+  /// d_n = d_{n+1}: the window is accepted (no copy: start_ is taken from end_ by the next
+  /// transmit(), which swaps the two before mapping into end_).
+  void accept_window() { start_is_end_ = true; }
 
   /// Initial data: combined = sent = previous = initial, transmitted, start = end.
   void initialize(const Eigen::MatrixXd& initial);
@@ -116,6 +117,7 @@ class Exchange {
   Eigen::MatrixXd accumulated_, combined_, sent_, previous_;
   int collected_ = 0;
   Eigen::MatrixXd start_, end_;
+  bool start_is_end_ = false;  // d_n = d_{n+1}: start_'s own values are stale
   double mapping_seconds_ = 0.0;
 };
 
