@@ -48,6 +48,10 @@ std::vector<std::pair<std::int64_t, fs::path>> restart_files(const fs::path& dir
 // |v_q|^2 of each row into `norm2` (column by column: contiguous passes over the column-major
 // array; the caller keeps `norm2`, no allocation per window).
 void row_norms2(const Eigen::MatrixXd& v, Eigen::ArrayXd& norm2) {
+  if (v.cols() == 3) {  // vectors: one fused pass, the same sums ((x^2 + y^2) + z^2)
+    norm2 = v.col(0).array().square() + v.col(1).array().square() + v.col(2).array().square();
+    return;
+  }
   norm2 = v.col(0).array().square();
   for (Eigen::Index c = 1; c < v.cols(); ++c) norm2 += v.col(c).array().square();
 }

@@ -10,18 +10,20 @@
 //   sum_i W_qi = 1                         (rows: a constant is reproduced exactly)
 //   sum_q w_q W_qi = A_i * (sum w / sum A)  (columns: the integral is preserved; exactly when the
 //                                           two meshes cover the same area)
-// both to round-off (relative 1e-15 per row and per source point), by construction, at any size.
+// both to round-off at any size (measured at 10^5 cells: 8e-16 relative, rows and columns), by
+// construction.
 //
 // Construction: P = diag(w) W is a transport plan that moves each target point's weight w_q
 // onto source points, c_i = A_i sum(w)/sum(A) onto source point i. It is built by recursive
 // bisection: cut the bounding box of the points across its longest side so that each side
 // holds half of the target weight, and cut the source points along the same axis at half of
 // theirs (the one point of each set that straddles a cut is split between the two sides); repeat
-// on both halves until one side has a single point, which then takes the others' weights. Both
-// cuts halve the weight of meshes that cover the same surface, so they lie within about one
-// point spacing of each other: each target point draws on the source points it overlaps, and P
-// has at most n_source + n_target entries per level where a cut splits a point (in practice
-// about 2 (n_source + n_target) in all). Set-up O(n log^2 n), no iteration, nothing to converge.
+// on both halves until one side has a single point, which then takes the others' weights. On
+// meshes that cover the same surface the two cuts of equal weight lie within about a point
+// spacing of each other, so each target point draws on the source points it overlaps (entries at
+// most 1.6 coarse spacings apart, about 2.3 per row, on the seed's plate at 10^5 cells). No
+// iteration, nothing to converge; set-up O(n log^2 n) (0.2 s per 10^5 cells). The totals are
+// summed in long double: the plan can be no closer to w and c than the two totals agree.
 //
 // Option `neighbors` k > 1 then smooths over each source point's k nearest source points:
 // W = W_bisection S with S_ij = e_ij / c_i (j != i), S_ii = 1 - sum_j e_ij / c_i, symmetric
@@ -30,7 +32,7 @@
 // no smoothing, the fewest entries (the cheapest map).
 //
 // Diagnosis: if more than 1 % of the weight moves farther than 4 point spacings, the two meshes
-// do not cover the same surface; the mapper warns once.
+// do not cover the same surface; the mapper warns at set-up.
 
 #include <memory>
 
