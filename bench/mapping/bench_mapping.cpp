@@ -131,7 +131,7 @@ void bench_area_balanced(double max_n, int repeat) {
   for (const int neighbors : {1, 6})
     for (const double cells : {1e4, 1e5, 1e6}) {
       if (cells > max_n * 1.0001) break;
-      const int n = static_cast<int>(std::lround(std::sqrt(cells / 2.0)));  // 2 n^2 triangles
+      const int n = static_cast<int>(std::lround(std::sqrt(cells / 2.0)));        // 2 n^2 triangles
       const int m = static_cast<int>(std::lround(std::sqrt(cells / 4.0 * 1.1)));  // ~10 % more
       const Mesh source = centre_mesh(n, 1);
       const Mesh target = gauss_mesh(m);
@@ -141,7 +141,8 @@ void bench_area_balanced(double max_n, int repeat) {
       const double compute = seconds_since(t0);
       const auto& w = mapper.matrix();
       const Eigen::VectorXd ones = Eigen::VectorXd::Ones(source.size());
-      const double row_err = (w * ones - Eigen::VectorXd::Ones(target.size())).cwiseAbs().maxCoeff();
+      const double row_err =
+          (w * ones - Eigen::VectorXd::Ones(target.size())).cwiseAbs().maxCoeff();
       long double sw = 0.0L, sa = 0.0L;  // the totals to 1e-16 (double sums: 1e-13 at 1e5)
       for (const double x : target.weights()) sw += x;
       for (const double x : source.weights()) sa += x;
@@ -162,9 +163,8 @@ void bench_area_balanced(double max_n, int repeat) {
       const double map = seconds_since(t0) / repeat;
       const std::string label = "area-balanced neighbors " + std::to_string(neighbors);
       std::printf("%-28s %9ld %9ld %10.4f %12.4f %10ld %10.2e %10.2e %10.2e %10.5f\n",
-                  label.c_str(), static_cast<long>(source.size()),
-                  static_cast<long>(target.size()), compute,
-                  compute / (static_cast<double>(source.size()) / 1e5),
+                  label.c_str(), static_cast<long>(source.size()), static_cast<long>(target.size()),
+                  compute, compute / (static_cast<double>(source.size()) / 1e5),
                   static_cast<long>(w.nonZeros()), row_err, col_err, spiky, map);
       std::fflush(stdout);
     }

@@ -709,7 +709,8 @@ void CaseRun::run() {
   std::vector<std::vector<Column>> columns_of(monitors_.size());
   for (std::size_t mi = 0; mi < monitors_.size(); ++mi)
     for (const auto& [p, q] : monitors_[mi].quantities) {
-      auto it = std::find_if(wanted.begin(), wanted.end(), [&](const Asked& a) { return a.p == p; });
+      auto it =
+          std::find_if(wanted.begin(), wanted.end(), [&](const Asked& a) { return a.p == p; });
       if (it == wanted.end()) it = wanted.insert(wanted.end(), Asked{p, {}, {}});
       it->names.push_back(q);
       columns_of[mi].push_back({static_cast<std::size_t>(it - wanted.begin()), &q});

@@ -276,8 +276,8 @@ const std::vector<double>& CaseRun::audit_balance() {
       const auto* sparse = dynamic_cast<const SparseMapper*>(e->mapper());
       if (!sparse) continue;
       const SparseMapper::Matrix& w = sparse->matrix();
-      if (w.nonZeros() > 0 && Eigen::Map<const Eigen::VectorXd>(w.valuePtr(), w.nonZeros())
-                                      .minCoeff() < 0.0)
+      if (w.nonZeros() > 0 &&
+          Eigen::Map<const Eigen::VectorXd>(w.valuePtr(), w.nonZeros()).minCoeff() < 0.0)
         continue;
       if (e->spec().kind == DataKind::extensive)
         audit_bounds_[i] = w.transpose() * Eigen::VectorXd::Ones(w.rows());

@@ -44,7 +44,9 @@ void Exchange::check_shape(const Eigen::MatrixXd& values, const char* what) cons
                 "' x components)");
 }
 
-void Exchange::begin_collect() { collected_ = 0; }
+void Exchange::begin_collect() {
+  collected_ = 0;
+}
 
 void Exchange::collect(const Eigen::MatrixXd& values) {
   check_shape(values, "wrote");

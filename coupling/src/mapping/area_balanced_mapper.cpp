@@ -1,7 +1,6 @@
 #include "partita/coupling/mapping/area_balanced_mapper.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -68,8 +67,7 @@ std::size_t append_halves(const Piece* pieces, std::size_t n, std::vector<Piece>
   while (k + 1 < n && below + pieces[k].mass <= half) below += pieces[k++].mass;
   out.insert(out.end(), pieces, pieces + k);
   // pieces[k] straddles the half: half - below of it lies left (> 0 unless below == half)
-  const double part =
-      std::clamp(static_cast<double>(half - below), 0.0, pieces[k].mass);
+  const double part = std::clamp(static_cast<double>(half - below), 0.0, pieces[k].mass);
   if (part > 0.0) out.push_back({pieces[k].index, part});
   const std::size_t left_end = out.size();
   out.push_back({pieces[k].index, pieces[k].mass - part});

@@ -47,9 +47,12 @@ void SparseMapper::map(const Eigen::MatrixXd& in, Eigen::MatrixXd& out) const {
   const double* x = in.data();
   double* y = out.data();
   switch (in.cols()) {
-    case 1: return csr_times_dense<1>(matrix_, x, in.rows(), y, out.rows());
-    case 2: return csr_times_dense<2>(matrix_, x, in.rows(), y, out.rows());
-    case 3: return csr_times_dense<3>(matrix_, x, in.rows(), y, out.rows());
+    case 1:
+      return csr_times_dense<1>(matrix_, x, in.rows(), y, out.rows());
+    case 2:
+      return csr_times_dense<2>(matrix_, x, in.rows(), y, out.rows());
+    case 3:
+      return csr_times_dense<3>(matrix_, x, in.rows(), y, out.rows());
     default:
       for (Eigen::Index c = 0; c < in.cols(); ++c)
         csr_times_dense<1>(matrix_, x + c * in.rows(), in.rows(), y + c * out.rows(), out.rows());

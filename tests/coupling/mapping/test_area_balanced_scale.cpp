@@ -30,8 +30,8 @@ Route seed_route(int stl_cells_per_side, int fe_cells_per_side) {
   const Mesh stl = plate_triangles("plate", stl_cells_per_side, stl_cells_per_side, 0.3, 7);
   Mesh centres = cell_centres("plate_centres", stl);
   centres.set_weights(stl.triangle_areas());
-  QuadFaces fe = plate_quads("bottom", "bottom_quadrature", fe_cells_per_side,
-                             fe_cells_per_side, 0.3, 8);
+  QuadFaces fe =
+      plate_quads("bottom", "bottom_quadrature", fe_cells_per_side, fe_cells_per_side, 0.3, 8);
   fe.quadrature.set_weights(fe.weights);
   const double h = plate_size / std::min(stl_cells_per_side, fe_cells_per_side);
   return {std::move(centres), std::move(fe.quadrature), h};
@@ -57,9 +57,8 @@ void check_balance(const Route& r, int neighbors) {
     for (SparseMapper::Matrix::InnerIterator e(w, q); e; ++e) {
       row += e.value();
       most_negative = std::min(most_negative, e.value());
-      farthest = std::max(farthest, (r.quadrature.points().row(q) -
-                                     r.centres.points().row(e.col()))
-                                        .norm());
+      farthest = std::max(farthest,
+                          (r.quadrature.points().row(q) - r.centres.points().row(e.col())).norm());
     }
     row_err = std::max(row_err, std::abs(row - 1.0));
   }
@@ -87,8 +86,7 @@ void check_balance(const Route& r, int neighbors) {
 
 }  // namespace
 
-TEST_CASE("area-balanced at 1e5 cells: rows and the integral per source point exact",
-          "[mapping]") {
+TEST_CASE("area-balanced at 1e5 cells: rows and the integral per source point exact", "[mapping]") {
   // 2 x 224^2 = 100352 STL cells -> 4 x 166^2 = 110224 Gauss points (non-matching, perturbed)
   check_balance(seed_route(224, 166), 1);
 }
@@ -97,8 +95,7 @@ TEST_CASE("area-balanced with smoothing over neighbours keeps both properties", 
   check_balance(seed_route(70, 52), 6);  // 9800 cells -> 10816 Gauss points
 }
 
-TEST_CASE("area-balanced: a target point of zero weight still reproduces constants",
-          "[mapping]") {
+TEST_CASE("area-balanced: a target point of zero weight still reproduces constants", "[mapping]") {
   Route r = seed_route(8, 6);
   Eigen::VectorXd w = r.quadrature.weights();
   w(5) = 0.0;
