@@ -5,7 +5,13 @@
 // shared machine), and the fitted growth exponent (log-log slope) of compute and map: about 1
 // (n log n) is the goal; 2 would mean an all-pairs loop somewhere.
 //
-//   bench_mapping [--quick] [--max-n N] [--rbf-max-n N] [--repeat R]
+// Then area-balanced (issue 16) between 10^4 and 10^6 interface cells: STL-like triangle centres
+// (weights: areas) to the 2 x 2 Gauss points of a non-matching quad grid (weights: h^2/4), as on
+// the seed's traction route. Prints set-up time per 10^5 cells (goal: under 1 s), the entries,
+// and the balance errors: max_q |sum_i W_qi - 1| (rows), max_i |sum_q w_q W_qi - c_i| / c_i
+// (columns) and the integral error of a spiky density (30 cells of 1000 per 10^4 loaded).
+//
+//   bench_mapping [--quick] [--max-n N] [--rbf-max-n N] [--area-max-n N] [--area-only] [--repeat R]
 
 #include <algorithm>
 #include <chrono>
@@ -18,6 +24,9 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
+#include "partita/coupling/mapping/area_balanced_mapper.hpp"
 #include "partita/coupling/mapping/mapper.hpp"
 #include "partita/coupling/mapping/register_mappers.hpp"
 #include "partita/interface/error.hpp"
@@ -81,6 +90,86 @@ double slope(const std::vector<double>& n, const std::vector<double>& t) {
   return (m * sxy - sx * sy) / (m * sxx - sx * sx);
 }
 
+/// Triangle centroids of plate_mesh(n) with the triangle areas as weights (STL cell centres).
+Mesh centre_mesh(int n, unsigned seed) {
+  const Mesh tri = plate_mesh("cells", n, seed, true);
+  const Mesh::Points c = tri.triangle_centroids();
+  Eigen::VectorXd a(tri.triangles().rows());
+  for (Eigen::Index t = 0; t < a.size(); ++t) {
+    const Eigen::Vector3d p0 = tri.points().row(tri.triangles()(t, 0));
+    const Eigen::Vector3d p1 = tri.points().row(tri.triangles()(t, 1));
+    const Eigen::Vector3d p2 = tri.points().row(tri.triangles()(t, 2));
+    a(t) = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+  }
+  Mesh m("cell_centres", c);
+  m.set_weights(a);
+  return m;
+}
+
+/// 2 x 2 Gauss points of an m x m quad grid on the plate, weights (h/2)^2 (FE quadrature).
+Mesh gauss_mesh(int m) {
+  const double h = plate / m, g = h / (2.0 * std::sqrt(3.0));
+  Mesh::Points q(4 * static_cast<Eigen::Index>(m) * m, 3);
+  Eigen::Index k = 0;
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < m; ++i)
+      for (int b = 0; b < 2; ++b)
+        for (int a = 0; a < 2; ++a)
+          q.row(k++) << (i + 0.5) * h + (a ? g : -g), (j + 0.5) * h + (b ? g : -g), 0.0;
+  Mesh mesh("quadrature", q);
+  mesh.set_weights(Eigen::VectorXd::Constant(q.rows(), h * h / 4));
+  return mesh;
+}
+
+void bench_area_balanced(double max_n, int repeat) {
+  std::printf(
+      "\n# area-balanced: triangle centres (areas) -> 2x2 Gauss points of a quad grid; set-up "
+      "per 1e5 cells = compute / (n_source / 1e5)\n");
+  std::printf("%-28s %9s %9s %10s %12s %10s %10s %10s %10s %10s\n", "mapper", "n_source",
+              "n_target", "compute[s]", "per 1e5[s]", "entries", "row err", "column err",
+              "spiky err", "map[s]");
+  for (const int neighbors : {1, 6})
+    for (const double cells : {1e4, 1e5, 1e6}) {
+      if (cells > max_n * 1.0001) break;
+      const int n = static_cast<int>(std::lround(std::sqrt(cells / 2.0)));        // 2 n^2 triangles
+      const int m = static_cast<int>(std::lround(std::sqrt(cells / 4.0 * 1.1)));  // ~10 % more
+      const Mesh source = centre_mesh(n, 1);
+      const Mesh target = gauss_mesh(m);
+      AreaBalancedMapper mapper(Constraint::consistent, neighbors);
+      auto t0 = std::chrono::steady_clock::now();
+      mapper.compute(source, target);
+      const double compute = seconds_since(t0);
+      const auto& w = mapper.matrix();
+      const Eigen::VectorXd ones = Eigen::VectorXd::Ones(source.size());
+      const double row_err =
+          (w * ones - Eigen::VectorXd::Ones(target.size())).cwiseAbs().maxCoeff();
+      long double sw = 0.0L, sa = 0.0L;  // the totals to 1e-16 (double sums: 1e-13 at 1e5)
+      for (const double x : target.weights()) sw += x;
+      for (const double x : source.weights()) sa += x;
+      const Eigen::VectorXd c = source.weights() * static_cast<double>(sw / sa);
+      const Eigen::VectorXd col = w.transpose() * target.weights();
+      const double col_err = ((col - c).array() / c.array()).abs().maxCoeff();
+      // spiky density: 3 of every 1000 cells loaded (as DEM contacts on an STL)
+      std::mt19937 rng(3);
+      std::uniform_int_distribution<Eigen::Index> pick(0, source.size() - 1);
+      Eigen::MatrixXd t = Eigen::MatrixXd::Zero(source.size(), 3);
+      for (Eigen::Index k = 0; k < source.size() / 333 + 1; ++k) t(pick(rng), 2) = -1.0e4;
+      Eigen::MatrixXd out;
+      mapper.map(t, out);
+      const double sent = c.dot(t.col(2));
+      const double spiky = std::abs(target.weights().dot(out.col(2)) - sent) / std::abs(sent);
+      t0 = std::chrono::steady_clock::now();
+      for (int r = 0; r < repeat; ++r) mapper.map(t, out);
+      const double map = seconds_since(t0) / repeat;
+      const std::string label = "area-balanced neighbors " + std::to_string(neighbors);
+      std::printf("%-28s %9ld %9ld %10.4f %12.4f %10ld %10.2e %10.2e %10.2e %10.5f\n",
+                  label.c_str(), static_cast<long>(source.size()), static_cast<long>(target.size()),
+                  compute, compute / (static_cast<double>(source.size()) / 1e5),
+                  static_cast<long>(w.nonZeros()), row_err, col_err, spiky, map);
+      std::fflush(stdout);
+    }
+}
+
 struct Case {
   std::string label;
   std::string yaml;  // the mapper node
@@ -92,26 +181,31 @@ struct Case {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false;
-  double max_n = 1.0e6, rbf_max_n = 1.0e5;
+  bool quick = false, area_only = false;
+  double max_n = 1.0e6, rbf_max_n = 1.0e5, area_max_n = 1.0e6;
   int repeat = 5;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--quick") {
       quick = true;
+    } else if (a == "--area-only") {
+      area_only = true;
     } else if (a == "--max-n" && i + 1 < argc) {
       max_n = std::atof(argv[++i]);
     } else if (a == "--rbf-max-n" && i + 1 < argc) {
       rbf_max_n = std::atof(argv[++i]);
+    } else if (a == "--area-max-n" && i + 1 < argc) {
+      area_max_n = std::atof(argv[++i]);
     } else if (a == "--repeat" && i + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else {
       std::fprintf(stderr,
-                   "usage: bench_mapping [--quick] [--max-n N] [--rbf-max-n N] [--repeat R]\n");
+                   "usage: bench_mapping [--quick] [--max-n N] [--rbf-max-n N] [--area-max-n N] "
+                   "[--area-only] [--repeat R]\n");
       return a == "--help" || a == "-h" ? 0 : 2;
     }
   }
-  if (quick) max_n = rbf_max_n = 1.0e4, repeat = 2;
+  if (quick) max_n = rbf_max_n = area_max_n = 1.0e4, repeat = 2;
 
   Registry<MapperFactory> registry("mapper");
   register_mappers(registry);
@@ -144,6 +238,7 @@ int main(int argc, char** argv) {
       repeat);
   std::printf("%-36s %9s %9s %10s %12s %9s %10s %12s %9s\n", "mapper", "n_source", "n_target",
               "compute[s]", "compute/pt", "x sort", "map[s]", "map/pt", "x sort");
+  if (area_only) cases.clear();
   for (const Case& c : cases) {
     std::vector<double> ns, tc, tm;
     for (double size : sizes) {
@@ -196,5 +291,6 @@ int main(int argc, char** argv) {
             return slope(ns, nl);
           }());
   }
+  bench_area_balanced(area_max_n, repeat);
   return 0;
 }

@@ -691,38 +691,66 @@ void CaseRun::run() {
     }
     m.csv = CsvSeries(output_dir_ / (m.name + ".csv"), "time", "s", mc);
   }
-  // The quantities each participant must report, asked for once per window.
-  std::map<Participant*, std::vector<std::string>> wanted;
-  for (const auto& m : monitors_)
-    for (const auto& [p, q] : m.quantities) wanted[p].push_back(q);
-  std::map<Participant*, std::vector<MonitorValue>> values;
+  // The quantities each participant must report, asked for once per window, and where each
+  // monitor column finds its value: (participant slot, position in what the solver returned),
+  // the position remembered from the last window and checked by name (no search per window
+  // unless a solver changes the order of its answer).
+  struct Asked {
+    Participant* p;
+    std::vector<std::string> names;
+    std::vector<MonitorValue> values;
+  };
+  std::vector<Asked> wanted;
+  struct Column {
+    std::size_t asked;
+    const std::string* name;
+    std::size_t at = 0;
+  };
+  std::vector<std::vector<Column>> columns_of(monitors_.size());
+  for (std::size_t mi = 0; mi < monitors_.size(); ++mi)
+    for (const auto& [p, q] : monitors_[mi].quantities) {
+      auto it =
+          std::find_if(wanted.begin(), wanted.end(), [&](const Asked& a) { return a.p == p; });
+      if (it == wanted.end()) it = wanted.insert(wanted.end(), Asked{p, {}, {}});
+      it->names.push_back(q);
+      columns_of[mi].push_back({static_cast<std::size_t>(it - wanted.begin()), &q});
+    }
+  std::vector<double> monitor_row;
   auto record_monitors = [&](double t, std::int64_t window) {
-    for (const auto& [p, names] : wanted) {
+    for (Asked& a : wanted) {
       Stopwatch clock;  // the solver computes its quantities: its time, not the core's
-      values[p] = p->solver().monitor_values(names);
-      p->add_seconds(clock.seconds());
-      for (const auto& mv : values[p])
+      a.values = a.p->solver().monitor_values(a.names);
+      a.p->add_seconds(clock.seconds());
+      for (const auto& mv : a.values)
         if (!std::isfinite(mv.value))
           throw Error(fmt::format(
               "window {} (t = {:.6g} s): participant '{}' reports {} = {} {}: the run is "
               "diverging; reduce time.window or the substep size, add damping, or check the "
               "materials and loads",
-              window, t, p->name(), mv.name, mv.value, mv.unit));
+              window, t, a.p->name(), mv.name, mv.value, mv.unit));
     }
-    for (auto& m : monitors_) {
-      std::vector<double> row;
-      for (const auto& [p, q] : m.quantities) {
-        double v = std::nan("");
-        for (const auto& mv : values[p])
-          if (mv.name == q) v = mv.value;
-        row.push_back(v);
+    for (std::size_t mi = 0; mi < monitors_.size(); ++mi) {
+      monitor_row.clear();
+      for (Column& c : columns_of[mi]) {
+        const std::vector<MonitorValue>& got = wanted[c.asked].values;
+        if (c.at >= got.size() || got[c.at].name != *c.name) {
+          // the last value of that name, as the search before (NaN where the solver gave none)
+          c.at = got.size();
+          for (std::size_t k = 0; k < got.size(); ++k)
+            if (got[k].name == *c.name) c.at = k;
+        }
+        monitor_row.push_back(c.at < got.size() ? got[c.at].value : std::nan(""));
       }
-      m.csv.record(t, row);
+      Stopwatch csv_clock;  // formatting the row: output time, not the core's
+      monitors_[mi].csv.record(t, monitor_row);
+      summary_.output_seconds += csv_clock.seconds();
     }
   };
   auto flush_all = [&] {
+    Stopwatch clock;
     coupling_csv_.flush();
     for (auto& m : monitors_) m.csv.flush();
+    summary_.output_seconds += clock.seconds();
   };
 
   Progress progress;
@@ -767,6 +795,7 @@ void CaseRun::run() {
       write_output(progress.frame++, 0.0);
     }
     TimeWindow window(window_size_, 0, 1);
+    std::vector<double> row;  // coupling.csv's row of the window
     for (std::int64_t n = progress.windows_done; n < window_count_; ++n) {
       window = TimeWindow(window_size_, n, 1);
       const WindowReport r = scheme_->advance(window);
@@ -777,9 +806,9 @@ void CaseRun::run() {
       summary_.max_window_iterations = std::max(summary_.max_window_iterations, r.iterations);
       if (!r.converged) ++summary_.unconverged_windows;
       check_window(n + 1, t);
-      std::vector<double> row = {t, static_cast<double>(r.iterations)};
+      row.assign({t, static_cast<double>(r.iterations)});  // keeps its capacity
       row.insert(row.end(), r.residuals.begin(), r.residuals.end());
-      const std::vector<double> imbalance = audit_balance();
+      const std::vector<double>& imbalance = audit_balance();
       row.insert(row.end(), imbalance.begin(), imbalance.end());
       for (auto& p : energy_pairs_) {
         const EnergyAudit a = audit_energy(p);
@@ -819,7 +848,9 @@ void CaseRun::run() {
                 n + 1, t, audited_[i]->label(), imbalance[i], balance_tolerance_);
           warned_imbalance = true;
         }
+      Stopwatch csv_clock;
       coupling_csv_.record(static_cast<double>(n + 1), row);
+      summary_.output_seconds += csv_clock.seconds();
       record_monitors(t, n + 1);
       const bool last = n + 1 == window_count_;
       if ((output_every_ > 0.0 && t >= progress.next_output - 1e-9 * window_size_) || last) {
@@ -866,8 +897,10 @@ void CaseRun::run() {
   }
   progress_line.finish();
   flush_all();
+  Stopwatch close_clock;
   coupling_csv_.close();
   for (auto& m : monitors_) m.csv.close();
+  summary_.output_seconds += close_clock.seconds();
   for (auto& p : participants_) {
     Stopwatch sc;
     p->solver().finalize();

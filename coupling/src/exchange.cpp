@@ -22,6 +22,8 @@ Exchange::Exchange(std::string data, End from, End to, DataSpec spec,
   const InterfaceMesh* tm = to_.participant->find_mesh(to_.mesh);
   if (!fm || !tm) throw Error("exchange " + label() + ": unknown mesh");
   from_points_ = fm->mesh.size();
+  source_mesh_ = &fm->mesh;
+  target_mesh_ = &tm->mesh;
   if (!mapper_ && fm->mesh.size() != tm->mesh.size())
     throw Error("exchange " + label() +
                 ": without a mapper the meshes need the same number of points (" +
@@ -43,7 +45,6 @@ void Exchange::check_shape(const Eigen::MatrixXd& values, const char* what) cons
 }
 
 void Exchange::begin_collect() {
-  accumulated_.setZero(from_points_, spec_.components);
   collected_ = 0;
 }
 
@@ -59,11 +60,20 @@ void Exchange::collect(const Eigen::MatrixXd& values) {
 
 void Exchange::finish_collect() {
   // average: f_{n+1} = 1/m Σ_{k=1..m} f_{n,k} (the running mean);  last: f_{n+1} = f_{n,m}
-  combined_ = accumulated_;
+  if (collected_ == 0) {
+    combined_.setZero(from_points_, spec_.components);
+    return;
+  }
+  // The next begin_collect()/collect() overwrite accumulated_ whole: swap instead of a copy.
+  combined_.swap(accumulated_);
 }
 
 void Exchange::transmit() {
   Stopwatch s;
+  if (start_is_end_) {
+    start_.swap(end_);  // d_n keeps the accepted value; end_'s storage is overwritten below
+    start_is_end_ = false;
+  }
   if (mapper_)
     mapper_->map(sent_, end_);
   else
@@ -71,13 +81,11 @@ void Exchange::transmit() {
   mapping_seconds_ += s.seconds();
 }
 
-void Exchange::read_at(double fraction, Eigen::MatrixXd& out) const {
-  if (reader_sees_ == ReaderSees::constant || fraction >= 1.0) {
-    out = end_;
-    return;
-  }
+const Eigen::MatrixXd& Exchange::read_at(double fraction, Eigen::MatrixXd& scratch) const {
+  if (reader_sees_ == ReaderSees::constant || fraction >= 1.0 || start_is_end_) return end_;
   // d_{n,k} = d_n + (k/m) (d_{n+1} - d_n)
-  out = start_ + fraction * (end_ - start_);
+  scratch = start_ + fraction * (end_ - start_);
+  return scratch;
 }
 
 void Exchange::initialize(const Eigen::MatrixXd& initial) {
@@ -86,19 +94,22 @@ void Exchange::initialize(const Eigen::MatrixXd& initial) {
   sent_ = initial;
   previous_ = initial;
   transmit();
-  start_ = end_;
+  start_is_end_ = true;  // start = end
 }
 
 void Exchange::write_state(BinaryWriter& out) const {
   out.section("exchange " + label());
-  for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) out.write(*m);
+  for (const Eigen::MatrixXd* m :
+       {&combined_, &sent_, &previous_, start_is_end_ ? &end_ : &start_, &end_})
+    out.write(*m);
 }
 
 void Exchange::read_state(BinaryReader& in) {
   in.expect_section("exchange " + label());
   for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) in.read(*m);
+  start_is_end_ = false;
   const Eigen::Index sender = from_points_;
-  const Eigen::Index receiver = to_.participant->find_mesh(to_.mesh)->mesh.size();
+  const Eigen::Index receiver = target_mesh_->size();
   for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_})
     if (m->rows() != sender || m->cols() != spec_.components)
       in.fail(fmt::format("{} x {} values of {} (the sender's mesh)", sender, spec_.components,

@@ -20,7 +20,7 @@ void register_mappers(Registry<MapperFactory>& registry) {
       RbfMapper::create, RbfMapper::spec());
   registry.add("area-balanced",
                "densities between weighted point sets (cell centres <-> quadrature points): "
-               "consistent and integral-preserving (Sinkhorn-balanced Gaussian weights)",
+               "consistent and integral-preserving to round-off (exact bisection of the weights)",
                AreaBalancedMapper::create, AreaBalancedMapper::spec());
 }
 

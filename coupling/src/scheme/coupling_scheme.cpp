@@ -6,12 +6,16 @@ namespace partita::coupling {
 
 CouplingScheme::CouplingScheme(std::vector<Participant*> participants,
                                std::vector<Exchange*> exchanges)
-    : participants_(std::move(participants)), exchanges_(std::move(exchanges)) {}
+    : participants_(std::move(participants)),
+      exchanges_(std::move(exchanges)),
+      read_buffers_(exchanges_.size()),
+      write_buffers_(exchanges_.size()) {}
 
 void CouplingScheme::initialize() {
-  for (Exchange* e : exchanges_) {
-    e->from().write(e->from_mesh(), e->data(), buffer_);
-    e->initialize(buffer_);
+  for (std::size_t i = 0; i < exchanges_.size(); ++i) {
+    Exchange* e = exchanges_[i];
+    e->from().write(e->from_mesh(), e->data(), write_buffers_[i]);
+    e->initialize(write_buffers_[i]);
   }
 }
 
@@ -28,17 +32,18 @@ void CouplingScheme::run_participant(Participant& p, const TimeWindow& window) {
   // for k = 0..m-1: read d(t_{n,k+1}); advance(t_{n,k+1} - t_{n,k}); write f_{n,k+1}
   while (!w.end_reached()) {
     const double fraction = w.fraction_at(w.substep() + 1);
-    for (Exchange* e : exchanges_) {
+    for (std::size_t i = 0; i < exchanges_.size(); ++i) {
+      Exchange* e = exchanges_[i];
       if (&e->to() != &p) continue;
-      e->read_at(fraction, buffer_);
-      p.read(e->to_mesh(), e->data(), buffer_);
+      p.read(e->to_mesh(), e->data(), e->read_at(fraction, read_buffers_[i]));
     }
     p.advance(w.next_substep_size());
     w.advance_substep();
-    for (Exchange* e : exchanges_) {
+    for (std::size_t i = 0; i < exchanges_.size(); ++i) {
+      Exchange* e = exchanges_[i];
       if (&e->from() != &p) continue;
-      p.write(e->from_mesh(), e->data(), buffer_);
-      e->collect(buffer_);
+      p.write(e->from_mesh(), e->data(), write_buffers_[i]);
+      e->collect(write_buffers_[i]);
     }
   }
   for (Exchange* e : exchanges_)

@@ -72,7 +72,7 @@ struct RunSummary {
   double wall_seconds = 0.0;
   std::vector<std::pair<std::string, double>> participant_seconds;
   double mapping_seconds = 0.0;
-  double output_seconds = 0.0;
+  double output_seconds = 0.0;         ///< VTK frames, restart files, CSV rows and flushes
   double core_seconds = 0.0;           ///< the rest: scheme, acceleration, time interpolation
   std::int64_t resumed_from = -1;      ///< windows done by the restart file resumed (-1: none)
   int stopped_by_signal = 0;           ///< the signal that stopped the run early (0: none)
@@ -129,7 +129,8 @@ class CaseRun {
   void read_restart_file(const std::filesystem::path& file, Progress& progress);
   std::filesystem::path newest_restart_file() const;
   void check_window(std::int64_t window, double time);
-  std::vector<double> audit_balance();
+  /// Per audited exchange: |received total - sent total| / scale (into imbalance_).
+  const std::vector<double>& audit_balance();
   std::string restart_blocker() const;  // why restart files cannot be written ("": they can)
 
   const Registries& registries_;
@@ -157,6 +158,10 @@ class CaseRun {
   // the balance audit: exchanges audited and the relative imbalance that warns
   std::vector<const Exchange*> audited_;
   double balance_tolerance_ = 0.01;
+  std::vector<double> imbalance_;  // audit_balance()'s result and scratch space, kept between
+  Eigen::VectorXd audit_sent_, audit_received_;  // windows (no allocation per window)
+  Eigen::ArrayXd audit_norm2_;
+  std::vector<Eigen::VectorXd> audit_bounds_;  // per audited exchange: W^T omega (or empty)
   // the energy audit: two participants that read from each other, each with the meshes it reads
   // the other's data on (where its solver reports Solver::interface_work)
   struct EnergyPair {

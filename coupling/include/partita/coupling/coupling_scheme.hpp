@@ -67,7 +67,9 @@ class CouplingScheme {
   std::vector<Exchange*> exchanges_;
 
  private:
-  Eigen::MatrixXd buffer_;
+  // Per exchange: what its receiver reads and what its sender writes (sized in the first
+  // window, reused after: no allocation per substep).
+  std::vector<Eigen::MatrixXd> read_buffers_, write_buffers_;
 };
 
 }  // namespace partita::coupling

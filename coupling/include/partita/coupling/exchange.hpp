@@ -56,10 +56,14 @@ class Exchange {
   ReaderSees reader_sees() const { return reader_sees_; }
   WriterCombines writer_combines() const { return writer_combines_; }
   const Mapper* mapper() const { return mapper_.get(); }
+  /// The sender's and the receiver's interface meshes (fixed for the run, see Solver::meshes()).
+  const Mesh& source_mesh() const { return *source_mesh_; }
+  const Mesh& target_mesh() const { return *target_mesh_; }
   /// "pressure fluid.nodes -> solid.nodes" for messages.
   std::string label() const;
 
   // --- sender side ------------------------------------------------------------------------
+  // Called every substep: no allocation once the arrays have their sizes (first window).
   void begin_collect();
   /// The writer's values after one substep (checked: points x components).
   void collect(const Eigen::MatrixXd& values);
@@ -77,12 +81,14 @@ class Exchange {
   void transmit();
 
   // --- receiver side ----------------------------------------------------------------------
-  /// The value the receiver sees after the fraction s = k/m of the window.
-  void read_at(double fraction, Eigen::MatrixXd& out) const;
+  /// The value the receiver sees after the fraction s = k/m of the window: received() itself
+  /// where that is the value (no copy), else the interpolation written into `scratch`.
+  const Eigen::MatrixXd& read_at(double fraction, Eigen::MatrixXd& scratch) const;
   /// The newest mapped value d_{n+1}.
   const Eigen::MatrixXd& received() const { return end_; }
-  /// d_n = d_{n+1}: the window is accepted.
-  void accept_window() { start_ = end_; }
+  /// d_n = d_{n+1}: the window is accepted (no copy: start_ is taken from end_ by the next
+  /// transmit(), which swaps the two before mapping into end_).
+  void accept_window() { start_is_end_ = true; }
 
   /// Initial data: combined = sent = previous = initial, transmitted, start = end.
   void initialize(const Eigen::MatrixXd& initial);
@@ -105,10 +111,13 @@ class Exchange {
   ReaderSees reader_sees_;
   WriterCombines writer_combines_;
   Eigen::Index from_points_ = 0;
+  const Mesh* source_mesh_ = nullptr;
+  const Mesh* target_mesh_ = nullptr;
 
   Eigen::MatrixXd accumulated_, combined_, sent_, previous_;
   int collected_ = 0;
   Eigen::MatrixXd start_, end_;
+  bool start_is_end_ = false;  // d_n = d_{n+1}: start_'s own values are stale
   double mapping_seconds_ = 0.0;
 };
 
