@@ -153,6 +153,13 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
               "binary: appended raw (the fastest to write), ascii: text (to read by eye)",
               vtk::format_names())
       .def("zlib");
+  vtk_spec
+      ->choice("precision",
+               "of the solvers' point and cell fields (displacement, stress, velocity, force, "
+               "...): float32 (7 significant digits, files 1.5x smaller) or float64 (the "
+               "solver's values exactly); coordinates and ids are always written exactly",
+               {"float32", "float64"})
+      .def("float32");
   vtk_spec->integer("zlib_level", "zlib compression level: 1 fastest .. 9 smallest")
       .min(1)
       .max(9)
@@ -287,6 +294,7 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     const config::Node v = root["output"]["vtk"];
     vtk_options_.format = vtk::parse_format(v.string("format"));
     vtk_options_.zlib_level = static_cast<int>(v.integer("zlib_level"));
+    vtk_options_.precision = vtk::parse_precision(v.string("precision"));
   }
   if (root.has("output") && root["output"].has("scripts"))
     for (const config::Node& sn : root["output"]["scripts"].items()) {

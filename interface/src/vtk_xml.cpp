@@ -32,8 +32,7 @@ std::string_view to_string(Format format) {
 
 std::vector<std::string> format_names() {
   std::vector<std::string> names;
-  for (Format f : {Format::zlib, Format::binary, Format::ascii})
-    names.emplace_back(to_string(f));
+  for (Format f : {Format::zlib, Format::binary, Format::ascii}) names.emplace_back(to_string(f));
   return names;
 }
 
@@ -41,6 +40,16 @@ Format parse_format(std::string_view name) {
   for (Format f : {Format::zlib, Format::binary, Format::ascii})
     if (to_string(f) == name) return f;
   throw Error("unknown VTK format '" + std::string(name) + "'; allowed: zlib, binary, ascii");
+}
+
+std::string_view to_string(Precision precision) {
+  return precision == Precision::float32 ? "float32" : "float64";
+}
+
+Precision parse_precision(std::string_view name) {
+  for (Precision p : {Precision::float64, Precision::float32})
+    if (to_string(p) == name) return p;
+  throw Error("unknown VTK precision '" + std::string(name) + "'; allowed: float64, float32");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -83,7 +92,8 @@ DataArray DataArray::rows(std::string name, const Eigen::Ref<const Eigen::Matrix
   for (Eigen::Index i = 0; i < m.rows(); ++i)
     for (Eigen::Index c = 0; c < m.cols(); ++c, ++k)
       v[k] = (finite_or_zero && !std::isfinite(m(i, c))) ? 0.0 : m(i, c);
-  DataArray a = own(std::move(name), std::move(v), static_cast<int>(std::max<Eigen::Index>(1, m.cols())));
+  DataArray a =
+      own(std::move(name), std::move(v), static_cast<int>(std::max<Eigen::Index>(1, m.cols())));
   a.tuples_ = static_cast<std::size_t>(m.rows());
   return a;
 }
@@ -186,12 +196,35 @@ std::string escape(const std::string& s) {
   return r;
 }
 
+// An array as it goes into the file: its own bytes, or its Float64 values as Float32.
+struct Encoded {
+  const DataArray* array = nullptr;
+  bool to_float32 = false;
+
+  Type type() const { return to_float32 ? Type::Float32 : array->type(); }
+  std::size_t bytes() const { return array->values() * DataArray::type_size(type()); }
+  const std::byte* contiguous() const { return to_float32 ? nullptr : array->contiguous(); }
+  // `offset` and `length` are multiples of 4 when converting
+  void copy(std::size_t offset, std::size_t length, std::byte* out) const {
+    if (!to_float32) {
+      array->copy_bytes(offset, length, out);
+      return;
+    }
+    const double* d = reinterpret_cast<const double*>(array->contiguous()) + offset / 4;
+    for (std::size_t k = 0; k < length / 4; ++k) {
+      const auto f = static_cast<float>(d[k]);
+      std::memcpy(out + 4 * k, &f, 4);
+    }
+  }
+};
+
 // ASCII values: one tuple per line, the shortest text that reads back to the same value.
 class AsciiValues {
  public:
   explicit AsciiValues(std::ostream& out) : out_(out) { text_.reserve(kBuffer + 64); }
 
-  void write(const DataArray& a) {
+  void write(const Encoded& e) {
+    const DataArray& a = *e.array;
     const std::size_t per = static_cast<std::size_t>(a.components());
     const std::byte* p = a.contiguous();
     for (std::size_t t = 0; t < a.tuples(); ++t) {
@@ -202,7 +235,11 @@ class AsciiValues {
         std::to_chars_result r{};
         switch (p ? a.type() : Type::Int64) {
           case Type::Float64:
-            r = std::to_chars(buf, buf + sizeof buf, reinterpret_cast<const double*>(p)[k]);
+            if (e.to_float32)
+              r = std::to_chars(buf, buf + sizeof buf,
+                                static_cast<float>(reinterpret_cast<const double*>(p)[k]));
+            else
+              r = std::to_chars(buf, buf + sizeof buf, reinterpret_cast<const double*>(p)[k]);
             break;
           case Type::Float32:
             r = std::to_chars(buf, buf + sizeof buf, reinterpret_cast<const float*>(p)[k]);
@@ -228,32 +265,47 @@ class AsciiValues {
   std::string text_;
 };
 
-// zlib deflate of one block at a time with one reused stream.
+// zlib streams of one block each, from two reused deflate streams: the chosen level, and level
+// 0 (stored) for blocks that do not compress.
 class Deflater {
  public:
   Deflater(int level, std::size_t block) {
-    if (deflateInit(&zs_, level) != Z_OK) throw Error("VTK output: zlib initialisation failed");
-    out_.resize(deflateBound(&zs_, static_cast<uLong>(block)));
+    if (deflateInit(&level_, level) != Z_OK || deflateInit(&stored_, 0) != Z_OK)
+      throw Error("VTK output: zlib initialisation failed");
+    out_.resize(std::max(deflateBound(&level_, static_cast<uLong>(block)),
+                         deflateBound(&stored_, static_cast<uLong>(block))));
     in_.resize(block);
   }
-  ~Deflater() { deflateEnd(&zs_); }
+  ~Deflater() {
+    deflateEnd(&level_);
+    deflateEnd(&stored_);
+  }
   Deflater(const Deflater&) = delete;
   Deflater& operator=(const Deflater&) = delete;
 
   /// Compress `length` bytes at `data`; returns the compressed bytes (valid until the next call).
   std::pair<const unsigned char*, std::size_t> block(const std::byte* data, std::size_t length) {
-    deflateReset(&zs_);
-    zs_.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(data));
-    zs_.avail_in = static_cast<uInt>(length);
-    zs_.next_out = out_.data();
-    zs_.avail_out = static_cast<uInt>(out_.size());
-    if (deflate(&zs_, Z_FINISH) != Z_STREAM_END) throw Error("VTK output: zlib compression failed");
-    return {out_.data(), out_.size() - zs_.avail_out};
+    z_stream* z = &level_;
+    if (length >= 2 * kProbe) {  // does the start of the block compress by 10 %?
+      const std::size_t probe = run(level_, data, kProbe);
+      if (10 * probe > 9 * kProbe) z = &stored_;
+    }
+    return {out_.data(), run(*z, data, length)};
   }
   std::byte* input() { return in_.data(); }
 
  private:
-  z_stream zs_{};
+  static constexpr std::size_t kProbe = 4096;
+  std::size_t run(z_stream& zs, const std::byte* data, std::size_t length) {
+    deflateReset(&zs);
+    zs.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(data));
+    zs.avail_in = static_cast<uInt>(length);
+    zs.next_out = out_.data();
+    zs.avail_out = static_cast<uInt>(out_.size());
+    if (deflate(&zs, Z_FINISH) != Z_STREAM_END) throw Error("VTK output: zlib compression failed");
+    return out_.size() - zs.avail_out;
+  }
+  z_stream level_{}, stored_{};
   std::vector<unsigned char> out_;
   std::vector<std::byte> in_;
 };
@@ -266,9 +318,11 @@ class XmlWriter {
       if (options.zlib_level < 1 || options.zlib_level > 9)
         throw Error("VTK output '" + path.string() + "': zlib level " +
                     std::to_string(options.zlib_level) + " is not in 1 .. 9");
-      if (options.block_size < 1024 || options.block_size > (1u << 30))
+      if (options.block_size < 1024 || options.block_size > (1u << 30) ||
+          options.block_size % 8 != 0)
         throw Error("VTK output '" + path.string() + "': zlib block size " +
-                    std::to_string(options.block_size) + " is not in 1 KiB .. 1 GiB");
+                    std::to_string(options.block_size) +
+                    " is not a multiple of 8 in 1 KiB .. 1 GiB");
     }
     out_ << "<?xml version=\"1.0\"?>\n<VTKFile type=\"" << type
          << "\" version=\"1.0\" byte_order=\"" << kByteOrder << "\" header_type=\"UInt64\"";
@@ -278,28 +332,31 @@ class XmlWriter {
 
   std::ostream& out() { return out_; }
 
-  void array(const DataArray& a, const char* indent) {
-    out_ << indent << "<DataArray type=\"" << DataArray::type_name(a.type()) << '"';
+  // `data`: a point or cell data array (written as Float32 if the options say so)
+  void array(const DataArray& a, const char* indent, bool data = false) {
+    const Encoded e{&a,
+                    data && a.type() == Type::Float64 && options_.precision == Precision::float32};
+    out_ << indent << "<DataArray type=\"" << DataArray::type_name(e.type()) << '"';
     if (!a.name().empty()) out_ << " Name=\"" << escape(a.name()) << '"';
     out_ << " NumberOfComponents=\"" << a.components() << "\" format=\""
          << (options_.format == Format::ascii ? "ascii" : "appended") << '"';
     if (options_.format == Format::ascii) {
       out_ << ">\n";
-      AsciiValues(out_).write(a);
+      AsciiValues(out_).write(e);
       out_ << indent << "</DataArray>\n";
       return;
     }
     out_ << " offset=\"";
     patch_.push_back(out_.tellp());
     out_ << std::string(kOffsetField, ' ') << "/>\n";
-    appended_.push_back(&a);
+    appended_.push_back(e);
   }
 
   void data(const char* tag, const std::vector<DataArray>& arrays, const ActiveArrays& active) {
     out_ << "      <" << tag;
     for (const auto& [k, v] : active) out_ << ' ' << k << "=\"" << escape(v) << '"';
     out_ << ">\n";
-    for (const DataArray& a : arrays) array(a, "        ");
+    for (const DataArray& a : arrays) array(a, "        ", true);
     out_ << "      </" << tag << ">\n";
   }
 
@@ -312,12 +369,12 @@ class XmlWriter {
       std::unique_ptr<Deflater> z;
       if (options_.format == Format::zlib)
         z = std::make_unique<Deflater>(options_.zlib_level, options_.block_size);
-      for (const DataArray* a : appended_) {
+      for (const Encoded& e : appended_) {
         offsets.push_back(static_cast<std::uint64_t>(out_.tellp() - base));
         if (z)
-          compressed(*a, *z);
+          compressed(e, *z);
         else
-          raw(*a);
+          raw(e);
       }
       out_ << "\n  </AppendedData>\n";
     }
@@ -333,7 +390,7 @@ class XmlWriter {
   void put64(std::uint64_t v) { out_.write(reinterpret_cast<const char*>(&v), 8); }
 
   // header: the byte count; then the bytes
-  void raw(const DataArray& a) {
+  void raw(const Encoded& a) {
     put64(a.bytes());
     if (const std::byte* p = a.contiguous()) {
       out_.write(reinterpret_cast<const char*>(p), static_cast<std::streamsize>(a.bytes()));
@@ -342,14 +399,14 @@ class XmlWriter {
     std::array<std::byte, kChunk> chunk;
     for (std::size_t at = 0; at < a.bytes(); at += kChunk) {
       const std::size_t n = std::min(kChunk, a.bytes() - at);
-      a.copy_bytes(at, n, chunk.data());
+      a.copy(at, n, chunk.data());
       out_.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(n));
     }
   }
 
   // header: blocks, block size, last partial block size, compressed size of each block; then
   // the compressed blocks (the header is written again once the sizes are known)
-  void compressed(const DataArray& a, Deflater& z) {
+  void compressed(const Encoded& a, Deflater& z) {
     const std::size_t total = a.bytes(), bs = options_.block_size;
     const std::size_t blocks = total / bs + (total % bs ? 1 : 0);
     std::vector<std::uint64_t> header(3 + blocks, 0);
@@ -363,7 +420,7 @@ class XmlWriter {
       const std::size_t n = std::min(bs, total - b * bs);
       const std::byte* in = a.contiguous() ? a.contiguous() + b * bs : nullptr;
       if (!in) {
-        a.copy_bytes(b * bs, n, z.input());
+        a.copy(b * bs, n, z.input());
         in = z.input();
       }
       const auto [c, size] = z.block(in, n);
@@ -381,7 +438,7 @@ class XmlWriter {
   std::ostream& out_;
   Options options_;
   std::vector<std::streampos> patch_;
-  std::vector<const DataArray*> appended_;
+  std::vector<Encoded> appended_;
 };
 
 [[noreturn]] void wrong_length(const std::filesystem::path& path, const std::string& what,
@@ -404,8 +461,8 @@ void check_cells(const std::filesystem::path& path, const char* kind, const Cell
     if ((a->type() != Type::Int64 && a->type() != Type::Int32) || a->components() != 1)
       throw Error("VTK output '" + path.string() + "': " + kind + " " + a->name() +
                   " must be one Int64 or Int32 per entry");
-  if (c.count() > 0 && static_cast<std::size_t>(c.offsets.integer(c.count() - 1)) !=
-                           c.connectivity.values())
+  if (c.count() > 0 &&
+      static_cast<std::size_t>(c.offsets.integer(c.count() - 1)) != c.connectivity.values())
     throw Error("VTK output '" + path.string() + "': " + kind + ": the last offset is " +
                 std::to_string(c.offsets.integer(c.count() - 1)) + ", the connectivity has " +
                 std::to_string(c.connectivity.values()) + " entries");

@@ -163,7 +163,7 @@ TEST_CASE("every registered adapter honours the Solver contract", "[adapters][co
       CHECK(s->check_state().empty());
 
       // output and monitors
-      s->write_output(OutputFrame{out / "vtk", "p_" + entry.name, 1, s->time()});
+      s->write_output(OutputFrame{out / "vtk", "p_" + entry.name, 1, s->time(), {}});
       for (const auto& [series, file] : s->output_files()) {
         INFO("output file " << file);
         CHECK(fs::exists(out / "vtk" / file));

@@ -71,7 +71,7 @@ TEST_CASE("dem adapter: fragments lower the stable step, monitors and the gradin
   auto s = test::make_dem(dem_yaml("breakage: {limit_strength: 0.2 MPa, reference_size: 2 mm, "
                          "weibull_modulus: 3, comminution_limit: 0.5 mm, pattern: equal-4}\n"),
                 out);
-  s->write_output(OutputFrame{out / "vtk", "p", 0, s->time()});
+  s->write_output(OutputFrame{out / "vtk", "p", 0, s->time(), {}});
   const double dt0 = s->stable_time_step();
   const double n0 = monitor(*s, "particles");
   int steps = 0;
@@ -94,7 +94,7 @@ TEST_CASE("dem adapter: fragments lower the stable step, monitors and the gradin
   const double t0 = s->time();
   CHECK_NOTHROW(s->advance(dt0));
   CHECK(s->time() == Approx(t0 + dt0).epsilon(1e-12));
-  s->write_output(OutputFrame{out / "vtk", "p", 1, s->time()});
+  s->write_output(OutputFrame{out / "vtk", "p", 1, s->time(), {}});
   std::ifstream csv(out / "p_grading.csv");
   std::stringstream text;
   text << csv.rdbuf();

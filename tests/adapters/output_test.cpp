@@ -30,12 +30,13 @@ fs::path scratch(const std::string& name) {
 }
 
 // Every file of the frame written in each format into its own folder; returns the folders.
-std::vector<fs::path> write_every_format(Solver& s, const fs::path& dir) {
+std::vector<fs::path> write_every_format(Solver& s, const fs::path& dir,
+                                         vtk::Precision p = vtk::Precision::float64) {
   std::vector<fs::path> dirs;
   for (const vtk::Format f : kFormats) {
-    const fs::path d = dir / std::string(vtk::to_string(f));
+    const fs::path d = dir / std::string(vtk::to_string(f)) / std::string(vtk::to_string(p));
     fs::create_directories(d);
-    s.write_output(OutputFrame{d, "p", 3, s.time(), {f}});
+    s.write_output(OutputFrame{d, "p", 3, s.time(), {f, 1, 1u << 20, p}});
     dirs.push_back(d);
   }
   return dirs;
@@ -43,7 +44,8 @@ std::vector<fs::path> write_every_format(Solver& s, const fs::path& dir) {
 
 }  // namespace
 
-TEST_CASE("fem adapter: the .vtu of every element type, in every format", "[adapters][fem][output]") {
+TEST_CASE("fem adapter: the .vtu of every element type, in every format",
+          "[adapters][fem][output]") {
   const fs::path dir = scratch("fem");
   const std::vector<std::tuple<std::string, int, int>> elements = {
       {"hex8", 12, 8}, {"hex20", 25, 20}, {"tet4", 10, 4}, {"tet10", 24, 10}};  // VTK cell types
@@ -72,7 +74,7 @@ TEST_CASE("fem adapter: the .vtu of every element type, in every format", "[adap
         INFO(c.text.substr(0, 3000));
         REQUIRE(c.ok);
         if (first.empty()) first = c.text;
-        CHECK(c.text == first);  // ascii, raw and zlib: the same values
+        CHECK(c.text == first);        // ascii, raw and zlib: the same values
         REQUIRE(c.types.size() >= 4);  // 4 hexahedra, or the tetrahedra they are cut into
         for (const auto t : c.types) CHECK(t == vtk_type);
         const auto& offsets = c.cells.at("cells").offsets;
@@ -98,10 +100,10 @@ TEST_CASE("fem adapter: the .vtu of every element type, in every format", "[adap
         const auto& vm = c.point.at("von_mises").values;
         for (std::size_t i = 0; i < c.points; ++i) {
           const double* t = &st[6 * i];
-          const double v = std::sqrt(0.5 * ((t[0] - t[1]) * (t[0] - t[1]) +
-                                            (t[1] - t[2]) * (t[1] - t[2]) +
-                                            (t[2] - t[0]) * (t[2] - t[0])) +
-                                     3.0 * (t[3] * t[3] + t[4] * t[4] + t[5] * t[5]));
+          const double v =
+              std::sqrt(0.5 * ((t[0] - t[1]) * (t[0] - t[1]) + (t[1] - t[2]) * (t[1] - t[2]) +
+                               (t[2] - t[0]) * (t[2] - t[0])) +
+                        3.0 * (t[3] * t[3] + t[4] * t[4] + t[5] * t[5]));
           CHECK(vm[i] == Approx(v).epsilon(1e-12).margin(1e-9));
         }
       }
@@ -197,7 +199,23 @@ TEST_CASE("dem adapter: particle and mesh files in every format, forces summing 
     // the plate moved with the displacement it was given
     for (std::size_t v = 0; v < 25; ++v) CHECK(m.xyz[3 * v + 2] == Approx(0.0072).epsilon(1e-12));
   }
+  // float32 (the case default): the fields rounded to float, coordinates and ids exact
+  std::string first32;
+  for (const fs::path& dd : write_every_format(*s, dir, vtk::Precision::float32)) {
+    const auto p = read_vtk(dd / "p_particles_000003.vtp");
+    const auto p64 = read_vtk(dir / "zlib" / "float64" / "p_particles_000003.vtp");
+    INFO(dd.string());
+    REQUIRE(p.ok);
+    if (first32.empty()) first32 = p.text;
+    CHECK(p.text == first32);
+    CHECK(p.xyz == p64.xyz);
+    CHECK(p.point.at("id").ints == p64.point.at("id").ints);
+    REQUIRE(p.point.at("force").type == "float");
+    const auto& f64 = p64.point.at("force").values;
+    for (std::size_t k = 0; k < f64.size(); ++k)
+      CHECK(p.point.at("force").values[k] == static_cast<double>(static_cast<float>(f64[k])));
+  }
   // a frame that cannot be written: an error, no half-written file
   std::ofstream(dir / "not_a_folder") << "x";
-  CHECK_THROWS_AS(s->write_output(OutputFrame{dir / "not_a_folder", "p", 4, s->time()}), Error);
+  CHECK_THROWS_AS(s->write_output(OutputFrame{dir / "not_a_folder", "p", 4, s->time(), {}}), Error);
 }

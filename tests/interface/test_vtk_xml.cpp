@@ -29,14 +29,18 @@ fs::path scratch(const std::string& name) {
   return dir;
 }
 
-std::vector<vtk::Options> every_format() {
-  return {{vtk::Format::ascii}, {vtk::Format::binary}, {vtk::Format::zlib},
-          {vtk::Format::zlib, 9, 1024}};  // level 9, blocks of 1 KiB: arrays span many blocks
+// Every format, the data arrays in their own precision (float64); then zlib level 9 with blocks
+// of 1 KiB, so that arrays span many blocks.
+std::vector<vtk::Options> every_format(vtk::Precision p = vtk::Precision::float64) {
+  return {{vtk::Format::ascii, 1, 1u << 20, p},
+          {vtk::Format::binary, 1, 1u << 20, p},
+          {vtk::Format::zlib, 1, 1u << 20, p},
+          {vtk::Format::zlib, 9, 1024, p}};
 }
 
 std::string describe(const vtk::Options& o) {
   return std::string(vtk::to_string(o.format)) + " level " + std::to_string(o.zlib_level) +
-         " block " + std::to_string(o.block_size);
+         " block " + std::to_string(o.block_size) + " " + std::string(vtk::to_string(o.precision));
 }
 
 // Values that a text format with too few digits or a wrong byte count would change.
@@ -125,8 +129,7 @@ TEST_CASE("vtk xml: every format holds the given values as VTK reads them (PolyD
         CHECK(static_cast<float>(c.point.at("single").values[i]) == f[i]);
       CHECK(c.point.at("id&<name>").ints == id);  // Int64 beyond 2^53, as integers
       CHECK(c.cell.at("flag").ints == std::vector<std::int64_t>(flag.begin(), flag.end()));
-      CHECK(c.cell.at("minus").ints ==
-            std::vector<std::int64_t>(cell_int.begin(), cell_int.end()));
+      CHECK(c.cell.at("minus").ints == std::vector<std::int64_t>(cell_int.begin(), cell_int.end()));
       CHECK(c.active.at("point Vectors") == "velocity");
     }
   }
@@ -179,7 +182,7 @@ TEST_CASE("vtk xml: every format holds the given values as VTK reads them (Unstr
 TEST_CASE("vtk xml: an empty piece and an array of exactly whole zlib blocks open in VTK",
           "[interface][output][vtk]") {
   const fs::path dir = scratch("edge");
-  for (const vtk::Options& o : every_format()) {
+  for (const vtk::Options& o : every_format(vtk::Precision::float32)) {
     INFO(describe(o));
     vtk::PolyData empty;
     empty.points = vtk::DataArray::view<double>("Points", nullptr, 0, 3);
@@ -199,7 +202,7 @@ TEST_CASE("vtk xml: an empty piece and an array of exactly whole zlib blocks ope
   piece.points = vtk::DataArray::view("Points", xyz.data(), 128, 3);
   piece.verts = vtk::Cells::vertices(128);
   const fs::path file = dir / "whole_blocks.vtp";
-  vtk::write(file, piece, {vtk::Format::zlib, 1, 1024});
+  vtk::write(file, piece, {vtk::Format::zlib, 1, 1024, vtk::Precision::float64});
   const auto c = read_vtk(file);
   INFO(c.text);
   REQUIRE(c.ok);
@@ -216,12 +219,14 @@ TEST_CASE("vtk xml: a raw binary file has exactly the bytes of its arrays and th
   piece.points = vtk::DataArray::view("Points", xyz.data(), n, 3);
   piece.verts = vtk::Cells::vertices(n);
   piece.point_data = {vtk::DataArray::view("radius", xyz.data(), n)};
-  vtk::write(dir / "p.vtp", piece, {vtk::Format::binary});
+  vtk::write(dir / "p.vtp", piece, {vtk::Format::binary, 1, 1u << 20, vtk::Precision::float64});
   const std::size_t payload = (8 + 24 * n) + (8 + 8 * n) + (8 + 8 * n) + (8 + 8 * n);
   const auto size = fs::file_size(dir / "p.vtp");
   CHECK(size > payload);
   CHECK(size < payload + 2000);  // the XML text around it
-  // the same zeros-and-halves compress: zlib is much smaller than raw
+  // float32: the radius (a data array) takes 4 bytes a value, the points keep 8
+  vtk::write(dir / "p32.vtp", piece, {vtk::Format::binary});
+  CHECK(size - fs::file_size(dir / "p32.vtp") == 4 * n);
   vtk::write(dir / "z.vtp", piece, {vtk::Format::zlib});
   CHECK(fs::file_size(dir / "z.vtp") < size / 10);
 }
@@ -236,9 +241,9 @@ TEST_CASE("vtk xml: bad input is refused with the file and the array named, no f
   piece.verts = vtk::Cells::vertices(10);
   piece.point_data = {vtk::DataArray::view("radius", short_array.data(), 9)};
   const fs::path file = dir / "p.vtp";
-  CHECK_THROWS_WITH(vtk::write(file, piece),
-                    Catch::Contains("p.vtp") && Catch::Contains("point array 'radius' has 9") &&
-                        Catch::Contains("expected 10"));
+  CHECK_THROWS_WITH(vtk::write(file, piece), Catch::Contains("p.vtp") &&
+                                                 Catch::Contains("point array 'radius' has 9") &&
+                                                 Catch::Contains("expected 10"));
   piece.point_data.clear();
   piece.cell_data = {vtk::DataArray::view("force", xyz.data(), 10, 3)};
   std::vector<std::int32_t> tri = {0, 1, 2};
@@ -252,7 +257,7 @@ TEST_CASE("vtk xml: bad input is refused with the file and the array named, no f
   CHECK_FALSE(fs::exists(file.string() + ".part"));
   std::ofstream(dir / "a_file") << "x";
   CHECK_THROWS_AS(vtk::write(dir / "a_file" / "p.vtp", piece), Error);  // cannot be created
-  vtk::write(file, piece);  // now valid
+  vtk::write(file, piece);                                              // now valid
   CHECK(read_vtk(file).ok);
   // a failed rewrite leaves the complete earlier file in place
   const auto before = fs::file_size(file);
@@ -261,4 +266,38 @@ TEST_CASE("vtk xml: bad input is refused with the file and the array named, no f
   CHECK(fs::file_size(file) == before);
   CHECK(vtk::parse_format("binary") == vtk::Format::binary);
   CHECK_THROWS_WITH(vtk::parse_format("gzip"), Catch::Contains("allowed: zlib, binary, ascii"));
+}
+
+TEST_CASE("vtk xml: float32 precision writes the data arrays as Float32, coordinates exactly",
+          "[interface][output][vtk]") {
+  const fs::path dir = scratch("float32");
+  const std::size_t n = 3000;
+  const std::vector<double> xyz = awkward_doubles(3 * n);
+  std::vector<double> field(n);
+  std::vector<std::int64_t> id(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    field[i] = 1.0 / (3.0 + static_cast<double>(i));  // not a float: rounded to one
+    id[i] = (std::int64_t{1} << 60) + static_cast<std::int64_t>(i);
+  }
+  vtk::PolyData piece;
+  piece.points = vtk::DataArray::view("Points", xyz.data(), n, 3);
+  piece.verts = vtk::Cells::vertices(n);
+  piece.point_data = {vtk::DataArray::view("field", field.data(), n),
+                      vtk::DataArray::view("id", id.data(), n)};
+  std::string first;
+  for (const vtk::Options& o : every_format(vtk::Precision::float32)) {
+    INFO(describe(o));
+    const fs::path file = dir / ("p_" + describe(o) + ".vtp");
+    vtk::write(file, piece, o);
+    const auto c = read_vtk(file);
+    INFO(c.text.substr(0, 1000));
+    REQUIRE(c.ok);
+    CHECK(c.xyz == xyz);  // the points keep their precision
+    REQUIRE(c.point.at("field").type == "float");
+    for (std::size_t i = 0; i < n; ++i)
+      CHECK(c.point.at("field").values[i] == static_cast<double>(static_cast<float>(field[i])));
+    CHECK(c.point.at("id").ints == id);
+    if (first.empty()) first = c.text;
+    CHECK(c.text == first);
+  }
 }

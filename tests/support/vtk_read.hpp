@@ -20,28 +20,29 @@ struct VtkContent {
     std::string type;  ///< VTK's name: double, float, long long, int, unsigned char, ...
     std::size_t tuples = 0;
     int components = 0;
-    std::vector<double> values;       ///< floating-point arrays
-    std::vector<std::int64_t> ints;   ///< integer arrays
+    std::vector<double> values;      ///< floating-point arrays
+    std::vector<std::int64_t> ints;  ///< integer arrays
   };
   struct CellBlock {
     std::size_t count = 0;
     std::vector<std::int64_t> connectivity, offsets;
   };
-  std::string text;   ///< everything vtk_arrays.py printed (equal text: equal content)
-  bool ok = false;    ///< VTK read the file
+  std::string text;  ///< everything vtk_arrays.py printed (equal text: equal content)
+  bool ok = false;   ///< VTK read the file
   std::size_t points = 0;
   std::vector<double> xyz;
   std::map<std::string, CellBlock> cells;  ///< "verts", "polys" (.vtp) or "cells" (.vtu)
-  std::vector<std::int64_t> types;          ///< .vtu cell types
+  std::vector<std::int64_t> types;         ///< .vtu cell types
   std::map<std::string, Array> point, cell;
   std::map<std::string, std::string> active;  ///< "point Scalars" -> array name
 };
 
 inline VtkContent read_vtk(const std::filesystem::path& file) {
   VtkContent c;
-  const auto r = run_command("/usr/bin/python3 " +
-                             quote(std::string(PARTITA_SOURCE_DIR) + "/tests/support/vtk_arrays.py") +
-                             " " + quote(file.string()));
+  const auto r =
+      run_command("/usr/bin/python3 " +
+                  quote(std::string(PARTITA_SOURCE_DIR) + "/tests/support/vtk_arrays.py") + " " +
+                  quote(file.string()));
   c.text = r.output;
   c.ok = r.status == 0;
   if (!c.ok) return c;

@@ -46,7 +46,8 @@ void write_fem_vtu(const fem::StructuralSolver& solver, const std::filesystem::p
                       DataArray::view("velocity", solver.velocity().data(), n, 3),
                       DataArray::view("stress", stress.data(), n, 6),
                       DataArray::view("von_mises", von_mises.data(), n)};
-  piece.point_active = {{"Vectors", "displacement"}, {"Tensors", "stress"}, {"Scalars", "von_mises"}};
+  piece.point_active = {
+      {"Vectors", "displacement"}, {"Tensors", "stress"}, {"Scalars", "von_mises"}};
   piece.cell_data = {DataArray::view("region", region.data(), ne)};
   if (eqps.size() > 0)
     piece.cell_data.push_back(DataArray::view("equivalent_plastic_strain", eqps.data(), ne));
