@@ -1,16 +1,18 @@
 // bench_vtk: one frame of N DEM particles (default 10^6) with the arrays the DEM adapter writes
 // (points, vertex cells, radius, id, velocity, angular_velocity, force), written
 //   - the old way: main's ASCII writer before issue 16 (System::write_particles_vtp: the arrays
-//     copied into per-array vectors, 12 significant digits through an ostream; kept here verbatim
-//     in spirit as the reference, since the solver no longer writes files),
+//     copied into per-array vectors, 12 significant digits through an ostream; kept here as the
+//     reference, since the solver no longer writes files),
 //   - by interface/vtk_xml in each format (ascii: shortest round-trip text; binary: appended raw;
-//     zlib: appended, compressed blocks, levels 1 and 6),
+//     zlib: appended, compressed blocks, levels 1 and 6), the data arrays in float64 and in
+//     float32 (interface/vtk_xml.hpp, Options::precision),
 // and prints bytes and seconds (best of --repeat runs, wall and CPU) with ratios against the old
 // ASCII. Values: positions uniform in a 0.1 m box, three radii, ids 1..N, velocities, spins and
 // forces normally distributed: every mantissa bit random, as in a real frame (the compression
-// ratio depends on that; zeros would compress far better).
+// ratio depends on that); --at-rest sets velocities, spins and forces to zero (the first frame of
+// a run), which compresses far better and shortens the ASCII.
 //
-// usage: bench_vtk [--particles N] [--repeat R] [--dir DIR] [--keep]
+// usage: bench_vtk [--particles N] [--repeat R] [--dir DIR] [--keep] [--at-rest]
 
 #include <charconv>
 #include <chrono>
@@ -40,7 +42,7 @@ struct Frame {
   std::vector<std::int64_t> id;
 };
 
-Frame make_frame(std::size_t n) {
+Frame make_frame(std::size_t n, bool at_rest) {
   Frame f;
   std::mt19937_64 rng(16);
   std::uniform_real_distribution<double> box(0.0, 0.1);
@@ -48,9 +50,15 @@ Frame make_frame(std::size_t n) {
   const double radii[3] = {2.0e-3, 1.5625e-3, 1.25e-3};
   for (std::size_t i = 0; i < n; ++i) {
     f.position.emplace_back(box(rng), box(rng), box(rng));
-    f.velocity.emplace_back(v(rng), v(rng), v(rng));
-    f.angular_velocity.emplace_back(w(rng), w(rng), w(rng));
-    f.force.emplace_back(force(rng), force(rng), force(rng));
+    if (at_rest) {  // the first frame of a run: nothing moves yet
+      f.velocity.emplace_back(Eigen::Vector3d::Zero());
+      f.angular_velocity.emplace_back(Eigen::Vector3d::Zero());
+      f.force.emplace_back(Eigen::Vector3d::Zero());
+    } else {
+      f.velocity.emplace_back(v(rng), v(rng), v(rng));
+      f.angular_velocity.emplace_back(w(rng), w(rng), w(rng));
+      f.force.emplace_back(force(rng), force(rng), force(rng));
+    }
     f.radius.push_back(radii[i % 3]);
     f.id.push_back(static_cast<std::int64_t>(i + 1));
   }
@@ -174,7 +182,7 @@ int main(int argc, char** argv) {
   std::size_t n = 1000000;
   int repeat = 3;
   fs::path dir = fs::temp_directory_path() / "partita_bench_vtk";
-  bool keep = false;
+  bool keep = false, at_rest = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -192,44 +200,41 @@ int main(int argc, char** argv) {
       dir = next();
     else if (a == "--keep")
       keep = true;
+    else if (a == "--at-rest")
+      at_rest = true;
     else {
-      std::cerr << "usage: bench_vtk [--particles N] [--repeat R] [--dir DIR] [--keep]\n";
+      std::cerr << "usage: bench_vtk [--particles N] [--repeat R] [--dir DIR] [--keep] "
+                   "[--at-rest]\n";
       return 2;
     }
   }
   try {
     fs::create_directories(dir);
-    const Frame frame = make_frame(n);
-    const auto f32 = vtk::Precision::float32;
+    const Frame frame = make_frame(n, at_rest);
     struct Line {
       std::string name;
       std::function<void(const std::string&)> write;
     };
+    const auto f64 = vtk::Precision::float64, f32 = vtk::Precision::float32;
+    auto with = [&](vtk::Format f, int level, vtk::Precision p) {
+      return [&frame, f, level, p](const std::string& path) {
+        new_writer(frame, path, {f, level, 1u << 20, p});
+      };
+    };
     const std::vector<Line> lines = {
         {"old ascii (main)", [&](const std::string& p) { old_ascii(frame, p); }},
-        {"ascii", [&](const std::string& p) { new_writer(frame, p, {vtk::Format::ascii}); }},
-        {"binary", [&](const std::string& p) { new_writer(frame, p, {vtk::Format::binary}); }},
-        {"zlib (level 1)",
-         [&](const std::string& p) {
-           new_writer(frame, p, {vtk::Format::zlib, 1});
-         }},
-        {"zlib (level 6)",
-         [&](const std::string& p) {
-           new_writer(frame, p, {vtk::Format::zlib, 6});
-         }},
-        {"binary float32",
-         [&](const std::string& p) {
-           new_writer(frame, p, {vtk::Format::binary, 1, 1u << 20, f32});
-         }},
-        {"zlib float32",
-         [&](const std::string& p) {
-           new_writer(frame, p, {vtk::Format::zlib, 1, 1u << 20, f32});
-         }},
+        {"ascii float64", with(vtk::Format::ascii, 1, f64)},
+        {"binary float64", with(vtk::Format::binary, 1, f64)},
+        {"zlib-1 float64", with(vtk::Format::zlib, 1, f64)},
+        {"zlib-6 float64", with(vtk::Format::zlib, 6, f64)},
+        {"ascii float32", with(vtk::Format::ascii, 1, f32)},
+        {"binary float32", with(vtk::Format::binary, 1, f32)},
+        {"zlib-1 float32", with(vtk::Format::zlib, 1, f32)},
     };
     std::printf(
         "# one frame of %zu particles (points, verts, radius, id, velocity, "
-        "angular_velocity, force), best of %d, files in %s\n",
-        n, repeat, dir.string().c_str());
+        "angular_velocity, force%s), best of %d, files in %s\n",
+        n, at_rest ? "; at rest" : "", repeat, dir.string().c_str());
     std::printf("%-18s %14s %9s %9s %11s %11s\n", "format", "bytes", "wall [s]", "cpu [s]",
                 "smaller", "faster");
     double ref_bytes = 0.0, ref_wall = 0.0;
