@@ -3,7 +3,8 @@
 //   - the old way: main's ASCII writer before issue 16 (System::write_particles_vtp: the arrays
 //     copied into per-array vectors, 12 significant digits through an ostream; kept here as the
 //     reference, since the solver no longer writes files),
-//   - by interface/vtk_xml in each format (ascii: shortest round-trip text; binary: appended raw;
+//   - by the DEM adapter's writer (adapters::write_particles_vtp, interface/vtk_xml) in each format
+//   (ascii: shortest round-trip text; binary: appended raw;
 //     zlib: appended, compressed blocks, levels 1 and 6), the data arrays in float64 and in
 //     float32 (interface/vtk_xml.hpp, Options::precision),
 // and prints bytes and seconds (best of --repeat runs, wall and CPU) with ratios against the old
@@ -28,6 +29,8 @@
 
 #include <Eigen/Core>
 
+#include "partita/adapters/dem_output.hpp"
+#include "partita/dem/particles.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/vtk_xml.hpp"
 
@@ -36,11 +39,7 @@ using namespace partita;
 
 namespace {
 
-struct Frame {
-  std::vector<Eigen::Vector3d> position, velocity, angular_velocity, force;
-  std::vector<double> radius;
-  std::vector<std::int64_t> id;
-};
+using Frame = dem::Particles;  // the arrays the DEM adapter writes
 
 Frame make_frame(std::size_t n, bool at_rest) {
   Frame f;
@@ -141,22 +140,6 @@ void old_ascii(const Frame& p, const std::string& path) {
   fs::rename(tmp, path);
 }
 
-// ---- the new writer: the arrays of adapters/src/dem/dem_output.cpp, viewed -------------------
-vtk::DataArray xyz(std::string name, const std::vector<Eigen::Vector3d>& v) {
-  return vtk::DataArray::view(std::move(name), v.front().data(), v.size(), 3);
-}
-
-void new_writer(const Frame& p, const std::string& path, const vtk::Options& o) {
-  const std::size_t n = p.position.size();
-  vtk::PolyData piece;
-  piece.points = xyz("", p.position);
-  piece.verts = vtk::Cells::vertices(n);
-  piece.point_data = {vtk::DataArray::view("radius", p.radius.data(), n),
-                      vtk::DataArray::view("id", p.id.data(), n), xyz("velocity", p.velocity),
-                      xyz("angular_velocity", p.angular_velocity), xyz("force", p.force)};
-  vtk::write(path, piece, o);
-}
-
 struct Timing {
   double wall = 1e300, cpu = 1e300;
 };
@@ -218,7 +201,7 @@ int main(int argc, char** argv) {
     const auto f64 = vtk::Precision::float64, f32 = vtk::Precision::float32;
     auto with = [&](vtk::Format f, int level, vtk::Precision p) {
       return [&frame, f, level, p](const std::string& path) {
-        new_writer(frame, path, {f, level, 1u << 20, p});
+        adapters::write_particles_vtp(frame, path, {f, level, 1u << 20, p});
       };
     };
     const std::vector<Line> lines = {

@@ -141,20 +141,7 @@ TEST_CASE("fem adapter: the .vtu carries the equivalent plastic strain of J2 pla
 TEST_CASE("dem adapter: particle and mesh files in every format, forces summing to the monitors",
           "[adapters][dem][output]") {
   const fs::path dir = scratch("dem");
-  auto s = test::make_dem(
-      "solver: dem\n"
-      "materials: {glass: {youngs_modulus: 200 MPa, poisson_ratio: 0.23, density: 400},\n"
-      "            steel: {youngs_modulus: 250 GPa, poisson_ratio: 0.3, density: 7850}}\n"
-      "interactions: [{pair: [glass, glass]}, {pair: [glass, steel], friction: 0.1}]\n"
-      "particles: {material: glass, generate: {box: {origin: [0, 0, 0], size: [0.01, 0.01, "
-      "0.01]},\n"
-      "            diameters: [2.5 mm, 2.0 mm], porosity: 0.55, seed: 3}}\n"
-      "walls: [{box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.02]}, open: [zmax], material: "
-      "steel}]\n"
-      "meshes: [{name: plate, rectangle: {origin: [0, 0, 0.0102], size: [0.01, 0.01], cells: [4, "
-      "4]}, material: steel}]\n"
-      "gravity: [0, 0, -9.81]\n",
-      dir);
+  auto s = test::make_dem(test::small_bed_yaml("gravity: [0, 0, -9.81]\n"), dir);
   // press the plate 3 mm into the bed: contact forces on the mesh
   const auto& plate = s->meshes().front();
   REQUIRE(plate.mesh.name() == "plate");

@@ -15,7 +15,11 @@ vtk::DataArray xyz(std::string name, const std::vector<Eigen::Vector3d>& v) {
 
 void write_particles_vtp(const dem::System& system, const std::filesystem::path& path,
                          const vtk::Options& options) {
-  const dem::Particles& p = system.particles();
+  write_particles_vtp(system.particles(), path, options);
+}
+
+void write_particles_vtp(const dem::Particles& p, const std::filesystem::path& path,
+                         const vtk::Options& options) {
   const std::size_t n = p.size();
   vtk::PolyData piece;
   piece.points = xyz("", p.position);
