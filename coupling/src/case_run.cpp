@@ -148,10 +148,11 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
       "restart files (a run stopped by SIGINT/SIGTERM writes one whether declared or not)",
       restart);
   auto vtk_spec = std::make_shared<Spec>("vtk", "encoding of the VTK XML files (.vtu, .vtp)");
-  vtk_spec->choice("format",
-              "zlib: appended binary, zlib-compressed (VTK's own default; the smallest files), "
-              "binary: appended raw (the fastest to write), ascii: text (to read by eye)",
-              vtk::format_names())
+  vtk_spec
+      ->choice("format",
+               "zlib: appended binary, zlib-compressed (VTK's own default; the smallest files), "
+               "binary: appended raw (the fastest to write), ascii: text (to read by eye)",
+               vtk::format_names())
       .def("zlib");
   vtk_spec
       ->choice("precision",

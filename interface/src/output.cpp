@@ -1,6 +1,5 @@
 #include "partita/interface/output.hpp"
 
-#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -159,16 +158,17 @@ void write_vtp(const std::filesystem::path& path, const Mesh& mesh, const VtkArr
   vtk::PolyData piece;
   piece.points = vtk::DataArray::rows("Points", P, true);
   if (tris) {
-    std::vector<std::int32_t> conn(3 * static_cast<std::size_t>(mesh.num_triangles()));
-    for (Eigen::Index c = 0, k = 0; c < mesh.num_triangles(); ++c)
-      for (int j = 0; j < 3; ++j) conn[static_cast<std::size_t>(k++)] = mesh.triangles()(c, j);
+    const auto nt = static_cast<std::size_t>(mesh.num_triangles());
+    std::vector<std::int32_t> conn(3 * nt);
+    for (std::size_t c = 0, k = 0; c < nt; ++c)
+      for (int j = 0; j < 3; ++j) conn[k++] = mesh.triangles()(static_cast<Eigen::Index>(c), j);
     piece.polys = {vtk::DataArray::own("connectivity", std::move(conn)),
-                   vtk::DataArray::sequence("offsets", static_cast<std::size_t>(mesh.num_triangles()),
-                                            3, 3)};
+                   vtk::DataArray::sequence("offsets", nt, 3, 3)};
   } else {
     piece.verts = vtk::Cells::vertices(np);
   }
-  for (const auto& [n, a] : point_data) piece.point_data.push_back(vtk::DataArray::rows(n, a, true));
+  for (const auto& [n, a] : point_data)
+    piece.point_data.push_back(vtk::DataArray::rows(n, a, true));
   for (const auto& [n, a] : cell_data) piece.cell_data.push_back(vtk::DataArray::rows(n, a, true));
   vtk::write(path, piece, options);
 }
