@@ -6,22 +6,32 @@ plate's deformed lower face, as a fraction of the largest deflection.
 
 Usage: plot_plate.py OUTPUT_DIR [FE_PARTICIPANT] [DEM_PARTICIPANT] [MESH]
        (defaults: plate granules plate) -> OUTPUT_DIR/plate.png
-Reads OUTPUT_DIR/vtk/<FE>_fem_NNNNNN.vtu and <DEM>_<MESH>_NNNNNN.vtp (ASCII VTK XML)."""
+Reads OUTPUT_DIR/vtk/<FE>_fem_NNNNNN.vtu and <DEM>_<MESH>_NNNNNN.vtp (VTK XML, any encoding,
+read with VTK's own reader)."""
 import glob
 import os
 import sys
-import xml.etree.ElementTree as ET
 
 
 def arrays(path):
-    """name -> (components, flat list of floats) for every DataArray of a VTK XML file."""
-    out = {}
-    for piece in ET.parse(path).getroot().iter("Piece"):
-        for section in piece:
-            for a in section.iter("DataArray"):
-                name = a.get("Name") or section.tag
-                if a.get("type", "").startswith(("Float", "Int", "UInt")):
-                    out[name] = (int(a.get("NumberOfComponents", "1")), [float(v) for v in a.text.split()])
+    """name -> (components, flat list of floats): the points ("Points") and every point and cell
+    data array of a VTK XML file in any encoding (zlib, binary or ascii), read with VTK's own
+    reader (python3-vtk9); a cell array replaces a point array of the same name."""
+    import vtk
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    vtu = path.endswith(".vtu")
+    reader = vtk.vtkXMLUnstructuredGridReader() if vtu else vtk.vtkXMLPolyDataReader()
+    reader.SetFileName(path)
+    reader.Update()
+    data = reader.GetOutput()
+    points = data.GetPoints()
+    xyz = [] if points is None else vtk_to_numpy(points.GetData()).ravel().tolist()
+    out = {"Points": (3, xyz)}
+    for attributes in (data.GetPointData(), data.GetCellData()):
+        for k in range(attributes.GetNumberOfArrays()):
+            a = attributes.GetArray(k)
+            out[a.GetName()] = (a.GetNumberOfComponents(), vtk_to_numpy(a).ravel().tolist())
     return out
 
 
