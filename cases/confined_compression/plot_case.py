@@ -31,6 +31,9 @@ import matplotlib.ticker  # noqa: E402
 from matplotlib.collections import PatchCollection  # noqa: E402
 from matplotlib.patches import Circle, Rectangle  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from vtk_file import arrays  # noqa: E402  (cases/vtk_file.py: VTK's reader, any encoding)
+
 
 def read_csv(path):
     """column name (without the unit) -> values"""
@@ -39,28 +42,6 @@ def read_csv(path):
         head = [h.split(" [")[0] for h in next(r)]
         rows = [row for row in r if row]
     return {h: [float(row[k]) for row in rows] for k, h in enumerate(head)}
-
-
-def arrays(path):
-    """name -> (components, flat list of floats): the points ("Points") and every point and cell
-    data array of a VTK XML file in any encoding (zlib, binary or ascii), read with VTK's own
-    reader (python3-vtk9); a cell array replaces a point array of the same name."""
-    import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
-
-    vtu = path.endswith(".vtu")
-    reader = vtk.vtkXMLUnstructuredGridReader() if vtu else vtk.vtkXMLPolyDataReader()
-    reader.SetFileName(path)
-    reader.Update()
-    data = reader.GetOutput()
-    points = data.GetPoints()
-    xyz = [] if points is None else vtk_to_numpy(points.GetData()).ravel().tolist()
-    out = {"Points": (3, xyz)}
-    for attributes in (data.GetPointData(), data.GetCellData()):
-        for k in range(attributes.GetNumberOfArrays()):
-            a = attributes.GetArray(k)
-            out[a.GetName()] = (a.GetNumberOfComponents(), vtk_to_numpy(a).ravel().tolist())
-    return out
 
 
 def points(path):
