@@ -3,14 +3,25 @@
 // deterministically from a seed.
 //
 // Method: the number of spheres of each size follows from the box volume, the porosity and the
-// number (or mass) fractions; the spheres are placed uniformly at random inside the box (shuffled
-// sizes, own 64-bit generator, so the result depends on the seed only), then overlaps are removed
-// by Jacobi relaxation: every overlapping pair is pushed apart along its normal (each sphere by a
-// share inversely proportional to its volume) and spheres are kept inside the box, until the
-// largest overlap is below max_overlap * R_min. Porosities above random loose packing (~0.4) are
-// reachable; 0.5 takes a few hundred sweeps. The spheres come out in cell order (by z, then y,
-// then x, cells 2 R_max wide), so that neighbours have nearby indices (the solver's cache and
-// thread parts depend on it).
+// number (or mass) fractions; the sizes are shuffled (own 64-bit generator, so the result depends
+// on the seed only, not on the platform or the thread count). Then two phases:
+// 1. Random sequential addition at shrunken radii (s^3 = 0.2 / solid fraction): the box is cut
+//    into cells of 2 R_max + skin, each cell receives its share of the sizes (proportional to the
+//    volume its centres can reach), and each sphere, largest first, takes the first of up to 1000
+//    uniform positions in its cell that overlaps no sphere placed before it at the shrunken radii.
+//    Cells are filled in eight passes by the parity of their indices (so that no side of a cell
+//    is favoured), each pass in cell order (so that the neighbours read stay in cache).
+// 2. Jacobi relaxation of the remaining overlaps (at most (1 - s) of a radii sum): each
+//    overlapping pair is pushed apart along its normal, each sphere by the share V_j / (V_i + V_j)
+//    of the overlap plus a small margin, all at once, spheres kept inside the box, until the
+//    largest overlap is below max_overlap * R_min. Pairs come from a neighbour list with a skin
+//    of 2 R_min; a sweep evaluates only the spheres that overlapped in the last sweep and their
+//    neighbours (the others cannot have changed), so the last sweeps, which untangle a few caged
+//    spheres, cost little.
+// Porosities above about 0.4 are reachable. Measured (bench_packing, porosity 0.5, three sizes):
+// 10^5 spheres in about 0.9 s, 10^6 in about 10 s on one core; time grows about linearly with N.
+// The spheres come out in cell order (by z, then y, then x), so that neighbours have nearby
+// indices (the solver's cache and thread parts depend on it).
 
 #include <cstdint>
 #include <functional>
