@@ -15,11 +15,13 @@
 // LIGGGHTS-style damping, mu = 0.3, Mindlin tangential history, walls x = 0, W, y = 0, W, z = 0
 // of the same material, g = 9.81 m/s^2, dt = 1.9e-6 s, skin 0.5 mm.
 
+#include "partita/adapters/dem_output.hpp"
 #include "partita/dem/breakage.hpp"
 #include "partita/dem/error.hpp"
 #include "partita/dem/lammps_data.hpp"
 #include "partita/dem/parallel.hpp"
 #include "partita/dem/system.hpp"
+#include "partita/interface/error.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -240,12 +242,15 @@ int main(int argc, char** argv) {
           std::fflush(stdout);
           if (!vtk_dir.empty() && with_breakage == 0) {
             std::filesystem::create_directories(vtk_dir);
-            sys.write_particles_vtp(vtk_dir + "/bed_" + c.name + ".vtp");
+            partita::adapters::write_particles_vtp(sys, vtk_dir + "/bed_" + c.name + ".vtp", {});
           }
         }
       }
     }
   } catch (const Error& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
+  } catch (const partita::Error& e) {  // writing the --vtk file
     std::cerr << e.what() << "\n";
     return 1;
   }

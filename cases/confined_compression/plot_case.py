@@ -22,7 +22,6 @@ import csv
 import glob
 import os
 import sys
-import xml.etree.ElementTree as ET
 
 import matplotlib
 
@@ -32,6 +31,9 @@ import matplotlib.ticker  # noqa: E402
 from matplotlib.collections import PatchCollection  # noqa: E402
 from matplotlib.patches import Circle, Rectangle  # noqa: E402
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from vtk_file import arrays  # noqa: E402  (cases/vtk_file.py: VTK's reader, any encoding)
+
 
 def read_csv(path):
     """column name (without the unit) -> values"""
@@ -40,17 +42,6 @@ def read_csv(path):
         head = [h.split(" [")[0] for h in next(r)]
         rows = [row for row in r if row]
     return {h: [float(row[k]) for row in rows] for k, h in enumerate(head)}
-
-
-def arrays(path):
-    """name -> (components, flat list of floats) for the DataArrays of an ASCII VTK XML file."""
-    out = {}
-    for piece in ET.parse(path).getroot().iter("Piece"):
-        for section in piece:
-            for a in section.iter("DataArray"):
-                name = a.get("Name") or section.tag
-                out[name] = (int(a.get("NumberOfComponents", "1")), [float(v) for v in a.text.split()])
-    return out
 
 
 def points(path):

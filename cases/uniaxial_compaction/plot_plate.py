@@ -6,23 +6,14 @@ plate's deformed lower face, as a fraction of the largest deflection.
 
 Usage: plot_plate.py OUTPUT_DIR [FE_PARTICIPANT] [DEM_PARTICIPANT] [MESH]
        (defaults: plate granules plate) -> OUTPUT_DIR/plate.png
-Reads OUTPUT_DIR/vtk/<FE>_fem_NNNNNN.vtu and <DEM>_<MESH>_NNNNNN.vtp (ASCII VTK XML)."""
+Reads OUTPUT_DIR/vtk/<FE>_fem_NNNNNN.vtu and <DEM>_<MESH>_NNNNNN.vtp (VTK XML, any encoding,
+read with VTK's own reader)."""
 import glob
 import os
 import sys
-import xml.etree.ElementTree as ET
 
-
-def arrays(path):
-    """name -> (components, flat list of floats) for every DataArray of a VTK XML file."""
-    out = {}
-    for piece in ET.parse(path).getroot().iter("Piece"):
-        for section in piece:
-            for a in section.iter("DataArray"):
-                name = a.get("Name") or section.tag
-                if a.get("type", "").startswith(("Float", "Int", "UInt")):
-                    out[name] = (int(a.get("NumberOfComponents", "1")), [float(v) for v in a.text.split()])
-    return out
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from vtk_file import arrays  # noqa: E402  (cases/vtk_file.py: VTK's reader, any encoding)
 
 
 def rows(arr):

@@ -147,6 +147,25 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
       "restart",
       "restart files (a run stopped by SIGINT/SIGTERM writes one whether declared or not)",
       restart);
+  auto vtk_spec = std::make_shared<Spec>("vtk", "encoding of the VTK XML files (.vtu, .vtp)");
+  vtk_spec
+      ->choice("format",
+               "zlib: appended binary, zlib-compressed (VTK's own default; the smallest files), "
+               "binary: appended raw (the fastest to write), ascii: text (to read by eye)",
+               vtk::format_names())
+      .def("zlib");
+  vtk_spec
+      ->choice("precision",
+               "of the solvers' point and cell fields (displacement, stress, velocity, force, "
+               "...): float32 (7 significant digits, files 1.5x smaller) or float64 (the "
+               "solver's values exactly); coordinates and ids are always written exactly",
+               {"float32", "float64"})
+      .def("float32");
+  vtk_spec->integer("zlib_level", "zlib compression level: 1 fastest .. 9 smallest")
+      .min(1)
+      .max(9)
+      .def(1);
+  output->section("vtk", "VTK file format (every participant's files)", vtk_spec);
   output->strings("scripts",
                   "post-processing scripts of the case folder, run by `partita run` after the last "
                   "window with the output folder as argument (e.g. plots of the final state)");
@@ -271,6 +290,12 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     if (r.has("every_minutes")) restart_every_seconds_ = 60.0 * r.real("every_minutes");
     restart_keep_ = static_cast<int>(r.integer("keep"));
     restart_at_end_ = r.boolean("at_end");
+  }
+  if (root.has("output") && root["output"].has("vtk")) {
+    const config::Node v = root["output"]["vtk"];
+    vtk_options_.format = vtk::parse_format(v.string("format"));
+    vtk_options_.zlib_level = static_cast<int>(v.integer("zlib_level"));
+    vtk_options_.precision = vtk::parse_precision(v.string("precision"));
   }
   if (root.has("output") && root["output"].has("scripts"))
     for (const config::Node& sn : root["output"]["scripts"].items()) {
@@ -626,7 +651,7 @@ void CaseRun::write_output(int frame, double time) {
   Stopwatch clock;
   const fs::path vtk = output_dir_ / "vtk";
   for (auto& p : participants_) {
-    OutputFrame f{vtk, p->name(), frame, time};
+    OutputFrame f{vtk, p->name(), frame, time, vtk_options_};
     p->solver().write_output(f);  // counted as output time, not the participant's
     for (const auto& [series, file] : p->solver().output_files()) {
       if (fs::path(file).has_parent_path() || file.empty() || file.front() == '.')
@@ -648,7 +673,7 @@ void CaseRun::write_output(int frame, double time) {
       if (arrays.empty() || im.mesh.size() > 200000) continue;
       const std::string file =
           fmt::format("{}_interface_{}_{:06d}.vtp", p->name(), im.mesh.name(), frame);
-      write_vtp(vtk / file, im.mesh, arrays);
+      write_vtp(vtk / file, im.mesh, arrays, {}, nullptr, vtk_options_);
       pvd(p->name() + "_interface_" + im.mesh.name()).add(time, file);
     }
   }

@@ -1,7 +1,5 @@
 #include "partita/interface/output.hpp"
 
-#include <charconv>
-#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -151,67 +149,28 @@ int remove_pvd_series(const std::filesystem::path& dir) {
 }
 
 // ---------------------------------------------------------------------------------------------
-namespace {
-// A double as text with `digits` significant digits (std::to_chars: several times faster than
-// an ostream's formatting, which dominated the output time).
-void put_number(std::ostream& out, double v, int digits) {
-  char buf[40];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, digits);
-  out.write(buf, r.ptr - buf);
-}
-
-void write_array(std::ostream& out, const std::string& name, const Eigen::MatrixXd& a) {
-  out << "        <DataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\""
-      << a.cols() << "\" format=\"ascii\">\n          ";
-  for (Eigen::Index i = 0; i < a.rows(); ++i)
-    for (Eigen::Index k = 0; k < a.cols(); ++k) {
-      put_number(out, std::isfinite(a(i, k)) ? a(i, k) : 0.0, 10);
-      out << ' ';
-    }
-  out << "\n        </DataArray>\n";
-}
-}  // namespace
-
 void write_vtp(const std::filesystem::path& path, const Mesh& mesh, const VtkArrays& point_data,
-               const VtkArrays& cell_data, const Mesh::Points* points) {
+               const VtkArrays& cell_data, const Mesh::Points* points,
+               const vtk::Options& options) {
   const Mesh::Points& P = (points && points->rows() > 0) ? *points : mesh.points();
-  const Eigen::Index np = P.rows();
+  const auto np = static_cast<std::size_t>(P.rows());
   const bool tris = mesh.has_triangles();
-  const Eigen::Index nc = tris ? mesh.num_triangles() : np;
+  vtk::PolyData piece;
+  piece.points = vtk::DataArray::rows("Points", P, true);
+  if (tris) {
+    const auto nt = static_cast<std::size_t>(mesh.num_triangles());
+    std::vector<std::int32_t> conn(3 * nt);
+    for (std::size_t c = 0, k = 0; c < nt; ++c)
+      for (int j = 0; j < 3; ++j) conn[k++] = mesh.triangles()(static_cast<Eigen::Index>(c), j);
+    piece.polys = {vtk::DataArray::own("connectivity", std::move(conn)),
+                   vtk::DataArray::sequence("offsets", nt, 3, 3)};
+  } else {
+    piece.verts = vtk::Cells::vertices(np);
+  }
   for (const auto& [n, a] : point_data)
-    if (a.rows() != np)
-      throw Error("VTK output '" + path.string() + "': point array '" + n + "' has wrong length");
-  for (const auto& [n, a] : cell_data)
-    if (a.rows() != nc)
-      throw Error("VTK output '" + path.string() + "': cell array '" + n + "' has wrong length");
-  AtomicFile f(path);
-  auto& out = f.stream();
-  out << std::setprecision(10);
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" "
-         "byte_order=\"LittleEndian\">\n"
-      << "  <PolyData>\n    <Piece NumberOfPoints=\"" << np << "\" NumberOfVerts=\""
-      << (tris ? 0 : np) << "\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\""
-      << (tris ? nc : 0) << "\">\n";
-  out << "      <Points>\n";
-  write_array(out, "Points", P);
-  out << "      </Points>\n";
-  out << "      <PointData>\n";
-  for (const auto& [n, a] : point_data) write_array(out, n, a);
-  out << "      </PointData>\n      <CellData>\n";
-  for (const auto& [n, a] : cell_data) write_array(out, n, a);
-  out << "      </CellData>\n";
-  const char* kind = tris ? "Polys" : "Verts";
-  const int per = tris ? 3 : 1;
-  out << "      <" << kind
-      << ">\n        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n          ";
-  for (Eigen::Index c = 0; c < nc; ++c)
-    for (int k = 0; k < per; ++k) out << (tris ? mesh.triangles()(c, k) : c) << ' ';
-  out << "\n        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" "
-         "format=\"ascii\">\n          ";
-  for (Eigen::Index c = 0; c < nc; ++c) out << (c + 1) * per << ' ';
-  out << "\n        </DataArray>\n      </" << kind
-      << ">\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
-  f.commit();
+    piece.point_data.push_back(vtk::DataArray::rows(n, a, true));
+  for (const auto& [n, a] : cell_data) piece.cell_data.push_back(vtk::DataArray::rows(n, a, true));
+  vtk::write(path, piece, options);
 }
 
 }  // namespace partita

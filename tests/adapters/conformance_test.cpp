@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 
+#include "dem_adapter_support.hpp"
 #include "partita/adapters/register_all.hpp"
 #include "partita/coupling/registries.hpp"
 
@@ -30,18 +31,7 @@ const std::map<std::string, std::string>& samples() {
        "constraints: [{set: all, fix: [x, y]}]\n"
        "loads: [{face: zmax, pressure: 10 kPa}, {gravity: [0, 0, -9.81]}]\n"
        "interfaces: [{name: bottom, face: zmin}]\n"},
-      {"dem",
-       "solver: dem\n"
-       "materials: {glass: {youngs_modulus: 200 MPa, poisson_ratio: 0.23, density: 400},\n"
-       "            steel: {youngs_modulus: 250 GPa, poisson_ratio: 0.3, density: 7850}}\n"
-       "interactions: [{pair: [glass, glass]}, {pair: [glass, steel], friction: 0.1}]\n"
-       "particles: {material: glass, generate: {box: {origin: [0, 0, 0], size: [0.01, 0.01, "
-       "0.01]},\n"
-       "            diameters: [2.5 mm, 2.0 mm], porosity: 0.55, seed: 3}}\n"
-       "walls: [{box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.02]}, open: [zmax], material: "
-       "steel}]\n"
-       "meshes: [{name: plate, rectangle: {origin: [0, 0, 0.0102], size: [0.01, 0.01], cells: [4, "
-       "4]}, material: steel}]\n"},
+      {"dem", test::small_bed_yaml()},
   };
   return s;
 }
@@ -163,7 +153,7 @@ TEST_CASE("every registered adapter honours the Solver contract", "[adapters][co
       CHECK(s->check_state().empty());
 
       // output and monitors
-      s->write_output(OutputFrame{out / "vtk", "p_" + entry.name, 1, s->time()});
+      s->write_output(OutputFrame{out / "vtk", "p_" + entry.name, 1, s->time(), {}});
       for (const auto& [series, file] : s->output_files()) {
         INFO("output file " << file);
         CHECK(fs::exists(out / "vtk" / file));

@@ -16,20 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string dem_yaml(const std::string& breakage) {
-  return "solver: dem\n"
-         "materials: {glass: {youngs_modulus: 200 MPa, poisson_ratio: 0.23, density: 400},\n"
-         "            steel: {youngs_modulus: 250 GPa, poisson_ratio: 0.3, density: 7850}}\n"
-         "interactions: [{pair: [glass, glass]}, {pair: [glass, steel], friction: 0.1}]\n"
-         "particles: {material: glass, generate: {box: {origin: [0, 0, 0], size: [0.01, 0.01, "
-         "0.01]},\n"
-         "            diameters: [2.5 mm, 2.0 mm], porosity: 0.55, seed: 3}}\n"
-         "walls: [{box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.02]}, open: [zmax], material: "
-         "steel}]\n"
-         "meshes: [{name: plate, rectangle: {origin: [0, 0, 0.0102], size: [0.01, 0.01], cells: "
-         "[4, 4]}, material: steel}]\n" +
-         breakage;
-}
+std::string dem_yaml(const std::string& breakage) { return test::small_bed_yaml(breakage); }
 
 }  // namespace
 
@@ -71,7 +58,7 @@ TEST_CASE("dem adapter: fragments lower the stable step, monitors and the gradin
   auto s = test::make_dem(dem_yaml("breakage: {limit_strength: 0.2 MPa, reference_size: 2 mm, "
                          "weibull_modulus: 3, comminution_limit: 0.5 mm, pattern: equal-4}\n"),
                 out);
-  s->write_output(OutputFrame{out / "vtk", "p", 0, s->time()});
+  s->write_output(OutputFrame{out / "vtk", "p", 0, s->time(), {}});
   const double dt0 = s->stable_time_step();
   const double n0 = monitor(*s, "particles");
   int steps = 0;
@@ -94,7 +81,7 @@ TEST_CASE("dem adapter: fragments lower the stable step, monitors and the gradin
   const double t0 = s->time();
   CHECK_NOTHROW(s->advance(dt0));
   CHECK(s->time() == Approx(t0 + dt0).epsilon(1e-12));
-  s->write_output(OutputFrame{out / "vtk", "p", 1, s->time()});
+  s->write_output(OutputFrame{out / "vtk", "p", 1, s->time(), {}});
   std::ifstream csv(out / "p_grading.csv");
   std::stringstream text;
   text << csv.rdbuf();

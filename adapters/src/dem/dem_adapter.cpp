@@ -9,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "partita/adapters/dem_output.hpp"
 #include "partita/dem/breakage.hpp"
 #include "partita/dem/error.hpp"
 #include "partita/dem/grading.hpp"
@@ -636,11 +637,11 @@ void DemAdapter::restore_checkpoint() {
 void DemAdapter::write_output(const OutputFrame& frame) {
   files_.clear();
   const std::string pfile = fmt::format("{}_particles_{:06d}.vtp", frame.prefix, frame.index);
-  system_.write_particles_vtp((frame.vtk_directory / pfile).string());
+  write_particles_vtp(system_, frame.vtk_directory / pfile, frame.vtk);
   files_.emplace_back("particles", pfile);
   for (const auto& m : meshes_dem_) {
     const std::string mfile = fmt::format("{}_{}_{:06d}.vtp", frame.prefix, m.name, frame.index);
-    system_.write_mesh_vtp(m.id, (frame.vtk_directory / mfile).string());
+    write_mesh_vtp(system_, m.id, frame.vtk_directory / mfile, frame.vtk);
     files_.emplace_back(m.name, mfile);
   }
   if (breakage_ >= 0) write_grading(frame);

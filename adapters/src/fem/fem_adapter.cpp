@@ -8,6 +8,7 @@
 #include "partita/fem/error.hpp"
 #include "partita/fem/state_io.hpp"
 
+#include "fem_output.hpp"
 #include "line_probe.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -704,7 +705,7 @@ void FemAdapter::read_restart(BinaryReader& in) {
 
 void FemAdapter::write_output(const OutputFrame& frame) {
   const std::string file = fmt::format("{}_fem_{:06d}.vtu", frame.prefix, frame.index);
-  fem::write_vtu((frame.vtk_directory / file).string(), *solver_);
+  write_fem_vtu(*solver_, frame.vtk_directory / file, frame.vtk);
   files_ = {{"fem", file}};
   for (const auto& p : probes_)
     write_file_atomically(frame.vtk_directory.parent_path() / "probes" /

@@ -50,7 +50,8 @@ void TubeFluidAdapter::write_output(const OutputFrame& frame) {
   write_vtp(frame.vtk_directory / file, meshes_.front().mesh,
             {{"velocity", flow_.velocity()},
              {"pressure", flow_.pressure()},
-             {"cross_section_area", flow_.area()}});
+             {"cross_section_area", flow_.area()}},
+            {}, nullptr, frame.vtk);
   files_ = {{"tube", file}};
 }
 

@@ -41,7 +41,8 @@ void TubeSolidAdapter::write_output(const OutputFrame& frame) {
   const Eigen::VectorXd radius = (wall_.area().array() / std::numbers::pi).sqrt();
   write_vtp(
       frame.vtk_directory / file, meshes_.front().mesh,
-      {{"cross_section_area", wall_.area()}, {"radius", radius}, {"pressure", wall_.pressure()}});
+      {{"cross_section_area", wall_.area()}, {"radius", radius}, {"pressure", wall_.pressure()}},
+      {}, nullptr, frame.vtk);
   files_ = {{"wall", file}};
 }
 

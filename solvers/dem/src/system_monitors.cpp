@@ -1,8 +1,7 @@
-// System: monitors (energies, forces, contact counts) and VTK output.
+// System: monitors (energies, forces, contact counts).
 #include "partita/dem/system.hpp"
 
 #include "partita/dem/error.hpp"
-#include "partita/dem/vtk_writer.hpp"
 
 #include <sstream>
 
@@ -110,48 +109,6 @@ std::size_t System::contact_count() const {
 
 double System::mean_contacts_per_particle() const {
   return store_.size() == 0 ? 0.0 : 2.0 * contact_count() / store_.size();
-}
-
-// ---- output -----------------------------------------------------------------------------------
-
-void System::write_particles_vtp(const std::string& path) const {
-  sync_particles();
-  const Particles& p = store_.core();
-  const std::size_t n = p.size();
-  std::vector<VtkArray> data(5);
-  data[0] = {"radius", 1, false, std::vector<double>(p.radius)};
-  data[1] = {"id", 1, true, {}};
-  data[2] = {"velocity", 3, false, {}};
-  data[3] = {"angular_velocity", 3, false, {}};
-  data[4] = {"force", 3, false, {}};
-  for (std::size_t i = 0; i < n; ++i) {
-    data[1].values.push_back(static_cast<double>(p.id[i]));
-    for (int k = 0; k < 3; ++k) {
-      data[2].values.push_back(p.velocity[i][k]);
-      data[3].values.push_back(p.angular_velocity[i][k]);
-      data[4].values.push_back(p.force[i][k]);
-    }
-  }
-  VtkWriter::write_points(path, p.position, data);
-}
-
-void System::write_mesh_vtp(int mesh, const std::string& path) const {
-  check_mesh(mesh, "write_mesh_vtp");
-  const TriangleMesh& m = meshes_[mesh];
-  std::vector<std::array<int, 3>> tris(m.triangle_count());
-  for (int t = 0; t < m.triangle_count(); ++t) tris[t] = m.triangle(t);
-  std::vector<VtkArray> point_data(2), cell_data(1);
-  point_data[0] = {"velocity", 3, false, {}};
-  point_data[1] = {"force", 3, false, {}};
-  cell_data[0] = {"force", 3, false, {}};
-  for (int v = 0; v < m.vertex_count(); ++v)
-    for (int k = 0; k < 3; ++k) {
-      point_data[0].values.push_back(m.velocities()[v][k]);
-      point_data[1].values.push_back(m.vertex_forces()(v, k));
-    }
-  for (int tt = 0; tt < m.triangle_count(); ++tt)
-    for (int k = 0; k < 3; ++k) cell_data[0].values.push_back(m.triangle_forces()(tt, k));
-  VtkWriter::write_triangles(path, m.positions(), tris, point_data, cell_data);
 }
 
 }  // namespace partita::dem

@@ -158,33 +158,6 @@ TEST_CASE("dem: reads the peer bed file", "[dem][io]") {
   CHECK(d.box_hi.x() == Approx(0.021));
 }
 
-TEST_CASE("dem: VTK output is complete and written atomically", "[dem][io]") {
-  System sys = falling_bed(6e-3, 0.6, 5);
-  sys.run(10, 0.1 * sys.rayleigh_time_step());
-  const auto dir = std::filesystem::path(PARTITA_BINARY_DIR) / "test_output" / "dem";
-  std::filesystem::create_directories(dir);
-  const auto particles = dir / "particles.vtp";
-  const auto mesh = dir / "mesh.vtp";
-  sys.write_particles_vtp(particles.string());
-  sys.write_mesh_vtp(0, mesh.string());
-  CHECK(!std::filesystem::exists(particles.string() + ".tmp"));
-  std::ifstream in(particles);
-  std::stringstream text;
-  text << in.rdbuf();
-  const std::string s = text.str();
-  CHECK(s.find("NumberOfPoints=\"" + std::to_string(sys.particle_count()) + "\"") !=
-        std::string::npos);
-  for (const char* name : {"radius", "velocity", "angular_velocity", "force", "\"id\""})
-    CHECK(s.find(name) != std::string::npos);
-  CHECK(s.find("</VTKFile>") != std::string::npos);
-  std::ifstream in2(mesh);
-  std::stringstream text2;
-  text2 << in2.rdbuf();
-  CHECK(text2.str().find("NumberOfPolys=\"4\"") != std::string::npos);
-  CHECK(text2.str().find("CellData") != std::string::npos);
-  CHECK_THROWS_AS(sys.write_particles_vtp("/nonexistent/dir/p.vtp"), Error);
-}
-
 TEST_CASE("dem: changes made between steps take effect and are seen at once", "[dem][state]") {
   // The moving state lives in the solver's packed arrays while stepping; particles() must show
   // it after every step, and set_particle_velocity()/add_particle() between steps must be used.

@@ -12,7 +12,6 @@
 #include "partita/fem/j2_plasticity_law.hpp"
 #include "partita/fem/nonlinear_operator.hpp"
 #include "partita/fem/structural_solver.hpp"
-#include "partita/fem/vtu_writer.hpp"
 
 using namespace partita::fem;
 
@@ -195,7 +194,7 @@ TEST_CASE("j2 energy balance: external work = elastic energy + plastic work, loa
   CHECK(std::abs(s.energy_balance()) <= 1e-10 * wp);
 }
 
-TEST_CASE("j2 output: the vtu file carries the element equivalent plastic strain",
+TEST_CASE("j2 output: the element equivalent plastic strain of a uniaxial test",
           "[fem][nonlinear][j2][output]") {
   const double h = kE / 10.0;
   const double eps_y = kSy / kE;
@@ -208,11 +207,6 @@ TEST_CASE("j2 output: the vtu file carries the element equivalent plastic strain
   ref.stress(3.0 * eps_y);
   REQUIRE(s.element_equivalent_plastic_strain().size() == 1);
   CHECK(s.element_equivalent_plastic_strain()[0] == Approx(ref.alpha).epsilon(1e-9));
-  const auto path = (std::filesystem::temp_directory_path() / "partita_fem_j2.vtu").string();
-  write_vtu(path, s);
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  CHECK(text.str().find("Name=\"equivalent_plastic_strain\"") != std::string::npos);
-  std::filesystem::remove(path);
+  // (the FEM adapter writes it as the cell array equivalent_plastic_strain of the .vtu:
+  // tests/adapters/output_test.cpp)
 }

@@ -141,6 +141,7 @@ class CaseRun {
   double window_size_ = 0.0;
   std::int64_t window_count_ = 0;
   double output_every_ = 0.0;                               // 0: first and last frame only
+  vtk::Options vtk_options_;                                // output.vtk
   std::vector<std::unique_ptr<Participant>> participants_;  // in scheme order
   std::vector<std::unique_ptr<Exchange>> exchanges_;
   std::unique_ptr<CouplingScheme> scheme_;

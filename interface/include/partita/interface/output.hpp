@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "partita/interface/mesh.hpp"
+#include "partita/interface/vtk_xml.hpp"
 
 namespace partita {
 
@@ -92,9 +93,11 @@ int remove_pvd_series(const std::filesystem::path& dir);
 /// Named point or cell arrays for VTK output (N x C each).
 using VtkArrays = std::vector<std::pair<std::string, Eigen::MatrixXd>>;
 
-/// Write a mesh (points + triangles, or points only as vertices) as VTK XML PolyData (.vtp),
-/// ASCII, atomically. `points` overrides the mesh's coordinates (e.g. deformed) when non-empty.
+/// Write a mesh (points + triangles, or points only as vertices) as VTK XML PolyData (.vtp) in
+/// the given format (vtk_xml.hpp), atomically. `points` overrides the mesh's coordinates (e.g.
+/// deformed) when non-empty. Non-finite values are written as 0 (data not exchanged yet).
 void write_vtp(const std::filesystem::path& path, const Mesh& mesh, const VtkArrays& point_data,
-               const VtkArrays& cell_data = {}, const Mesh::Points* points = nullptr);
+               const VtkArrays& cell_data = {}, const Mesh::Points* points = nullptr,
+               const vtk::Options& options = {});
 
 }  // namespace partita

@@ -42,6 +42,7 @@
 #include "partita/interface/config.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/mesh.hpp"
+#include "partita/interface/vtk_xml.hpp"
 
 namespace partita {
 
@@ -88,6 +89,7 @@ struct OutputFrame {
   std::string prefix;                   ///< participant name: files start with it
   int index = 0;                        ///< frame number, 0, 1, 2, ...
   double time = 0.0;                    ///< simulated time [s]
+  vtk::Options vtk;                     ///< format of the VTK files (case key output.vtk)
 };
 
 /// The abstract solver a coupling participant wraps. See the call order above.

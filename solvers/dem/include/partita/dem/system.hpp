@@ -10,7 +10,7 @@
 //   2. dt = time_step_fraction * rayleigh_time_step() (a dt above the Rayleigh step throws).
 //   3. loop: [set_vertex_positions(mesh, X[, V]) / set_wall_velocity()] then step(dt) or
 //      run(n, dt); read monitors (kinetic_energy(), wall_force(), mesh_force(),
-//      triangle_forces(), vertex_forces()) and write output (write_particles_vtp(), ...).
+//      triangle_forces(), vertex_forces()); output files are the adapter's (adapters/src/dem).
 //   4. implicit coupling: save_state() at the window start, restore_state() to repeat it;
 //      restart files: write_state(ostream) / read_state(istream) (versioned binary, see
 //      SystemState).
@@ -235,10 +235,6 @@ class System {
   std::size_t contact_count() const;
   /// 2 contact_count() / N (particle-particle, as LAMMPS compute contact/atom).
   double mean_contacts_per_particle() const;
-
-  // ---- output (VTK XML PolyData, written to a temporary name then renamed) -------------------
-  void write_particles_vtp(const std::string& path) const;
-  void write_mesh_vtp(int mesh, const std::string& path) const;
 
  private:
   void prepare();

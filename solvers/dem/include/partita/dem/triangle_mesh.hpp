@@ -38,6 +38,7 @@ class TriangleMesh {
   const std::vector<Eigen::Vector3d>& positions() const { return position_; }
   const std::vector<Eigen::Vector3d>& velocities() const { return velocity_; }
   const std::array<int, 3>& triangle(int t) const { return triangles_[t]; }
+  const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
   /// Edge ids of triangle t: edges (v0,v1), (v1,v2), (v2,v0).
   const std::array<int, 3>& triangle_edges(int t) const { return triangle_edges_[t]; }
   const std::array<int, 2>& edge(int e) const { return edges_[e]; }

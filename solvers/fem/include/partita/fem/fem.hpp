@@ -13,4 +13,3 @@
 #include "partita/fem/neo_hooke_law.hpp"
 #include "partita/fem/state_io.hpp"
 #include "partita/fem/structural_solver.hpp"
-#include "partita/fem/vtu_writer.hpp"
