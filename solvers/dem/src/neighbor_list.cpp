@@ -257,9 +257,12 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
 void NeighborList::build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes,
                                          double r_max) {
   const int n = static_cast<int>(p.size());
-  mesh_offsets_.assign(n + 1, 0);
   mesh_candidates_.clear();
-  if (meshes.empty()) return;
+  if (meshes.empty()) {  // no offsets per particle either
+    mesh_offsets_.assign(1, 0);
+    return;
+  }
+  mesh_offsets_.assign(n + 1, 0);
   const double grow = r_max + skin_;
   const double cell = 1.0 / grid_.inv_cell;
   const Eigen::Vector3d grid_hi =

@@ -33,7 +33,8 @@
 //   NeighborList    cells, the pair half list (slots), plane masks, mesh candidates
 //   PairContacts    per pair slot: tangential history and touching flag
 //   WallContacts    planes, walls, wall forces (histories: a store array)
-//   MeshContacts    the mesh contact kernel and reduction (histories: store arrays)
+//   MeshContacts    the mesh contact kernel, reduction and histories (rows of the particles
+//                   near a mesh only)
 //   ThreadPartition parts of the particles per thread, cross pairs and their forces
 //   CellOrder       renumbering in cell order
 //   StepHookList    the step hooks (breakage, ...)
@@ -273,14 +274,12 @@ class System {
   // packed copy reloaded after a caller's change (verlet_.invalidate())
   mutable ParticleStore store_;
   VelocityVerlet verlet_;
-  int h_mesh_slot_count_ = -1;  // mesh contacts of each particle (<= max_mesh_contacts)
-  int h_mesh_slot_key_ = -1;    // N x max_mesh_contacts feature keys
-  int h_mesh_slot_shear_ = -1;  // N x max_mesh_contacts tangential histories
-  int h_mesh_records_ = -1;     // N x max_mesh_contacts results of the last force evaluation
   WallContacts walls_;  // planes, their histories and wall forces
   std::vector<TriangleMesh> meshes_;
   NeighborList neighbors_;
   PairContacts pairs_;  // per pair slot of neighbors_: tangential histories, touching flags
+  // rows of the particles near a mesh: contacts, histories, records (follow builds, renumbering)
+  MeshContacts mesh_contacts_;
   StepHookList hooks_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
   double skin_ = -1.0;
