@@ -187,7 +187,7 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   particle_cell_.resize(n);
   cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
   counts_.reserve(std::max(static_cast<std::size_t>(max_cells), static_cast<std::size_t>(n)) + 1);
-  tri_cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
+  if (!meshes.empty()) tri_cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
   cell_start_.assign(grid_.cells() + 1, 0);
   for (int i = 0; i < n; ++i) {
     const auto c = grid_.coords(p.position[i]);
