@@ -235,7 +235,18 @@ std::size_t MeshContacts::contact_count() const {
 
 // ---- rows: layout, following the particles, state -------------------------------------------
 
-void MeshContacts::start_layout() {
+// Room for `rows` rows of `slots` slots in all; a buffer that must grow gets half as much again,
+// so that the rows of a bed whose surface layer fluctuates settle after a few builds.
+void MeshContacts::start_layout(std::size_t rows, std::size_t slots) {
+  const auto room = [](auto& v, std::size_t n) {
+    if (v.capacity() < n) v.reserve(n + n / 2);
+  };
+  room(new_particle_, rows);
+  room(new_count_, rows);
+  room(new_slot_, rows + 1);
+  room(new_key_, slots);
+  room(new_shear_, slots);
+  room(new_record_, slots);
   new_particle_.clear();
   new_count_.clear();
   new_slot_.assign(1, 0);
@@ -272,20 +283,28 @@ void MeshContacts::finish_layout() {
 void MeshContacts::follow_build(const NeighborList& nl) {
   const int n = static_cast<int>(nl.mesh_offsets_.size()) - 1;
   const int old_rows = static_cast<int>(particle_.size());
-  start_layout();
-  int r = 0;
-  for (int i = 0; i < n; ++i) {
-    const int candidates = nl.mesh_offsets_[i + 1] - nl.mesh_offsets_[i];
-    if (candidates == 0) continue;
-    while (r < old_rows && particle_[r] < i) ++r;
-    const int from = r < old_rows && particle_[r] == i ? r : -1;
-    const int held = from >= 0 ? count_[from] : 0;
-    add_row(i, std::max(std::min(max_contacts, candidates), held), from);
+  for (int pass = 0; pass < 2; ++pass) {  // count, then lay out
+    std::size_t rows = 0, slots = 0;
+    int r = 0;
+    for (int i = 0; i < n; ++i) {
+      const int candidates = nl.mesh_offsets_[i + 1] - nl.mesh_offsets_[i];
+      if (candidates == 0) continue;
+      while (r < old_rows && particle_[r] < i) ++r;
+      const int from = r < old_rows && particle_[r] == i ? r : -1;
+      const int capacity =
+          std::max(std::min(max_contacts, candidates), from >= 0 ? count_[from] : 0);
+      if (pass == 0)
+        ++rows, slots += static_cast<std::size_t>(capacity);
+      else
+        add_row(i, capacity, from);
+    }
+    if (pass == 0) start_layout(rows, slots);
   }
   finish_layout();
 }
 
 void MeshContacts::renumber(const std::vector<int>& new_of_old) {
+  if (order_.capacity() < particle_.size()) order_.reserve(particle_.size() * 3 / 2);
   order_.clear();
   for (std::size_t r = 0; r < particle_.size(); ++r) {
     const auto i = static_cast<std::size_t>(particle_[r]);
@@ -293,7 +312,7 @@ void MeshContacts::renumber(const std::vector<int>& new_of_old) {
     if (k >= 0) order_.emplace_back(k, static_cast<int>(r));
   }
   std::sort(order_.begin(), order_.end());
-  start_layout();
+  start_layout(order_.size(), key_.size());
   for (const auto& [k, r] : order_) add_row(k, slot_[r + 1] - slot_[r], r);
   finish_layout();
 }
@@ -316,8 +335,8 @@ void MeshContacts::read(BinaryReader& in, std::size_t particles) {
   in.array(record_, "mesh contact records");
   const std::size_t rows = particle_.size();
   bool ok = slot_.size() == rows + 1 && count_.size() == rows && slot_[0] == 0 &&
-            static_cast<std::size_t>(slot_.back()) == key_.size() &&
-            shear_.size() == key_.size() && record_.size() == key_.size();
+            static_cast<std::size_t>(slot_.back()) == key_.size() && shear_.size() == key_.size() &&
+            record_.size() == key_.size();
   for (std::size_t r = 0; ok && r < rows; ++r)
     ok = particle_[r] >= 0 && static_cast<std::size_t>(particle_[r]) < particles &&
          (r == 0 || particle_[r - 1] < particle_[r]) && slot_[r + 1] >= slot_[r] &&

@@ -318,7 +318,10 @@ void NeighborList::build_mesh_candidates(const Particles& p, std::vector<Triangl
     mesh_offsets_[i + 1] = count;
   }
   for (int i = 0; i < n; ++i) mesh_offsets_[i + 1] += mesh_offsets_[i];
-  mesh_candidates_.resize(mesh_offsets_[n]);
+  // (the candidates of a bed's surface layer fluctuate: room for half as many again)
+  const auto total = static_cast<std::size_t>(mesh_offsets_[n]);
+  if (mesh_candidates_.capacity() < total) mesh_candidates_.reserve(total + total / 2);
+  mesh_candidates_.resize(total);
 #pragma omp parallel for schedule(dynamic, 64) if (n >= 1024)
   for (int i = 0; i < n; ++i) {
     int k = mesh_offsets_[i];

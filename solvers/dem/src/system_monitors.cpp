@@ -62,15 +62,17 @@ double System::elastic_energy() const {
       e += hertz_elastic_energy(model_.pair(p.material[i], planes[k].material), delta, p.radius[i],
                                 have_shear ? plane_shear[i * np + k] : no_shear);
     }
-  mesh_contacts_.for_each_contact(
-      [&](int i, const MeshContactRecord& rec, const Eigen::Vector3d& shear) {
-        e += hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta, rec.r_eff,
-                                  shear);
-      });
+  mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec,
+                                      const Eigen::Vector3d& shear) {
+    e +=
+        hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta, rec.r_eff, shear);
+  });
   return e;
 }
 
-Eigen::Vector3d System::wall_force(int wall) const { return walls_.wall_force(wall); }
+Eigen::Vector3d System::wall_force(int wall) const {
+  return walls_.wall_force(wall);
+}
 
 Eigen::Vector3d System::mesh_force(int mesh) const {
   check_mesh(mesh, "mesh_force");

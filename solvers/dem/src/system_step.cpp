@@ -75,7 +75,8 @@ void System::step(double dt) {
       }
     }
     // moved2 is complete after the loop's barrier; every thread reaches the same decision
-    const bool rebuild_here = !have_build || neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_);
+    const bool rebuild_here =
+        !have_build || neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_);
     if (!rebuild_here) evaluate_forces(dt, true, half);
 #pragma omp master
     rebuild = rebuild_here;
@@ -172,9 +173,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     for (int k = 0; k < n_cross; ++k) {
       const ThreadPartition::CrossPair& c = tp.cross_pairs[k];
       ThreadPartition::CrossForce& cf = tp.cross_force[k];
-      cf.touching = pairs.force<Load>(c.slot, model_, packed[c.i], packed[c.j], dt,
-                                      update_history, cf.force_i, cf.torque_i, cf.torque_j,
-                                      cf.load);
+      cf.touching = pairs.force<Load>(c.slot, model_, packed[c.i], packed[c.j], dt, update_history,
+                                      cf.force_i, cf.torque_i, cf.torque_j, cf.load);
     }
   }
 #pragma omp for schedule(static, 1)
@@ -225,8 +225,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
             load[j] = std::max(load[j], lij);
           }
         }
-        walls.add_forces<Load>(i, qi, np <= 64 ? nl.plane_mask_[i] : 0, model_, dt,
-                               update_history, f, t, load_i, block_wall);
+        walls.add_forces<Load>(i, qi, np <= 64 ? nl.plane_mask_[i] : 0, model_, dt, update_history,
+                               f, t, load_i, block_wall);
         if (mesh_row < mesh.rows && mesh.particle[mesh_row] == i) {
           // own accumulators: f and t keep their registers
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();

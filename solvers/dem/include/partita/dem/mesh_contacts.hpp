@@ -10,8 +10,8 @@
 // tangential history, record). Rows are laid out again after each build (follow_build(): a
 // particle keeps its contacts, particles without candidates lose theirs, as the next pass would
 // drop them) and follow the particles through renumbering and removal (renumber()); save/restore
-// writes them. No meshes: no rows, nothing per particle. No allocation once sized (the arrays
-// and their scratch are swapped, growth is geometric).
+// writes them. No meshes: no rows, nothing per particle. No allocation once sized: the arrays
+// and their scratch are swapped, and a buffer that must grow gets half as much room again.
 
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
@@ -72,8 +72,13 @@ class MeshContacts {
     }
   };
   Pass pass() {
-    return Pass{particle_.data(), slot_.data(),  count_.data(), key_.data(),
-                shear_.data(),    record_.data(), static_cast<int>(particle_.size())};
+    return Pass{particle_.data(),
+                slot_.data(),
+                count_.data(),
+                key_.data(),
+                shear_.data(),
+                record_.data(),
+                static_cast<int>(particle_.size())};
   }
 
   /// Lays the rows out for the candidates of the neighbour list's last build(), keeping each
@@ -113,16 +118,16 @@ class MeshContacts {
  private:
   // lays out new_* for rows (particle, capacity), copies each kept row's contacts from row
   // `from` (-1: none), then swaps them in
-  void start_layout();
+  void start_layout(std::size_t rows, std::size_t slots);
   void add_row(int particle, int capacity, int from);
   void finish_layout();
 
-  std::vector<int> particle_;  // per row
-  std::vector<int> slot_;      // per row: first slot; rows + 1
-  std::vector<int> count_;     // per row: contacts of the last pass
-  std::vector<std::int64_t> key_;           // per slot: feature key
-  std::vector<Eigen::Vector3d> shear_;      // per slot: tangential history
-  std::vector<MeshContactRecord> record_;   // per slot: result of the last pass
+  std::vector<int> particle_;              // per row
+  std::vector<int> slot_;                  // per row: first slot; rows + 1
+  std::vector<int> count_;                 // per row: contacts of the last pass
+  std::vector<std::int64_t> key_;          // per slot: feature key
+  std::vector<Eigen::Vector3d> shear_;     // per slot: tangential history
+  std::vector<MeshContactRecord> record_;  // per slot: result of the last pass
   // scratch (swapped with the arrays above)
   std::vector<int> new_particle_, new_slot_, new_count_;
   std::vector<std::int64_t> new_key_;

@@ -218,6 +218,9 @@ class System {
   std::size_t particle_count() const { return store_.size(); }
   const ContactModel& contact_model() const { return model_; }
   const NeighborList& neighbor_list() const { return neighbors_; }
+  /// The mesh contacts: rows of the particles near a mesh at the last list build (row_count()),
+  /// their contacts of the last force pass (contact_count()).
+  const MeshContacts& mesh_contacts() const { return mesh_contacts_; }
   /// Kinetic energy, translational + rotational [J].
   double kinetic_energy() const;
   /// Elastic energy stored in all contacts (Hertz 8/15 E* sqrt(R*) delta^(5/2) + tangential
