@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <numbers>
+#include <sstream>
 
 using namespace partita::dem;
 
@@ -246,6 +247,11 @@ TEST_CASE("dem: mesh contact rows exist only for particles near a mesh and follo
     for (int a = 0; a < 5; ++a)
       for (int b = 0; b < 5; ++b)
         sys.add_particle({(3 * a - 6 + 0.1) * R, (3 * b - 6 + 0.2) * R, z}, R, m);
+  {  // a state written before the first step (no lists, no rows yet) reads back
+    std::stringstream state;
+    sys.write_state(state);
+    CHECK_NOTHROW(sys.read_state(state));
+  }
   const double dt = 0.1 * sys.rayleigh_time_step();
   sys.step(dt);
   // without a mesh: no mesh rows and no per-particle mesh array

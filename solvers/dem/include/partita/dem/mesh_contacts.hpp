@@ -123,7 +123,7 @@ class MeshContacts {
   void finish_layout();
 
   std::vector<int> particle_;              // per row
-  std::vector<int> slot_;                  // per row: first slot; rows + 1
+  std::vector<int> slot_{0};               // per row: first slot; rows + 1
   std::vector<int> count_;                 // per row: contacts of the last pass
   std::vector<std::int64_t> key_;          // per slot: feature key
   std::vector<Eigen::Vector3d> shear_;     // per slot: tangential history
