@@ -1,5 +1,7 @@
 #include "partita/dem/mesh_contacts.hpp"
 
+#include "partita/dem/error.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -25,7 +27,7 @@ std::int64_t feature_key(int mesh, int type, int index) {
 template <bool Load>
 void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
                             const std::vector<TriangleMesh>& meshes, const ContactModel& model,
-                            const History& h, double dt, bool update_history, Eigen::Vector3d& f,
+                            const Row& row, double dt, bool update_history, Eigen::Vector3d& f,
                             Eigen::Vector3d& t, double& load) {
   struct Candidate {
     int mesh, triangle, type, feature;
@@ -110,20 +112,19 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
           for (int v : m.edge(acc.feature)) keep = keep && v != k.feature;
       }
     }
-    if (keep && na < max_contacts) accepted[na++] = c;
+    // (capacity >= min(max_contacts, candidates): the bound is max_contacts)
+    if (keep && na < row.capacity) accepted[na++] = c;
   }
-  // Histories: the previous step's slots of particle i, matched by feature key.
-  int* const slot_count = h.count;
-  std::int64_t* const slot_key = h.key;
-  Eigen::Vector3d* const slot_shear = h.shear;
-  MeshContactRecord* const records = h.records;
-  const std::size_t base = static_cast<std::size_t>(i) * max_contacts;
+  // Histories: the previous step's slots of particle i (its row), matched by feature key.
+  std::int64_t* const slot_key = row.key;
+  Eigen::Vector3d* const slot_shear = row.shear;
+  MeshContactRecord* const records = row.records;
   std::int64_t old_key[max_contacts];
   Eigen::Vector3d old_shear[max_contacts];
-  const int n_old = slot_count[i];
+  const int n_old = row.count;
   for (int s = 0; s < n_old; ++s) {
-    old_key[s] = slot_key[base + s];
-    old_shear[s] = slot_shear[base + s];
+    old_key[s] = slot_key[s];
+    old_shear[s] = slot_shear[s];
   }
   // A contact keeps its history when its feature stays (same key) and also when it passes to
   // a neighbouring feature of the same mesh, rolling or sliding across triangle boundaries: an
@@ -144,7 +145,7 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     const TriangleMesh& m = meshes[k.mesh];
     double best = r * (r - std::sqrt(k.dist2));  // (contact radius)^2
     for (int s = 0; s < n_old; ++s) {
-      const MeshContactRecord& rec = records[base + s];
+      const MeshContactRecord& rec = records[s];
       if (old_taken[s] || rec.mesh != k.mesh) continue;
       const auto& tri = m.triangle(rec.triangle);
       const Eigen::Vector3d p = rec.barycentric[0] * m.position_[tri[0]] +
@@ -182,9 +183,9 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
       const double kw = pp.e_star / r;
       load = std::max(load, fn * kw * kw);
     }
-    slot_key[base + a] = key;
-    slot_shear[base + a] = shear;
-    MeshContactRecord& rec = records[base + a];
+    slot_key[a] = key;
+    slot_shear[a] = shear;
+    MeshContactRecord& rec = records[a];
     rec.mesh = k.mesh;
     rec.triangle = k.triangle;
     rec.barycentric = k.cp.barycentric;
@@ -193,34 +194,30 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     rec.r_eff = r;
     rec.material = m.material();
   }
-  slot_count[i] = na;
+  row.count = na;
 }
 
 template void MeshContacts::evaluate<false>(int, const Particle&, const NeighborList&,
                                             const std::vector<TriangleMesh>&, const ContactModel&,
-                                            const History&, double, bool, Eigen::Vector3d&,
+                                            const Row&, double, bool, Eigen::Vector3d&,
                                             Eigen::Vector3d&, double&);
 template void MeshContacts::evaluate<true>(int, const Particle&, const NeighborList&,
                                            const std::vector<TriangleMesh>&, const ContactModel&,
-                                           const History&, double, bool, Eigen::Vector3d&,
+                                           const Row&, double, bool, Eigen::Vector3d&,
                                            Eigen::Vector3d&, double&);
 
 // Each contact's reaction shared among its triangle's vertices with the barycentric weights of
 // the contact point, particles in order (a fixed summation order); then each triangle's force
 // from its vertices' (each vertex's force shared equally among its triangles): continuous as a
 // contact moves across triangles, sums preserved (see TriangleMesh::triangle_forces).
-void MeshContacts::reduce(int n, const int* slot_count, const MeshContactRecord* records,
-                          std::vector<TriangleMesh>& meshes) {
+void MeshContacts::reduce(std::vector<TriangleMesh>& meshes) const {
   for (TriangleMesh& m : meshes) m.vertex_force_.setZero();
-  for (int i = 0; i < n; ++i) {
-    for (int c = 0; c < slot_count[i]; ++c) {
-      const MeshContactRecord& rec = records[static_cast<std::size_t>(i) * max_contacts + c];
-      TriangleMesh& m = meshes[rec.mesh];
-      const auto& tri = m.triangle(rec.triangle);
-      for (int k = 0; k < 3; ++k)
-        m.vertex_force_.row(tri[k]) -= rec.barycentric[k] * rec.force.transpose();
-    }
-  }
+  for_each_contact([&](int, const MeshContactRecord& rec, const Eigen::Vector3d&) {
+    TriangleMesh& m = meshes[rec.mesh];
+    const auto& tri = m.triangle(rec.triangle);
+    for (int k = 0; k < 3; ++k)
+      m.vertex_force_.row(tri[k]) -= rec.barycentric[k] * rec.force.transpose();
+  });
   for (TriangleMesh& m : meshes)
     for (int t = 0; t < m.triangle_count(); ++t) {
       const auto& tri = m.triangle(t);
@@ -228,6 +225,124 @@ void MeshContacts::reduce(int n, const int* slot_count, const MeshContactRecord*
                                  m.vertex_share_[tri[1]] * m.vertex_force_.row(tri[1]) +
                                  m.vertex_share_[tri[2]] * m.vertex_force_.row(tri[2]);
     }
+}
+
+std::size_t MeshContacts::contact_count() const {
+  std::size_t n = 0;
+  for (int c : count_) n += static_cast<std::size_t>(c);
+  return n;
+}
+
+// ---- rows: layout, following the particles, state -------------------------------------------
+
+// Room for `rows` rows of `slots` slots in all; a buffer that must grow gets half as much again,
+// so that the rows of a bed whose surface layer fluctuates settle after a few builds.
+void MeshContacts::start_layout(std::size_t rows, std::size_t slots) {
+  const auto room = [](auto& v, std::size_t n) {
+    if (v.capacity() < n) v.reserve(n + n / 2);
+  };
+  room(new_particle_, rows);
+  room(new_count_, rows);
+  room(new_slot_, rows + 1);
+  room(new_key_, slots);
+  room(new_shear_, slots);
+  room(new_record_, slots);
+  new_particle_.clear();
+  new_count_.clear();
+  new_slot_.assign(1, 0);
+}
+
+void MeshContacts::add_row(int particle, int capacity, int from) {
+  new_particle_.push_back(particle);
+  new_count_.push_back(from >= 0 ? count_[from] : 0);
+  new_slot_.push_back(new_slot_.back() + capacity);
+  const std::size_t slots = static_cast<std::size_t>(new_slot_.back());
+  new_key_.resize(slots);
+  new_shear_.resize(slots);
+  new_record_.resize(slots);
+  if (from < 0) return;
+  const std::size_t src = static_cast<std::size_t>(slot_[from]);
+  const std::size_t dst = static_cast<std::size_t>(new_slot_[new_slot_.size() - 2]);
+  const std::size_t c = static_cast<std::size_t>(count_[from]);
+  std::copy_n(key_.begin() + src, c, new_key_.begin() + dst);
+  std::copy_n(shear_.begin() + src, c, new_shear_.begin() + dst);
+  std::copy_n(record_.begin() + src, c, new_record_.begin() + dst);
+}
+
+void MeshContacts::finish_layout() {
+  particle_.swap(new_particle_);
+  slot_.swap(new_slot_);
+  count_.swap(new_count_);
+  key_.swap(new_key_);
+  shear_.swap(new_shear_);
+  record_.swap(new_record_);
+}
+
+// A row for every particle with candidates (ascending); its contacts of the last pass come along
+// (both row lists are in particle order: one merge).
+void MeshContacts::follow_build(const NeighborList& nl) {
+  const int n = static_cast<int>(nl.mesh_offsets_.size()) - 1;
+  const int old_rows = static_cast<int>(particle_.size());
+  for (int pass = 0; pass < 2; ++pass) {  // count, then lay out
+    std::size_t rows = 0, slots = 0;
+    int r = 0;
+    for (int i = 0; i < n; ++i) {
+      const int candidates = nl.mesh_offsets_[i + 1] - nl.mesh_offsets_[i];
+      if (candidates == 0) continue;
+      while (r < old_rows && particle_[r] < i) ++r;
+      const int from = r < old_rows && particle_[r] == i ? r : -1;
+      const int capacity =
+          std::max(std::min(max_contacts, candidates), from >= 0 ? count_[from] : 0);
+      if (pass == 0)
+        ++rows, slots += static_cast<std::size_t>(capacity);
+      else
+        add_row(i, capacity, from);
+    }
+    if (pass == 0) start_layout(rows, slots);
+  }
+  finish_layout();
+}
+
+void MeshContacts::renumber(const std::vector<int>& new_of_old) {
+  if (order_.capacity() < particle_.size()) order_.reserve(particle_.size() * 3 / 2);
+  order_.clear();
+  for (std::size_t r = 0; r < particle_.size(); ++r) {
+    const auto i = static_cast<std::size_t>(particle_[r]);
+    const int k = i < new_of_old.size() ? new_of_old[i] : -1;
+    if (k >= 0) order_.emplace_back(k, static_cast<int>(r));
+  }
+  std::sort(order_.begin(), order_.end());
+  start_layout(order_.size(), key_.size());
+  for (const auto& [k, r] : order_) add_row(k, slot_[r + 1] - slot_[r], r);
+  finish_layout();
+}
+
+void MeshContacts::write(BinaryWriter& out) const {
+  out.array(particle_);
+  out.array(slot_);
+  out.array(count_);
+  out.array(key_);
+  out.array(shear_);
+  out.array(record_);
+}
+
+void MeshContacts::read(BinaryReader& in, std::size_t particles) {
+  in.array(particle_, "mesh contact rows");
+  in.array(slot_, "mesh contact row slots");
+  in.array(count_, "mesh contact counts");
+  in.array(key_, "mesh contact features");
+  in.array(shear_, "mesh contact histories");
+  in.array(record_, "mesh contact records");
+  const std::size_t rows = particle_.size();
+  bool ok = slot_.size() == rows + 1 && count_.size() == rows && slot_[0] == 0 &&
+            static_cast<std::size_t>(slot_.back()) == key_.size() && shear_.size() == key_.size() &&
+            record_.size() == key_.size();
+  for (std::size_t r = 0; ok && r < rows; ++r)
+    ok = particle_[r] >= 0 && static_cast<std::size_t>(particle_[r]) < particles &&
+         (r == 0 || particle_[r - 1] < particle_[r]) && slot_[r + 1] >= slot_[r] &&
+         slot_[r + 1] - slot_[r] <= max_contacts && count_[r] >= 0 &&
+         count_[r] <= slot_[r + 1] - slot_[r];
+  if (!ok) throw Error("corrupt state: the mesh contact rows do not agree");
 }
 
 }  // namespace partita::dem

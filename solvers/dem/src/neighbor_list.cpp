@@ -187,7 +187,7 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   particle_cell_.resize(n);
   cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
   counts_.reserve(std::max(static_cast<std::size_t>(max_cells), static_cast<std::size_t>(n)) + 1);
-  tri_cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
+  if (!meshes.empty()) tri_cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
   cell_start_.assign(grid_.cells() + 1, 0);
   for (int i = 0; i < n; ++i) {
     const auto c = grid_.coords(p.position[i]);
@@ -257,9 +257,12 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
 void NeighborList::build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes,
                                          double r_max) {
   const int n = static_cast<int>(p.size());
-  mesh_offsets_.assign(n + 1, 0);
   mesh_candidates_.clear();
-  if (meshes.empty()) return;
+  if (meshes.empty()) {  // no offsets per particle either
+    mesh_offsets_.assign(1, 0);
+    return;
+  }
+  mesh_offsets_.assign(n + 1, 0);
   const double grow = r_max + skin_;
   const double cell = 1.0 / grid_.inv_cell;
   const Eigen::Vector3d grid_hi =
@@ -315,7 +318,10 @@ void NeighborList::build_mesh_candidates(const Particles& p, std::vector<Triangl
     mesh_offsets_[i + 1] = count;
   }
   for (int i = 0; i < n; ++i) mesh_offsets_[i + 1] += mesh_offsets_[i];
-  mesh_candidates_.resize(mesh_offsets_[n]);
+  // (the candidates of a bed's surface layer fluctuate: room for half as many again)
+  const auto total = static_cast<std::size_t>(mesh_offsets_[n]);
+  if (mesh_candidates_.capacity() < total) mesh_candidates_.reserve(total + total / 2);
+  mesh_candidates_.resize(total);
 #pragma omp parallel for schedule(dynamic, 64) if (n >= 1024)
   for (int i = 0; i < n; ++i) {
     int k = mesh_offsets_[i];

@@ -68,7 +68,8 @@ void ParticleStore::permute(const std::vector<int>& order) {
   if (order.size() != size())
     throw Error("particle store: permute() needs one index per particle, got " +
                 std::to_string(order.size()) + " for " + std::to_string(size()));
-  for (auto& c : columns_) c->permute(core_, order);
+  done_.assign(order.size(), 0);
+  for (auto& c : columns_) c->permute(core_, order, done_.data());
 }
 
 void ParticleStore::write(BinaryWriter& out) const {

@@ -26,15 +26,7 @@ std::uint64_t new_identity() {
 
 System::System() : identity_(new_identity()) {
   neighbors_.clear();
-  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   walls_.attach(store_);
-  h_mesh_slot_count_ = store_.add_array<int>("mesh_slot_count", 1, 0);
-  h_mesh_slot_key_ =
-      store_.add_array<std::int64_t>("mesh_slot_key", max_mesh_contacts, std::int64_t{-1});
-  h_mesh_slot_shear_ =
-      store_.add_array<Eigen::Vector3d>("mesh_slot_shear", max_mesh_contacts, zero);
-  h_mesh_records_ =
-      store_.add_array<MeshContactRecord>("mesh_records", max_mesh_contacts, MeshContactRecord{});
 }
 
 // ---- set-up ---------------------------------------------------------------------------------
@@ -166,9 +158,10 @@ void System::remove_particles(const std::vector<char>& remove) {
   }
   if (std::none_of(remove.begin(), remove.end(), [](char c) { return c != 0; })) return;
   store_.remove(remove, new_of_old_);
-  // pair histories follow their particles; the lists are rebuilt before the next use
+  // pair and mesh histories follow their particles; the lists are rebuilt before the next use
   neighbors_.renumber(new_of_old_, static_cast<int>(store_.size()));
   pairs_follow_lists();
+  mesh_contacts_.renumber(new_of_old_);
   particles_changed();
 }
 
@@ -190,6 +183,7 @@ void System::renumber_particles(const std::vector<int>& order) {
   store_.permute(order);
   neighbors_.renumber(new_of_old_);
   pairs_follow_lists();
+  mesh_contacts_.renumber(new_of_old_);
   verlet_.invalidate();
   partition_.invalidate();
   prepared_ = false;
@@ -395,6 +389,7 @@ void System::reorder_particles() {
   store_.permute(cell_order_.order());
   neighbors_.renumber(cell_order_.new_of_old());
   pairs_follow_lists();
+  mesh_contacts_.renumber(cell_order_.new_of_old());
   verlet_.invalidate();
   partition_.invalidate();
   ++sorts_;
@@ -404,6 +399,7 @@ void System::rebuild_lists() {
   sync_particles();
   neighbors_.build(store_.core(), walls_.planes(), meshes_);
   pairs_follow_lists();
+  mesh_contacts_.follow_build(neighbors_);
   partition_.invalidate();
   lists_current_ = true;
 }

@@ -33,10 +33,6 @@ double System::elastic_energy() const {
   const Particles& p = store_.core();
   const std::vector<Eigen::Vector3d>& plane_shear = walls_.shear(store_);
   const std::vector<PlaneWall>& planes = walls_.planes();
-  const std::vector<int>& slot_count = store_.array<int>(h_mesh_slot_count_);
-  const std::vector<Eigen::Vector3d>& slot_shear =
-      store_.array<Eigen::Vector3d>(h_mesh_slot_shear_);
-  const std::vector<MeshContactRecord>& records = store_.array<MeshContactRecord>(h_mesh_records_);
   const NeighborList& nl = neighbors_;
   double e = 0.0;
   const int n = static_cast<int>(p.size());
@@ -65,17 +61,17 @@ double System::elastic_energy() const {
       e += hertz_elastic_energy(model_.pair(p.material[i], planes[k].material), delta, p.radius[i],
                                 have_shear ? plane_shear[i * np + k] : no_shear);
     }
-  for (int i = 0; i < n; ++i)
-    for (int c = 0; c < slot_count[i]; ++c) {
-      const std::size_t s = static_cast<std::size_t>(i) * max_mesh_contacts + c;
-      const MeshContactRecord& rec = records[s];
-      e += hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta, rec.r_eff,
-                                slot_shear[s]);
-    }
+  mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec,
+                                      const Eigen::Vector3d& shear) {
+    e +=
+        hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta, rec.r_eff, shear);
+  });
   return e;
 }
 
-Eigen::Vector3d System::wall_force(int wall) const { return walls_.wall_force(wall); }
+Eigen::Vector3d System::wall_force(int wall) const {
+  return walls_.wall_force(wall);
+}
 
 Eigen::Vector3d System::mesh_force(int mesh) const {
   check_mesh(mesh, "mesh_force");

@@ -114,6 +114,7 @@ void System::write_body(BinaryWriter& w) const {
   for (int k = 0; k < hooks_.size(); ++k) w.string(hooks_[k].name());
   // particles with every registered array (histories with planes and meshes included)
   store_.write(w);
+  mesh_contacts_.write(w);  // (format version 2: its rows; version 1 had store arrays)
   walls_.write(w);
   for (const TriangleMesh& m : meshes_) m.write_state(w);
   // the lists, the pairs' histories between their rows and build references (format version 1:
@@ -153,6 +154,7 @@ void System::read_body(BinaryReader& r) {
                   name + "' in the state, '" + hooks_[k].name() + "' here");
   }
   store_.read(r);
+  mesh_contacts_.read(r, store_.size());
   walls_.read(r);
   for (TriangleMesh& m : meshes_) m.read_state(r);
   neighbors_.read_rows(r);

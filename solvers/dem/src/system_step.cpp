@@ -75,7 +75,8 @@ void System::step(double dt) {
       }
     }
     // moved2 is complete after the loop's barrier; every thread reaches the same decision
-    const bool rebuild_here = !have_build || neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_);
+    const bool rebuild_here =
+        !have_build || neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_);
     if (!rebuild_here) evaluate_forces(dt, true, half);
 #pragma omp master
     rebuild = rebuild_here;
@@ -164,21 +165,16 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   Eigen::Vector3d* const torque = p.torque.data();
   double* load = Load ? load_.data() : nullptr;
   const double* load_limit = Limit ? store_.array<double>(h_load_limit_).data() : nullptr;
-  const MeshContacts::History mesh_history{store_.array<int>(h_mesh_slot_count_).data(),
-                                           store_.array<std::int64_t>(h_mesh_slot_key_).data(),
-                                           store_.array<Eigen::Vector3d>(h_mesh_slot_shear_).data(),
-                                           store_.array<MeshContactRecord>(h_mesh_records_).data()};
+  const MeshContacts::Pass mesh = mesh_contacts_.pass();  // rows: particles near a mesh
   const int np = walls.np;
-  const bool have_meshes = !meshes_.empty();
   if (parts > 1) {  // the cross pairs, shared evenly among the threads
     const int n_cross = static_cast<int>(tp.cross_pairs.size());
 #pragma omp for schedule(static)
     for (int k = 0; k < n_cross; ++k) {
       const ThreadPartition::CrossPair& c = tp.cross_pairs[k];
       ThreadPartition::CrossForce& cf = tp.cross_force[k];
-      cf.touching = pairs.force<Load>(c.slot, model_, packed[c.i], packed[c.j], dt,
-                                      update_history, cf.force_i, cf.torque_i, cf.torque_j,
-                                      cf.load);
+      cf.touching = pairs.force<Load>(c.slot, model_, packed[c.i], packed[c.j], dt, update_history,
+                                      cf.force_i, cf.torque_i, cf.torque_j, cf.load);
     }
   }
 #pragma omp for schedule(static, 1)
@@ -196,6 +192,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     }
     int cross = tp.cross_out_begin[part];
     const int lo = tp.begin(part), hi = tp.begin(part + 1);
+    int mesh_row = mesh.rows > 0 ? mesh.first_row(lo) : 0;  // the next particle near a mesh
     for (int b = lo / block_size; b * block_size < hi; ++b) {
       // plane forces summed per block of particles, then over blocks (fixed order)
       Eigen::Vector3d* block_wall = walls.start_block(b);
@@ -228,13 +225,14 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
             load[j] = std::max(load[j], lij);
           }
         }
-        walls.add_forces<Load>(i, qi, np <= 64 ? nl.plane_mask_[i] : 0, model_, dt,
-                               update_history, f, t, load_i, block_wall);
-        if (have_meshes) {  // own accumulators: f and t keep their registers
+        walls.add_forces<Load>(i, qi, np <= 64 ? nl.plane_mask_[i] : 0, model_, dt, update_history,
+                               f, t, load_i, block_wall);
+        if (mesh_row < mesh.rows && mesh.particle[mesh_row] == i) {
+          // own accumulators: f and t keep their registers
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
           const MeshContacts::Particle q{qi.x, qi.r, qi.v, qi.m, qi.w, qi.material};
-          MeshContacts::evaluate<Load>(i, q, nl, meshes_, model_, mesh_history, dt, update_history,
-                                       fm, tm, load_i);
+          MeshContacts::evaluate<Load>(i, q, nl, meshes_, model_, mesh.row(mesh_row++), dt,
+                                       update_history, fm, tm, load_i);
           f += fm;
           t += tm;
         }
@@ -257,8 +255,7 @@ void System::reduce_wall_and_mesh_forces() {
   walls_.reduce(n);
   // Mesh forces: particles in order (MeshContacts::reduce).
   if (meshes_.empty()) return;
-  MeshContacts::reduce(n, store_.array<int>(h_mesh_slot_count_).data(),
-                       store_.array<MeshContactRecord>(h_mesh_records_).data(), meshes_);
+  mesh_contacts_.reduce(meshes_);
 }
 
 }  // namespace partita::dem

@@ -114,6 +114,38 @@ TEST_CASE("dem: renumbering the particles at list builds allocates no memory eit
   if (PARTITA_COUNT_ALLOCATIONS) CHECK(made == 0);
 }
 
+TEST_CASE("dem: steps with a mesh under the bed allocate no memory (renumbering included)",
+          "[dem][performance][mesh]") {
+  // the bed drifts sideways over a large flat mesh: the particles near it stay much the same, so
+  // the mesh contact rows keep about their size (the first steps size them); sort interval 1:
+  // half the bed moves against the other half, every build renumbers (rows follow)
+  for (const int sort : {0, 1}) {
+    System sys = drifting_bed(sort > 0);
+    sys.set_sort_interval(sort);
+    Eigen::MatrixX3d v(4, 3);
+    v << -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0;
+    TriangleMesh::Triangles t(2, 3);
+    t << 0, 1, 2, 0, 2, 3;
+    sys.add_mesh(v, t, 0);
+    const double dt = 0.2 * sys.rayleigh_time_step();
+    sys.run(100, dt);
+    const std::size_t rows = sys.mesh_contacts().row_count();
+    const long builds = sys.neighbor_list().build_count();
+    const long sorts = sys.sort_count();
+    const long count = allocations.load();
+    sys.run(400, dt);
+    const long made = allocations.load() - count;
+    INFO(made << " allocations in 400 steps with " << sys.neighbor_list().build_count() - builds
+              << " list rebuilds, " << sys.sort_count() - sorts << " renumberings, sort interval "
+              << sort << ", " << rows << " -> " << sys.mesh_contacts().row_count() << " mesh rows");
+    CHECK(rows > 0);                         // the bottom layer is within R + skin of the mesh
+    CHECK(rows < sys.particle_count() / 4);  // and only it
+    CHECK(sys.neighbor_list().build_count() - builds >= 2);
+    if (sort > 0) CHECK(sys.sort_count() - sorts >= 2);
+    if (PARTITA_COUNT_ALLOCATIONS) CHECK(made == 0);
+  }
+}
+
 TEST_CASE("dem: steps with breakage enabled but nothing breaking allocate no memory",
           "[dem][performance][breakage]") {
   const int before = max_threads();

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <numbers>
+#include <sstream>
 
 using namespace partita::dem;
 
@@ -231,4 +232,54 @@ TEST_CASE("dem: a mesh moved by the caller pushes a particle like a moving plane
   INFO("plane " << vp << " mesh " << vm << " theory " << (1 + e) * u);
   CHECK(vp == Approx((1 + e) * u).epsilon(0.02));
   CHECK(vm == Approx(vp).epsilon(1e-6));
+}
+
+TEST_CASE("dem: mesh contact rows exist only for particles near a mesh and follow them",
+          "[dem][mesh][lifecycle]") {
+  // A layer of 5 x 5 spheres 1 um into a triangulated plane at z = 0 and a layer 12 R above it,
+  // 3 R apart (no pair contacts): only the first layer is within R + skin of the mesh, and each
+  // of its spheres touches the plane once (one face or edge: coplanar features count once).
+  System sys;
+  const int m = sys.add_material({E, NU, RHO});
+  sys.add_interaction(m, m, {0.3, 0.5, 0.0});
+  sys.set_skin(0.1 * R);
+  for (const double z : {R - 1e-6, 12 * R})
+    for (int a = 0; a < 5; ++a)
+      for (int b = 0; b < 5; ++b)
+        sys.add_particle({(3 * a - 6 + 0.1) * R, (3 * b - 6 + 0.2) * R, z}, R, m);
+  {  // a state written before the first step (no lists, no rows yet) reads back
+    std::stringstream state;
+    sys.write_state(state);
+    CHECK_NOTHROW(sys.read_state(state));
+  }
+  const double dt = 0.1 * sys.rayleigh_time_step();
+  sys.step(dt);
+  // without a mesh: no mesh rows and no per-particle mesh array
+  CHECK(sys.mesh_contacts().row_count() == 0);
+  for (int k = 0; k < sys.store().array_count(); ++k)
+    CHECK(sys.store().array_name(k).find("mesh") == std::string::npos);
+  Eigen::MatrixX3d v;
+  TriangleMesh::Triangles t;
+  triangulated_plane(10 * R, 8, v, t);
+  sys.add_mesh(v, t, m);
+  sys.step(dt);
+  CHECK(sys.mesh_contacts().row_count() == 25);
+  CHECK(sys.mesh_contacts().contact_count() == 25);
+  CHECK(sys.mesh_force(0).z() < 0.0);  // the spheres push the plane down
+  // every other sphere of the first layer removed: its rows and contacts go with it, the others'
+  // follow their particles (also through a renumbering)
+  std::vector<char> remove(sys.particle_count(), 0);
+  for (std::size_t i = 0; i < 25; i += 2) remove[i] = 1;
+  sys.remove_particles(remove);
+  CHECK(sys.mesh_contacts().row_count() == 12);
+  CHECK(sys.mesh_contacts().contact_count() == 12);
+  std::vector<int> order(sys.particle_count());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(order.size() - 1 - k);
+  sys.renumber_particles(order);
+  CHECK(sys.mesh_contacts().contact_count() == 12);
+  sys.step(dt);
+  CHECK(sys.mesh_contacts().row_count() == 12);
+  CHECK(sys.mesh_contacts().contact_count() == 12);
+  for (std::size_t i = 0; i < sys.particle_count(); ++i)  // the first layer is now at the end
+    CHECK((sys.particles().position[i].z() < 2 * R) == (i >= 25));
 }

@@ -1,15 +1,29 @@
 #pragma once
 // Contacts of a sphere with the triangle meshes (faces, edges, vertices, each counted once), their
 // tangential histories carried from feature to feature, and the reduction of the contact forces to
-// the meshes' triangles and vertices. Stateless: the histories and the last pass's records are
-// per-particle arrays of the System's store (slots of max_contacts per particle).
+// the meshes' triangles and vertices.
+//
+// Storage in proportion to use: only particles that have mesh candidates at the last neighbour
+// list build (those within R + skin of a triangle: the only ones that can touch a mesh until the
+// next build) have a row, with room for min(max_contacts, candidates) contacts (more if it held
+// more before the build). A row holds the contacts of the last force pass (feature key,
+// tangential history, record). Rows are laid out again after each build (follow_build(): a
+// particle keeps its contacts, particles without candidates lose theirs, as the next pass would
+// drop them) and follow the particles through renumbering and removal (renumber()); save/restore
+// writes them. No meshes: no rows, nothing per particle. No allocation once sized: the arrays
+// and their scratch are swapped, and a buffer that must grow gets half as much room again.
 
+#include "partita/dem/binary_reader.hpp"
+#include "partita/dem/binary_writer.hpp"
 #include "partita/dem/contact_model.hpp"
 #include "partita/dem/mesh_contact_record.hpp"
 #include "partita/dem/neighbor_list.hpp"
 #include "partita/dem/triangle_mesh.hpp"
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -29,23 +43,97 @@ class MeshContacts {
     const Eigen::Vector3d& w;
     int material;
   };
-  struct History {  ///< the store's mesh-contact arrays (particle i: slots [i max_contacts, ...))
-    int* count;
+  /// One particle's row: its contacts of the last pass (count), their feature keys, tangential
+  /// histories and records, room for `capacity`.
+  struct Row {
+    int& count;
+    int capacity;
     std::int64_t* key;
     Eigen::Vector3d* shear;
     MeshContactRecord* records;
   };
+  /// What one force pass reads and writes, taken once per pass (raw pointers).
+  struct Pass {
+    const int* particle;  // per row: its particle (ascending)
+    const int* slot;      // per row: its first slot (rows + 1 entries)
+    int* count;
+    std::int64_t* key;
+    Eigen::Vector3d* shear;
+    MeshContactRecord* records;
+    int rows;
 
-  /// Adds the mesh contact forces and torques of particle i to f and t, updates its slots;
-  /// Load: also the largest F_n (E*/R*)^2 into load (R* = R).
+    /// The first row whose particle is >= i.
+    int first_row(int i) const {
+      return static_cast<int>(std::lower_bound(particle, particle + rows, i) - particle);
+    }
+    Row row(int r) const {
+      const int s = slot[r];
+      return Row{count[r], slot[r + 1] - s, key + s, shear + s, records + s};
+    }
+  };
+  Pass pass() {
+    return Pass{particle_.data(),
+                slot_.data(),
+                count_.data(),
+                key_.data(),
+                shear_.data(),
+                record_.data(),
+                static_cast<int>(particle_.size())};
+  }
+
+  /// Lays the rows out for the candidates of the neighbour list's last build(), keeping each
+  /// particle's contacts.
+  void follow_build(const NeighborList& lists);
+  /// After the particles were renumbered or removed (old particle i is now new_of_old[i], < 0:
+  /// removed): the rows follow their particles (removed ones are dropped).
+  void renumber(const std::vector<int>& new_of_old);
+  /// Rows (particles that may touch a mesh) and contacts of the last pass.
+  std::size_t row_count() const { return particle_.size(); }
+  std::size_t contact_count() const;
+  /// Calls visit(i, record, shear) for every contact of the last pass, particles in order.
+  template <class Visit>
+  void for_each_contact(Visit&& visit) const {
+    for (std::size_t r = 0; r < particle_.size(); ++r)
+      for (int c = 0; c < count_[r]; ++c) {
+        const std::size_t s = static_cast<std::size_t>(slot_[r] + c);
+        visit(particle_[r], record_[s], shear_[s]);
+      }
+  }
+
+  /// Adds the mesh contact forces and torques of particle i (candidates from `lists`) to f and t,
+  /// updates its row; Load: also the largest F_n (E*/R*)^2 into load (R* = R).
   template <bool Load>
   static void evaluate(int i, const Particle& q, const NeighborList& lists,
                        const std::vector<TriangleMesh>& meshes, const ContactModel& model,
-                       const History& history, double dt, bool update_history, Eigen::Vector3d& f,
+                       const Row& row, double dt, bool update_history, Eigen::Vector3d& f,
                        Eigen::Vector3d& t, double& load);
-  /// The meshes' triangle and vertex forces from the records of n particles.
-  static void reduce(int n, const int* slot_count, const MeshContactRecord* records,
-                     std::vector<TriangleMesh>& meshes);
+  /// The meshes' triangle and vertex forces from the contacts of the last pass.
+  void reduce(std::vector<TriangleMesh>& meshes) const;
+
+  /// Writes / reads the rows (System's state). read() throws Error when they are inconsistent
+  /// or name a particle >= `particles`.
+  void write(BinaryWriter& out) const;
+  void read(BinaryReader& in, std::size_t particles);
+
+ private:
+  // lays out new_* for rows (particle, capacity), copies each kept row's contacts from row
+  // `from` (-1: none), then swaps them in
+  void start_layout(std::size_t rows, std::size_t slots);
+  void add_row(int particle, int capacity, int from);
+  void finish_layout();
+
+  std::vector<int> particle_;              // per row
+  std::vector<int> slot_{0};               // per row: first slot; rows + 1
+  std::vector<int> count_;                 // per row: contacts of the last pass
+  std::vector<std::int64_t> key_;          // per slot: feature key
+  std::vector<Eigen::Vector3d> shear_;     // per slot: tangential history
+  std::vector<MeshContactRecord> record_;  // per slot: result of the last pass
+  // scratch (swapped with the arrays above)
+  std::vector<int> new_particle_, new_slot_, new_count_;
+  std::vector<std::int64_t> new_key_;
+  std::vector<Eigen::Vector3d> new_shear_;
+  std::vector<MeshContactRecord> new_record_;
+  std::vector<std::pair<int, int>> order_;  // renumber(): (new particle, old row)
 };
 
 }  // namespace partita::dem

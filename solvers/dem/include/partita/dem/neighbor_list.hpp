@@ -121,7 +121,7 @@ class NeighborList {
   // particle-triangle candidates
   std::vector<int> tri_cell_start_;
   std::vector<MeshCandidate> tri_cell_items_;
-  std::vector<int> mesh_offsets_;
+  std::vector<int> mesh_offsets_;  // N + 1 (just {0} when there are no meshes)
   std::vector<MeshCandidate> mesh_candidates_;
 };
 

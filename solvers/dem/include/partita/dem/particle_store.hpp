@@ -10,8 +10,12 @@
 // and restart. add() takes the caller's id or, given a negative one, the next free id (one more
 // than the largest id ever held, so an id is never reused within a run).
 //
-// Scratch space is kept between calls: permute() and remove() allocate nothing once the store
-// has had its largest size.
+// Memory: each array holds exactly its particles' entries (add_particles() reserves the final
+// size; growth one particle at a time is geometric, one array at a time). permute() works in
+// place, array by array, following the permutation's cycles (one block of `width` entries in
+// hand), and remove() compacts in place: neither holds a second copy of any array. Their scratch
+// (one byte per particle: the cycle marks) is kept between calls, so they allocate nothing once
+// the store has had its largest size.
 
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
@@ -86,7 +90,8 @@ class ParticleStore {
     virtual void resize(Particles& core, std::size_t n) = 0;
     virtual void reserve(Particles& core, std::size_t n) = 0;
     virtual void compact(Particles& core, const std::vector<int>& new_of_old, std::size_t n) = 0;
-    virtual void permute(Particles& core, const std::vector<int>& order) = 0;
+    // done[] (one flag per particle, all 0 on entry) marks the rows already placed
+    virtual void permute(Particles& core, const std::vector<int>& order, char* done) = 0;
     virtual void set_width(Particles& core, std::size_t width) = 0;
     virtual void write(const Particles& core, BinaryWriter& out) const = 0;
     virtual void read(Particles& core, BinaryReader& in) = 0;
@@ -100,6 +105,7 @@ class ParticleStore {
   Particles core_;
   std::vector<std::unique_ptr<Column>> columns_;
   std::int64_t next_id_ = 0;
+  std::vector<char> done_;  // scratch of permute(): rows placed in the current array
 };
 
 // ---- implementation of the typed arrays ------------------------------------------------------
@@ -109,7 +115,7 @@ struct ParticleStore::TypedColumn final : Column {
   std::vector<T> own;                           // the data, unless it is a core array
   std::vector<T> Particles::*member = nullptr;  // the core array it stands for
   T fill{};
-  std::vector<T> scratch;
+  std::vector<T> block;  // scratch of permute(): one particle's entries (width)
 
   std::vector<T>& data(Particles& core) { return member ? core.*member : own; }
   const std::vector<T>& data(const Particles& core) const { return member ? core.*member : own; }
@@ -133,13 +139,28 @@ struct ParticleStore::TypedColumn final : Column {
     }
     v.resize(n * width);
   }
-  void permute(Particles& core, const std::vector<int>& order) override {
+  // new row k = old row order[k], in place: each cycle k0 -> order[k0] -> ... is shifted by one
+  // row with the first row in hand; done[] marks the rows placed (and is cleared again).
+  void permute(Particles& core, const std::vector<int>& order, char* done) override {
     std::vector<T>& v = data(core);
-    scratch.resize(v.size());
-    for (std::size_t k = 0; k < order.size(); ++k)
-      std::copy_n(v.begin() + static_cast<std::size_t>(order[k]) * width, width,
-                  scratch.begin() + k * width);
-    std::copy(scratch.begin(), scratch.end(), v.begin());
+    if (width == 0) return;
+    block.resize(width);
+    const std::size_t n = order.size();
+    auto row = [&](std::size_t k) { return v.begin() + k * width; };
+    for (std::size_t start = 0; start < n; ++start) {
+      if (done[start] || static_cast<std::size_t>(order[start]) == start) continue;
+      std::copy_n(row(start), width, block.begin());
+      std::size_t k = start;
+      for (;;) {
+        done[k] = 1;
+        const auto from = static_cast<std::size_t>(order[k]);
+        if (from == start) break;
+        std::copy_n(row(from), width, row(k));
+        k = from;
+      }
+      std::copy_n(block.begin(), width, row(k));
+    }
+    std::fill_n(done, n, char{0});
   }
   void set_width(Particles& core, std::size_t w) override {
     std::vector<T>& v = data(core);

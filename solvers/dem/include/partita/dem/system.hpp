@@ -33,7 +33,8 @@
 //   NeighborList    cells, the pair half list (slots), plane masks, mesh candidates
 //   PairContacts    per pair slot: tangential history and touching flag
 //   WallContacts    planes, walls, wall forces (histories: a store array)
-//   MeshContacts    the mesh contact kernel and reduction (histories: store arrays)
+//   MeshContacts    the mesh contact kernel, reduction and histories (rows of the particles
+//                   near a mesh only)
 //   ThreadPartition parts of the particles per thread, cross pairs and their forces
 //   CellOrder       renumbering in cell order
 //   StepHookList    the step hooks (breakage, ...)
@@ -217,6 +218,9 @@ class System {
   std::size_t particle_count() const { return store_.size(); }
   const ContactModel& contact_model() const { return model_; }
   const NeighborList& neighbor_list() const { return neighbors_; }
+  /// The mesh contacts: rows of the particles near a mesh at the last list build (row_count()),
+  /// their contacts of the last force pass (contact_count()).
+  const MeshContacts& mesh_contacts() const { return mesh_contacts_; }
   /// Kinetic energy, translational + rotational [J].
   double kinetic_energy() const;
   /// Elastic energy stored in all contacts (Hertz 8/15 E* sqrt(R*) delta^(5/2) + tangential
@@ -269,14 +273,12 @@ class System {
   // packed copy reloaded after a caller's change (verlet_.invalidate())
   mutable ParticleStore store_;
   VelocityVerlet verlet_;
-  int h_mesh_slot_count_ = -1;  // mesh contacts of each particle (<= max_mesh_contacts)
-  int h_mesh_slot_key_ = -1;    // N x max_mesh_contacts feature keys
-  int h_mesh_slot_shear_ = -1;  // N x max_mesh_contacts tangential histories
-  int h_mesh_records_ = -1;     // N x max_mesh_contacts results of the last force evaluation
   WallContacts walls_;  // planes, their histories and wall forces
   std::vector<TriangleMesh> meshes_;
   NeighborList neighbors_;
   PairContacts pairs_;  // per pair slot of neighbors_: tangential histories, touching flags
+  // rows of the particles near a mesh: contacts, histories, records (follow builds, renumbering)
+  MeshContacts mesh_contacts_;
   StepHookList hooks_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
   double skin_ = -1.0;

@@ -10,7 +10,8 @@
 //   header   8 bytes magic "PTDEMST1", uint32 format version, uint32 byte-order mark 0x01020304,
 //            float64 time [s], int64 step count, uint64 particle count, uint64 body size
 //   body     set-up check (material, plane, mesh and hook counts and names), the particle store
-//            (per array: name, width, element size, contents), plane positions and velocities,
+//            (per array: name, width, element size, contents), the mesh contact rows (particle,
+//            slots, contacts, feature keys, histories, records), plane positions and velocities,
 //            per mesh its vertex positions/velocities/forces, neighbour lists with histories,
 //            wall forces, System counters, each hook's state
 // Values are raw little-endian IEEE 754 bytes of this build; a file from a machine of another
@@ -29,7 +30,9 @@ namespace partita::dem {
 
 class SystemState {
  public:
-  static constexpr std::uint32_t format_version = 1;
+  // 2: mesh contact histories as rows of the particles near a mesh (MeshContacts), after the
+  // particle store, which no longer has the four mesh arrays of version 1
+  static constexpr std::uint32_t format_version = 2;
 
   double time() const { return time_; }
   long step_count() const { return steps_; }
