@@ -1,0 +1,34 @@
+// Every case shipped under cases/ is valid: `partita check` reads it completely (parameters,
+// meshes, particle files, the participants' set-up, the sweep's variants) and exits 0. Keeps the
+// cases from rotting when a key is renamed or a default changes. Files whose name starts with
+// '_' are scratch copies and are skipped; checks.yaml files are read by tests/cases.
+
+#include <catch2/catch.hpp>
+
+#include "../support/run_command.hpp"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+TEST_CASE("shipped cases: partita check accepts every case file under cases/",
+          "[app][cases][slow]") {
+  const fs::path root = fs::path(PARTITA_SOURCE_DIR) / "cases";
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    const fs::path f = entry.path();
+    if (!entry.is_regular_file() || f.extension() != ".yaml") continue;
+    const std::string name = f.filename().string();
+    if (name.rfind('_', 0) == 0 || name == "checks.yaml") continue;
+    files.push_back(f);
+  }
+  REQUIRE(files.size() >= 10);
+  for (const auto& f : files) {
+    const auto r = partita::test::run_command(partita::test::quote(PARTITA_EXECUTABLE) +
+                                              " check " + partita::test::quote(f.string()));
+    INFO(f.string() << "\n" << r.output);
+    CHECK(r.status == 0);
+  }
+}
