@@ -733,7 +733,9 @@ void CaseRun::run() {
   };
   std::vector<std::vector<Column>> columns_of(monitors_.size());
   for (std::size_t mi = 0; mi < monitors_.size(); ++mi)
-    for (const auto& [p, q] : monitors_[mi].quantities) {
+    for (const auto& pq : monitors_[mi].quantities) {
+      const auto& p = pq.first;  // not a structured binding: clang 14 cannot capture those
+      const auto& q = pq.second;
       auto it =
           std::find_if(wanted.begin(), wanted.end(), [&](const Asked& a) { return a.p == p; });
       if (it == wanted.end()) it = wanted.insert(wanted.end(), Asked{p, {}, {}});
