@@ -14,10 +14,41 @@ DofPartition::DofPartition(const std::vector<char>& constrained)
   }
 }
 
+namespace {
+// Refills the values of `out` from the columns `cols` of `a` when out already has the pattern
+// that extracting them would give (a matrix of the same pattern split before): no allocation.
+// False (out untouched in its pattern, values possibly partly written) when the patterns differ.
+bool refill(const SparseMatrix& a, const std::vector<Eigen::Index>& cols,
+            const std::vector<Eigen::Index>& free_index, Eigen::Index nf, SparseMatrix& out) {
+  if (!out.isCompressed() || out.rows() != nf ||
+      out.cols() != static_cast<Eigen::Index>(cols.size()))
+    return false;
+  const int* outer = out.outerIndexPtr();
+  const int* inner = out.innerIndexPtr();
+  double* values = out.valuePtr();
+  int pos = 0;
+  for (std::size_t k = 0; k < cols.size(); ++k) {
+    if (outer[k] != pos) return false;
+    for (SparseMatrix::InnerIterator it(a, cols[k]); it; ++it) {
+      const Eigen::Index r = free_index[static_cast<std::size_t>(it.row())];
+      if (r < 0) continue;
+      if (pos >= out.nonZeros() || inner[pos] != r) return false;
+      values[pos++] = it.value();
+    }
+  }
+  return pos == out.nonZeros();
+}
+}  // namespace
+
 void DofPartition::split(const SparseMatrix& a, SparseMatrix& aff, SparseMatrix& afc) const {
   // Free dofs keep their relative order, so columns and rows stay sorted.
   const auto nf = static_cast<Eigen::Index>(free_.size());
   const auto nc = static_cast<Eigen::Index>(constrained_.size());
+  // the same pattern as at the last split (a Newton tangent, iteration after iteration): values
+  // only
+  if (aff.nonZeros() > 0 && refill(a, free_, free_index_, nf, aff) &&
+      refill(a, constrained_, free_index_, nf, afc))
+    return;
   auto extract = [&](const std::vector<Eigen::Index>& cols, Eigen::Index ncols, SparseMatrix& out) {
     std::vector<int> outer(static_cast<std::size_t>(ncols) + 1, 0), inner;
     std::vector<double> values;

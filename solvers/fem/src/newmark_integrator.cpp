@@ -1,5 +1,6 @@
 #include "partita/fem/newmark_integrator.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 #include "partita/fem/error.hpp"
@@ -9,11 +10,34 @@ namespace {
 
 // R(u_1) = F_1 - f_int(u_1) - M (a_1 + alpha v_1) - beta_R K0 v_1 on the free dofs, with
 // a_1 = c0 (u_1 - u) - c2 v - c3 a and v_1 = v + dt ((1 - gamma) a + gamma a_1).
+// Adds c B to A in place when both have the same sparsity pattern (checked once per pair of
+// matrices and remembered in `checked` / `same`): the values then line up entry by entry and the
+// sum is the one Eigen's sparse sum would give, without building a new matrix.
+// Returns false when it had to build a new matrix (the patterns differ).
+bool add_scaled(SparseMatrix& a, double c, const SparseMatrix& b, bool& checked, bool& same) {
+  if (!checked) {
+    same = a.isCompressed() && b.isCompressed() && a.rows() == b.rows() &&
+           a.cols() == b.cols() && a.nonZeros() == b.nonZeros() &&
+           std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1, b.outerIndexPtr()) &&
+           std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr());
+    checked = true;
+  }
+  if (same) {
+    double* av = a.valuePtr();
+    const double* bv = b.valuePtr();
+    for (Eigen::Index i = 0; i < a.nonZeros(); ++i) av[i] += c * bv[i];
+    return true;
+  }
+  a += c * b;
+  return false;
+}
+
 class NewmarkProblem final : public NonlinearProblem {
  public:
   NewmarkProblem(StructuralSystem& s, const Kinematics& kin, const Eigen::VectorXd& f1,
-                 Eigen::VectorXd& u1, double beta, double gamma, double dt)
-      : s_(s), kin_(kin), f1_(f1), u1_(u1), gamma_(gamma), dt_(dt) {
+                 Eigen::VectorXd& u1, double beta, double gamma, double dt,
+                 NewmarkIntegrator::Work& work)
+      : s_(s), kin_(kin), f1_(f1), u1_(u1), gamma_(gamma), dt_(dt), w_(work) {
     c0_ = 1.0 / (beta * dt * dt);
     c2_ = 1.0 / (beta * dt);
     c3_ = 0.5 / beta - 1.0;
@@ -24,21 +48,35 @@ class NewmarkProblem final : public NonlinearProblem {
   }
   void residual(const Eigen::VectorXd& x, Eigen::VectorXd& r, SparseMatrix* k) override {
     s_.dofs().scatter_free(x, u1_);
-    s_.internal_forces().evaluate(u1_, f_int_, k != nullptr ? &k_full_ : nullptr);
-    velocity_acceleration(v1_, a1_);
+    // the operator assembles into its own pattern: a K_full whose pattern a sum has changed is
+    // made anew
+    if (w_.k_full_foreign) {
+      w_.k_full = SparseMatrix();
+      w_.k_full_foreign = false;
+    }
+    s_.internal_forces().evaluate(u1_, w_.f_int, k != nullptr ? &w_.k_full : nullptr);
+    velocity_acceleration(w_.v1, w_.a1);
     const double alpha = s_.mass_damping(), beta_r = s_.stiffness_damping();
     const SparseMatrix& m = s_.mass();
+    // F_1 - f_int - M (a_1 + alpha v_1) [- beta_R K0 v_1]
+    // one expression, as Eigen evaluates it into a new vector (the products accumulated into
+    // the sum), here into kept storage: the same bits, no allocation
     if (beta_r == 0.0) {
-      s_.dofs().gather_free(f1_ - f_int_ - m * (a1_ + alpha * v1_), r);
+      w_.rhs.noalias() = f1_ - w_.f_int - m * (w_.a1 + alpha * w_.v1);
     } else {
-      s_.dofs().gather_free(
-          f1_ - f_int_ - m * (a1_ + alpha * v1_) - beta_r * (s_.damping_stiffness() * v1_), r);
+      w_.rhs.noalias() = f1_ - w_.f_int - m * (w_.a1 + alpha * w_.v1) -
+                         beta_r * (s_.damping_stiffness() * w_.v1);
     }
+    s_.dofs().gather_free(w_.rhs, r);
     if (k == nullptr) return;
     // K = K_t + (c0 + alpha gamma c2) M + beta_R gamma c2 K0   (d v_1 / d u_1 = gamma c2)
-    k_full_ += (c0_ + alpha * gamma_ * c2_) * m;
-    if (beta_r != 0.0) k_full_ += (beta_r * gamma_ * c2_) * s_.damping_stiffness();
-    s_.dofs().split(k_full_, *k, k_fc_);
+    if (!add_scaled(w_.k_full, c0_ + alpha * gamma_ * c2_, m, w_.mass_pattern_checked,
+                    w_.mass_pattern_same))
+      w_.k_full_foreign = true;
+    if (beta_r != 0.0 && !add_scaled(w_.k_full, beta_r * gamma_ * c2_, s_.damping_stiffness(),
+                                     w_.k0_pattern_checked, w_.k0_pattern_same))
+      w_.k_full_foreign = true;
+    s_.dofs().split(w_.k_full, *k, w_.k_fc);
   }
 
  private:
@@ -47,8 +85,7 @@ class NewmarkProblem final : public NonlinearProblem {
   const Eigen::VectorXd& f1_;
   Eigen::VectorXd& u1_;
   double gamma_, dt_, c0_ = 0, c2_ = 0, c3_ = 0;
-  Eigen::VectorXd f_int_, v1_, a1_;
-  SparseMatrix k_full_, k_fc_;
+  NewmarkIntegrator::Work& w_;
 };
 
 }  // namespace
@@ -59,32 +96,34 @@ NewmarkIntegrator::NewmarkIntegrator(double beta, double gamma, NewtonOptions op
 
 bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, double dt) {
   const double t1 = kin.time + dt;
-  Eigen::VectorXd f1, u1 = kin.u, x;
-  system.external_force(t1, f1);
-  system.apply_prescribed(t1, u1);
-  system.dofs().gather_free(u1, x);
-  NewmarkProblem problem(system, kin, f1, u1, beta_, gamma_, dt);
-  last_ = newton_.solve(problem, x, std::max(f1.norm(), 1e-300));
+  Work& w = work_;
+  w.u1 = kin.u;
+  system.external_force(t1, w.f1);
+  system.apply_prescribed(t1, w.u1);
+  system.dofs().gather_free(w.u1, w.x);
+  NewmarkProblem problem(system, kin, w.f1, w.u1, beta_, gamma_, dt, w);
+  last_ = newton_.solve(problem, w.x, std::max(w.f1.norm(), 1e-300));
   step_iterations_ += last_.iterations;
   if (!last_.converged) return false;
-  system.dofs().scatter_free(x, u1);
-  Eigen::VectorXd f_int, v1, a1;
-  system.internal_forces().evaluate(u1, f_int, nullptr);
+  system.dofs().scatter_free(w.x, w.u1);
+  system.internal_forces().evaluate(w.u1, w.f_int, nullptr);
   system.internal_forces().commit();
-  problem.velocity_acceleration(v1, a1);
+  problem.velocity_acceleration(w.v1, w.a1);
   // prescribed dofs: Newmark velocity and acceleration of the prescribed motion
-  const Eigen::VectorXd v_mid = 0.5 * (kin.v + v1);
+  w.v_mid = 0.5 * (kin.v + w.v1);
   // dt v_mid . C v_mid: exact for average acceleration (the mean of the equations at n and
   // n+1 times u_1 - u = dt v_mid)
-  kin.damping_work += dt * system.mass_damping() * v_mid.dot(system.mass() * v_mid);
-  if (system.stiffness_damping() != 0.0)
-    kin.damping_work +=
-        dt * system.stiffness_damping() * v_mid.dot(system.damping_stiffness() * v_mid);
-  kin.external_work += 0.5 * (kin.f + f1).dot(u1 - kin.u);
-  kin.u = u1;
-  kin.v = v1;
-  kin.a = a1;
-  kin.f = f1;
+  w.m_v.noalias() = system.mass() * w.v_mid;
+  kin.damping_work += dt * system.mass_damping() * w.v_mid.dot(w.m_v);
+  if (system.stiffness_damping() != 0.0) {
+    w.m_v.noalias() = system.damping_stiffness() * w.v_mid;
+    kin.damping_work += dt * system.stiffness_damping() * w.v_mid.dot(w.m_v);
+  }
+  kin.external_work += 0.5 * (kin.f + w.f1).dot(w.u1 - kin.u);
+  kin.u = w.u1;
+  kin.v = w.v1;
+  kin.a = w.a1;
+  kin.f = w.f1;
   kin.time = t1;
   return true;
 }

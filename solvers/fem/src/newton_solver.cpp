@@ -10,8 +10,8 @@ namespace partita::fem {
 NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
                                  double reference_force) {
   NewtonReport rep;
-  Eigen::VectorXd r, r_trial, dx, x_trial;
-  SparseMatrix k;
+  Eigen::VectorXd &r = r_, &r_trial = r_trial_, &dx = dx_, &x_trial = x_trial_;
+  SparseMatrix& k = k_;
   try {
     problem.residual(x, r, &k);
   } catch (const Error& e) {
@@ -75,7 +75,7 @@ NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
     double s = 1.0;
     bool accepted = false;
     for (int ls = 0; ls <= options_.max_line_search_steps; ++ls, s *= 0.5) {
-      x_trial = x + s * dx;
+      x_trial.noalias() = x + s * dx;
       try {
         problem.residual(x_trial, r_trial, nullptr);
       } catch (const Error&) {

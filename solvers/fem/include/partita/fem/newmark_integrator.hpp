@@ -29,6 +29,21 @@ class NewmarkIntegrator {
   void step_with_cutback(StructuralSystem& system, Kinematics& kin, double dt, int depth);
   double beta_, gamma_;
   NewtonSolver newton_;
+
+ public:
+  // Work storage of a step, kept between steps (sized once, then reused: no allocation per step
+  // once the patterns are set). Public only so that the step's problem can use it.
+  struct Work {
+    Eigen::VectorXd f1, u1, x, f_int, v1, a1, v_mid, m_v;  // the step
+    Eigen::VectorXd rhs;                                   // a residual evaluation
+    SparseMatrix k_full, k_fc;                             // the tangent on all dofs, K_fc
+    bool mass_pattern_checked = false, mass_pattern_same = false;
+    bool k0_pattern_checked = false, k0_pattern_same = false;
+    bool k_full_foreign = false;  // k_full's pattern is a sum's, not the operator's
+  };
+
+ private:
+  Work work_;
   NewtonReport last_;
   int step_iterations_ = 0;
 };

@@ -32,6 +32,10 @@ class NewtonSolver {
   FillOrdering ordering_;
   std::unique_ptr<SparseFactorisation> factor_;
   Eigen::Index pattern_nonzeros_ = -1, pattern_size_ = -1;
+  // Work storage kept between solves (a time integrator calls solve() at every step): sized
+  // once, then reused; the tangent keeps its pattern, so the problem can refill its values.
+  Eigen::VectorXd r_, r_trial_, dx_, x_trial_;
+  SparseMatrix k_;
 };
 
 }  // namespace partita::fem
