@@ -11,6 +11,7 @@
 
 #include "partita/adapters/dem_output.hpp"
 #include "partita/dem/breakage.hpp"
+#include "partita/dem/wall_servo.hpp"
 #include "partita/dem/error.hpp"
 #include "partita/dem/grading.hpp"
 #include "partita/dem/lammps_data.hpp"
@@ -110,6 +111,21 @@ std::shared_ptr<Spec> make_spec() {
       .def(std::vector<double>{0, 0, 0});
   wall->any("velocity_table", std::string("the velocity times a factor over time: ") +
                                   TimeTable::doc() + " (e.g. press, hold and release a lid)");
+  auto servo = std::make_shared<Spec>(
+      "servo",
+      "a plane wall driven along its normal to a target force: after every step its velocity is "
+      "clamp(gain (force - F_n), -max_velocity, max_velocity) along the normal, F_n the force "
+      "the particles push it back with (e.g. a lid pressing a bed to a given load)");
+  servo->real("force", "target normal force").unit("N").positive().required();
+  servo->real("max_velocity", "largest speed of the wall (small against the bed's wave speed)")
+      .unit("m/s")
+      .positive()
+      .required();
+  servo->real("gain", "velocity per force error (default: max_velocity / force)")
+      .unit("m/(s N)")
+      .positive();
+  wall->section("servo", "a plane wall pressed to a target force (not with velocity or "
+                "velocity_table)", servo);
   wall->one_of({"plane", "box"});
 
   auto grid = std::make_shared<Spec>(
@@ -433,6 +449,21 @@ DemAdapter::DemAdapter(const SolverContext& context)
         wall.velocity = v;
         wall.table = TimeTable::from_node(w["velocity_table"]);
         wall.moving = true;
+      }
+      if (w.has("servo")) {
+        const Node s = w["servo"];
+        if (!w.has("plane"))
+          s.fail("a servo drives a plane wall along its normal; this wall is a box (use a "
+                 "plane wall, e.g. a lid)");
+        if (w.has("velocity_table") || v.norm() > 0)
+          s.fail("a servo wall sets its own velocity: remove velocity / velocity_table");
+        dem::WallServoParameters sp;
+        sp.wall = wall.id;
+        sp.normal = w["plane"].vec3("normal").normalized();
+        sp.force = s.real("force");
+        sp.max_velocity = s.real("max_velocity");
+        sp.gain = s.has("gain") ? s.real("gain") : sp.max_velocity / sp.force;
+        system_.add_hook(std::make_unique<dem::WallServo>(sp));
       }
       walls_.push_back(wall);
     }
