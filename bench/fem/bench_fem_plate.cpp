@@ -8,11 +8,12 @@
 //
 // usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] [--lumped] [--no-ccx]
 //                        [--peers DIR] [--backends
-//                        eigen-ldlt,cholmod-nesdis,cholmod-metis,cholmod-amd]
+//                        eigen-ldlt,cholmod-nesdis,cholmod-nesdis-t,cholmod-metis,cholmod-amd]
 //                        [--no-static]   (transient only: the large plates)
 // Each mesh is solved with every linear solver built in (Eigen's SimplicialLDLT + AMD; CHOLMOD
-// supernodal with NESDIS, METIS and AMD orderings), and the summary prints their factorisation and
-// step times as ratios to the first one listed, and to CalculiX. Timings are wall-clock on a
+// supernodal with NESDIS, METIS and AMD orderings, solved by CHOLMOD; cholmod-nesdis-t: NESDIS
+// solved by the threaded supernodal solve, on all OpenMP threads), and the summary prints their
+// factorisation and step times as ratios to the first one listed, and to CalculiX. Timings are wall-clock on a
 // possibly shared machine: read them with that caveat.
 #include <algorithm>
 #include <array>
@@ -125,15 +126,18 @@ double run_ccx(const Options& opt, std::array<int, 3> c) {
 }
 
 struct Backend {
-  std::string name;  // eigen-ldlt, cholmod-metis, cholmod-amd
+  std::string name;  // eigen-ldlt, cholmod-nesdis, cholmod-nesdis-t, cholmod-metis, cholmod-amd
   LinearSolver solver;
   FillOrdering ordering;
+  SolveThreading threading = SolveThreading::Serial;  // CHOLMOD's solve or the threaded one
 };
 
 std::vector<Backend> all_backends() {
   std::vector<Backend> b = {{"eigen-ldlt", LinearSolver::EigenLdlt, FillOrdering::Automatic}};
   if (cholmod_available()) {
     b.push_back({"cholmod-nesdis", LinearSolver::Cholmod, FillOrdering::Nesdis});
+    b.push_back({"cholmod-nesdis-t", LinearSolver::Cholmod, FillOrdering::Nesdis,
+                 SolveThreading::Threaded});
     b.push_back({"cholmod-metis", LinearSolver::Cholmod, FillOrdering::Metis});
     b.push_back({"cholmod-amd", LinearSolver::Cholmod, FillOrdering::Amd});
   }
@@ -154,6 +158,7 @@ Result bench_backend(const Options& opt, const Model& model, const Backend& b) {
     SolverOptions so;
     so.linear_solver = b.solver;
     so.fill_ordering = b.ordering;
+    so.solve_threading = b.threading;
     const auto t0 = Clock::now();
     StructuralSolver s(model, so);
     const double t_setup = since(t0);
@@ -174,6 +179,7 @@ Result bench_backend(const Options& opt, const Model& model, const Backend& b) {
   so.mass = opt.lumped ? MassType::Lumped : MassType::Consistent;
   so.linear_solver = b.solver;
   so.fill_ordering = b.ordering;
+  so.solve_threading = b.threading;
   const auto t0 = Clock::now();
   StructuralSolver s(model, so);
   double rmin = 1e300, rmax = -1e300, rlast = 0.0;
@@ -299,7 +305,7 @@ int main(int argc, char** argv) {
       } else if (a == "-h" || a == "--help") {
         std::cout << "usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] "
                      "[--lumped] [--no-ccx] [--peers DIR] [--backends "
-                     "eigen-ldlt,cholmod-nesdis,cholmod-metis,cholmod-amd] "
+                     "eigen-ldlt,cholmod-nesdis,cholmod-nesdis-t,cholmod-metis,cholmod-amd] "
                      "[--no-static]\n";
         return 0;
       } else {

@@ -5,6 +5,8 @@
 #include <cstring>
 
 #include "partita/fem/error.hpp"
+#include "supernodal_kernels.hpp"
+#include "supernodal_solve.hpp"
 
 #ifdef PARTITA_HAS_CHOLMOD
 #include <cholmod.h>
@@ -58,8 +60,26 @@ std::string to_string(FillOrdering ordering) {
   return "?";
 }
 
+std::string to_string(SolveThreading threading) {
+  switch (threading) {
+    case SolveThreading::Automatic:
+      return "auto";
+    case SolveThreading::Threaded:
+      return "threaded";
+    case SolveThreading::Serial:
+      return "serial";
+  }
+  return "?";
+}
+
+std::string threaded_solve_kernels() {
+  return detail::supernodal_kernels().name;
+}
+
 struct SparseFactorisation::Impl {
   virtual ~Impl() = default;
+  virtual void set_solve_threading(SolveThreading) {}
+  virtual bool threaded_solve() const { return false; }
   virtual void analyze(const SparseMatrix& a) = 0;
   virtual bool factorize(const SparseMatrix& a) = 0;
   virtual void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
@@ -154,6 +174,7 @@ class Cholmod final : public SparseFactorisation::Impl {
     }
     factorised_ = false;
     fallback_.reset();
+    tree_state_ = TreeState::Unprepared;
   }
   bool factorize(const SparseMatrix& a) override {
     if (l_ == nullptr || static_cast<Eigen::Index>(l_->n) != a.rows()) analyze(a);
@@ -173,6 +194,16 @@ class Cholmod final : public SparseFactorisation::Impl {
       return fallback_->factorize(a);
     }
     factorised_ = positive_definite;
+    if (factorised_ && tree_state_ == TreeState::Unprepared) {
+      // the schedule depends on the structure alone: built once per analysis
+      const bool wanted =
+          threading_ == SolveThreading::Threaded ||
+          (threading_ == SolveThreading::Automatic && c_.lnz >= kThreadedSolveMinEntries);
+      tree_state_ = wanted && l_->is_super && l_->is_ll && l_->itype == CHOLMOD_INT &&
+                            l_->xtype == CHOLMOD_REAL && tree_.prepare(factor_view())
+                        ? TreeState::Ready
+                        : TreeState::Unusable;
+    }
     return factorised_;
   }
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override {
@@ -181,6 +212,11 @@ class Cholmod final : public SparseFactorisation::Impl {
       return;
     }
     if (!factorised_) throw Error("SparseFactorisation::solve: no successful factorisation");
+    if (tree_state_ == TreeState::Ready) {
+      x.resize(b.size());
+      tree_.solve(factor_view(), b.data(), x.data());
+      return;
+    }
     cholmod_dense rhs{};
     rhs.nrow = rhs.d = rhs.nzmax = static_cast<std::size_t>(b.size());
     rhs.ncol = 1;
@@ -193,6 +229,13 @@ class Cholmod final : public SparseFactorisation::Impl {
     }
     x.resize(b.size());
     std::memcpy(x.data(), x_->x, sizeof(double) * static_cast<std::size_t>(b.size()));
+  }
+  void set_solve_threading(SolveThreading threading) override {
+    if (threading != threading_) tree_state_ = TreeState::Unprepared;
+    threading_ = threading;
+  }
+  bool threaded_solve() const override {
+    return factorised_ && !use_fallback_ && tree_state_ == TreeState::Ready;
   }
   double factor_nonzeros() const override {
     if (use_fallback_) return fallback_->factor_nonzeros();
@@ -220,8 +263,30 @@ class Cholmod final : public SparseFactorisation::Impl {
     return s;
   }
 
+  detail::SupernodalFactor factor_view() const {
+    detail::SupernodalFactor f;
+    f.n = static_cast<int>(l_->n);
+    f.nsuper = static_cast<int>(l_->nsuper);
+    f.super = static_cast<const int*>(l_->super);
+    f.pi = static_cast<const int*>(l_->pi);
+    f.px = static_cast<const int*>(l_->px);
+    f.rows = static_cast<const int*>(l_->s);
+    f.perm = static_cast<const int*>(l_->Perm);
+    f.values = static_cast<const double*>(l_->x);
+    return f;
+  }
+
+  // The threaded solve (supernodal_solve.hpp) for factors of at least this many entries (16 MB):
+  // below, the solve is short and CHOLMOD's own is as fast. Decided by the structure alone, so
+  // the results never depend on the number of threads.
+  static constexpr double kThreadedSolveMinEntries = 2e6;
+  enum class TreeState { Unprepared, Ready, Unusable };
+
   cholmod_common c_{};
   cholmod_factor* l_ = nullptr;
+  detail::SupernodalSolve tree_;
+  TreeState tree_state_ = TreeState::Unprepared;
+  SolveThreading threading_ = SolveThreading::Automatic;
   cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;
   bool indefinite_ok_;
   bool factorised_ = false;
@@ -272,6 +337,14 @@ void SparseFactorisation::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
 
 double SparseFactorisation::factor_nonzeros() const {
   return impl_->factor_nonzeros();
+}
+
+void SparseFactorisation::set_solve_threading(SolveThreading threading) {
+  impl_->set_solve_threading(threading);
+}
+
+bool SparseFactorisation::threaded_solve() const {
+  return !empty_ && impl_->threaded_solve();
 }
 
 }  // namespace partita::fem

@@ -20,6 +20,13 @@ enum class LinearSolver { Automatic, Cholmod, EigenLdlt };
 // or Amd (approximate minimum degree). Automatic = Nesdis, the smallest factor and the fastest
 // factorisation and solve on the plates of bench_fem_plate (figures in bench/README.md).
 enum class FillOrdering { Automatic, Metis, Nesdis, Amd };
+// The two triangular solves with a CHOLMOD factor (each solve() reads the whole factor twice,
+// which is memory-bound): Threaded splits the factor's elimination tree over the OpenMP threads
+// (independent subtrees as tasks, the top separators shared row- or columnwise), Serial is
+// CHOLMOD's own solve on one thread; Automatic = Threaded for factors of at least 2e6 entries,
+// Serial below. Either way the solution does not depend on the number of threads (the order of
+// every sum is fixed by the factor's structure); Threaded and Serial differ by round-off.
+enum class SolveThreading { Automatic, Threaded, Serial };
 
 // Whether this build has CHOLMOD (PARTITA_CHOLMOD).
 bool cholmod_available();
@@ -28,6 +35,11 @@ LinearSolver resolve(LinearSolver solver);
 // "auto", "cholmod", "eigen-ldlt" (the names the FEM adapter accepts).
 std::string to_string(LinearSolver solver);
 std::string to_string(FillOrdering ordering);
+std::string to_string(SolveThreading threading);
+// The instruction set of the threaded solve's kernels on this processor: "avx2-fma" or "sse2"
+// (environment PARTITA_FEM_SOLVE_KERNELS=sse2 forces the portable set). The two differ by
+// round-off (a fused multiply-add rounds once), each gives the same bits on any thread count.
+std::string threaded_solve_kernels();
 
 // A symmetric positive definite sparse factorisation A = L D L^T (or L L^T) with its symbolic
 // analysis kept: analyze() once per sparsity pattern, factorize() whenever the values change,
@@ -61,6 +73,11 @@ class SparseFactorisation {
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   // Nonzeros of the factor L, its diagonal included (0 before the first factorize()).
   double factor_nonzeros() const;
+  // How solve() runs with a CHOLMOD factor (no effect with Eigen's); takes effect at the next
+  // factorize().
+  void set_solve_threading(SolveThreading threading);
+  // Whether the last factorisation is solved by the threaded solve.
+  bool threaded_solve() const;
 
   struct Impl;  // the backend (defined in linear_solver.cpp)
 

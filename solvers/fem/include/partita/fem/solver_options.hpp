@@ -32,6 +32,8 @@ struct SolverOptions {
   // Cholmod in a build without it: StructuralSolver throws Error. The ordering is CHOLMOD's.
   LinearSolver linear_solver = LinearSolver::Automatic;
   FillOrdering fill_ordering = FillOrdering::Automatic;
+  // The triangular solves of the linear path's static and Newmark steps (linear_solver.hpp).
+  SolveThreading solve_threading = SolveThreading::Automatic;
 };
 
 }  // namespace partita::fem

@@ -1,0 +1,200 @@
+// The threaded supernodal solve (SolveThreading::Threaded): the two triangular solves with
+// CHOLMOD's factor, the elimination tree split into independent subtrees and shared top
+// separators. What must hold: it solves A x = b (to round-off, against a known solution and
+// against CHOLMOD's own solve and Eigen's L D L^T); its result does not depend on the number of
+// threads, bit for bit (restarts and thread counts must not change a run); and the automatic
+// choice takes it only for large factors.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "partita/fem/box_mesher.hpp"
+#include "partita/fem/linear_solver.hpp"
+#include "partita/fem/structural_solver.hpp"
+
+using namespace partita::fem;
+
+namespace {
+
+// The 7-point Laplacian of an nx x ny x nz grid plus a small multiple of the identity (SPD),
+// both triangles stored: nested dissection gives it a deep tree with large top separators.
+SparseMatrix grid_laplacian(int nx, int ny, int nz) {
+  const int n = nx * ny * nz;
+  auto id = [&](int i, int j, int k) { return (k * ny + j) * nx + i; };
+  std::vector<Eigen::Triplet<double>> t;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const int a = id(i, j, k);
+        t.emplace_back(a, a, 6.01);
+        if (i + 1 < nx)
+          t.emplace_back(a, id(i + 1, j, k), -1.0), t.emplace_back(id(i + 1, j, k), a, -1.0);
+        if (j + 1 < ny)
+          t.emplace_back(a, id(i, j + 1, k), -1.0), t.emplace_back(id(i, j + 1, k), a, -1.0);
+        if (k + 1 < nz)
+          t.emplace_back(a, id(i, j, k + 1), -1.0), t.emplace_back(id(i, j, k + 1), a, -1.0);
+      }
+  SparseMatrix a(n, n);
+  a.setFromTriplets(t.begin(), t.end());
+  return a;
+}
+
+// a solution with every digit in play
+Eigen::VectorXd known_solution(Eigen::Index n) {
+  Eigen::VectorXd x(n);
+  for (Eigen::Index i = 0; i < n; ++i) x[i] = std::sin(0.37 * static_cast<double>(i)) + 0.5;
+  return x;
+}
+
+double relative_difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return (a - b).norm() / b.norm();
+}
+
+int threads_available() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+void use_threads(int n) {
+#ifdef _OPENMP
+  omp_set_num_threads(n);
+#else
+  (void)n;
+#endif
+}
+
+}  // namespace
+
+TEST_CASE("threaded solve: solves a grid Laplacian to round-off and agrees with CHOLMOD's solve",
+          "[fem][linear-solver][threaded-solve]") {
+  if (!cholmod_available()) {
+    WARN("built without CHOLMOD: the threaded solve works on CHOLMOD's factor");
+    return;
+  }
+  CHECK(to_string(SolveThreading::Threaded) == "threaded");
+  const char* forced = std::getenv("PARTITA_FEM_SOLVE_KERNELS");
+  if (forced != nullptr && std::string(forced) == "sse2") CHECK(threaded_solve_kernels() == "sse2");
+  INFO("kernels " << threaded_solve_kernels());
+  const SparseMatrix a = grid_laplacian(24, 24, 12);  // 6,912 unknowns
+  const Eigen::VectorXd exact = known_solution(a.rows());
+  const Eigen::VectorXd b = a * exact;
+  for (auto ordering : {FillOrdering::Nesdis, FillOrdering::Metis, FillOrdering::Amd}) {
+    INFO("ordering " << to_string(ordering));
+    SparseFactorisation threaded(LinearSolver::Cholmod, ordering);
+    threaded.set_solve_threading(SolveThreading::Threaded);
+    SparseFactorisation serial(LinearSolver::Cholmod, ordering);
+    serial.set_solve_threading(SolveThreading::Serial);
+    threaded.analyze(a);
+    serial.analyze(a);
+    REQUIRE(threaded.factorize(a));
+    REQUIRE(serial.factorize(a));
+    CHECK(threaded.threaded_solve());
+    CHECK_FALSE(serial.threaded_solve());
+    Eigen::VectorXd x, y;
+    threaded.solve(b, x);
+    serial.solve(b, y);
+    // cond(A) < 12.01 / 0.01 ~ 1.2e3: round-off of the order 1e-13 at most
+    CHECK(relative_difference(x, exact) <= 1e-12);
+    CHECK(relative_difference(x, y) <= 1e-12);
+    // new values with the same pattern (the schedule is the structure's): 2 A x = b gives x / 2
+    const SparseMatrix a2 = 2.0 * a;
+    REQUIRE(threaded.factorize(a2));
+    threaded.solve(b, x);
+    CHECK(relative_difference(2.0 * x, exact) <= 1e-12);
+  }
+}
+
+TEST_CASE("threaded solve: the same bits on 1, 2, 3 and 4 threads and on every repeat",
+          "[fem][linear-solver][threaded-solve]") {
+  if (!cholmod_available()) {
+    WARN("built without CHOLMOD: the threaded solve works on CHOLMOD's factor");
+    return;
+  }
+  const int before = threads_available();
+  const SparseMatrix a = grid_laplacian(20, 20, 16);
+  const Eigen::VectorXd b = a * known_solution(a.rows());
+  SparseFactorisation f(LinearSolver::Cholmod);
+  f.set_solve_threading(SolveThreading::Threaded);
+  f.analyze(a);
+  REQUIRE(f.factorize(a));
+  REQUIRE(f.threaded_solve());
+  use_threads(1);
+  Eigen::VectorXd reference;
+  f.solve(b, reference);
+  for (int threads : {1, 2, 3, 4}) {
+    use_threads(threads);
+    for (int repeat = 0; repeat < 3; ++repeat) {
+      Eigen::VectorXd x;
+      f.solve(b, x);
+      INFO(threads << " threads, repeat " << repeat);
+      CHECK((x.array() == reference.array()).all());
+    }
+  }
+  use_threads(before);
+}
+
+TEST_CASE("threaded solve: automatic only for large factors, same plate results either way",
+          "[fem][linear-solver][threaded-solve]") {
+  if (!cholmod_available()) {
+    WARN("built without CHOLMOD: the threaded solve works on CHOLMOD's factor");
+    return;
+  }
+  // a small factor: CHOLMOD's own solve; asked for, the threaded one
+  const SparseMatrix small = grid_laplacian(10, 10, 10);
+  SparseFactorisation automatic(LinearSolver::Cholmod);
+  automatic.analyze(small);
+  REQUIRE(automatic.factorize(small));
+  CHECK(automatic.factor_nonzeros() < 2e6);
+  CHECK_FALSE(automatic.threaded_solve());
+  automatic.set_solve_threading(SolveThreading::Threaded);
+  REQUIRE(automatic.factorize(small));
+  CHECK(automatic.threaded_solve());
+
+  // the seed plate (20 x 20 x 2 Hex8, 10 kPa on top): static and 30 Newmark steps with the
+  // threaded solve against Eigen's L D L^T (the brief's 1e-10) and against CHOLMOD's own solve
+  const double tol = 1e-12, l = 0.02;
+  Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(l, l, 0.002), {20, 20, 2}, ElementType::Hex8});
+  mesh.add_node_set_where("lateral", [&](const Vec3& x) {
+    return x[0] < tol || x[0] > l - tol || x[1] < tol || x[1] > l - tol;
+  });
+  mesh.add_node_set_where("corners", [&](const Vec3& x) {
+    return x[2] < tol && (x[0] < tol || x[0] > l - tol) && (x[1] < tol || x[1] > l - tol);
+  });
+  Model model(mesh, Material{250e9, 0.3, 7850});
+  model.fix("lateral", {0, 1});
+  model.fix("corners", {2});
+  model.add_pressure("zmax", 10e3);
+  SolverOptions threaded, serial, eigen;
+  threaded.linear_solver = serial.linear_solver = LinearSolver::Cholmod;
+  threaded.solve_threading = SolveThreading::Threaded;
+  serial.solve_threading = SolveThreading::Serial;
+  eigen.linear_solver = LinearSolver::EigenLdlt;
+  StructuralSolver st(model, threaded), ss(model, serial), se(model, eigen);
+  st.solve_static();
+  ss.solve_static();
+  se.solve_static();
+  CHECK(relative_difference(st.displacement(), se.displacement()) <= 1e-10);
+  CHECK(relative_difference(st.displacement(), ss.displacement()) <= 1e-12);
+  CHECK(st.reaction("corners")[2] == Approx(10e3 * l * l).epsilon(1e-9));  // p A = 4 N
+  StructuralSolver dt(model, threaded), ds(model, serial), de(model, eigen);
+  double worst_eigen = 0.0, worst_serial = 0.0;
+  for (int k = 0; k < 30; ++k) {
+    dt.step(1e-6);
+    ds.step(1e-6);
+    de.step(1e-6);
+    worst_eigen = std::max(worst_eigen, relative_difference(dt.displacement(), de.displacement()));
+    worst_serial =
+        std::max(worst_serial, relative_difference(dt.displacement(), ds.displacement()));
+  }
+  CHECK(dt.max_displacement() > 0.0);
+  CHECK(worst_eigen <= 1e-10);
+  CHECK(worst_serial <= 1e-10);
+}
