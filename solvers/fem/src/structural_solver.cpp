@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "block_assembler.hpp"
+#include "parallel_product.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/linear_elastic_operator.hpp"
 #include "partita/fem/quadrature.hpp"
@@ -340,7 +341,8 @@ void StructuralSolver::clear_coupling_loads() {
 double StructuralSolver::face_traction_work(const std::string& face, const MatrixX3& tractions,
                                             const Eigen::VectorXd& du) const {
   const auto& op = face_operator(face);
-  if (static_cast<std::size_t>(tractions.rows()) != op.num_qp || du.size() != coupling_force_.size())
+  if (static_cast<std::size_t>(tractions.rows()) != op.num_qp ||
+      du.size() != coupling_force_.size())
     throw Error("face_traction_work('" + face + "'): " + std::to_string(op.num_qp) +
                 " tractions and " + std::to_string(coupling_force_.size()) + " dofs expected");
   double w = 0.0;
@@ -543,6 +545,7 @@ void StructuralSolver::step(double dt) {
 
   // work vectors are members: no allocation once sized
   Work& w = work_;
+  if (!product_) product_ = std::make_unique<detail::ParallelProduct>();
   evaluate_external_force(t1, w.f1);
   // K_eff u1 = F1 + M (c0 u + c2 v + c3 a) + C (c1 u + c4 v + c5 a)
   w.pm = c0 * kin_.u + c2 * kin_.v + c3 * kin_.a;
@@ -550,13 +553,13 @@ void StructuralSolver::step(double dt) {
   if (options_.rayleigh_alpha != 0.0 || options_.rayleigh_beta != 0.0) {
     w.pc = c1 * kin_.u + c4 * kin_.v + c5 * kin_.a;
     w.pm += options_.rayleigh_alpha * w.pc;
-    w.rhs.noalias() += m_ * w.pm;
+    product_->add(m_, w.pm, w.rhs);
     if (options_.rayleigh_beta != 0.0) {
       w.pc *= options_.rayleigh_beta;
-      w.rhs.noalias() += k_ * w.pc;
+      product_->add(k_, w.pc, w.rhs);
     }
   } else {
-    w.rhs.noalias() += m_ * w.pm;
+    product_->add(m_, w.pm, w.rhs);
   }
   prescribed_values(t1, w.uc);
   w.rf.resize(static_cast<Eigen::Index>(dofs_.free_dofs().size()));
