@@ -10,7 +10,7 @@
 namespace partita::fem::detail {
 namespace {
 // Below this many entries one thread does it (a parallel region costs microseconds).
-constexpr Eigen::Index kParallelMinEntries = 200000;
+constexpr Eigen::Index kParallelMinEntries = 1000000;
 }  // namespace
 
 void ParallelProduct::add(const SparseMatrix& a, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
