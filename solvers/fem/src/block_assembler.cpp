@@ -43,11 +43,18 @@ SparseMatrix BlockAssembler::make_matrix() const {
 
 void BlockAssembler::add(SparseMatrix& a, std::span<const std::size_t> nodes,
                          const ElementMatrix& ke) const {
+  add_columns(a, nodes, ke, 0, num_nodes_);
+}
+
+void BlockAssembler::add_columns(SparseMatrix& a, std::span<const std::size_t> nodes,
+                                 const ElementMatrix& ke, std::size_t first_node,
+                                 std::size_t end_node) const {
   double* values = a.valuePtr();
   const int* outer = a.outerIndexPtr();
   const auto n = nodes.size();
   for (std::size_t b = 0; b < n; ++b) {
     const std::size_t j = nodes[b];
+    if (j < first_node || j >= end_node) continue;
     const auto first = neighbours_.begin() + static_cast<std::ptrdiff_t>(offsets_[j]);
     const auto last = neighbours_.begin() + static_cast<std::ptrdiff_t>(offsets_[j + 1]);
     for (std::size_t aa = 0; aa < n; ++aa) {

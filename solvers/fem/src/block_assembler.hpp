@@ -18,6 +18,12 @@ class BlockAssembler {
   SparseMatrix make_matrix() const;
   // A(3 a_g + r, 3 b_g + c) += Ke(3 a + r, 3 b + c) for the element's global nodes a_g, b_g.
   void add(SparseMatrix& a, std::span<const std::size_t> nodes, const ElementMatrix& ke) const;
+  // The same, only into the columns of the nodes b_g in [first_node, end_node): threads that
+  // take disjoint node ranges and the elements in the same order add every entry's
+  // contributions in element order, as add() over all elements does.
+  void add_columns(SparseMatrix& a, std::span<const std::size_t> nodes, const ElementMatrix& ke,
+                   std::size_t first_node, std::size_t end_node) const;
+  std::size_t num_nodes() const { return num_nodes_; }
 
  private:
   std::size_t num_nodes_ = 0;

@@ -6,8 +6,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <unordered_map>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "block_assembler.hpp"
 #include "parallel_product.hpp"
@@ -97,6 +102,54 @@ StructuralSolver::~StructuralSolver() = default;
 
 // ---------------------------------------------------------------- setup and assembly
 
+namespace {
+// A = sum_e A_e^T M_e A_e with M_e = element(e): the element matrices of a chunk computed in
+// parallel (each into its own slot), then added serially in element order, so A is the same,
+// bit for bit, on any number of threads. An exception of an element (a degenerate element) is
+// the one of the first element that threw, as in a serial loop. The additions are shared by
+// column ranges, each entry's in element order.
+template <class ElementFunction>
+void assemble_elements(const Mesh& mesh, const BlockAssembler& assembler, SparseMatrix& a,
+                       ElementFunction element) {
+  constexpr std::size_t kChunk = 512;
+  const auto& elements = mesh.elements();
+  const std::size_t ne = elements.size();
+  std::vector<ElementMatrix> chunk(std::min(ne, kChunk));
+  for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
+    const long n = static_cast<long>(std::min(ne - c0, kChunk));
+    std::exception_ptr error;
+    long error_at = n;
+#pragma omp parallel for schedule(static) if (n >= 64)
+    for (long i = 0; i < n; ++i) {
+      try {
+        element(elements[c0 + static_cast<std::size_t>(i)], chunk[static_cast<std::size_t>(i)]);
+      } catch (...) {
+#pragma omp critical(partita_fem_assembly_error)
+        if (i < error_at) {
+          error_at = i;
+          error = std::current_exception();
+        }
+      }
+    }
+    if (error) std::rethrow_exception(error);
+      // each thread adds into the columns of its own range of nodes, the elements in order
+#pragma omp parallel if (n >= 64)
+    {
+      std::size_t part = 0, parts = 1;
+#ifdef _OPENMP
+      part = static_cast<std::size_t>(omp_get_thread_num());
+      parts = static_cast<std::size_t>(omp_get_num_threads());
+#endif
+      const std::size_t nodes = assembler.num_nodes();
+      const std::size_t first = nodes * part / parts, end = nodes * (part + 1) / parts;
+      for (long i = 0; i < n; ++i)
+        assembler.add_columns(a, elements[c0 + static_cast<std::size_t>(i)].node_span(),
+                              chunk[static_cast<std::size_t>(i)], first, end);
+    }
+  }
+}
+}  // namespace
+
 void StructuralSolver::setup_dofs() {
   std::vector<char> constrained(ndof_, 0);
   std::vector<SpaceTimeFunction> value(ndof_);
@@ -116,17 +169,15 @@ void StructuralSolver::assemble_stiffness() {
   const auto t0 = Clock::now();
   const BlockAssembler assembler(mesh());
   k_ = assembler.make_matrix();
-  ElementMatrix ke;
   std::vector<Matrix6> d;
   for (std::size_t r = 0; r < std::max<std::size_t>(1, mesh().region_names().size()); ++r) {
     d.push_back(model_.material(static_cast<int>(r)).elasticity_matrix());
   }
   // K = sum_e A_e^T K_e A_e
-  for (const auto& e : mesh().elements()) {
+  assemble_elements(mesh(), assembler, k_, [&](const Element& e, ElementMatrix& m) {
     integrator_.stiffness(e.type, element_coordinates(mesh(), e),
-                          d[static_cast<std::size_t>(e.region)], ke);
-    assembler.add(k_, e.node_span(), ke);
-  }
+                          d[static_cast<std::size_t>(e.region)], m);
+  });
   dofs_.split(k_, k_ff_, k_fc_);
   timings_.assembly += seconds_since(t0);
 }
@@ -137,13 +188,11 @@ void StructuralSolver::assemble_mass() {
   if (options_.mass == MassType::Consistent) {
     const BlockAssembler assembler(mesh());
     m_ = assembler.make_matrix();
-    ElementMatrix me;
     // M = sum_e A_e^T M_e A_e
-    for (const auto& e : mesh().elements()) {
+    assemble_elements(mesh(), assembler, m_, [&](const Element& e, ElementMatrix& m) {
       integrator_.consistent_mass(e.type, element_coordinates(mesh(), e), model_.density(e.region),
-                                  me);
-      assembler.add(m_, e.node_span(), me);
-    }
+                                  m);
+    });
   } else {
     Eigen::VectorXd diag = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ndof_));
     Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
