@@ -189,6 +189,15 @@ std::shared_ptr<Spec> make_spec() {
                "round-off",
                {"auto", "cholmod", "eigen-ldlt"})
       .def("auto");
+  analysis
+      ->choice("solve_threading",
+               "the two triangular solves with a CHOLMOD factor (a linear static or Newmark "
+               "step): threaded (the factor's elimination tree shared among the --threads), "
+               "serial (CHOLMOD's own solve, one thread), or auto (threaded for factors of at "
+               "least 2e6 entries); results never depend on the thread count, threaded and "
+               "serial differ by round-off",
+               {"auto", "threaded", "serial"})
+      .def("auto");
   auto nonlinear = std::make_shared<Spec>(
       "nonlinear", "Newton iterations of neo-hooke and j2-plasticity (static and Newmark)");
   nonlinear->integer("max_iterations", "Newton iterations per load or time step").min(1).def(25);
@@ -445,6 +454,11 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     } else if (linear_solver == "eigen-ldlt") {
       options.linear_solver = fem::LinearSolver::EigenLdlt;
     }
+    const std::string threading = an.string("solve_threading");
+    if (threading == "threaded")
+      options.solve_threading = fem::SolveThreading::Threaded;
+    else if (threading == "serial")
+      options.solve_threading = fem::SolveThreading::Serial;
     const Node nl = an["nonlinear"];
     options.newton.max_iterations = static_cast<int>(nl.integer("max_iterations"));
     options.newton.force_tolerance = nl.real("force_tolerance");
