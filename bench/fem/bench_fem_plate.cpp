@@ -29,6 +29,10 @@
 #include <string>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "partita/fem/box_mesher.hpp"
 #include "partita/fem/linear_solver.hpp"
 #include "partita/fem/structural_solver.hpp"
@@ -242,7 +246,7 @@ void bench(const Options& opt, std::array<int, 3> cells) {
     }
   }
   // summary: ratios to the first backend (eigen-ldlt when listed) and to CalculiX
-  std::printf("  %-14s %12s %10s %10s %9s %16s %12s %10s\n", "backend", "factorise s", "nnz(L)",
+  std::printf("  %-16s %10s %10s %10s %9s %16s %12s %10s\n", "backend", "factorise s", "nnz(L)",
               "step ms", "(cpu ms)", "vs " /* first */, "ccx/partita", "|du|/|u|");
   for (std::size_t i = 0; i < results.size(); ++i) {
     const auto& r = results[i];
@@ -259,7 +263,7 @@ void bench(const Options& opt, std::array<int, 3> cells) {
       std::snprintf(cx, sizeof cx, "%.0fx", ccx / r.per_step);
     else
       std::snprintf(cx, sizeof cx, "-");
-    std::printf("  %-14s %12.3f %10.3g %10.2f %9.2f %16s %12s %10.1e\n", backends[i].name.c_str(),
+    std::printf("  %-16s %10.3f %10.3g %10.2f %9.2f %16s %12s %10.1e\n", backends[i].name.c_str(),
                 f, r.nnz_l, 1e3 * r.per_step, 1e3 * r.per_step_cpu, vs, cx, std::max(du, dv));
   }
   std::printf(
@@ -274,6 +278,14 @@ void bench(const Options& opt, std::array<int, 3> cells) {
 }
 
 }  // namespace
+
+int max_threads() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
 
 int main(int argc, char** argv) {
   Options opt;
@@ -318,8 +330,9 @@ int main(int argc, char** argv) {
     if (opt.meshes.empty()) opt.meshes = {{20, 20, 2}, {40, 40, 4}};
     std::printf(
         "bench_fem_plate: seed plate, %d steps of %g s. Wall-clock timings on a possibly shared "
-        "machine.\n",
-        opt.steps, opt.dt);
+        "machine. OpenMP threads: %d (cholmod-nesdis-t's solve, the step's products, the "
+        "assembly); threaded-solve kernels: %s\n",
+        opt.steps, opt.dt, max_threads(), threaded_solve_kernels().c_str());
     for (const auto& c : opt.meshes) bench(opt, c);
   } catch (const std::exception& e) {
     std::cerr << "bench_fem_plate: " << e.what() << "\n";
