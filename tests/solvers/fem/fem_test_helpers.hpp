@@ -24,6 +24,25 @@ class Lcg {
   unsigned long long s_;
 };
 
+// The seed plate of bench_fem_plate (20 x 20 x 2 mm steel, E = 250 GPa, nu = 0.3, rho = 7850;
+// lateral nodes fixed in x and y, bottom corners in z, 10 kPa on the top face: the corners carry
+// p A = 4 N), n x n x nz Hex8 cells.
+inline Model seed_plate(int n, int nz) {
+  const double lx = 0.02, ly = 0.02, tol = 1e-12;
+  Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(lx, ly, 0.002), {n, n, nz}, ElementType::Hex8});
+  mesh.add_node_set_where("lateral", [&](const Vec3& x) {
+    return x[0] < tol || x[0] > lx - tol || x[1] < tol || x[1] > ly - tol;
+  });
+  mesh.add_node_set_where("corners", [&](const Vec3& x) {
+    return x[2] < tol && (x[0] < tol || x[0] > lx - tol) && (x[1] < tol || x[1] > ly - tol);
+  });
+  Model model(mesh, Material{250e9, 0.3, 7850});
+  model.fix("lateral", {0, 1});
+  model.fix("corners", {2});
+  model.add_pressure("zmax", 10e3);
+  return model;
+}
+
 // Union of node sets.
 inline void add_union_set(Mesh& mesh, const std::string& name,
                           const std::vector<std::string>& sets) {

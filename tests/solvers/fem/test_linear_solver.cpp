@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 
+#include "fem_test_helpers.hpp"
 #include "partita/fem/box_mesher.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/linear_solver.hpp"
@@ -14,26 +15,9 @@
 #include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
+using partita::fem::test::seed_plate;
 
 namespace {
-
-// The seed plate of bench_fem_plate (20 x 20 x 2 mm steel, lateral nodes fixed in x and y,
-// bottom corners in z, 10 kPa on the top face), n x n x nz Hex8 cells.
-Model seed_plate(int n, int nz) {
-  const double lx = 0.02, ly = 0.02, tol = 1e-12;
-  Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(lx, ly, 0.002), {n, n, nz}, ElementType::Hex8});
-  mesh.add_node_set_where("lateral", [&](const Vec3& x) {
-    return x[0] < tol || x[0] > lx - tol || x[1] < tol || x[1] > ly - tol;
-  });
-  mesh.add_node_set_where("corners", [&](const Vec3& x) {
-    return x[2] < tol && (x[0] < tol || x[0] > lx - tol) && (x[1] < tol || x[1] > ly - tol);
-  });
-  Model model(mesh, Material{250e9, 0.3, 7850});
-  model.fix("lateral", {0, 1});
-  model.fix("corners", {2});
-  model.add_pressure("zmax", 10e3);
-  return model;
-}
 
 double relative_difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return (a - b).norm() / b.norm();

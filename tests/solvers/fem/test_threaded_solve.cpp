@@ -14,11 +14,13 @@
 #include <omp.h>
 #endif
 
+#include "fem_test_helpers.hpp"
 #include "partita/fem/box_mesher.hpp"
 #include "partita/fem/linear_solver.hpp"
 #include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
+using partita::fem::test::seed_plate;
 
 namespace {
 
@@ -69,24 +71,6 @@ void use_threads(int n) {
 #else
   (void)n;
 #endif
-}
-
-// The seed plate of bench_fem_plate (20 x 20 x 2 mm steel, lateral nodes fixed in x and y,
-// bottom corners in z, 10 kPa on the top face), n x n x nz Hex8 cells.
-Model seed_plate(int n, int nz) {
-  const double tol = 1e-12, l = 0.02;
-  Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(l, l, 0.002), {n, n, nz}, ElementType::Hex8});
-  mesh.add_node_set_where("lateral", [&](const Vec3& x) {
-    return x[0] < tol || x[0] > l - tol || x[1] < tol || x[1] > l - tol;
-  });
-  mesh.add_node_set_where("corners", [&](const Vec3& x) {
-    return x[2] < tol && (x[0] < tol || x[0] > l - tol) && (x[1] < tol || x[1] > l - tol);
-  });
-  Model model(mesh, Material{250e9, 0.3, 7850});
-  model.fix("lateral", {0, 1});
-  model.fix("corners", {2});
-  model.add_pressure("zmax", 10e3);
-  return model;
 }
 
 }  // namespace
