@@ -15,7 +15,6 @@
 #endif
 
 #include "block_assembler.hpp"
-#include "parallel_product.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/linear_elastic_operator.hpp"
 #include "partita/fem/quadrature.hpp"
@@ -594,7 +593,6 @@ void StructuralSolver::step(double dt) {
 
   // work vectors are members: no allocation once sized
   Work& w = work_;
-  if (!product_) product_ = std::make_unique<detail::ParallelProduct>();
   evaluate_external_force(t1, w.f1);
   // K_eff u1 = F1 + M (c0 u + c2 v + c3 a) + C (c1 u + c4 v + c5 a)
   w.pm = c0 * kin_.u + c2 * kin_.v + c3 * kin_.a;
@@ -602,13 +600,13 @@ void StructuralSolver::step(double dt) {
   if (options_.rayleigh_alpha != 0.0 || options_.rayleigh_beta != 0.0) {
     w.pc = c1 * kin_.u + c4 * kin_.v + c5 * kin_.a;
     w.pm += options_.rayleigh_alpha * w.pc;
-    product_->add(m_, w.pm, w.rhs);
+    w.rhs.noalias() += m_ * w.pm;
     if (options_.rayleigh_beta != 0.0) {
       w.pc *= options_.rayleigh_beta;
-      product_->add(k_, w.pc, w.rhs);
+      w.rhs.noalias() += k_ * w.pc;
     }
   } else {
-    product_->add(m_, w.pm, w.rhs);
+    w.rhs.noalias() += m_ * w.pm;
   }
   prescribed_values(t1, w.uc);
   w.rf.resize(static_cast<Eigen::Index>(dofs_.free_dofs().size()));

@@ -21,23 +21,23 @@ constexpr int kSupernodeBlock = 64;
 
 struct SupernodalKernels {
   const char* name;
-  // y_s = L_ss^-1 y_s on the columns [j0, j1) of the block, rows below the block untouched
-  void (*forward_triangle)(const SupernodeBlock& b, double* y, int j0, int j1);
-  // y_s[i] -= sum_{j in [j0, j1)} L_ij y_j for the own rows i in [r0, r1), j ascending
-  void (*forward_rows_below)(const SupernodeBlock& b, double* y, int j0, int j1, int r0, int r1);
-  // w[i - r0] = sum_j L_ij y_j over all own columns (ascending), rows i in [r0, r1)
-  void (*forward_offdiagonal)(const SupernodeBlock& b, const double* y, int r0, int r1, double* w);
-  // the transposed triangle of the columns [j0, j1): y_j for j descending
-  void (*backward_triangle)(const SupernodeBlock& b, double* y, int j0, int j1);
-  // ys[j] -= L(r0 .. r0+m-1, j) . v for the columns j in [c0, c1)
-  void (*columns_dot)(const SupernodeBlock& b, const double* v, int r0, int m, double* ys, int c0,
-                      int c1);
-  // a whole supernode by one thread, the same sums as the kernels above in the shared order;
-  // forward: off-diagonal updates of rows below inside_end go to y, the others are added to
-  // outside; w, g: work space of nrow - ncol doubles
+  // One supernode by one thread. Forward: y_s = L_ss^-1 y_s (row i's updates subtracted in
+  // ascending column order, blocks of kSupernodeBlock columns), then w = L_os y_s (each row's sum
+  // over the columns ascending); the off-diagonal rows below inside_end get y_r -= w, the others
+  // outside[r] += w. Backward: y_s -= L_os^T g (g: y gathered at the off-diagonal rows), then
+  // y_s = L_ss^-T y_s by blocks from the last. w, g: work space of nrow - ncol doubles.
   void (*forward_serial)(const SupernodeBlock& b, double* y, double* w, int inside_end,
                          double* outside);
   void (*backward_serial)(const SupernodeBlock& b, double* y, double* g);
+  // The pieces, for a supernode whose rows or columns the threads share (the same sums):
+  // the diagonal triangle forward (all of it: y_s = L_ss^-1 y_s);
+  void (*forward_diagonal)(const SupernodeBlock& b, double* y);
+  // w[i - r0] = sum_j L_ij y_j over all own columns (ascending), off-diagonal rows [r0, r1);
+  void (*forward_offdiagonal)(const SupernodeBlock& b, const double* y, int r0, int r1, double* w);
+  // y_j -= L(ncol .. nrow-1, j) . g for the columns j in [c0, c1) (c0 even: pairs as the serial);
+  void (*backward_offdiagonal)(const SupernodeBlock& b, const double* g, double* y, int c0, int c1);
+  // the diagonal triangle backward (all of it: y_s = L_ss^-T y_s)
+  void (*backward_diagonal)(const SupernodeBlock& b, double* y);
 };
 
 // The best set this processor runs (AVX2 + FMA or SSE2), chosen on the first call.

@@ -5,15 +5,17 @@
 // Why: a transient step with a factorised K_eff is two triangular solves, and these are
 // memory-bound (the whole factor is read twice a step: 650 MB at 263k dofs). One core streams
 // about half of what two cores do, and CHOLMOD's solve uses one (OpenBLAS serial, for
-// determinism). This solve splits the supernodal elimination tree:
-//  - the subtrees below a cut are independent tasks (one thread each; a forward update that
-//    leaves a subtree goes into the task's own buffer, added to the ancestors afterwards in
-//    task order);
-//  - the supernodes above the cut (the top separators of a nested-dissection ordering, few and
-//    large) are taken one at a time, their rows or columns shared among the threads.
-// Determinism: the cut, the tasks and every sum's order depend on the factor's structure only,
-// never on the number of threads or on which thread runs a task, so the solution is the same bit
-// for bit on any thread count (it differs from CHOLMOD's own solve by round-off).
+// determinism). This solve cuts the supernodal elimination tree at a few levels of subtree work
+// (1/256, 1/32, 1/4 of the factor's entries): the tasks of a level are the largest subtrees
+// below its limit, less the tasks of the lower levels, and are independent of each other. A
+// thread takes a whole task; a forward update that leaves a task goes into the task's own
+// buffer, and the buffers are added to the ancestors in a fixed order once the level is done.
+// What is left (the top separators, whose subtrees hold over a quarter of the work) is taken one
+// supernode at a time, the rectangle below a large one's triangle shared by rows or columns.
+// So a solve has few barriers (a thread that the system deschedules holds up each one), and the
+// cut, the tasks and every sum's order depend on the factor's structure only, never on the number
+// of threads or on which thread runs a task: the solution is the same bit for bit on any thread
+// count (it differs from CHOLMOD's own solve by round-off).
 #include <vector>
 
 namespace partita::fem::detail {
@@ -38,29 +40,28 @@ class SupernodalSolve {
   // OpenMP threads available (omp_get_max_threads()); no allocation after the first call.
   void solve(const SupernodalFactor& f, const double* b, double* x);
 
-  int tasks() const { return static_cast<int>(task_root_.size()); }
+  // the levels of tasks (the last level, taken supernode by supernode, not counted)
+  int levels() const { return static_cast<int>(level_begin_.size()) - 1; }
+  int tasks(int level) const { return level_begin_[level + 1] - level_begin_[level]; }
   int top_supernodes() const { return static_cast<int>(top_.size()); }
-  // share of the factor's entries in the top part (taken one supernode at a time)
-  double top_share() const { return top_share_; }
-  // share of the factor's entries in the diagonal triangles of the top supernodes
-  double top_triangle_share() const { return top_triangle_; }
+  // share of the factor's entries in the tasks of a level (levels(): the last level's)
+  double share(int level) const { return level_share_[static_cast<std::size_t>(level)]; }
 
  private:
   void forward_task(const SupernodalFactor& f, int t, double* y, double* scratch);
   void backward_task(const SupernodalFactor& f, int t, double* y, double* g);
 
-  std::vector<int> task_first_, task_root_;  // task t: supernodes task_first_[t] .. task_root_[t]
-  std::vector<int> task_buffer_begin_;       // task t's buffer: buffer_[begin[t] .. begin[t+1])
-  std::vector<int> top_;                     // the supernodes above the cut, ascending
-  struct TopStep {
-    int first, last;  // supernodes first .. last (ascending) of the top
-    bool shared;      // one large supernode shared by the threads, else a run for one thread
-  };
-  std::vector<TopStep> top_steps_;
-  std::vector<double> buffer_;                // forward updates leaving a task, per task
-  std::vector<std::vector<double>> scratch_;  // per thread, size n, zero between tasks
-  std::vector<double> y_, work_;              // permuted right-hand side; top-part work space
-  double top_share_ = 0.0, top_triangle_ = 0.0;
+  // task t: supernodes members_[member_begin_[t] .. member_begin_[t+1]) (ascending), the last
+  // one its root; the tasks of level l: level_begin_[l] .. level_begin_[l+1]
+  std::vector<int> members_, member_begin_, level_begin_;
+  std::vector<int> buffer_begin_;  // task t's buffer: buffer_[begin[t] .. begin[t+1])
+  std::vector<double> buffer_;     // forward updates leaving a task, per task
+  std::vector<double> level_share_;
+  std::vector<int> top_;                      // the last level's supernodes, ascending
+  std::vector<double> work_;                  // the last level's gathered rows
+  std::vector<std::vector<double>> scratch_;  // per thread: n (zero between tasks) + work space
+  std::vector<double> y_;                     // the permuted right-hand side and solution
+  int widest_ = 0;                            // most off-diagonal rows of a supernode
 };
 
 }  // namespace partita::fem::detail

@@ -193,9 +193,9 @@ TEST_CASE("threaded solve: automatic only for large factors, same plate results 
 
 TEST_CASE("threaded solve: a Newmark run of the plate gives the same bits on 1 and 2 threads",
           "[fem][linear-solver][threaded-solve]") {
-  // 40 x 40 x 2 cells: the step's mass product (about 1e6 entries) is shared among the threads
-  // too; on one thread it is Eigen's own product, so equal bits on 1 and 2 threads also say
-  // that the shared product adds exactly what Eigen's does. Rayleigh damping brings in K v.
+  // 40 x 40 x 2 cells: the assembly of K and M is shared among the threads too (element
+  // matrices in parallel, added by column ranges in element order); Rayleigh damping brings in
+  // K v.
   const Model model = seed_plate(40, 2);
   const int before = threads_available();
   for (auto threading : {SolveThreading::Serial, SolveThreading::Threaded}) {

@@ -22,12 +22,6 @@
 #include "partita/fem/structural_system.hpp"
 
 namespace partita::fem {
-namespace detail {
-class ParallelProduct;  // y += A x with the rows shared among threads (parallel_product.hpp)
-}
-}  // namespace partita::fem
-
-namespace partita::fem {
 
 // Static and transient structural analysis of a Model.
 //
@@ -235,7 +229,6 @@ class StructuralSolver final : private StructuralSystem {
     Eigen::VectorXd f1, pm, pc, rhs, uc, rf, uf, u1, a1;
   };
   Work work_;
-  std::unique_ptr<detail::ParallelProduct> product_;  // the step's M and K products
 
   SolverTimings timings_;
 };
