@@ -144,7 +144,7 @@ TEST_CASE("threaded solve: the same bits on 1, 2, 3 and 4 threads and on every r
 }
 
 TEST_CASE("threaded solve: automatic only for large factors, same plate results either way",
-          "[fem][linear-solver][threaded-solve]") {
+          "[fem][linear-solver][threaded-solve][slow]") {
   if (!cholmod_available()) {
     WARN("built without CHOLMOD: the threaded solve works on CHOLMOD's factor");
     return;
@@ -192,7 +192,7 @@ TEST_CASE("threaded solve: automatic only for large factors, same plate results 
 }
 
 TEST_CASE("threaded solve: a Newmark run of the plate gives the same bits on 1 and 2 threads",
-          "[fem][linear-solver][threaded-solve]") {
+          "[fem][linear-solver][threaded-solve][slow]") {
   // 40 x 40 x 2 cells: the assembly of K and M is shared among the threads too (element
   // matrices in parallel, added by column ranges in element order); Rayleigh damping brings in
   // K v.
