@@ -7,7 +7,9 @@
 namespace partita::fem::detail {
 
 // v4 values passed between the kernels' own (internal, inlined) functions: no ABI concern
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__clang__)
+#pragma clang diagnostic ignored "-Wpsabi"
+#elif defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
