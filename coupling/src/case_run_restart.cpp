@@ -45,15 +45,18 @@ std::vector<std::pair<std::int64_t, fs::path>> restart_files(const fs::path& dir
   return files;
 }
 
-// |v_q|^2 of each row into `norm2` (column by column: contiguous passes over the column-major
-// array; the caller keeps `norm2`, no allocation per window).
-void row_norms2(const Eigen::MatrixXd& v, Eigen::ArrayXd& norm2) {
+// |v_q| of each row into `norm` (column by column: contiguous passes over the column-major
+// array; the caller keeps `norm`, no allocation per window). One square root per row, taken
+// once: the totals below and the bound in audit_balance() read the same values.
+void row_norms(const Eigen::MatrixXd& v, Eigen::ArrayXd& norm) {
   if (v.cols() == 3) {  // vectors: one fused pass, the same sums ((x^2 + y^2) + z^2)
-    norm2 = v.col(0).array().square() + v.col(1).array().square() + v.col(2).array().square();
+    norm =
+        (v.col(0).array().square() + v.col(1).array().square() + v.col(2).array().square()).sqrt();
     return;
   }
-  norm2 = v.col(0).array().square();
-  for (Eigen::Index c = 1; c < v.cols(); ++c) norm2 += v.col(c).array().square();
+  norm = v.col(0).array().square();
+  for (Eigen::Index c = 1; c < v.cols(); ++c) norm += v.col(c).array().square();
+  norm = norm.sqrt();
 }
 
 // Sum (extensive data) or integral over the point weights (intensive data) of each component.
@@ -65,10 +68,10 @@ void component_totals(const Eigen::MatrixXd& v, const Mesh& mesh, bool extensive
     sum.noalias() = v.transpose() * mesh.weights();
 }
 
-// The same of the magnitudes, from row_norms2(): the scale the imbalance is measured against.
-double magnitude_total(const Eigen::ArrayXd& norm2, const Mesh& mesh, bool extensive) {
-  if (extensive) return norm2.sqrt().sum();
-  return (norm2.sqrt() * mesh.weights().array().abs()).sum();
+// The same of the magnitudes, from row_norms(): the scale the imbalance is measured against.
+double magnitude_total(const Eigen::ArrayXd& norm, const Mesh& mesh, bool extensive) {
+  if (extensive) return norm.sum();
+  return (norm * mesh.weights().array().abs()).sum();
 }
 
 }  // namespace
@@ -291,17 +294,17 @@ const std::vector<double>& CaseRun::audit_balance() {
     const bool extensive = e->spec().kind == DataKind::extensive;
     component_totals(e->sent(), e->source_mesh(), extensive, audit_sent_);
     component_totals(e->received(), e->target_mesh(), extensive, audit_received_);
-    row_norms2(e->sent(), audit_norm2_);
-    const double ss = magnitude_total(audit_norm2_, e->source_mesh(), extensive);
+    row_norms(e->sent(), audit_norm_);
+    const double ss = magnitude_total(audit_norm_, e->source_mesh(), extensive);
     // scale = max(|sent|, |received|) (totals of the magnitudes). Where the bound above shows
     // |received| <= |sent| to 1e-12 (consistent area-balanced when sum(w) <= sum(A); conservative
     // mappers with W >= 0), the received magnitudes are not summed: the scale is then the same
     // to 1e-12 relative.
     const Eigen::VectorXd& u = audit_bounds_[i];
     double scale = ss;
-    if (u.size() == 0 || (audit_norm2_.sqrt() * u.array()).sum() > ss * (1.0 + 1e-12)) {
-      row_norms2(e->received(), audit_norm2_);
-      scale = std::max(ss, magnitude_total(audit_norm2_, e->target_mesh(), extensive));
+    if (u.size() == 0 || (audit_norm_ * u.array()).sum() > ss * (1.0 + 1e-12)) {
+      row_norms(e->received(), audit_norm_);
+      scale = std::max(ss, magnitude_total(audit_norm_, e->target_mesh(), extensive));
     }
     imbalance_[i] = scale > 0.0 ? (audit_received_ - audit_sent_).norm() / scale : 0.0;
   }

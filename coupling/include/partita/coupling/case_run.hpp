@@ -161,7 +161,7 @@ class CaseRun {
   double balance_tolerance_ = 0.01;
   std::vector<double> imbalance_;  // audit_balance()'s result and scratch space, kept between
   Eigen::VectorXd audit_sent_, audit_received_;  // windows (no allocation per window)
-  Eigen::ArrayXd audit_norm2_;
+  Eigen::ArrayXd audit_norm_;
   std::vector<Eigen::VectorXd> audit_bounds_;  // per audited exchange: W^T omega (or empty)
   // the energy audit: two participants that read from each other, each with the meshes it reads
   // the other's data on (where its solver reports Solver::interface_work)
