@@ -709,8 +709,8 @@ void CaseRun::run() {
   for (auto& m : monitors_) {
     std::vector<std::pair<std::string, std::string>> mc;
     for (const auto& [p, q] : m.quantities) {
-      std::string unit;
-      for (const auto& v : p->solver().monitors())
+      std::string unit;  // only that quantity: monitors() would compute every one (energies)
+      for (const auto& v : p->solver().monitor_values({q}))
         if (v.name == q) unit = v.unit;
       mc.emplace_back(p->name() + "." + q, unit);
     }
