@@ -832,10 +832,11 @@ void CaseRun::run() {
       summary_.iterations += r.iterations;
       summary_.max_window_iterations = std::max(summary_.max_window_iterations, r.iterations);
       if (!r.converged) ++summary_.unconverged_windows;
-      check_window(n + 1, t);
+      // the audit first: where its totals are finite, the check need not read the values again
+      const std::vector<double>& imbalance = audit_balance();
+      check_window(n + 1, t, true);
       row.assign({t, static_cast<double>(r.iterations)});  // keeps its capacity
       row.insert(row.end(), r.residuals.begin(), r.residuals.end());
-      const std::vector<double>& imbalance = audit_balance();
       row.insert(row.end(), imbalance.begin(), imbalance.end());
       for (auto& p : energy_pairs_) {
         const EnergyAudit a = audit_energy(p);

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "elementwise.hpp"
 #include "partita/coupling/case_run.hpp"
 #include "partita/coupling/mapping/sparse_mapper.hpp"
 #include "partita/coupling/stopwatch.hpp"
@@ -50,8 +51,8 @@ std::vector<std::pair<std::int64_t, fs::path>> restart_files(const fs::path& dir
 // once: the totals below and the bound in audit_balance() read the same values.
 void row_norms(const Eigen::MatrixXd& v, Eigen::ArrayXd& norm) {
   if (v.cols() == 3) {  // vectors: one fused pass, the same sums ((x^2 + y^2) + z^2)
-    norm =
-        (v.col(0).array().square() + v.col(1).array().square() + v.col(2).array().square()).sqrt();
+    norm.resize(v.rows());
+    elementwise::norms3(norm.data(), v.col(0).data(), v.col(1).data(), v.col(2).data(), v.rows());
     return;
   }
   norm = v.col(0).array().square();
@@ -257,9 +258,14 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
   in.expect_section("end");
 }
 
-void CaseRun::check_window(std::int64_t window, double time) {
+void CaseRun::check_window(std::int64_t window, double time, bool after_audit) {
   for (const auto& e : exchanges_) {
     const Exchange& x = *e;
+    if (after_audit) {
+      const auto a = std::find(audited_.begin(), audited_.end(), &x);
+      if (a != audited_.end() && audit_finite_[static_cast<std::size_t>(a - audited_.begin())])
+        continue;  // sent and received both summed to finite totals in audit_balance()
+    }
     for (const bool sent : {true, false}) {
       const Eigen::MatrixXd* side = sent ? &x.sent() : &x.received();
       // One vectorised pass per window; the count below only runs on the way to the error.
@@ -304,11 +310,15 @@ const std::vector<double>& CaseRun::audit_balance() {
     }
   }
   imbalance_.resize(audited_.size());
+  audit_finite_.resize(audited_.size());
   for (std::size_t i = 0; i < audited_.size(); ++i) {
     const Exchange* e = audited_[i];
     const bool extensive = e->spec().kind == DataKind::extensive;
     component_totals(e->sent(), e->source_mesh(), extensive, audit_sent_);
     component_totals(e->received(), e->target_mesh(), extensive, audit_received_);
+    // A NaN or an infinity among the values makes its total NaN or infinite (weights are finite
+    // and >= 0; 0 times an infinity is NaN): finite totals let check_window() skip the values.
+    audit_finite_[i] = std::isfinite(audit_sent_.sum()) && std::isfinite(audit_received_.sum());
     row_norms(e->sent(), audit_norm_);
     const double ss = magnitude_total(audit_norm_, e->source_mesh(), extensive);
     // scale = max(|sent|, |received|) (totals of the magnitudes). Where the bound above shows

@@ -128,7 +128,10 @@ class CaseRun {
   void write_restart_file(const Progress& progress);
   void read_restart_file(const std::filesystem::path& file, Progress& progress);
   std::filesystem::path newest_restart_file() const;
-  void check_window(std::int64_t window, double time);
+  /// Stops the run (throws) on non-finite exchanged values or a solver's own finding. With
+  /// `after_audit`, the exchanges whose audit totals of this window were finite are not read
+  /// again: a finite total has only finite terms.
+  void check_window(std::int64_t window, double time, bool after_audit = false);
   /// Per audited exchange: |received total - sent total| / scale (into imbalance_).
   const std::vector<double>& audit_balance();
   std::string restart_blocker() const;  // why restart files cannot be written ("": they can)
@@ -162,6 +165,7 @@ class CaseRun {
   std::vector<double> imbalance_;  // audit_balance()'s result and scratch space, kept between
   Eigen::VectorXd audit_sent_, audit_received_;  // windows (no allocation per window)
   Eigen::ArrayXd audit_norm_;
+  std::vector<char> audit_finite_;  // per audited exchange: this window's totals were finite
   std::vector<Eigen::VectorXd> audit_bounds_;  // per audited exchange: W^T omega (or empty)
   // the energy audit: two participants that read from each other, each with the meshes it reads
   // the other's data on (where its solver reports Solver::interface_work)
