@@ -31,8 +31,16 @@ __attribute__((target("avx"))) std::ptrdiff_t mean_step_avx(double* mean, const 
   for (; i + 4 <= n; i += 4) {
     const __m256d m = _mm256_loadu_pd(mean + i);
     const __m256d d = _mm256_sub_pd(_mm256_loadu_pd(x + i), m);
-    const __m256d q = multiply ? _mm256_mul_pd(d, kk) : _mm256_div_pd(d, kk);
-    _mm256_storeu_pd(mean + i, _mm256_add_pd(m, q));
+    // Where the 4 differences are all 0 (no change: interface points without contact), d / k
+    // is d itself (a zero of the same sign): the division is skipped, the sum still done.
+    const bool all_zero =
+        _mm256_movemask_pd(_mm256_cmp_pd(d, _mm256_setzero_pd(), _CMP_NEQ_UQ)) == 0;
+    if (all_zero)
+      _mm256_storeu_pd(mean + i, _mm256_add_pd(m, d));
+    else if (multiply)
+      _mm256_storeu_pd(mean + i, _mm256_add_pd(m, _mm256_mul_pd(d, kk)));
+    else
+      _mm256_storeu_pd(mean + i, _mm256_add_pd(m, _mm256_div_pd(d, kk)));
   }
   return i;
 }
@@ -59,7 +67,14 @@ __attribute__((target("avx"))) std::ptrdiff_t norms3_avx(double* out, const doub
     const __m256d yy = _mm256_loadu_pd(y + i);
     const __m256d zz = _mm256_loadu_pd(z + i);
     const __m256d xy = _mm256_add_pd(_mm256_mul_pd(xx, xx), _mm256_mul_pd(yy, yy));
-    _mm256_storeu_pd(out + i, _mm256_sqrt_pd(_mm256_add_pd(xy, _mm256_mul_pd(zz, zz))));
+    const __m256d n2 = _mm256_add_pd(xy, _mm256_mul_pd(zz, zz));
+    // 4 zero vectors (+0: a sum of squares): sqrt(+0) = +0, the square root is skipped
+    const bool all_zero =
+        _mm256_movemask_pd(_mm256_cmp_pd(n2, _mm256_setzero_pd(), _CMP_NEQ_UQ)) == 0;
+    if (all_zero)
+      _mm256_storeu_pd(out + i, n2);
+    else
+      _mm256_storeu_pd(out + i, _mm256_sqrt_pd(n2));
   }
   return i;
 }
