@@ -68,62 +68,64 @@ Eigen::MatrixXd values(Eigen::Index n, std::mt19937& g) {
   return v;
 }
 
+// Two participants of n points and the exchange of "f" between them (no mapper). 1539 rows x 3:
+// neither a multiple of 2 nor of 4 values (the vector loops' remainders run too).
+struct Pair {
+  static constexpr Eigen::Index n = 1539;
+  std::unique_ptr<Participant> a =
+      std::make_unique<Participant>("a", std::make_unique<ArraySolver>(n, DataKind::extensive));
+  std::unique_ptr<Participant> b =
+      std::make_unique<Participant>("b", std::make_unique<ArraySolver>(n, DataKind::extensive));
+  Exchange exchange{"f", {a.get(), "points"}, {b.get(), "points"}, DataSpec{"f", 3, "N"}, nullptr};
+};
+
 }  // namespace
 
-TEST_CASE("Exchange: the substep average is the running mean of its formula, bit for bit",
-          "[coupling][exchange]") {
-  // 1539 rows x 3: neither a multiple of 2 nor of 4 values (the vector loops' remainders too)
-  const Eigen::Index n = 1539;
-  auto a =
-      std::make_unique<Participant>("a", std::make_unique<ArraySolver>(n, DataKind::extensive));
-  auto b =
-      std::make_unique<Participant>("b", std::make_unique<ArraySolver>(n, DataKind::extensive));
-  Exchange e("f", {a.get(), "points"}, {b.get(), "points"}, DataSpec{"f", 3, "N"}, nullptr);
+TEST_CASE(
+    "Exchange: the substep average and the time interpolation follow their formulas bit "
+    "for bit",
+    "[coupling][exchange]") {
+  Pair pair;
+  Exchange& e = pair.exchange;
+  const Eigen::Index n = Pair::n;
   std::mt19937 g(7);
-  for (int m = 1; m <= 9; ++m) {
-    INFO("substeps " << m);
-    e.begin_collect();
-    Eigen::MatrixXd mean;
-    for (int k = 1; k <= m; ++k) {
-      const Eigen::MatrixXd v = values(n, g);
-      e.collect(v);
-      // f̄_k = f̄_{k-1} + (f_k - f̄_{k-1}) / k, f̄_1 = f_1 (Eigen's own elementwise evaluation)
-      if (k == 1)
-        mean = v;
-      else
-        mean = mean + (v - mean) / static_cast<double>(k);
+  SECTION("the average of m substeps is the running mean") {
+    for (int m = 1; m <= 9; ++m) {
+      INFO("substeps " << m);
+      e.begin_collect();
+      Eigen::MatrixXd mean;
+      for (int k = 1; k <= m; ++k) {
+        const Eigen::MatrixXd v = values(n, g);
+        e.collect(v);
+        // f̄_k = f̄_{k-1} + (f_k - f̄_{k-1}) / k, f̄_1 = f_1 (Eigen's own elementwise evaluation)
+        if (k == 1)
+          mean = v;
+        else
+          mean = mean + (v - mean) / static_cast<double>(k);
+      }
+      e.finish_collect();
+      CHECK(same_bits(e.combined(), mean));
     }
+    // a constant output averages to itself exactly
+    const Eigen::MatrixXd c = values(n, g);
+    e.begin_collect();
+    for (int k = 0; k < 7; ++k) e.collect(c);
     e.finish_collect();
-    CHECK(same_bits(e.combined(), mean));
+    CHECK((e.combined().array() == c.array()).all());
   }
-  // a constant output averages to itself exactly
-  const Eigen::MatrixXd c = values(n, g);
-  e.begin_collect();
-  for (int k = 0; k < 7; ++k) e.collect(c);
-  e.finish_collect();
-  CHECK((e.combined().array() == c.array()).all());
-}
-
-TEST_CASE("Exchange: the reader sees d_n + (k/m) (d_n+1 - d_n), bit for bit",
-          "[coupling][exchange]") {
-  const Eigen::Index n = 1539;
-  auto a =
-      std::make_unique<Participant>("a", std::make_unique<ArraySolver>(n, DataKind::extensive));
-  auto b =
-      std::make_unique<Participant>("b", std::make_unique<ArraySolver>(n, DataKind::extensive));
-  Exchange e("f", {a.get(), "points"}, {b.get(), "points"}, DataSpec{"f", 3, "N"}, nullptr);
-  std::mt19937 g(11);
-  const Eigen::MatrixXd d0 = values(n, g), d1 = values(n, g);
-  e.initialize(d0);
-  e.sent() = d1;
-  e.transmit();
-  Eigen::MatrixXd scratch;
-  for (int k = 1; k < 7; ++k) {
-    const double s = static_cast<double>(k) / 7.0;
-    const Eigen::MatrixXd expected = d0 + s * (d1 - d0);
-    CHECK(same_bits(e.read_at(s, scratch), expected));
+  SECTION("the reader sees d_n + (k/m) (d_n+1 - d_n)") {
+    const Eigen::MatrixXd d0 = values(n, g), d1 = values(n, g);
+    e.initialize(d0);
+    e.sent() = d1;
+    e.transmit();
+    Eigen::MatrixXd scratch;
+    for (int k = 1; k < 7; ++k) {
+      const double s = static_cast<double>(k) / 7.0;
+      const Eigen::MatrixXd expected = d0 + s * (d1 - d0);
+      CHECK(same_bits(e.read_at(s, scratch), expected));
+    }
+    CHECK(same_bits(e.read_at(1.0, scratch), d1));
   }
-  CHECK(same_bits(e.read_at(1.0, scratch), d1));
 }
 
 TEST_CASE("a NaN in an audited exchange stops the run with the exchange and the window",
