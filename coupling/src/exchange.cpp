@@ -64,12 +64,27 @@ void Exchange::collect(const Eigen::MatrixXd& values) {
 
 void Exchange::finish_collect() {
   // average: f_{n+1} = 1/m Σ_{k=1..m} f_{n,k} (the running mean);  last: f_{n+1} = f_{n,m}
+  combined_is_sent_ = false;
   if (collected_ == 0) {
     combined_.setZero(from_points_, spec_.components);
     return;
   }
   // The next begin_collect()/collect() overwrite accumulated_ whole: swap instead of a copy.
   combined_.swap(accumulated_);
+}
+
+Eigen::MatrixXd& Exchange::sent() {
+  if (combined_is_sent_) {  // the caller may change sent: combined keeps its own copy
+    combined_ = sent_;
+    combined_is_sent_ = false;
+  }
+  return sent_;
+}
+
+void Exchange::send_combined() {
+  if (combined_is_sent_) return;
+  sent_.swap(combined_);
+  combined_is_sent_ = true;
 }
 
 void Exchange::transmit() {
@@ -96,6 +111,7 @@ const Eigen::MatrixXd& Exchange::read_at(double fraction, Eigen::MatrixXd& scrat
 void Exchange::initialize(const Eigen::MatrixXd& initial) {
   check_shape(initial, "gave as initial data");
   combined_ = initial;
+  combined_is_sent_ = false;
   sent_ = initial;
   previous_ = initial;
   transmit();
@@ -105,13 +121,14 @@ void Exchange::initialize(const Eigen::MatrixXd& initial) {
 void Exchange::write_state(BinaryWriter& out) const {
   out.section("exchange " + label());
   for (const Eigen::MatrixXd* m :
-       {&combined_, &sent_, &previous_, start_is_end_ ? &end_ : &start_, &end_})
+       {&combined(), &sent_, &previous_, start_is_end_ ? &end_ : &start_, &end_})
     out.write(*m);
 }
 
 void Exchange::read_state(BinaryReader& in) {
   in.expect_section("exchange " + label());
   for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) in.read(*m);
+  combined_is_sent_ = false;
   start_is_end_ = false;
   const Eigen::Index sender = from_points_;
   const Eigen::Index receiver = target_mesh_->size();

@@ -65,7 +65,7 @@ void CouplingScheme::run_participant(Participant& p, const TimeWindow& window) {
 void CouplingScheme::send_outputs(const Participant& p) {
   for (Exchange* e : exchanges_) {
     if (&e->from() != &p) continue;
-    e->sent() = e->combined();
+    e->send_combined();  // sent = combined (a swap, no copy)
     e->transmit();
   }
 }
