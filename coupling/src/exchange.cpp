@@ -62,6 +62,13 @@ void Exchange::collect(const Eigen::MatrixXd& values) {
                          static_cast<double>(collected_));
 }
 
+void Exchange::collect_taking(Eigen::MatrixXd& values) {
+  if (writer_combines_ == WriterCombines::average && collected_ > 0) return collect(values);
+  check_shape(values, "wrote");
+  ++collected_;
+  accumulated_.swap(values);  // where collect() copies
+}
+
 void Exchange::finish_collect() {
   // average: f_{n+1} = 1/m Σ_{k=1..m} f_{n,k} (the running mean);  last: f_{n+1} = f_{n,m}
   combined_is_sent_ = false;

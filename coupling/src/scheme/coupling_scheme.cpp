@@ -56,7 +56,7 @@ void CouplingScheme::run_participant(Participant& p, const TimeWindow& window) {
     }
     w.advance_substep();
     for (std::size_t i = 0; i < exchanges_.size(); ++i)  // the core: average over the substeps
-      if (&exchanges_[i]->from() == &p) exchanges_[i]->collect(write_buffers_[i]);
+      if (&exchanges_[i]->from() == &p) exchanges_[i]->collect_taking(write_buffers_[i]);
   }
   for (Exchange* e : exchanges_)
     if (&e->from() == &p) e->finish_collect();

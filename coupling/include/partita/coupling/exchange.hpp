@@ -67,6 +67,10 @@ class Exchange {
   void begin_collect();
   /// The writer's values after one substep (checked: points x components).
   void collect(const Eigen::MatrixXd& values);
+  /// The same, taking `values`' storage where it would copy them (the first substep of an
+  /// average, every substep of `last`): `values` then holds stale numbers, of the shape of an
+  /// earlier substep or empty, for a writer whose next write() sets (and sizes) every value.
+  void collect_taking(Eigen::MatrixXd& values);
   /// combined = average or last of the collected substeps.
   void finish_collect();
   const Eigen::MatrixXd& combined() const { return combined_is_sent_ ? sent_ : combined_; }
