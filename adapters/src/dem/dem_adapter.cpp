@@ -592,17 +592,10 @@ void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
   if (data == "force") {
     values = f;
   } else if (data == "traction") {
-    // t_i = f_i / A_i (seed 000, Algorithm 1), with the reference areas. Most cells carry no
-    // force (no granule touches them): where f_i = 0 and A_i > 0, t_i = f_i (0 / A = 0 with the
-    // sign of the zero) is copied rather than divided; a division costs 4-8 additions.
+    // t_i = f_i / A_i (seed 000, Algorithm 1), with the reference areas: column by column
+    // (contiguous, two divisions per instruction; the same quotients as row by row)
     values.resize(f.rows(), 3);
-    for (Eigen::Index i = 0; i < f.rows(); ++i) {
-      const double a = cm.areas(i);
-      if (f(i, 0) == 0.0 && f(i, 1) == 0.0 && f(i, 2) == 0.0 && a > 0.0)
-        values.row(i) = f.row(i);
-      else
-        values.row(i) = f.row(i) / a;
-    }
+    values.array() = f.array().colwise() / cm.areas.array();
   } else {
     throw Error("dem '" + name_ + "' writes 'force' and 'traction' on mesh '" + cm.name +
                 "_centres', not '" + std::string(data) + "'");
