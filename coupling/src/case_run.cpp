@@ -691,11 +691,15 @@ void CaseRun::run() {
     if (const std::string why = restart_blocker(); !why.empty())
       throw Error("cannot resume from " + resume_file.string() + ": " + why);
   }
-  fs::create_directories(output_dir_ / "vtk");
-  if (!resume)
-    if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
-      logger->info("removed {} VTK files of an earlier run from {}", removed,
-                   (output_dir_ / "vtk").string());
+  {
+    Stopwatch clock;  // the output folder and an earlier run's VTK files: output time
+    fs::create_directories(output_dir_ / "vtk");
+    if (!resume)
+      if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
+        logger->info("removed {} VTK files of an earlier run from {}", removed,
+                     (output_dir_ / "vtk").string());
+    summary_.output_seconds += clock.seconds();
+  }
 
   std::vector<std::pair<std::string, std::string>> columns = {{"time", "s"}, {"iterations", ""}};
   for (const auto& c : scheme_->residual_columns()) columns.push_back(c);
