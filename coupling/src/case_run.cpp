@@ -691,11 +691,15 @@ void CaseRun::run() {
     if (const std::string why = restart_blocker(); !why.empty())
       throw Error("cannot resume from " + resume_file.string() + ": " + why);
   }
-  fs::create_directories(output_dir_ / "vtk");
-  if (!resume)
-    if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
-      logger->info("removed {} VTK files of an earlier run from {}", removed,
-                   (output_dir_ / "vtk").string());
+  {
+    Stopwatch clock;  // the output folder and an earlier run's VTK files: output time
+    fs::create_directories(output_dir_ / "vtk");
+    if (!resume)
+      if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
+        logger->info("removed {} VTK files of an earlier run from {}", removed,
+                     (output_dir_ / "vtk").string());
+    summary_.output_seconds += clock.seconds();
+  }
 
   std::vector<std::pair<std::string, std::string>> columns = {{"time", "s"}, {"iterations", ""}};
   for (const auto& c : scheme_->residual_columns()) columns.push_back(c);
@@ -709,8 +713,8 @@ void CaseRun::run() {
   for (auto& m : monitors_) {
     std::vector<std::pair<std::string, std::string>> mc;
     for (const auto& [p, q] : m.quantities) {
-      std::string unit;
-      for (const auto& v : p->solver().monitors())
+      std::string unit;  // only that quantity: monitors() would compute every one (energies)
+      for (const auto& v : p->solver().monitor_values({q}))
         if (v.name == q) unit = v.unit;
       mc.emplace_back(p->name() + "." + q, unit);
     }
@@ -832,10 +836,11 @@ void CaseRun::run() {
       summary_.iterations += r.iterations;
       summary_.max_window_iterations = std::max(summary_.max_window_iterations, r.iterations);
       if (!r.converged) ++summary_.unconverged_windows;
-      check_window(n + 1, t);
+      // the audit first: where its totals are finite, the check need not read the values again
+      const std::vector<double>& imbalance = audit_balance();
+      check_window(n + 1, t, true);
       row.assign({t, static_cast<double>(r.iterations)});  // keeps its capacity
       row.insert(row.end(), r.residuals.begin(), r.residuals.end());
-      const std::vector<double>& imbalance = audit_balance();
       row.insert(row.end(), imbalance.begin(), imbalance.end());
       for (auto& p : energy_pairs_) {
         const EnergyAudit a = audit_energy(p);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "elementwise.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
@@ -51,21 +52,46 @@ void Exchange::begin_collect() {
 void Exchange::collect(const Eigen::MatrixXd& values) {
   check_shape(values, "wrote");
   ++collected_;
-  if (writer_combines_ == WriterCombines::average && collected_ > 1)
-    // running mean f̄_k = f̄_{k-1} + (f_k - f̄_{k-1}) / k: exact for a constant output
-    accumulated_ += (values - accumulated_) / static_cast<double>(collected_);
-  else
+  if (writer_combines_ != WriterCombines::average || collected_ == 1) {
     accumulated_ = values;
+    return;
+  }
+  // running mean f̄_k = f̄_{k-1} + (f_k - f̄_{k-1}) / k: exact for a constant output.
+  // (The divisions dominate a window's core time: elementwise.hpp halves them where it can.)
+  elementwise::mean_step(accumulated_.data(), values.data(), values.size(),
+                         static_cast<double>(collected_));
+}
+
+void Exchange::collect_taking(Eigen::MatrixXd& values) {
+  if (writer_combines_ == WriterCombines::average && collected_ > 0) return collect(values);
+  check_shape(values, "wrote");
+  ++collected_;
+  accumulated_.swap(values);  // where collect() copies
 }
 
 void Exchange::finish_collect() {
   // average: f_{n+1} = 1/m Σ_{k=1..m} f_{n,k} (the running mean);  last: f_{n+1} = f_{n,m}
+  combined_is_sent_ = false;
   if (collected_ == 0) {
     combined_.setZero(from_points_, spec_.components);
     return;
   }
   // The next begin_collect()/collect() overwrite accumulated_ whole: swap instead of a copy.
   combined_.swap(accumulated_);
+}
+
+Eigen::MatrixXd& Exchange::sent() {
+  if (combined_is_sent_) {  // the caller may change sent: combined keeps its own copy
+    combined_ = sent_;
+    combined_is_sent_ = false;
+  }
+  return sent_;
+}
+
+void Exchange::send_combined() {
+  if (combined_is_sent_) return;
+  sent_.swap(combined_);
+  combined_is_sent_ = true;
 }
 
 void Exchange::transmit() {
@@ -84,13 +110,15 @@ void Exchange::transmit() {
 const Eigen::MatrixXd& Exchange::read_at(double fraction, Eigen::MatrixXd& scratch) const {
   if (reader_sees_ == ReaderSees::constant || fraction >= 1.0 || start_is_end_) return end_;
   // d_{n,k} = d_n + (k/m) (d_{n+1} - d_n)
-  scratch = start_ + fraction * (end_ - start_);
+  scratch.resize(end_.rows(), end_.cols());  // (keeps its storage: same shape every substep)
+  elementwise::interpolate(scratch.data(), start_.data(), end_.data(), end_.size(), fraction);
   return scratch;
 }
 
 void Exchange::initialize(const Eigen::MatrixXd& initial) {
   check_shape(initial, "gave as initial data");
   combined_ = initial;
+  combined_is_sent_ = false;
   sent_ = initial;
   previous_ = initial;
   transmit();
@@ -100,13 +128,14 @@ void Exchange::initialize(const Eigen::MatrixXd& initial) {
 void Exchange::write_state(BinaryWriter& out) const {
   out.section("exchange " + label());
   for (const Eigen::MatrixXd* m :
-       {&combined_, &sent_, &previous_, start_is_end_ ? &end_ : &start_, &end_})
+       {&combined(), &sent_, &previous_, start_is_end_ ? &end_ : &start_, &end_})
     out.write(*m);
 }
 
 void Exchange::read_state(BinaryReader& in) {
   in.expect_section("exchange " + label());
   for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) in.read(*m);
+  combined_is_sent_ = false;
   start_is_end_ = false;
   const Eigen::Index sender = from_points_;
   const Eigen::Index receiver = target_mesh_->size();

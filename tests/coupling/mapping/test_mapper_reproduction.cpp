@@ -3,10 +3,13 @@
 // (barycentric interpolation / the polynomial part hold linear functions).
 #include <catch2/catch.hpp>
 
+#include <cstring>
+
 #include <Eigen/Geometry>
 
 #include "make_mapper.hpp"
 #include "partita/coupling/mapping/rbf_mapper.hpp"
+#include "partita/coupling/mapping/sparse_mapper.hpp"
 #include "plate_meshes.hpp"
 
 using namespace partita;
@@ -152,4 +155,31 @@ TEST_CASE("rbf: conjugate gradients give the Cholesky solution to their toleranc
   b->map(in, iterative);
   // ||x - x*|| <= cond(Phi) tol ||x*||; the values are O(1)
   CHECK((direct - iterative).cwiseAbs().maxCoeff() < 1e-8);
+}
+
+TEST_CASE("a sparse mapper's map() gives the sparse product W in bit for bit", "[mapping]") {
+  // Each row of W in: ((0 + w_1 x_1) + w_2 x_2) + ... in the stored order, every operation
+  // IEEE-rounded: Eigen's own sparse product, and map() whatever vector width it uses (3
+  // components: x, y, z of a point in one register), must give the same bits.
+  const Mesh from = plate_triangles("from", 13, 11, 0.2, 1),
+             to = plate_triangles("to", 8, 9, 0.2, 2);
+  for (const char* name : {"nearest-neighbor", "nearest-projection"})
+    for (const Constraint c : {Constraint::consistent, Constraint::conservative})
+      for (const int components : {1, 2, 3, 4}) {
+        INFO(name << ", " << components << " components");
+        auto m = make_mapper(name, c);
+        m->compute(from, to);
+        const auto* sparse = dynamic_cast<const SparseMapper*>(m.get());
+        REQUIRE(sparse != nullptr);
+        Eigen::MatrixXd in = Eigen::MatrixXd::Random(from.size(), components);
+        in.row(3).setZero();
+        in(5, 0) = -0.0;
+        Eigen::MatrixXd out;
+        m->map(in, out);
+        const Eigen::MatrixXd expected = sparse->matrix() * in;
+        REQUIRE(out.rows() == expected.rows());
+        REQUIRE(out.cols() == expected.cols());
+        CHECK(std::memcmp(out.data(), expected.data(),
+                          sizeof(double) * static_cast<std::size_t>(out.size())) == 0);
+      }
 }

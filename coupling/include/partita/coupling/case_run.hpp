@@ -72,7 +72,8 @@ struct RunSummary {
   double wall_seconds = 0.0;
   std::vector<std::pair<std::string, double>> participant_seconds;
   double mapping_seconds = 0.0;
-  double output_seconds = 0.0;         ///< VTK frames, restart files, CSV rows and flushes
+  double output_seconds = 0.0;         ///< VTK frames, restart files, CSV rows and flushes, and the
+                                       ///< removal of an earlier run's VTK files from the folder
   double core_seconds = 0.0;           ///< the rest: scheme, acceleration, time interpolation
   std::int64_t resumed_from = -1;      ///< windows done by the restart file resumed (-1: none)
   int stopped_by_signal = 0;           ///< the signal that stopped the run early (0: none)
@@ -128,7 +129,10 @@ class CaseRun {
   void write_restart_file(const Progress& progress);
   void read_restart_file(const std::filesystem::path& file, Progress& progress);
   std::filesystem::path newest_restart_file() const;
-  void check_window(std::int64_t window, double time);
+  /// Stops the run (throws) on non-finite exchanged values or a solver's own finding. With
+  /// `after_audit`, the exchanges whose audit totals of this window were finite are not read
+  /// again: a finite total has only finite terms.
+  void check_window(std::int64_t window, double time, bool after_audit = false);
   /// Per audited exchange: |received total - sent total| / scale (into imbalance_).
   const std::vector<double>& audit_balance();
   std::string restart_blocker() const;  // why restart files cannot be written ("": they can)
@@ -161,7 +165,8 @@ class CaseRun {
   double balance_tolerance_ = 0.01;
   std::vector<double> imbalance_;  // audit_balance()'s result and scratch space, kept between
   Eigen::VectorXd audit_sent_, audit_received_;  // windows (no allocation per window)
-  Eigen::ArrayXd audit_norm2_;
+  Eigen::ArrayXd audit_norm_;
+  std::vector<char> audit_finite_;  // per audited exchange: this window's totals were finite
   std::vector<Eigen::VectorXd> audit_bounds_;  // per audited exchange: W^T omega (or empty)
   // the energy audit: two participants that read from each other, each with the meshes it reads
   // the other's data on (where its solver reports Solver::interface_work)

@@ -70,6 +70,7 @@ class CouplingScheme {
   // Per exchange: what its receiver reads and what its sender writes (sized in the first
   // window, reused after: no allocation per substep).
   std::vector<Eigen::MatrixXd> read_buffers_, write_buffers_;
+  std::vector<const Eigen::MatrixXd*> inputs_;  // per exchange: what its reader sees this substep
 };
 
 }  // namespace partita::coupling

@@ -67,12 +67,19 @@ class Exchange {
   void begin_collect();
   /// The writer's values after one substep (checked: points x components).
   void collect(const Eigen::MatrixXd& values);
+  /// The same, taking `values`' storage where it would copy them (the first substep of an
+  /// average, every substep of `last`): `values` then holds stale numbers, of the shape of an
+  /// earlier substep or empty, for a writer whose next write() sets (and sizes) every value.
+  void collect_taking(Eigen::MatrixXd& values);
   /// combined = average or last of the collected substeps.
   void finish_collect();
-  const Eigen::MatrixXd& combined() const { return combined_; }
+  const Eigen::MatrixXd& combined() const { return combined_is_sent_ ? sent_ : combined_; }
   /// The values that transmit() maps (combined, or an accelerated iterate).
-  Eigen::MatrixXd& sent() { return sent_; }
+  Eigen::MatrixXd& sent();
   const Eigen::MatrixXd& sent() const { return sent_; }
+  /// sent = combined without a copy (the two arrays swap; combined() reads sent's until the
+  /// next finish_collect(), or until sent() is written).
+  void send_combined();
   /// previous = sent (the iterate the readers saw), before an iteration overwrites sent().
   void remember_previous() { previous_ = sent_; }
   const Eigen::MatrixXd& previous() const { return previous_; }
@@ -115,6 +122,7 @@ class Exchange {
   const Mesh* target_mesh_ = nullptr;
 
   Eigen::MatrixXd accumulated_, combined_, sent_, previous_;
+  bool combined_is_sent_ = false;  // after send_combined(): combined_'s own values are stale
   int collected_ = 0;
   Eigen::MatrixXd start_, end_;
   bool start_is_end_ = false;  // d_n = d_{n+1}: start_'s own values are stale

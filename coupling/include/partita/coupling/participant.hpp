@@ -1,6 +1,8 @@
 #pragma once
 // A coupling participant: a named Solver with its substep setting and the wall time it used.
-// The calls to the solver go through this class, which times them (for the run's summary).
+// The calls to the solver go through this class, which times them (for the run's summary); a
+// caller that makes several calls in a row (a substep's read, advance, write) may instead time
+// them as one with a Stopwatch on solver() and add_seconds().
 
 #include <memory>
 #include <string>

@@ -111,7 +111,8 @@ class Solver {
   virtual void read(std::string_view mesh, std::string_view data,
                     const Eigen::MatrixXd& values) = 0;
 
-  /// Ask the solver for the values of a field it sends (resized to N x C by the solver).
+  /// Ask the solver for the values of a field it sends (resized to N x C by the solver, every
+  /// value set: the array the core passes may hold the numbers of an earlier call, or none).
   virtual void write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) = 0;
 
   /// The largest step the solver can take now [s]; +infinity when unconditionally stable.

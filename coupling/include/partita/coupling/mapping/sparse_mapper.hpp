@@ -6,7 +6,10 @@
 //   conservative from A to B:  out_B = W_AB^T in_A,  W_AB = interpolation(B, A)
 //
 // Either way the stored matrix is |B| x |A|, row-major, so map() is one sparse product with
-// no allocation beyond `out`.
+// no allocation beyond `out` (and, for 3 components on a processor with AVX, a copy of the
+// input with each point's x, y, z side by side, kept between calls).
+
+#include <vector>
 
 #include <Eigen/SparseCore>
 
@@ -35,6 +38,7 @@ class SparseMapper : public Mapper {
  private:
   Constraint constraint_;
   Matrix matrix_;
+  mutable std::vector<double> packed_;  // map()'s scratch: the input as rows (x, y, z, 0)
 };
 
 }  // namespace partita::coupling

@@ -1,0 +1,167 @@
+// Exchange: the substep average and the time interpolation give, bit for bit, the numbers of
+// their plain formulas (each operation is IEEE-rounded, so any correct evaluation of the same
+// operations in the same order must agree to the last bit, whatever vector width it uses); and a
+// run stops on non-finite values of an audited exchange (whose check reads the audit's totals).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <random>
+
+#include "ode_participant.hpp"
+#include "partita/coupling/case_run.hpp"
+#include "partita/coupling/exchange.hpp"
+#include "partita/interface/error.hpp"
+
+using namespace partita;
+using namespace partita::coupling;
+
+namespace {
+
+// One mesh of n points that writes and reads "f" (3 components); write() gives `next`.
+class ArraySolver : public Solver {
+ public:
+  ArraySolver(Eigen::Index n, DataKind kind, double nan_from = INFINITY) : nan_from_(nan_from) {
+    InterfaceMesh m;
+    m.mesh = Mesh("points", Mesh::Points::Random(n, 3));
+    m.writes.push_back(DataSpec{"f", 3, "N", kind});
+    m.reads.push_back(DataSpec{"f", 3, "N", kind});
+    meshes_.push_back(std::move(m));
+    next.setOnes(n, 3);
+  }
+  const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
+  void read(std::string_view, std::string_view, const Eigen::MatrixXd& v) override { seen = v; }
+  void write(std::string_view, std::string_view, Eigen::MatrixXd& v) override {
+    v = next;
+    if (t_ >= nan_from_) v(v.rows() / 2, 1) = std::numeric_limits<double>::quiet_NaN();
+  }
+  double stable_time_step() const override { return INFINITY; }
+  void advance(double dt) override { t_ += dt; }
+  double time() const override { return t_; }
+  void save_checkpoint() override {}
+  void restore_checkpoint() override {}
+
+  Eigen::MatrixXd next, seen;
+
+ private:
+  std::vector<InterfaceMesh> meshes_;
+  double t_ = 0.0, nan_from_;
+};
+
+bool same_bits(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
+}
+
+// Values of every kind the interface carries: zeros of both signs (no contact), small and large
+// magnitudes of both signs.
+Eigen::MatrixXd values(Eigen::Index n, std::mt19937& g) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_int_distribution<int> e(-30, 30), kind(0, 5);
+  Eigen::MatrixXd v(n, 3);
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    const int k = kind(g);
+    v.data()[i] = k == 0 ? 0.0 : k == 1 ? -0.0 : std::ldexp(u(g), e(g));
+  }
+  return v;
+}
+
+// Two participants of n points and the exchange of "f" between them (no mapper). 1539 rows x 3:
+// neither a multiple of 2 nor of 4 values (the vector loops' remainders run too).
+struct Pair {
+  static constexpr Eigen::Index n = 1539;
+  std::unique_ptr<Participant> a =
+      std::make_unique<Participant>("a", std::make_unique<ArraySolver>(n, DataKind::extensive));
+  std::unique_ptr<Participant> b =
+      std::make_unique<Participant>("b", std::make_unique<ArraySolver>(n, DataKind::extensive));
+  Exchange exchange{"f", {a.get(), "points"}, {b.get(), "points"}, DataSpec{"f", 3, "N"}, nullptr};
+};
+
+}  // namespace
+
+TEST_CASE(
+    "Exchange: the substep average and the time interpolation follow their formulas bit "
+    "for bit",
+    "[coupling][exchange]") {
+  Pair pair;
+  Exchange& e = pair.exchange;
+  const Eigen::Index n = Pair::n;
+  std::mt19937 g(7);
+  SECTION("the average of m substeps is the running mean") {
+    for (int m = 1; m <= 9; ++m) {
+      INFO("substeps " << m);
+      e.begin_collect();
+      Eigen::MatrixXd mean;
+      for (int k = 1; k <= m; ++k) {
+        const Eigen::MatrixXd v = values(n, g);
+        e.collect(v);
+        // f̄_k = f̄_{k-1} + (f_k - f̄_{k-1}) / k, f̄_1 = f_1 (Eigen's own elementwise evaluation)
+        if (k == 1)
+          mean = v;
+        else
+          mean = mean + (v - mean) / static_cast<double>(k);
+      }
+      e.finish_collect();
+      CHECK(same_bits(e.combined(), mean));
+    }
+    // a constant output averages to itself exactly
+    const Eigen::MatrixXd c = values(n, g);
+    e.begin_collect();
+    for (int k = 0; k < 7; ++k) e.collect(c);
+    e.finish_collect();
+    CHECK((e.combined().array() == c.array()).all());
+  }
+  SECTION("the reader sees d_n + (k/m) (d_n+1 - d_n)") {
+    const Eigen::MatrixXd d0 = values(n, g), d1 = values(n, g);
+    e.initialize(d0);
+    e.sent() = d1;
+    e.transmit();
+    Eigen::MatrixXd scratch;
+    for (int k = 1; k < 7; ++k) {
+      const double s = static_cast<double>(k) / 7.0;
+      const Eigen::MatrixXd expected = d0 + s * (d1 - d0);
+      CHECK(same_bits(e.read_at(s, scratch), expected));
+    }
+    CHECK(same_bits(e.read_at(1.0, scratch), d1));
+  }
+}
+
+TEST_CASE("a NaN in an audited exchange stops the run with the exchange and the window",
+          "[coupling][exchange][divergence]") {
+  // Forces (extensive: audited for their balance) turning NaN at t = 0.25: the run stops in the
+  // window that produced them, naming the participant and the field.
+  Registries r = test::test_registries();
+  auto spec = std::make_shared<config::Spec>("test-array", "37 points writing and reading f");
+  spec->real("nan_from", "time from which f has a NaN").def(1e300);
+  r.solvers.add(
+      "test-array", "array solver",
+      [](const SolverContext& c) -> std::unique_ptr<Solver> {
+        return std::make_unique<ArraySolver>(37, DataKind::extensive, c.config.real("nan_from"));
+      },
+      spec);
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("partita_exchange_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto file = dir / "nan.yaml";
+  std::ofstream(file) << "case: nan\ntime: {window: 0.1, end: 1.0}\n"
+                         "participants:\n"
+                         "  one: {solver: test-array, nan_from: 0.25}\n"
+                         "  two: {solver: test-array}\n"
+                         "coupling:\n  scheme: explicit-serial\n  exchanges:\n"
+                         "    - {data: f, from: one.points, to: two.points}\n";
+  RunOptions o;
+  o.output_dir = dir / "out";
+  std::string what = "no error";
+  try {
+    CaseRun run(file, r, o);
+    run.run();
+  } catch (const Error& e) {
+    what = e.what();
+  }
+  CHECK_THAT(what, Catch::Contains("window 3 ") && Catch::Contains("participant 'one' sent") &&
+                       Catch::Contains("non-finite values (1 of 111)") &&
+                       Catch::Contains("'f' on one.points"));
+  std::filesystem::remove_all(dir);
+}
