@@ -219,6 +219,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   double* load = Load ? load_.data() : nullptr;
   const double* load_limit = Limit ? store_.array<double>(h_load_limit_).data() : nullptr;
   const MeshContacts::Pass mesh = mesh_contacts_.pass();  // rows: particles near a mesh
+  const int* const offsets = nl.offsets_.data();
+  const int* const neighbors = nl.neighbors_.data();
   const int np = walls.np;
   // Drift: the integrator's first half of particle i (with kick = dt/2), |x - x_build|^2 into
   // m2, and the start of its force sums, as the loop before the pass does it (step())
@@ -285,9 +287,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       const int i_end = std::min(hi, (b + 1) * block_size);
       for (int i = b * block_size; i < i_end; ++i) {
         if constexpr (Drift) {  // i and its row's neighbours in this part drift first
-          const int row_end = nl.offsets_[i + 1];
+          const int row_end = offsets[i + 1];
           const int need =
-              row_end > nl.offsets_[i] ? std::max(i, std::min(nl.neighbors_[row_end - 1], hi - 1))
+              row_end > offsets[i] ? std::max(i, std::min(neighbors[row_end - 1], hi - 1))
                                        : i;
           for (; frontier <= need && frontier < tail; ++frontier) drift(frontier, m2);
         }
@@ -295,8 +297,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         Eigen::Vector3d f = qi.f;
         Eigen::Vector3d t = qi.t;
         double load_i = Load ? load[i] : 0.0;
-        for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
-          const int j = nl.neighbors_[s];
+        for (int s = offsets[i]; s < offsets[i + 1]; ++s) {
+          const int j = neighbors[s];
           if (j >= hi) {  // a cross pair, already evaluated
             const ThreadPartition::CrossForce& cf = tp.cross_force[cross++];
             if (cf.touching) {
