@@ -71,20 +71,18 @@ void System::step(double dt) {
   // Both give the same bits: the first half, the rebuild decision and every force sum are the
   // same operations in the same order.
   bool fused = false;
+  double bound = 0.0;  // fused: no particle is further than this from its position at the build
   if (have_build && verlet_.has_motion()) {
     const VelocityVerlet::Motion& mo = verlet_.motion();
     const double drift = dt * (mo.speed + half * mo.accel);
     // (rounding: relative in the sums, absolute in x += dt v and x - x_build)
     const double eps = std::numeric_limits<double>::epsilon();
-    const double bound = (mo.moved + drift) * (1.0 + 1e-12) + 8.0 * eps * (mo.extent + drift);
+    bound = (mo.moved + drift) * (1.0 + 1e-12) + 8.0 * eps * (mo.extent + drift);
     fused = !neighbors_.needs_rebuild(bound * bound, walls_.planes(), meshes_);
   }
   if (fused) {
 #pragma omp parallel if (parts > 1) num_threads(parts)
     evaluate_forces(dt, true, half, true);
-    for (int t = 0; t < parts; ++t) moved2 = std::max(moved2, part_motion_[t].moved2);
-    if (neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_))
-      throw Error("step: internal error: a particle moved beyond its motion bound");
     reduce_wall_and_mesh_forces();
   } else {
     const VelocityVerlet::Pass verlet = verlet_.pass(p);
@@ -113,7 +111,9 @@ void System::step(double dt) {
       reduce_wall_and_mesh_forces();
     }
   }
-  set_motion(rebuild, moved2);
+  // the next step's bound starts from this one's (fused: the distances from the build positions
+  // were not computed) or from the exact distances
+  set_motion(fused ? bound : rebuild ? 0.0 : std::sqrt(moved2));
   for (TriangleMesh& m : meshes_) m.position_last_step_ = m.position_;
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].post_force(*this, dt);
   time_ += dt;
@@ -143,9 +143,9 @@ void System::start_load_pass(int parts) {
 }
 
 // After a step's kick: the bound of the next step's motion (VelocityVerlet::Motion).
-void System::set_motion(bool rebuilt, double moved2) {
+void System::set_motion(double moved) {
   VelocityVerlet::Motion mo;
-  mo.moved = rebuilt ? 0.0 : std::sqrt(moved2);
+  mo.moved = moved;
   double speed2 = 0.0, accel2 = 0.0;
   for (int t = 0; t < partition_.parts(); ++t) {
     speed2 = std::max(speed2, part_motion_[t].speed2);
@@ -222,13 +222,12 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   const int* const offsets = nl.offsets_.data();
   const int* const neighbors = nl.neighbors_.data();
   const int np = walls.np;
-  // Drift: the integrator's first half of particle i (with kick = dt/2), |x - x_build|^2 into
-  // m2, and the start of its force sums, as the loop before the pass does it (step())
-  const Eigen::Vector3d* const x_build = neighbors_.position_at_build_.data();
+  // Drift: the integrator's first half of particle i (with kick = dt/2) and the start of its
+  // force sums, as the loop before the pass does it (step(), which knows that no particle can
+  // have moved beyond the skin)
   const Eigen::Vector3d gravity = gravity_;
-  auto drift = [&](int i, double& m2) {
-    const Eigen::Vector3d& x = verlet.first_half(i, dt, kick);
-    m2 = std::max(m2, (x - x_build[i]).squaredNorm());
+  auto drift = [&](int i) {
+    verlet.first_half(i, dt, kick);
     PackedParticle& q = packed[i];
     q.f = mass[i] * gravity;
     q.t.setZero();
@@ -238,10 +237,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     if (parts > 1) {  // the particles that cross pairs read drift first
 #pragma omp for schedule(static, 1)
       for (int part = 0; part < parts; ++part) {
-        double m2 = 0.0;
-        for (int i = tp.begin(part); i < tp.drift_head_end[part]; ++i) drift(i, m2);
-        for (int i = tp.drift_tail_begin[part]; i < tp.begin(part + 1); ++i) drift(i, m2);
-        part_motion_[part].moved2 = m2;
+        for (int i = tp.begin(part); i < tp.drift_head_end[part]; ++i) drift(i);
+        for (int i = tp.drift_tail_begin[part]; i < tp.begin(part + 1); ++i) drift(i);
       }
     }
   }
@@ -273,11 +270,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     const int lo = tp.begin(part), hi = tp.begin(part + 1);
     // Drift: particles [frontier, tail) have not drifted yet
     int frontier = hi, tail = hi;
-    double m2 = 0.0;
     if constexpr (Drift) {
       frontier = parts > 1 ? tp.drift_head_end[part] : lo;
       tail = parts > 1 ? tp.drift_tail_begin[part] : hi;
-      m2 = parts > 1 ? part_motion_[part].moved2 : 0.0;
     }
     double speed2 = 0.0, accel2 = 0.0, extent = 0.0;  // maxima after the kick
     int mesh_row = mesh.rows > 0 ? mesh.first_row(lo) : 0;  // the next particle near a mesh
@@ -291,7 +286,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           const int need =
               row_end > offsets[i] ? std::max(i, std::min(neighbors[row_end - 1], hi - 1))
                                        : i;
-          for (; frontier <= need && frontier < tail; ++frontier) drift(frontier, m2);
+          for (; frontier <= need && frontier < tail; ++frontier) drift(frontier);
         }
         PackedParticle& qi = packed[i];
         Eigen::Vector3d f = qi.f;
@@ -348,7 +343,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       }
     }
     if (reached) load_reached_[part] = 1;
-    part_motion_[part] = {m2, speed2, accel2, extent};
+    part_motion_[part] = {speed2, accel2, extent};
   }
 }
 
