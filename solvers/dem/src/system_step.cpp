@@ -183,23 +183,19 @@ void System::compute_forces(double dt, bool update_history, double kick, bool st
 // directly when j is its own; pairs reaching into a later part (cross pairs) are evaluated first,
 // each once, into its cross_force, then added by both owners in the same place of their sums.
 void System::evaluate_forces(double dt, bool update_history, double kick, bool drift) {
-  if (drift) {
+  auto run = [&]<bool Drift>() {
     if (track_load_)
       if (h_load_limit_ >= 0)
-        evaluate_forces_impl<true, true, true>(dt, update_history, kick);
+        evaluate_forces_impl<true, true, Drift>(dt, update_history, kick);
       else
-        evaluate_forces_impl<true, false, true>(dt, update_history, kick);
+        evaluate_forces_impl<true, false, Drift>(dt, update_history, kick);
     else
-      evaluate_forces_impl<false, false, true>(dt, update_history, kick);
-  } else {
-    if (track_load_)
-      if (h_load_limit_ >= 0)
-        evaluate_forces_impl<true, true, false>(dt, update_history, kick);
-      else
-        evaluate_forces_impl<true, false, false>(dt, update_history, kick);
-    else
-      evaluate_forces_impl<false, false, false>(dt, update_history, kick);
-  }
+      evaluate_forces_impl<false, false, Drift>(dt, update_history, kick);
+  };
+  if (drift)
+    run.template operator()<true>();
+  else
+    run.template operator()<false>();
 }
 
 template <bool Load, bool Limit, bool Drift>
@@ -248,9 +244,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     for (int k = 0; k < n_cross; ++k) {
       const ThreadPartition::CrossPair& c = tp.cross_pairs[k];
       ThreadPartition::CrossForce& cf = tp.cross_force[k];
-      cf.touching = pairs.force<Load>(c.slot, model_, c.i, packed[c.i], c.j, packed[c.j], dt,
-                                      update_history, cf.force_i, cf.torque_i, cf.torque_j,
-                                      cf.load);
+      cf.touching =
+          pairs.force<Load>(c.slot, model_, c.i, packed[c.i], c.j, packed[c.j], dt, update_history,
+                            cf.force_i, cf.torque_i, cf.torque_j, cf.load);
     }
   }
 #pragma omp for schedule(static, 1)
@@ -274,7 +270,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       frontier = parts > 1 ? tp.drift_head_end[part] : lo;
       tail = parts > 1 ? tp.drift_tail_begin[part] : hi;
     }
-    double speed2 = 0.0, accel2 = 0.0, extent = 0.0;  // maxima after the kick
+    double speed2 = 0.0, accel2 = 0.0, extent = 0.0;        // maxima after the kick
     int mesh_row = mesh.rows > 0 ? mesh.first_row(lo) : 0;  // the next particle near a mesh
     for (int b = lo / block_size; b * block_size < hi; ++b) {
       // plane forces summed per block of particles, then over blocks (fixed order)
@@ -284,8 +280,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         if constexpr (Drift) {  // i and its row's neighbours in this part drift first
           const int row_end = offsets[i + 1];
           const int need =
-              row_end > offsets[i] ? std::max(i, std::min(neighbors[row_end - 1], hi - 1))
-                                       : i;
+              row_end > offsets[i] ? std::max(i, std::min(neighbors[row_end - 1], hi - 1)) : i;
           for (; frontier <= need && frontier < tail; ++frontier) drift(frontier);
         }
         PackedParticle& qi = packed[i];

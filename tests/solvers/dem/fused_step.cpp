@@ -14,9 +14,9 @@ using namespace partita::dem;
 
 namespace {
 
-// Stirred granules falling into a box: fast enough that the lists are rebuilt many times (every path of
-// the step: fused, exact, exact with a rebuild). (No mesh: a state saved while no particle is
-// near a mesh does not read back, "the mesh contact rows do not agree", in main as here.)
+// Stirred granules falling into a box: fast enough that the lists are rebuilt many times (every
+// path of the step: fused, exact, exact with a rebuild). (No mesh: a state saved while no particle
+// is near a mesh does not read back, "the mesh contact rows do not agree", in main as here.)
 System falling_bed() {
   System sys;
   const int m = sys.add_material({1.0e7, 0.3, 2500.0});

@@ -75,12 +75,11 @@ class PairContacts {
   /// Load: also the contact load F_n (E*/R*)^2 (breakage criterion, System::contact_load()).
   template <bool Load>
   static PARTITA_DEM_INLINE bool force(const ContactModel& model, const PackedParticle& qi,
-                                       const PackedParticle& qj, const double& mi,
-                                       const double& mj, const int& material_i,
-                                       const int& material_j, Eigen::Vector3d& shear,
-                                       char& touching, double dt, bool update_history,
-                                       Eigen::Vector3d& fij, Eigen::Vector3d& ti,
-                                       Eigen::Vector3d& tj, double& load) {
+                                       const PackedParticle& qj, const double& mi, const double& mj,
+                                       const int& material_i, const int& material_j,
+                                       Eigen::Vector3d& shear, char& touching, double dt,
+                                       bool update_history, Eigen::Vector3d& fij,
+                                       Eigen::Vector3d& ti, Eigen::Vector3d& tj, double& load) {
     const Eigen::Vector3d d = qi.x - qj.x;
     const double ri = qi.r, rj = qj.r;
     const double rsum = ri + rj;
