@@ -154,7 +154,10 @@ void System::set_motion(double moved) {
   }
   mo.speed = std::sqrt(speed2);
   mo.accel = std::sqrt(accel2);
-  if (std::isfinite(mo.moved + mo.speed + mo.accel + mo.extent)) verlet_.set_motion(mo);
+  if (std::isfinite(mo.moved + mo.speed + mo.accel + mo.extent))
+    verlet_.set_motion(mo);
+  else
+    verlet_.forget_motion();  // (a diverging run: the next step takes the exact path)
 }
 
 void System::compute_forces(double dt, bool update_history, double kick, bool started) {
