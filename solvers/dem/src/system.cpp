@@ -397,6 +397,7 @@ void System::reorder_particles() {
 
 void System::rebuild_lists() {
   sync_particles();
+  verlet_.forget_motion();  // (its distances were from the last build's positions)
   neighbors_.build(store_.core(), walls_.planes(), meshes_);
   pairs_follow_lists();
   mesh_contacts_.follow_build(neighbors_);

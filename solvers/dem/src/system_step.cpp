@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace partita::dem {
@@ -37,6 +38,7 @@ void System::step(double dt) {
     throw Error(msg.str());
   }
   if (!verlet_.loaded()) verlet_.load(store_.core());
+  verlet_.moved();  // from here on the packed copy is ahead of the store's
   if (!forces_valid_) {
     compute_forces(dt, false, 0.0, false);
     forces_valid_ = true;
@@ -56,39 +58,62 @@ void System::step(double dt) {
   const int parts = set_partition();
   partition_.prepare_cross_pairs(neighbors_);  // for the current lists (a rebuild below: its own)
   start_load_pass(parts);
-  const VelocityVerlet::Pass verlet = verlet_.pass(p);
-  // One parallel region for the whole step unless the lists need a rebuild: the integrator's
-  // first half (VelocityVerlet: v += dt/2 F/m, x += dt v, omega += dt/2 T/I), the start of the
-  // force sums (F = m g, T = 0), then the forces at t + dt and the integrator's kick
-  // (v += dt/2 F/m, omega += dt/2 T/I) particle by particle as each total is complete. With a
-  // rebuild the region ends after the first half and the (parallel) build and force evaluation
-  // follow. Every loop runs over the same parts (thread t: part t), so a particle's data stays in
-  // one core's cache.
+  // Without a rebuild, one parallel region does the whole step: the integrator's first half
+  // (VelocityVerlet: v += dt/2 F/m, x += dt v, omega += dt/2 T/I), the start of the force sums
+  // (F = m g, T = 0), then the forces at t + dt and the integrator's kick (v += dt/2 F/m,
+  // omega += dt/2 T/I) particle by particle as each total is complete. Every loop runs over the
+  // same parts (thread t: part t), so a particle's data stays in one core's cache.
+  // When the last step's motion bound shows that this first half cannot move a particle beyond
+  // the skin, the first half runs inside the force pass, each particle just before the first row
+  // that reads it: the particle's two cache lines are read once per step instead of twice (a
+  // pass of its own over a bed larger than the L2 cache reads them back from L3). Otherwise the
+  // first half is a loop of its own, then the exact decision: forces, or rebuild and forces.
+  // Both give the same bits: the first half, the rebuild decision and every force sum are the
+  // same operations in the same order.
+  bool fused = false;
+  double bound = 0.0;  // fused: no particle is further than this from its position at the build
+  if (have_build && verlet_.has_motion()) {
+    const VelocityVerlet::Motion& mo = verlet_.motion();
+    const double drift = dt * (mo.speed + half * mo.accel);
+    // (rounding: relative in the sums, absolute in x += dt v and x - x_build)
+    const double eps = std::numeric_limits<double>::epsilon();
+    bound = (mo.moved + drift) * (1.0 + 1e-12) + 8.0 * eps * (mo.extent + drift);
+    fused = !neighbors_.needs_rebuild(bound * bound, walls_.planes(), meshes_);
+  }
+  if (fused) {
 #pragma omp parallel if (parts > 1) num_threads(parts)
-  {
-#pragma omp for schedule(static, 1) reduction(max : moved2)
-    for (int part = 0; part < parts; ++part) {
-      for (int i = partition_.begin(part); i < partition_.begin(part + 1); ++i) {
-        const Eigen::Vector3d& x = verlet.first_half(i, dt, half);
-        if (have_build) moved2 = std::max(moved2, (x - x_build[i]).squaredNorm());
-        start_sums(i);
-      }
-    }
-    // moved2 is complete after the loop's barrier; every thread reaches the same decision
-    const bool rebuild_here =
-        !have_build || neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_);
-    if (!rebuild_here) evaluate_forces(dt, true, half);
-#pragma omp master
-    rebuild = rebuild_here;
-  }
-  if (rebuild) {
-    if (sort_interval_ > 0 && ++builds_since_sort_ >= sort_interval_) reorder_particles();
-    rebuild_lists();
-    compute_forces(dt, true, half, true);
-  } else {
+    evaluate_forces(dt, true, half, true);
     reduce_wall_and_mesh_forces();
+  } else {
+    const VelocityVerlet::Pass verlet = verlet_.pass(p);
+#pragma omp parallel if (parts > 1) num_threads(parts)
+    {
+#pragma omp for schedule(static, 1) reduction(max : moved2)
+      for (int part = 0; part < parts; ++part) {
+        for (int i = partition_.begin(part); i < partition_.begin(part + 1); ++i) {
+          const Eigen::Vector3d& x = verlet.first_half(i, dt, half);
+          if (have_build) moved2 = std::max(moved2, (x - x_build[i]).squaredNorm());
+          start_sums(i);
+        }
+      }
+      // moved2 is complete after the loop's barrier; every thread reaches the same decision
+      const bool rebuild_here =
+          !have_build || neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_);
+      if (!rebuild_here) evaluate_forces(dt, true, half);
+#pragma omp master
+      rebuild = rebuild_here;
+    }
+    if (rebuild) {
+      if (sort_interval_ > 0 && ++builds_since_sort_ >= sort_interval_) reorder_particles();
+      rebuild_lists();
+      compute_forces(dt, true, half, true);
+    } else {
+      reduce_wall_and_mesh_forces();
+    }
   }
-  verlet_.moved();
+  // the next step's bound starts from this one's (fused: the distances from the build positions
+  // were not computed) or from the exact distances
+  set_motion(fused ? bound : rebuild ? 0.0 : std::sqrt(moved2));
   for (TriangleMesh& m : meshes_) m.position_last_step_ = m.position_;
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].post_force(*this, dt);
   time_ += dt;
@@ -102,21 +127,42 @@ void System::run(long steps, double dt) {
 
 // ---- forces -----------------------------------------------------------------------------------
 
-// Starts the force sums of a step: F = m g, T = 0.
+// Starts the force sums of a step in the packed state: F = m g, T = 0.
 void System::start_sums(int i) {
-  Particles& p = store_.core();
-  p.force[i] = verlet_.particle(i).m * gravity_;
-  p.torque[i].setZero();
+  PackedParticle& q = verlet_.particle(i);
+  q.f = store_.core().mass[i] * gravity_;
+  q.t.setZero();
   if (track_load_) load_[i] = 0.0;
 }
 
-// Clears the per-part flags of the load limits (no allocation once sized).
+// Clears the per-part flags of the load limits, sizes the per-part motion maxima (no allocation
+// once sized).
 void System::start_load_pass(int parts) {
   load_reached_.assign(h_load_limit_ >= 0 ? static_cast<std::size_t>(parts) : 0, 0);
+  part_motion_.resize(static_cast<std::size_t>(parts));
+}
+
+// After a step's kick: the bound of the next step's motion (VelocityVerlet::Motion).
+void System::set_motion(double moved) {
+  VelocityVerlet::Motion mo;
+  mo.moved = moved;
+  double speed2 = 0.0, accel2 = 0.0;
+  for (int t = 0; t < partition_.parts(); ++t) {
+    speed2 = std::max(speed2, part_motion_[t].speed2);
+    accel2 = std::max(accel2, part_motion_[t].accel2);
+    mo.extent = std::max(mo.extent, part_motion_[t].extent);
+  }
+  mo.speed = std::sqrt(speed2);
+  mo.accel = std::sqrt(accel2);
+  if (std::isfinite(mo.moved + mo.speed + mo.accel + mo.extent))
+    verlet_.set_motion(mo);
+  else
+    verlet_.forget_motion();  // (a diverging run: the next step takes the exact path)
 }
 
 void System::compute_forces(double dt, bool update_history, double kick, bool started) {
   if (!verlet_.loaded()) verlet_.load(store_.core());
+  verlet_.moved();
   const int parts = set_partition();
   partition_.prepare_cross_pairs(neighbors_);
   start_load_pass(parts);
@@ -139,17 +185,23 @@ void System::compute_forces(double dt, bool update_history, double kick, bool st
 // row. Part t owns the particles [begin(t), begin(t+1)) of partition_ and adds pair forces to j
 // directly when j is its own; pairs reaching into a later part (cross pairs) are evaluated first,
 // each once, into its cross_force, then added by both owners in the same place of their sums.
-void System::evaluate_forces(double dt, bool update_history, double kick) {
-  if (track_load_)
-    if (h_load_limit_ >= 0)
-      evaluate_forces_impl<true, true>(dt, update_history, kick);
+void System::evaluate_forces(double dt, bool update_history, double kick, bool drift) {
+  auto run = [&]<bool Drift>() {
+    if (track_load_)
+      if (h_load_limit_ >= 0)
+        evaluate_forces_impl<true, true, Drift>(dt, update_history, kick);
+      else
+        evaluate_forces_impl<true, false, Drift>(dt, update_history, kick);
     else
-      evaluate_forces_impl<true, false>(dt, update_history, kick);
+      evaluate_forces_impl<false, false, Drift>(dt, update_history, kick);
+  };
+  if (drift)
+    run.template operator()<true>();
   else
-    evaluate_forces_impl<false, false>(dt, update_history, kick);
+    run.template operator()<false>();
 }
 
-template <bool Load, bool Limit>
+template <bool Load, bool Limit, bool Drift>
 void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   Particles& p = store_.core();
   const NeighborList& nl = neighbors_;
@@ -159,22 +211,45 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   // Raw pointers, taken once: the loops keep them in registers (a vector's data pointer would be
   // reloaded after every store through the char touching flags, which may alias it).
   const VelocityVerlet::Pass verlet = verlet_.pass(p);
-  const PairContacts::Pass pairs = pairs_.pass();
+  const PairContacts::Pass pairs = pairs_.pass(p);
   PackedParticle* const packed = verlet.packed;
-  Eigen::Vector3d* const force = p.force.data();
-  Eigen::Vector3d* const torque = p.torque.data();
+  const double* const mass = p.mass.data();
+  const int* const material = p.material.data();
   double* load = Load ? load_.data() : nullptr;
   const double* load_limit = Limit ? store_.array<double>(h_load_limit_).data() : nullptr;
   const MeshContacts::Pass mesh = mesh_contacts_.pass();  // rows: particles near a mesh
+  const int* const offsets = nl.offsets_.data();
+  const int* const neighbors = nl.neighbors_.data();
   const int np = walls.np;
+  // Drift: the integrator's first half of particle i (with kick = dt/2) and the start of its
+  // force sums, as the loop before the pass does it (step(), which knows that no particle can
+  // have moved beyond the skin)
+  const Eigen::Vector3d gravity = gravity_;
+  auto drift = [&](int i) {
+    verlet.first_half(i, dt, kick);
+    PackedParticle& q = packed[i];
+    q.f = mass[i] * gravity;
+    q.t.setZero();
+    if constexpr (Load) load[i] = 0.0;
+  };
+  if constexpr (Drift) {
+    if (parts > 1) {  // the particles that cross pairs read drift first
+#pragma omp for schedule(static, 1)
+      for (int part = 0; part < parts; ++part) {
+        for (int i = tp.begin(part); i < tp.drift_head_end[part]; ++i) drift(i);
+        for (int i = tp.drift_tail_begin[part]; i < tp.begin(part + 1); ++i) drift(i);
+      }
+    }
+  }
   if (parts > 1) {  // the cross pairs, shared evenly among the threads
     const int n_cross = static_cast<int>(tp.cross_pairs.size());
 #pragma omp for schedule(static)
     for (int k = 0; k < n_cross; ++k) {
       const ThreadPartition::CrossPair& c = tp.cross_pairs[k];
       ThreadPartition::CrossForce& cf = tp.cross_force[k];
-      cf.touching = pairs.force<Load>(c.slot, model_, packed[c.i], packed[c.j], dt, update_history,
-                                      cf.force_i, cf.torque_i, cf.torque_j, cf.load);
+      cf.touching =
+          pairs.force<Load>(c.slot, model_, c.i, packed[c.i], c.j, packed[c.j], dt, update_history,
+                            cf.force_i, cf.torque_i, cf.torque_j, cf.load);
     }
   }
 #pragma omp for schedule(static, 1)
@@ -186,24 +261,37 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       const ThreadPartition::CrossForce& cf = tp.cross_force[c];
       if (!cf.touching) continue;
       const int j = tp.cross_pairs[c].j;
-      force[j] -= cf.force_i;
-      torque[j] += cf.torque_j;
+      packed[j].f -= cf.force_i;
+      packed[j].t += cf.torque_j;
       if constexpr (Load) load[j] = std::max(load[j], cf.load);
     }
     int cross = tp.cross_out_begin[part];
     const int lo = tp.begin(part), hi = tp.begin(part + 1);
+    // Drift: particles [frontier, tail) have not drifted yet
+    int frontier = hi, tail = hi;
+    if constexpr (Drift) {
+      frontier = parts > 1 ? tp.drift_head_end[part] : lo;
+      tail = parts > 1 ? tp.drift_tail_begin[part] : hi;
+    }
+    double speed2 = 0.0, accel2 = 0.0, extent = 0.0;        // maxima after the kick
     int mesh_row = mesh.rows > 0 ? mesh.first_row(lo) : 0;  // the next particle near a mesh
     for (int b = lo / block_size; b * block_size < hi; ++b) {
       // plane forces summed per block of particles, then over blocks (fixed order)
       Eigen::Vector3d* block_wall = walls.start_block(b);
       const int i_end = std::min(hi, (b + 1) * block_size);
       for (int i = b * block_size; i < i_end; ++i) {
-        const PackedParticle& qi = packed[i];
-        Eigen::Vector3d f = force[i];
-        Eigen::Vector3d t = torque[i];
+        if constexpr (Drift) {  // i and its row's neighbours in this part drift first
+          const int row_end = offsets[i + 1];
+          const int need =
+              row_end > offsets[i] ? std::max(i, std::min(neighbors[row_end - 1], hi - 1)) : i;
+          for (; frontier <= need && frontier < tail; ++frontier) drift(frontier);
+        }
+        PackedParticle& qi = packed[i];
+        Eigen::Vector3d f = qi.f;
+        Eigen::Vector3d t = qi.t;
         double load_i = Load ? load[i] : 0.0;
-        for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
-          const int j = nl.neighbors_[s];
+        for (int s = offsets[i]; s < offsets[i + 1]; ++s) {
+          const int j = neighbors[s];
           if (j >= hi) {  // a cross pair, already evaluated
             const ThreadPartition::CrossForce& cf = tp.cross_force[cross++];
             if (cf.touching) {
@@ -214,39 +302,46 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           }
           Eigen::Vector3d fij, ti, tj;
           double lij = 0.0;
-          if (!pairs.force<Load>(s, model_, qi, packed[j], dt, update_history, fij, ti, tj, lij))
+          PackedParticle& qj = packed[j];
+          if (!pairs.force<Load>(s, model_, i, qi, j, qj, dt, update_history, fij, ti, tj, lij))
             continue;
           f += fij;
           t += ti;
-          force[j] -= fij;
-          torque[j] += tj;
+          qj.f -= fij;
+          qj.t += tj;
           if constexpr (Load) {
             load_i = std::max(load_i, lij);
             load[j] = std::max(load[j], lij);
           }
         }
-        walls.add_forces<Load>(i, qi, np <= 64 ? nl.plane_mask_[i] : 0, model_, dt, update_history,
-                               f, t, load_i, block_wall);
+        walls.add_forces<Load>(i, qi, mass[i], material[i], np <= 64 ? nl.plane_mask_[i] : 0,
+                               model_, dt, update_history, f, t, load_i, block_wall);
         if (mesh_row < mesh.rows && mesh.particle[mesh_row] == i) {
           // own accumulators: f and t keep their registers
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
-          const MeshContacts::Particle q{qi.x, qi.r, qi.v, qi.m, qi.w, qi.material};
+          const MeshContacts::Particle q{qi.x, qi.r, qi.v, mass[i], qi.w, material[i]};
           MeshContacts::evaluate<Load>(i, q, nl, meshes_, model_, mesh.row(mesh_row++), dt,
                                        update_history, fm, tm, load_i);
           f += fm;
           t += tm;
         }
-        force[i] = f;
-        torque[i] = t;
+        qi.f = f;
+        qi.t = t;
         if constexpr (Load) {  // (i's load is complete: the pairs (k, i), k < i, came first)
           load[i] = load_i;
           if constexpr (Limit) reached |= load_i >= load_limit[i];
         }
         // the integrator's closing kick (no other row reads particle i any more in this pass)
-        if (kick > 0.0) verlet.kick(i, kick, f, t);
+        if (kick > 0.0) {
+          verlet.kick(i, kick, f, t);
+          speed2 = std::max(speed2, qi.v.squaredNorm());
+          accel2 = std::max(accel2, f.squaredNorm() / (mass[i] * mass[i]));
+          extent = std::max(extent, qi.x.cwiseAbs().maxCoeff());
+        }
       }
     }
     if (reached) load_reached_[part] = 1;
+    part_motion_[part] = {speed2, accel2, extent};
   }
 }
 

@@ -63,6 +63,18 @@ void ThreadPartition::prepare_cross_pairs(const NeighborList& nl) {
     const int t = part_of(cross_pairs[k].j);
     cross_in[cross_in_begin[t] + counts_[t]++] = k;
   }
+  // the particles of each part that cross pairs read: a head (incoming j) and a tail (outgoing i)
+  drift_head_end.resize(np);
+  drift_tail_begin.resize(np);
+  for (int t = 0; t < np; ++t) {
+    int head = begin_[t], tail = begin_[t + 1];
+    for (int k = cross_in_begin[t]; k < cross_in_begin[t + 1]; ++k)
+      head = std::max(head, cross_pairs[cross_in[k]].j + 1);
+    for (int k = cross_out_begin[t]; k < cross_out_begin[t + 1]; ++k)
+      tail = std::min(tail, cross_pairs[k].i);
+    drift_head_end[t] = head;
+    drift_tail_begin[t] = std::max(head, tail);
+  }
   valid_ = true;
 }
 

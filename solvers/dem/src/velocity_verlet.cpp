@@ -9,10 +9,11 @@ void VelocityVerlet::load(const Particles& p) {
   for (int i = 0; i < n; ++i) {
     PackedParticle& q = packed_[i];
     q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
-    q.r = p.radius[i], q.m = p.mass[i], q.material = p.material[i];
+    q.r = p.radius[i], q.f = p.force[i], q.t = p.torque[i];
   }
   loaded_ = true;
   mirror_current_ = true;
+  has_motion_ = false;
 }
 
 void VelocityVerlet::copy_back(Particles& p) const {
@@ -20,6 +21,8 @@ void VelocityVerlet::copy_back(Particles& p) const {
     p.position[i] = packed_[i].x;
     p.velocity[i] = packed_[i].v;
     p.angular_velocity[i] = packed_[i].w;
+    p.force[i] = packed_[i].f;
+    p.torque[i] = packed_[i].t;
   }
   mirror_current_ = true;
 }

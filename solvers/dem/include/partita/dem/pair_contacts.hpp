@@ -17,6 +17,7 @@
 #include "partita/dem/contact_model.hpp"
 #include "partita/dem/neighbor_list.hpp"
 #include "partita/dem/packed_particle.hpp"
+#include "partita/dem/particles.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -42,18 +43,23 @@ class PairContacts {
   struct Pass {
     Eigen::Vector3d* shear;
     char* touching;
+    const double* mass;   // the store's masses
+    const int* material;  // the store's material ids
 
-    /// The kernel (force()) for the pair in slot s.
+    /// The kernel (force()) for the pair (i, j) in slot s.
     template <bool Load>
-    PARTITA_DEM_INLINE bool force(int s, const ContactModel& model, const PackedParticle& qi,
-                                  const PackedParticle& qj, double dt, bool update_history,
+    PARTITA_DEM_INLINE bool force(int s, const ContactModel& model, int i, const PackedParticle& qi,
+                                  int j, const PackedParticle& qj, double dt, bool update_history,
                                   Eigen::Vector3d& fij, Eigen::Vector3d& ti, Eigen::Vector3d& tj,
                                   double& load) const {
-      return PairContacts::force<Load>(model, qi, qj, shear[s], touching[s], dt, update_history,
-                                       fij, ti, tj, load);
+      return PairContacts::force<Load>(model, qi, qj, mass[i], mass[j], material[i], material[j],
+                                       shear[s], touching[s], dt, update_history, fij, ti, tj,
+                                       load);
     }
   };
-  Pass pass() { return Pass{shear_.data(), touching_.data()}; }
+  Pass pass(const Particles& p) {
+    return Pass{shear_.data(), touching_.data(), p.mass.data(), p.material.data()};
+  }
 
   /// Writes / reads the histories and flags (in the state format, between the neighbour list's
   /// rows and its build references: see System::write_body()). read() throws Error when their
@@ -61,17 +67,19 @@ class PairContacts {
   void write(BinaryWriter& out) const;
   void read(BinaryReader& in, std::size_t slots);
 
-  /// Force of the pair (i, j) on i and the torques on i and j; false (and the history settled:
+  /// Force of the pair (i, j) on i and the torques on i and j (masses mi, mj and materials of the
+  /// two, read only when they overlap); false (and the history settled:
   /// zeroed once the spheres part) when they do not overlap. Torques T_i = -cr_i n x F_t,
   /// T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
   /// T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
   /// Load: also the contact load F_n (E*/R*)^2 (breakage criterion, System::contact_load()).
   template <bool Load>
   static PARTITA_DEM_INLINE bool force(const ContactModel& model, const PackedParticle& qi,
-                                       const PackedParticle& qj, Eigen::Vector3d& shear,
-                                       char& touching, double dt, bool update_history,
-                                       Eigen::Vector3d& fij, Eigen::Vector3d& ti,
-                                       Eigen::Vector3d& tj, double& load) {
+                                       const PackedParticle& qj, const double& mi, const double& mj,
+                                       const int& material_i, const int& material_j,
+                                       Eigen::Vector3d& shear, char& touching, double dt,
+                                       bool update_history, Eigen::Vector3d& fij,
+                                       Eigen::Vector3d& ti, Eigen::Vector3d& tj, double& load) {
     const Eigen::Vector3d d = qi.x - qj.x;
     const double ri = qi.r, rj = qj.r;
     const double rsum = ri + rj;
@@ -88,8 +96,7 @@ class PairContacts {
     const Eigen::Vector3d nrm =
         r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
     const double delta = rsum - r;
-    const double mi = qi.m, mj = qj.m;
-    const PairParameters& pp = model.pair(qi.material, qj.material);
+    const PairParameters& pp = model.pair(material_i, material_j);
     const double r_eff = ri * rj / rsum;
     const double m_eff = mi * mj / (mi + mj);
     const double cri = ri - 0.5 * delta, crj = rj - 0.5 * delta;

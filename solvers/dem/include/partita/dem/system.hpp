@@ -256,11 +256,15 @@ class System {
   void pairs_follow_lists() { pairs_.follow(neighbors_.slot_sources()); }
   void start_sums(int i);
   void rebuild_lists();
+  // the integrator's motion bound after a step (VelocityVerlet::Motion): moved, the largest
+  // distance from the build positions (or a bound of it), the rest from the parts' maxima
+  void set_motion(double moved);
   int set_partition();
-  // called inside a parallel region (orphaned omp for)
-  void evaluate_forces(double dt, bool update_history, double kick);
-  // Load: record the contact loads; Limit: compare them with a hook's limits
-  template <bool Load, bool Limit>
+  // called inside a parallel region (orphaned omp for); drift: the pass also runs the
+  // integrator's first half (step(); kick = dt/2), each particle just before a row reads it
+  void evaluate_forces(double dt, bool update_history, double kick, bool drift = false);
+  // Load: record the contact loads; Limit: compare them with a hook's limits; Drift: as drift
+  template <bool Load, bool Limit, bool Drift>
   void evaluate_forces_impl(double dt, bool update_history, double kick);
   void reduce_wall_and_mesh_forces();  // wall totals and mesh forces of the last pass
   void start_load_pass(int parts);
@@ -293,6 +297,10 @@ class System {
   std::vector<double> load_;    // largest contact load per particle (track_load_)
   int h_load_limit_ = -1;       // a hook's per-particle load limits (store array) or -1
   std::vector<char> load_reached_;  // per part: a load reached its limit in the last pass
+  struct PartMotion {  // per part, maxima after the last pass's kick: |v|^2, |F/m|^2, |x_k|
+    double speed2 = 0.0, accel2 = 0.0, extent = 0.0;
+  };
+  std::vector<PartMotion> part_motion_;
 
   ThreadPartition partition_;
   // renumbering in cell order

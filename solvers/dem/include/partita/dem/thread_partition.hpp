@@ -44,6 +44,11 @@ class ThreadPartition {
   std::vector<int> cross_in;           ///< indices into cross_pairs, by part of j
   std::vector<int> cross_in_begin;     ///< parts + 1
   std::vector<CrossForce> cross_force;
+  /// Per part, for a force pass that also runs the integrator's first half (System::step()):
+  /// the particles [begin(t), drift_head_end[t]) and [drift_tail_begin[t], begin(t + 1)) take
+  /// part in cross pairs and drift before the cross pairs are evaluated; the others drift as the
+  /// part's rows reach them.
+  std::vector<int> drift_head_end, drift_tail_begin;
 
  private:
   std::vector<int> begin_;

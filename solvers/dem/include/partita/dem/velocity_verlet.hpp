@@ -8,11 +8,12 @@
 //
 // with I = 2/5 m R^2 unless the caller set another (System::set_particle_mass()).
 //
-// VelocityVerlet owns the packed state (PackedParticle: x, v, omega and what the contact kernels
-// read about a neighbour, r, m, material: 96 bytes, two cache lines instead of one per array) and
-// its mirror logic: positions, velocities and angular velocities live in the packed copy while
-// stepping, the particle store's arrays are brought up to date on demand (sync()), and the packed
-// copy is loaded again (load()) after the caller changed the store (invalidate()).
+// VelocityVerlet owns the packed state (PackedParticle: x, v, omega, the force and torque sums
+// and the radius a contact kernel reads about a neighbour: 128 bytes, two aligned cache lines
+// instead of one or two per array) and its mirror logic: positions, velocities, angular
+// velocities, forces and torques live in the packed copy while stepping, the particle store's
+// arrays are brought up to date on demand (sync()), and the packed copy is loaded again (load())
+// after the caller changed the store (invalidate()).
 // The per-particle operations are inline members of a Pass (raw pointers taken once per loop), so
 // that System's fused parallel loops (one parallel region per step: first half, forces and kick
 // particle by particle as each force sum completes) call them without a loop of their own.
@@ -37,11 +38,15 @@ class VelocityVerlet {
   void load(const Particles& p);
   /// The caller changed the store (particles added, removed, renumbered, velocities or masses
   /// set, a state restored): the next step loads the packed copy again.
-  void invalidate() { loaded_ = false; }
-  /// The packed state moved on (a step): the store's copies are stale until sync().
+  void invalidate() {
+    loaded_ = false;
+    has_motion_ = false;
+  }
+  /// The packed state is about to move on (a step, a force pass): the store's copies are stale
+  /// until sync().
   void moved() { mirror_current_ = false; }
-  /// Brings the store's positions, velocities and angular velocities up to date (cheap when
-  /// they are).
+  /// Brings the store's positions, velocities, angular velocities, forces and torques up to date
+  /// (cheap when they are).
   void sync(Particles& p) const {
     if (!mirror_current_) copy_back(p);
   }
@@ -50,25 +55,43 @@ class VelocityVerlet {
   void store_replaced() {
     mirror_current_ = true;
     loaded_ = false;
+    has_motion_ = false;
   }
 
+  /// What the last step left to bound the next one's motion, so that System::step() can tell
+  /// before a step that its first half moves no particle beyond the neighbour lists' skin:
+  /// moved, the largest distance of a particle from its position at the last list build; speed,
+  /// the largest |v|; accel, the largest |F|/m; extent, the largest |x| component. The next
+  /// first half moves a particle by dt |v + dt/2 F/m| <= dt (speed + dt/2 accel). Forgotten with
+  /// the packed copy (load(), invalidate(), store_replaced()) and by forget_motion().
+  struct Motion {
+    double moved = 0.0, speed = 0.0, accel = 0.0, extent = 0.0;
+  };
+  bool has_motion() const { return has_motion_; }
+  const Motion& motion() const { return motion_; }
+  void set_motion(const Motion& m) {
+    motion_ = m;
+    has_motion_ = true;
+  }
+  void forget_motion() { has_motion_ = false; }
+
   const PackedParticle& particle(std::size_t i) const { return packed_[i]; }
+  PackedParticle& particle(std::size_t i) { return packed_[i]; }
 
   /// What one loop over the particles reads and writes, taken once per loop (raw pointers the
   /// loop keeps in registers).
   struct Pass {
     PackedParticle* packed;
-    const Eigen::Vector3d* force;
-    const Eigen::Vector3d* torque;
+    const double* mass;
     const double* inertia;
 
     /// First half of the step for particle i with the forces of the last pass: v += half F/m,
     /// x += dt v, omega += half T/I (half = dt/2). Returns the new position.
     PARTITA_DEM_INLINE const Eigen::Vector3d& first_half(int i, double dt, double half) const {
       PackedParticle& q = packed[i];
-      q.v += (half / q.m) * force[i];
+      q.v += (half / mass[i]) * q.f;
       q.x += dt * q.v;
-      q.w += (half / inertia[i]) * torque[i];
+      q.w += (half / inertia[i]) * q.t;
       return q.x;
     }
     /// Closing kick of particle i with its complete force f and torque t of this pass:
@@ -76,21 +99,21 @@ class VelocityVerlet {
     PARTITA_DEM_INLINE void kick(int i, double kick, const Eigen::Vector3d& f,
                                  const Eigen::Vector3d& t) const {
       PackedParticle& q = packed[i];
-      q.v += (kick / q.m) * f;
+      q.v += (kick / mass[i]) * f;
       q.w += (kick / inertia[i]) * t;
     }
   };
-  /// The pass over the packed state; forces, torques and inertias from the store's arrays.
-  Pass pass(const Particles& p) {
-    return Pass{packed_.data(), p.force.data(), p.torque.data(), p.inertia.data()};
-  }
+  /// The pass over the packed state; masses and inertias from the store's arrays.
+  Pass pass(const Particles& p) { return Pass{packed_.data(), p.mass.data(), p.inertia.data()}; }
 
  private:
   void copy_back(Particles& p) const;
 
   std::vector<PackedParticle> packed_;  // the moving state while stepping
   bool loaded_ = false;                 // packed_ holds the store's current state
-  mutable bool mirror_current_ = true;  // the store's x, v, omega equal packed_'s
+  bool has_motion_ = false;             // motion_ bounds the current state's next step
+  Motion motion_;
+  mutable bool mirror_current_ = true;  // the store's x, v, omega, F, T equal packed_'s
 };
 
 }  // namespace partita::dem

@@ -74,11 +74,12 @@ class WallContacts {
       for (int k = 0; k < np; ++k) s[k].setZero();
       return s;
     }
-    /// Forces of the planes near particle i (bit k of `mask`: plane k; every plane when there
-    /// are more than 64) added to f and t, their reactions to `block`; Load: the largest contact
-    /// load F_n (E*/R)^2 into load.
+    /// Forces of the planes near particle i (mass mi, material material_i; bit k of `mask`: plane
+    /// k; every plane when there are more than 64) added to f and t, their reactions to `block`;
+    /// Load: the largest contact load F_n (E*/R)^2 into load.
     template <bool Load>
-    PARTITA_DEM_INLINE void add_forces(int i, const PackedParticle& qi, std::uint64_t mask,
+    PARTITA_DEM_INLINE void add_forces(int i, const PackedParticle& qi, const double& mi,
+                                       const int& material_i, std::uint64_t mask,
                                        const ContactModel& model, double dt, bool update_history,
                                        Eigen::Vector3d& f, Eigen::Vector3d& t, double& load,
                                        Eigen::Vector3d* block) const;
@@ -103,12 +104,10 @@ class WallContacts {
 };
 
 template <bool Load>
-PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(int i, const PackedParticle& qi,
-                                                       std::uint64_t mask,
-                                                       const ContactModel& model, double dt,
-                                                       bool update_history, Eigen::Vector3d& f,
-                                                       Eigen::Vector3d& t, double& load,
-                                                       Eigen::Vector3d* block) const {
+PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(
+    int i, const PackedParticle& qi, const double& mi, const int& material_i, std::uint64_t mask,
+    const ContactModel& model, double dt, bool update_history, Eigen::Vector3d& f,
+    Eigen::Vector3d& t, double& load, Eigen::Vector3d* block) const {
   const double ri = qi.r;
   for (int k = 0; k < np; ++k) {
     if (np <= 64) {  // jump to the next plane near i
@@ -123,11 +122,11 @@ PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(int i, const PackedPartic
       sh.setZero();
       continue;
     }
-    const PairParameters& pp = model.pair(qi.material, w.material);
+    const PairParameters& pp = model.pair(material_i, w.material);
     const double cr = ri - 0.5 * delta;
     Eigen::Vector3d fw, ft;
-    const double fn = hertz_mindlin(pp, delta, ri, qi.m, w.normal, qi.v - w.velocity, cr * qi.w,
-                                    sh, dt, update_history, fw, ft);
+    const double fn = hertz_mindlin(pp, delta, ri, mi, w.normal, qi.v - w.velocity, cr * qi.w, sh,
+                                    dt, update_history, fw, ft);
     f += fw;
     t -= cr * w.normal.cross(ft);
     if (pp.rolling_friction > 0.0) {
