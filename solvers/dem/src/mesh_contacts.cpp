@@ -250,6 +250,12 @@ void MeshContacts::start_layout(std::size_t rows, std::size_t slots) {
   new_particle_.clear();
   new_count_.clear();
   new_slot_.assign(1, 0);
+  // the slot arrays grow from empty in add_row(): whatever an earlier layout left in them (they
+  // are the previous arrays, swapped out) must not survive a layout with fewer slots, nor reach a
+  // saved state (a layout without rows kept them, and the state then failed its own check)
+  new_key_.clear();
+  new_shear_.clear();
+  new_record_.clear();
 }
 
 void MeshContacts::add_row(int particle, int capacity, int from) {
