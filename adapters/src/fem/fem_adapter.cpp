@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 #include <algorithm>
-#include <limits>
 #include <sstream>
+#include <limits>
 
 #include "partita/fem/error.hpp"
 #include "partita/fem/state_io.hpp"
@@ -610,15 +610,9 @@ void FemAdapter::advance(double dt) {
     Interface::Work& a = i.audit;
     double w = 0.0;
     if (i.has_tractions) {
-      if (a.tractions.rows() == i.tractions.rows()) {
-        // both ends of the step in one pass (the same two sums, added in the same order)
-        const auto [now, before] =
-            solver_->face_traction_works(i.face, i.tractions, a.tractions, du_);
-        w += now;
-        w += before;
-      } else {
-        w += solver_->face_traction_work(i.face, i.tractions, du_);
-      }
+      w += solver_->face_traction_work(i.face, i.tractions, du_);
+      if (a.tractions.rows() == i.tractions.rows())
+        w += solver_->face_traction_work(i.face, a.tractions, du_);
       a.tractions = i.tractions;
     }
     if (i.has_forces) {

@@ -400,24 +400,6 @@ double StructuralSolver::face_traction_work(const std::string& face, const Matri
   return w;
 }
 
-std::array<double, 2> StructuralSolver::face_traction_works(const std::string& face,
-                                                            const MatrixX3& a, const MatrixX3& b,
-                                                            const Eigen::VectorXd& du) const {
-  const auto& op = face_operator(face);
-  if (static_cast<std::size_t>(a.rows()) != op.num_qp ||
-      static_cast<std::size_t>(b.rows()) != op.num_qp || du.size() != coupling_force_.size())
-    throw Error("face_traction_works('" + face + "'): " + std::to_string(op.num_qp) +
-                " tractions and " + std::to_string(coupling_force_.size()) + " dofs expected");
-  double wa = 0.0, wb = 0.0;
-  for (std::size_t k = 0; k < op.node.size(); ++k) {
-    const auto q = static_cast<Eigen::Index>(op.qp[k]);
-    const auto d = du.segment<3>(3 * static_cast<Eigen::Index>(op.node[k]));
-    wa += op.coefficient[k] * a.row(q).dot(d);
-    wb += op.coefficient[k] * b.row(q).dot(d);
-  }
-  return {wa, wb};
-}
-
 void StructuralSolver::update_coupling_force() {
   coupling_force_.setZero();
   // f_a = sum_q N_a(x_q) t_q w_q over every face with tractions

@@ -83,17 +83,6 @@ TEST_CASE("fem uniform traction at quadrature points equals the pressure load", 
     for (std::size_t q = 0; q < qps.size(); ++q)
       integral += qps[q].weight * t.row(static_cast<Eigen::Index>(q)).transpose();
     CHECK((b.total_coupling_force() - integral).norm() < 1e-13 * integral.norm());
-    // the work over the static displacement is f(t) . u (the audit's quantity), and the two-set
-    // form gives each set's sum bit for bit (the audit adds both ends of a step in one pass)
-    const Eigen::VectorXd& u = b.displacement();
-    const double work = b.face_traction_work("zmax", t, u);
-    CHECK(work == Approx(b.external_force().dot(u)).epsilon(1e-12));
-    const MatrixX3 t2 = 0.5 * t + MatrixX3::Constant(t.rows(), 3, 0.1 * p);
-    const auto both = b.face_traction_works("zmax", t, t2, u);
-    CHECK(both[0] == work);
-    CHECK(both[1] == b.face_traction_work("zmax", t2, u));
-    CHECK_THROWS_WITH(b.face_traction_works("zmax", t, MatrixX3::Zero(3, 3), u),
-                      Catch::Contains("tractions"));
     // wrong number of rows is a clear error
     CHECK_THROWS_WITH(b.set_face_tractions_at_quadrature_points("zmax", MatrixX3::Zero(3, 3)),
                       Catch::Contains("quadrature points"));

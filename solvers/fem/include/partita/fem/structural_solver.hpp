@@ -1,5 +1,4 @@
 #pragma once
-#include <array>
 #include <cstddef>
 #include <map>
 #include <memory>
@@ -86,10 +85,6 @@ class StructuralSolver final : private StructuralSystem {
   // the face, as above) over the displacement increment du (all dofs) (interface energy audit).
   double face_traction_work(const std::string& face, const MatrixX3& tractions,
                             const Eigen::VectorXd& du) const;
-  // The works of two sets of tractions over the same du in one pass over the face (each the sum
-  // face_traction_work() forms, bit for bit): {work of a, work of b}.
-  std::array<double, 2> face_traction_works(const std::string& face, const MatrixX3& a,
-                                            const MatrixX3& b, const Eigen::VectorXd& du) const;
 
   // --- analyses ---
   // K u = F(time()) with the prescribed values at time(); velocity = acceleration = 0.
