@@ -13,8 +13,8 @@
 // Each mesh is solved with every linear solver built in (Eigen's SimplicialLDLT + AMD; CHOLMOD
 // supernodal with NESDIS, METIS and AMD orderings, solved by CHOLMOD; cholmod-nesdis-t: NESDIS
 // solved by the threaded supernodal solve, on all OpenMP threads), and the summary prints their
-// factorisation and step times as ratios to the first one listed, and to CalculiX. Timings are wall-clock on a
-// possibly shared machine: read them with that caveat.
+// factorisation and step times as ratios to the first one listed, and to CalculiX. Timings are
+// wall-clock on a possibly shared machine: read them with that caveat.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -330,8 +330,8 @@ int main(int argc, char** argv) {
     if (opt.meshes.empty()) opt.meshes = {{20, 20, 2}, {40, 40, 4}};
     std::printf(
         "bench_fem_plate: seed plate, %d steps of %g s. Wall-clock timings on a possibly shared "
-        "machine. OpenMP threads: %d (cholmod-nesdis-t's solve, the step's products, the "
-        "assembly); threaded-solve kernels: %s\n",
+        "machine. OpenMP threads: %d (cholmod-nesdis-t's solve and the assembly); threaded-solve "
+        "kernels: %s\n",
         opt.steps, opt.dt, max_threads(), threaded_solve_kernels().c_str());
     for (const auto& c : opt.meshes) bench(opt, c);
   } catch (const std::exception& e) {
