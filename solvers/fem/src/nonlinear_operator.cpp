@@ -1,11 +1,10 @@
 #include "partita/fem/nonlinear_operator.hpp"
 
-#include <exception>
-
 #include <array>
 #include <cmath>
 
 #include "block_assembler.hpp"
+#include "parallel_loop.hpp"
 #include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/linear_elastic_law.hpp"
@@ -105,23 +104,9 @@ void NonlinearOperator::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_in
   for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
     const long n = static_cast<long>(std::min(ne - c0, kChunk));
     // A material law may throw (a radial return that does not converge: the Newton solver cuts
-    // the step back); an exception cannot leave a parallel region, so the one of the first
-    // element that threw is kept and rethrown after it, as the serial loop would have thrown it.
-    std::exception_ptr error;
-    long error_at = n;
-#pragma omp parallel for schedule(static) if (n >= 32)
-    for (long i = 0; i < n; ++i) {
-      try {
-        evaluate_chunk_element(c0, i, u, k != nullptr);
-      } catch (...) {
-#pragma omp critical(partita_fem_operator_error)
-        if (i < error_at) {
-          error_at = i;
-          error = std::current_exception();
-        }
-      }
-    }
-    if (error) std::rethrow_exception(error);
+    // the step back): the first element's exception comes out, as from a serial loop.
+    detail::parallel_for_first_error(
+        n, 32, [&](long i) { evaluate_chunk_element(c0, i, u, k != nullptr); });
     for (long i = 0; i < n; ++i) {
       const Element& el = elements[c0 + static_cast<std::size_t>(i)];
       const int nn = node_count(el.type);

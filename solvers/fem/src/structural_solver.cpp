@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <unordered_map>
 
@@ -15,6 +14,7 @@
 #endif
 
 #include "block_assembler.hpp"
+#include "parallel_loop.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/linear_elastic_operator.hpp"
 #include "partita/fem/quadrature.hpp"
@@ -116,22 +116,10 @@ void assemble_elements(const Mesh& mesh, const BlockAssembler& assembler, Sparse
   std::vector<ElementMatrix> chunk(std::min(ne, kChunk));
   for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
     const long n = static_cast<long>(std::min(ne - c0, kChunk));
-    std::exception_ptr error;
-    long error_at = n;
-#pragma omp parallel for schedule(static) if (n >= 64)
-    for (long i = 0; i < n; ++i) {
-      try {
-        element(elements[c0 + static_cast<std::size_t>(i)], chunk[static_cast<std::size_t>(i)]);
-      } catch (...) {
-#pragma omp critical(partita_fem_assembly_error)
-        if (i < error_at) {
-          error_at = i;
-          error = std::current_exception();
-        }
-      }
-    }
-    if (error) std::rethrow_exception(error);
-      // each thread adds into the columns of its own range of nodes, the elements in order
+    detail::parallel_for_first_error(n, 64, [&](long i) {
+      element(elements[c0 + static_cast<std::size_t>(i)], chunk[static_cast<std::size_t>(i)]);
+    });
+    // each thread adds into the columns of its own range of nodes, the elements in order
 #pragma omp parallel if (n >= 64)
     {
       std::size_t part = 0, parts = 1;
