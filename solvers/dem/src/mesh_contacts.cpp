@@ -263,8 +263,10 @@ void MeshContacts::add_row(int particle, int capacity, int from) {
   new_count_.push_back(from >= 0 ? count_[from] : 0);
   new_slot_.push_back(new_slot_.back() + capacity);
   const std::size_t slots = static_cast<std::size_t>(new_slot_.back());
+  // free slots are zero (Eigen's vectors are not initialised by their default constructor, and
+  // every slot of a row goes into a saved state)
   new_key_.resize(slots);
-  new_shear_.resize(slots);
+  new_shear_.resize(slots, Eigen::Vector3d::Zero());
   new_record_.resize(slots);
   if (from < 0) return;
   const std::size_t src = static_cast<std::size_t>(slot_[from]);

@@ -16,6 +16,12 @@ struct MeshContactRecord {
   double delta = 0.0;                               ///< overlap [m]
   double r_eff = 0.0;
   int material = 0;
+  // The 4 bytes after `material`, made a member: the records go into state files as raw bytes,
+  // and padding would carry whatever the heap held there (two identical runs wrote files that
+  // differed in those bytes). A member is copied with the record and stays zero.
+  int reserved = 0;
 };
+static_assert(sizeof(MeshContactRecord) == 4 * sizeof(int) + 8 * sizeof(double),
+              "no padding: the records are written as raw bytes");
 
 }  // namespace partita::dem
