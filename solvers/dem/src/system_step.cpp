@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+
 namespace partita::dem {
 
 namespace {
@@ -140,6 +141,19 @@ void System::start_sums(int i) {
 void System::start_load_pass(int parts) {
   load_reached_.assign(h_load_limit_ >= 0 ? static_cast<std::size_t>(parts) : 0, 0);
   part_motion_.resize(static_cast<std::size_t>(parts));
+  // the force pass's per-part lists hold the listed pairs of one block of rows
+  pair_scratch_.resize(static_cast<std::size_t>(parts));
+  const std::vector<int>& offsets = neighbors_.offsets_;
+  const int n = static_cast<int>(offsets.size()) - 1;
+  int most = 0;
+  for (int b = 0; b * block_size < n; ++b)
+    most = std::max(most, offsets[std::min(n, (b + 1) * block_size)] - offsets[b * block_size]);
+  const auto size = static_cast<std::size_t>(most);
+  for (PairScratch& sc : pair_scratch_) {
+    if (sc.tasks.size() >= size) continue;
+    sc.tasks.resize(size + size / 4);  // (headroom: lists grow a little between builds)
+    sc.forces.resize(size + size / 4);
+  }
 }
 
 // After a step's kick: the bound of the next step's motion (VelocityVerlet::Motion).
@@ -221,6 +235,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   const int* const offsets = nl.offsets_.data();
   const int* const neighbors = nl.neighbors_.data();
   const int np = walls.np;
+  const PairBatchKernel batch = Load ? pair_batch_kernels().with_load : pair_batch_kernels().plain;
   // Drift: the integrator's first half of particle i (with kick = dt/2) and the start of its
   // force sums, as the loop before the pass does it (step(), which knows that no particle can
   // have moved beyond the skin)
@@ -275,43 +290,73 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     }
     double speed2 = 0.0, accel2 = 0.0, extent = 0.0;        // maxima after the kick
     int mesh_row = mesh.rows > 0 ? mesh.first_row(lo) : 0;  // the next particle near a mesh
+    PairTask* const tasks = pair_scratch_[part].tasks.data();
+    PairForce* const forces = pair_scratch_[part].forces.data();
+    int row_first[block_size + 1];  // where each row's touching pairs start in tasks
+    int row_cross[block_size];      // each row's first cross pair (slot)
     for (int b = lo / block_size; b * block_size < hi; ++b) {
       // plane forces summed per block of particles, then over blocks (fixed order)
       Eigen::Vector3d* block_wall = walls.start_block(b);
+      const int i_begin = b * block_size;
       const int i_end = std::min(hi, (b + 1) * block_size);
-      for (int i = b * block_size; i < i_end; ++i) {
-        if constexpr (Drift) {  // i and its row's neighbours in this part drift first
-          const int row_end = offsets[i + 1];
-          const int need =
-              row_end > offsets[i] ? std::max(i, std::min(neighbors[row_end - 1], hi - 1)) : i;
-          for (; frontier <= need && frontier < tail; ++frontier) drift(frontier);
+      if constexpr (Drift) {  // the block's particles and their neighbours in this part drift
+        int need = i_end - 1;
+        for (int i = i_begin; i < i_end; ++i)
+          if (offsets[i + 1] > offsets[i]) need = std::max(need, neighbors[offsets[i + 1] - 1]);
+        need = std::min(need, hi - 1);
+        for (; frontier <= need && frontier < tail; ++frontier) drift(frontier);
+      }
+      // The block's touching pairs (pair_batch.hpp): listed without a branch on the overlap
+      // test (a pair that parted has its history settled, zeroed, as PairContacts::force()
+      // does), evaluated by the batched kernel, then added row by row in the order of the rows.
+      // Cross pairs (j in a later part) come last in a row; their forces were evaluated before.
+      int n_touch = 0;
+      for (int i = i_begin; i < i_end; ++i) {
+        row_first[i - i_begin] = n_touch;
+        const PackedParticle& qi = packed[i];
+        int s = offsets[i];
+        const int row_end = offsets[i + 1];
+        for (; s < row_end; ++s) {
+          const int j = neighbors[s];
+          if (j >= hi) break;  // cross pairs (rows are sorted by j: the rest of the row)
+          const PackedParticle& qj = packed[j];
+          const Eigen::Vector3d d = qi.x - qj.x;
+          const double rsum = qi.r + qj.r;
+          const bool touch = !(d.squaredNorm() >= rsum * rsum);  // (as the scalar kernel)
+          const bool parted = (pairs.touching[s] != 0) & !touch;  // (no branch on the flag)
+          pairs.touching[s] = static_cast<char>(touch);
+          if (parted) pairs.shear[s].setZero();
+          tasks[n_touch] = PairTask{s, i, j};
+          n_touch += touch ? 1 : 0;
         }
+        row_cross[i - i_begin] = s;
+      }
+      row_first[i_end - i_begin] = n_touch;
+      batch(tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
+            forces);
+      for (int i = i_begin; i < i_end; ++i) {
         PackedParticle& qi = packed[i];
         Eigen::Vector3d f = qi.f;
         Eigen::Vector3d t = qi.t;
         double load_i = Load ? load[i] : 0.0;
-        for (int s = offsets[i]; s < offsets[i + 1]; ++s) {
-          const int j = neighbors[s];
-          if (j >= hi) {  // a cross pair, already evaluated
-            const ThreadPartition::CrossForce& cf = tp.cross_force[cross++];
-            if (cf.touching) {
-              f += cf.force_i, t += cf.torque_i;
-              if constexpr (Load) load_i = std::max(load_i, cf.load);
-            }
-            continue;
-          }
-          Eigen::Vector3d fij, ti, tj;
-          double lij = 0.0;
-          PackedParticle& qj = packed[j];
-          if (!pairs.force<Load>(s, model_, i, qi, j, qj, dt, update_history, fij, ti, tj, lij))
-            continue;
+        for (int k = row_first[i - i_begin]; k < row_first[i - i_begin + 1]; ++k) {
+          const PairForce& o = forces[k];
+          const Eigen::Map<const Eigen::Vector3d> fij(o.f), ti(o.ti), tj(o.tj);
+          PackedParticle& qj = packed[tasks[k].j];
           f += fij;
           t += ti;
           qj.f -= fij;
           qj.t += tj;
           if constexpr (Load) {
-            load_i = std::max(load_i, lij);
-            load[j] = std::max(load[j], lij);
+            load_i = std::max(load_i, o.load);
+            load[tasks[k].j] = std::max(load[tasks[k].j], o.load);
+          }
+        }
+        for (int s = row_cross[i - i_begin]; s < offsets[i + 1]; ++s) {  // already evaluated
+          const ThreadPartition::CrossForce& cf = tp.cross_force[cross++];
+          if (cf.touching) {
+            f += cf.force_i, t += cf.torque_i;
+            if constexpr (Load) load_i = std::max(load_i, cf.load);
           }
         }
         walls.add_forces<Load>(i, qi, mass[i], material[i], np <= 64 ? nl.plane_mask_[i] : 0,

@@ -48,6 +48,7 @@
 #include "partita/dem/mesh_contacts.hpp"
 #include "partita/dem/neighbor_list.hpp"
 #include "partita/dem/packed_particle.hpp"
+#include "partita/dem/pair_batch.hpp"
 #include "partita/dem/pair_contacts.hpp"
 #include "partita/dem/particle_store.hpp"
 #include "partita/dem/particles.hpp"
@@ -301,6 +302,14 @@ class System {
     double speed2 = 0.0, accel2 = 0.0, extent = 0.0;
   };
   std::vector<PartMotion> part_motion_;
+  // per part, the force pass's lists of a block of rows (pair_batch.hpp): its touching pairs,
+  // their forces, where each row's pairs start and where its cross pairs start; sized by
+  // start_load_pass() for the largest block (no allocation while the lists keep their size)
+  struct PairScratch {
+    std::vector<PairTask> tasks;
+    std::vector<PairForce> forces;
+  };
+  std::vector<PairScratch> pair_scratch_;
 
   ThreadPartition partition_;
   // renumbering in cell order
