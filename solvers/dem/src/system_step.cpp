@@ -299,19 +299,19 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       Eigen::Vector3d* block_wall = walls.start_block(b);
       const int i_begin = b * block_size;
       const int i_end = std::min(hi, (b + 1) * block_size);
-      if constexpr (Drift) {  // the block's particles and their neighbours in this part drift
-        int need = i_end - 1;
-        for (int i = i_begin; i < i_end; ++i)
-          if (offsets[i + 1] > offsets[i]) need = std::max(need, neighbors[offsets[i + 1] - 1]);
-        need = std::min(need, hi - 1);
-        for (; frontier <= need && frontier < tail; ++frontier) drift(frontier);
-      }
       // The block's touching pairs (pair_batch.hpp): listed without a branch on the overlap
       // test (a pair that parted has its history settled, zeroed, as PairContacts::force()
       // does), evaluated by the batched kernel, then added row by row in the order of the rows.
       // Cross pairs (j in a later part) come last in a row; their forces were evaluated before.
       int n_touch = 0;
       for (int i = i_begin; i < i_end; ++i) {
+        if constexpr (Drift) {  // i and its row's neighbours in this part drift first (row by
+          // row, so that their loads from memory overlap the rows' work)
+          const int row_end = offsets[i + 1];
+          const int need =
+              row_end > offsets[i] ? std::max(i, std::min(neighbors[row_end - 1], hi - 1)) : i;
+          for (; frontier <= need && frontier < tail; ++frontier) drift(frontier);
+        }
         row_first[i - i_begin] = n_touch;
         const PackedParticle& qi = packed[i];
         int s = offsets[i];
@@ -323,9 +323,12 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           const Eigen::Vector3d d = qi.x - qj.x;
           const double rsum = qi.r + qj.r;
           const bool touch = !(d.squaredNorm() >= rsum * rsum);  // (as the scalar kernel)
-          const bool parted = (pairs.touching[s] != 0) & !touch;  // (no branch on the flag)
-          pairs.touching[s] = static_cast<char>(touch);
-          if (parted) pairs.shear[s].setZero();
+          // the flag changes only where a contact starts or ends (rare: a predictable branch,
+          // unlike one on the flag or on the test themselves)
+          if (static_cast<char>(touch) != pairs.touching[s]) {
+            pairs.touching[s] = static_cast<char>(touch);
+            if (!touch) pairs.shear[s].setZero();  // parted: the history is settled
+          }
           tasks[n_touch] = PairTask{s, i, j};
           n_touch += touch ? 1 : 0;
         }
