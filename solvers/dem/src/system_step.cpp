@@ -12,7 +12,6 @@
 #include <limits>
 #include <sstream>
 
-
 namespace partita::dem {
 
 namespace {

@@ -4,8 +4,8 @@
 // rolling resistance off and on; restitution 1, no damping; coincident centres), every kernel
 // set this CPU runs gives the scalar kernel's bits: forces, torques, load and history.
 
-#include "partita/dem/contact_model.hpp"
 #include "partita/dem/pair_batch.hpp"
+#include "partita/dem/contact_model.hpp"
 #include "partita/dem/pair_contacts.hpp"
 
 #include <catch2/catch.hpp>

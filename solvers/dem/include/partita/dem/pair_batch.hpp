@@ -46,9 +46,9 @@ struct PairForce {
 /// shear[tasks[k].s] as PairContacts::force() does for a pair known to overlap (the caller marks
 /// their slots touching). mass and material: the store's arrays.
 using PairBatchKernel = void (*)(const PairTask* tasks, int n, const PackedParticle* packed,
-                                 const double* mass, const int* material,
-                                 const ContactModel& model, Eigen::Vector3d* shear, double dt,
-                                 bool update_history, PairForce* out);
+                                 const double* mass, const int* material, const ContactModel& model,
+                                 Eigen::Vector3d* shear, double dt, bool update_history,
+                                 PairForce* out);
 
 struct PairBatchKernels {
   const char* name;  ///< "avx512", "avx2" or "sse2"
