@@ -8,7 +8,6 @@
 
 #include "elementwise.hpp"
 #include "partita/coupling/case_run.hpp"
-#include "partita/coupling/mapping/sparse_mapper.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
@@ -46,20 +45,6 @@ std::vector<std::pair<std::int64_t, fs::path>> restart_files(const fs::path& dir
   return files;
 }
 
-// |v_q| of each row into `norm` (column by column: contiguous passes over the column-major
-// array; the caller keeps `norm`, no allocation per window). One square root per row, taken
-// once: the totals below and the bound in audit_balance() read the same values.
-void row_norms(const Eigen::MatrixXd& v, Eigen::ArrayXd& norm) {
-  if (v.cols() == 3) {  // vectors: one fused pass, the same sums ((x^2 + y^2) + z^2)
-    norm.resize(v.rows());
-    elementwise::norms3(norm.data(), v.col(0).data(), v.col(1).data(), v.col(2).data(), v.rows());
-    return;
-  }
-  norm = v.col(0).array().square();
-  for (Eigen::Index c = 1; c < v.cols(); ++c) norm += v.col(c).array().square();
-  norm = norm.sqrt();
-}
-
 // Every value finite: x - x is 0 for a finite x and NaN for an infinity or a NaN, and a NaN
 // stays in a sum. Eight independent sums (no chain of dependent additions, no overflow of a
 // plain sum of the values) in one pass over the array; about 3 times faster than sum().
@@ -76,19 +61,27 @@ bool all_finite(const Eigen::MatrixXd& v) {
   return all == 0.0;
 }
 
-// Sum (extensive data) or integral over the point weights (intensive data) of each component.
-void component_totals(const Eigen::MatrixXd& v, const Mesh& mesh, bool extensive,
-                      Eigen::VectorXd& sum) {
+// The totals of each component of v (sums for extensive data, integrals over the point weights
+// for intensive data) into `total`, and the same of the vector lengths |v_q| (the scale the
+// imbalance is measured against), in one pass over the values. Vectors take the fused kernel;
+// other component counts plain Eigen passes (the caller keeps `total` and `norm`: no allocation
+// per window).
+double totals(const Eigen::MatrixXd& v, const Mesh& mesh, bool extensive, Eigen::VectorXd& total,
+              Eigen::ArrayXd& norm) {
+  total.resize(v.cols());
+  const double* w = extensive ? nullptr : mesh.weights().data();
+  if (v.cols() == 3) {
+    double magnitude = 0.0;
+    elementwise::weighted_totals3(v.col(0).data(), v.col(1).data(), v.col(2).data(), w, v.rows(),
+                                  total.data(), magnitude);
+    return magnitude;
+  }
   if (extensive)
-    sum.noalias() = v.colwise().sum().transpose();
+    total.noalias() = v.colwise().sum().transpose();
   else
-    sum.noalias() = v.transpose() * mesh.weights();
-}
-
-// The same of the magnitudes, from row_norms(): the scale the imbalance is measured against.
-double magnitude_total(const Eigen::ArrayXd& norm, const Mesh& mesh, bool extensive) {
-  if (extensive) return norm.sum();
-  return (norm * mesh.weights().array().abs()).sum();
+    total.noalias() = v.transpose() * mesh.weights();
+  norm = v.rowwise().norm().array();
+  return extensive ? norm.sum() : (norm * mesh.weights().array().abs()).sum();
 }
 
 }  // namespace
@@ -291,46 +284,19 @@ void CaseRun::check_window(std::int64_t window, double time, bool after_audit) {
 }
 
 const std::vector<double>& CaseRun::audit_balance() {
-  if (audit_bounds_.size() != audited_.size()) {
-    // Once: for a mapper with an explicit operator W >= 0, u = W^T omega (omega: the target's
-    // weights, or 1 for a sum) bounds what can arrive: sum_q omega_q |r_q| <= sum_i u_i |s_i|.
-    audit_bounds_.assign(audited_.size(), Eigen::VectorXd());
-    for (std::size_t i = 0; i < audited_.size(); ++i) {
-      const Exchange* e = audited_[i];
-      const auto* sparse = dynamic_cast<const SparseMapper*>(e->mapper());
-      if (!sparse) continue;
-      const SparseMapper::Matrix& w = sparse->matrix();
-      if (w.nonZeros() > 0 &&
-          Eigen::Map<const Eigen::VectorXd>(w.valuePtr(), w.nonZeros()).minCoeff() < 0.0)
-        continue;
-      if (e->spec().kind == DataKind::extensive)
-        audit_bounds_[i] = w.transpose() * Eigen::VectorXd::Ones(w.rows());
-      else
-        audit_bounds_[i] = w.transpose() * e->target_mesh().weights();
-    }
-  }
   imbalance_.resize(audited_.size());
   audit_finite_.resize(audited_.size());
   for (std::size_t i = 0; i < audited_.size(); ++i) {
     const Exchange* e = audited_[i];
     const bool extensive = e->spec().kind == DataKind::extensive;
-    component_totals(e->sent(), e->source_mesh(), extensive, audit_sent_);
-    component_totals(e->received(), e->target_mesh(), extensive, audit_received_);
+    const double ss = totals(e->sent(), e->source_mesh(), extensive, audit_sent_, audit_norm_);
+    const double sr =
+        totals(e->received(), e->target_mesh(), extensive, audit_received_, audit_norm_);
     // A NaN or an infinity among the values makes its total NaN or infinite (weights are finite
     // and >= 0; 0 times an infinity is NaN): finite totals let check_window() skip the values.
     audit_finite_[i] = std::isfinite(audit_sent_.sum()) && std::isfinite(audit_received_.sum());
-    row_norms(e->sent(), audit_norm_);
-    const double ss = magnitude_total(audit_norm_, e->source_mesh(), extensive);
-    // scale = max(|sent|, |received|) (totals of the magnitudes). Where the bound above shows
-    // |received| <= |sent| to 1e-12 (consistent area-balanced when sum(w) <= sum(A); conservative
-    // mappers with W >= 0), the received magnitudes are not summed: the scale is then the same
-    // to 1e-12 relative.
-    const Eigen::VectorXd& u = audit_bounds_[i];
-    double scale = ss;
-    if (u.size() == 0 || (audit_norm_ * u.array()).sum() > ss * (1.0 + 1e-12)) {
-      row_norms(e->received(), audit_norm_);
-      scale = std::max(ss, magnitude_total(audit_norm_, e->target_mesh(), extensive));
-    }
+    // relative to the larger of the two magnitude totals |sent|, |received|
+    const double scale = std::max(ss, sr);
     imbalance_[i] = scale > 0.0 ? (audit_received_ - audit_sent_).norm() / scale : 0.0;
   }
   return imbalance_;

@@ -58,24 +58,34 @@ __attribute__((target("avx"))) std::ptrdiff_t interpolate_avx(double* out, const
   return i;
 }
 
-__attribute__((target("avx"))) std::ptrdiff_t norms3_avx(double* out, const double* x,
-                                                         const double* y, const double* z,
-                                                         std::ptrdiff_t n) {
+// Blocks of 4 rows, row i into lane i mod 4; returns the rows done (a multiple of 4) and leaves
+// the lanes' partial sums in acc[quantity][lane] (quantities: x, y, z totals, magnitude).
+__attribute__((target("avx"))) std::ptrdiff_t weighted_totals3_avx(const double* x, const double* y,
+                                                                   const double* z, const double* w,
+                                                                   std::ptrdiff_t n,
+                                                                   double acc[4][4]) {
+  __m256d tx = _mm256_setzero_pd(), ty = tx, tz = tx, tm = tx;
+  const __m256d one = _mm256_set1_pd(1.0);
+  const __m256d sign = _mm256_set1_pd(-0.0);
   std::ptrdiff_t i = 0;
   for (; i + 4 <= n; i += 4) {
     const __m256d xx = _mm256_loadu_pd(x + i);
     const __m256d yy = _mm256_loadu_pd(y + i);
     const __m256d zz = _mm256_loadu_pd(z + i);
+    const __m256d ww = w ? _mm256_loadu_pd(w + i) : one;
+    tx = _mm256_add_pd(tx, _mm256_mul_pd(ww, xx));
+    ty = _mm256_add_pd(ty, _mm256_mul_pd(ww, yy));
+    tz = _mm256_add_pd(tz, _mm256_mul_pd(ww, zz));
     const __m256d xy = _mm256_add_pd(_mm256_mul_pd(xx, xx), _mm256_mul_pd(yy, yy));
     const __m256d n2 = _mm256_add_pd(xy, _mm256_mul_pd(zz, zz));
-    // 4 zero vectors (+0: a sum of squares): sqrt(+0) = +0, the square root is skipped
-    const bool all_zero =
-        _mm256_movemask_pd(_mm256_cmp_pd(n2, _mm256_setzero_pd(), _CMP_NEQ_UQ)) == 0;
-    if (all_zero)
-      _mm256_storeu_pd(out + i, n2);
-    else
-      _mm256_storeu_pd(out + i, _mm256_sqrt_pd(n2));
+    // 4 zero vectors (points without load: most of an interface): sqrt(+0) = +0 is skipped
+    if (_mm256_movemask_pd(_mm256_cmp_pd(n2, _mm256_setzero_pd(), _CMP_NEQ_UQ)) != 0)
+      tm = _mm256_add_pd(tm, _mm256_mul_pd(_mm256_andnot_pd(sign, ww), _mm256_sqrt_pd(n2)));
   }
+  _mm256_storeu_pd(acc[0], tx);
+  _mm256_storeu_pd(acc[1], ty);
+  _mm256_storeu_pd(acc[2], tz);
+  _mm256_storeu_pd(acc[3], tm);
   return i;
 }
 #endif
@@ -103,12 +113,25 @@ void interpolate(double* out, const double* a, const double* b, std::ptrdiff_t n
   for (; i < n; ++i) out[i] = a[i] + s * (b[i] - a[i]);
 }
 
-void norms3(double* out, const double* x, const double* y, const double* z, std::ptrdiff_t n) {
+void weighted_totals3(const double* x, const double* y, const double* z, const double* w,
+                      std::ptrdiff_t n, double total[3], double& magnitude) {
+  double acc[4][4] = {};  // [x, y, z, magnitude][lane]
   std::ptrdiff_t i = 0;
 #ifdef PARTITA_AVX_KERNELS
-  if (has_avx()) i = norms3_avx(out, x, y, z, n);
+  if (has_avx()) i = weighted_totals3_avx(x, y, z, w, n, acc);
 #endif
-  for (; i < n; ++i) out[i] = std::sqrt((x[i] * x[i] + y[i] * y[i]) + z[i] * z[i]);
+  for (; i < n; ++i) {
+    const double wi = w ? w[i] : 1.0;
+    const std::ptrdiff_t l = i % 4;
+    acc[0][l] += wi * x[i];
+    acc[1][l] += wi * y[i];
+    acc[2][l] += wi * z[i];
+    // + 0 where the vector is zero, as the AVX lanes that skip the square root (|w| 0 = +0)
+    const double n2 = (x[i] * x[i] + y[i] * y[i]) + z[i] * z[i];
+    if (n2 != 0.0) acc[3][l] += std::abs(wi) * std::sqrt(n2);
+  }
+  for (int q = 0; q < 3; ++q) total[q] = (acc[q][0] + acc[q][1]) + (acc[q][2] + acc[q][3]);
+  magnitude = (acc[3][0] + acc[3][1]) + (acc[3][2] + acc[3][3]);
 }
 
 }  // namespace partita::coupling::elementwise

@@ -1,6 +1,6 @@
 #pragma once
 // Element-by-element kernels of the per-window core (the substep average, the time
-// interpolation, the audit's vector lengths) over contiguous arrays of doubles.
+// interpolation, the balance audit's sums) over contiguous arrays of doubles.
 //
 // Each result is the IEEE-rounded value of the same operations in the same order as the plain
 // expression in its comment, so the results are bit for bit those of that expression on every
@@ -20,7 +20,14 @@ void mean_step(double* mean, const double* x, std::ptrdiff_t n, double k);
 /// out[i] = a[i] + s * (b[i] - a[i])
 void interpolate(double* out, const double* a, const double* b, std::ptrdiff_t n, double s);
 
-/// out[i] = sqrt((x[i] * x[i] + y[i] * y[i]) + z[i] * z[i])
-void norms3(double* out, const double* x, const double* y, const double* z, std::ptrdiff_t n);
+/// Totals of a 3-component field over weighted points and of its magnitudes, in one pass (the
+/// balance audit's sums):
+///   total[c]  = sum_i w[i] * v_c[i]                                  (v_0 = x, v_1 = y, v_2 = z)
+///   magnitude = sum_i |w[i]| * sqrt((x[i] * x[i] + y[i] * y[i]) + z[i] * z[i])
+/// with w[i] = 1 where w is null. Summed in 4 partial sums, row i into sum i mod 4, added
+/// as (s0 + s1) + (s2 + s3): the same bits with or without AVX. A NaN or an infinity among
+/// the values makes a total NaN or infinite (weights finite: 0 times infinity is NaN).
+void weighted_totals3(const double* x, const double* y, const double* z, const double* w,
+                      std::ptrdiff_t n, double total[3], double& magnitude);
 
 }  // namespace partita::coupling::elementwise

@@ -9,7 +9,9 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <sstream>
 
+#include "../../coupling/src/elementwise.hpp"  // the core's internal kernels
 #include "ode_participant.hpp"
 #include "partita/coupling/case_run.hpp"
 #include "partita/coupling/exchange.hpp"
@@ -23,9 +25,11 @@ namespace {
 // One mesh of n points that writes and reads "f" (3 components); write() gives `next`.
 class ArraySolver : public Solver {
  public:
-  ArraySolver(Eigen::Index n, DataKind kind, double nan_from = INFINITY) : nan_from_(nan_from) {
+  ArraySolver(Eigen::Index n, DataKind kind, double nan_from = INFINITY, double weight = 0.0)
+      : nan_from_(nan_from) {
     InterfaceMesh m;
     m.mesh = Mesh("points", Mesh::Points::Random(n, 3));
+    if (weight > 0.0) m.mesh.set_weights(Eigen::VectorXd::Constant(n, weight));
     m.writes.push_back(DataSpec{"f", 3, "N", kind});
     m.reads.push_back(DataSpec{"f", 3, "N", kind});
     meshes_.push_back(std::move(m));
@@ -164,4 +168,151 @@ TEST_CASE("a NaN in an audited exchange stops the run with the exchange and the 
                        Catch::Contains("non-finite values (1 of 111)") &&
                        Catch::Contains("'f' on one.points"));
   std::filesystem::remove_all(dir);
+}
+
+namespace {
+
+// Runs 10 windows of `one` (n1 points) sending f = (1, 1, 1) at every point to `two` (n2 points)
+// through nearest-neighbor with `constraint`; returns the imbalance column of coupling.csv and
+// the number of windows that warned.
+struct AuditRun {
+  std::vector<double> imbalance;
+  long warnings = 0;
+};
+AuditRun audit_run(const std::string& kind, double w1, double w2, const std::string& constraint) {
+  Registries r = test::test_registries();
+  auto spec = std::make_shared<config::Spec>("test-points", "points writing and reading f");
+  spec->integer("points", "number of points").min(1).def(37);
+  spec->real("weight", "the weight of every point (0: none)").def(0.0);
+  spec->string("kind", "extensive or intensive").def("extensive");
+  r.solvers.add(
+      "test-points", "array solver",
+      [](const SolverContext& c) -> std::unique_ptr<Solver> {
+        return std::make_unique<ArraySolver>(
+            c.config.integer("points"),
+            c.config.string("kind") == "extensive" ? DataKind::extensive : DataKind::intensive,
+            INFINITY, c.config.real("weight"));
+      },
+      spec);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("partita_audit_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto file = dir / "audit.yaml";
+  std::ofstream(file) << "case: audit\ntime: {window: 0.1, end: 1.0}\n"
+                         "participants:\n"
+                         "  one: {solver: test-points, points: 37, kind: "
+                      << kind << ", weight: " << w1
+                      << "}\n  two: {solver: test-points, points: 23, kind: " << kind
+                      << ", weight: " << w2 << "}\n"
+                      << "coupling:\n  scheme: explicit-serial\n  exchanges:\n"
+                         "    - {data: f, from: one.points, to: two.points, mapper: "
+                         "nearest-neighbor, constraint: "
+                      << constraint << "}\n";
+  RunOptions o;
+  o.output_dir = dir / "out";
+  AuditRun result;
+  {
+    CaseRun run(file, r, o);
+    run.run();
+    result.warnings = run.summary().imbalance_warnings;
+  }
+  std::ifstream csv(dir / "out" / "coupling.csv");
+  std::string line;
+  std::getline(csv, line);
+  const bool audited = line.find("imbalance 'f' one.points -> two.points") != std::string::npos;
+  while (audited && std::getline(csv, line)) {
+    std::stringstream row(line);
+    std::string cell;
+    for (int c = 0; c < 4; ++c) std::getline(row, cell, ',');  // window, time, iterations, it
+    result.imbalance.push_back(std::stod(cell));
+  }
+  std::filesystem::remove_all(dir);
+  return result;
+}
+
+}  // namespace
+
+TEST_CASE("the balance audit measures |total received - total sent| / max(|sent|, |received|)",
+          "[coupling][exchange][audit]") {
+  // 37 points send (1, 1, 1) each; nearest-neighbor gives 23 points. Consistent: each target
+  // takes one source's value, so 23 arrive of 37; conservative: each source's value goes to one
+  // target, all 37 arrive. Magnitudes: sqrt(3) a point.
+  SECTION("extensive data (sums)") {
+    const AuditRun consistent = audit_run("extensive", 0.0, 0.0, "consistent");
+    REQUIRE(consistent.imbalance.size() == 10);
+    for (const double v : consistent.imbalance) CHECK(v == Approx(14.0 / 37.0).epsilon(1e-9));
+    CHECK(consistent.warnings == 10);
+    const AuditRun conservative = audit_run("extensive", 0.0, 0.0, "conservative");
+    REQUIRE(conservative.imbalance.size() == 10);
+    for (const double v : conservative.imbalance) CHECK(std::abs(v) < 1e-15);
+    CHECK(conservative.warnings == 0);
+  }
+  SECTION("intensive data on weighted points (integrals)") {
+    // sent: 37 x 0.5 = 18.5 a component; received (consistent): 23 x 2 = 46
+    const AuditRun consistent = audit_run("intensive", 0.5, 2.0, "consistent");
+    REQUIRE(consistent.imbalance.size() == 10);
+    for (const double v : consistent.imbalance)
+      CHECK(v == Approx((46.0 - 18.5) / 46.0).epsilon(1e-9));
+    CHECK(consistent.warnings == 10);
+  }
+  SECTION("intensive data without weights is not audited") {
+    CHECK(audit_run("intensive", 0.0, 0.0, "consistent").imbalance.empty());
+  }
+}
+
+TEST_CASE("the audit's fused totals follow their formula bit for bit and sum correctly",
+          "[coupling][exchange][audit]") {
+  std::mt19937 g(11);
+  std::uniform_real_distribution<double> u(0.0, 2.0);
+  for (const Eigen::Index n : {0, 1, 3, 4, 5, 7, 8, 13, 1539}) {
+    for (const bool weighted : {false, true}) {
+      INFO("n " << n << (weighted ? ", weighted" : ""));
+      Eigen::MatrixXd v = values(n, g);
+      for (Eigen::Index i = 0; i < n; i += 3) v.row(i).setZero();  // points without load
+      Eigen::VectorXd w(n);
+      for (Eigen::Index i = 0; i < n; ++i) w(i) = u(g);
+      double total[3], magnitude = 0.0;
+      partita::coupling::elementwise::weighted_totals3(
+          v.col(0).data(), v.col(1).data(), v.col(2).data(), weighted ? w.data() : nullptr, n,
+          total, magnitude);
+      // the documented formula: row i into partial sum i mod 4, (s0 + s1) + (s2 + s3)
+      double acc[4][4] = {};
+      long double exact[4] = {};
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const double wi = weighted ? w(i) : 1.0;
+        for (int c = 0; c < 3; ++c) {
+          acc[c][i % 4] += wi * v(i, c);
+          exact[c] += static_cast<long double>(wi) * v(i, c);
+        }
+        const double len = std::sqrt((v(i, 0) * v(i, 0) + v(i, 1) * v(i, 1)) + v(i, 2) * v(i, 2));
+        acc[3][i % 4] += std::abs(wi) * len;
+        exact[3] += static_cast<long double>(std::abs(wi)) * v.row(i).norm();
+      }
+      for (int c = 0; c < 3; ++c) {
+        const double expected = (acc[c][0] + acc[c][1]) + (acc[c][2] + acc[c][3]);
+        CHECK(std::memcmp(&total[c], &expected, sizeof(double)) == 0);
+      }
+      const double expected_m = (acc[3][0] + acc[3][1]) + (acc[3][2] + acc[3][3]);
+      CHECK(std::memcmp(&magnitude, &expected_m, sizeof(double)) == 0);
+      // and the sums are right: to round-off against a long-double accumulation, relative to
+      // the magnitude total (the scale of every term)
+      const double scale = static_cast<double>(exact[3]);
+      for (int c = 0; c < 3; ++c)
+        CHECK(std::abs(total[c] - static_cast<double>(exact[c])) <= 1e-13 * scale);
+      CHECK(std::abs(magnitude - scale) <= 1e-13 * scale);
+    }
+  }
+  // a NaN or an infinity reaches the totals
+  Eigen::MatrixXd v = Eigen::MatrixXd::Ones(9, 3);
+  v(6, 2) = std::numeric_limits<double>::infinity();
+  double total[3], magnitude = 0.0;
+  partita::coupling::elementwise::weighted_totals3(v.col(0).data(), v.col(1).data(),
+                                                   v.col(2).data(), nullptr, 9, total, magnitude);
+  CHECK(std::isinf(total[2]));
+  CHECK(std::isfinite(total[0]));
+  v(2, 0) = std::numeric_limits<double>::quiet_NaN();
+  partita::coupling::elementwise::weighted_totals3(v.col(0).data(), v.col(1).data(),
+                                                   v.col(2).data(), nullptr, 9, total, magnitude);
+  CHECK(std::isnan(total[0]));
+  CHECK(std::isnan(magnitude));
 }
