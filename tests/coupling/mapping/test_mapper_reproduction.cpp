@@ -161,25 +161,37 @@ TEST_CASE("a sparse mapper's map() gives the sparse product W in bit for bit", "
   // Each row of W in: ((0 + w_1 x_1) + w_2 x_2) + ... in the stored order, every operation
   // IEEE-rounded: Eigen's own sparse product, and map() whatever vector width it uses (3
   // components: x, y, z of a point in one register), must give the same bits.
-  const Mesh from = plate_triangles("from", 13, 11, 0.2, 1),
-             to = plate_triangles("to", 8, 9, 0.2, 2);
-  for (const char* name : {"nearest-neighbor", "nearest-projection"})
+  Mesh from = plate_triangles("from", 13, 11, 0.2, 1), to = plate_triangles("to", 8, 9, 0.2, 2);
+  from.set_weights(Eigen::VectorXd::Constant(from.size(), 0.04 / double(from.size())));
+  to.set_weights(Eigen::VectorXd::Constant(to.size(), 0.04 / double(to.size())));
+  // Dense input, and sparse input (a few loaded points among zeros of both signs, as a face
+  // that granules touch at a few cells).
+  for (const char* name : {"nearest-neighbor", "nearest-projection", "area-balanced"})
     for (const Constraint c : {Constraint::consistent, Constraint::conservative})
-      for (const int components : {1, 2, 3, 4}) {
-        INFO(name << ", " << components << " components");
-        auto m = make_mapper(name, c);
-        m->compute(from, to);
-        const auto* sparse = dynamic_cast<const SparseMapper*>(m.get());
-        REQUIRE(sparse != nullptr);
-        Eigen::MatrixXd in = Eigen::MatrixXd::Random(from.size(), components);
-        in.row(3).setZero();
-        in(5, 0) = -0.0;
-        Eigen::MatrixXd out;
-        m->map(in, out);
-        const Eigen::MatrixXd expected = sparse->matrix() * in;
-        REQUIRE(out.rows() == expected.rows());
-        REQUIRE(out.cols() == expected.cols());
-        CHECK(std::memcmp(out.data(), expected.data(),
-                          sizeof(double) * static_cast<std::size_t>(out.size())) == 0);
-      }
+      for (const int components : {1, 2, 3, 4})
+        for (const int loaded : {-1, 0, 1, 7}) {  // -1: every point
+          INFO(name << ", " << components << " components, loaded points " << loaded);
+          auto m = make_mapper(name, c);
+          m->compute(from, to);
+          const auto* sparse = dynamic_cast<const SparseMapper*>(m.get());
+          REQUIRE(sparse != nullptr);
+          Eigen::MatrixXd in = Eigen::MatrixXd::Random(from.size(), components);
+          if (loaded >= 0) {
+            const Eigen::MatrixXd values = in;
+            in.setZero();
+            for (Eigen::Index j = 0; j < in.rows(); j += 2) in.row(j).setConstant(-0.0);
+            for (int k = 0; k < loaded; ++k) in.row(11 * k + 4) = values.row(11 * k + 4);
+          }
+          in.row(3).setZero();
+          in(5, 0) = -0.0;
+          Eigen::MatrixXd out;
+          for (int repeat = 0; repeat < 2; ++repeat) {  // the second call reuses the scratch
+            m->map(in, out);
+            const Eigen::MatrixXd expected = sparse->matrix() * in;
+            REQUIRE(out.rows() == expected.rows());
+            REQUIRE(out.cols() == expected.cols());
+            CHECK(std::memcmp(out.data(), expected.data(),
+                              sizeof(double) * static_cast<std::size_t>(out.size())) == 0);
+          }
+        }
 }
