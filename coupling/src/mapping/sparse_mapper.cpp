@@ -1,5 +1,8 @@
 #include "partita/coupling/mapping/sparse_mapper.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "partita/interface/error.hpp"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -19,7 +22,46 @@ void SparseMapper::compute(const Mesh& from, const Mesh& to) {
     matrix_ = Matrix(interpolation(to, from).transpose());
   }
   matrix_.makeCompressed();
+  pad_rows();
   set_meshes(from, to);
+}
+
+void SparseMapper::pad_rows() {
+  // K minimising the work: K entries a row (a multiply and an add each) plus the extra entries
+  // (each a load, a multiply, an add and a store of 3 values: about 3 padded entries)
+  const Eigen::Index rows = matrix_.rows();
+  const int* outer = matrix_.outerIndexPtr();
+  std::vector<Eigen::Index> longer(1, rows);  // longer[k]: rows with more than k entries
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const auto n = static_cast<std::size_t>(outer[r + 1] - outer[r]);
+    if (longer.size() <= n) longer.resize(n + 1, 0);
+    for (std::size_t k = 1; k < n; ++k) ++longer[k];
+    if (n > 0) ++longer[0];
+  }
+  Padded& p = padded_;
+  p = Padded{};
+  double best = INFINITY;
+  for (std::size_t k = 1; k <= std::max<std::size_t>(1, longer.size()); ++k) {
+    double extra = 0.0;  // entries beyond k: sum over m >= k of longer[m]
+    for (std::size_t m = k; m < longer.size(); ++m) extra += static_cast<double>(longer[m]);
+    const double cost = static_cast<double>(rows) * static_cast<double>(k) + 3.0 * extra;
+    if (cost < best) best = cost, p.width = static_cast<int>(k);
+  }
+  const int pad = static_cast<int>(matrix_.cols());  // the zero point
+  p.index.assign(static_cast<std::size_t>(rows * p.width), pad);
+  p.weight.assign(p.index.size(), 0.0);
+  for (Eigen::Index r = 0; r < rows; ++r)
+    for (int k = outer[r]; k < outer[r + 1]; ++k) {
+      const int slot = k - outer[r];
+      if (slot < p.width) {
+        p.index[static_cast<std::size_t>(r * p.width + slot)] = matrix_.innerIndexPtr()[k];
+        p.weight[static_cast<std::size_t>(r * p.width + slot)] = matrix_.valuePtr()[k];
+      } else {
+        p.extra_row.push_back(static_cast<int>(r));
+        p.extra_index.push_back(matrix_.innerIndexPtr()[k]);
+        p.extra_weight.push_back(matrix_.valuePtr()[k]);
+      }
+    }
 }
 
 namespace {
@@ -48,15 +90,38 @@ bool has_avx() {
 }
 
 // csr_times_dense<3> with the three components of a point in one 4-lane register: the input is
-// first copied into rows (x, y, z, 0) of `packed`, so each stored entry costs one load of the
-// point instead of three. Each lane does the operations of the scalar loop in its order (no
-// FMA): the same numbers, bit for bit.
-__attribute__((target("avx"))) void csr_times_dense3_avx(const SparseMapper::Matrix& w,
-                                                         const double* in, Eigen::Index in_stride,
-                                                         double* out, Eigen::Index out_stride,
-                                                         std::vector<double>& packed) {
+// first copied into rows (x, y, z, 0) of `packed` (and a row of zeros after them, the padding
+// point), so each entry costs one load of the point instead of three. Rows padded to K entries
+// (SparseMapper::Padded): a loop of fixed length, then the extra entries of the longer rows
+// added to their sums in order. Each lane does the operations of the scalar loop in its order
+// (no FMA): the same numbers, bit for bit.
+template <int K>
+__attribute__((target("avx"))) void padded_rows3_avx(const int* index, const double* weight,
+                                                     int width, Eigen::Index rows, const double* p,
+                                                     double* out_x, double* out_y, double* out_z) {
+  const int k_end = K > 0 ? K : width;
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    const int* idx = index + r * k_end;
+    const double* w = weight + r * k_end;
+    __m256d s = _mm256_setzero_pd();
+    for (int k = 0; k < k_end; ++k)
+      s = _mm256_add_pd(s,
+                        _mm256_mul_pd(_mm256_broadcast_sd(w + k),
+                                      _mm256_loadu_pd(p + 4 * static_cast<Eigen::Index>(idx[k]))));
+    const __m128d xy = _mm256_castpd256_pd128(s);
+    _mm_storel_pd(out_x + r, xy);
+    _mm_storeh_pd(out_y + r, xy);
+    _mm_store_sd(out_z + r, _mm256_extractf128_pd(s, 1));
+  }
+}
+
+__attribute__((target("avx"))) void csr_times_dense3_avx(
+    const SparseMapper::Matrix& w, const int* index, const double* weight, int width,
+    const int* extra_row, const int* extra_index, const double* extra_weight, std::size_t extras,
+    const double* in, Eigen::Index in_stride, double* out, Eigen::Index out_stride,
+    std::vector<double>& packed) {
   const Eigen::Index n = w.cols();
-  packed.resize(static_cast<std::size_t>(4 * n));
+  packed.resize(static_cast<std::size_t>(4 * (n + 1)));
   double* p = packed.data();
   for (Eigen::Index j = 0; j < n; ++j) {
     p[4 * j] = in[j];
@@ -64,20 +129,34 @@ __attribute__((target("avx"))) void csr_times_dense3_avx(const SparseMapper::Mat
     p[4 * j + 2] = in[j + 2 * in_stride];
     p[4 * j + 3] = 0.0;
   }
-  const int* outer = w.outerIndexPtr();
-  const int* inner = w.innerIndexPtr();
-  const double* value = w.valuePtr();
-  alignas(32) double sum[4];
-  for (Eigen::Index r = 0; r < w.rows(); ++r) {
-    __m256d s = _mm256_setzero_pd();
-    for (int k = outer[r]; k < outer[r + 1]; ++k)
-      s = _mm256_add_pd(
-          s, _mm256_mul_pd(_mm256_set1_pd(value[k]),
-                           _mm256_loadu_pd(p + 4 * static_cast<Eigen::Index>(inner[k]))));
-    _mm256_store_pd(sum, s);
-    out[r] = sum[0];
-    out[r + out_stride] = sum[1];
-    out[r + 2 * out_stride] = sum[2];
+  for (int c = 0; c < 4; ++c) p[4 * n + c] = 0.0;  // the padding point
+  double* out_x = out;
+  double* out_y = out + out_stride;
+  double* out_z = out + 2 * out_stride;
+  const Eigen::Index rows = w.rows();
+  switch (width) {
+    case 1:
+      padded_rows3_avx<1>(index, weight, width, rows, p, out_x, out_y, out_z);
+      break;
+    case 2:
+      padded_rows3_avx<2>(index, weight, width, rows, p, out_x, out_y, out_z);
+      break;
+    case 3:
+      padded_rows3_avx<3>(index, weight, width, rows, p, out_x, out_y, out_z);
+      break;
+    case 4:
+      padded_rows3_avx<4>(index, weight, width, rows, p, out_x, out_y, out_z);
+      break;
+    default:
+      padded_rows3_avx<0>(index, weight, width, rows, p, out_x, out_y, out_z);
+  }
+  for (std::size_t e = 0; e < extras; ++e) {  // rows ascending, each row's entries in order
+    const double v = extra_weight[e];
+    const double* x = p + 4 * static_cast<Eigen::Index>(extra_index[e]);
+    const Eigen::Index r = extra_row[e];
+    out_x[r] += v * x[0];
+    out_y[r] += v * x[1];
+    out_z[r] += v * x[2];
   }
 }
 #define PARTITA_AVX_KERNELS 1
@@ -99,7 +178,11 @@ void SparseMapper::map(const Eigen::MatrixXd& in, Eigen::MatrixXd& out) const {
       return csr_times_dense<2>(matrix_, x, in.rows(), y, out.rows());
     case 3:
 #ifdef PARTITA_AVX_KERNELS
-      if (has_avx()) return csr_times_dense3_avx(matrix_, x, in.rows(), y, out.rows(), packed_);
+      if (has_avx())
+        return csr_times_dense3_avx(matrix_, padded_.index.data(), padded_.weight.data(),
+                                    padded_.width, padded_.extra_row.data(),
+                                    padded_.extra_index.data(), padded_.extra_weight.data(),
+                                    padded_.extra_row.size(), x, in.rows(), y, out.rows(), packed_);
 #endif
       return csr_times_dense<3>(matrix_, x, in.rows(), y, out.rows());
     default:
