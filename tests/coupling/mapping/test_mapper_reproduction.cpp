@@ -166,7 +166,8 @@ TEST_CASE("a sparse mapper's map() gives the sparse product W in bit for bit", "
   to.set_weights(Eigen::VectorXd::Constant(to.size(), 0.04 / double(to.size())));
   // Dense input, and sparse input (a few loaded points among zeros of both signs, as a face
   // that granules touch at a few cells).
-  for (const char* name : {"nearest-neighbor", "nearest-projection", "area-balanced"})
+  for (const char* name : {"nearest-neighbor", "nearest-projection", "area-balanced",
+                           "{type: area-balanced, neighbors: 12}"})
     for (const Constraint c : {Constraint::consistent, Constraint::conservative})
       for (const int components : {1, 2, 3, 4})
         for (const int loaded : {-1, 0, 1, 7}) {  // -1: every point
