@@ -263,21 +263,27 @@ TEST_CASE("the balance audit measures |total received - total sent| / max(|sent|
 TEST_CASE("the audit's fused totals follow their formula bit for bit and sum correctly",
           "[coupling][exchange][audit]") {
   std::mt19937 g(11);
-  std::uniform_real_distribution<double> u(0.0, 2.0);
+  std::uniform_real_distribution<double> u_dist(0.0, 2.0);
   for (const Eigen::Index n : {0, 1, 3, 4, 5, 7, 8, 13, 1539}) {
     for (const bool weighted : {false, true}) {
       INFO("n " << n << (weighted ? ", weighted" : ""));
       Eigen::MatrixXd v = values(n, g);
       for (Eigen::Index i = 0; i < n; i += 3) v.row(i).setZero();  // points without load
       Eigen::VectorXd w(n);
-      for (Eigen::Index i = 0; i < n; ++i) w(i) = u(g);
-      double total[3], magnitude = 0.0;
-      partita::coupling::elementwise::weighted_totals3(
+      for (Eigen::Index i = 0; i < n; ++i) w(i) = u_dist(g);
+      Eigen::VectorXd u(n);
+      for (Eigen::Index i = 0; i < n; ++i) u(i) = u_dist(g);
+      const auto t = partita::coupling::elementwise::weighted_totals3(
+          v.col(0).data(), v.col(1).data(), v.col(2).data(), weighted ? w.data() : nullptr, n, true,
+          u.data());
+      const auto plain = partita::coupling::elementwise::weighted_totals3(
           v.col(0).data(), v.col(1).data(), v.col(2).data(), weighted ? w.data() : nullptr, n,
-          total, magnitude);
+          false);
+      const double* total = t.total;
+      const double magnitude = t.magnitude;
       // the documented formula: row i into partial sum i mod 4, (s0 + s1) + (s2 + s3)
-      double acc[4][4] = {};
-      long double exact[4] = {};
+      double acc[5][4] = {};
+      long double exact[5] = {};
       for (Eigen::Index i = 0; i < n; ++i) {
         const double wi = weighted ? w(i) : 1.0;
         for (int c = 0; c < 3; ++c) {
@@ -286,7 +292,9 @@ TEST_CASE("the audit's fused totals follow their formula bit for bit and sum cor
         }
         const double len = std::sqrt((v(i, 0) * v(i, 0) + v(i, 1) * v(i, 1)) + v(i, 2) * v(i, 2));
         acc[3][i % 4] += std::abs(wi) * len;
+        if (len != 0.0) acc[4][i % 4] += u(i) * len;  // (a zero length adds +0 either way)
         exact[3] += static_cast<long double>(std::abs(wi)) * v.row(i).norm();
+        exact[4] += static_cast<long double>(u(i)) * v.row(i).norm();
       }
       for (int c = 0; c < 3; ++c) {
         const double expected = (acc[c][0] + acc[c][1]) + (acc[c][2] + acc[c][3]);
@@ -294,25 +302,31 @@ TEST_CASE("the audit's fused totals follow their formula bit for bit and sum cor
       }
       const double expected_m = (acc[3][0] + acc[3][1]) + (acc[3][2] + acc[3][3]);
       CHECK(std::memcmp(&magnitude, &expected_m, sizeof(double)) == 0);
+      const double expected_b = (acc[4][0] + acc[4][1]) + (acc[4][2] + acc[4][3]);
+      CHECK(std::memcmp(&t.bound, &expected_b, sizeof(double)) == 0);
+      // without the lengths: the same totals, no lengths summed
+      CHECK(std::memcmp(plain.total, t.total, sizeof t.total) == 0);
+      CHECK(plain.magnitude == 0.0);
+      CHECK(plain.bound == 0.0);
       // and the sums are right: to round-off against a long-double accumulation, relative to
       // the magnitude total (the scale of every term)
       const double scale = static_cast<double>(exact[3]);
       for (int c = 0; c < 3; ++c)
         CHECK(std::abs(total[c] - static_cast<double>(exact[c])) <= 1e-13 * scale);
       CHECK(std::abs(magnitude - scale) <= 1e-13 * scale);
+      CHECK(std::abs(t.bound - static_cast<double>(exact[4])) <= 1e-13 * 2.0 * scale + 1e-300);
     }
   }
   // a NaN or an infinity reaches the totals
   Eigen::MatrixXd v = Eigen::MatrixXd::Ones(9, 3);
   v(6, 2) = std::numeric_limits<double>::infinity();
-  double total[3], magnitude = 0.0;
-  partita::coupling::elementwise::weighted_totals3(v.col(0).data(), v.col(1).data(),
-                                                   v.col(2).data(), nullptr, 9, total, magnitude);
-  CHECK(std::isinf(total[2]));
-  CHECK(std::isfinite(total[0]));
+  auto t = partita::coupling::elementwise::weighted_totals3(v.col(0).data(), v.col(1).data(),
+                                                            v.col(2).data(), nullptr, 9, true);
+  CHECK(std::isinf(t.total[2]));
+  CHECK(std::isfinite(t.total[0]));
   v(2, 0) = std::numeric_limits<double>::quiet_NaN();
-  partita::coupling::elementwise::weighted_totals3(v.col(0).data(), v.col(1).data(),
-                                                   v.col(2).data(), nullptr, 9, total, magnitude);
-  CHECK(std::isnan(total[0]));
-  CHECK(std::isnan(magnitude));
+  t = partita::coupling::elementwise::weighted_totals3(v.col(0).data(), v.col(1).data(),
+                                                       v.col(2).data(), nullptr, 9, true);
+  CHECK(std::isnan(t.total[0]));
+  CHECK(std::isnan(t.magnitude));
 }

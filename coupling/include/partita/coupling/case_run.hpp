@@ -167,6 +167,7 @@ class CaseRun {
   Eigen::VectorXd audit_sent_, audit_received_;  // windows (no allocation per window)
   Eigen::ArrayXd audit_norm_;
   std::vector<char> audit_finite_;  // per audited exchange: this window's totals were finite
+  std::vector<Eigen::VectorXd> audit_bounds_;  // per audited exchange: W^T omega (or empty)
   // the energy audit: two participants that read from each other, each with the meshes it reads
   // the other's data on (where its solver reports Solver::interface_work)
   struct EnergyPair {
