@@ -4,8 +4,12 @@
 // particle-particle contacts per particle (peers: 4.14 small, 4.62 large) and the ratio to
 // LIGGGHTS: measured in the same invocation when `liggghts` is on PATH, else the recorded figures.
 //
-// usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] [--quick]
-//                        [--vtk DIR] [--no-peer] [--shuffle] [--sort N] [--breakage]
+// usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] [--scaling]
+//                        [--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N] [--breakage]
+// --scaling: the large bed (unless --case names another) on 1, 2, 4, ... threads up to the
+// machine's processors (and that number), then the speed-up over 1 thread of each (issue 16's
+// aim: 12x at 16 threads; 9.7x measured when it was filed). With more than 2 threads the ratio
+// to LIGGGHTS is printed only where LIGGGHTS ran (as many MPI ranks) in the same invocation.
 // --shuffle numbers the bed's particles in a random order (as a data file written by another code
 // may); --sort N renumbers them in cell order at the first step and every N-th list build
 // (System::set_sort_interval; default 0: the file's order, which is already spatial).
@@ -122,6 +126,30 @@ double run_liggghts(const std::string& dem_dir, const Case& c, long n_atoms, int
   return 0.0;
 }
 
+std::string fmt_ratio(double r) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.2fx", r);
+  return b;
+}
+
+// The speed-up over the 1-thread run of each other thread count, and the parallel efficiency.
+void print_scaling(const std::string& bed, const std::vector<std::pair<int, double>>& rates) {
+  double one = 0.0;
+  for (const auto& [t, r] : rates)
+    if (t == 1) one = r;
+  if (one <= 0.0 || rates.size() < 2) return;
+  std::printf("# %s bed, thread scaling (particle-steps/s over 1 thread's; efficiency):",
+              bed.c_str());
+  for (const auto& [t, r] : rates)
+    if (t != 1) std::printf("  %d: %.2fx (%.0f %%)", t, r / one, 100.0 * r / one / t);
+  std::printf("\n");
+  for (const auto& [t, r] : rates)
+    if (t == 16)
+      std::printf("# issue 16's aim at 16 threads: 12x (9.7x when it was filed); here %.2fx\n",
+                  r / one);
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -129,7 +157,8 @@ int main(int argc, char** argv) {
   std::string data_dir = dem_dir + "/data";
   std::string which = "all", vtk_dir;
   std::vector<int> threads = {1, 2};
-  bool quick = false, no_peer = false, shuffle = false, breakage = false;
+  bool quick = false, no_peer = false, shuffle = false, breakage = false, scaling = false;
+  bool case_given = false;
   int sort_interval = 0;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
@@ -145,6 +174,9 @@ int main(int argc, char** argv) {
       dem_dir = (std::filesystem::path(data_dir) / "..").lexically_normal().string();
     } else if (arg == "--case") {
       which = next();
+      case_given = true;
+    } else if (arg == "--scaling") {
+      scaling = true;
     } else if (arg == "--threads") {
       threads.clear();
       std::istringstream is(next());
@@ -164,11 +196,26 @@ int main(int argc, char** argv) {
       vtk_dir = next();
     } else {
       std::cerr << "usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] "
-                   "[--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N] [--breakage]\n"
-                   "  --no-peer: do not run LIGGGHTS; ratios use the recorded figures\n";
+                   "[--scaling] [--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N] "
+                   "[--breakage]\n"
+                   "  --no-peer: do not run LIGGGHTS; ratios use the recorded figures\n"
+                   "  --scaling: the large bed on 1, 2, 4, ... threads up to the processors, and "
+                   "the speed-up of each over 1 thread\n";
       return arg == "--help" || arg == "-h" ? 0 : 2;
     }
   }
+  if (scaling) {
+    const int most = max_threads();
+    threads.clear();
+    for (int t = 1; t < most; t *= 2) threads.push_back(t);
+    threads.push_back(most);
+    if (!case_given) which = "large";
+  }
+  for (const int t : threads)
+    if (t < 1) {
+      std::cerr << "bench_dem_peers: --threads takes counts of at least 1\n";
+      return 2;
+    }
   const std::vector<Case> cases = {{"small", 0.02, 20000, 4.14, 5.58e6, 1.09e7},
                                    {"large", 0.06, 5000, 4.62, 4.79e6, 9.62e6}};
   const bool liggghts = !no_peer && on_path("liggghts");
@@ -195,6 +242,7 @@ int main(int argc, char** argv) {
       if (which != "all" && which != c.name) continue;
       const LammpsData data = LammpsData::read(data_dir + "/bed_" + c.name + ".data");
       const long steps = quick ? c.steps / 20 : c.steps;
+      std::vector<std::pair<int, double>> rates;  // (threads, particle-steps/s) of the plain runs
       for (int nt : threads) {
         double plain_cpu = 0.0, plain_rate = 0.0;
         for (int with_breakage = 0; with_breakage <= (breakage ? 1 : 0); ++with_breakage) {
@@ -215,8 +263,9 @@ int main(int argc, char** argv) {
             ke_trans += 0.5 * sys.particles().mass[i] * sys.particles().velocity[i].squaredNorm();
           const double rate = static_cast<double>(sys.particle_count()) * steps / seconds;
           const double cn = sys.mean_contacts_per_particle();
-          double peer = nt == 1 ? c.liggghts_1 : c.liggghts_2;
-          const char* peer_kind = "rec";
+          // recorded LIGGGHTS figures exist for 1 and 2 ranks only
+          double peer = nt == 1 ? c.liggghts_1 : nt == 2 ? c.liggghts_2 : 0.0;
+          const char* peer_kind = peer > 0.0 ? "rec" : "";
           if (liggghts && with_breakage == 0) {
             const double measured =
                 run_liggghts(dem_dir, c, static_cast<long>(data.size()), nt, steps);
@@ -224,13 +273,15 @@ int main(int argc, char** argv) {
           }
           const std::string name = c.name + (with_breakage ? "/brk" : "");
           std::printf(
-              "%-9s %3d %8zu %7ld %6ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %6.2fx "
+              "%-9s %3d %8zu %7ld %6ld %9.3f %9.3f %11.4g %9.4f %8.2f %10.3g %10.3g %7s "
               "%s%s\n",
               name.c_str(), nt, sys.particle_count(), steps, builds, seconds, cpu, rate, cn,
-              c.peer_contacts, sys.kinetic_energy(), ke_trans, rate / peer, peer_kind,
+              c.peer_contacts, sys.kinetic_energy(), ke_trans,
+              peer > 0.0 ? fmt_ratio(rate / peer).c_str() : "-", peer_kind,
               std::abs(cn / c.peer_contacts - 1.0) > 0.02 ? "  CONTACTS DIFFER >2%" : "");
           if (with_breakage == 0) {
             plain_cpu = cpu, plain_rate = rate;
+            rates.emplace_back(nt, rate);
           } else {
             std::printf(
                 "# %s, %d thread(s): breakage enabled, nothing broken (%lld events): "
@@ -246,6 +297,7 @@ int main(int argc, char** argv) {
           }
         }
       }
+      print_scaling(c.name, rates);
     }
   } catch (const Error& e) {
     std::cerr << e.what() << "\n";
