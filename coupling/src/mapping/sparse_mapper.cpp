@@ -134,22 +134,12 @@ __attribute__((target("avx"))) void csr_times_dense3_avx(
   double* out_y = out + out_stride;
   double* out_z = out + 2 * out_stride;
   const Eigen::Index rows = w.rows();
-  switch (width) {
-    case 1:
-      padded_rows3_avx<1>(index, weight, width, rows, p, out_x, out_y, out_z);
-      break;
-    case 2:
-      padded_rows3_avx<2>(index, weight, width, rows, p, out_x, out_y, out_z);
-      break;
-    case 3:
-      padded_rows3_avx<3>(index, weight, width, rows, p, out_x, out_y, out_z);
-      break;
-    case 4:
-      padded_rows3_avx<4>(index, weight, width, rows, p, out_x, out_y, out_z);
-      break;
-    default:
-      padded_rows3_avx<0>(index, weight, width, rows, p, out_x, out_y, out_z);
-  }
+  // widths 1-4 with the entry loop unrolled at compile time, others through the general loop
+  using Rows = void (*)(const int*, const double*, int, Eigen::Index, const double*, double*,
+                        double*, double*);
+  static constexpr Rows kRows[] = {padded_rows3_avx<0>, padded_rows3_avx<1>, padded_rows3_avx<2>,
+                                   padded_rows3_avx<3>, padded_rows3_avx<4>};
+  kRows[width <= 4 ? width : 0](index, weight, width, rows, p, out_x, out_y, out_z);
   for (std::size_t e = 0; e < extras; ++e) {  // rows ascending, each row's entries in order
     const double v = extra_weight[e];
     const double* x = p + 4 * static_cast<Eigen::Index>(extra_index[e]);
