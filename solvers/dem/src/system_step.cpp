@@ -17,6 +17,7 @@ namespace partita::dem {
 namespace {
 
 constexpr int block_size = ThreadPartition::block_size;
+constexpr int cross_chunk = 64;  // cross pairs a chunk of the force pass (stack arrays: ~6 KB)
 
 }  // namespace
 
@@ -255,15 +256,47 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       }
     }
   }
-  if (parts > 1) {  // the cross pairs, shared evenly among the threads
+  if (parts > 1) {
+    // The cross pairs, shared evenly among the threads in chunks, each chunk as a block of rows:
+    // its touching pairs listed without a branch on the overlap test (a pair that parted has its
+    // history settled), evaluated by the batched kernel, the results stored per pair. (With 16
+    // parts of a 20,000-particle bed a quarter of the pairs cross; the scalar kernel made the
+    // pass 1.4x the work of one part's.)
     const int n_cross = static_cast<int>(tp.cross_pairs.size());
+    const int chunks = (n_cross + cross_chunk - 1) / cross_chunk;
 #pragma omp for schedule(static)
-    for (int k = 0; k < n_cross; ++k) {
-      const ThreadPartition::CrossPair& c = tp.cross_pairs[k];
-      ThreadPartition::CrossForce& cf = tp.cross_force[k];
-      cf.touching =
-          pairs.force<Load>(c.slot, model_, c.i, packed[c.i], c.j, packed[c.j], dt, update_history,
-                            cf.force_i, cf.torque_i, cf.torque_j, cf.load);
+    for (int ch = 0; ch < chunks; ++ch) {
+      PairTask chunk_tasks[cross_chunk];
+      PairForce chunk_forces[cross_chunk];
+      const int k0 = ch * cross_chunk, k1 = std::min(n_cross, k0 + cross_chunk);
+      int n_touch = 0;
+      for (int k = k0; k < k1; ++k) {
+        const ThreadPartition::CrossPair& c = tp.cross_pairs[k];
+        const PackedParticle& qi = packed[c.i];
+        const PackedParticle& qj = packed[c.j];
+        const Eigen::Vector3d d = qi.x - qj.x;
+        const double rsum = qi.r + qj.r;
+        const bool touch = !(d.squaredNorm() >= rsum * rsum);  // (as the scalar kernel)
+        if (static_cast<char>(touch) != pairs.touching[c.slot]) {
+          pairs.touching[c.slot] = static_cast<char>(touch);
+          if (!touch) pairs.shear[c.slot].setZero();  // parted: the history is settled
+        }
+        tp.cross_force[k].touching = touch;
+        chunk_tasks[n_touch] = PairTask{c.slot, c.i, c.j};
+        n_touch += touch ? 1 : 0;
+      }
+      batch(chunk_tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
+            chunk_forces);
+      const PairForce* o = chunk_forces;
+      for (int k = k0; k < k1; ++k) {
+        ThreadPartition::CrossForce& cf = tp.cross_force[k];
+        if (!cf.touching) continue;
+        cf.force_i = Eigen::Vector3d(o->f[0], o->f[1], o->f[2]);
+        cf.torque_i = Eigen::Vector3d(o->ti[0], o->ti[1], o->ti[2]);
+        cf.torque_j = Eigen::Vector3d(o->tj[0], o->tj[1], o->tj[2]);
+        if constexpr (Load) cf.load = o->load;
+        ++o;
+      }
     }
   }
 #pragma omp for schedule(static, 1)
