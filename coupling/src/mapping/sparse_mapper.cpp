@@ -31,19 +31,19 @@ void SparseMapper::pad_rows() {
   // (each a load, a multiply, an add and a store of 3 values: about 3 padded entries)
   const Eigen::Index rows = matrix_.rows();
   const int* outer = matrix_.outerIndexPtr();
-  std::vector<Eigen::Index> longer(1, rows);  // longer[k]: rows with more than k entries
+  std::vector<double> rows_with(1, 0.0);  // rows_with[n]: rows of n entries
   for (Eigen::Index r = 0; r < rows; ++r) {
     const auto n = static_cast<std::size_t>(outer[r + 1] - outer[r]);
-    if (longer.size() <= n) longer.resize(n + 1, 0);
-    for (std::size_t k = 1; k < n; ++k) ++longer[k];
-    if (n > 0) ++longer[0];
+    if (rows_with.size() <= n) rows_with.resize(n + 1, 0.0);
+    rows_with[n] += 1.0;
   }
   Padded& p = padded_;
   p = Padded{};
   double best = INFINITY;
-  for (std::size_t k = 1; k <= std::max<std::size_t>(1, longer.size()); ++k) {
-    double extra = 0.0;  // entries beyond k: sum over m >= k of longer[m]
-    for (std::size_t m = k; m < longer.size(); ++m) extra += static_cast<double>(longer[m]);
+  for (std::size_t k = 1; k < std::max<std::size_t>(2, rows_with.size()); ++k) {
+    double extra = 0.0;  // entries beyond the first k of each row
+    for (std::size_t n = k + 1; n < rows_with.size(); ++n)
+      extra += static_cast<double>(n - k) * rows_with[n];
     const double cost = static_cast<double>(rows) * static_cast<double>(k) + 3.0 * extra;
     if (cost < best) best = cost, p.width = static_cast<int>(k);
   }
