@@ -5,8 +5,10 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define PARTITA_DEM_WIDE_KERNELS 1
@@ -93,9 +95,16 @@ const PairBatchKernels& pair_batch_kernels() {
     const PairBatchKernels* sets[3];
     const int n = pair_batch_kernel_sets(sets, 3);
     const char* forced = std::getenv("PARTITA_DEM_PAIR_KERNELS");
-    if (forced != nullptr)
-      for (int k = 0; k < n; ++k)
-        if (std::strcmp(forced, sets[k]->name) == 0) return sets[k];
+    if (forced == nullptr || *forced == '\0') return sets[0];
+    for (int k = 0; k < n; ++k)
+      if (std::strcmp(forced, sets[k]->name) == 0) return sets[k];
+    // a developer's switch, not an input: say once that it is not followed, and go on
+    std::string runs;
+    for (int k = 0; k < n; ++k) runs += std::string(k ? ", " : "") + sets[k]->name;
+    std::fprintf(stderr,
+                 "partita: PARTITA_DEM_PAIR_KERNELS=%s is not a kernel set this processor runs "
+                 "(it runs: %s); using %s\n",
+                 forced, runs.c_str(), sets[0]->name);
     return sets[0];
   }();
   return *chosen;
