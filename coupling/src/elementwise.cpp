@@ -22,50 +22,12 @@ bool has_avx() {
   return yes;
 }
 
-bool has_avx512() {
-  static const bool yes = __builtin_cpu_supports("avx512f");
-  return yes;
-}
-
-// mean_step and interpolate 8 lanes at a time where the processor has AVX-512 (half the
-// instructions of the 4-lane loops, which these short passes are bound by); elementwise, so
-// the same numbers. The rest (n mod 8) goes to the 4-lane and scalar loops.
-__attribute__((target("avx512f"))) std::ptrdiff_t mean_step_avx512(double* mean, const double* x,
-                                                                   std::ptrdiff_t n, double k,
-                                                                   bool multiply) {
-  const __m512d kk = _mm512_set1_pd(multiply ? 1.0 / k : k);
-  std::ptrdiff_t i = 0;
-  for (; i + 8 <= n; i += 8) {
-    const __m512d m = _mm512_loadu_pd(mean + i);
-    const __m512d d = _mm512_sub_pd(_mm512_loadu_pd(x + i), m);
-    if (_mm512_cmp_pd_mask(d, _mm512_setzero_pd(), _CMP_NEQ_UQ) == 0)
-      _mm512_storeu_pd(mean + i, _mm512_add_pd(m, d));
-    else if (multiply)
-      _mm512_storeu_pd(mean + i, _mm512_add_pd(m, _mm512_mul_pd(d, kk)));
-    else
-      _mm512_storeu_pd(mean + i, _mm512_add_pd(m, _mm512_div_pd(d, kk)));
-  }
-  return i;
-}
-
-__attribute__((target("avx512f"))) std::ptrdiff_t interpolate_avx512(double* out, const double* a,
-                                                                     const double* b,
-                                                                     std::ptrdiff_t n, double s) {
-  const __m512d ss = _mm512_set1_pd(s);
-  std::ptrdiff_t i = 0;
-  for (; i + 8 <= n; i += 8) {
-    const __m512d aa = _mm512_loadu_pd(a + i);
-    const __m512d d = _mm512_sub_pd(_mm512_loadu_pd(b + i), aa);
-    _mm512_storeu_pd(out + i, _mm512_add_pd(aa, _mm512_mul_pd(ss, d)));
-  }
-  return i;
-}
-
-// The same operations, 4 lanes at a time from i; the remainder (n mod 4) in the scalar loops below.
+// The same operations, 4 lanes at a time; the remainder (n mod 4) in the scalar loops below.
 __attribute__((target("avx"))) std::ptrdiff_t mean_step_avx(double* mean, const double* x,
-                                                            std::ptrdiff_t i, std::ptrdiff_t n,
-                                                            double k, bool multiply) {
+                                                            std::ptrdiff_t n, double k,
+                                                            bool multiply) {
   const __m256d kk = _mm256_set1_pd(multiply ? 1.0 / k : k);
+  std::ptrdiff_t i = 0;
   for (; i + 4 <= n; i += 4) {
     const __m256d m = _mm256_loadu_pd(mean + i);
     const __m256d d = _mm256_sub_pd(_mm256_loadu_pd(x + i), m);
@@ -84,9 +46,10 @@ __attribute__((target("avx"))) std::ptrdiff_t mean_step_avx(double* mean, const 
 }
 
 __attribute__((target("avx"))) std::ptrdiff_t interpolate_avx(double* out, const double* a,
-                                                              const double* b, std::ptrdiff_t i,
-                                                              std::ptrdiff_t n, double s) {
+                                                              const double* b, std::ptrdiff_t n,
+                                                              double s) {
   const __m256d ss = _mm256_set1_pd(s);
+  std::ptrdiff_t i = 0;
   for (; i + 4 <= n; i += 4) {
     const __m256d aa = _mm256_loadu_pd(a + i);
     const __m256d d = _mm256_sub_pd(_mm256_loadu_pd(b + i), aa);
@@ -142,8 +105,7 @@ void mean_step(double* mean, const double* x, std::ptrdiff_t n, double k) {
   const double r = 1.0 / k;
   std::ptrdiff_t i = 0;
 #ifdef PARTITA_AVX_KERNELS
-  if (has_avx512()) i = mean_step_avx512(mean, x, n, k, multiply);
-  if (has_avx()) i = mean_step_avx(mean, x, i, n, k, multiply);
+  if (has_avx()) i = mean_step_avx(mean, x, n, k, multiply);
 #endif
   if (multiply)
     for (; i < n; ++i) mean[i] += (x[i] - mean[i]) * r;
@@ -154,8 +116,7 @@ void mean_step(double* mean, const double* x, std::ptrdiff_t n, double k) {
 void interpolate(double* out, const double* a, const double* b, std::ptrdiff_t n, double s) {
   std::ptrdiff_t i = 0;
 #ifdef PARTITA_AVX_KERNELS
-  if (has_avx512()) i = interpolate_avx512(out, a, b, n, s);
-  if (has_avx()) i = interpolate_avx(out, a, b, i, n, s);
+  if (has_avx()) i = interpolate_avx(out, a, b, n, s);
 #endif
   for (; i < n; ++i) out[i] = a[i] + s * (b[i] - a[i]);
 }

@@ -5,9 +5,9 @@
 // Each result is the IEEE-rounded value of the same operations in the same order as the plain
 // expression in its comment, so the results are bit for bit those of that expression on every
 // machine. Where the processor has AVX (checked once at run time), 4 values go through each
-// instruction instead of the 2 of the SSE2 baseline the project is compiled for, and 8 with
-// AVX-512 in the elementwise kernels (mean_step, interpolate; the sums keep their 4 partial
-// sums). No fused multiply-add is used (it would round differently).
+// instruction instead of the 2 of the SSE2 baseline the project is compiled for. (8-lane
+// AVX-512 versions of mean_step and interpolate measured no faster: these passes are bound by
+// L2 traffic.) No fused multiply-add is used (it would round differently).
 
 #include <cstddef>
 

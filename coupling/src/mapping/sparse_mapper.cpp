@@ -89,10 +89,10 @@ bool has_avx() {
   return yes;
 }
 
-// csr_times_dense<3> with the three components of a point in one 4-lane register: the input is
-// first copied into rows (x, y, z, 0) of `packed` (and a row of zeros after them, the padding
-// point), so each entry costs one load of the point instead of three. Rows padded to K entries
-// (SparseMapper::Padded): a loop of fixed length, then the extra entries of the longer rows
+// csr_times_dense<3>'s product with the three components of a point in one 4-lane register: the
+// input is first copied into rows (x, y, z, 0) of `packed` (and a row of zeros after them, the
+// padding point), so each entry costs one load of the point instead of three. Rows padded to K
+// entries (SparseMapper::Padded): a loop of fixed length, then the extra entries of the longer rows
 // added to their sums in order. Each lane does the operations of the scalar loop in its order
 // (no FMA): the same numbers, bit for bit.
 template <int K>
@@ -115,12 +115,12 @@ __attribute__((target("avx"))) void padded_rows3_avx(const int* index, const dou
   }
 }
 
-__attribute__((target("avx"))) void csr_times_dense3_avx(
-    const SparseMapper::Matrix& w, const int* index, const double* weight, int width,
-    const int* extra_row, const int* extra_index, const double* extra_weight, std::size_t extras,
-    const double* in, Eigen::Index in_stride, double* out, Eigen::Index out_stride,
-    std::vector<double>& packed) {
-  const Eigen::Index n = w.cols();
+__attribute__((target("avx"))) void padded_times_dense3_avx(const SparseMapper::Padded& w,
+                                                            Eigen::Index rows, Eigen::Index n,
+                                                            const double* in, double* out,
+                                                            Eigen::Index out_stride,
+                                                            std::vector<double>& packed) {
+  const Eigen::Index in_stride = n;
   packed.resize(static_cast<std::size_t>(4 * (n + 1)));
   double* p = packed.data();
   for (Eigen::Index j = 0; j < n; ++j) {
@@ -133,17 +133,17 @@ __attribute__((target("avx"))) void csr_times_dense3_avx(
   double* out_x = out;
   double* out_y = out + out_stride;
   double* out_z = out + 2 * out_stride;
-  const Eigen::Index rows = w.rows();
   // widths 1-4 with the entry loop unrolled at compile time, others through the general loop
   using Rows = void (*)(const int*, const double*, int, Eigen::Index, const double*, double*,
                         double*, double*);
   static constexpr Rows kRows[] = {padded_rows3_avx<0>, padded_rows3_avx<1>, padded_rows3_avx<2>,
                                    padded_rows3_avx<3>, padded_rows3_avx<4>};
-  kRows[width <= 4 ? width : 0](index, weight, width, rows, p, out_x, out_y, out_z);
-  for (std::size_t e = 0; e < extras; ++e) {  // rows ascending, each row's entries in order
-    const double v = extra_weight[e];
-    const double* x = p + 4 * static_cast<Eigen::Index>(extra_index[e]);
-    const Eigen::Index r = extra_row[e];
+  kRows[w.width <= 4 ? w.width : 0](w.index.data(), w.weight.data(), w.width, rows, p, out_x, out_y,
+                                    out_z);
+  for (std::size_t e = 0; e < w.extra_row.size(); ++e) {  // rows ascending, entries in order
+    const double v = w.extra_weight[e];
+    const double* x = p + 4 * static_cast<Eigen::Index>(w.extra_index[e]);
+    const Eigen::Index r = w.extra_row[e];
     out_x[r] += v * x[0];
     out_y[r] += v * x[1];
     out_z[r] += v * x[2];
@@ -169,10 +169,8 @@ void SparseMapper::map(const Eigen::MatrixXd& in, Eigen::MatrixXd& out) const {
     case 3:
 #ifdef PARTITA_AVX_KERNELS
       if (has_avx())
-        return csr_times_dense3_avx(matrix_, padded_.index.data(), padded_.weight.data(),
-                                    padded_.width, padded_.extra_row.data(),
-                                    padded_.extra_index.data(), padded_.extra_weight.data(),
-                                    padded_.extra_row.size(), x, in.rows(), y, out.rows(), packed_);
+        return padded_times_dense3_avx(padded_, matrix_.rows(), matrix_.cols(), x, y, out.rows(),
+                                       packed_);
 #endif
       return csr_times_dense<3>(matrix_, x, in.rows(), y, out.rows());
     default:

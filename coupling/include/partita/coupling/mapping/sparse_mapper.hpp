@@ -38,6 +38,17 @@ class SparseMapper : public Mapper {
   /// The operator of map(): target.size() x source.size().
   const Matrix& matrix() const { return matrix_; }
 
+  /// map()'s copy of W for vectors: rows of `width` entries (row-major; padding: weight 0 on
+  /// point cols()), and the entries beyond `width` (row, column, weight; rows ascending, in
+  /// their order in W).
+  struct Padded {
+    int width = 0;
+    std::vector<int> index;
+    std::vector<double> weight;
+    std::vector<int> extra_row, extra_index;
+    std::vector<double> extra_weight;
+  };
+
  protected:
   /// Consistent interpolation weights from `source` to `target`: a target.size() x
   /// source.size() matrix whose rows sum to 1.
@@ -49,15 +60,6 @@ class SparseMapper : public Mapper {
   Constraint constraint_;
   Matrix matrix_;
   mutable std::vector<double> packed_;  // map()'s scratch: the input as rows (x, y, z, 0)
-  /// W with rows of `width` entries (row-major; padding: weight 0 on point cols()), and the
-  /// entries beyond `width` (row, column, weight; rows ascending, in their order in W).
-  struct Padded {
-    int width = 0;
-    std::vector<int> index;
-    std::vector<double> weight;
-    std::vector<int> extra_row, extra_index;
-    std::vector<double> extra_weight;
-  };
   Padded padded_;
 };
 
