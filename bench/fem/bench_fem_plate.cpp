@@ -8,11 +8,14 @@
 //
 // usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] [--lumped] [--no-ccx]
 //                        [--peers DIR] [--backends
-//                        eigen-ldlt,cholmod-nesdis,cholmod-nesdis-t,cholmod-metis,cholmod-amd]
+//                        eigen-ldlt,cholmod-nesdis,cholmod-nesdis-t,cholmod-nesdis-tf,
+//                        cholmod-metis,cholmod-amd,cholmod-amd-tf]
 //                        [--no-static]   (transient only: the large plates)
 // Each mesh is solved with every linear solver built in (Eigen's SimplicialLDLT + AMD; CHOLMOD
 // supernodal with NESDIS, METIS and AMD orderings, solved by CHOLMOD; cholmod-nesdis-t: NESDIS
-// solved by the threaded supernodal solve, on all OpenMP threads), and the summary prints their
+// solved by the threaded supernodal solve, on all OpenMP threads; cholmod-nesdis-tf and
+// cholmod-amd-tf: CHOLMOD's analysis with that ordering, partita's threaded supernodal
+// factorisation and the threaded solve, on all OpenMP threads), and the summary prints their
 // factorisation and step times as ratios to the first one listed, and to CalculiX. Timings are
 // wall-clock on a possibly shared machine: read them with that caveat.
 #include <algorithm>
@@ -130,10 +133,11 @@ double run_ccx(const Options& opt, std::array<int, 3> c) {
 }
 
 struct Backend {
-  std::string name;  // eigen-ldlt, cholmod-nesdis, cholmod-nesdis-t, cholmod-metis, cholmod-amd
+  std::string name;  // eigen-ldlt, cholmod-nesdis, cholmod-nesdis-t, cholmod-nesdis-tf, ...
   LinearSolver solver;
   FillOrdering ordering;
   SolveThreading threading = SolveThreading::Serial;  // CHOLMOD's solve or the threaded one
+  FactorThreading factor = FactorThreading::Serial;   // CHOLMOD's factorisation or partita's
 };
 
 std::vector<Backend> all_backends() {
@@ -142,8 +146,12 @@ std::vector<Backend> all_backends() {
     b.push_back({"cholmod-nesdis", LinearSolver::Cholmod, FillOrdering::Nesdis});
     b.push_back({"cholmod-nesdis-t", LinearSolver::Cholmod, FillOrdering::Nesdis,
                  SolveThreading::Threaded});
+    b.push_back({"cholmod-nesdis-tf", LinearSolver::Cholmod, FillOrdering::Nesdis,
+                 SolveThreading::Threaded, FactorThreading::Threaded});
     b.push_back({"cholmod-metis", LinearSolver::Cholmod, FillOrdering::Metis});
     b.push_back({"cholmod-amd", LinearSolver::Cholmod, FillOrdering::Amd});
+    b.push_back({"cholmod-amd-tf", LinearSolver::Cholmod, FillOrdering::Amd,
+                 SolveThreading::Threaded, FactorThreading::Threaded});
   }
   return b;
 }
@@ -163,6 +171,7 @@ Result bench_backend(const Options& opt, const Model& model, const Backend& b) {
     so.linear_solver = b.solver;
     so.fill_ordering = b.ordering;
     so.solve_threading = b.threading;
+    so.factor_threading = b.factor;
     const auto t0 = Clock::now();
     StructuralSolver s(model, so);
     const double t_setup = since(t0);
@@ -184,6 +193,7 @@ Result bench_backend(const Options& opt, const Model& model, const Backend& b) {
   so.linear_solver = b.solver;
   so.fill_ordering = b.ordering;
   so.solve_threading = b.threading;
+  so.factor_threading = b.factor;
   const auto t0 = Clock::now();
   StructuralSolver s(model, so);
   double rmin = 1e300, rmax = -1e300, rlast = 0.0;
@@ -317,7 +327,8 @@ int main(int argc, char** argv) {
       } else if (a == "-h" || a == "--help") {
         std::cout << "usage: bench_fem_plate [NXxNYxNZ ...] [--steps N] [--dt S] [--qm6] "
                      "[--lumped] [--no-ccx] [--peers DIR] [--backends "
-                     "eigen-ldlt,cholmod-nesdis,cholmod-nesdis-t,cholmod-metis,cholmod-amd] "
+                     "eigen-ldlt,cholmod-nesdis,cholmod-nesdis-t,cholmod-nesdis-tf,cholmod-metis,"
+                     "cholmod-amd,cholmod-amd-tf] "
                      "[--no-static]\n";
         return 0;
       } else {

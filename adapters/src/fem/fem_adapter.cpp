@@ -198,6 +198,16 @@ std::shared_ptr<Spec> make_spec() {
                "serial differ by round-off",
                {"auto", "threaded", "serial"})
       .def("auto");
+  analysis
+      ->choice("factor_threading",
+               "the numeric factorisation of a CHOLMOD factor (a linear static solve, Newmark's "
+               "K_eff): threaded (partita's supernodal factorisation, subtrees of the elimination "
+               "tree and the rows of large supernodes shared among the --threads), serial "
+               "(CHOLMOD's own, one thread), or auto (threaded for factors of at least 2e6 "
+               "entries); results never depend on the thread count, threaded and serial differ "
+               "by round-off",
+               {"auto", "threaded", "serial"})
+      .def("auto");
   auto nonlinear = std::make_shared<Spec>(
       "nonlinear", "Newton iterations of neo-hooke and j2-plasticity (static and Newmark)");
   nonlinear->integer("max_iterations", "Newton iterations per load or time step").min(1).def(25);
@@ -459,6 +469,11 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       options.solve_threading = fem::SolveThreading::Threaded;
     else if (threading == "serial")
       options.solve_threading = fem::SolveThreading::Serial;
+    const std::string factor_threading = an.string("factor_threading");
+    if (factor_threading == "threaded")
+      options.factor_threading = fem::FactorThreading::Threaded;
+    else if (factor_threading == "serial")
+      options.factor_threading = fem::FactorThreading::Serial;
     const Node nl = an["nonlinear"];
     options.newton.max_iterations = static_cast<int>(nl.integer("max_iterations"));
     options.newton.force_tolerance = nl.real("force_tolerance");

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "partita/fem/error.hpp"
+#include "supernodal_factorize.hpp"
 #include "supernodal_kernels.hpp"
 #include "supernodal_solve.hpp"
 
@@ -72,6 +73,18 @@ std::string to_string(SolveThreading threading) {
   return "?";
 }
 
+std::string to_string(FactorThreading threading) {
+  switch (threading) {
+    case FactorThreading::Automatic:
+      return "auto";
+    case FactorThreading::Threaded:
+      return "threaded";
+    case FactorThreading::Serial:
+      return "serial";
+  }
+  return "?";
+}
+
 std::string threaded_solve_kernels() {
   return detail::supernodal_kernels().name;
 }
@@ -80,6 +93,8 @@ struct SparseFactorisation::Impl {
   virtual ~Impl() = default;
   virtual void set_solve_threading(SolveThreading) {}
   virtual bool threaded_solve() const { return false; }
+  virtual void set_factor_threading(FactorThreading) {}
+  virtual bool threaded_factorisation() const { return false; }
   virtual void analyze(const SparseMatrix& a) = 0;
   virtual bool factorize(const SparseMatrix& a) = 0;
   virtual void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
@@ -175,15 +190,42 @@ class Cholmod final : public SparseFactorisation::Impl {
     factorised_ = false;
     fallback_.reset();
     tree_state_ = TreeState::Unprepared;
+    factor_state_ = TreeState::Unprepared;
   }
   bool factorize(const SparseMatrix& a) override {
     if (l_ == nullptr || static_cast<Eigen::Index>(l_->n) != a.rows()) analyze(a);
-    cholmod_sparse view = lower_view(a);
     factorised_ = false;
-    const int ok = cholmod_factorize(&view, l_, &c_);
-    if (c_.status == CHOLMOD_OUT_OF_MEMORY)
-      throw Error("CHOLMOD: out of memory in the factorisation");
-    bool positive_definite = ok && c_.status != CHOLMOD_NOT_POSDEF && l_->minor >= l_->n;
+    const detail::SparsePattern pattern{static_cast<int>(a.cols()), a.outerIndexPtr(),
+                                        a.innerIndexPtr()};
+    if (factor_state_ == TreeState::Ready && !(a.isCompressed() && threaded_.same_pattern(pattern)))
+      analyze(a);  // another pattern: the analysis and the schedule are the old pattern's
+    if (factor_state_ == TreeState::Unprepared) {
+      // the schedule depends on the structure alone: built once per analysis
+      const bool wanted =
+          factor_threading_ == FactorThreading::Threaded ||
+          (factor_threading_ == FactorThreading::Automatic && c_.lnz >= kThreadedMinEntries);
+      factor_state_ = wanted && a.isCompressed() && l_->is_super && l_->itype == CHOLMOD_INT &&
+                              threaded_.prepare(factor_view(), pattern)
+                          ? TreeState::Ready
+                          : TreeState::Unusable;
+    }
+    bool positive_definite = false;
+    if (factor_state_ == TreeState::Ready) {
+      if (l_->xtype == CHOLMOD_PATTERN &&
+          !cholmod_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, l_, &c_)) {
+        throw Error("CHOLMOD: out of memory for the factor's values (status " +
+                    std::to_string(c_.status) + ")");
+      }
+      const int failed = threaded_.factorize(factor_view(), a.valuePtr(), static_cast<double*>(l_->x));
+      l_->minor = failed < 0 ? l_->n : static_cast<std::size_t>(failed);
+      positive_definite = failed < 0;
+    } else {
+      cholmod_sparse view = lower_view(a);
+      const int ok = cholmod_factorize(&view, l_, &c_);
+      if (c_.status == CHOLMOD_OUT_OF_MEMORY)
+        throw Error("CHOLMOD: out of memory in the factorisation");
+      positive_definite = ok && c_.status != CHOLMOD_NOT_POSDEF && l_->minor >= l_->n;
+    }
     // (min_i L_ii / max_i L_ii)^2 = min d / max d of the equivalent L D L^T
     if (positive_definite && !indefinite_ok_)
       positive_definite = cholmod_rcond(l_, &c_) > kMinPivotRatio;
@@ -198,7 +240,7 @@ class Cholmod final : public SparseFactorisation::Impl {
       // the schedule depends on the structure alone: built once per analysis
       const bool wanted =
           threading_ == SolveThreading::Threaded ||
-          (threading_ == SolveThreading::Automatic && c_.lnz >= kThreadedSolveMinEntries);
+          (threading_ == SolveThreading::Automatic && c_.lnz >= kThreadedMinEntries);
       tree_state_ = wanted && l_->is_super && l_->is_ll && l_->itype == CHOLMOD_INT &&
                             l_->xtype == CHOLMOD_REAL && tree_.prepare(factor_view())
                         ? TreeState::Ready
@@ -236,6 +278,13 @@ class Cholmod final : public SparseFactorisation::Impl {
   }
   bool threaded_solve() const override {
     return factorised_ && !use_fallback_ && tree_state_ == TreeState::Ready;
+  }
+  void set_factor_threading(FactorThreading threading) override {
+    if (threading != factor_threading_) factor_state_ = TreeState::Unprepared;
+    factor_threading_ = threading;
+  }
+  bool threaded_factorisation() const override {
+    return factorised_ && !use_fallback_ && factor_state_ == TreeState::Ready;
   }
   double factor_nonzeros() const override {
     if (use_fallback_) return fallback_->factor_nonzeros();
@@ -276,10 +325,11 @@ class Cholmod final : public SparseFactorisation::Impl {
     return f;
   }
 
-  // The threaded solve (supernodal_solve.hpp) for factors of at least this many entries (16 MB):
-  // below, the solve is short and CHOLMOD's own is as fast. Decided by the structure alone, so
-  // the results never depend on the number of threads.
-  static constexpr double kThreadedSolveMinEntries = 2e6;
+  // The threaded solve (supernodal_solve.hpp) and factorisation (supernodal_factorize.hpp) for
+  // factors of at least this many entries (16 MB): below, CHOLMOD's own are as fast (a parallel
+  // region costs as much as it saves). Decided by the structure alone, so the results never
+  // depend on the number of threads.
+  static constexpr double kThreadedMinEntries = 2e6;
   enum class TreeState { Unprepared, Ready, Unusable };
 
   cholmod_common c_{};
@@ -287,6 +337,9 @@ class Cholmod final : public SparseFactorisation::Impl {
   detail::SupernodalSolve tree_;
   TreeState tree_state_ = TreeState::Unprepared;
   SolveThreading threading_ = SolveThreading::Automatic;
+  detail::SupernodalFactorize threaded_;
+  TreeState factor_state_ = TreeState::Unprepared;
+  FactorThreading factor_threading_ = FactorThreading::Automatic;
   cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;
   bool indefinite_ok_;
   bool factorised_ = false;
@@ -345,6 +398,14 @@ void SparseFactorisation::set_solve_threading(SolveThreading threading) {
 
 bool SparseFactorisation::threaded_solve() const {
   return !empty_ && impl_->threaded_solve();
+}
+
+void SparseFactorisation::set_factor_threading(FactorThreading threading) {
+  impl_->set_factor_threading(threading);
+}
+
+bool SparseFactorisation::threaded_factorisation() const {
+  return !empty_ && impl_->threaded_factorisation();
 }
 
 }  // namespace partita::fem

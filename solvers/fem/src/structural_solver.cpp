@@ -449,6 +449,7 @@ void StructuralSolver::solve_static() {
     static_factor_ =
         std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
     static_factor_->set_solve_threading(options_.solve_threading);
+    static_factor_->set_factor_threading(options_.factor_threading);
     static_factor_->analyze(k_ff_);
     factorise_or_throw(*static_factor_, k_ff_, "static stiffness matrix K_ff");
     timings_.factor_nonzeros = static_factor_->factor_nonzeros();
@@ -537,6 +538,7 @@ void StructuralSolver::factorise_dynamic(double dt) {
     dynamic_factor_ =
         std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
     dynamic_factor_->set_solve_threading(options_.solve_threading);
+    dynamic_factor_->set_factor_threading(options_.factor_threading);
     dynamic_factor_->analyze(keff_ff);
   }
   factorise_or_throw(*dynamic_factor_, keff_ff, "effective matrix K_eff");

@@ -1,5 +1,6 @@
 #include "supernodal_kernels.hpp"
 
+#include <cmath>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
@@ -15,7 +16,11 @@ namespace partita::fem::detail {
 
 namespace generic {
 #define PARTITA_KERNELS_NAME "sse2"
+#define PARTITA_FMA4(a, b, c) ((a) * (b) + (c))
+#define PARTITA_FMA1(a, b, c) ((a) * (b) + (c))
 #include "supernodal_kernels.inc"
+#undef PARTITA_FMA1
+#undef PARTITA_FMA4
 #undef PARTITA_KERNELS_NAME
 }  // namespace generic
 
@@ -29,7 +34,12 @@ namespace generic {
 #endif
 namespace avx2 {
 #define PARTITA_KERNELS_NAME "avx2-fma"
+// one rounding a multiply-add, in the lanes and in the scalar tails alike
+#define PARTITA_FMA4(a, b, c) __builtin_ia32_vfmaddpd256((a), (b), (c))
+#define PARTITA_FMA1(a, b, c) __builtin_fma((a), (b), (c))
 #include "supernodal_kernels.inc"
+#undef PARTITA_FMA1
+#undef PARTITA_FMA4
 #undef PARTITA_KERNELS_NAME
 }  // namespace avx2
 #if defined(__clang__)
@@ -39,16 +49,35 @@ namespace avx2 {
 #endif
 #endif
 
-const SupernodalKernels& supernodal_kernels() {
+namespace {
+bool use_avx2() {
 #ifdef PARTITA_HAVE_AVX2_KERNELS
   // PARTITA_FEM_SOLVE_KERNELS=sse2 takes the portable set on any processor (the test suite runs
-  // the threaded-solve tests once with it, so both sets are checked on an AVX2 machine)
+  // the threaded-solve and factorisation tests once with it, so both sets are checked on an
+  // AVX2 machine)
   static const bool avx2 = [] {
     const char* forced = std::getenv("PARTITA_FEM_SOLVE_KERNELS");
     if (forced != nullptr && std::strcmp(forced, "sse2") == 0) return false;
     return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   }();
-  return avx2 ? avx2::kKernels : generic::kKernels;
+  return avx2;
+#else
+  return false;
+#endif
+}
+}  // namespace
+
+const FactorKernels& factor_kernels() {
+#ifdef PARTITA_HAVE_AVX2_KERNELS
+  return use_avx2() ? avx2::kFactorKernels : generic::kFactorKernels;
+#else
+  return generic::kFactorKernels;
+#endif
+}
+
+const SupernodalKernels& supernodal_kernels() {
+#ifdef PARTITA_HAVE_AVX2_KERNELS
+  return use_avx2() ? avx2::kKernels : generic::kKernels;
 #else
   return generic::kKernels;
 #endif

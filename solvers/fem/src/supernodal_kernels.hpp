@@ -43,4 +43,24 @@ struct SupernodalKernels {
 // The best set this processor runs (AVX2 + FMA or SSE2), chosen on the first call.
 const SupernodalKernels& supernodal_kernels();
 
+// The dense kernels of the threaded factorisation (supernodal_factorize.hpp), in the same two
+// sets. Column-major blocks with leading dimensions; every entry's sum is formed in one fixed
+// order (from zero over k ascending, then subtracted), whichever block of the output or thread
+// computes it, so a set gives the same bits on any thread count.
+constexpr int kPanelBlock = 32;  // columns of a supernode factorised together
+struct FactorKernels {
+  const char* name;
+  // C -= A B^T: C m x n, A m x k, B n x k.
+  void (*gemm_nt_minus)(int m, int n, int k, const double* a, int lda, const double* b, int ldb,
+                        double* c, int ldc);
+  // Cholesky of a supernode's panel P (leading dimension ld): the n x n triangle and the rows
+  // [n, rows_end) below it, left-looking by blocks of kPanelBlock columns. Returns the column of
+  // a pivot that is not positive (the panel is then incomplete), else -1.
+  int (*panel_factor)(int n, double* p, int ld, int rows_end);
+  // Rows [r0, r1) below the factorised triangle: P_r := P_r L^-T, the same operations as
+  // panel_factor does on its own rows.
+  void (*panel_solve_rows)(int n, double* p, int ld, int r0, int r1);
+};
+const FactorKernels& factor_kernels();
+
 }  // namespace partita::fem::detail

@@ -27,6 +27,13 @@ enum class FillOrdering { Automatic, Metis, Nesdis, Amd };
 // Serial below. Either way the solution does not depend on the number of threads (the order of
 // every sum is fixed by the factor's structure); Threaded and Serial differ by round-off.
 enum class SolveThreading { Automatic, Threaded, Serial };
+// The numeric factorisation with CHOLMOD's symbolic analysis: Threaded is partita's supernodal
+// factorisation (the same left-looking method and BLAS kernels as CHOLMOD's, disjoint subtrees of
+// the elimination tree as OpenMP tasks, the rows of the large supernodes near the root shared),
+// Serial is CHOLMOD's own on one thread; Automatic = Threaded for factors of at least 2e6 entries,
+// Serial below. Either way the factor does not depend on the number of threads (every sum's
+// order is fixed by the factor's structure); Threaded and Serial differ by round-off.
+enum class FactorThreading { Automatic, Threaded, Serial };
 
 // Whether this build has CHOLMOD (PARTITA_CHOLMOD).
 bool cholmod_available();
@@ -36,6 +43,7 @@ LinearSolver resolve(LinearSolver solver);
 std::string to_string(LinearSolver solver);
 std::string to_string(FillOrdering ordering);
 std::string to_string(SolveThreading threading);
+std::string to_string(FactorThreading threading);
 // The instruction set of the threaded solve's kernels on this processor: "avx2-fma" or "sse2"
 // (environment PARTITA_FEM_SOLVE_KERNELS=sse2 forces the portable set). The two differ by
 // round-off (a fused multiply-add rounds once), each gives the same bits on any thread count.
@@ -78,6 +86,11 @@ class SparseFactorisation {
   void set_solve_threading(SolveThreading threading);
   // Whether the last factorisation is solved by the threaded solve.
   bool threaded_solve() const;
+  // How factorize() runs with CHOLMOD (no effect with Eigen's); takes effect at the next
+  // factorize().
+  void set_factor_threading(FactorThreading threading);
+  // Whether the last factorisation was partita's threaded one.
+  bool threaded_factorisation() const;
 
   struct Impl;  // the backend (defined in linear_solver.cpp)
 

@@ -34,6 +34,9 @@ struct SolverOptions {
   FillOrdering fill_ordering = FillOrdering::Automatic;
   // The triangular solves of the linear path's static and Newmark steps (linear_solver.hpp).
   SolveThreading solve_threading = SolveThreading::Automatic;
+  // The numeric factorisation of the linear path's K_ff and K_eff (linear_solver.hpp); Newton's
+  // tangents always take Automatic.
+  FactorThreading factor_threading = FactorThreading::Automatic;
 };
 
 }  // namespace partita::fem
