@@ -144,36 +144,49 @@ bool SupernodalFactorize::prepare(const SupernodalFactor& f, const SparsePattern
   }
   begin_.assign(a.begin, a.begin + a.n + 1);
   index_.assign(a.index, a.index + a.begin[a.n]);
-  std::vector<std::int64_t> src, dst;
-  std::vector<int> owner;
-  for (int j = 0; j < a.n; ++j) {
+  // counted by supernode, then filled in A's order, then each supernode's entries resolved with
+  // its rows' map (no search)
+  entry_begin_.assign(static_cast<std::size_t>(ns) + 1, 0);
+  for (int j = 0; j < a.n; ++j)
     for (int p = a.begin[j]; p < a.begin[j + 1]; ++p) {
       const int r = a.index[p];
       if (r < j) continue;  // upper triangle: ignored
       if (r >= a.n) return false;
-      const int pi = at(pinv, r), pj = at(pinv, j);
-      const int lo = std::min(pi, pj), hi = std::max(pi, pj);
-      const int s = at(col_super_, lo);
-      const int* rows = f.rows + f.pi[s];
-      const int nrow = f.pi[s + 1] - f.pi[s];
-      const int* hit = std::lower_bound(rows, rows + nrow, hi);
-      if (hit == rows + nrow || *hit != hi) return false;  // outside L's pattern
-      src.push_back(p);
-      dst.push_back(static_cast<std::int64_t>(f.px[s]) +
-                    static_cast<std::int64_t>(lo - f.super[s]) * nrow + (hit - rows));
-      owner.push_back(s);
+      ++at(entry_begin_, at(col_super_, std::min(at(pinv, r), at(pinv, j))) + 1);
     }
-  }
-  entry_begin_.assign(static_cast<std::size_t>(ns) + 1, 0);
-  for (const int s : owner) ++at(entry_begin_, s + 1);
   for (int s = 0; s < ns; ++s) at(entry_begin_, s + 1) += at(entry_begin_, s);
-  src_.resize(src.size());
-  dst_.resize(dst.size());
-  std::vector<std::int64_t> put(entry_begin_.begin(), entry_begin_.end() - 1);
-  for (std::size_t k = 0; k < src.size(); ++k) {
-    const std::int64_t q = at(put, owner[k])++;
-    at(src_, q) = src[k];
-    at(dst_, q) = dst[k];
+  const std::size_t entries = static_cast<std::size_t>(entry_begin_.back());
+  src_.resize(entries);
+  dst_.resize(entries);
+  std::vector<int> lo_of(entries), hi_of(entries);
+  {
+    std::vector<std::int64_t> put(entry_begin_.begin(), entry_begin_.end() - 1);
+    for (int j = 0; j < a.n; ++j)
+      for (int p = a.begin[j]; p < a.begin[j + 1]; ++p) {
+        const int r = a.index[p];
+        if (r < j) continue;
+        const int pi = at(pinv, r), pj = at(pinv, j);
+        const int lo = std::min(pi, pj);
+        const std::int64_t q = at(put, at(col_super_, lo))++;
+        at(src_, q) = p;
+        at(lo_of, q) = lo;
+        at(hi_of, q) = std::max(pi, pj);
+      }
+  }
+  std::vector<int> map(static_cast<std::size_t>(f.n)), mark(static_cast<std::size_t>(f.n), -1);
+  for (int s = 0; s < ns; ++s) {
+    const int* rows = f.rows + f.pi[s];
+    const int nrow = f.pi[s + 1] - f.pi[s];
+    for (int i = 0; i < nrow; ++i) {
+      at(map, rows[i]) = i;
+      at(mark, rows[i]) = s;
+    }
+    for (std::int64_t q = at(entry_begin_, s); q < at(entry_begin_, s + 1); ++q) {
+      const int hi = at(hi_of, q);
+      if (at(mark, hi) != s) return false;  // outside L's pattern
+      at(dst_, q) = static_cast<std::int64_t>(f.px[s]) +
+                    static_cast<std::int64_t>(at(lo_of, q) - f.super[s]) * nrow + at(map, hi);
+    }
   }
   scratch_.clear();
   return true;
