@@ -208,6 +208,8 @@ int SupernodalFactorize::factorize(const SupernodalFactor& f, const double* ax, 
     if (sc.rel.size() < static_cast<std::size_t>(widest_))
       sc.rel.assign(static_cast<std::size_t>(widest_), 0);
     if (sc.c.size() < work_size_) sc.c.assign(work_size_, 0.0);
+    if (sc.pack.size() != static_cast<std::size_t>(kFactorPackSize))
+      sc.pack.assign(static_cast<std::size_t>(kFactorPackSize), 0.0);
     sc.owner = -1;  // the values of the map are the last factorisation's: refilled on first use
   }
   failed_.store(false);
@@ -263,19 +265,19 @@ void SupernodalFactorize::supernode(const SupernodalFactor& f, double* values, i
   const FactorKernels& k = factor_kernels();
   if (!at(shared_, s)) {
     update_rows(f, values, s, 0, nrow);
-    fail_at(s, k.panel_factor(ncol, ls, nrow, nrow));
+    fail_at(s, k.panel_factor(ncol, ls, nrow, nrow, pack()));
     return;
   }
   const int blocks = (nrow + kRowBlock - 1) / kRowBlock;
 #pragma omp taskloop grainsize(1) untied
   for (int b = 0; b < blocks; ++b)
     update_rows(f, values, s, b * kRowBlock, std::min(nrow, (b + 1) * kRowBlock));
-  if (fail_at(s, k.panel_factor(ncol, ls, nrow, ncol))) return;
+  if (fail_at(s, k.panel_factor(ncol, ls, nrow, ncol, pack()))) return;
   const int below = (nrow - ncol + kRowBlock - 1) / kRowBlock;
 #pragma omp taskloop grainsize(1) untied
   for (int b = 0; b < below; ++b)
     k.panel_solve_rows(ncol, ls, nrow, ncol + b * kRowBlock,
-                       std::min(nrow, ncol + (b + 1) * kRowBlock));
+                       std::min(nrow, ncol + (b + 1) * kRowBlock), pack());
 }
 
 // Rows [r0, r1) of supernode s (local rows) receive every descendant's update:
@@ -319,7 +321,7 @@ void SupernodalFactorize::update_rows(const SupernodalFactor& f, double* values,
     const double* ld = values + f.px[d];
     // c = -L_d(q0..q1) L_d(p1..p1+n)^T, then added where it belongs in s
     std::fill(c, c + static_cast<std::size_t>(m) * static_cast<std::size_t>(n), 0.0);
-    k.gemm_nt_minus(m, n, ncol_d, ld + q0, nrow_d, ld + p1, nrow_d, c, m);
+    k.gemm_nt_minus(m, n, ncol_d, ld + q0, nrow_d, ld + p1, nrow_d, c, m, sc.pack.data());
     for (int i = 0; i < m; ++i) rel[i] = map[rows_d[q0 + i]];
     for (int j = 0; j < n; ++j) {
       double* col = ls + static_cast<std::size_t>(map[rows_d[p1 + j]]) * nrow;
@@ -327,6 +329,10 @@ void SupernodalFactorize::update_rows(const SupernodalFactor& f, double* values,
       for (int i = std::max(0, p1 + j - q0); i < m; ++i) col[rel[i]] += cj[i];
     }
   }
+}
+
+double* SupernodalFactorize::pack() {
+  return at(scratch_, thread_id()).pack.data();
 }
 
 bool SupernodalFactorize::fail_at(int s, int column) {

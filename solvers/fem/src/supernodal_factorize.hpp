@@ -65,6 +65,7 @@ class SupernodalFactorize {
   void subtree(const SupernodalFactor& f, double* values, int s, double task_min);
   void supernode(const SupernodalFactor& f, double* values, int s);
   void update_rows(const SupernodalFactor& f, double* values, int s, int r0, int r1);
+  double* pack();  // this thread's pack buffer
   // records a failed pivot (column >= 0: a local column of s); returns whether it failed
   bool fail_at(int s, int column);
   int columns_begin(int s) const { return super_begin_[static_cast<std::size_t>(s)]; }
@@ -88,7 +89,7 @@ class SupernodalFactorize {
   // per thread: the relative map (row of P A P^T -> local row of map_owner), work block, rows
   struct Scratch {
     std::vector<int> map, rel;
-    std::vector<double> c;
+    std::vector<double> c, pack;  // an update's block; packed operands (supernodal_kernels.hpp)
     int owner = -1;
   };
   std::vector<Scratch> scratch_;

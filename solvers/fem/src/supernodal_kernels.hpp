@@ -48,18 +48,22 @@ const SupernodalKernels& supernodal_kernels();
 // order (from zero over k ascending, then subtracted), whichever block of the output or thread
 // computes it, so a set gives the same bits on any thread count.
 constexpr int kPanelBlock = 32;  // columns of a supernode factorised together
+constexpr int kGemmK = 256;      // the products' packed blocks: k's
+constexpr int kGemmN = 128;      // and columns
+constexpr int kFactorPackSize = 12 * kGemmK + kGemmN * kGemmK;  // doubles of a pack buffer
 struct FactorKernels {
   const char* name;
-  // C -= A B^T: C m x n, A m x k, B n x k.
+  // C -= A B^T: C m x n, A m x k, B n x k; each entry c := c - a_0 b_0 - a_1 b_1 - ... in turn.
+  // pack: kFactorPackSize doubles of the caller's (one per thread), or nullptr (in place).
   void (*gemm_nt_minus)(int m, int n, int k, const double* a, int lda, const double* b, int ldb,
-                        double* c, int ldc);
+                        double* c, int ldc, double* pack);
   // Cholesky of a supernode's panel P (leading dimension ld): the n x n triangle and the rows
   // [n, rows_end) below it, left-looking by blocks of kPanelBlock columns. Returns the column of
   // a pivot that is not positive (the panel is then incomplete), else -1.
-  int (*panel_factor)(int n, double* p, int ld, int rows_end);
+  int (*panel_factor)(int n, double* p, int ld, int rows_end, double* pack);
   // Rows [r0, r1) below the factorised triangle: P_r := P_r L^-T, the same operations as
   // panel_factor does on its own rows.
-  void (*panel_solve_rows)(int n, double* p, int ld, int r0, int r1);
+  void (*panel_solve_rows)(int n, double* p, int ld, int r0, int r1, double* pack);
 };
 const FactorKernels& factor_kernels();
 
