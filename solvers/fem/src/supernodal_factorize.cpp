@@ -5,11 +5,9 @@
 #include <cstddef>
 #include <cstring>
 
+#include "omp_threads.hpp"
 #include "supernodal_kernels.hpp"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace partita::fem::detail {
 namespace {
@@ -20,20 +18,6 @@ namespace {
 constexpr int kRowBlock = 128;
 constexpr double kSharedMinWork = 4e6;
 
-int max_threads() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
-}
-int thread_id() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
 
 template <class V>
 auto& at(V& v, std::int64_t i) {

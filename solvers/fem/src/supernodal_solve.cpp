@@ -4,11 +4,9 @@
 #include <cstddef>
 #include <numeric>
 
+#include "omp_threads.hpp"
 #include "supernodal_kernels.hpp"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 namespace partita::fem::detail {
 namespace {
@@ -27,20 +25,6 @@ constexpr double kSharedMin = 65536.0;
 constexpr int kRowChunk = 256;
 constexpr int kColumnChunk = 16;
 
-int max_threads() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
-}
-int thread_id() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
 
 inline SupernodeBlock block(const SupernodalFactor& f, int s) {
   return {f.super[s], f.super[s + 1] - f.super[s], f.pi[s + 1] - f.pi[s], f.rows + f.pi[s],

@@ -4,6 +4,10 @@
 #include <string>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "partita/fem/box_mesher.hpp"
 #include "partita/fem/element_topology.hpp"
 #include "partita/fem/mesh.hpp"
@@ -27,6 +31,57 @@ class Lcg {
 // The seed plate of bench_fem_plate (20 x 20 x 2 mm steel, E = 250 GPa, nu = 0.3, rho = 7850;
 // lateral nodes fixed in x and y, bottom corners in z, 10 kPa on the top face: the corners carry
 // p A = 4 N), n x n x nz Hex8 cells.
+// The 7-point Laplacian of an nx x ny x nz grid plus shift times the identity (SPD for
+// shift > 0), both triangles stored: nested dissection gives it a deep tree with large top
+// separators (the threaded solve's and factorisation's tests).
+inline SparseMatrix grid_laplacian(int nx, int ny, int nz, double shift = 0.01) {
+  const int n = nx * ny * nz;
+  auto id = [&](int i, int j, int k) { return (k * ny + j) * nx + i; };
+  std::vector<Eigen::Triplet<double>> t;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const int a = id(i, j, k);
+        t.emplace_back(a, a, 6.0 + shift);
+        if (i + 1 < nx)
+          t.emplace_back(a, id(i + 1, j, k), -1.0), t.emplace_back(id(i + 1, j, k), a, -1.0);
+        if (j + 1 < ny)
+          t.emplace_back(a, id(i, j + 1, k), -1.0), t.emplace_back(id(i, j + 1, k), a, -1.0);
+        if (k + 1 < nz)
+          t.emplace_back(a, id(i, j, k + 1), -1.0), t.emplace_back(id(i, j, k + 1), a, -1.0);
+      }
+  SparseMatrix a(n, n);
+  a.setFromTriplets(t.begin(), t.end());
+  return a;
+}
+
+// a solution with every digit in play
+inline Eigen::VectorXd known_solution(Eigen::Index n) {
+  Eigen::VectorXd x(n);
+  for (Eigen::Index i = 0; i < n; ++i) x[i] = std::sin(0.37 * static_cast<double>(i)) + 0.5;
+  return x;
+}
+
+inline double relative_difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return (a - b).norm() / b.norm();
+}
+
+inline int threads_available() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+inline void use_threads(int n) {
+#ifdef _OPENMP
+  omp_set_num_threads(n);
+#else
+  (void)n;
+#endif
+}
+
 inline Model seed_plate(int n, int nz) {
   const double lx = 0.02, ly = 0.02, tol = 1e-12;
   Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(lx, ly, 0.002), {n, n, nz}, ElementType::Hex8});

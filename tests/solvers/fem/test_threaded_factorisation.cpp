@@ -9,67 +9,14 @@
 #include <cmath>
 #include <vector>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "fem_test_helpers.hpp"
 #include "partita/fem/linear_solver.hpp"
 #include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
-using partita::fem::test::seed_plate;
+using namespace partita::fem::test;
 
 namespace {
-
-// The 7-point Laplacian of an nx x ny x nz grid plus shift times the identity, both triangles
-// stored (SPD for shift > 0). Nested dissection gives it a deep tree and top separators of
-// nx x ny rows: wide supernodes whose rows the threads share.
-SparseMatrix grid_laplacian(int nx, int ny, int nz, double shift = 0.01) {
-  const int n = nx * ny * nz;
-  auto id = [&](int i, int j, int k) { return (k * ny + j) * nx + i; };
-  std::vector<Eigen::Triplet<double>> t;
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const int a = id(i, j, k);
-        t.emplace_back(a, a, 6.0 + shift);
-        if (i + 1 < nx)
-          t.emplace_back(a, id(i + 1, j, k), -1.0), t.emplace_back(id(i + 1, j, k), a, -1.0);
-        if (j + 1 < ny)
-          t.emplace_back(a, id(i, j + 1, k), -1.0), t.emplace_back(id(i, j + 1, k), a, -1.0);
-        if (k + 1 < nz)
-          t.emplace_back(a, id(i, j, k + 1), -1.0), t.emplace_back(id(i, j, k + 1), a, -1.0);
-      }
-  SparseMatrix a(n, n);
-  a.setFromTriplets(t.begin(), t.end());
-  return a;
-}
-
-Eigen::VectorXd known_solution(Eigen::Index n) {
-  Eigen::VectorXd x(n);
-  for (Eigen::Index i = 0; i < n; ++i) x[i] = std::sin(0.37 * static_cast<double>(i)) + 0.5;
-  return x;
-}
-
-double relative_difference(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return (a - b).norm() / b.norm();
-}
-
-int threads_available() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
-}
-void use_threads(int n) {
-#ifdef _OPENMP
-  omp_set_num_threads(n);
-#else
-  (void)n;
-#endif
-}
 
 // Sets the factor threading and CHOLMOD's own solve (so that only the factor differs between
 // two factorisations).
