@@ -76,7 +76,6 @@ bool SupernodalFactorize::prepare(const SupernodalFactor& f, const SparsePattern
   // work (flops): the own factorisation c^3/3 + (m - c) c^2, and each update received
   // 2 c_d (m_d - p1) (p2 - p1); d ascending, so every list is in ascending order
   subtree_work_.assign(static_cast<std::size_t>(ns), 0.0);
-  work_size_ = 0;
   for (int d = 0; d < ns; ++d) {
     const int ncol = f.super[d + 1] - f.super[d], nrow = f.pi[d + 1] - f.pi[d];
     const int* rows = f.rows + f.pi[d];
@@ -87,8 +86,6 @@ bool SupernodalFactorize::prepare(const SupernodalFactor& f, const SparsePattern
       while (i < nrow && at(col_super_, rows[i]) == s) ++i;
       at(updates_, at(next, s)++) = {d, p1, i};
       at(subtree_work_, s) += 2.0 * ncol * static_cast<double>(nrow - p1) * (i - p1);
-      work_size_ =
-          std::max(work_size_, static_cast<std::size_t>(nrow - p1) * static_cast<std::size_t>(i - p1));
     }
   }
   shared_.assign(static_cast<std::size_t>(ns), 0);
@@ -100,6 +97,18 @@ bool SupernodalFactorize::prepare(const SupernodalFactor& f, const SparsePattern
       ++shared_count_;
     }
   }
+  // the largest update block a thread computes: rows of d from the target's first column on (at
+  // most a block of kRowBlock of them where the target shares its rows) times the target's
+  // columns that d holds
+  work_size_ = 0;
+  for (int s = 0; s < ns; ++s)
+    for (int u = at(update_begin_, s); u < at(update_begin_, s + 1); ++u) {
+      const Update& up = at(updates_, u);
+      const int rows = f.pi[up.d + 1] - f.pi[up.d] - up.p1;
+      const std::size_t m =
+          static_cast<std::size_t>(at(shared_, s) ? std::min(rows, kRowBlock) : rows);
+      work_size_ = std::max(work_size_, m * static_cast<std::size_t>(up.p2 - up.p1));
+    }
   // subtree work (children before parents) and the children lists
   total_work_ = 0.0;
   std::vector<int> nchild(static_cast<std::size_t>(ns), 0);
