@@ -2,8 +2,8 @@
 
 #include <fmt/format.h>
 #include <algorithm>
-#include <sstream>
 #include <limits>
+#include <sstream>
 
 #include "partita/fem/error.hpp"
 #include "partita/fem/state_io.hpp"

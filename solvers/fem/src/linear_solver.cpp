@@ -216,7 +216,8 @@ class Cholmod final : public SparseFactorisation::Impl {
         throw Error("CHOLMOD: out of memory for the factor's values (status " +
                     std::to_string(c_.status) + ")");
       }
-      const int failed = threaded_.factorize(factor_view(), a.valuePtr(), static_cast<double*>(l_->x));
+      const int failed =
+          threaded_.factorize(factor_view(), a.valuePtr(), static_cast<double*>(l_->x));
       l_->minor = failed < 0 ? l_->n : static_cast<std::size_t>(failed);
       positive_definite = failed < 0;
     } else {

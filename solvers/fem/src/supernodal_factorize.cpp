@@ -8,7 +8,6 @@
 #include "omp_threads.hpp"
 #include "supernodal_kernels.hpp"
 
-
 namespace partita::fem::detail {
 namespace {
 
@@ -17,7 +16,6 @@ namespace {
 // does it in one piece. Both are structure only, so the bits do not depend on the thread count.
 constexpr int kRowBlock = 128;
 constexpr double kSharedMinWork = 4e6;
-
 
 template <class V>
 auto& at(V& v, std::int64_t i) {
@@ -197,7 +195,8 @@ int SupernodalFactorize::factorize(const SupernodalFactor& f, const double* ax, 
   if (scratch_.size() < static_cast<std::size_t>(threads))
     scratch_.resize(static_cast<std::size_t>(threads));
   for (auto& sc : scratch_) {
-    if (sc.map.size() != static_cast<std::size_t>(n_)) sc.map.assign(static_cast<std::size_t>(n_), 0);
+    if (sc.map.size() != static_cast<std::size_t>(n_))
+      sc.map.assign(static_cast<std::size_t>(n_), 0);
     if (sc.rel.size() < static_cast<std::size_t>(widest_))
       sc.rel.assign(static_cast<std::size_t>(widest_), 0);
     if (sc.c.size() < work_size_) sc.c.assign(work_size_, 0.0);
@@ -252,7 +251,8 @@ void SupernodalFactorize::supernode(const SupernodalFactor& f, double* values, i
   const int ncol = f.super[s + 1] - f.super[s], nrow = f.pi[s + 1] - f.pi[s];
   // assemble: the block zeroed, A's entries put in
   double* ls = values + f.px[s];
-  std::memset(ls, 0, sizeof(double) * static_cast<std::size_t>(nrow) * static_cast<std::size_t>(ncol));
+  std::memset(ls, 0,
+              sizeof(double) * static_cast<std::size_t>(nrow) * static_cast<std::size_t>(ncol));
   for (std::int64_t k = at(entry_begin_, s); k < at(entry_begin_, s + 1); ++k)
     ls[at(dst_, k) - f.px[s]] = ax_[at(src_, k)];
   const FactorKernels& k = factor_kernels();

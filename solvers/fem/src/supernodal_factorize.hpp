@@ -12,11 +12,11 @@
 // factorised and the rows below it solved. The dense kernels are partita's own
 // (supernodal_kernels.hpp: AVX2 + FMA or SSE2), not the BLAS: Debian's OpenBLAS (serial) gives
 // wrong results now and then when two threads call dgemm or dtrsm at once (measured: 7 and 48 of
-// 8,000 calls of random sizes on 2 threads differed from the same calls made one at a time). A supernode needs only finished
-// descendants, so disjoint subtrees of the elimination tree run in parallel (OpenMP tasks, one per
-// subtree above a work limit), and a large supernode near the root, which all threads wait for,
-// shares its rows: its update and its triangular solve are cut into blocks of rows that the
-// threads take as they come.
+// 8,000 calls of random sizes on 2 threads differed from the same calls made one at a time). A
+// supernode needs only finished descendants, so disjoint subtrees of the elimination tree run in
+// parallel (OpenMP tasks, one per subtree above a work limit), and a large supernode near the root,
+// which all threads wait for, shares its rows: its update and its triangular solve are cut into
+// blocks of rows that the threads take as they come.
 //
 // Determinism: what a supernode computes (its list of descendants in ascending order, the blocks
 // of rows, each BLAS call's operands) is fixed by the factor's structure alone; threads decide

@@ -7,7 +7,6 @@
 #include "omp_threads.hpp"
 #include "supernodal_kernels.hpp"
 
-
 namespace partita::fem::detail {
 namespace {
 
@@ -24,7 +23,6 @@ constexpr int kLevels = 4;
 constexpr double kSharedMin = 65536.0;
 constexpr int kRowChunk = 256;
 constexpr int kColumnChunk = 16;
-
 
 inline SupernodeBlock block(const SupernodalFactor& f, int s) {
   return {f.super[s], f.super[s + 1] - f.super[s], f.pi[s + 1] - f.pi[s], f.rows + f.pi[s],
