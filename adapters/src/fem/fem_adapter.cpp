@@ -201,7 +201,8 @@ std::shared_ptr<Spec> make_spec() {
   analysis
       ->choice("factor_threading",
                "the numeric factorisation of a CHOLMOD factor (a linear static solve, Newmark's "
-               "K_eff): threaded (partita's supernodal factorisation, subtrees of the elimination "
+               "K_eff, Newton's tangents): threaded (partita's supernodal factorisation, subtrees "
+               "of the elimination "
                "tree and the rows of large supernodes shared among the --threads), serial "
                "(CHOLMOD's own, one thread), or auto (threaded for factors of at least 2e6 "
                "entries); results never depend on the thread count, threaded and serial differ "

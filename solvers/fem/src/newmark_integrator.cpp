@@ -16,8 +16,8 @@ namespace {
 // Returns false when it had to build a new matrix (the patterns differ).
 bool add_scaled(SparseMatrix& a, double c, const SparseMatrix& b, bool& checked, bool& same) {
   if (!checked) {
-    same = a.isCompressed() && b.isCompressed() && a.rows() == b.rows() &&
-           a.cols() == b.cols() && a.nonZeros() == b.nonZeros() &&
+    same = a.isCompressed() && b.isCompressed() && a.rows() == b.rows() && a.cols() == b.cols() &&
+           a.nonZeros() == b.nonZeros() &&
            std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1, b.outerIndexPtr()) &&
            std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr());
     checked = true;
@@ -64,8 +64,8 @@ class NewmarkProblem final : public NonlinearProblem {
     if (beta_r == 0.0) {
       w_.rhs.noalias() = f1_ - w_.f_int - m * (w_.a1 + alpha * w_.v1);
     } else {
-      w_.rhs.noalias() = f1_ - w_.f_int - m * (w_.a1 + alpha * w_.v1) -
-                         beta_r * (s_.damping_stiffness() * w_.v1);
+      w_.rhs.noalias() =
+          f1_ - w_.f_int - m * (w_.a1 + alpha * w_.v1) - beta_r * (s_.damping_stiffness() * w_.v1);
     }
     s_.dofs().gather_free(w_.rhs, r);
     if (k == nullptr) return;
@@ -91,8 +91,9 @@ class NewmarkProblem final : public NonlinearProblem {
 }  // namespace
 
 NewmarkIntegrator::NewmarkIntegrator(double beta, double gamma, NewtonOptions options,
-                                     LinearSolver linear_solver, FillOrdering ordering)
-    : beta_(beta), gamma_(gamma), newton_(options, linear_solver, ordering) {}
+                                     LinearSolver linear_solver, FillOrdering ordering,
+                                     FactorThreading factor_threading)
+    : beta_(beta), gamma_(gamma), newton_(options, linear_solver, ordering, factor_threading) {}
 
 bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, double dt) {
   const double t1 = kin.time + dt;

@@ -52,9 +52,11 @@ NewtonReport NewtonSolver::solve(NonlinearProblem& problem, Eigen::VectorXd& x,
     }
     // K dx = R
     // symbolic analysis once per sparsity pattern, numeric factorisation per iteration
-    if (!factor_)
+    if (!factor_) {
       factor_ = std::make_unique<SparseFactorisation>(
           linear_solver_, ordering_, SparseFactorisation::Matrix::SymmetricIndefiniteAllowed);
+      factor_->set_factor_threading(factor_threading_);
+    }
     if (k.nonZeros() != pattern_nonzeros_ || k.rows() != pattern_size_) {
       factor_->analyze(k);
       pattern_nonzeros_ = k.nonZeros();

@@ -38,9 +38,10 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
     : model_(std::move(model)),
       options_(options),
       integrator_(model_.hex8_formulation()),
-      static_(options_.newton, options_.linear_solver, options_.fill_ordering),
+      static_(options_.newton, options_.linear_solver, options_.fill_ordering,
+              options_.factor_threading),
       newmark_(options_.newmark_beta, options_.newmark_gamma, options_.newton,
-               options_.linear_solver, options_.fill_ordering) {
+               options_.linear_solver, options_.fill_ordering, options_.factor_threading) {
   if (!(options_.newmark_beta > 0.0) || !(options_.newmark_gamma > 0.0)) {
     throw Error("Newmark parameters must be > 0 (beta = 1/4, gamma = 1/2 is the default)");
   }

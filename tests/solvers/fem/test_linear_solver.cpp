@@ -78,7 +78,7 @@ TEST_CASE("linear solver: CHOLMOD and Eigen's LDLT agree to 1e-10 on the plate, 
   }
 }
 
-TEST_CASE("linear solver: the Newton path with CHOLMOD matches Eigen's LDLT to 1e-10",
+TEST_CASE("linear solver: Newton on CHOLMOD's or the threaded factor agrees with Eigen's LDLT",
           "[fem][linear-solver][nonlinear]") {
   if (!cholmod_available()) {
     WARN("built without CHOLMOD: nothing to compare");
@@ -86,37 +86,49 @@ TEST_CASE("linear solver: the Newton path with CHOLMOD matches Eigen's LDLT to 1
   }
   // A Neo-Hooke rubber plate (the seed geometry, 8 x 8 x 2 cells) under 200 kPa: large
   // deflection, Newton to |R| <= 1e-12 |F| so that both converge to round-off.
-  auto make = [](LinearSolver solver) {
+  auto make = [](LinearSolver solver, FactorThreading factor = FactorThreading::Serial) {
     Model m = seed_plate(8, 2);
     Model rubber(m.mesh());
     rubber.set_material_law(std::make_shared<NeoHookeLaw>(5e6, 0.45, 1100.0));
     rubber.fix("lateral", {0, 1, 2});
     rubber.add_pressure("zmax", 200e3);
     SolverOptions o = with_solver(solver);
+    o.factor_threading = factor;
     o.newton.force_tolerance = 1e-12;
     o.newton.load_steps = 2;
     return std::make_unique<StructuralSolver>(std::move(rubber), o);
   };
   auto a = make(LinearSolver::EigenLdlt);
   auto b = make(LinearSolver::Cholmod);
+  // the tangents through partita's threaded factorisation (asked for: the factor is small)
+  auto t = make(LinearSolver::Cholmod, FactorThreading::Threaded);
   a->solve_static();
   b->solve_static();
+  t->solve_static();
   REQUIRE(a->max_displacement() > 1e-4);  // large deflection of a 2 mm plate: nonlinear
   for (const auto& r : b->static_reports()) CHECK(r.converged);
+  for (const auto& r : t->static_reports()) CHECK(r.converged);
   CHECK(relative_difference(b->displacement(), a->displacement()) <= 1e-10);
+  CHECK(relative_difference(t->displacement(), a->displacement()) <= 1e-10);
   // Newmark from rest under the same load (one Newton solve per step, the tangent
   // refactorised per iteration on the analysed pattern)
   auto c = make(LinearSolver::EigenLdlt);
   auto d = make(LinearSolver::Cholmod);
-  double worst = 0.0;
+  auto e = make(LinearSolver::Cholmod, FactorThreading::Threaded);
+  double worst = 0.0, worst_threaded = 0.0;
   for (int k = 0; k < 5; ++k) {
     c->step(1e-4);
     d->step(1e-4);
+    e->step(1e-4);
     CHECK(d->newmark_report().converged);
+    CHECK(e->newmark_report().converged);
     worst = std::max(worst, relative_difference(d->displacement(), c->displacement()));
+    worst_threaded =
+        std::max(worst_threaded, relative_difference(e->displacement(), c->displacement()));
   }
   CHECK(d->max_displacement() > 1e-5);
   CHECK(worst <= 1e-10);
+  CHECK(worst_threaded <= 1e-10);
 }
 
 TEST_CASE("linear solver: a plate free to move rigidly is a clear error with either solver",

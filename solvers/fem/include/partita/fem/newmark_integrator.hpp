@@ -18,7 +18,8 @@ class NewmarkIntegrator {
  public:
   NewmarkIntegrator(double beta, double gamma, NewtonOptions options = {},
                     LinearSolver linear_solver = LinearSolver::Automatic,
-                    FillOrdering ordering = FillOrdering::Automatic);
+                    FillOrdering ordering = FillOrdering::Automatic,
+                    FactorThreading factor_threading = FactorThreading::Automatic);
   void step(StructuralSystem& system, Kinematics& kin, double dt);
   const NewtonReport& last_report() const { return last_; }
   // Newton iterations of the last step(), summed over its cut-back substeps and failed tries.

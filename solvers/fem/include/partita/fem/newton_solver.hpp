@@ -20,8 +20,12 @@ class NewtonSolver {
  public:
   explicit NewtonSolver(NewtonOptions options = {},
                         LinearSolver linear_solver = LinearSolver::Automatic,
-                        FillOrdering ordering = FillOrdering::Automatic)
-      : options_(options), linear_solver_(linear_solver), ordering_(ordering) {}
+                        FillOrdering ordering = FillOrdering::Automatic,
+                        FactorThreading factor_threading = FactorThreading::Automatic)
+      : options_(options),
+        linear_solver_(linear_solver),
+        ordering_(ordering),
+        factor_threading_(factor_threading) {}
   const NewtonOptions& options() const { return options_; }
   // Solves R(x) = 0 from the given x (changed in place; on failure x holds the last iterate).
   NewtonReport solve(NonlinearProblem& problem, Eigen::VectorXd& x, double reference_force);
@@ -30,6 +34,7 @@ class NewtonSolver {
   NewtonOptions options_;
   LinearSolver linear_solver_;
   FillOrdering ordering_;
+  FactorThreading factor_threading_;
   std::unique_ptr<SparseFactorisation> factor_;
   Eigen::Index pattern_nonzeros_ = -1, pattern_size_ = -1;
   // Work storage kept between solves (a time integrator calls solve() at every step): sized

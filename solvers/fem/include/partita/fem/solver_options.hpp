@@ -34,8 +34,8 @@ struct SolverOptions {
   FillOrdering fill_ordering = FillOrdering::Automatic;
   // The triangular solves of the linear path's static and Newmark steps (linear_solver.hpp).
   SolveThreading solve_threading = SolveThreading::Automatic;
-  // The numeric factorisation of the linear path's K_ff and K_eff (linear_solver.hpp); Newton's
-  // tangents always take Automatic.
+  // The numeric factorisation of a CHOLMOD factor (linear_solver.hpp): the linear path's K_ff and
+  // K_eff, and Newton's tangents.
   FactorThreading factor_threading = FactorThreading::Automatic;
 };
 

@@ -17,8 +17,9 @@ class StaticIntegrator {
  public:
   explicit StaticIntegrator(NewtonOptions options = {},
                             LinearSolver linear_solver = LinearSolver::Automatic,
-                            FillOrdering ordering = FillOrdering::Automatic)
-      : newton_(options, linear_solver, ordering) {}
+                            FillOrdering ordering = FillOrdering::Automatic,
+                            FactorThreading factor_threading = FactorThreading::Automatic)
+      : newton_(options, linear_solver, ordering, factor_threading) {}
   // Velocity and acceleration are set to zero; kin.time = t1.
   void solve(StructuralSystem& system, Kinematics& kin, double t1);
   // Reports of the Newton solves of the last solve() (converged increments and failures).
