@@ -275,7 +275,7 @@ void SupernodalFactorize::supernode(const SupernodalFactor& f, double* values, i
 
 // Rows [r0, r1) of supernode s (local rows) receive every descendant's update:
 //   L_s(r, c) -= sum_k L_d(r, k) L_d(c, k)   for the rows r and columns c of s that d holds,
-// r >= c; the descendants in ascending order, each one dgemm over its rows in [r0, r1).
+// r >= c; the descendants in ascending order, each one product over its rows in [r0, r1).
 void SupernodalFactorize::update_rows(const SupernodalFactor& f, double* values, int s, int r0,
                                       int r1) {
   Scratch& sc = at(scratch_, thread_id());

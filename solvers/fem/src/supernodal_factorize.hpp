@@ -19,7 +19,7 @@
 // blocks of rows that the threads take as they come.
 //
 // Determinism: what a supernode computes (its list of descendants in ascending order, the blocks
-// of rows, each BLAS call's operands) is fixed by the factor's structure alone; threads decide
+// of rows, each kernel call's operands) is fixed by the factor's structure alone; threads decide
 // only who runs which piece, never what the piece adds in which order. So the factor is the same
 // bit for bit on any thread count and in every repeat (it differs from CHOLMOD's by round-off).
 #include <atomic>

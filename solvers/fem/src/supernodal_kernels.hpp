@@ -1,5 +1,6 @@
 #pragma once
-// The dense kernels of the threaded supernodal solve (supernodal_solve.hpp), compiled twice:
+// The dense kernels of the threaded supernodal solve (supernodal_solve.hpp) and, below, of the
+// threaded factorisation (supernodal_factorize.hpp), compiled twice:
 // for any x86-64 (SSE2) and, where the compiler can, for AVX2 with FMA, chosen once at run time
 // by the processor. A solve is memory-bound only once its kernels stream a double per cycle or
 // more; with SSE2 alone they execute about three times CHOLMOD's (OpenBLAS's) instructions.
