@@ -175,8 +175,7 @@ bool SupernodalFactorize::prepare(const SupernodalFactor& f, const SparsePattern
     for (std::int64_t q = at(entry_begin_, s); q < at(entry_begin_, s + 1); ++q) {
       const int hi = at(hi_of, q);
       if (at(mark, hi) != s) return false;  // outside L's pattern
-      at(dst_, q) = static_cast<std::int64_t>(f.px[s]) +
-                    static_cast<std::int64_t>(at(lo_of, q) - f.super[s]) * nrow + at(map, hi);
+      at(dst_, q) = f.px[s] + (at(lo_of, q) - f.super[s]) * nrow + at(map, hi);
     }
   }
   scratch_.clear();
@@ -254,7 +253,7 @@ void SupernodalFactorize::supernode(const SupernodalFactor& f, double* values, i
   std::memset(ls, 0,
               sizeof(double) * static_cast<std::size_t>(nrow) * static_cast<std::size_t>(ncol));
   for (std::int64_t k = at(entry_begin_, s); k < at(entry_begin_, s + 1); ++k)
-    ls[at(dst_, k) - f.px[s]] = ax_[at(src_, k)];
+    values[at(dst_, k)] = ax_[at(src_, k)];
   const FactorKernels& k = factor_kernels();
   if (!at(shared_, s)) {
     update_rows(f, values, s, 0, nrow);

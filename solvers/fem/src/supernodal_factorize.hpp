@@ -71,8 +71,9 @@ class SupernodalFactorize {
   int columns_begin(int s) const { return super_begin_[static_cast<std::size_t>(s)]; }
 
   int n_ = 0, nsuper_ = 0;
-  std::vector<int> begin_, index_;           // A's pattern at prepare()
-  std::vector<std::int64_t> src_, dst_;      // A entry src_[k] goes to values[dst_[k]]
+  std::vector<int> begin_, index_;  // A's pattern at prepare()
+  std::vector<int> src_, dst_;      // A entry src_[k] goes to values[dst_[k]] (the factor's offsets
+                                    // are CHOLMOD's int px: below 2^31)
   std::vector<std::int64_t> entry_begin_;    // supernode s's entries: entry_begin_[s] ..
   const double* ax_ = nullptr;               // A's values during factorize()
   std::vector<int> parent_, first_;          // supernodal tree; subtree of s: first_[s] .. s
