@@ -190,6 +190,14 @@ std::shared_ptr<Spec> make_spec() {
                {"auto", "cholmod", "eigen-ldlt"})
       .def("auto");
   analysis
+      ->choice("fill_ordering",
+               "CHOLMOD's fill-reducing ordering: nesdis (CHOLMOD's nested dissection: METIS "
+               "separators, then constrained minimum degree), metis (METIS_NodeND), amd "
+               "(approximate minimum degree: the quickest analysis, more fill on large thin "
+               "plates), or auto (nesdis); no effect with eigen-ldlt (AMD)",
+               {"auto", "nesdis", "metis", "amd"})
+      .def("auto");
+  analysis
       ->choice("solve_threading",
                "the two triangular solves with a CHOLMOD factor (a linear static or Newmark "
                "step): threaded (the factor's elimination tree shared among the --threads), "
@@ -465,6 +473,13 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     } else if (linear_solver == "eigen-ldlt") {
       options.linear_solver = fem::LinearSolver::EigenLdlt;
     }
+    const std::string ordering = an.string("fill_ordering");
+    if (ordering == "nesdis")
+      options.fill_ordering = fem::FillOrdering::Nesdis;
+    else if (ordering == "metis")
+      options.fill_ordering = fem::FillOrdering::Metis;
+    else if (ordering == "amd")
+      options.fill_ordering = fem::FillOrdering::Amd;
     const std::string threading = an.string("solve_threading");
     if (threading == "threaded")
       options.solve_threading = fem::SolveThreading::Threaded;
