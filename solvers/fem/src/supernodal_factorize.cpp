@@ -87,13 +87,9 @@ bool SupernodalFactorize::prepare(const SupernodalFactor& f, const SparsePattern
     }
   }
   shared_.assign(static_cast<std::size_t>(ns), 0);
-  shared_count_ = 0;
   for (int s = 0; s < ns; ++s) {
     const int nrow = f.pi[s + 1] - f.pi[s];
-    if (nrow >= 2 * kRowBlock && at(subtree_work_, s) >= kSharedMinWork) {
-      at(shared_, s) = 1;
-      ++shared_count_;
-    }
+    at(shared_, s) = nrow >= 2 * kRowBlock && at(subtree_work_, s) >= kSharedMinWork;
   }
   // the largest update block a thread computes: rows of d from the target's first column on (at
   // most a block of kRowBlock of them where the target shares its rows) times the target's

@@ -52,11 +52,6 @@ class SupernodalFactorize {
   // values are then incomplete).
   int factorize(const SupernodalFactor& f, const double* ax, double* values);
 
-  // Statistics of the schedule: supernodes that share their rows among the threads, and the
-  // flops of the factorisation (each update counted in full).
-  int shared_supernodes() const { return shared_count_; }
-  double flops() const { return total_work_; }
-
  private:
   struct Update {
     int d;       // the descendant supernode
@@ -83,7 +78,6 @@ class SupernodalFactorize {
   std::vector<Update> updates_;
   std::vector<int> col_super_, super_begin_;
   std::vector<char> shared_;  // s's rows are cut into blocks of kRowBlock (structure's choice)
-  int shared_count_ = 0;
   double total_work_ = 0.0;
   std::size_t work_size_ = 0;  // largest update block (rows x columns)
   int widest_ = 0;             // most rows of a supernode
