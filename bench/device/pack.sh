@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Packs what the 16-core measurements need for the lent device machine (no Debian packages there,
+# nothing can be fetched): the Release binaries of build/, the shared libraries they link that are
+# not the C library, and the peer beds. Writes .dev/bundle.tar.xz (ignored through
+# .git/info/exclude) and prints the device call. See bench/README.md, "16 cores".
+#   bench/device/pack.sh [PEER_DATA_DIR]   (default ../shared/bench/peers/dem/data)
+set -euo pipefail
+root=$(git rev-parse --show-toplevel)
+cd "$root"
+data=${1:-../shared/bench/peers/dem/data}
+bins=(build/app/partita build/tests/partita_tests build/bench/dem/bench_dem_peers
+      build/bench/fem/bench_fem_plate)
+for b in "${bins[@]}"; do
+  [[ -x $b ]] || { echo "pack.sh: $b is missing: build first (./build.sh test)" >&2; exit 1; }
+done
+for f in bed_large.data bed_small.data; do
+  [[ -f $data/$f ]] || { echo "pack.sh: $data/$f is missing (the peer beds)" >&2; exit 1; }
+done
+grep -qx '/.dev/' .git/info/exclude 2>/dev/null || echo '/.dev/' >> .git/info/exclude
+stage=$(mktemp -d)
+trap 'rm -rf "$stage"' EXIT
+mkdir -p "$stage/bin" "$stage/lib" "$stage/data"
+for b in "${bins[@]}"; do strip -o "$stage/bin/$(basename "$b")" "$b"; done
+# every library the binaries load, but the C library and the loader (the device's own are newer)
+ldd "${bins[@]}" | awk '$3 ~ /^\// {print $3}' | sort -u |
+  grep -v -E '/(libc|libm|libdl|libpthread|librt|ld-linux[^/]*)\.so' |
+  while read -r lib; do cp -L "$lib" "$stage/lib/"; done
+cp "$data"/bed_large.data "$data"/bed_small.data "$stage/data/"
+mkdir -p .dev
+tar -C "$stage" -cJf .dev/bundle.tar.xz bin lib data
+echo "pack.sh: .dev/bundle.tar.xz $(du -h .dev/bundle.tar.xz | cut -f1) (binaries of $(git rev-parse --short HEAD))"
+echo "device call: run(command='bash bench/device/scaling.sh', carry=['.dev'], timeout_s=540)"
