@@ -9,7 +9,10 @@
 // --scaling: the large bed (unless --case names another) on 1, 2, 4, ... threads up to the
 // machine's processors (and that number), then the speed-up over 1 thread of each (issue 16's
 // aim: 12x at 16 threads; 9.7x measured when it was filed); particles renumbered in cell order
-// every 10 list builds as in a partita run, unless --sort says otherwise. With more than 2 threads
+// every 10 list builds as in a partita run, unless --sort says otherwise. --profile (with or
+// without --scaling) adds, after each plain line, where a step's wall time went thread by thread
+// (System::step_profile(): the fork, each phase's busy time, mean and slowest thread, the waits at
+// its barriers, the work of all threads against one thread's). With more than 2 threads
 // the ratio to LIGGGHTS is printed only where LIGGGHTS ran (as many MPI ranks) in the same
 // invocation.
 // --shuffle numbers the bed's particles in a random order (as a data file written by another code
@@ -152,6 +155,44 @@ void print_scaling(const std::string& bed, const std::vector<std::pair<int, doub
   std::fflush(stdout);
 }
 
+// One line per run: where a fused step's wall time went (System::StepProfile), in us per step.
+// busy_one: the busy time per fused step of the 1-thread run (0: not known), for the work of all
+// threads against one thread's.
+void print_profile(int nt, const System::StepProfile& p, double busy_one) {
+  if (p.fused_steps == 0) {
+    std::printf("# profile %d thr: no fused step\n", nt);
+    return;
+  }
+  const double per = 1e6 / static_cast<double>(p.fused_steps);  // s in total -> us a step
+  int team = 0;
+  double mean[7] = {}, most[7] = {};
+  for (const System::StepProfile::Thread& t : p.threads) {
+    if (t.enter + t.busy() + t.join_wait == 0.0) continue;
+    ++team;
+    const double v[7] = {t.enter, t.drift, t.drift_wait, t.cross, t.cross_wait, t.rows, t.join_wait};
+    for (int k = 0; k < 7; ++k) mean[k] += v[k], most[k] = std::max(most[k], v[k]);
+  }
+  for (double& m : mean) m /= std::max(team, 1);
+  const double busy = mean[1] + mean[3] + mean[5];
+  std::printf(
+      "# profile %d thr (%d in the team), us per fused step (%ld of %ld steps; the others %.1f us): "
+      "step %.1f = outside the region %.1f + region %.1f; in the region, mean/slowest thread: "
+      "fork %.1f/%.1f, drift %.1f/%.1f, wait %.1f, cross %.1f/%.1f, wait %.1f, rows %.1f/%.1f, "
+      "then waiting %.1f for the step's slowest thread (done at %.1f) and the join (%.1f); "
+      "busy %.1f a thread",
+      nt, team, p.fused_steps, p.steps,
+      p.steps > p.fused_steps
+          ? 1e6 * (p.step_s - p.fused_step_s) / static_cast<double>(p.steps - p.fused_steps)
+          : 0.0,
+      p.fused_step_s * per, (p.fused_step_s - p.fused_region_s) * per, p.fused_region_s * per,
+      mean[0] * per, most[0] * per, mean[1] * per, most[1] * per, mean[2] * per, mean[3] * per,
+      most[3] * per, mean[4] * per, mean[5] * per, most[5] * per, mean[6] * per,
+      p.fused_slowest_s * per, (p.fused_region_s - p.fused_slowest_s) * per, busy * per);
+  if (busy_one > 0.0)
+    std::printf(", all threads' work %.2fx one thread's", busy * team * per / busy_one);
+  std::printf("\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -160,7 +201,7 @@ int main(int argc, char** argv) {
   std::string which = "all", vtk_dir;
   std::vector<int> threads = {1, 2};
   bool quick = false, no_peer = false, shuffle = false, breakage = false, scaling = false;
-  bool case_given = false, sort_given = false;
+  bool case_given = false, sort_given = false, profile = false;
   int sort_interval = 0;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
@@ -193,17 +234,20 @@ int main(int argc, char** argv) {
     } else if (arg == "--sort") {
       sort_interval = std::stoi(next());
       sort_given = true;
+    } else if (arg == "--profile") {
+      profile = true;
     } else if (arg == "--breakage") {
       breakage = true;
     } else if (arg == "--vtk") {
       vtk_dir = next();
     } else {
       std::cerr << "usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] "
-                   "[--scaling] [--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N] "
-                   "[--breakage]\n"
+                   "[--scaling] [--profile] [--quick] [--vtk DIR] [--no-peer] [--shuffle] "
+                   "[--sort N] [--breakage]\n"
                    "  --no-peer: do not run LIGGGHTS; ratios use the recorded figures\n"
                    "  --scaling: the large bed on 1, 2, 4, ... threads up to the processors, and "
-                   "the speed-up of each over 1 thread\n";
+                   "the speed-up of each over 1 thread\n"
+                   "  --profile: where each step's time went, thread by thread\n";
       return arg == "--help" || arg == "-h" ? 0 : 2;
     }
   }
@@ -248,6 +292,7 @@ int main(int argc, char** argv) {
       const LammpsData data = LammpsData::read(data_dir + "/bed_" + c.name + ".data");
       const long steps = quick ? c.steps / 20 : c.steps;
       std::vector<std::pair<int, double>> rates;  // (threads, particle-steps/s) of the plain runs
+      double busy_one = 0.0;  // --profile: busy time per fused step on 1 thread [us]
       for (int nt : threads) {
         double plain_cpu = 0.0, plain_rate = 0.0;
         for (int with_breakage = 0; with_breakage <= (breakage ? 1 : 0); ++with_breakage) {
@@ -258,6 +303,8 @@ int main(int argc, char** argv) {
           const auto t0 = std::chrono::steady_clock::now();
           const std::clock_t c0 = std::clock();
           const long builds0 = sys.neighbor_list().build_count();
+          const bool profiled = profile && with_breakage == 0;
+          sys.set_step_profiling(profiled);
           sys.run(steps, dt);
           const long builds = sys.neighbor_list().build_count() - builds0;
           const double cpu = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
@@ -287,6 +334,12 @@ int main(int argc, char** argv) {
               quick                                         ? "  (quick: contacts not compared)"
               : std::abs(cn / c.peer_contacts - 1.0) > 0.02 ? "  CONTACTS DIFFER >2%"
                                                             : "");
+          if (profiled) {
+            const System::StepProfile& p = sys.step_profile();
+            print_profile(nt, p, busy_one);
+            if (nt == 1 && p.fused_steps > 0 && !p.threads.empty())
+              busy_one = 1e6 * p.threads[0].busy() / static_cast<double>(p.fused_steps);
+          }
           if (with_breakage == 0) {
             plain_cpu = cpu, plain_rate = rate;
             rates.emplace_back(nt, rate);

@@ -3,7 +3,8 @@
 # bench/device/pack.sh made here (carry ['.dev']). One call, about 5 minutes:
 #   1. the machine (processors, caches, the C library);
 #   2. the threaded-solver and thread-count tests on all cores (the same bits on any count);
-#   3. the DEM's thread scaling 1-16 of the large peer bed, twice (issue 16: aim 12x at 16);
+#   3. the DEM's thread scaling 1-16 of the large peer bed, twice (issue 16: aim 12x at 16), the
+#      second time with each step's time thread by thread (--profile);
 #   4. the 263k-dof plate's factorisation and transient step at 1, 2, 4, 8 and 16 threads;
 #   5. the 10^6-granule scale case at 16 threads (time per participant).
 # Everything goes to $OUT/scaling.log (or ./scaling.log without $OUT).
@@ -35,10 +36,9 @@ run "$dev/bin/partita" --version
 step "thread-count tests on $(nproc) processors"
 run timeout 150 "$dev/bin/partita_tests" "[threads],[threaded-solve],[threaded-factorisation]"
 
-step "DEM: large peer bed, thread scaling (twice)"
-for k in 1 2; do
-  run timeout 120 "$dev/bin/bench_dem_peers" --data "$dev/data" --case large --scaling --no-peer
-done
+step "DEM: large peer bed, thread scaling (twice; the second with where each step's time goes)"
+run timeout 120 "$dev/bin/bench_dem_peers" --data "$dev/data" --case large --scaling --no-peer
+run timeout 120 "$dev/bin/bench_dem_peers" --data "$dev/data" --case large --scaling --no-peer --profile
 
 step "FEM: 170x170x2 plate (263k dofs), factorisation and steps by thread count"
 for t in 1 2 4 8 16; do

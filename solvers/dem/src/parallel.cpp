@@ -25,4 +25,12 @@ int max_threads() {
 #endif
 }
 
+int thread_num() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
 }  // namespace partita::dem

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -19,11 +20,19 @@ namespace {
 constexpr int block_size = ThreadPartition::block_size;
 constexpr int cross_chunk = 64;  // cross pairs a chunk of the force pass (stack arrays: ~6 KB)
 
+// the step profile's clock [ns]
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 }  // namespace
 
 // ---- time stepping ----------------------------------------------------------------------------
 
 void System::step(double dt) {
+  const std::int64_t profile_start = profiling_ ? now_ns() : 0;
   prepare();
   if (!(dt > 0.0) || !std::isfinite(dt)) {
     std::ostringstream msg;
@@ -82,8 +91,14 @@ void System::step(double dt) {
     fused = !neighbors_.needs_rebuild(bound * bound, walls_.planes(), meshes_);
   }
   if (fused) {
+    std::int64_t fork = 0;
+    if (profiling_) {
+      for (int t = 0; t < parts; ++t) marks_[t].enter = 0;  // (set by the threads of the team)
+      fork = now_ns();
+    }
 #pragma omp parallel if (parts > 1) num_threads(parts)
     evaluate_forces(dt, true, half, true);
+    if (profiling_) record_fused_pass(fork, now_ns(), parts);
     reduce_wall_and_mesh_forces();
   } else {
     const VelocityVerlet::Pass verlet = verlet_.pass(p);
@@ -120,6 +135,40 @@ void System::step(double dt) {
   time_ += dt;
   ++steps_;
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].end_of_step(*this, dt);
+  if (profiling_) {
+    const double wall = 1e-9 * static_cast<double>(now_ns() - profile_start);
+    ++profile_.steps;
+    profile_.step_s += wall;
+    if (fused) ++profile_.fused_steps, profile_.fused_step_s += wall;
+  }
+}
+
+void System::set_step_profiling(bool on) {
+  profiling_ = on;
+  if (on) profile_ = StepProfile{};
+}
+
+// After the join of a fused step's region: each team thread's marks into the profile.
+void System::record_fused_pass(std::int64_t fork, std::int64_t join, int parts) {
+  if (profile_.threads.size() < static_cast<std::size_t>(parts))
+    profile_.threads.resize(static_cast<std::size_t>(parts));
+  profile_.fused_region_s += 1e-9 * static_cast<double>(join - fork);
+  std::int64_t last = fork;  // the slowest thread's end of its rows
+  for (int t = 0; t < parts; ++t) {
+    const ThreadMarks& m = marks_[t];
+    if (m.enter == 0) continue;  // not in the team (fewer threads than parts)
+    last = std::max(last, m.rows);
+    StepProfile::Thread& p = profile_.threads[t];
+    auto s = [](std::int64_t from, std::int64_t to) { return 1e-9 * static_cast<double>(to - from); };
+    p.enter += s(fork, m.enter);
+    p.drift += s(m.enter, m.drift);
+    p.drift_wait += s(m.drift, m.drift_released);
+    p.cross += s(m.drift_released, m.cross);
+    p.cross_wait += s(m.cross, m.cross_released);
+    p.rows += s(m.cross_released, m.rows);
+    p.join_wait += s(m.rows, join);
+  }
+  profile_.fused_slowest_s += 1e-9 * static_cast<double>(last - fork);
 }
 
 void System::run(long steps, double dt) {
@@ -141,6 +190,8 @@ void System::start_sums(int i) {
 void System::start_load_pass(int parts) {
   load_reached_.assign(h_load_limit_ >= 0 ? static_cast<std::size_t>(parts) : 0, 0);
   part_motion_.resize(static_cast<std::size_t>(parts));
+  if (profiling_ && marks_.size() < static_cast<std::size_t>(parts))
+    marks_.resize(static_cast<std::size_t>(parts));
   // the force pass's per-part lists hold the listed pairs of one block of rows
   pair_scratch_.resize(static_cast<std::size_t>(parts));
   const std::vector<int>& offsets = neighbors_.offsets_;
@@ -247,13 +298,22 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     q.t.setZero();
     if constexpr (Load) load[i] = 0.0;
   };
+  // step profile: this thread's clock at the phases (the barriers are explicit for that)
+  ThreadMarks* const marks = profiling_ ? &marks_[thread_num()] : nullptr;
+  if (marks) {
+    const std::int64_t now = now_ns();
+    *marks = ThreadMarks{now, now, now, now, now, now};
+  }
   if constexpr (Drift) {
     if (parts > 1) {  // the particles that cross pairs read drift first
-#pragma omp for schedule(static, 1)
+#pragma omp for schedule(static, 1) nowait
       for (int part = 0; part < parts; ++part) {
         for (int i = tp.begin(part); i < tp.drift_head_end[part]; ++i) drift(i);
         for (int i = tp.drift_tail_begin[part]; i < tp.begin(part + 1); ++i) drift(i);
       }
+      if (marks) marks->drift = now_ns();
+#pragma omp barrier
+      if (marks) marks->drift_released = marks->cross = marks->cross_released = now_ns();
     }
   }
   if (parts > 1) {
@@ -264,7 +324,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     // took them with its overlap branch, a coin flip for the predictor.)
     const int n_cross = static_cast<int>(tp.cross_pairs.size());
     const int chunks = (n_cross + cross_chunk - 1) / cross_chunk;
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
     for (int ch = 0; ch < chunks; ++ch) {
       PairTask chunk_tasks[cross_chunk];
       PairForce chunk_forces[cross_chunk];
@@ -298,8 +358,12 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         ++o;
       }
     }
+    if (marks) marks->cross = now_ns();
+#pragma omp barrier
+    if (marks) marks->cross_released = now_ns();
   }
-#pragma omp for schedule(static, 1)
+  // (no barrier at the end: the region's join follows in every caller)
+#pragma omp for schedule(static, 1) nowait
   for (int part = 0; part < parts; ++part) {
     bool reached = false;  // a particle's load reached its limit (load_limit)
     // pairs (k, i) from earlier parts, ascending k
@@ -423,6 +487,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     if (reached) load_reached_[part] = 1;
     part_motion_[part] = {speed2, accel2, extent};
   }
+  if (marks) marks->rows = now_ns();
 }
 
 void System::reduce_wall_and_mesh_forces() {

@@ -63,3 +63,58 @@ TEST_CASE("dem: the fused step gives the bits of the step with the exact rebuild
   }
   set_num_threads(before);
 }
+
+TEST_CASE("dem: the step profile adds up and changes no bit", "[dem][threads]") {
+  // System::StepProfile: per thread, the phases of a fused step are consecutive clock readings
+  // from the fork to the join, so they add up to the region's wall; the region lies within the
+  // fused steps' wall, those within all steps'. Reading the clock changes nothing in the physics.
+  const int before = max_threads();
+  for (int threads : {1, 2, 3}) {
+    set_num_threads(threads);
+    System profiled = falling_bed();
+    System plain = falling_bed();
+    const double dt = 0.2 * profiled.rayleigh_time_step();
+    profiled.set_step_profiling(true);
+    profiled.run(300, dt);
+    plain.run(300, dt);
+    INFO(threads << " threads");
+    const Particles& p = profiled.particles();
+    const Particles& q = plain.particles();
+    CHECK(p.position == q.position);
+    CHECK(p.velocity == q.velocity);
+    CHECK(p.angular_velocity == q.angular_velocity);
+    CHECK(profiled.wall_force(0) == plain.wall_force(0));
+
+    const System::StepProfile& prof = profiled.step_profile();
+    CHECK(prof.steps == 300);
+    // the bed is rebuilt now and then (at least 6 times: the fused-step test above), not at
+    // every step, and the fused path is taken between rebuilds
+    CHECK(prof.fused_steps > 0);
+    CHECK(prof.fused_steps < prof.steps);
+    CHECK(prof.step_s >= prof.fused_step_s);
+    CHECK(prof.fused_step_s >= prof.fused_region_s);
+    CHECK(prof.fused_region_s >= prof.fused_slowest_s);
+    CHECK(prof.fused_slowest_s > 0.0);
+    int team = 0;
+    for (const System::StepProfile::Thread& t : prof.threads) {
+      const double sum = t.enter + t.drift + t.drift_wait + t.cross + t.cross_wait + t.rows +
+                         t.join_wait;
+      if (sum == 0.0) continue;
+      ++team;
+      for (double v : {t.enter, t.drift, t.drift_wait, t.cross, t.cross_wait, t.rows, t.join_wait})
+        CHECK(v >= 0.0);
+      CHECK(t.rows > 0.0);
+      CHECK(sum == Approx(prof.fused_region_s).epsilon(1e-9));
+    }
+    CHECK(team == threads);  // > 1024 particles: one part a thread
+
+    // off: the profile stays as it was
+    const long steps = prof.steps;
+    const double wall = prof.step_s;
+    profiled.set_step_profiling(false);
+    profiled.run(10, dt);
+    CHECK(profiled.step_profile().steps == steps);
+    CHECK(profiled.step_profile().step_s == wall);
+  }
+  set_num_threads(before);
+}

@@ -8,5 +8,7 @@ namespace partita::dem {
 void set_num_threads(int n);
 /// The number of threads the next parallel region will use (1 without OpenMP).
 int max_threads();
+/// The calling thread's number in its team (0 outside a parallel region or without OpenMP).
+int thread_num();
 
 }  // namespace partita::dem

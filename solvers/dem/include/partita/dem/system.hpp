@@ -236,6 +236,35 @@ class System {
   /// Force on each triangle (M x 3) / each vertex (N x 3, barycentric shares) in the last step.
   const Eigen::MatrixX3d& triangle_forces(int mesh) const;
   const Eigen::MatrixX3d& vertex_forces(int mesh) const;
+  /// Where the steps' wall time goes, thread by thread: for measuring thread scaling
+  /// (bench_dem_peers --profile). Off by default; while on, each step reads the clock about
+  /// six times a thread (tens of ns each) and the physics is unchanged (the same bits).
+  /// The threads' figures are those of the fused steps (one parallel region a step: no list
+  /// rebuild possible; most steps of a settled bed); per thread they add up to the region's wall.
+  struct StepProfile {
+    struct Thread {      // seconds, summed over the fused steps
+      double enter = 0;  // from the fork to this thread's start in the region
+      double drift = 0;  // the integrator's first half of the particles that cross pairs read
+      double drift_wait = 0;  // then waiting for the other threads (a barrier)
+      double cross = 0;       // the pairs between two threads' parts
+      double cross_wait = 0;  // then waiting (a barrier)
+      double rows = 0;        // its part's rows (pairs, walls, meshes, the rest of the drift, kick)
+      double join_wait = 0;   // from its end to the join of the region
+      double busy() const { return drift + cross + rows; }
+    };
+    long steps = 0;               // steps taken while profiling
+    long fused_steps = 0;         // of which fused
+    double step_s = 0.0;          // wall of all of them [s]
+    double fused_step_s = 0.0;    // wall of the fused steps [s]
+    double fused_region_s = 0.0;  // of which from the fork to the join [s]
+    double fused_slowest_s = 0.0;  // of which from the fork to the end of the step's slowest
+                                   // thread (the rest: the join) [s]
+    std::vector<Thread> threads;  // by thread number
+  };
+  /// Starts (and clears) or stops the step profile.
+  void set_step_profiling(bool on);
+  const StepProfile& step_profile() const { return profile_; }
+
   /// Particle-particle pairs with overlap > 0 at the current positions.
   std::size_t contact_count() const;
   /// 2 contact_count() / N (particle-particle, as LAMMPS compute contact/atom).
@@ -310,6 +339,15 @@ class System {
     std::vector<PairForce> forces;
   };
   std::vector<PairScratch> pair_scratch_;
+
+  // step profile (set_step_profiling()): per thread, the clock (ns) at the phases of a pass
+  struct alignas(64) ThreadMarks {
+    std::int64_t enter = 0, drift = 0, drift_released = 0, cross = 0, cross_released = 0, rows = 0;
+  };
+  bool profiling_ = false;
+  StepProfile profile_;
+  std::vector<ThreadMarks> marks_;
+  void record_fused_pass(std::int64_t fork, std::int64_t join, int parts);
 
   ThreadPartition partition_;
   // renumbering in cell order
