@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Packs what the 16-core measurements need for the lent device machine (no Debian packages there,
 # nothing can be fetched): the Release binaries of build/, the shared libraries they link that are
-# not the C library, and the peer beds. Writes .dev/bundle.tar.xz (ignored through
+# not the C library, and the peer beds. Writes .dev/bundle.tar.gz (ignored through
 # .git/info/exclude) and prints the device call. See bench/README.md, "16 cores".
 #   bench/device/pack.sh [PEER_DATA_DIR]   (default ../shared/bench/peers/dem/data)
 set -euo pipefail
@@ -10,6 +10,10 @@ cd "$root"
 data=${1:-../shared/bench/peers/dem/data}
 bins=(build/app/partita build/tests/partita_tests build/bench/dem/bench_dem_peers
       build/bench/fem/bench_fem_plate)
+# the binaries of the working tree as it is (nothing to do when current)
+if [[ -f build/build.ninja ]]; then
+  cmake --build build --target partita partita_tests bench_dem_peers bench_fem_plate >/dev/null
+fi
 for b in "${bins[@]}"; do
   [[ -x $b ]] || { echo "pack.sh: $b is missing: build first (./build.sh test)" >&2; exit 1; }
 done
@@ -27,6 +31,6 @@ ldd "${bins[@]}" | awk '$3 ~ /^\// {print $3}' | sort -u |
   while read -r lib; do cp -L "$lib" "$stage/lib/"; done
 cp "$data"/bed_large.data "$data"/bed_small.data "$stage/data/"
 mkdir -p .dev
-tar -C "$stage" -cJf .dev/bundle.tar.xz bin lib data
-echo "pack.sh: .dev/bundle.tar.xz $(du -h .dev/bundle.tar.xz | cut -f1) (binaries of $(git rev-parse --short HEAD))"
+tar -C "$stage" -czf .dev/bundle.tar.gz bin lib data
+echo "pack.sh: .dev/bundle.tar.gz $(du -h .dev/bundle.tar.gz | cut -f1) (binaries of $(git rev-parse --short HEAD))"
 echo "device call: run(command='bash bench/device/scaling.sh', carry=['.dev'], timeout_s=540)"

@@ -18,7 +18,7 @@ run() { say "\$ $*"; "$@" 2>&1 | tee -a "$log"; say "(rc ${PIPESTATUS[0]})"; }
 
 dev=/tmp/partita-dev
 rm -rf "$dev" && mkdir -p "$dev"
-tar -C "$dev" -xJf .dev/bundle.tar.xz || { say "no .dev/bundle.tar.xz: run bench/device/pack.sh here first"; exit 1; }
+tar -C "$dev" -xzf .dev/bundle.tar.gz || { say "no .dev/bundle.tar.gz: run bench/device/pack.sh here first"; exit 1; }
 export LD_LIBRARY_PATH=$dev/lib
 export PARTITA_LOG_LEVEL=warn
 unset OMP_WAIT_POLICY OMP_NUM_THREADS
