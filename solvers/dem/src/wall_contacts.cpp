@@ -80,12 +80,20 @@ void WallContacts::resize(ParticleStore& store, std::size_t n) {
   wall_force_.resize(wall_count_, Eigen::Vector3d::Zero());
 }
 
+// Each plane's total over the blocks in block order, then each wall's over its planes in plane
+// order: a fixed order whatever the number of threads. The planes' sums are independent chains
+// (one chain per wall, as before 2026-11-27, took 2-3 us a step for the 313 blocks of the
+// 20,001-particle peer bed, serial between the parallel force passes).
 void WallContacts::reduce(std::size_t n) {
   const std::size_t np = planes_.size();
   const std::size_t blocks = (n + ThreadPartition::block_size - 1) / ThreadPartition::block_size;
+  plane_force_.assign(np, Eigen::Vector3d::Zero());  // (no allocation once sized)
+  Eigen::Vector3d* const sum = plane_force_.data();
+  const Eigen::Vector3d* block = block_force_.data();
+  for (std::size_t b = 0; b < blocks; ++b, block += np)
+    for (std::size_t k = 0; k < np; ++k) sum[k] += block[k];
   for (Eigen::Vector3d& w : wall_force_) w.setZero();
-  for (std::size_t b = 0; b < blocks; ++b)
-    for (std::size_t k = 0; k < np; ++k) wall_force_[planes_[k].wall] += block_force_[b * np + k];
+  for (std::size_t k = 0; k < np; ++k) wall_force_[planes_[k].wall] += sum[k];
 }
 
 void WallContacts::write(BinaryWriter& out) const { out.array(planes_); }

@@ -101,6 +101,7 @@ class WallContacts {
   int h_shear_ = -1;                          // store array: N x planes tangential histories
   std::vector<Eigen::Vector3d> block_force_;  // blocks x planes
   std::vector<Eigen::Vector3d> wall_force_;   // per wall
+  std::vector<Eigen::Vector3d> plane_force_;  // per plane: reduce()'s sums over the blocks
 };
 
 template <bool Load>
