@@ -171,6 +171,17 @@ TEST_CASE("every registered adapter honours the Solver contract", "[adapters][co
         REQUIRE(doc != entry.quantities.end());
         CHECK(doc->unit == mv.unit);
       }
+      // monitor_values(names), what the core asks each window: exactly the named quantities,
+      // with the values and units monitors() gives (a solver may compute only those asked)
+      for (const auto& mv : s->monitors()) {
+        INFO("monitor " << mv.name);
+        const auto one = s->monitor_values({mv.name});
+        REQUIRE(one.size() == 1);
+        CHECK(one[0].name == mv.name);
+        CHECK(one[0].unit == mv.unit);
+        CHECK(one[0].value == mv.value);
+      }
+      CHECK(s->monitor_values({"no_such_quantity"}).empty());
       s->finalize();
     }
   }

@@ -795,35 +795,48 @@ void DemAdapter::receive_mesh(const std::string& name, const Mesh& mesh) {
 }
 
 std::string DemAdapter::check_state() const {
+  // the first particle (lowest index) that is not finite or lies beyond the margin, if any
+  const std::ptrdiff_t astray = system_.first_particle_astray(domain_lo_, domain_hi_, lost_margin_);
+  if (astray < 0) return {};
   const dem::Particles& p = system_.particles();
-  for (std::size_t i = 0; i < p.position.size(); ++i) {
-    if (!p.position[i].allFinite() || !p.velocity[i].allFinite())
-      return fmt::format(
-          "particle {} has a non-finite position or velocity: the DEM step is unstable; lower "
-          "time_step_fraction (now {:.3g}) or check the materials and the coupled loads",
-          p.id[i], time_step_fraction_);
-    const Eigen::Vector3d& x = p.position[i];
-    const double out = std::max((domain_lo_ - x).maxCoeff(), (x - domain_hi_).maxCoeff());
-    if (out > lost_margin_)
-      return fmt::format(
-          "particle {} is lost: at ({:.4g}, {:.4g}, {:.4g}) m it lies {:.3g} m outside the "
-          "domain [{:.4g} {:.4g} {:.4g}] .. [{:.4g} {:.4g} {:.4g}] m (lost_margin {:.3g} m); a "
-          "wall or mesh lets particles through (an open face, an overlap too large for the time "
-          "step) or the run is diverging",
-          p.id[i], x.x(), x.y(), x.z(), out, domain_lo_.x(), domain_lo_.y(), domain_lo_.z(),
-          domain_hi_.x(), domain_hi_.y(), domain_hi_.z(), lost_margin_);
-  }
-  return {};
+  const auto i = static_cast<std::size_t>(astray);
+  if (!p.position[i].allFinite() || !p.velocity[i].allFinite())
+    return fmt::format(
+        "particle {} has a non-finite position or velocity: the DEM step is unstable; lower "
+        "time_step_fraction (now {:.3g}) or check the materials and the coupled loads",
+        p.id[i], time_step_fraction_);
+  const Eigen::Vector3d& x = p.position[i];
+  const double out = std::max((domain_lo_ - x).maxCoeff(), (x - domain_hi_).maxCoeff());
+  return fmt::format(
+      "particle {} is lost: at ({:.4g}, {:.4g}, {:.4g}) m it lies {:.3g} m outside the "
+      "domain [{:.4g} {:.4g} {:.4g}] .. [{:.4g} {:.4g} {:.4g}] m (lost_margin {:.3g} m); a "
+      "wall or mesh lets particles through (an open face, an overlap too large for the time "
+      "step) or the run is diverging",
+      p.id[i], x.x(), x.y(), x.z(), out, domain_lo_.x(), domain_lo_.y(), domain_lo_.z(),
+      domain_hi_.x(), domain_hi_.y(), domain_hi_.z(), lost_margin_);
 }
 
 std::vector<MonitorValue> DemAdapter::monitors() const {
+  return monitor_values({});
+}
+
+// names empty: all quantities. Those that take a pass over every particle or pair (the kinetic
+// energy, the mass, the contacts, the stable step) are computed only when asked for: the core asks
+// each window for what the case records.
+std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::string>& names) const {
+  auto wanted = [&](const std::string& n) {
+    return names.empty() || std::find(names.begin(), names.end(), n) != names.end();
+  };
   std::vector<MonitorValue> v;
-  v.push_back({"kinetic_energy", "J", system_.kinetic_energy()});
+  if (wanted("kinetic_energy")) v.push_back({"kinetic_energy", "J", system_.kinetic_energy()});
   v.push_back({"particles", "", static_cast<double>(system_.particle_count())});
-  double mass = 0.0;
-  for (const double m : system_.particles().mass) mass += m;
-  v.push_back({"mass", "kg", mass});
-  v.push_back({"contacts_per_particle", "", system_.mean_contacts_per_particle()});
+  if (wanted("mass")) {
+    double mass = 0.0;
+    for (const double m : system_.particles().mass) mass += m;
+    v.push_back({"mass", "kg", mass});
+  }
+  if (wanted("contacts_per_particle"))
+    v.push_back({"contacts_per_particle", "", system_.mean_contacts_per_particle()});
   const char* xyz[] = {"x", "y", "z"};
   for (const auto& m : meshes_dem_) {
     const Eigen::Vector3d f = system_.mesh_force(m.id);
@@ -841,9 +854,13 @@ std::vector<MonitorValue> DemAdapter::monitors() const {
     v.push_back({"breakage.mass_lost", "kg", c.mass_lost});
     v.push_back({"breakage.mass_restored", "kg", c.mass_restored});
     v.push_back({"breakage.energy_released", "J", c.energy_released});
-    v.push_back({"stable_time_step", "s", stable_time_step()});
+    if (wanted("stable_time_step")) v.push_back({"stable_time_step", "s", stable_time_step()});
   }
-  return v;
+  if (names.empty()) return v;
+  std::vector<MonitorValue> out;
+  for (auto& m : v)
+    if (wanted(m.name)) out.push_back(m);
+  return out;
 }
 
 }  // namespace partita::adapters

@@ -57,6 +57,7 @@ class DemAdapter : public Solver {
   void write_restart(BinaryWriter& out) const override;
   void read_restart(BinaryReader& in) override;
   std::vector<MonitorValue> monitors() const override;
+  std::vector<MonitorValue> monitor_values(const std::vector<std::string>& names) const override;
   std::optional<double> interface_work(std::string_view mesh) const override;
   void finalize() override;
 

@@ -1,6 +1,7 @@
 #include "partita/dem/mesh_contacts.hpp"
 
 #include "partita/dem/error.hpp"
+#include "partita/dem/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -210,8 +211,15 @@ template void MeshContacts::evaluate<true>(int, const Particle&, const NeighborL
 // the contact point, particles in order (a fixed summation order); then each triangle's force
 // from its vertices' (each vertex's force shared equally among its triangles): continuous as a
 // contact moves across triangles, sums preserved (see TriangleMesh::triangle_forces).
+// Every step, after the force pass. The contacts' scatter to the vertices is serial (a fixed
+// order); clearing the vertices and the triangles' shares run in parallel on large meshes (the
+// scale case's plate: 160,083 vertices, 105,800 triangles, every DEM step).
 void MeshContacts::reduce(std::vector<TriangleMesh>& meshes) const {
-  for (TriangleMesh& m : meshes) m.vertex_force_.setZero();
+  for (TriangleMesh& m : meshes) {
+    const Eigen::Index nv = m.vertex_force_.rows();
+#pragma omp parallel for schedule(static) if (nv >= parallel_pass_min)
+    for (Eigen::Index v = 0; v < nv; ++v) m.vertex_force_.row(v).setZero();
+  }
   for_each_contact([&](int, const MeshContactRecord& rec, const Eigen::Vector3d&) {
     TriangleMesh& m = meshes[rec.mesh];
     const auto& tri = m.triangle(rec.triangle);
@@ -219,6 +227,7 @@ void MeshContacts::reduce(std::vector<TriangleMesh>& meshes) const {
       m.vertex_force_.row(tri[k]) -= rec.barycentric[k] * rec.force.transpose();
   });
   for (TriangleMesh& m : meshes)
+#pragma omp parallel for schedule(static) if (m.triangle_count() >= parallel_pass_min)
     for (int t = 0; t < m.triangle_count(); ++t) {
       const auto& tri = m.triangle(t);
       m.triangle_force_.row(t) = m.vertex_share_[tri[0]] * m.vertex_force_.row(tri[0]) +

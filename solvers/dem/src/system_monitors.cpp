@@ -2,29 +2,61 @@
 #include "partita/dem/system.hpp"
 
 #include "partita/dem/error.hpp"
+#include "partita/dem/parallel.hpp"
 
+#include <algorithm>
+#include <cstddef>
 #include <sstream>
+#include <vector>
 
 namespace partita::dem {
 
+namespace {
+
+// sum_i term(i) over n particles in a fixed order whatever the number of threads: chunks of
+// parallel_pass_min particles summed in ascending i (in parallel), then the chunks' sums in
+// ascending order. (One chunk below that size: the plain ascending sum.)
+template <class Term>
+double ordered_sum(std::ptrdiff_t n, Term term) {
+  const std::ptrdiff_t chunk = parallel_pass_min;
+  const std::ptrdiff_t chunks = (n + chunk - 1) / chunk;
+  std::vector<double> part(static_cast<std::size_t>(chunks), 0.0);
+#pragma omp parallel for schedule(static) if (chunks > 1)
+  for (std::ptrdiff_t c = 0; c < chunks; ++c) {
+    double s = 0.0;
+    for (std::ptrdiff_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i) s += term(i);
+    part[static_cast<std::size_t>(c)] = s;
+  }
+  double total = 0.0;
+  for (const double s : part) total += s;
+  return total;
+}
+
+}  // namespace
+
 // ---- monitors ---------------------------------------------------------------------------------
 
+// (Read from the packed state while it is ahead of the store's: no pass to copy it back first.
+// The same values either way.)
 double System::kinetic_energy() const {
-  sync_particles();
-  double e = 0.0;
   const Particles& p = store_.core();
-  for (std::size_t i = 0; i < p.size(); ++i)
-    e += 0.5 * p.mass[i] * p.velocity[i].squaredNorm() +
-         0.5 * p.inertia[i] * p.angular_velocity[i].squaredNorm();
-  return e;
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+  if (const PackedParticle* q = verlet_.ahead())
+    return ordered_sum(n, [&](std::ptrdiff_t i) {
+      return 0.5 * p.mass[i] * q[i].v.squaredNorm() + 0.5 * p.inertia[i] * q[i].w.squaredNorm();
+    });
+  return ordered_sum(n, [&](std::ptrdiff_t i) {
+    return 0.5 * p.mass[i] * p.velocity[i].squaredNorm() +
+           0.5 * p.inertia[i] * p.angular_velocity[i].squaredNorm();
+  });
 }
 
 double System::potential_energy() const {
   sync_particles();
   const Particles& p = store_.core();
-  double e = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) e -= p.mass[i] * gravity_.dot(p.position[i]);
-  return e;
+  return -ordered_sum(static_cast<std::ptrdiff_t>(p.size()), [&](std::ptrdiff_t i) {
+    return p.mass[i] * gravity_.dot(p.position[i]);
+  });
 }
 
 double System::elastic_energy() const {
@@ -92,15 +124,34 @@ std::size_t System::contact_count() const {
   sync_particles();
   const Particles& p = store_.core();
   const NeighborList& nl = neighbors_;
-  std::size_t count = 0;
   if (nl.offsets_.size() != p.size() + 1) return 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+  std::size_t count = 0;  // (an integer: the same in any order)
+#pragma omp parallel for schedule(static) reduction(+ : count) if (n >= parallel_pass_min)
+  for (std::ptrdiff_t i = 0; i < n; ++i)
     for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
       const int j = nl.neighbors_[s];
       const double rsum = p.radius[i] + p.radius[j];
       if ((p.position[i] - p.position[j]).squaredNorm() < rsum * rsum) ++count;
     }
   return count;
+}
+
+std::ptrdiff_t System::first_particle_astray(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                             double margin) const {
+  const Particles& p = store_.core();
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+  const PackedParticle* q = verlet_.ahead();  // (as kinetic_energy())
+  std::ptrdiff_t first = n;
+#pragma omp parallel for schedule(static) reduction(min : first) if (n >= parallel_pass_min)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& x = q ? q[i].x : p.position[i];
+    const Eigen::Vector3d& v = q ? q[i].v : p.velocity[i];
+    if (!x.allFinite() || !v.allFinite() ||
+        std::max((lo - x).maxCoeff(), (x - hi).maxCoeff()) > margin)
+      first = std::min(first, i);
+  }
+  return first < n ? first : -1;
 }
 
 double System::mean_contacts_per_particle() const {

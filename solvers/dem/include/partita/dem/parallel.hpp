@@ -4,6 +4,10 @@
 
 namespace partita::dem {
 
+/// Particles below which a light pass over them (a copy, a monitor's sum, a check) runs on one
+/// thread: a fork costs about as much as such a pass over this many particles.
+inline constexpr int parallel_pass_min = 16384;
+
 /// Sets the number of threads used by the following steps (n >= 1).
 void set_num_threads(int n);
 /// The number of threads the next parallel region will use (1 without OpenMP).

@@ -265,6 +265,11 @@ class System {
   void set_step_profiling(bool on);
   const StepProfile& step_profile() const { return profile_; }
 
+  /// The lowest index of a particle whose position or velocity is not finite, or whose position
+  /// lies more than `margin` outside the box [lo, hi] (max_k max(lo_k - x_k, x_k - hi_k) >
+  /// margin); -1 when there is none. A check of a run's state, in parallel for large beds.
+  std::ptrdiff_t first_particle_astray(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                       double margin) const;
   /// Particle-particle pairs with overlap > 0 at the current positions.
   std::size_t contact_count() const;
   /// 2 contact_count() / N (particle-particle, as LAMMPS compute contact/atom).

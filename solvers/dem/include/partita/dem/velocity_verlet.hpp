@@ -50,6 +50,9 @@ class VelocityVerlet {
   void sync(Particles& p) const {
     if (!mirror_current_) copy_back(p);
   }
+  /// The packed state while it is ahead of the store's copies (stepping, no sync() since), else
+  /// nullptr (the store's copies are current): for reading x, v, omega without a sync().
+  const PackedParticle* ahead() const { return mirror_current_ ? nullptr : packed_.data(); }
   /// The store's copies are current (a state was read into the store): nothing to sync, and the
   /// packed copy is loaded again before the next use.
   void store_replaced() {
