@@ -17,10 +17,11 @@ Mat3 gradient() {
   return g;
 }
 
-void run_patch(ElementType type, Hex8Formulation formulation) {
+MatrixX6 run_patch(ElementType type, Hex8Formulation formulation,
+                   std::array<int, 3> cells = {3, 3, 3}) {
   BoxSpec spec;
   spec.size = Vec3(1.0, 0.8, 1.2);
-  spec.cells = {3, 3, 3};
+  spec.cells = cells;
   spec.element = type;
   Mesh mesh = make_box_mesh(spec);
   test::distort_interior(mesh, spec, 0.25, 7);
@@ -54,6 +55,7 @@ void run_patch(ElementType type, Hex8Formulation formulation) {
     serr = std::max(serr, (s.row(i).transpose() - sigma).norm());
   INFO("max stress error / |sigma| = " << serr / sigma.norm());
   CHECK(serr / sigma.norm() < 1e-8);
+  return s;
 }
 
 }  // namespace
@@ -74,6 +76,22 @@ TEST_CASE("fem patch test: linear field on a distorted mesh", "[fem][patch]") {
   SECTION("tet10") {
     run_patch(ElementType::Tet10, Hex8Formulation::IncompatibleModes);
   }
+}
+
+TEST_CASE("fem patch test: nodal stresses of a larger mesh on 1, 2 and 3 threads", "[fem][patch]") {
+  // 12 x 12 x 10 = 1440 elements: more than one chunk of the threaded element loop (1024)
+  const int before = test::threads_available();
+  MatrixX6 one;
+  for (int threads : {1, 2, 3}) {
+    test::use_threads(threads);
+    INFO(threads << " threads");
+    const MatrixX6 s = run_patch(ElementType::Hex8, Hex8Formulation::IncompatibleModes, {12, 12, 10});
+    if (threads == 1)
+      one = s;
+    else
+      CHECK((s.array() == one.array()).all());  // the same sums in the same order
+  }
+  test::use_threads(before);
 }
 
 TEST_CASE("fem box mesher: sets, faces and volumes", "[fem][mesh]") {
