@@ -6,7 +6,7 @@
 #   3. the DEM's thread scaling 1-16 of the large peer bed, twice (issue 16: aim 12x at 16), the
 #      second time with each step's time thread by thread (--profile);
 #   4. the 263k-dof plate's factorisation and transient step at 1, 2, 4, 8 and 16 threads;
-#   5. the 10^6-granule scale case at 16 threads (time per participant).
+#   5. the 10^6-granule scale case on 2, 8 and 16 threads (time per participant, memory).
 # Everything goes to $OUT/scaling.log (or ./scaling.log without $OUT).
 set -uo pipefail
 out=${OUT:-.}
@@ -46,7 +46,12 @@ for t in 1 2 4 8 16; do
     --steps 6 --backends cholmod-nesdis-t,cholmod-nesdis-tf
 done
 
-step "scale case (10^6 granules, 10^5-element plate), 16 threads"
+step "scale case (10^6 granules, 10^5-element plate) on 2, 8 and 16 threads"
+for t in 2 8; do
+  say "\$ partita run cases/scale/scale.yaml --threads $t"
+  "$dev/bin/partita" run cases/scale/scale.yaml --threads $t --output /tmp/scale-out 2>&1 |
+    grep -E 'set-up of|summary' | tee -a "$log"
+done
 /usr/bin/time -v "$dev/bin/partita" run cases/scale/scale.yaml --threads 16 --output /tmp/scale-out \
   2>&1 | grep -v -E '^\s+(Average|Exit|Socket|Signals|Swaps|Page size|File system)' | tail -40 | tee -a "$log"
 step done
