@@ -1,6 +1,7 @@
 #include "partita/dem/neighbor_list.hpp"
 
 #include "partita/dem/error.hpp"
+#include "partita/dem/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -46,9 +47,14 @@ bool NeighborList::needs_rebuild(double max_moved2, const std::vector<PlaneWall>
   if (max_moved2 > limit2) return true;
   for (std::size_t k = 0; k < planes.size(); ++k)
     if ((planes[k].point - plane_at_build_[k]).squaredNorm() > limit2) return true;
-  for (const TriangleMesh& m : meshes)
-    for (int v = 0; v < m.vertex_count(); ++v)
-      if ((m.position_[v] - m.position_at_build_[v]).squaredNorm() > limit2) return true;
+  for (const TriangleMesh& m : meshes) {
+    const int nv = m.vertex_count();
+    double most2 = 0.0;  // (the largest vertex motion since the build: exact in any order)
+#pragma omp parallel for schedule(static) reduction(max : most2) if (nv >= parallel_pass_min)
+    for (int v = 0; v < nv; ++v)
+      most2 = std::max(most2, (m.position_[v] - m.position_at_build_[v]).squaredNorm());
+    if (most2 > limit2) return true;
+  }
   return false;
 }
 

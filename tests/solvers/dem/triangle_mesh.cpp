@@ -3,6 +3,8 @@
 
 #include "dem_test_helpers.hpp"
 
+#include "partita/dem/parallel.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <numbers>
@@ -232,6 +234,49 @@ TEST_CASE("dem: a mesh moved by the caller pushes a particle like a moving plane
   INFO("plane " << vp << " mesh " << vm << " theory " << (1 + e) * u);
   CHECK(vp == Approx((1 + e) * u).epsilon(0.02));
   CHECK(vm == Approx(vp).epsilon(1e-6));
+}
+
+TEST_CASE("dem: a large moving mesh (parallel vertex loops) pushes like a plane on 1 and 2 threads",
+          "[dem][mesh][threads]") {
+  // As above with a mesh of 131 x 131 = 17,161 vertices (34,322 triangles): enough for the
+  // step's vertex loops (velocities from the motion, the copy of the positions, the rebuild test,
+  // the force shares) to run on the threads. The vertices' velocities are the motion's, u.
+  const double u = 0.2, e = 0.5;
+  const int before = max_threads();
+  double first = 0.0;
+  for (int threads : {1, 2}) {
+    set_num_threads(threads);
+    System sys = test::single_material(E, NU, RHO, e, 0.0);
+    sys.add_particle({0.0, 0.0, R + 2e-6}, R, 0);
+    Eigen::MatrixX3d v;
+    TriangleMesh::Triangles t;
+    triangulated_plane(4.0 * R, 130, v, t);
+    REQUIRE(v.rows() >= parallel_pass_min);
+    const int id = sys.add_mesh(v, t, 0);
+    const double dt = 0.1 * sys.rayleigh_time_step();
+    const long builds0 = sys.neighbor_list().build_count();
+    for (int s = 1; s <= 3000; ++s) {
+      Eigen::MatrixX3d x = v;
+      x.col(2).array() += u * dt * s;
+      sys.set_vertex_positions(id, x);
+      sys.step(dt);
+      if (s > 100 && sys.particles().velocity[0].z() > 1.2 * u) break;  // left the wall
+    }
+    INFO(threads << " threads");
+    double vz_min = 1e300, vz_max = -1e300;
+    for (const Eigen::Vector3d& w : sys.mesh(id).velocities())
+      vz_min = std::min(vz_min, w.z()), vz_max = std::max(vz_max, w.z());
+    CHECK(vz_min == Approx(u).epsilon(1e-6));
+    CHECK(vz_max == Approx(u).epsilon(1e-6));
+    CHECK(sys.neighbor_list().build_count() > builds0 + 1);  // the mesh's motion rebuilt the lists
+    const double vp = sys.particles().velocity[0].z();
+    CHECK(vp == Approx((1 + e) * u).epsilon(0.02));
+    if (threads == 1)
+      first = vp;
+    else
+      CHECK(vp == first);  // the same bits on any number of threads
+  }
+  set_num_threads(before);
 }
 
 TEST_CASE("dem: mesh contact rows exist only for particles near a mesh and follow them",
