@@ -68,8 +68,12 @@ void ParticleStore::permute(const std::vector<int>& order) {
   if (order.size() != size())
     throw Error("particle store: permute() needs one index per particle, got " +
                 std::to_string(order.size()) + " for " + std::to_string(size()));
-  done_.assign(order.size(), 0);
-  for (auto& c : columns_) c->permute(core_, order, done_.data());
+  std::size_t entry = 1;
+  for (const auto& c : columns_) entry = std::max(entry, c->element_size());
+  const std::size_t words = (order.size() * entry + sizeof(std::max_align_t) - 1) /
+                            sizeof(std::max_align_t);
+  if (scratch_.size() < words) scratch_.resize(words);  // (kept: no allocation next time)
+  for (auto& c : columns_) c->permute(core_, order, scratch_.data());
 }
 
 void ParticleStore::write(BinaryWriter& out) const {

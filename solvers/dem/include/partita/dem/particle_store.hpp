@@ -11,11 +11,14 @@
 // than the largest id ever held, so an id is never reused within a run).
 //
 // Memory: each array holds exactly its particles' entries (add_particles() reserves the final
-// size; growth one particle at a time is geometric, one array at a time). permute() works in
-// place, array by array, following the permutation's cycles (one block of `width` entries in
-// hand), and remove() compacts in place: neither holds a second copy of any array. Their scratch
-// (one byte per particle: the cycle marks) is kept between calls, so they allocate nothing once
-// the store has had its largest size.
+// size; growth one particle at a time is geometric, one array at a time). permute() gathers one
+// entry column at a time (entry j of every particle of one array) into a scratch of one entry per
+// particle, in parallel on large stores, and copies it back: no second copy of any array, and
+// independent reads that the processor overlaps (an in-place walk along the permutation's cycles
+// waits for each read in turn: 0.29-0.31 s for the scale case's 10^6 granules on 2 threads,
+// against 0.087-0.094 s). remove() compacts in place. The scratch (the largest entry size per
+// particle: 24 B for a Vector3d) is kept between calls, so neither allocates once the store has
+// had its largest size.
 
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
@@ -26,6 +29,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <new>
 #include <string>
 #include <typeinfo>
 #include <vector>
@@ -90,8 +94,9 @@ class ParticleStore {
     virtual void resize(Particles& core, std::size_t n) = 0;
     virtual void reserve(Particles& core, std::size_t n) = 0;
     virtual void compact(Particles& core, const std::vector<int>& new_of_old, std::size_t n) = 0;
-    // done[] (one flag per particle, all 0 on entry) marks the rows already placed
-    virtual void permute(Particles& core, const std::vector<int>& order, char* done) = 0;
+    // scratch: room for one entry per particle (element_size() bytes each, max_align_t aligned)
+    virtual void permute(Particles& core, const std::vector<int>& order,
+                         std::max_align_t* scratch) = 0;
     virtual void set_width(Particles& core, std::size_t width) = 0;
     virtual void write(const Particles& core, BinaryWriter& out) const = 0;
     virtual void read(Particles& core, BinaryReader& in) = 0;
@@ -105,7 +110,7 @@ class ParticleStore {
   Particles core_;
   std::vector<std::unique_ptr<Column>> columns_;
   std::int64_t next_id_ = 0;
-  std::vector<char> done_;  // scratch of permute(): rows placed in the current array
+  std::vector<std::max_align_t> scratch_;  // of permute(): one entry per particle
 };
 
 // ---- implementation of the typed arrays ------------------------------------------------------
@@ -115,7 +120,6 @@ struct ParticleStore::TypedColumn final : Column {
   std::vector<T> own;                           // the data, unless it is a core array
   std::vector<T> Particles::*member = nullptr;  // the core array it stands for
   T fill{};
-  std::vector<T> block;  // scratch of permute(): one particle's entries (width)
 
   std::vector<T>& data(Particles& core) { return member ? core.*member : own; }
   const std::vector<T>& data(const Particles& core) const { return member ? core.*member : own; }
@@ -139,28 +143,26 @@ struct ParticleStore::TypedColumn final : Column {
     }
     v.resize(n * width);
   }
-  // new row k = old row order[k], in place: each cycle k0 -> order[k0] -> ... is shifted by one
-  // row with the first row in hand; done[] marks the rows placed (and is cleared again).
-  void permute(Particles& core, const std::vector<int>& order, char* done) override {
+  // new row k = old row order[k]: entry column by entry column, gathered into the scratch (in
+  // parallel: independent reads), then copied back
+  void permute(Particles& core, const std::vector<int>& order,
+               std::max_align_t* scratch) override {
+    static_assert(alignof(T) <= alignof(std::max_align_t));
     std::vector<T>& v = data(core);
-    if (width == 0) return;
-    block.resize(width);
-    const std::size_t n = order.size();
-    auto row = [&](std::size_t k) { return v.begin() + k * width; };
-    for (std::size_t start = 0; start < n; ++start) {
-      if (done[start] || static_cast<std::size_t>(order[start]) == start) continue;
-      std::copy_n(row(start), width, block.begin());
-      std::size_t k = start;
-      for (;;) {
-        done[k] = 1;
-        const auto from = static_cast<std::size_t>(order[k]);
-        if (from == start) break;
-        std::copy_n(row(from), width, row(k));
-        k = from;
+    const auto n = static_cast<std::ptrdiff_t>(order.size());
+    const auto w = static_cast<std::ptrdiff_t>(width);
+    T* const tmp = reinterpret_cast<T*>(scratch);
+    T* const d = v.data();
+    const int* const o = order.data();
+    for (std::ptrdiff_t j = 0; j < w; ++j) {
+#pragma omp parallel for schedule(static) if (n >= 16384)
+      for (std::ptrdiff_t k = 0; k < n; ++k) new (tmp + k) T(d[o[k] * w + j]);
+#pragma omp parallel for schedule(static) if (n >= 16384)
+      for (std::ptrdiff_t k = 0; k < n; ++k) {
+        d[k * w + j] = tmp[k];
+        tmp[k].~T();
       }
-      std::copy_n(block.begin(), width, row(k));
     }
-    std::fill_n(done, n, char{0});
   }
   void set_width(Particles& core, std::size_t w) override {
     std::vector<T>& v = data(core);
