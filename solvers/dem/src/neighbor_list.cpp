@@ -169,14 +169,19 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   ++builds_;
   const int n = static_cast<int>(p.size());
   // Grid over the particles' bounding box, cells 2 R_max + skin wide (at most ~4 N cells).
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
-  Eigen::Vector3d hi = -lo;
-  double r_max = 0.0;
+  // (the passes over every particle below run on the threads for large beds; minima, maxima and
+  // per-particle results are the same in any order)
+  const double big = std::numeric_limits<double>::max();
+  double lx = big, ly = big, lz = big, hx = -big, hy = -big, hz = -big, r_max = 0.0;
+#pragma omp parallel for schedule(static) if (n >= parallel_pass_min) \
+    reduction(min : lx, ly, lz) reduction(max : hx, hy, hz, r_max)
   for (int i = 0; i < n; ++i) {
-    lo = lo.cwiseMin(p.position[i]);
-    hi = hi.cwiseMax(p.position[i]);
+    const Eigen::Vector3d& x = p.position[i];
+    lx = std::min(lx, x.x()), ly = std::min(ly, x.y()), lz = std::min(lz, x.z());
+    hx = std::max(hx, x.x()), hy = std::max(hy, x.y()), hz = std::max(hz, x.z());
     r_max = std::max(r_max, p.radius[i]);
   }
+  Eigen::Vector3d lo(lx, ly, lz), hi(hx, hy, hz);
   if (n == 0) lo = hi = Eigen::Vector3d::Zero();
   double cell = std::max(2.0 * r_max + skin_, 1e-12);
   const Eigen::Vector3d extent = hi - lo;
@@ -195,11 +200,12 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   counts_.reserve(std::max(static_cast<std::size_t>(max_cells), static_cast<std::size_t>(n)) + 1);
   if (!meshes.empty()) tri_cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
   cell_start_.assign(grid_.cells() + 1, 0);
+#pragma omp parallel for schedule(static) if (n >= parallel_pass_min)
   for (int i = 0; i < n; ++i) {
     const auto c = grid_.coords(p.position[i]);
     particle_cell_[i] = grid_.index(c[0], c[1], c[2]);
-    ++cell_start_[particle_cell_[i] + 1];
   }
+  for (int i = 0; i < n; ++i) ++cell_start_[particle_cell_[i] + 1];
   for (int c = 0; c < grid_.cells(); ++c) cell_start_[c + 1] += cell_start_[c];
   cell_items_.resize(n);
   counts_.assign(grid_.cells(), 0);
@@ -239,12 +245,15 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   offsets_.swap(new_offsets_);
   neighbors_.swap(new_neighbors_);
 
-  position_at_build_ = p.position;
+  position_at_build_.resize(p.position.size());
+#pragma omp parallel for schedule(static) if (n >= parallel_pass_min)
+  for (int i = 0; i < n; ++i) position_at_build_[i] = p.position[i];
   // Planes within R + skin of each particle.
   plane_at_build_.resize(planes.size());
   for (std::size_t k = 0; k < planes.size(); ++k) plane_at_build_[k] = planes[k].point;
   plane_mask_.resize(n);
   const int np = static_cast<int>(planes.size());
+#pragma omp parallel for schedule(static) if (n >= parallel_pass_min)
   for (int i = 0; i < n; ++i) {
     std::uint64_t mask = 0;
     if (np > 64) {
