@@ -9,6 +9,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -134,20 +136,28 @@ TEST_CASE("dem: identical runs write identical state bytes", "[dem][state]") {
   CHECK(differing == 0);
 }
 
-TEST_CASE("dem: results do not depend on the number of threads", "[dem][threads]") {
-  // > 1024 particles so that the parallel loops run in parallel
-  auto run = [](int threads) {
+namespace {
+
+// A falling bed (falling_bed(box, 0.6, seed)) after `steps` steps on 1, 2 and 3 threads (3: a
+// middle part with pairs crossing into and out of it).
+std::array<System, 3> falling_on_threads(double box, std::uint64_t seed, long steps) {
+  const int before = max_threads();
+  auto run = [&](int threads) {
     set_num_threads(threads);
-    System sys = falling_bed(14e-3, 0.6, 9);
-    const double dt = 0.2 * sys.rayleigh_time_step();
-    sys.run(200, dt);
+    System sys = falling_bed(box, 0.6, seed);
+    sys.run(steps, 0.2 * sys.rayleigh_time_step());
     return sys;
   };
-  const int before = max_threads();
-  const System one = run(1);
-  const System two = run(2);
-  const System three = run(3);  // a middle part with pairs crossing into and out of it
+  std::array<System, 3> out = {run(1), run(2), run(3)};
   set_num_threads(before);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("dem: results do not depend on the number of threads", "[dem][threads]") {
+  // > 1024 particles so that the parallel loops run in parallel
+  const auto [one, two, three] = falling_on_threads(14e-3, 9, 200);
   INFO(one.particle_count() << " particles");
   CHECK(one.particle_count() > 1024);
   CHECK(same_state(one, two));
@@ -160,18 +170,7 @@ TEST_CASE("dem: a bed of 20 thousand particles gives the same bits on 1 2 and 3 
           "[dem][threads]") {
   // above parallel_pass_min: the list builds' passes over every particle (bounds, cells, plane
   // masks), the copies and the monitors run on the threads too
-  auto run = [](int threads) {
-    set_num_threads(threads);
-    System sys = falling_bed(33e-3, 0.6, 4);
-    const double dt = 0.2 * sys.rayleigh_time_step();
-    sys.run(100, dt);
-    return sys;
-  };
-  const int before = max_threads();
-  const System one = run(1);
-  const System two = run(2);
-  const System three = run(3);
-  set_num_threads(before);
+  const auto [one, two, three] = falling_on_threads(33e-3, 4, 100);
   INFO(one.particle_count() << " particles");
   CHECK(one.particle_count() > static_cast<std::size_t>(parallel_pass_min));
   CHECK(one.neighbor_list().build_count() > 1);  // rebuilt while falling
