@@ -1,7 +1,7 @@
 #include "partita/dem/mesh_contacts.hpp"
 
 #include "partita/dem/error.hpp"
-#include "partita/dem/parallel.hpp"
+#include "parallel_pass.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -215,11 +215,9 @@ template void MeshContacts::evaluate<true>(int, const Particle&, const NeighborL
 // order); clearing the vertices and the triangles' shares run in parallel on large meshes (the
 // scale case's plate: 160,083 vertices, 105,800 triangles, every DEM step).
 void MeshContacts::reduce(std::vector<TriangleMesh>& meshes) const {
-  for (TriangleMesh& m : meshes) {
-    const Eigen::Index nv = m.vertex_force_.rows();
-#pragma omp parallel for schedule(static) if (nv >= parallel_pass_min)
-    for (Eigen::Index v = 0; v < nv; ++v) m.vertex_force_.row(v).setZero();
-  }
+  for (TriangleMesh& m : meshes)
+    detail::parallel_pass(m.vertex_force_.rows(),
+                          [&](Eigen::Index v) { m.vertex_force_.row(v).setZero(); });
   for_each_contact([&](int, const MeshContactRecord& rec, const Eigen::Vector3d&) {
     TriangleMesh& m = meshes[rec.mesh];
     const auto& tri = m.triangle(rec.triangle);
@@ -227,13 +225,12 @@ void MeshContacts::reduce(std::vector<TriangleMesh>& meshes) const {
       m.vertex_force_.row(tri[k]) -= rec.barycentric[k] * rec.force.transpose();
   });
   for (TriangleMesh& m : meshes)
-#pragma omp parallel for schedule(static) if (m.triangle_count() >= parallel_pass_min)
-    for (int t = 0; t < m.triangle_count(); ++t) {
+    detail::parallel_pass(m.triangle_count(), [&](int t) {
       const auto& tri = m.triangle(t);
       m.triangle_force_.row(t) = m.vertex_share_[tri[0]] * m.vertex_force_.row(tri[0]) +
                                  m.vertex_share_[tri[1]] * m.vertex_force_.row(tri[1]) +
                                  m.vertex_share_[tri[2]] * m.vertex_force_.row(tri[2]);
-    }
+    });
 }
 
 std::size_t MeshContacts::contact_count() const {

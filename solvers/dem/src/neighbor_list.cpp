@@ -3,6 +3,8 @@
 #include "partita/dem/error.hpp"
 #include "partita/dem/parallel.hpp"
 
+#include "parallel_pass.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -49,10 +51,15 @@ bool NeighborList::needs_rebuild(double max_moved2, const std::vector<PlaneWall>
     if ((planes[k].point - plane_at_build_[k]).squaredNorm() > limit2) return true;
   for (const TriangleMesh& m : meshes) {
     const int nv = m.vertex_count();
-    double most2 = 0.0;  // (the largest vertex motion since the build: exact in any order)
-#pragma omp parallel for schedule(static) reduction(max : most2) if (nv >= parallel_pass_min)
-    for (int v = 0; v < nv; ++v)
-      most2 = std::max(most2, (m.position_[v] - m.position_at_build_[v]).squaredNorm());
+    auto moved2 = [&](int v) { return (m.position_[v] - m.position_at_build_[v]).squaredNorm(); };
+    if (nv < parallel_pass_min) {  // (a step's test: no parallel construct for small meshes)
+      for (int v = 0; v < nv; ++v)
+        if (moved2(v) > limit2) return true;
+      continue;
+    }
+    double most2 = 0.0;  // the largest vertex motion since the build: exact in any order
+#pragma omp parallel for schedule(static) reduction(max : most2)
+    for (int v = 0; v < nv; ++v) most2 = std::max(most2, moved2(v));
     if (most2 > limit2) return true;
   }
   return false;
@@ -200,11 +207,10 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   counts_.reserve(std::max(static_cast<std::size_t>(max_cells), static_cast<std::size_t>(n)) + 1);
   if (!meshes.empty()) tri_cell_start_.reserve(static_cast<std::size_t>(max_cells) + 1);
   cell_start_.assign(grid_.cells() + 1, 0);
-#pragma omp parallel for schedule(static) if (n >= parallel_pass_min)
-  for (int i = 0; i < n; ++i) {
+  detail::parallel_pass(n, [&](int i) {
     const auto c = grid_.coords(p.position[i]);
     particle_cell_[i] = grid_.index(c[0], c[1], c[2]);
-  }
+  });
   for (int i = 0; i < n; ++i) ++cell_start_[particle_cell_[i] + 1];
   for (int c = 0; c < grid_.cells(); ++c) cell_start_[c + 1] += cell_start_[c];
   cell_items_.resize(n);
@@ -246,15 +252,13 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   neighbors_.swap(new_neighbors_);
 
   position_at_build_.resize(p.position.size());
-#pragma omp parallel for schedule(static) if (n >= parallel_pass_min)
-  for (int i = 0; i < n; ++i) position_at_build_[i] = p.position[i];
+  detail::parallel_pass(n, [&](int i) { position_at_build_[i] = p.position[i]; });
   // Planes within R + skin of each particle.
   plane_at_build_.resize(planes.size());
   for (std::size_t k = 0; k < planes.size(); ++k) plane_at_build_[k] = planes[k].point;
   plane_mask_.resize(n);
   const int np = static_cast<int>(planes.size());
-#pragma omp parallel for schedule(static) if (n >= parallel_pass_min)
-  for (int i = 0; i < n; ++i) {
+  detail::parallel_pass(n, [&](int i) {
     std::uint64_t mask = 0;
     if (np > 64) {
       mask = ~std::uint64_t{0};
@@ -264,7 +268,7 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
           mask |= std::uint64_t{1} << k;
     }
     plane_mask_[i] = mask;
-  }
+  });
   build_mesh_candidates(p, meshes, r_max);
   valid_ = true;
 }

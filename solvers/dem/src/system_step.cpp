@@ -5,6 +5,7 @@
 #include "partita/dem/error.hpp"
 #include "partita/dem/mesh_contacts.hpp"
 #include "partita/dem/parallel.hpp"
+#include "parallel_pass.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -57,9 +58,9 @@ void System::step(double dt) {
   // 160,083 vertices, a serial pass over them each step would limit the thread scaling)
   for (TriangleMesh& m : meshes_) {
     if (!m.velocity_from_motion_) continue;
-    const int nv = m.vertex_count();
-#pragma omp parallel for schedule(static) if (nv >= parallel_pass_min)
-    for (int v = 0; v < nv; ++v) m.velocity_[v] = (m.position_[v] - m.position_last_step_[v]) / dt;
+    detail::parallel_pass(m.vertex_count(), [&](int v) {
+      m.velocity_[v] = (m.position_[v] - m.position_last_step_[v]) / dt;
+    });
   }
   Particles& p = store_.core();
   const double half = 0.5 * dt;
@@ -133,11 +134,8 @@ void System::step(double dt) {
   // the next step's bound starts from this one's (fused: the distances from the build positions
   // were not computed) or from the exact distances
   set_motion(fused ? bound : rebuild ? 0.0 : std::sqrt(moved2));
-  for (TriangleMesh& m : meshes_) {
-    const int nv = m.vertex_count();
-#pragma omp parallel for schedule(static) if (nv >= parallel_pass_min)
-    for (int v = 0; v < nv; ++v) m.position_last_step_[v] = m.position_[v];
-  }
+  for (TriangleMesh& m : meshes_)
+    detail::parallel_pass(m.vertex_count(), [&](int v) { m.position_last_step_[v] = m.position_[v]; });
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].post_force(*this, dt);
   time_ += dt;
   ++steps_;

@@ -1,7 +1,7 @@
 // VelocityVerlet: loading the packed state from the particle store and mirroring it back.
 #include "partita/dem/velocity_verlet.hpp"
 
-#include "partita/dem/parallel.hpp"
+#include "parallel_pass.hpp"
 
 #include <cstddef>
 
@@ -10,12 +10,11 @@ namespace partita::dem {
 void VelocityVerlet::load(const Particles& p) {
   const int n = static_cast<int>(p.size());
   packed_.resize(n);
-#pragma omp parallel for schedule(static) if (n >= parallel_pass_min)
-  for (int i = 0; i < n; ++i) {
+  detail::parallel_pass(n, [&](int i) {
     PackedParticle& q = packed_[i];
     q.x = p.position[i], q.v = p.velocity[i], q.w = p.angular_velocity[i];
     q.r = p.radius[i], q.f = p.force[i], q.t = p.torque[i];
-  }
+  });
   loaded_ = true;
   mirror_current_ = true;
   has_motion_ = false;
@@ -24,15 +23,13 @@ void VelocityVerlet::load(const Particles& p) {
 // (in parallel for large beds: a serial pass over 10^6 particles, once a coupling window, would
 // limit the thread scaling of the parallel steps around it)
 void VelocityVerlet::copy_back(Particles& p) const {
-  const auto n = static_cast<std::ptrdiff_t>(packed_.size());
-#pragma omp parallel for schedule(static) if (n >= parallel_pass_min)
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
+  detail::parallel_pass(static_cast<std::ptrdiff_t>(packed_.size()), [&](std::ptrdiff_t i) {
     p.position[i] = packed_[i].x;
     p.velocity[i] = packed_[i].v;
     p.angular_velocity[i] = packed_[i].w;
     p.force[i] = packed_[i].f;
     p.torque[i] = packed_[i].t;
-  }
+  });
   mirror_current_ = true;
 }
 
