@@ -675,13 +675,16 @@ MatrixX6 StructuralSolver::nodal_stress() const {
   // into a slot of its own), then added to the nodes in element order (the same sums on any
   // number of threads). (105,800 Hex8 with incompatible modes: about 1 s on one thread, which was
   // most of the scale case's VTK output.)
+  // Small meshes stay on one thread: a frame of the steel case's 800 elements takes a few ms, and
+  // waking the threads for it left them spinning into the next steps (its plate took 6 % longer).
   constexpr std::size_t kChunk = 1024;
   const auto& elements = mesh().elements();
   const std::size_t ne = elements.size();
+  const long min_parallel = ne >= 4 * kChunk ? 64 : static_cast<long>(kChunk) + 1;
   std::vector<ElementStresses> chunk(std::min(ne, kChunk));
   for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
     const long n = static_cast<long>(std::min(ne - c0, kChunk));
-    detail::parallel_for_first_error(n, 64, [&](long k) {
+    detail::parallel_for_first_error(n, min_parallel, [&](long k) {
       const Element& e = elements[c0 + static_cast<std::size_t>(k)];
       const int nn = node_count(e.type);
       ElementVector ue(3 * nn);

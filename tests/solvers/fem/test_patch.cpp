@@ -79,13 +79,13 @@ TEST_CASE("fem patch test: linear field on a distorted mesh", "[fem][patch]") {
 }
 
 TEST_CASE("fem patch test: nodal stresses of a larger mesh on 1, 2 and 3 threads", "[fem][patch]") {
-  // 12 x 12 x 10 = 1440 elements: more than one chunk of the threaded element loop (1024)
+  // 16 x 16 x 16 = 4096 elements: threaded (from 4096 on), in four chunks of 1024
   const int before = test::threads_available();
   MatrixX6 one;
   for (int threads : {1, 2, 3}) {
     test::use_threads(threads);
     INFO(threads << " threads");
-    const MatrixX6 s = run_patch(ElementType::Hex8, Hex8Formulation::IncompatibleModes, {12, 12, 10});
+    const MatrixX6 s = run_patch(ElementType::Hex8, Hex8Formulation::IncompatibleModes, {16, 16, 16});
     if (threads == 1)
       one = s;
     else
