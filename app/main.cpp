@@ -277,8 +277,18 @@ int main(int argc, char** argv) {
   } catch (const partita::Error& e) {
     std::cerr << "partita: error: " << e.what() << "\n";
     return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "partita: error: out of memory: the case needs more memory than this machine "
+                 "gives the process (fewer particles or elements, or a machine with more "
+                 "memory)\n";
+    return 1;
   } catch (const std::exception& e) {
-    std::cerr << "partita: error: " << e.what() << "\n";
+    // A condition partita does not check for yet: no library text reaches the user (it names
+    // internals, not the input); the detail goes to the log for the bug report.
+    partita::log::get("app")->debug("unexpected exception: {}", e.what());
+    std::cerr << "partita: internal error: the run stopped on a condition that partita does not "
+                 "check for yet; this is a bug, please report it with the case file and the "
+                 "output of the same command with --log-level debug\n";
     return 1;
   }
 }

@@ -43,6 +43,15 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
   const config::Node root = config::Node::load_file(options.case_file, options.overrides)
                                 .validated(coupling::case_spec(registries));
   const coupling::Sweep sweep(root);
+  {
+    // What `partita check` does, before any folder is made: the case and every swept value,
+    // each as its variants will run it (an error names the value's line in the case file).
+    coupling::RunOptions check;
+    check.check_only = true;
+    check.overrides = options.overrides;
+    check.threads = options.threads;
+    const coupling::CaseRun checked(options.case_file, registries, check);
+  }
   const fs::path dir = options.output_dir.empty() ? fs::current_path() / "out" / root.string("case")
                                                   : options.output_dir;
   fs::create_directories(dir);

@@ -46,7 +46,9 @@ void register_all(coupling::Registries& r) {
         "total force the interface received (tractions times areas plus nodal forces), x"},
        {"<interface>.force_y", "N", "... y"},
        {"<interface>.force_z", "N", "... z"},
-       {"<interface>.displacement_x", "m", "mean displacement of the interface's nodes, x"},
+       {"<interface>.displacement_x", "m",
+        "an interface: mean displacement of its nodes; a point (points:): the displacement "
+        "interpolated at it, x"},
        {"<interface>.displacement_y", "m", "... y"},
        {"<interface>.displacement_z", "m", "... z"},
        {"static_reaction_x", "N",

@@ -12,6 +12,7 @@
 #include "partita/coupling/progress_line.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/coupling/sweep.hpp"
+#include "plain_name.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
@@ -218,18 +219,6 @@ std::uint64_t case_identity(const config::Node& root) {
 }
 
 // A case name becomes a folder name (out/<case>/) and part of file names: a plain name only.
-void check_plain_name(const config::Node& n, const std::string& name, const std::string& what) {
-  const bool bad_char = std::any_of(name.begin(), name.end(), [](char c) {
-    const auto u = static_cast<unsigned char>(c);
-    return !(std::isalnum(u) || c == '-' || c == '_' || c == '.' || c == '+');
-  });
-  if (name.empty() || bad_char || name == "." || name == ".." || name.front() == '.')
-    n.fail(what +
-           " is used in folder and file names, so it must be a plain name: letters, digits, "
-           "'-', '_', '.', '+', not starting with '.' (no '/', no spaces, no quotes); found '" +
-           name + "'");
-}
-
 }  // namespace
 
 Participant* CaseRun::participant(const std::string& name) const {
@@ -241,7 +230,8 @@ Participant* CaseRun::participant(const std::string& name) const {
 CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOptions options)
     : registries_(registries), options_(std::move(options)) {
   const config::Node root =
-      config::Node::load_file(case_file, options_.overrides).validated(case_spec(registries));
+      config::Node::load_file(case_file, options_.overrides, options_.override_origins)
+          .validated(case_spec(registries));
   name_ = root.string("case");
   check_plain_name(root["case"], name_, "the case name");
   case_dir_ = fs::absolute(case_file).parent_path();
@@ -323,7 +313,10 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
   }
 
   build_monitors(root);
-  if (root.has("sweep")) (void)Sweep(root);  // validates the swept keys, results and plot
+  if (root.has("sweep")) {
+    const Sweep sweep(root);  // validates the swept keys, labels, results and plot
+    if (options_.check_only && options_.check_sweep_values) check_sweep_values(case_file, sweep);
+  }
 
   if (root.has("output") && root["output"].has("restart") && !restart_blocker().empty())
     root["output"]["restart"].fail(restart_blocker() + "; remove output.restart");
@@ -360,6 +353,27 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
 }
 
 CaseRun::~CaseRun() = default;
+
+// Each swept value is checked where it will be used: the case is built (check only) with that
+// one value set, as the variant will run it; an error names the value's line in the sweep list.
+// One build per value, not per combination (a value valid alone is assumed valid with the
+// others: keys that depend on each other are checked when the variant runs).
+void CaseRun::check_sweep_values(const fs::path& case_file, const Sweep& sweep) const {
+  for (const Sweep::Parameter& par : sweep.parameters())
+    for (std::size_t i = 0; i < par.values.size(); ++i) {
+      RunOptions o = options_;
+      o.check_sweep_values = false;
+      o.override_origins.resize(o.overrides.size());
+      o.overrides.push_back(par.key + "=" + par.values[i]);
+      o.override_origins.push_back(par.origins[i]);
+      try {
+        CaseRun variant(case_file, registries_, o);
+      } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (the swept value " + par.values[i] + " of " +
+                    par.key + ", as its variants will run it)");
+      }
+    }
+}
 
 void CaseRun::build_participants(const config::Node& root) {
   const config::Node ps = root["participants"];
@@ -691,13 +705,14 @@ void CaseRun::run() {
     if (const std::string why = restart_blocker(); !why.empty())
       throw Error("cannot resume from " + resume_file.string() + ": " + why);
   }
-  {
+  // A resumed run changes nothing in its folder before the restart file has been read and
+  // accepted (read_restart_file() below); a new run prepares the folder here.
+  if (!resume) {
     Stopwatch clock;  // the output folder and an earlier run's VTK files: output time
     fs::create_directories(output_dir_ / "vtk");
-    if (!resume)
-      if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
-        logger->info("removed {} VTK files of an earlier run from {}", removed,
-                     (output_dir_ / "vtk").string());
+    if (const int removed = remove_pvd_series(output_dir_ / "vtk"); removed > 0)
+      logger->info("removed {} VTK files of an earlier run from {}", removed,
+                   (output_dir_ / "vtk").string());
     summary_.output_seconds += clock.seconds();
   }
 
@@ -786,16 +801,12 @@ void CaseRun::run() {
 
   Progress progress;
   progress.next_output = output_every_;
-  if (resume) {
+  if (!resume) {
+    flush_all();  // the headers
+  } else {
     read_restart_file(resume_file, progress);
+    fs::create_directories(output_dir_ / "vtk");
     summary_.resumed_from = progress.windows_done;
-    if (progress.windows_done >= window_count_)
-      throw Error(fmt::format(
-          "{}: the restart point is window {} (t = {:.6g} s), and the case ends there (window "
-          "{}): nothing to continue; raise time.end, e.g. --set time.end={:.6g}",
-          resume_file.string(), progress.windows_done,
-          static_cast<double>(progress.windows_done) * window_size_, window_count_,
-          2.0 * static_cast<double>(progress.windows_done) * window_size_));
   }
 
   logger->info(

@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kMagic = "partita restart file";
-constexpr std::uint32_t kVersion = 2;  // 2: the energy audit
+constexpr std::uint32_t kVersion = 3;  // 2: the energy audit; 3: section checksums
 constexpr std::uint32_t kByteOrder = 0x01020304u;
 
 // DIR/restart/w000000001234.bin -> 1234; -1 for other names.
@@ -167,6 +167,7 @@ void CaseRun::write_restart_file(const Progress& progress) {
       p->solver().write_restart(out);
     }
     out.section("end");
+    out.finish();  // the sections' CRC-32 table
     file.commit();
   }
   summary_.last_restart = path;
@@ -190,6 +191,23 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
   } catch (const Error&) {
   }
   if (magic != kMagic) throw Error(path.string() + " is not a partita restart file");
+  // Every section against its CRC-32 before any value is used. A file of an older format has
+  // no table: its version, when readable, says so more plainly than the missing table.
+  try {
+    in.verify_checksums();
+  } catch (const Error&) {
+    std::uint32_t version = 0;
+    try {
+      in.read(version);
+    } catch (const Error&) {
+    }
+    if (version != 0 && version < kVersion)
+      throw Error(fmt::format(
+          "{} has restart format version {}; this partita reads version {} (resume with the "
+          "partita that wrote it)",
+          path.string(), version, kVersion));
+    throw;
+  }
   const auto version = in.get<std::uint32_t>();
   const auto order = in.get<std::uint32_t>();
   if (order != kByteOrder)
@@ -211,33 +229,42 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
   if (window != window_size_)
     throw Error(fmt::format("{} was written with time.window = {:.17g} s; this case has {:.17g} s",
                             path.string(), window, window_size_));
-  in.read(progress.windows_done);
-  in.read(progress.frame);
-  in.read(progress.next_output);
-  summary_.iterations = static_cast<long>(in.get<std::int64_t>());
-  summary_.unconverged_windows = static_cast<long>(in.get<std::int64_t>());
-  in.read(summary_.max_window_iterations);
-  summary_.imbalance_warnings = static_cast<long>(in.get<std::int64_t>());
+  // Nothing in the output folder changes until the whole file has been read and accepted: the
+  // CSV texts and the VTK series' entries wait here and are written at the end.
+  Progress read;
+  in.read(read.windows_done);
+  in.read(read.frame);
+  in.read(read.next_output);
+  if (read.windows_done < 0 || read.frame < 0 || !std::isfinite(read.next_output))
+    in.fail("a window count, a frame count and an output time");
+  RunSummary summary = summary_;
+  summary.iterations = static_cast<long>(in.get<std::int64_t>());
+  summary.unconverged_windows = static_cast<long>(in.get<std::int64_t>());
+  in.read(summary.max_window_iterations);
+  summary.imbalance_warnings = static_cast<long>(in.get<std::int64_t>());
   in.expect_section("energy audit");
-  summary_.energy_warnings = static_cast<long>(in.get<std::int64_t>());
-  for (auto& p : energy_pairs_) {
+  summary.energy_warnings = static_cast<long>(in.get<std::int64_t>());
+  std::vector<EnergyPair> pairs = energy_pairs_;
+  for (auto& p : pairs) {
     in.read(p.last_a);
     in.read(p.last_b);
     in.read(p.passed);
     in.read(p.over);
   }
-  summary_.windows = progress.windows_done;
+  summary.windows = read.windows_done;
   in.expect_section("csv");
-  coupling_csv_.restore_text(in.get_string());
+  std::string coupling_text = in.get_string();
   const auto monitors = in.get<std::uint64_t>();
   if (monitors != monitors_.size())
     in.fail(fmt::format("{} monitors (found {})", monitors_.size(), monitors));
+  std::vector<std::string> monitor_texts;
   for (auto& m : monitors_) {
     if (in.get_string() != m.name) in.fail("the monitor '" + m.name + "'");
-    m.csv.restore_text(in.get_string());
+    monitor_texts.push_back(in.get_string());
   }
   in.expect_section("vtk");
   const auto series = in.get<std::uint64_t>();
+  std::vector<std::pair<std::string, std::vector<std::pair<double, std::string>>>> pvd_entries;
   for (std::uint64_t i = 0; i < series; ++i) {
     const std::string s = in.get_string();
     const auto n = in.get<std::uint64_t>();
@@ -246,7 +273,7 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
       const double t = in.get<double>();
       entries.emplace_back(t, in.get_string());
     }
-    pvd(s).restore_entries(std::move(entries));
+    pvd_entries.emplace_back(s, std::move(entries));
   }
   scheme_->read_state(in);
   const auto participants = in.get<std::uint64_t>();
@@ -257,6 +284,24 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
     p->solver().read_restart(in);
   }
   in.expect_section("end");
+  if (read.windows_done >= window_count_)
+    throw Error(fmt::format(
+        "{}: the restart point is window {} (t = {:.6g} s), and the case ends there (window "
+        "{}): nothing to continue; raise time.end, e.g. --set time.end={:.6g}",
+        path.string(), read.windows_done,
+        static_cast<double>(read.windows_done) * window_size_, window_count_,
+        2.0 * static_cast<double>(read.windows_done) * window_size_));
+
+  // Accepted: now the run's state and its files.
+  progress.windows_done = read.windows_done;
+  progress.frame = read.frame;
+  progress.next_output = read.next_output;
+  summary_ = summary;
+  energy_pairs_ = std::move(pairs);
+  coupling_csv_.restore_text(std::move(coupling_text));
+  for (std::size_t i = 0; i < monitors_.size(); ++i)
+    monitors_[i].csv.restore_text(std::move(monitor_texts[i]));
+  for (auto& [s, entries] : pvd_entries) pvd(s).restore_entries(std::move(entries));
 }
 
 void CaseRun::check_window(std::int64_t window, double time, bool after_audit) {

@@ -10,6 +10,7 @@
 
 #include "partita/interface/error.hpp"
 #include "partita/interface/output.hpp"
+#include "plain_name.hpp"
 
 namespace partita::coupling {
 
@@ -95,6 +96,25 @@ void check_key_path(const config::Node& root, const config::Node& where, const s
   }
 }
 
+// The path in one spelling: "a.b[1].c" and "a.b.[1].c" alike become "a.b[1].c".
+std::string normal_path(const std::string& path) {
+  std::string s;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (path[i] == '.' && i + 1 < path.size() && path[i + 1] == '[') continue;
+    s += path[i];
+  }
+  return s;
+}
+
+// One key path inside the other (or equal): setting both sets one value twice.
+bool nested_paths(const std::string& a, const std::string& b) {
+  const std::string& shorter = a.size() <= b.size() ? a : b;
+  const std::string& longer = a.size() <= b.size() ? b : a;
+  if (longer.compare(0, shorter.size(), shorter) != 0) return false;
+  return longer.size() == shorter.size() || longer[shorter.size()] == '.' ||
+         longer[shorter.size()] == '[';
+}
+
 std::string folder_text(const std::string& value) {
   std::string s;
   for (char c : value)
@@ -133,10 +153,27 @@ Sweep::Sweep(const config::Node& root) {
     par.key = p.string("key");
     check_key_path(root, p["key"], par.key);
     if (par.key.rfind("sweep", 0) == 0) p["key"].fail("the sweep cannot sweep itself");
-    par.label = p.has("label") ? p.string("label")
-                               : par.key.substr(par.key.find_last_of('.') == std::string::npos
-                                                    ? 0
-                                                    : par.key.find_last_of('.') + 1);
+    for (const auto& other : parameters_)
+      if (nested_paths(normal_path(other.key), normal_path(par.key)))
+        p["key"].fail(
+            normal_path(other.key) == normal_path(par.key)
+                ? "the key '" + par.key +
+                      "' is swept twice: each variant would set it twice and only the second "
+                      "value would run; list all its values in one parameter"
+                : "the keys '" + other.key + "' and '" + par.key +
+                      "' are both swept, and one lies inside the other: each variant would set "
+                      "the inner value twice; sweep one of them");
+    if (p.has("label")) {
+      par.label = p.string("label");
+      check_plain_name(p["label"], par.label, "the sweep label");
+    } else {  // the key's last name, brackets as '_' ("loads[0]" -> "loads_0")
+      for (const char c : par.key.substr(par.key.find_last_of('.') == std::string::npos
+                                             ? 0
+                                             : par.key.find_last_of('.') + 1))
+        if (c != ']') par.label += c == '[' ? '_' : c;
+      check_plain_name(p["key"], par.label,
+                       "the sweep label (the key's last name; or give label:)");
+    }
     const config::Node values = p["values"];
     if (!values.is_sequence() || values.size() == 0)
       values.fail("expected a non-empty list of values, e.g. [1, 2, 3]; found " +
@@ -145,6 +182,7 @@ Sweep::Sweep(const config::Node& root) {
       YAML::Emitter e;
       e << YAML::Flow << v.yaml();
       par.values.push_back(e.c_str());
+      par.origins.push_back(v.location());
     }
     for (const auto& other : parameters_)
       if (other.label == par.label)

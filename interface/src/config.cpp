@@ -531,10 +531,11 @@ Node Node::load_file(const std::filesystem::path& file) {
   return load_string(ss.str(), file.string());
 }
 
-Node Node::load_file(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+Node Node::load_file(const std::filesystem::path& file, const std::vector<std::string>& overrides,
+                     const std::vector<SourceLocation>& origins) {
   Node n = load_file(file);
   if (overrides.empty()) return n;
-  std::vector<std::string> overridden;
+  std::vector<std::pair<std::string, SourceLocation>> overridden;
   if (!n.node_.IsDefined() || n.node_.IsNull()) n.node_ = YAML::Node(YAML::NodeType::Map);
   for (const std::string& a : overrides) {
     const auto eq = a.find('=');
@@ -543,7 +544,8 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
           "--set '" + a +
           "': expected KEY.PATH=VALUE, e.g. time.end=0.01 or coupling.exchanges[0].mapper=rbf");
     const std::string path = a.substr(0, eq);
-    overridden.push_back(path);
+    const std::size_t index = overridden.size();
+    overridden.emplace_back(path, index < origins.size() ? origins[index] : SourceLocation{});
     YAML::Node value;
     try {
       value = YAML::Load(a.substr(eq + 1));
@@ -602,7 +604,9 @@ Node Node::load_file(const std::filesystem::path& file, const std::vector<std::s
     }
   }
   DocumentCheck(nullptr, "command line (--set)").walk(n.node_, "");
-  n.overridden_ = std::make_shared<const std::vector<std::string>>(std::move(overridden));
+  n.overridden_ =
+      std::make_shared<const std::vector<std::pair<std::string, SourceLocation>>>(
+          std::move(overridden));
   return n;
 }
 
@@ -612,9 +616,10 @@ const std::string& Node::file() const {
 
 SourceLocation Node::location() const {
   if (overridden_)
-    for (const std::string& p : *overridden_)
+    for (const auto& [p, origin] : *overridden_)
       if (path_ == p || path_.rfind(p + ".", 0) == 0 || path_.rfind(p + "[", 0) == 0)
-        return SourceLocation{"command line (--set " + p + "=...)", 0, 0};
+        return origin.file.empty() ? SourceLocation{"command line (--set " + p + "=...)", 0, 0}
+                                   : origin;
   if (node_.IsDefined()) {
     const YAML::Mark m = node_.Mark();
     if (m.line >= 0) return SourceLocation{file(), m.line + 1, m.column + 1};

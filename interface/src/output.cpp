@@ -65,7 +65,6 @@ CsvSeries::CsvSeries(std::filesystem::path path, std::string first_column, std::
   text_ = header_cell(first_column, first_unit);
   for (const auto& [n, u] : columns) text_ += "," + header_cell(n, u);
   text_ += "\n";
-  flush();
 }
 
 void CsvSeries::record(double first, const std::vector<double>& values) {

@@ -1,8 +1,10 @@
-// The Solver contract, checked on every registered adapter: meshes are non-empty and their data
-// well-formed, the stable time step is positive, write() returns N x C values, read() accepts
-// them, checkpoint/restore returns a bit-identical state (the same window repeated gives the
-// same outputs), time advances by dt, output files and monitors exist and are finite.
+// The Solver contract (partita/interface/conformance.hpp), checked on every registered adapter:
+// meshes are non-empty and their data well-formed, the stable time step is positive, write()
+// returns N x C values, read() accepts them, checkpoint/restore returns a bit-identical state
+// (the same window repeated gives the same outputs), time advances by dt, restart streams
+// continue bit for bit, output files and monitors exist, are finite and documented.
 // Every registered solver needs a sample configuration below: a new adapter without one fails.
+// The check also fails when it should: a solver that breaks the contract on purpose.
 
 #include <catch2/catch.hpp>
 
@@ -14,6 +16,7 @@
 #include "dem_adapter_support.hpp"
 #include "partita/adapters/register_all.hpp"
 #include "partita/coupling/registries.hpp"
+#include "partita/interface/conformance.hpp"
 
 using namespace partita;
 namespace fs = std::filesystem;
@@ -36,35 +39,6 @@ const std::map<std::string, std::string>& samples() {
   return s;
 }
 
-// Deterministic, non-trivial input of the right shape: small values (e.g. a displacement of a
-// few micrometres, a pressure of a few pascals) so that every solver stays in its valid range.
-Eigen::MatrixXd input(const InterfaceMesh& m, const DataSpec& d, double scale) {
-  // Fields that must stay near a reference value (a tube's cross-section) get it as baseline.
-  const double base = d.name == "cross_section_area" ? 1.0 : 0.0;
-  Eigen::MatrixXd v = Eigen::MatrixXd::Constant(m.mesh.size(), d.components, base);
-  for (Eigen::Index i = 0; i < v.rows(); ++i)
-    for (Eigen::Index k = 0; k < v.cols(); ++k)
-      v(i, k) += scale * (1e-6 * static_cast<double>((i * 7 + k * 3) % 5));
-  return v;
-}
-
-// Advance one "window" of n steps with inputs, and collect every written field.
-std::vector<Eigen::MatrixXd> window(Solver& s, double dt, int n) {
-  for (int k = 0; k < n; ++k) {
-    for (const auto& m : s.meshes())
-      for (const auto& d : m.reads) s.read(m.mesh.name(), d.name, input(m, d, 1.0 + k));
-    s.advance(dt);
-  }
-  std::vector<Eigen::MatrixXd> out;
-  for (const auto& m : s.meshes())
-    for (const auto& d : m.writes) {
-      Eigen::MatrixXd v;
-      s.write(m.mesh.name(), d.name, v);
-      out.push_back(v);
-    }
-  return out;
-}
-
 }  // namespace
 
 TEST_CASE("every registered adapter honours the Solver contract", "[adapters][conformance]") {
@@ -81,109 +55,73 @@ TEST_CASE("every registered adapter honours the Solver contract", "[adapters][co
       INFO("add a sample configuration for '" << entry.name
                                               << "' to tests/adapters/conformance_test.cpp");
       REQUIRE(it != samples().end());
-      config::Node node = config::Node::load_string(it->second, entry.name + ".yaml");
-      if (entry.spec) {
-        auto spec = std::make_shared<config::Spec>(*entry.spec);
-        if (!spec->find("solver")) spec->string("solver", "name").required();
-        node = node.validated(spec);
-      }
-      SolverContext ctx{"p", node, fs::path(PARTITA_SOURCE_DIR), out, 1};
-      std::unique_ptr<Solver> s = entry.factory(ctx);
-      REQUIRE(s);
-
-      // meshes: non-empty, named, with data of positive width
-      REQUIRE_FALSE(s->meshes().empty());
-      for (const auto& m : s->meshes()) {
-        CHECK_FALSE(m.mesh.name().empty());
-        CHECK(m.mesh.size() > 0);
-        CHECK(m.reads.size() + m.writes.size() > 0);
-        for (const auto* list : {&m.reads, &m.writes})
-          for (const auto& d : *list) CHECK(d.components > 0);
-      }
-
-      const double dt_stable = s->stable_time_step();
-      CHECK(dt_stable > 0.0);
-      const double dt = std::isfinite(dt_stable) ? 0.5 * dt_stable : 1e-4;
-      CHECK(s->time() == 0.0);
-
-      // write() gives N x C for every written field
-      for (const auto& m : s->meshes())
-        for (const auto& d : m.writes) {
-          Eigen::MatrixXd v;
-          s->write(m.mesh.name(), d.name, v);
-          CHECK(v.rows() == m.mesh.size());
-          CHECK(v.cols() == d.components);
-          CHECK(v.allFinite());
-        }
-
-      // checkpoint / restore: repeating a window gives bit-identical outputs and time
-      window(*s, dt, 2);
-      s->save_checkpoint();
-      const double t0 = s->time();
-      const auto first = window(*s, dt, 3);
-      CHECK(s->time() == Approx(t0 + 3 * dt).epsilon(1e-12));
-      s->restore_checkpoint();
-      CHECK(s->time() == t0);
-      const auto again = window(*s, dt, 3);
-      REQUIRE(first.size() == again.size());
-      for (std::size_t i = 0; i < first.size(); ++i)
-        CHECK((first[i].array() == again[i].array()).all());
-
-      // restart files: a fresh solver built from the same configuration and read from what
-      // this one wrote continues bit for bit (as the checkpoint does, in another process)
-      if (s->supports_restart()) {
-        std::stringstream file;
-        BinaryWriter w(file);
-        s->write_restart(w);
-        REQUIRE(w.good());
-        std::unique_ptr<Solver> fresh = entry.factory(ctx);
-        BinaryReader rd(file, "conformance");
-        fresh->read_restart(rd);
-        CHECK(fresh->time() == s->time());
-        const auto a = window(*s, dt, 3);
-        const auto b = window(*fresh, dt, 3);
-        REQUIRE(a.size() == b.size());
-        for (std::size_t i = 0; i < a.size(); ++i) CHECK((a[i].array() == b[i].array()).all());
-        // a truncated file is an error, never a crash or a half-read state
-        std::stringstream cut(file.str().substr(0, file.str().size() / 2));
-        BinaryReader rc(cut, "cut");
-        std::unique_ptr<Solver> other = entry.factory(ctx);
-        CHECK_THROWS_AS(other->read_restart(rc), Error);
-      }
-      CHECK(s->check_state().empty());
-
-      // output and monitors
-      s->write_output(OutputFrame{out / "vtk", "p_" + entry.name, 1, s->time(), {}});
-      for (const auto& [series, file] : s->output_files()) {
-        INFO("output file " << file);
-        CHECK(fs::exists(out / "vtk" / file));
-        CHECK(fs::file_size(out / "vtk" / file) > 0);
-      }
-      for (const auto& mv : s->monitors()) {
-        INFO("monitor " << mv.name);
-        CHECK_FALSE(mv.name.empty());
-        CHECK(std::isfinite(mv.value));
-        // every reported quantity is on the solver's `partita docs` page, with its unit
-        const auto doc =
-            std::find_if(entry.quantities.begin(), entry.quantities.end(),
-                         [&](const QuantityDoc& d) { return quantity_matches(d, mv.name); });
-        INFO("document it in the solver's registration (adapters/src/adapters.cpp)");
-        REQUIRE(doc != entry.quantities.end());
-        CHECK(doc->unit == mv.unit);
-      }
-      // monitor_values(names), what the core asks each window: exactly the named quantities,
-      // with the values and units monitors() gives (a solver may compute only those asked)
-      for (const auto& mv : s->monitors()) {
-        INFO("monitor " << mv.name);
-        const auto one = s->monitor_values({mv.name});
-        REQUIRE(one.size() == 1);
-        CHECK(one[0].name == mv.name);
-        CHECK(one[0].unit == mv.unit);
-        CHECK(one[0].value == mv.value);
-      }
-      CHECK(s->monitor_values({"no_such_quantity"}).empty());
-      s->finalize();
+      // the contract itself: partita::check_solver_contract (installed with the package, so
+      // that an adapter written out of tree runs the same checks)
+      const auto failures =
+          check_solver_contract(entry, it->second, fs::path(PARTITA_SOURCE_DIR), out / entry.name);
+      for (const auto& f : failures) FAIL_CHECK(f);
     }
   }
   fs::remove_all(out);
+}
+
+namespace {
+
+// A solver that breaks the contract on purpose: its checkpoint forgets the state, it reports an
+// undocumented monitor and a write() of the wrong shape.
+class BrokenSolver final : public Solver {
+ public:
+  BrokenSolver() {
+    InterfaceMesh m;
+    Mesh::Points p(2, 3);
+    p << 0, 0, 0, 1, 0, 0;
+    m.mesh = Mesh("points", p);
+    m.writes.push_back(DataSpec{"position", 1, "m", DataKind::intensive});
+    m.reads.push_back(DataSpec{"force", 1, "N", DataKind::extensive});
+    meshes_.push_back(std::move(m));
+  }
+  const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
+  void read(std::string_view, std::string_view, const Eigen::MatrixXd& v) override {
+    f_ = v.sum();
+  }
+  void write(std::string_view, std::string_view, Eigen::MatrixXd& v) override {
+    v = Eigen::MatrixXd::Constant(1, 1, x_);  // one row for a mesh of two points
+  }
+  void advance(double dt) override {
+    x_ += dt * (1.0 + f_);
+    t_ += dt;
+  }
+  double time() const override { return t_; }
+  void save_checkpoint() override { saved_t_ = t_; }
+  void restore_checkpoint() override { t_ = saved_t_; }  // x_ is not restored
+  std::vector<MonitorValue> monitors() const override { return {{"secret", "m", x_}}; }
+
+ private:
+  std::vector<InterfaceMesh> meshes_;
+  double x_ = 0.0, f_ = 0.0, t_ = 0.0, saved_t_ = 0.0;
+};
+
+}  // namespace
+
+TEST_CASE("the contract check finds a solver that breaks it", "[adapters][conformance]") {
+  Registry<SolverFactory> r("solver");
+  r.add("broken", "breaks the contract", [](const SolverContext&) {
+    return std::unique_ptr<Solver>(std::make_unique<BrokenSolver>());
+  });
+  const fs::path out =
+      fs::temp_directory_path() / ("partita_conformance_broken_" + std::to_string(::getpid()));
+  const auto failures = check_solver_contract(*r.find("broken"), "solver: broken\n", out, out);
+  fs::remove_all(out);
+  auto found = [&](const std::string& text) {
+    return std::any_of(failures.begin(), failures.end(),
+                       [&](const std::string& f) { return f.find(text) != std::string::npos; });
+  };
+  INFO([&] {
+    std::string all;
+    for (const auto& f : failures) all += f + "\n";
+    return all;
+  }());
+  CHECK(found("gives 1 x 1 values, not 2 x 1"));
+  CHECK(found("not bit-identical"));
+  CHECK(found("monitor secret is not documented"));
 }

@@ -72,6 +72,11 @@ TEST_CASE("bad inputs: partita check exits non-zero with one clear message", "[a
     // One message: a single error line (plus nothing that looks like a stack dump).
     CHECK(r.output.find("AddressSanitizer") == std::string::npos);
     CHECK(r.output.find("runtime error") == std::string::npos);
+    // No standard-library text reaches the user ("cannot create std::vector larger than
+    // max_size()", "stoul", "basic_string"): every message is the project's own.
+    CHECK(r.output.find("std::") == std::string::npos);
+    CHECK(r.output.find("basic_string") == std::string::npos);
+    CHECK(r.output.find("internal error") == std::string::npos);
   }
   CHECK(count >= 25);
 }

@@ -12,6 +12,7 @@
 #include <catch2/catch.hpp>
 
 #include "../support/run_command.hpp"
+#include "../support/scratch_files.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -36,24 +37,13 @@ namespace {
 
 const fs::path kSource = PARTITA_SOURCE_DIR;
 
-fs::path scratch(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("partita_services_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return partita::test::scratch_dir("services", name); }
 
 partita::test::CommandResult partita_run(const std::string& args) {
   return partita::test::run_command(quote(PARTITA_EXECUTABLE) + " " + args);
 }
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string read_all(const fs::path& p) { return partita::test::read_file(p); }
 
 std::size_t lines(const fs::path& p) {
   const std::string t = read_all(p);

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include "../support/run_command.hpp"
+#include "../support/scratch_files.hpp"
 
 #include <unistd.h>
 
@@ -23,20 +24,9 @@ namespace {
 
 const fs::path kCase = fs::path(PARTITA_SOURCE_DIR) / "tests/inputs/sweep/tube_sweep.yaml";
 
-fs::path scratch(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("partita_sweep_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return partita::test::scratch_dir("sweep", name); }
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string read_all(const fs::path& p) { return partita::test::read_file(p); }
 
 partita::test::CommandResult run(const std::string& args) {
   return partita::test::run_command(quote(PARTITA_EXECUTABLE) + " run " + quote(kCase.string()) +

@@ -62,6 +62,10 @@ TEST_CASE("output: a CSV series has a header with units and only complete rows o
   const fs::path dir = scratch("csv");
   const fs::path file = dir / "reaction.csv";
   CsvSeries csv(file, "time", "s", {{"force_z", "N"}, {"iterations", ""}});
+  // nothing on disk before the first flush (a resumed run replaces the text first: a file of
+  // the run it continues stays untouched until the restart file is accepted)
+  CHECK_FALSE(fs::exists(file));
+  csv.flush();
   CHECK(read(file) == "time [s],force_z [N],iterations\n");
   csv.record(0.5, {4.0, 2.0});
   CHECK(read(file) == "time [s],force_z [N],iterations\n");  // not flushed yet

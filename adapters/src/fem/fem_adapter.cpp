@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "partita/fem/error.hpp"
+#include "partita/fem/face_area.hpp"
 #include "partita/fem/state_io.hpp"
 
 #include "fem_output.hpp"
@@ -119,12 +120,18 @@ std::shared_ptr<Spec> make_spec() {
                   std::string("instead of ramp: the displacement times ") + TimeTable::doc());
   constraint->one_of({"fix", "displacement"});
 
-  auto load = std::make_shared<Spec>("load", "a load: pressure or traction on a face, or gravity");
+  auto load = std::make_shared<Spec>(
+      "load", "a load: pressure, traction or total force on a face, or gravity");
   load->string("face", "face name (box: xmin ... zmax; Gmsh: physical surface names)");
   load->real("pressure",
              "uniform pressure, positive pushing into the body (against the outward normal)")
       .unit("Pa");
   load->reals("traction", "uniform traction vector").unit("Pa").size(3);
+  load->reals("force",
+              "total force on the face, spread as the uniform traction force / area (the face's "
+              "reference area)")
+      .unit("N")
+      .size(3);
   load->reals("gravity", "gravitational acceleration acting on the whole body")
       .unit("m/s^2")
       .size(3);
@@ -134,7 +141,7 @@ std::shared_ptr<Spec> make_spec() {
       .non_negative()
       .def(0.0);
   load->any("table", std::string("instead of ramp: the load times ") + TimeTable::doc());
-  load->one_of({"pressure", "traction", "gravity"});
+  load->one_of({"pressure", "traction", "force", "gravity"});
 
   auto probe = std::make_shared<Spec>(
       "probe", "a line probe: N points from 'from' to 'to', sampled at every output time");
@@ -144,6 +151,14 @@ std::shared_ptr<Spec> make_spec() {
   probe->integer("points", "points along the segment").min(2).def(50);
   probe->strings("fields", "what to sample (default: displacement)")
       .choices({"displacement", "stress", "von_mises"});
+
+  auto point = std::make_shared<Spec>(
+      "point", "a point monitor: the displacement interpolated at a point of the model");
+  point->string("name", "monitor quantities <name>.displacement_x, _y, _z").required();
+  point->reals("at", "the point, in the reference configuration (inside or on the model)")
+      .unit("m")
+      .size(3)
+      .required();
 
   auto interface = std::make_shared<Spec>("interface", "a coupling interface on a face");
   interface->string("name", "interface name: meshes <name> (nodes) and <name>_quadrature (quadrature points)")
@@ -255,6 +270,10 @@ std::shared_ptr<Spec> make_spec() {
           "line probes: one CSV per output time along a segment (s, x, y, z, the fields; the "
           "stress is the element-averaged nodal stress interpolated)",
           probe);
+  s->list("points",
+          "point monitors: <name>.displacement_x/_y/_z, the displacement at a point of the "
+          "reference configuration (interpolated in the element that holds it)",
+          point);
   s->list("interfaces",
           "coupling interfaces (faces whose meshes the coupling can use, and whose mean "
           "displacement and received force are monitor quantities)",
@@ -439,13 +458,20 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         continue;
       }
       if (!l.has("face"))
-        l.fail("a pressure or traction load needs 'face: <name>'; faces: " + join_names(faces));
+        l.fail("a pressure, traction or force load needs 'face: <name>'; faces: " +
+               join_names(faces));
       const std::string face = l.string("face");
       require_name(l["face"], face, faces, "face");
-      if (l.has("pressure"))
+      if (l.has("pressure")) {
         model.add_pressure(face, l.real("pressure"), amp);
-      else
+      } else if (l.has("force")) {
+        // F spread evenly: t = F / A over the face's reference area (a follower of nothing:
+        // fixed in direction and size, as a traction load)
+        const double area = fem::face_area(model.mesh(), face);
+        model.add_traction(face, l.vec3("force") / area, amp);
+      } else {
         model.add_traction(face, l.vec3("traction"), amp);
+      }
     }
 
     const Node an = c["analysis"];
@@ -554,12 +580,36 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       const std::string pname = p.string("name");
       for (const auto& other : probes_)
         if (other.name() == pname) p["name"].fail("probe name '" + pname + "' is used twice");
+      if (const fem::Vec3 d = p.vec3("to") - p.vec3("from");
+          !(d.norm() > 1e-12 * std::max(1.0, p.vec3("from").norm())))
+        p["to"].fail(fmt::format(
+            "line probe '{}': 'to' equals 'from' ({}, {}, {}): a line probe samples a segment of "
+            "positive length; give 'to' another point",
+            pname, p.vec3("from").x(), p.vec3("from").y(), p.vec3("from").z()));
       try {
         probes_.emplace_back(pname, solver_->mesh(), p.vec3("from"), p.vec3("to"),
                              static_cast<int>(p.integer("points")), fields);
       } catch (const fem::Error& e) {
         p.fail(e.what());
       }
+    }
+    for (const Node& p : c["points"].items()) {
+      const std::string pname = p.string("name");
+      for (const auto& i : interfaces_)
+        if (i.name == pname)
+          p["name"].fail("'" + pname +
+                         "' names an interface already; its monitor quantities would be the "
+                         "same: give the point another name");
+      for (const auto& other : points_)
+        if (other.name == pname) p["name"].fail("point name '" + pname + "' is used twice");
+      if (!locator_) locator_ = std::make_unique<MeshLocator>(solver_->mesh());
+      const auto at = locator_->locate(p.vec3("at"));
+      if (!at)
+        p["at"].fail(fmt::format(
+            "point '{}' at ({}, {}, {}) lies in no element of the model (give a point inside "
+            "or on its surface, in the reference configuration)",
+            pname, p.vec3("at").x(), p.vec3("at").y(), p.vec3("at").z()));
+      points_.push_back({pname, *at});
     }
     if (!transient_) solver_->solve_static();
   } catch (const fem::Error& e) {
@@ -786,6 +836,12 @@ std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::stri
     for (int k = 0; k < 3; ++k)
       m.push_back(
           {i.name + ".displacement_" + kComponents[static_cast<std::size_t>(k)], "m", d(k)});
+  }
+  for (const auto& p : points_) {
+    const Eigen::Vector3d d = locator_->interpolate(p.at, solver_->displacement());
+    for (int k = 0; k < 3; ++k)
+      m.push_back(
+          {p.name + ".displacement_" + kComponents[static_cast<std::size_t>(k)], "m", d(k)});
   }
   // Minus the applied loads (gravity included): what the interfaces carry in static equilibrium.
   const Eigen::Vector3d applied = solver_->total_external_force() - solver_->total_coupling_force();

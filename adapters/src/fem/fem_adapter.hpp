@@ -22,6 +22,7 @@
 
 #include "line_probe.hpp"
 #include "partita/fem/fem.hpp"
+#include "mesh_locator.hpp"
 #include "partita/interface/solver.hpp"
 
 namespace partita::adapters {
@@ -87,6 +88,13 @@ class FemAdapter : public Solver {
   Eigen::Vector3d applied_per_unit_ = Eigen::Vector3d::Zero();
   double model_size_ = 0.0;
   std::vector<LineProbe> probes_;  // diagonal of the mesh's bounding box [m]
+  // point monitors (points:): where each lies in the mesh
+  struct PointMonitor {
+    std::string name;
+    MeshLocation at;
+  };
+  std::unique_ptr<MeshLocator> locator_;  // only with point monitors
+  std::vector<PointMonitor> points_;
 };
 
 }  // namespace partita::adapters

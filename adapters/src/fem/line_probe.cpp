@@ -1,5 +1,7 @@
 #include "line_probe.hpp"
 
+#include "mesh_locator.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -14,41 +16,6 @@ namespace partita::adapters {
 
 namespace {
 
-bool is_tet(fem::ElementType t) {
-  return t == fem::ElementType::Tet4 || t == fem::ElementType::Tet10;
-}
-
-// Inside the reference element, with a tolerance: hexahedra [-1, 1]^3, tetrahedra
-// xi, eta, zeta >= 0 and xi + eta + zeta <= 1.
-bool inside(fem::ElementType t, const fem::Vec3& xi, double tol) {
-  if (is_tet(t)) return xi.minCoeff() >= -tol && xi.sum() <= 1.0 + tol;
-  return xi.cwiseAbs().maxCoeff() <= 1.0 + tol;
-}
-
-// Local coordinates of x in element e by Newton on x(xi) = sum N_i(xi) X_i; false if it does
-// not converge or the point lies outside.
-bool locate(const fem::Mesh& mesh, const fem::Element& e, const fem::Vec3& x, fem::Vec3& xi) {
-  fem::ShapeVector n;
-  fem::ShapeGradient dn;
-  xi = is_tet(e.type) ? fem::Vec3::Constant(0.25) : fem::Vec3::Zero();
-  const auto nodes = e.node_span();
-  for (int it = 0; it < 30; ++it) {
-    fem::shape_functions(e.type, xi, n, dn);
-    fem::Vec3 r = -x;
-    Eigen::Matrix3d j = Eigen::Matrix3d::Zero();  // dx/dxi
-    for (std::size_t a = 0; a < nodes.size(); ++a) {
-      const fem::Vec3& xa = mesh.node(nodes[a]);
-      r += n(static_cast<Eigen::Index>(a)) * xa;
-      j += xa * dn.row(static_cast<Eigen::Index>(a));
-    }
-    const fem::Vec3 step = j.partialPivLu().solve(r);
-    xi -= step;
-    if (!xi.allFinite() || xi.cwiseAbs().maxCoeff() > 10.0) return false;
-    if (step.norm() < 1e-14) break;
-  }
-  return inside(e.type, xi, 1e-9);
-}
-
 void append(std::string& s, double v) {
   char buf[32];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);
@@ -61,32 +28,18 @@ LineProbe::LineProbe(std::string name, const fem::Mesh& mesh, const fem::Vec3& f
                      const fem::Vec3& to, int points, std::vector<Field> fields)
     : name_(std::move(name)), mesh_(&mesh), fields_(std::move(fields)) {
   if (points < 2) throw fem::Error("line probe '" + name_ + "': at least 2 points are needed");
-  // element bounding boxes for a cheap first test
-  std::vector<std::pair<fem::Vec3, fem::Vec3>> boxes;
-  boxes.reserve(mesh.num_elements());
-  for (const auto& e : mesh.elements()) {
-    fem::Vec3 lo = fem::Vec3::Constant(std::numeric_limits<double>::max()), hi = -lo;
-    for (const std::size_t k : e.node_span()) {
-      lo = lo.cwiseMin(mesh.node(k));
-      hi = hi.cwiseMax(mesh.node(k));
-    }
-    const double pad = 1e-9 * (hi - lo).norm();
-    boxes.emplace_back(lo.array() - pad, hi.array() + pad);
-  }
+  const MeshLocator locator(mesh);
   const double length = (to - from).norm();
   for (int p = 0; p < points; ++p) {
     Point pt;
     const double f = static_cast<double>(p) / static_cast<double>(points - 1);
     pt.x = from + f * (to - from);
     pt.s = f * length;
-    bool found = false;
-    for (std::size_t e = 0; e < mesh.num_elements() && !found; ++e) {
-      const auto& [lo, hi] = boxes[e];
-      if ((pt.x.array() < lo.array()).any() || (pt.x.array() > hi.array()).any()) continue;
-      if (locate(mesh, mesh.element(e), pt.x, pt.xi)) {
-        pt.element = e;
-        found = true;
-      }
+    const auto at = locator.locate(pt.x);
+    const bool found = at.has_value();
+    if (found) {
+      pt.element = at->element;
+      pt.xi = at->xi;
     }
     if (!found)
       throw fem::Error("line probe '" + name_ + "': point " + std::to_string(p) + " at (" +

@@ -55,6 +55,10 @@ struct RunOptions {
   bool check_only = false;  ///< validate and build everything, write nothing, run nothing
   /// "key.path[i].key=YAML value" assignments applied to the case file before validation.
   std::vector<std::string> overrides;
+  /// Where each override comes from (same order; missing or empty: the command line).
+  std::vector<SourceLocation> override_origins;
+  /// check_only: also build the case once with each value of its sweep section set.
+  bool check_sweep_values = true;
   /// Continue the run whose output folder this is from its newest restart file (the output
   /// goes to the same folder).
   std::filesystem::path resume_dir;
@@ -123,6 +127,7 @@ class CaseRun {
   void build_participants(const config::Node& root);
   void build_exchanges(const config::Node& coupling);
   void build_monitors(const config::Node& root);
+  void check_sweep_values(const std::filesystem::path& case_file, const class Sweep& sweep) const;
   void write_output(int frame, double time);
 
   // Restart files and run-time checks (case_run_restart.cpp)

@@ -33,6 +33,7 @@ class Sweep {
     std::string key;                  ///< key path in the case, as --set takes it
     std::string label;                ///< folder and column name
     std::vector<std::string> values;  ///< YAML text of each value
+    std::vector<SourceLocation> origins;  ///< where each value is in the case file
   };
   struct Result {
     std::string name, monitor, column, of;  ///< of: final | max | min | mean
@@ -44,8 +45,10 @@ class Sweep {
   };
 
   /// The validated `sweep` section of the case `root` (throws partita::Error at the key: a key
-  /// path that is not in the case file, with did-you-mean; an empty value list; a result or
-  /// plot that names no declared monitor or column).
+  /// path that is not in the case file, with did-you-mean; two parameters that set the same key
+  /// or one inside the other; a label that is not a plain name (it becomes a folder name); an
+  /// empty value list; a result or plot that names no declared monitor or column). The values'
+  /// types are checked by CaseRun (check) against the declaration of the key they set.
   Sweep(const config::Node& root);
 
   /// The schema of the `sweep` section (for the case schema and `partita docs`).

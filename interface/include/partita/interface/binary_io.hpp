@@ -10,6 +10,15 @@
 // Every read is checked: a truncated stream, a section name that differs from the one expected
 // or a size that cannot fit what remains gives partita::Error naming the source and what was
 // expected, never a crash or a silently wrong state.
+//
+// Integrity: the writer keeps a CRC-32 (zlib's, the polynomial of gzip and PNG) of each section,
+// the bytes from one marker to the next (the bytes before the first marker form the section
+// "header"), and finish() appends a table of them:
+//   [u64 count] count x ([string name][u64 offset][u64 length][u32 crc])    the table
+//   [u64 table offset][u32 CRC-32 of the table][8 bytes "PRTCRC01"]         the footer (20 bytes)
+// A reader calls verify_checksums() before it uses anything: every section's bytes are checked
+// against the table (one pass over the file), so a flipped bit anywhere is an error naming the
+// section, never a resumed run with a moved particle. Reads then stop at the table.
 
 #include <cstdint>
 #include <cstring>
@@ -31,17 +40,16 @@ class BinaryWriter {
 
   template <class T>
   requires std::is_arithmetic_v<T>
-  void write(T v) { out_.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
+  void write(T v) { put(&v, sizeof(T)); }
   void write(const std::string& s) {
     write(static_cast<std::uint64_t>(s.size()));
-    out_.write(s.data(), static_cast<std::streamsize>(s.size()));
+    put(s.data(), s.size());
   }
   template <class T>
   requires std::is_arithmetic_v<T>
   void write(const std::vector<T>& v) {
     write(static_cast<std::uint64_t>(v.size()));
-    out_.write(reinterpret_cast<const char*>(v.data()),
-               static_cast<std::streamsize>(v.size() * sizeof(T)));
+    put(v.data(), v.size() * sizeof(T));
   }
   /// Any dense Eigen matrix or vector of doubles (rows, cols, column-major values).
   template <class Derived>
@@ -49,18 +57,32 @@ class BinaryWriter {
     static_assert(std::is_same_v<typename Derived::Scalar, double>, "doubles only");
     write(static_cast<std::int64_t>(m.rows()));
     write(static_cast<std::int64_t>(m.cols()));
-    out_.write(reinterpret_cast<const char*>(m.data()),
-               static_cast<std::streamsize>(m.size() * static_cast<Eigen::Index>(sizeof(double))));
+    put(m.data(), static_cast<std::size_t>(m.size()) * sizeof(double));
   }
-  /// A named marker; the reader checks it (catches a reader and writer out of step).
-  void section(const std::string& name) { write("§" + name); }
+  /// A named marker; the reader checks it (catches a reader and writer out of step). It also
+  /// starts a new checksummed section.
+  void section(const std::string& name);
   /// Raw bytes of a nested stream (a solver's own format), length first.
   void bytes(const std::string& b) { write(b); }
+  /// Append the checksum table and footer (see above); nothing may be written after it.
+  void finish();
 
   bool good() const { return static_cast<bool>(out_); }
 
  private:
+  struct Section {
+    std::string name;
+    std::uint64_t offset = 0;
+    std::uint64_t length = 0;
+    std::uint32_t crc = 0;
+  };
+  void put(const void* p, std::size_t n);
+  void close_section();
   std::ostream& out_;
+  std::uint64_t size_ = 0;  // bytes written so far
+  Section current_{"header", 0, 0, 0};
+  std::vector<Section> sections_;
+  bool finished_ = false;
 };
 
 class BinaryReader {
@@ -119,6 +141,11 @@ class BinaryReader {
   }
   std::string bytes() { return get_string(); }
 
+  /// Check every section against the checksum table that BinaryWriter::finish() wrote, before
+  /// anything is read: an Error naming the damaged section (or the missing table). Reads after
+  /// it end at the table. The stream position is kept.
+  void verify_checksums();
+
   const std::string& source() const { return source_; }
   /// Throw "<source>: restart data ends or differs where <what> was expected".
   [[noreturn]] void fail(const std::string& what) const {
@@ -130,6 +157,12 @@ class BinaryReader {
   long long position() const { return static_cast<long long>(in_.tellg()); }
   void raw(void* p, std::size_t n, const char* what) {
     if (n == 0) return;
+    if (limit_ >= 0) {  // verified: the data ends at the checksum table
+      const auto here = in_.tellg();
+      if (here >= 0 && (here > limit_ || n > static_cast<std::uint64_t>(limit_ - here)))
+        throw Error(source_ + ": restart data is truncated: " + what + " of " +
+                    std::to_string(n) + " bytes runs into the checksum table");
+    }
     in_.read(static_cast<char*>(p), static_cast<std::streamsize>(n));
     if (static_cast<std::size_t>(in_.gcount()) != n) {
       in_.clear();
@@ -147,9 +180,12 @@ class BinaryReader {
   void check_remaining(std::uint64_t n, const char* what) {
     const auto here = in_.tellg();
     if (here < 0) return;  // not seekable: the read itself checks
-    in_.seekg(0, std::ios::end);
-    const auto end = in_.tellg();
-    in_.seekg(here);
+    std::streamoff end = limit_;
+    if (end < 0) {
+      in_.seekg(0, std::ios::end);
+      end = in_.tellg();
+      in_.seekg(here);
+    }
     if (end >= here && n > static_cast<std::uint64_t>(end - here))
       throw Error(source_ + ": restart data is truncated or damaged: " + what + " of " +
                   std::to_string(n) + " bytes is announced, " +
@@ -158,6 +194,7 @@ class BinaryReader {
 
   std::istream& in_;
   std::string source_;
+  std::streamoff limit_ = -1;  // where the data ends (the checksum table), once verified
 };
 
 }  // namespace partita

@@ -191,8 +191,11 @@ class Node {
   static Node load_file(const std::filesystem::path& file);
   /// Parse a YAML file, then apply assignments "a.b[2].c=VALUE" (VALUE is YAML: a number, a
   /// string, [a, b] or {k: v}); a missing key is created, a bad path is a partita::Error.
+  /// `origins`, where given (one per assignment), is where each assignment comes from (a sweep
+  /// value in the case file): messages about that key name it instead of the command line.
   static Node load_file(const std::filesystem::path& file,
-                        const std::vector<std::string>& overrides);
+                        const std::vector<std::string>& overrides,
+                        const std::vector<SourceLocation>& origins = {});
   /// Parse YAML text; `name` stands for the file name in messages.
   static Node load_string(const std::string& text, const std::string& name = "<string>");
 
@@ -263,7 +266,8 @@ class Node {
   std::string path_;
   std::shared_ptr<const Spec> spec_;
   SourceLocation fallback_;  // where a missing (defaulted) node would have been
-  std::shared_ptr<const std::vector<std::string>> overridden_;  // key paths set by --set
+  // key paths set by --set, each with where it came from (empty file: the command line)
+  std::shared_ptr<const std::vector<std::pair<std::string, SourceLocation>>> overridden_;
 };
 
 }  // namespace partita::config

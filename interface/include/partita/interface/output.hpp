@@ -46,7 +46,8 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
 class CsvSeries {
  public:
   CsvSeries() = default;
-  /// columns: (name, unit) pairs after the first column.
+  /// columns: (name, unit) pairs after the first column. Nothing is written before the first
+  /// flush() (a resumed run replaces the text first: an existing file stays as it is until then).
   CsvSeries(std::filesystem::path path, std::string first_column, std::string first_unit,
             std::vector<std::pair<std::string, std::string>> columns);
   void record(double first, const std::vector<double>& values);

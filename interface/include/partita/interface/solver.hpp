@@ -26,6 +26,8 @@
 //
 // read() may be called several times before one advance(); the last call for a field wins.
 // A field's values are N x C matrices: N = the mesh's number of points, C = its components.
+// partita::check_solver_contract (conformance.hpp) checks an implementation against this
+// contract; docs/writing_an_adapter.md walks through one, in tree and out of tree.
 
 #include <filesystem>
 #include <functional>
@@ -142,8 +144,8 @@ class Solver {
     throw Error("this solver does not support restart files");
   }
 
-  /// Write VTK files for this frame under frame.vtk_directory (the core keeps the .pvd series
-  /// from what add_output_file() was told).
+  /// Write VTK files for this frame under frame.vtk_directory (the core keeps one .pvd series
+  /// per series name from what output_files() returns after this call).
   virtual void write_output(const OutputFrame& frame) {}
 
   /// Files written by the last write_output() call, relative to vtk_directory, with a series
@@ -175,7 +177,7 @@ class Solver {
   /// with the trapezoidal rule over its own steps, restored with checkpoints and restart files.
   /// nullopt where the solver does not track it (the default). The core pairs the meshes two
   /// participants read from each other: a lossless interface does no net work, so the sum over
-  /// both sides is the energy the coupling itself creates (see docs/coupling.md).
+  /// both sides is the energy the coupling itself creates (the README's "Energy audit").
   virtual std::optional<double> interface_work(std::string_view mesh) const {
     return std::nullopt;
   }

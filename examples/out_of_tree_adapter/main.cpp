@@ -1,0 +1,37 @@
+// partita with one more solver: the stock commands for cases that use it, and its contract check.
+#include <iostream>
+
+#include "oscillator_adapter.hpp"
+#include "partita/adapters/register_all.hpp"
+#include "partita/coupling/case_run.hpp"
+#include "partita/interface/conformance.hpp"
+
+int main(int argc, char** argv) try {
+  partita::coupling::Registries registries;
+  partita::coupling::register_builtin(registries);  // mappers, schemes, accelerations, ...
+  partita::adapters::register_all(registries);      // the built-in solvers: dem, fem, tube1d
+  registries.solvers.add("oscillator", "a mass on a spring along z", OscillatorAdapter::create,
+                         OscillatorAdapter::spec(), OscillatorAdapter::quantities());
+  const std::string command = argc > 1 ? argv[1] : "";
+  if (command == "conformance") {
+    const auto failures = partita::check_solver_contract(
+        *registries.solvers.find("oscillator"), "solver: oscillator\nmass: 2\nstiffness: 50\n",
+        ".", "conformance");
+    for (const auto& f : failures) std::cerr << f << "\n";
+    std::cout << "conformance: " << failures.size() << " failures\n";
+    return failures.empty() ? 0 : 1;
+  }
+  if (command != "run" || argc < 3) {
+    std::cerr << "usage: " << argv[0] << " run CASE.yaml [OUTPUT_DIR] | conformance\n";
+    return 2;
+  }
+  partita::coupling::RunOptions options;
+  if (argc > 3) options.output_dir = argv[3];
+  partita::coupling::CaseRun run(argv[2], registries, options);
+  run.run();
+  std::cout << "finished; output in " << run.output_dir().string() << "\n";
+  return 0;
+} catch (const partita::Error& e) {
+  std::cerr << "error: " << e.what() << "\n";
+  return 1;
+}

@@ -1,0 +1,13 @@
+#pragma once
+#include <string>
+
+#include "partita/fem/mesh.hpp"
+
+namespace partita::fem {
+
+// Area [m^2] of a named face in the reference configuration, A = sum_e sum_q w_q |dx/dxi x
+// dx/deta| with each surface element's face rule (exact for flat faces). Throws Error for an
+// unknown face (listing the known ones) or a degenerate surface element.
+double face_area(const Mesh& mesh, const std::string& face);
+
+}  // namespace partita::fem

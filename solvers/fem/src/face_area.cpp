@@ -1,0 +1,33 @@
+#include "partita/fem/face_area.hpp"
+
+#include "partita/fem/error.hpp"
+#include "partita/fem/quadrature.hpp"
+#include "partita/fem/shape_functions.hpp"
+
+namespace partita::fem {
+
+double face_area(const Mesh& mesh, const std::string& face) {
+  const auto& elements = mesh.face(face);
+  FaceShapeVector n;
+  FaceShapeGradient dn;
+  double total = 0.0;
+  for (std::size_t s = 0; s < elements.size(); ++s) {
+    const auto& se = elements[s];
+    const int nn = node_count(se.type);
+    Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxFaceNodes, 3> x(nn, 3);
+    for (int a = 0; a < nn; ++a) x.row(a) = mesh.node(se.nodes[a]).transpose();
+    for (const auto& q : face_rule(se.type)) {
+      shape_functions(se.type, q.xi, n, dn);
+      // dA = |dx/dxi x dx/deta| dxi deta
+      const Vec3 t1 = x.transpose() * dn.col(0);
+      const Vec3 t2 = x.transpose() * dn.col(1);
+      const double da = t1.cross(t2).norm();
+      if (!(da > 0.0))
+        throw Error("face '" + face + "': degenerate surface element " + std::to_string(s));
+      total += q.weight * da;
+    }
+  }
+  return total;
+}
+
+}  // namespace partita::fem
