@@ -336,7 +336,7 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
   for (const auto& e : exchanges_) {
     Participant* reader = &e->to();
     Participant* writer = &e->from();
-    if (reader == writer || !reader->solver().interface_work(e->to_mesh())) continue;
+    if (reader == writer || !reader->interface_work(e->to_mesh())) continue;
     auto it = std::find_if(energy_pairs_.begin(), energy_pairs_.end(), [&](const EnergyPair& p) {
       return (p.a == reader && p.b == writer) || (p.a == writer && p.b == reader);
     });
@@ -524,11 +524,11 @@ void CaseRun::build_participants(const config::Node& root) {
           name, window_size_ / s.count, window_size_, s.count, stable, name,
           static_cast<long>(std::ceil(window_size_ / stable * (1.0 - 1e-12))), name));
     }
-    participants_.push_back(std::make_unique<Participant>(name, std::move(b.solver), s));
-    if (coupled && participants_.back()->solver().meshes().empty())
+    participants_.push_back(std::make_unique<LocalParticipant>(name, std::move(b.solver), s));
+    if (coupled && participants_.back()->meshes().empty())
       pn.fail("solver '" + b.solver_name + "' of participant '" + name +
               "' exposes no coupling mesh");
-    for (const auto& m : participants_.back()->solver().meshes())
+    for (const auto& m : participants_.back()->meshes())
       check_plain_name(pn, m.mesh.name(),
                        "the mesh name '" + m.mesh.name() + "' of '" + name + "'");
   }
@@ -551,7 +551,7 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
       n.fail("unknown participant '" + pname + "'; participants: " + join_names(names) +
              did_you_mean(pname, names));
     std::vector<std::string> meshes;
-    for (const auto& m : p->solver().meshes()) meshes.push_back(m.mesh.name());
+    for (const auto& m : p->meshes()) meshes.push_back(m.mesh.name());
     const InterfaceMesh* m = p->find_mesh(mname);
     if (!m)
       n.fail("participant '" + pname + "' has no mesh '" + mname +
@@ -641,7 +641,7 @@ void CaseRun::build_monitors(const config::Node& root) {
         q.fail("unknown participant '" + pname + "'; participants: " + join_names(names) +
                did_you_mean(pname, names));
       std::vector<std::string> known;
-      for (const auto& v : p->solver().monitors()) known.push_back(v.name);
+      for (const auto& v : p->monitors()) known.push_back(v.name);
       if (std::find(known.begin(), known.end(), quantity) == known.end())
         q.fail("participant '" + pname + "' reports no quantity '" + quantity + "'; it reports: " +
                (known.empty() ? "nothing" : join_names(known)) + did_you_mean(quantity, known));
@@ -666,15 +666,15 @@ void CaseRun::write_output(int frame, double time) {
   const fs::path vtk = output_dir_ / "vtk";
   for (auto& p : participants_) {
     OutputFrame f{vtk, p->name(), frame, time, vtk_options_};
-    p->solver().write_output(f);  // counted as output time, not the participant's
-    for (const auto& [series, file] : p->solver().output_files()) {
+    p->write_output(f);  // counted as output time, not the participant's
+    for (const auto& [series, file] : p->output_files()) {
       if (fs::path(file).has_parent_path() || file.empty() || file.front() == '.')
         throw Error("participant '" + p->name() + "' wrote the output file '" + file +
                     "', which is not a plain file name inside " + vtk.string());
       pvd(p->name() + "_" + series).add(time, file);
     }
     // interface meshes with their exchanged data
-    for (const auto& im : p->solver().meshes()) {
+    for (const auto& im : p->meshes()) {
       VtkArrays arrays;
       for (const auto& e : exchanges_) {
         if (&e->from() == p.get() && e->from_mesh() == im.mesh.name() &&
@@ -729,7 +729,7 @@ void CaseRun::run() {
     std::vector<std::pair<std::string, std::string>> mc;
     for (const auto& [p, q] : m.quantities) {
       std::string unit;  // only that quantity: monitors() would compute every one (energies)
-      for (const auto& v : p->solver().monitor_values({q}))
+      for (const auto& v : p->monitor_values({q}))
         if (v.name == q) unit = v.unit;
       mc.emplace_back(p->name() + "." + q, unit);
     }
@@ -765,7 +765,7 @@ void CaseRun::run() {
   auto record_monitors = [&](double t, std::int64_t window) {
     for (Asked& a : wanted) {
       Stopwatch clock;  // the solver computes its quantities: its time, not the core's
-      a.values = a.p->solver().monitor_values(a.names);
+      a.values = a.p->monitor_values(a.names);
       a.p->add_seconds(clock.seconds());
       for (const auto& mv : a.values)
         if (!std::isfinite(mv.value))
@@ -946,7 +946,7 @@ void CaseRun::run() {
   summary_.output_seconds += close_clock.seconds();
   for (auto& p : participants_) {
     Stopwatch sc;
-    p->solver().finalize();
+    p->finalize();
     p->add_seconds(sc.seconds());
   }
 

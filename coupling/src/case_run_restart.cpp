@@ -96,7 +96,7 @@ void totals(const Eigen::MatrixXd& v, const Mesh& mesh, bool extensive, bool mag
 
 std::string CaseRun::restart_blocker() const {
   for (const auto& p : participants_)
-    if (!p->solver().supports_restart())
+    if (!p->supports_restart())
       return "participant '" + p->name() + "' has a solver that cannot write restart files";
   return {};
 }
@@ -164,7 +164,7 @@ void CaseRun::write_restart_file(const Progress& progress) {
     out.write(static_cast<std::uint64_t>(participants_.size()));
     for (const auto& p : participants_) {
       out.section("participant " + p->name());
-      p->solver().write_restart(out);
+      p->write_restart(out);
     }
     out.section("end");
     out.finish();  // the sections' CRC-32 table
@@ -281,7 +281,7 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
     in.fail(fmt::format("{} participants (found {})", participants_.size(), participants));
   for (auto& p : participants_) {
     in.expect_section("participant " + p->name());
-    p->solver().read_restart(in);
+    p->read_restart(in);
   }
   in.expect_section("end");
   if (read.windows_done >= window_count_)
@@ -328,7 +328,7 @@ void CaseRun::check_window(std::int64_t window, double time, bool after_audit) {
   }
   for (const auto& p : participants_) {
     Stopwatch clock;  // the solver's own work: its time, not the core's
-    const std::string why = p->solver().check_state();
+    const std::string why = p->check_state();
     p->add_seconds(clock.seconds());
     if (!why.empty())
       throw Error(fmt::format("window {} (t = {:.6g} s): participant '{}': {}", window, time,
@@ -382,8 +382,8 @@ const std::vector<double>& CaseRun::audit_balance() {
 
 CaseRun::EnergyAudit CaseRun::audit_energy(const EnergyPair& pair) const {
   EnergyAudit a;
-  for (const auto& m : pair.a_meshes) a.on_a += pair.a->solver().interface_work(m).value_or(0.0);
-  for (const auto& m : pair.b_meshes) a.on_b += pair.b->solver().interface_work(m).value_or(0.0);
+  for (const auto& m : pair.a_meshes) a.on_a += pair.a->interface_work(m).value_or(0.0);
+  for (const auto& m : pair.b_meshes) a.on_b += pair.b->interface_work(m).value_or(0.0);
   return a;
 }
 

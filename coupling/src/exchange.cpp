@@ -21,7 +21,11 @@ Exchange::Exchange(std::string data, End from, End to, DataSpec spec,
       writer_combines_(writer_combines) {
   const InterfaceMesh* fm = from_.participant->find_mesh(from_.mesh);
   const InterfaceMesh* tm = to_.participant->find_mesh(to_.mesh);
-  if (!fm || !tm) throw Error("exchange " + label() + ": unknown mesh");
+  if (!fm || !tm)
+    throw Error("exchange '" + data_ + "' " + from_.participant->name() + "." + from_.mesh +
+                " -> " + to_.participant->name() + "." + to_.mesh + ": unknown mesh");
+  label_ = "'" + data_ + "' " + from_.participant->name() + "." + from_.mesh + " -> " +
+           to_.participant->name() + "." + to_.mesh;
   from_points_ = fm->mesh.size();
   source_mesh_ = &fm->mesh;
   target_mesh_ = &tm->mesh;
@@ -31,53 +35,14 @@ Exchange::Exchange(std::string data, End from, End to, DataSpec spec,
                 std::to_string(fm->mesh.size()) + " and " + std::to_string(tm->mesh.size()) + ")");
 }
 
-std::string Exchange::label() const {
-  return "'" + data_ + "' " + from_.participant->name() + "." + from_.mesh + " -> " +
-         to_.participant->name() + "." + to_.mesh;
+WindowOutput Exchange::window_output() {
+  combined_is_sent_ = false;  // the writer fills combined_ (its own storage again)
+  return WindowOutput{&from_.mesh, &data_, writer_combines_, from_points_, spec_.components,
+                      &label_, &combined_};
 }
 
-void Exchange::check_shape(const Eigen::MatrixXd& values, const char* what) const {
-  if (values.rows() != from_points_ || values.cols() != spec_.components)
-    throw Error("exchange " + label() + ": participant '" + from_.participant->name() + "' " +
-                what + " a " + std::to_string(values.rows()) + " x " +
-                std::to_string(values.cols()) + " array; expected " + std::to_string(from_points_) +
-                " x " + std::to_string(spec_.components) + " (points of mesh '" + from_.mesh +
-                "' x components)");
-}
-
-void Exchange::begin_collect() {
-  collected_ = 0;
-}
-
-void Exchange::collect(const Eigen::MatrixXd& values) {
-  check_shape(values, "wrote");
-  ++collected_;
-  if (writer_combines_ != WriterCombines::average || collected_ == 1) {
-    accumulated_ = values;
-    return;
-  }
-  // running mean f̄_k = f̄_{k-1} + (f_k - f̄_{k-1}) / k: exact for a constant output.
-  // (The divisions dominate a window's core time: elementwise.hpp halves them where it can.)
-  elementwise::mean_step(accumulated_.data(), values.data(), values.size(),
-                         static_cast<double>(collected_));
-}
-
-void Exchange::collect_taking(Eigen::MatrixXd& values) {
-  if (writer_combines_ == WriterCombines::average && collected_ > 0) return collect(values);
-  check_shape(values, "wrote");
-  ++collected_;
-  accumulated_.swap(values);  // where collect() copies
-}
-
-void Exchange::finish_collect() {
-  // average: f_{n+1} = 1/m Σ_{k=1..m} f_{n,k} (the running mean);  last: f_{n+1} = f_{n,m}
-  combined_is_sent_ = false;
-  if (collected_ == 0) {
-    combined_.setZero(from_points_, spec_.components);
-    return;
-  }
-  // The next begin_collect()/collect() overwrite accumulated_ whole: swap instead of a copy.
-  combined_.swap(accumulated_);
+WindowInput Exchange::window_input() const {
+  return WindowInput{&to_.mesh, &data_, reader_sees_, &start_, &end_, start_is_end_};
 }
 
 Eigen::MatrixXd& Exchange::sent() {
@@ -107,20 +72,10 @@ void Exchange::transmit() {
   mapping_seconds_ += s.seconds();
 }
 
-const Eigen::MatrixXd& Exchange::read_at(double fraction, Eigen::MatrixXd& scratch) const {
-  if (reader_sees_ == ReaderSees::constant || fraction >= 1.0 || start_is_end_) return end_;
-  // d_{n,k} = d_n + (k/m) (d_{n+1} - d_n)
-  scratch.resize(end_.rows(), end_.cols());  // (keeps its storage: same shape every substep)
-  elementwise::interpolate(scratch.data(), start_.data(), end_.data(), end_.size(), fraction);
-  return scratch;
-}
-
-void Exchange::initialize(const Eigen::MatrixXd& initial) {
-  check_shape(initial, "gave as initial data");
-  combined_ = initial;
+void Exchange::initialize() {
   combined_is_sent_ = false;
-  sent_ = initial;
-  previous_ = initial;
+  sent_ = combined_;
+  previous_ = combined_;
   transmit();
   start_is_end_ = true;  // start = end
 }

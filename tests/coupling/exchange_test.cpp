@@ -1,5 +1,5 @@
-// Exchange: the substep average and the time interpolation give, bit for bit, the numbers of
-// their plain formulas (each operation is IEEE-rounded, so any correct evaluation of the same
+// A participant's side of a window (LocalParticipant over an Exchange's values): the substep
+// average and the time interpolation give, bit for bit, the numbers of their plain formulas (each operation is IEEE-rounded, so any correct evaluation of the same
 // operations in the same order must agree to the last bit, whatever vector width it uses); and a
 // run stops on non-finite values of an audited exchange (whose check reads the audit's totals).
 #include <catch2/catch.hpp>
@@ -36,9 +36,12 @@ class ArraySolver : public Solver {
     next.setOnes(n, 3);
   }
   const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
-  void read(std::string_view, std::string_view, const Eigen::MatrixXd& v) override { seen = v; }
+  void read(std::string_view, std::string_view, const Eigen::MatrixXd& v) override {
+    seen = v;
+    if (log_reads) reads.push_back(v);
+  }
   void write(std::string_view, std::string_view, Eigen::MatrixXd& v) override {
-    v = next;
+    v = script.empty() ? next : script[written++ % script.size()];
     if (t_ >= nan_from_) v(v.rows() / 2, 1) = std::numeric_limits<double>::quiet_NaN();
   }
   double stable_time_step() const override { return INFINITY; }
@@ -48,6 +51,10 @@ class ArraySolver : public Solver {
   void restore_checkpoint() override {}
 
   Eigen::MatrixXd next, seen;
+  std::vector<Eigen::MatrixXd> script;  // written in turn, one a write() (empty: `next`)
+  std::size_t written = 0;
+  bool log_reads = false;
+  std::vector<Eigen::MatrixXd> reads;
 
  private:
   std::vector<InterfaceMesh> meshes_;
@@ -76,17 +83,17 @@ Eigen::MatrixXd values(Eigen::Index n, std::mt19937& g) {
 // neither a multiple of 2 nor of 4 values (the vector loops' remainders run too).
 struct Pair {
   static constexpr Eigen::Index n = 1539;
-  std::unique_ptr<Participant> a =
-      std::make_unique<Participant>("a", std::make_unique<ArraySolver>(n, DataKind::extensive));
-  std::unique_ptr<Participant> b =
-      std::make_unique<Participant>("b", std::make_unique<ArraySolver>(n, DataKind::extensive));
+  std::unique_ptr<LocalParticipant> a = std::make_unique<LocalParticipant>(
+      "a", std::make_unique<ArraySolver>(n, DataKind::extensive));
+  std::unique_ptr<LocalParticipant> b = std::make_unique<LocalParticipant>(
+      "b", std::make_unique<ArraySolver>(n, DataKind::extensive));
   Exchange exchange{"f", {a.get(), "points"}, {b.get(), "points"}, DataSpec{"f", 3, "N"}, nullptr};
 };
 
 }  // namespace
 
 TEST_CASE(
-    "Exchange: the substep average and the time interpolation follow their formulas bit "
+    "Participant: the substep average and the time interpolation follow their formulas bit "
     "for bit",
     "[coupling][exchange]") {
   Pair pair;
@@ -96,39 +103,51 @@ TEST_CASE(
   SECTION("the average of m substeps is the running mean") {
     for (int m = 1; m <= 9; ++m) {
       INFO("substeps " << m);
-      e.begin_collect();
+      LocalParticipant a("a", std::make_unique<ArraySolver>(n, DataKind::extensive),
+                         Substeps{false, m});
+      auto& solver = static_cast<ArraySolver&>(a.solver());
       Eigen::MatrixXd mean;
       for (int k = 1; k <= m; ++k) {
         const Eigen::MatrixXd v = values(n, g);
-        e.collect(v);
+        solver.script.push_back(v);
         // f̄_k = f̄_{k-1} + (f_k - f̄_{k-1}) / k, f̄_1 = f_1 (Eigen's own elementwise evaluation)
         if (k == 1)
           mean = v;
         else
           mean = mean + (v - mean) / static_cast<double>(k);
       }
-      e.finish_collect();
+      WindowOutput out = e.window_output();
+      a.run_window(TimeWindow(1.0, 0, 1), {}, std::span<WindowOutput>(&out, 1));
       CHECK(same_bits(e.combined(), mean));
     }
     // a constant output averages to itself exactly
     const Eigen::MatrixXd c = values(n, g);
-    e.begin_collect();
-    for (int k = 0; k < 7; ++k) e.collect(c);
-    e.finish_collect();
+    LocalParticipant a("a", std::make_unique<ArraySolver>(n, DataKind::extensive),
+                       Substeps{false, 7});
+    static_cast<ArraySolver&>(a.solver()).next = c;
+    WindowOutput out = e.window_output();
+    a.run_window(TimeWindow(1.0, 0, 1), {}, std::span<WindowOutput>(&out, 1));
     CHECK((e.combined().array() == c.array()).all());
   }
   SECTION("the reader sees d_n + (k/m) (d_n+1 - d_n)") {
     const Eigen::MatrixXd d0 = values(n, g), d1 = values(n, g);
-    e.initialize(d0);
+    *e.window_output().combined = d0;
+    e.initialize();
     e.sent() = d1;
     e.transmit();
-    Eigen::MatrixXd scratch;
+    LocalParticipant b("b", std::make_unique<ArraySolver>(n, DataKind::extensive),
+                       Substeps{false, 7});
+    auto& solver = static_cast<ArraySolver&>(b.solver());
+    solver.log_reads = true;
+    const WindowInput in = e.window_input();
+    b.run_window(TimeWindow(1.0, 0, 1), std::span<const WindowInput>(&in, 1), {});
+    REQUIRE(solver.reads.size() == 7);
     for (int k = 1; k < 7; ++k) {
       const double s = static_cast<double>(k) / 7.0;
       const Eigen::MatrixXd expected = d0 + s * (d1 - d0);
-      CHECK(same_bits(e.read_at(s, scratch), expected));
+      CHECK(same_bits(solver.reads[static_cast<std::size_t>(k - 1)], expected));
     }
-    CHECK(same_bits(e.read_at(1.0, scratch), d1));
+    CHECK(same_bits(solver.reads.back(), d1));
   }
 }
 

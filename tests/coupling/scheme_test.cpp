@@ -34,8 +34,8 @@ struct Setup {
     auto o2 = std::make_unique<OdeParticipant>("y2", "y1", a2, b2, 0.0);
     s1 = o1.get();
     s2 = o2.get();
-    p1 = std::make_unique<Participant>("one", std::move(o1));
-    p2 = std::make_unique<Participant>("two", std::move(o2), Substeps{false, substeps2});
+    p1 = std::make_unique<LocalParticipant>("one", std::move(o1));
+    p2 = std::make_unique<LocalParticipant>("two", std::move(o2), Substeps{false, substeps2});
     e12 = std::make_unique<Exchange>("y1", Exchange::End{p1.get(), "point"},
                                      Exchange::End{p2.get(), "point"}, DataSpec{"y1", 1, "m"},
                                      nullptr, sees, combines);

@@ -7,17 +7,16 @@ namespace partita::coupling {
 
 CouplingScheme::CouplingScheme(std::vector<Participant*> participants,
                                std::vector<Exchange*> exchanges)
-    : participants_(std::move(participants)),
-      exchanges_(std::move(exchanges)),
-      read_buffers_(exchanges_.size()),
-      write_buffers_(exchanges_.size()) {}
+    : participants_(std::move(participants)), exchanges_(std::move(exchanges)) {}
 
 void CouplingScheme::initialize() {
-  for (std::size_t i = 0; i < exchanges_.size(); ++i) {
-    Exchange* e = exchanges_[i];
-    e->from().write(e->from_mesh(), e->data(), write_buffers_[i]);
-    e->initialize(write_buffers_[i]);
+  for (Participant* p : participants_) {
+    outputs_.clear();
+    for (Exchange* e : exchanges_)
+      if (&e->from() == p) outputs_.push_back(e->window_output());
+    p->initial_values(outputs_);
   }
+  for (Exchange* e : exchanges_) e->initialize();
 }
 
 WindowReport CouplingScheme::advance(const TimeWindow& window) {
@@ -26,40 +25,16 @@ WindowReport CouplingScheme::advance(const TimeWindow& window) {
   return report;
 }
 
+// One window of p on its side (subcycling, the inputs' time interpolation and the outputs'
+// combination are the participant's): what it reads at the window's ends, what it wrote back.
 void CouplingScheme::run_participant(Participant& p, const TimeWindow& window) {
-  TimeWindow w = window.with_substeps(p.substeps(window.size()));
-  for (Exchange* e : exchanges_)
-    if (&e->from() == &p) e->begin_collect();
-  std::vector<const Eigen::MatrixXd*>& inputs = inputs_;  // sized once (one per exchange)
-  inputs.resize(exchanges_.size());
-  Solver& solver = p.solver();
-  // for k = 0..m-1: read d(t_{n,k+1}); advance(t_{n,k+1} - t_{n,k}); write f_{n,k+1}
-  while (!w.end_reached()) {
-    const double fraction = w.fraction_at(w.substep() + 1);
-    for (std::size_t i = 0; i < exchanges_.size(); ++i)  // the core: time interpolation
-      if (&exchanges_[i]->to() == &p)
-        inputs[i] = &exchanges_[i]->read_at(fraction, read_buffers_[i]);
-    {
-      // The participant's own work, read + advance + write, timed as one: one clock pair per
-      // substep rather than one per call (a clock read costs 20-50 ns; 6 substeps a window).
-      const Stopwatch s;
-      for (std::size_t i = 0; i < exchanges_.size(); ++i) {
-        const Exchange* e = exchanges_[i];
-        if (&e->to() == &p) solver.read(e->to_mesh(), e->data(), *inputs[i]);
-      }
-      solver.advance(w.next_substep_size());
-      for (std::size_t i = 0; i < exchanges_.size(); ++i) {
-        const Exchange* e = exchanges_[i];
-        if (&e->from() == &p) solver.write(e->from_mesh(), e->data(), write_buffers_[i]);
-      }
-      p.add_seconds(s.seconds());
-    }
-    w.advance_substep();
-    for (std::size_t i = 0; i < exchanges_.size(); ++i)  // the core: average over the substeps
-      if (&exchanges_[i]->from() == &p) exchanges_[i]->collect_taking(write_buffers_[i]);
+  inputs_.clear();  // (capacity kept: no allocation after the first window)
+  outputs_.clear();
+  for (Exchange* e : exchanges_) {
+    if (&e->to() == &p) inputs_.push_back(e->window_input());
+    if (&e->from() == &p) outputs_.push_back(e->window_output());
   }
-  for (Exchange* e : exchanges_)
-    if (&e->from() == &p) e->finish_collect();
+  p.run_window(window, inputs_, outputs_);
 }
 
 void CouplingScheme::send_outputs(const Participant& p) {

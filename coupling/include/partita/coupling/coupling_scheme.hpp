@@ -7,10 +7,10 @@
 //   initialize()                       — once: each exchange's writer gives its initial values
 //   for windows n = 0, 1, ...: advance(window n)   — returns the window's report
 //
-// Subcycling a participant through a window of m substeps (Algorithm 1 of seed 000):
-//   for k = 0..m-1:  read each input at the substep's end, t_{n,k+1} (time interpolation by
-//                    the exchange), advance(t_{n,k+1} - t_{n,k}), write each output (collected)
-//   each output's window value = average (or last) of its m substep values.
+// A participant takes a window on its side (participant.hpp: Algorithm 1 of seed 000, its
+// substeps, the time interpolation of what it reads and the combination of what it writes):
+// the scheme hands it each input's values at the window's ends and gets back each output's
+// window value, one call per participant per window (per iteration when implicit).
 
 #include <memory>
 #include <string>
@@ -35,7 +35,7 @@ class CouplingScheme {
   CouplingScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges);
   virtual ~CouplingScheme() = default;
 
-  /// Initial data of every exchange: the writer's write() before the first window, mapped.
+  /// Initial data of every exchange: the writer's initial value before the first window, mapped.
   void initialize();
   /// Take every participant through `window` (substep counts are the participants' own) and
   /// accept it.
@@ -58,7 +58,7 @@ class CouplingScheme {
   /// Run the window until it can be accepted (explicit: once; implicit: until converged).
   virtual WindowReport run_window(const TimeWindow& window) = 0;
 
-  /// Subcycle participant p through the window; its outputs' combined() values are then set.
+  /// Participant p takes the window; its outputs' combined() values are then set.
   void run_participant(Participant& p, const TimeWindow& window);
   /// sent = combined; transmit (for every output of p).
   void send_outputs(const Participant& p);
@@ -67,10 +67,9 @@ class CouplingScheme {
   std::vector<Exchange*> exchanges_;
 
  private:
-  // Per exchange: what its receiver reads and what its sender writes (sized in the first
-  // window, reused after: no allocation per substep).
-  std::vector<Eigen::MatrixXd> read_buffers_, write_buffers_;
-  std::vector<const Eigen::MatrixXd*> inputs_;  // per exchange: what its reader sees this substep
+  // What run_participant() hands over (sized once: no allocation per window).
+  std::vector<WindowInput> inputs_;
+  std::vector<WindowOutput> outputs_;
 };
 
 }  // namespace partita::coupling

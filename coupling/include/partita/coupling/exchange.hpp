@@ -1,19 +1,19 @@
 #pragma once
-// One data field sent from a participant's mesh to another participant's mesh, with what the
-// core does in between:
+// One data field sent from a participant's mesh to another participant's mesh: the values the
+// core holds between the two sides, and the mapping.
 //
-//   sender:   writes once per substep; the window's value is the average over its m substeps
-//             (f = 1/m Σ_k f_k, `average`) or the last substep's value (`last`) — combined();
-//             an implicit scheme may replace it by an accelerated value — sent();
+//   sender:   its window value (averaged or last over its substeps: the participant's side,
+//             participant.hpp) arrives in combined(); an implicit scheme may replace it by an
+//             accelerated value — sent();
 //   mapping:  received = M sent (the mapper; identity when none) — transmit();
-//   receiver: at substep k of m it reads, for `linear`, d_n + (k/m) (d_{n+1} - d_n) between the
-//             window's start value d_n and the newest value d_{n+1}; for `constant`, d_{n+1}.
-//             Where no new value came yet (first participant of a serial scheme, parallel
-//             explicit schemes) d_{n+1} = d_n and both give the start value.
+//   receiver: gets the window's start value d_n and the newest value d_{n+1} on its own mesh
+//             (window_input()) and sees them in time as it subcycles (its side again). Where no
+//             new value came yet (first participant of a serial scheme, parallel explicit
+//             schemes) d_{n+1} = d_n.
 //
-// Call order per window: begin_collect(); collect() after each substep of the writer;
-// finish_collect(); [remember_previous() per iteration]; set sent(); transmit();
-// read_at() during the reader's substeps; accept_window() once the window is accepted.
+// Call order per window: window_output() handed to the writer's run_window(); [remember_previous()
+// per iteration]; set sent(); transmit(); window_input() handed to the reader's run_window();
+// accept_window() once the window is accepted.
 
 #include <memory>
 #include <string>
@@ -30,9 +30,6 @@ class BinaryReader;
 }  // namespace partita
 
 namespace partita::coupling {
-
-enum class ReaderSees { constant, linear };
-enum class WriterCombines { average, last };
 
 class Exchange {
  public:
@@ -59,20 +56,12 @@ class Exchange {
   /// The sender's and the receiver's interface meshes (fixed for the run, see Solver::meshes()).
   const Mesh& source_mesh() const { return *source_mesh_; }
   const Mesh& target_mesh() const { return *target_mesh_; }
-  /// "pressure fluid.nodes -> solid.nodes" for messages.
-  std::string label() const;
+  /// "'pressure' fluid.nodes -> solid.nodes" for messages.
+  const std::string& label() const { return label_; }
 
   // --- sender side ------------------------------------------------------------------------
-  // Called every substep: no allocation once the arrays have their sizes (first window).
-  void begin_collect();
-  /// The writer's values after one substep (checked: points x components).
-  void collect(const Eigen::MatrixXd& values);
-  /// The same, taking `values`' storage where it would copy them (the first substep of an
-  /// average, every substep of `last`): `values` then holds stale numbers, of the shape of an
-  /// earlier substep or empty, for a writer whose next write() sets (and sizes) every value.
-  void collect_taking(Eigen::MatrixXd& values);
-  /// combined = average or last of the collected substeps.
-  void finish_collect();
+  /// What the writer's run_window() fills: combined() (the window's value over its substeps).
+  WindowOutput window_output();
   const Eigen::MatrixXd& combined() const { return combined_is_sent_ ? sent_ : combined_; }
   /// The values that transmit() maps (combined, or an accelerated iterate).
   Eigen::MatrixXd& sent();
@@ -88,17 +77,17 @@ class Exchange {
   void transmit();
 
   // --- receiver side ----------------------------------------------------------------------
-  /// The value the receiver sees after the fraction s = k/m of the window: received() itself
-  /// where that is the value (no copy), else the interpolation written into `scratch`.
-  const Eigen::MatrixXd& read_at(double fraction, Eigen::MatrixXd& scratch) const;
+  /// What the reader's run_window() sees: d_n and d_{n+1} on its mesh, and how.
+  WindowInput window_input() const;
   /// The newest mapped value d_{n+1}.
   const Eigen::MatrixXd& received() const { return end_; }
   /// d_n = d_{n+1}: the window is accepted (no copy: start_ is taken from end_ by the next
   /// transmit(), which swaps the two before mapping into end_).
   void accept_window() { start_is_end_ = true; }
 
-  /// Initial data: combined = sent = previous = initial, transmitted, start = end.
-  void initialize(const Eigen::MatrixXd& initial);
+  /// Initial data, once the writer's initial_values() filled window_output()'s combined:
+  /// sent = previous = combined, transmitted, start = end.
+  void initialize();
 
   /// Restart files: the values carried between windows (sent, combined, previous, start, end).
   void write_state(BinaryWriter& out) const;
@@ -109,8 +98,6 @@ class Exchange {
   double mapping_seconds() const { return mapping_seconds_; }
 
  private:
-  void check_shape(const Eigen::MatrixXd& values, const char* what) const;
-
   std::string data_;
   End from_, to_;
   DataSpec spec_;
@@ -121,9 +108,9 @@ class Exchange {
   const Mesh* source_mesh_ = nullptr;
   const Mesh* target_mesh_ = nullptr;
 
-  Eigen::MatrixXd accumulated_, combined_, sent_, previous_;
+  std::string label_;
+  Eigen::MatrixXd combined_, sent_, previous_;
   bool combined_is_sent_ = false;  // after send_combined(): combined_'s own values are stale
-  int collected_ = 0;
   Eigen::MatrixXd start_, end_;
   bool start_is_end_ = false;  // d_n = d_{n+1}: start_'s own values are stale
   double mapping_seconds_ = 0.0;
