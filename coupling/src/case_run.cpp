@@ -516,13 +516,13 @@ void CaseRun::build_participants(const config::Node& root) {
     if (!coupled) s.automatic = true;  // alone: as many steps per window as its stability needs
     // A fixed number of substeps must not exceed the solver's stable time step.
     const double stable = b.solver->stable_time_step();
-    if (!s.automatic && window_size_ / s.count > stable * (1.0 + 1e-12)) {
+    if (!s.automatic && TimeWindow::longer_than(window_size_ / s.count, stable)) {
       const config::Node where = substeps.count(name) ? coupling["substeps"][name] : pn;
       where.fail(fmt::format(
           "participant '{}' would step {:.4g} s (window {:.4g} s / {} substeps), above its stable "
           "time step {:.4g} s; use substeps: {{{}: {}}} or more, or {{{}: auto}}",
           name, window_size_ / s.count, window_size_, s.count, stable, name,
-          static_cast<long>(std::ceil(window_size_ / stable * (1.0 - 1e-12))), name));
+          TimeWindow::substeps_for(window_size_, stable), name));
     }
     participants_.push_back(std::make_unique<LocalParticipant>(name, std::move(b.solver), s));
     if (coupled && participants_.back()->meshes().empty())
@@ -896,9 +896,10 @@ void CaseRun::run() {
       summary_.output_seconds += csv_clock.seconds();
       record_monitors(t, n + 1);
       const bool last = n + 1 == window_count_;
-      if ((output_every_ > 0.0 && t >= progress.next_output - 1e-9 * window_size_) || last) {
+      if ((output_every_ > 0.0 && TimeWindow::reached(t, progress.next_output, window_size_)) ||
+          last) {
         write_output(progress.frame++, t);
-        while (output_every_ > 0.0 && progress.next_output <= t + 1e-9 * window_size_)
+        while (output_every_ > 0.0 && TimeWindow::reached(t, progress.next_output, window_size_))
           progress.next_output = static_cast<double>(progress.frame) * output_every_;
       }
       const int signal = options_.stop_signal ? options_.stop_signal->load() : 0;

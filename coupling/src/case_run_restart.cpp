@@ -8,7 +8,6 @@
 
 #include "elementwise.hpp"
 #include "partita/coupling/case_run.hpp"
-#include "partita/coupling/mapping/sparse_mapper.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
@@ -343,16 +342,12 @@ const std::vector<double>& CaseRun::audit_balance() {
     audit_bounds_.assign(audited_.size(), Eigen::VectorXd());
     for (std::size_t i = 0; i < audited_.size(); ++i) {
       const Exchange* e = audited_[i];
-      const auto* sparse = dynamic_cast<const SparseMapper*>(e->mapper());
-      if (!sparse) continue;
-      const SparseMapper::Matrix& w = sparse->matrix();
-      if (w.nonZeros() > 0 &&
-          Eigen::Map<const Eigen::VectorXd>(w.valuePtr(), w.nonZeros()).minCoeff() < 0.0)
-        continue;
-      if (e->spec().kind == DataKind::extensive)
-        audit_bounds_[i] = w.transpose() * Eigen::VectorXd::Ones(w.rows());
-      else
-        audit_bounds_[i] = w.transpose() * e->target_mesh().weights();
+      if (!e->mapper()) continue;
+      const Eigen::VectorXd omega = e->spec().kind == DataKind::extensive
+                                        ? Eigen::VectorXd::Ones(e->target_mesh().size())
+                                        : Eigen::VectorXd(e->target_mesh().weights());
+      Eigen::VectorXd u;
+      if (e->mapper()->arrival_bound(omega, u)) audit_bounds_[i] = std::move(u);
     }
   }
   imbalance_.resize(audited_.size());

@@ -28,7 +28,7 @@ int LocalParticipant::substeps(double window_size) const {
   const double stable = solver_->stable_time_step();
   if (!substeps_.automatic) {
     // The stable step may fall during a run (a DEM whose granules break into smaller ones).
-    if (window_size / substeps_.count > stable * (1.0 + 1e-12))
+    if (TimeWindow::longer_than(window_size / substeps_.count, stable))
       throw Error(fmt::format(
           "participant '{}': its stable time step has fallen to {:.4g} s, below the {:.4g} s of "
           "coupling.substeps.{} = {}; use substeps: {{{}: {}}} or more, or {{{}: auto}}",

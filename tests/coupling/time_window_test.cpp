@@ -45,3 +45,19 @@ TEST_CASE("TimeWindow: substeps tile the window exactly and counts are robust",
   CHECK_THROWS_AS(TimeWindow(0.0), partita::Error);
   CHECK_THROWS_AS(TimeWindow(0.1, 0, 0), partita::Error);
 }
+
+TEST_CASE("TimeWindow: one tolerance for steps against a stable step and for reached times",
+          "[coupling][time]") {
+  // a step is longer than the stable one exactly when it would need two substeps
+  CHECK_FALSE(TimeWindow::longer_than(1e-5, 1e-5));
+  CHECK_FALSE(TimeWindow::longer_than(1e-5 * (1.0 + 1e-12), 1e-5));  // round-off of a division
+  CHECK(TimeWindow::longer_than(1e-5 * (1.0 + 1e-6), 1e-5));
+  CHECK_FALSE(TimeWindow::longer_than(1.0, INFINITY));
+  for (const double step : {1e-7, 3.3e-6, 1e-5, 0.7})
+    for (const double stable : {2e-7, 1e-6, 9.9e-6, 0.1})
+      CHECK(TimeWindow::longer_than(step, stable) == (TimeWindow::substeps_for(step, stable) > 1));
+  // 3 windows of 0.1 s end at 0.30000000000000004 > 0.3: reached, and 0.1 is not 0.2
+  CHECK(TimeWindow::reached(3 * 0.1, 0.3, 0.1));
+  CHECK(TimeWindow::reached(0.3, 3 * 0.1, 0.1));
+  CHECK_FALSE(TimeWindow::reached(0.1, 0.2, 0.1));
+}

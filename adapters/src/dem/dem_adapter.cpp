@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "partita/adapters/dem_output.hpp"
+#include "partita/coupling/time_window.hpp"
 #include "partita/dem/breakage.hpp"
 #include "partita/dem/wall_servo.hpp"
 #include "partita/dem/error.hpp"
@@ -625,8 +626,8 @@ void DemAdapter::advance(double dt) {
   int parts = 1;
   if (breakage_ >= 0) {
     const double stable = stable_time_step();
-    if (dt > stable * (1.0 + 1e-12))
-      parts = static_cast<int>(std::ceil(dt / stable * (1.0 - 1e-12)));
+    if (coupling::TimeWindow::longer_than(dt, stable))
+      parts = coupling::TimeWindow::substeps_for(dt, stable);
   }
   try {
     for (int k = 0; k < parts; ++k) system_.step(dt / parts);

@@ -212,4 +212,12 @@ void SparseMapper::map(const Eigen::MatrixXd& in, Eigen::MatrixXd& out) const {
   }
 }
 
+bool SparseMapper::arrival_bound(const Eigen::VectorXd& omega, Eigen::VectorXd& u) const {
+  if (matrix_.nonZeros() > 0 &&
+      Eigen::Map<const Eigen::VectorXd>(matrix_.valuePtr(), matrix_.nonZeros()).minCoeff() < 0.0)
+    return false;
+  u = matrix_.transpose() * omega;
+  return true;
+}
+
 }  // namespace partita::coupling

@@ -59,6 +59,14 @@ class TimeWindow {
   /// Substeps for a window of `size` with steps no longer than `max_step`: ceil(size / max_step)
   /// with the same tolerance; 1 when max_step is infinite. Throws if max_step <= 0.
   static int substeps_for(double size, double max_step);
+  /// Whether a step of `step` is longer than `max_step` beyond that same tolerance (exactly when
+  /// substeps_for(step, max_step) > 1): the one test of a step against a stable step.
+  static bool longer_than(double step, double max_step) {
+    return substeps_for(step, max_step) > 1;
+  }
+  /// Whether time t has reached `target` on a clock of windows of `size`: t >= target less
+  /// 1e-9 of a window (a time that is a sum or a product of windows rounds either way).
+  static bool reached(double t, double target, double size) { return t >= target - 1e-9 * size; }
 
  private:
   double size_;

@@ -43,6 +43,14 @@ class Mapper {
   virtual Constraint constraint() const = 0;
   /// Registered name, for messages and the summary.
   virtual std::string name() const = 0;
+  /// The balance audit's bound: for a mapper whose map() is out = W in with an explicit W >= 0,
+  /// u = W^T omega (then sum_q omega_q |out_q| <= sum_i u_i |in_i| for any in) and true; false
+  /// where the mapper has no such operator (the default: the audit then measures both sides).
+  virtual bool arrival_bound(const Eigen::VectorXd& omega, Eigen::VectorXd& u) const {
+    (void)omega;
+    (void)u;
+    return false;
+  }
 
   /// Sizes and names of the meshes of the last compute() (-1 / "" before the first).
   Eigen::Index source_size() const { return source_size_; }

@@ -37,6 +37,8 @@ class SparseMapper : public Mapper {
 
   /// The operator of map(): target.size() x source.size().
   const Matrix& matrix() const { return matrix_; }
+  /// u = W^T omega where every entry of W is >= 0 (see Mapper).
+  bool arrival_bound(const Eigen::VectorXd& omega, Eigen::VectorXd& u) const final;
 
   /// map()'s copy of W for vectors: rows of `width` entries (row-major; padding: weight 0 on
   /// point cols()), and the entries beyond `width` (row, column, weight; rows ascending, in
