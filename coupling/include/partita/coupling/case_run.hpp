@@ -26,6 +26,10 @@
 //     - {name: outlet, quantities: [fluid.outlet_pressure, solid.outlet_area]}
 //   output: {every: 0.1, restart: {every_windows: 100}}
 //
+// The phases live in their own files: the schema (case_schema.cpp), building a run from a
+// case (case_run_build.cpp), the run window by window (case_run.cpp), restart files and the
+// checks after a window (case_run_restart.cpp).
+//
 // Restart files: DIR/restart/w<window>.bin hold the complete state after a window (every
 // participant's solver, the exchanges' values, the acceleration's history, the CSV rows and
 // the VTK series so far); `partita run CASE --resume DIR` continues from the newest one bit for

@@ -1,0 +1,491 @@
+// CaseRun, phase one: building a run from a validated case (participants, meshes handed over,
+// exchanges and their mappers, the scheme, monitors, the audits' pairs).
+#include "partita/coupling/case_run.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "partita/coupling/explicit_scheme.hpp"
+#include "partita/coupling/progress_line.hpp"
+#include "partita/coupling/stopwatch.hpp"
+#include "partita/coupling/sweep.hpp"
+#include "plain_name.hpp"
+#include "partita/interface/error.hpp"
+#include "partita/interface/log.hpp"
+
+namespace partita::coupling {
+
+namespace fs = std::filesystem;
+
+namespace {
+// Above this many windows a run is almost surely a typing error in time.window or time.end.
+constexpr double kWindowWarning = 1e8;
+}  // namespace
+
+namespace {
+
+std::pair<std::string, std::string> split_dot(const config::Node& n, const char* what) {
+  const std::string s = n.as_string();
+  const auto dot = s.find('.');
+  if (dot == std::string::npos || dot == 0 || dot + 1 == s.size())
+    n.fail(std::string("expected ") + what + " written participant." +
+           (std::string(what) == "a quantity" ? "quantity" : "mesh") + ", found '" + s + "'");
+  return {s.substr(0, dot), s.substr(dot + 1)};
+}
+
+// What a restart file must come from: the same participants and coupling (the time and output
+// sections may change, e.g. a later end time). FNV-1a of their YAML text.
+std::uint64_t case_identity(const config::Node& root) {
+  std::string text = root.string("case");
+  for (const char* key : {"participants", "coupling"}) {
+    YAML::Emitter e;
+    e << root[key].yaml();
+    text += std::string("\n") + key + ":\n" + e.c_str();
+  }
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
+// A case name becomes a folder name (out/<case>/) and part of file names: a plain name only.
+}  // namespace
+
+Participant* CaseRun::participant(const std::string& name) const {
+  for (const auto& p : participants_)
+    if (p->name() == name) return p.get();
+  return nullptr;
+}
+
+CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOptions options)
+    : registries_(registries), options_(std::move(options)) {
+  const config::Node root =
+      config::Node::load_file(case_file, options_.overrides, options_.override_origins)
+          .validated(case_spec(registries));
+  name_ = root.string("case");
+  check_plain_name(root["case"], name_, "the case name");
+  case_dir_ = fs::absolute(case_file).parent_path();
+  output_dir_ =
+      options_.output_dir.empty() ? fs::current_path() / "out" / name_ : options_.output_dir;
+  if (!options_.resume_dir.empty()) {
+    if (!options_.output_dir.empty() &&
+        fs::weakly_canonical(options_.output_dir) != fs::weakly_canonical(options_.resume_dir))
+      throw Error("--resume " + options_.resume_dir.string() +
+                  " continues in that folder; leave out --output (" + options_.output_dir.string() +
+                  ")");
+    output_dir_ = options_.resume_dir;
+  }
+  identity_ = case_identity(root);
+
+  const config::Node time = root["time"];
+  window_size_ = time.real("window");
+  if (time.has("windows")) {
+    window_count_ = time.integer("windows");
+  } else {
+    try {
+      window_count_ = TimeWindow::count_to(time.real("end"), window_size_);
+    } catch (const Error& e) {
+      time["end"].fail(e.what());
+    }
+    if (window_size_ > time.real("end"))
+      log::get("coupling")
+          ->warn(
+              "{}: time.window ({:.6g} s) is longer than time.end ({:.6g} s): the run makes one "
+              "window "
+              "and ends at t = {:.6g} s",
+              time["window"].location().str(), window_size_, time.real("end"), window_size_);
+  }
+  if (static_cast<double>(window_count_) > kWindowWarning)
+    log::get("coupling")
+        ->warn(
+            "{}: {} windows of {:.6g} s is more than {:.0e}: at a microsecond per window that is "
+            "over "
+            "a day of run time; check time.window and time.end",
+            time.location().str(), window_count_, window_size_, kWindowWarning);
+  if (root.has("output") && root["output"].has("every"))
+    output_every_ = root["output"].real("every");
+  if (root.has("output") && root["output"].has("restart")) {
+    const config::Node r = root["output"]["restart"];
+    if (r.has("every_windows")) restart_every_windows_ = r.integer("every_windows");
+    if (r.has("every_minutes")) restart_every_seconds_ = 60.0 * r.real("every_minutes");
+    restart_keep_ = static_cast<int>(r.integer("keep"));
+    restart_at_end_ = r.boolean("at_end");
+  }
+  if (root.has("output") && root["output"].has("vtk")) {
+    const config::Node v = root["output"]["vtk"];
+    vtk_options_.format = vtk::parse_format(v.string("format"));
+    vtk_options_.zlib_level = static_cast<int>(v.integer("zlib_level"));
+    vtk_options_.precision = vtk::parse_precision(v.string("precision"));
+  }
+  if (root.has("output") && root["output"].has("scripts"))
+    for (const config::Node& sn : root["output"]["scripts"].items()) {
+      const fs::path script = case_dir_ / sn.as_string();
+      if (!fs::exists(script))
+        sn.fail("post-processing script '" + script.string() + "' does not exist");
+      scripts_.push_back(script);
+    }
+
+  build_participants(root);
+  const config::Node coupling = root["coupling"];
+  if (root.has("coupling")) {
+    build_exchanges(coupling);
+    SchemeContext ctx;
+    ctx.config = coupling;
+    ctx.registries = &registries_;
+    for (auto& p : participants_) ctx.participants.push_back(p.get());
+    for (auto& e : exchanges_) ctx.exchanges.push_back(e.get());
+    const auto& entry = registries_.schemes.get(coupling["scheme"]);
+    scheme_ = entry.factory(ctx);
+  } else {
+    // A single-solver case: the participant steps through the windows alone (no exchanges).
+    scheme_ = std::make_unique<ExplicitScheme>(std::vector<Participant*>{participants_[0].get()},
+                                               std::vector<Exchange*>{}, true);
+  }
+
+  build_monitors(root);
+  if (root.has("sweep")) {
+    const Sweep sweep(root);  // validates the swept keys, labels, results and plot
+    if (options_.check_only && options_.check_sweep_values) check_sweep_values(case_file, sweep);
+  }
+
+  if (root.has("output") && root["output"].has("restart") && !restart_blocker().empty())
+    root["output"]["restart"].fail(restart_blocker() + "; remove output.restart");
+  if (root.has("coupling")) {
+    balance_tolerance_ = coupling.real("balance_tolerance");
+    energy_tolerance_ = coupling.real("energy_tolerance");
+    energy_stop_ = coupling.string("on_energy_created") == "stop";
+  }
+  for (const auto& e : exchanges_) {
+    const bool extensive = e->spec().kind == DataKind::extensive;
+    const bool weighted = e->from().find_mesh(e->from_mesh())->mesh.has_weights() &&
+                          e->to().find_mesh(e->to_mesh())->mesh.has_weights();
+    if (extensive || weighted) audited_.push_back(e.get());
+  }
+  // Energy audit: pairs of participants with exchanges both ways whose solvers report the work
+  // done on them through the meshes they read on.
+  for (const auto& e : exchanges_) {
+    Participant* reader = &e->to();
+    Participant* writer = &e->from();
+    if (reader == writer || !reader->interface_work(e->to_mesh())) continue;
+    auto it = std::find_if(energy_pairs_.begin(), energy_pairs_.end(), [&](const EnergyPair& p) {
+      return (p.a == reader && p.b == writer) || (p.a == writer && p.b == reader);
+    });
+    if (it == energy_pairs_.end()) {
+      energy_pairs_.push_back({reader->name() + "-" + writer->name(), reader, writer, {}, {}});
+      it = std::prev(energy_pairs_.end());
+    }
+    auto& meshes = it->a == reader ? it->a_meshes : it->b_meshes;
+    if (std::find(meshes.begin(), meshes.end(), e->to_mesh()) == meshes.end())
+      meshes.push_back(e->to_mesh());
+  }
+  std::erase_if(energy_pairs_,
+                [](const EnergyPair& p) { return p.a_meshes.empty() || p.b_meshes.empty(); });
+}
+
+CaseRun::~CaseRun() = default;
+
+// Each swept value is checked where it will be used: the case is built (check only) with that
+// one value set, as the variant will run it; an error names the value's line in the sweep list.
+// One build per value, not per combination (a value valid alone is assumed valid with the
+// others: keys that depend on each other are checked when the variant runs).
+void CaseRun::check_sweep_values(const fs::path& case_file, const Sweep& sweep) const {
+  for (const Sweep::Parameter& par : sweep.parameters())
+    for (std::size_t i = 0; i < par.values.size(); ++i) {
+      RunOptions o = options_;
+      o.check_sweep_values = false;
+      o.override_origins.resize(o.overrides.size());
+      o.overrides.push_back(par.key + "=" + par.values[i]);
+      o.override_origins.push_back(par.origins[i]);
+      try {
+        CaseRun variant(case_file, registries_, o);
+      } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (the swept value " + par.values[i] + " of " +
+                    par.key + ", as its variants will run it)");
+      }
+    }
+}
+
+void CaseRun::build_participants(const config::Node& root) {
+  const config::Node ps = root["participants"];
+  if (!ps.is_map() || ps.size() == 0)
+    ps.fail(
+        "expected a map of participants, e.g. participants: {fluid: {solver: tube1d-fluid}}; "
+        "found " +
+        ps.describe());
+  std::vector<std::string> names = ps.keys();
+  // scheme order
+  const config::Node coupling = root["coupling"];
+  std::vector<std::string> order = names;
+  if (coupling.has("order")) {
+    order = coupling.strings("order");
+    const config::Node on = coupling["order"];
+    std::set<std::string> seen;
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const config::Node item = on.is_sequence() ? on[i] : on;
+      if (std::find(names.begin(), names.end(), order[i]) == names.end())
+        item.fail("unknown participant '" + order[i] + "'; participants: " + join_names(names) +
+                  did_you_mean(order[i], names));
+      if (!seen.insert(order[i]).second)
+        item.fail("participant '" + order[i] + "' appears twice in the order");
+    }
+    if (order.size() != names.size()) {
+      std::vector<std::string> missing;
+      for (const auto& n : names)
+        if (!seen.count(n)) missing.push_back(n);
+      on.fail("the order must list every participant once; missing: " + join_names(missing));
+    }
+  }
+  const bool coupled = root.has("coupling");
+  if (coupled && names.size() < 2)
+    ps.fail("a coupled case needs at least 2 participants, found " + std::to_string(names.size()) +
+            " (a single-solver case has no coupling section)");
+  if (!coupled && names.size() != 1)
+    ps.fail("a case with " + std::to_string(names.size()) +
+            " participants needs a coupling section (scheme and exchanges); only a case with one "
+            "participant runs without one");
+
+  // substeps
+  std::map<std::string, Substeps> substeps;
+  if (coupling.has("substeps")) {
+    const config::Node sn = coupling["substeps"];
+    if (!sn.is_map())
+      sn.fail("expected a map participant -> number of substeps or auto, found " + sn.describe());
+    for (const std::string& k : sn.keys()) {
+      const config::Node v = sn[k];
+      if (std::find(names.begin(), names.end(), k) == names.end())
+        v.fail("unknown participant '" + k + "'; participants: " + join_names(names) +
+               did_you_mean(k, names));
+      Substeps s;
+      if (v.is_scalar() && v.as_string() == "auto") {
+        s.automatic = true;
+      } else {
+        if (!v.is_scalar())
+          v.fail("expected a number of substeps (>= 1) or auto, found " + v.describe());
+        std::string text = v.as_string();
+        long n = 0;
+        try {
+          n = v.as_integer();
+        } catch (const Error&) {
+          v.fail("expected a whole number of substeps (>= 1) or auto, found '" + text + "'" +
+                 did_you_mean(text, {"auto"}));
+        }
+        if (n < 1) v.fail("substeps must be >= 1 (or auto), found " + std::to_string(n));
+        s.count = static_cast<int>(n);
+      }
+      substeps[k] = s;
+    }
+  }
+
+  struct Built {
+    std::string name;
+    config::Node node;
+    std::string solver_name;
+    std::unique_ptr<Solver> solver;
+  };
+  std::vector<Built> built;
+  for (const std::string& name : order) {
+    const config::Node pn = ps[name];
+    if (name.find('.') != std::string::npos)
+      pn.fail("a participant name may not contain '.', found '" + name +
+              "' (meshes are named participant.mesh)");
+    check_plain_name(pn, name, "a participant name");
+    if (!pn.is_map() || !pn.has("solver"))
+      pn.fail("participant '" + name + "' needs 'solver: <name>'; known solvers: " +
+              join_names(registries_.solvers.names()));
+    const auto& entry = registries_.solvers.get(pn["solver"]);
+    config::Node validated = pn;
+    if (entry.spec) {
+      auto spec = std::make_shared<config::Spec>(*entry.spec);
+      if (!spec->find("solver")) spec->string("solver", "the registered solver's name").required();
+      validated = pn.validated(spec);
+    }
+    SolverContext ctx{name, validated, case_dir_, output_dir_, options_.threads};
+    log::get("coupling")->debug("setting up participant '{}' ({})", name, entry.name);
+    Stopwatch setup;
+    std::unique_ptr<Solver> solver = entry.factory(ctx);
+    if (setup.seconds() > 1.0)
+      log::get("coupling")
+          ->info("set-up of participant '{}' ({}): {:.1f} s", name, entry.name, setup.seconds());
+    if (!solver) pn.fail("solver '" + entry.name + "' could not be built");
+    built.push_back(Built{name, pn, entry.name, std::move(solver)});
+  }
+
+  // Surfaces handed from one participant to another (an FE face as a DEM wall): once every
+  // participant is built, before anyone's meshes() is used for the exchanges.
+  for (auto& b : built)
+    for (const MeshRequest& req : b.solver->mesh_requests()) {
+      const auto dot = req.source.find('.');
+      const std::string pname = req.source.substr(0, dot);
+      const std::string mname = dot == std::string::npos ? "" : req.source.substr(dot + 1);
+      const Built* from = nullptr;
+      for (const auto& other : built)
+        if (other.name == pname) from = &other;
+      if (dot == std::string::npos || !from)
+        req.where.fail("'" + req.source + "' names no participant's mesh (participant.mesh); " +
+                       "participants: " + join_names(names) + did_you_mean(pname, names));
+      if (from == &b) req.where.fail("a participant cannot take a mesh from itself");
+      std::vector<std::string> known;
+      const InterfaceMesh* found = nullptr;
+      for (const auto& m : from->solver->meshes()) {
+        known.push_back(m.mesh.name());
+        if (m.mesh.name() == mname) found = &m;
+      }
+      if (!found)
+        req.where.fail("participant '" + pname + "' has no mesh '" + mname +
+                       "'; its meshes: " + join_names(known) + did_you_mean(mname, known));
+      if (found->mesh.num_triangles() == 0)
+        req.where.fail("mesh '" + req.source +
+                       "' has no triangles (a point set): a surface is needed");
+      b.solver->receive_mesh(req.name, found->mesh);
+    }
+
+  for (auto& b : built) {
+    const std::string& name = b.name;
+    const config::Node& pn = b.node;
+    Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
+    if (!coupled) s.automatic = true;  // alone: as many steps per window as its stability needs
+    // A fixed number of substeps must not exceed the solver's stable time step.
+    const double stable = b.solver->stable_time_step();
+    if (!s.automatic && TimeWindow::longer_than(window_size_ / s.count, stable)) {
+      const config::Node where = substeps.count(name) ? coupling["substeps"][name] : pn;
+      where.fail(fmt::format(
+          "participant '{}' would step {:.4g} s (window {:.4g} s / {} substeps), above its stable "
+          "time step {:.4g} s; use substeps: {{{}: {}}} or more, or {{{}: auto}}",
+          name, window_size_ / s.count, window_size_, s.count, stable, name,
+          TimeWindow::substeps_for(window_size_, stable), name));
+    }
+    participants_.push_back(std::make_unique<LocalParticipant>(name, std::move(b.solver), s));
+    if (coupled && participants_.back()->meshes().empty())
+      pn.fail("solver '" + b.solver_name + "' of participant '" + name +
+              "' exposes no coupling mesh");
+    for (const auto& m : participants_.back()->meshes())
+      check_plain_name(pn, m.mesh.name(),
+                       "the mesh name '" + m.mesh.name() + "' of '" + name + "'");
+  }
+}
+
+void CaseRun::build_exchanges(const config::Node& coupling) {
+  std::vector<std::string> names;
+  for (const auto& p : participants_) names.push_back(p->name());
+  const std::vector<config::Node> items = coupling["exchanges"].items();
+  if (items.empty()) coupling["exchanges"].fail("a coupled case needs at least one exchange");
+
+  struct Resolved {
+    Participant* p;
+    const InterfaceMesh* mesh;
+  };
+  auto resolve = [&](const config::Node& n) {
+    const auto [pname, mname] = split_dot(n, "a mesh");
+    Participant* p = participant(pname);
+    if (!p)
+      n.fail("unknown participant '" + pname + "'; participants: " + join_names(names) +
+             did_you_mean(pname, names));
+    std::vector<std::string> meshes;
+    for (const auto& m : p->meshes()) meshes.push_back(m.mesh.name());
+    const InterfaceMesh* m = p->find_mesh(mname);
+    if (!m)
+      n.fail("participant '" + pname + "' has no mesh '" + mname +
+             "'; its meshes: " + join_names(meshes) + did_you_mean(mname, meshes));
+    return Resolved{p, m};
+  };
+  auto names_of = [](const std::vector<DataSpec>& v) {
+    std::vector<std::string> n;
+    for (const auto& d : v) n.push_back(d.name);
+    return n;
+  };
+
+  for (const config::Node& item : items) {
+    const std::string data = item.string("data");
+    const Resolved from = resolve(item["from"]);
+    const Resolved to = resolve(item["to"]);
+    if (from.p == to.p) item["to"].fail("an exchange goes between two different participants");
+    const DataSpec* ws = nullptr;
+    for (const auto& d : from.mesh->writes)
+      if (d.name == data) ws = &d;
+    if (!ws) {
+      const auto w = names_of(from.mesh->writes);
+      item["data"].fail("participant '" + from.p->name() + "' does not write '" + data +
+                        "' on mesh '" + from.mesh->mesh.name() + "'; it writes: " +
+                        (w.empty() ? "nothing" : join_names(w)) + did_you_mean(data, w));
+    }
+    const DataSpec* rs = nullptr;
+    for (const auto& d : to.mesh->reads)
+      if (d.name == data) rs = &d;
+    if (!rs) {
+      const auto r = names_of(to.mesh->reads);
+      item["data"].fail("participant '" + to.p->name() + "' does not read '" + data +
+                        "' on mesh '" + to.mesh->mesh.name() + "'; it reads: " +
+                        (r.empty() ? "nothing" : join_names(r)) + did_you_mean(data, r));
+    }
+    if (ws->components != rs->components)
+      item["data"].fail("'" + data + "' has " + std::to_string(ws->components) +
+                        " components where '" + from.p->name() + "' writes it but " +
+                        std::to_string(rs->components) + " where '" + to.p->name() + "' reads it");
+    for (const auto& e : exchanges_)
+      if (&e->to() == to.p && e->to_mesh() == to.mesh->mesh.name() && e->data() == data)
+        item.fail("'" + data + "' on " + to.p->name() + "." + to.mesh->mesh.name() +
+                  " already has a sender (" + e->label() + ")");
+    Constraint constraint =
+        ws->kind == DataKind::extensive ? Constraint::conservative : Constraint::consistent;
+    if (item.has("constraint"))
+      constraint = item.string("constraint") == "conservative" ? Constraint::conservative
+                                                               : Constraint::consistent;
+    std::unique_ptr<Mapper> mapper =
+        create_mapper(registries_.mappers, MapperContext{item["mapper"], constraint});
+    Stopwatch setup;
+    mapper->compute(from.mesh->mesh, to.mesh->mesh);
+    if (setup.seconds() > 1.0)
+      log::get("coupling")
+          ->info("set-up of the mapping of '{}' {}.{} -> {}.{}: {:.1f} s", data, from.p->name(),
+                 from.mesh->mesh.name(), to.p->name(), to.mesh->mesh.name(), setup.seconds());
+    const ReaderSees rsee =
+        item.string("reader_sees") == "constant" ? ReaderSees::constant : ReaderSees::linear;
+    const WriterCombines wc =
+        item.string("writer_combines") == "last" ? WriterCombines::last : WriterCombines::average;
+    exchanges_.push_back(std::make_unique<Exchange>(
+        data, Exchange::End{from.p, from.mesh->mesh.name()},
+        Exchange::End{to.p, to.mesh->mesh.name()}, *ws, std::move(mapper), rsee, wc));
+  }
+}
+
+void CaseRun::build_monitors(const config::Node& root) {
+  if (!root.has("monitors")) return;
+  std::vector<std::string> names;
+  for (const auto& p : participants_) names.push_back(p->name());
+  std::set<std::string> files;
+  for (const config::Node& m : root["monitors"].items()) {
+    Monitor mon;
+    mon.name = m.string("name");
+    if (mon.name.empty() || mon.name.find('/') != std::string::npos || mon.name == "coupling")
+      m["name"].fail(
+          "a monitor name becomes DIR/<name>.csv: it must be non-empty, without '/', and not "
+          "'coupling'");
+    if (!files.insert(mon.name).second) m["name"].fail("two monitors are named '" + mon.name + "'");
+    const config::Node qn = m["quantities"];
+    const std::vector<std::string> qs = m.strings("quantities");
+    for (std::size_t i = 0; i < qs.size(); ++i) {
+      const config::Node q = qn.is_sequence() ? qn[i] : qn;
+      const auto [pname, quantity] = split_dot(q, "a quantity");
+      Participant* p = participant(pname);
+      if (!p)
+        q.fail("unknown participant '" + pname + "'; participants: " + join_names(names) +
+               did_you_mean(pname, names));
+      std::vector<std::string> known;
+      for (const auto& v : p->monitors()) known.push_back(v.name);
+      if (std::find(known.begin(), known.end(), quantity) == known.end())
+        q.fail("participant '" + pname + "' reports no quantity '" + quantity + "'; it reports: " +
+               (known.empty() ? "nothing" : join_names(known)) + did_you_mean(quantity, known));
+      mon.quantities.emplace_back(p, quantity);
+    }
+    monitors_.push_back(std::move(mon));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Running
+
+}  // namespace partita::coupling

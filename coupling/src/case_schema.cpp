@@ -1,0 +1,180 @@
+// The case file's schema: every key a case accepts, declared once (validation and `partita docs`).
+#include "partita/coupling/case_run.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "partita/coupling/explicit_scheme.hpp"
+#include "partita/coupling/sweep.hpp"
+#include "plain_name.hpp"
+#include "partita/interface/error.hpp"
+#include "partita/interface/log.hpp"
+
+namespace partita::coupling {
+
+// ---------------------------------------------------------------------------------------------
+// Schema
+
+std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
+  using config::Spec;
+  auto time = std::make_shared<Spec>("time", "fixed time windows");
+  time->real("window", "size of a coupling time window").unit("s").positive().required();
+  time->real("end", "end time (the last window ends at or just after it)").unit("s").positive();
+  time->integer("windows", "number of windows (instead of end)").min(1);
+  time->one_of({"end", "windows"});
+
+  auto exchange =
+      std::make_shared<Spec>("exchange", "one data field sent from one mesh to another");
+  exchange
+      ->string("data",
+               "name of the field (a write of the sender's mesh and a read of the receiver's)")
+      .required();
+  exchange->string("from", "sender as participant.mesh").required();
+  exchange->string("to", "receiver as participant.mesh").required();
+  exchange
+      ->any("mapper",
+            "a mapper name, or a map {type: name, <the mapper's own keys>} (partita docs NAME "
+            "lists them; e.g. {type: rbf, support_radius: 2 mm}); known: " +
+                join_names(registries.mappers.names()))
+      .def("nearest-neighbor");
+  exchange->choice("constraint",
+                   "override the constraint that the data kind implies (intensive: consistent, "
+                   "extensive: conservative)",
+                   {"consistent", "conservative"});
+  exchange
+      ->choice("reader_sees",
+               "what a subcycling reader sees at substep k/m: the newest value (constant) or "
+               "linear interpolation between the window's start and end values",
+               {"constant", "linear"})
+      .def("linear");
+  exchange
+      ->choice("writer_combines",
+               "how a subcycling writer's substep values make the window's value",
+               {"average", "last"})
+      .def("average");
+
+  auto coupling = std::make_shared<Spec>("coupling", "how the participants advance together");
+  coupling->string("scheme", "coupling scheme; known: " + join_names(registries.schemes.names()))
+      .required();
+  coupling->strings(
+      "order",
+      "participants in scheme order (default: file order); a serial scheme runs the first "
+      "first");
+  coupling->any("substeps",
+                "per participant: a number of substeps per window (>= 1) or auto (from its "
+                "stable time step); default 1");
+  coupling->list("exchanges", "the exchanged fields", exchange).required();
+  coupling->list("convergence",
+                 "implicit schemes: measures, all must hold; each {type, data, limit}; known "
+                 "types: " +
+                     join_names(registries.convergence_measures.names()),
+                 nullptr);
+  coupling->any("acceleration",
+                "implicit schemes: {type: name, <the acceleration's own keys>} (partita docs "
+                "NAME lists them; e.g. {type: iqn-ils, initial_relaxation: 0.1}); known: " +
+                    join_names(registries.accelerations.names()));
+  coupling->integer("max_iterations", "implicit schemes: most iterations per window")
+      .min(1)
+      .def(100);
+  coupling
+      ->choice("on_max_iterations",
+               "implicit schemes: at max_iterations stop with an error, or accept the "
+               "window with a warning",
+               {"error", "accept"})
+      .def("accept");
+  coupling
+      ->real("balance_tolerance",
+             "warn when an exchange's total (a force's sum, or a traction's or other field's "
+             "integral over point weights) arrives after mapping off by more than this fraction "
+             "of what was sent (audit columns in coupling.csv)")
+      .positive()
+      .def(0.01);
+  coupling
+      ->real("energy_tolerance",
+             "energy audit: the largest share of the work that passed through an interface "
+             "(both ways, since t = 0) that the coupling itself may create (the sum of the work "
+             "done on both participants; zero for a lossless interface; columns in "
+             "coupling.csv); acts when exceeded for 20 windows in a row")
+      .positive()
+      .def(0.5);
+  coupling
+      ->choice("on_energy_created",
+               "energy audit beyond energy_tolerance: stop the run with a diagnosis, or warn once "
+               "and count the windows",
+               {"stop", "warn"})
+      .def("stop");
+
+  auto monitor =
+      std::make_shared<Spec>("monitor", "a CSV time series DIR/<name>.csv of solver quantities");
+  monitor->string("name", "file name without .csv").required();
+  monitor->strings("quantities", "participant.quantity of each column").required();
+
+  auto output = std::make_shared<Spec>("output", "VTK output under DIR/vtk");
+  output->real("every", "simulated time between frames (default: first and last frame only)")
+      .unit("s")
+      .positive();
+  output->boolean("interface", "also write the interface meshes with their exchanged data (.vtp)")
+      .def(true);
+  auto restart = std::make_shared<Spec>(
+      "restart",
+      "restart files DIR/restart/w<window>.bin; continue with partita run CASE --resume DIR");
+  restart->integer("every_windows", "windows between restart files").min(1);
+  restart->real("every_minutes", "wall-clock minutes between restart files").positive();
+  restart->integer("keep", "newest restart files kept (older ones are removed)").min(1).def(2);
+  restart->boolean("at_end", "also write one after the last window (to extend the run later)")
+      .def(true);
+  output->section(
+      "restart",
+      "restart files (a run stopped by SIGINT/SIGTERM writes one whether declared or not)",
+      restart);
+  auto vtk_spec = std::make_shared<Spec>("vtk", "encoding of the VTK XML files (.vtu, .vtp)");
+  vtk_spec
+      ->choice("format",
+               "zlib: appended binary, zlib-compressed (VTK's own default; the smallest files), "
+               "binary: appended raw (the fastest to write), ascii: text (to read by eye)",
+               vtk::format_names())
+      .def("zlib");
+  vtk_spec
+      ->choice("precision",
+               "of the solvers' point and cell fields (displacement, stress, velocity, force, "
+               "...): float32 (7 significant digits, files 1.5x smaller) or float64 (the "
+               "solver's values exactly); coordinates and ids are always written exactly",
+               {"float32", "float64"})
+      .def("float32");
+  vtk_spec->integer("zlib_level", "zlib compression level: 1 fastest .. 9 smallest")
+      .min(1)
+      .max(9)
+      .def(1);
+  output->section("vtk", "VTK file format (every participant's files)", vtk_spec);
+  output->strings("scripts",
+                  "post-processing scripts of the case folder, run by `partita run` after the last "
+                  "window with the output folder as argument (e.g. plots of the final state)");
+
+  auto root = std::make_shared<Spec>("case", "a coupled simulation");
+  root->string("case", "the case's name (output goes to out/<name> by default)").required();
+  root->section("time", "time windows", time).required();
+  root->any("participants",
+            "map of participant name -> {solver: <registered solver>, solver keys...}; solvers: " +
+                join_names(registries.solvers.names()))
+      .required();
+  root->section("coupling",
+                "coupling scheme and exchanges (leave it out for a case of one participant: it "
+                "then steps alone, as many steps per window as its stable time step needs)",
+                coupling);
+  root->list("monitors", "scalar time series", monitor);
+  root->section("output", "VTK output", output);
+  root->section("sweep",
+                "a parametric sweep (partita run runs every variant; see partita docs case)",
+                Sweep::spec());
+  return root;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Building
+
+}  // namespace partita::coupling
