@@ -32,9 +32,23 @@ void register_all(coupling::Registries& r) {
        {"<mesh>.force_x", "N", "total contact force of the particles on a mesh, x"},
        {"<mesh>.force_y", "N", "... y"},
        {"<mesh>.force_z", "N", "... z"},
-       {"<wall>.force_x", "N", "total contact force of the particles on a plane wall, x"},
+       {"<wall>.force_x", "N",
+        "total contact force of the particles on a wall (a plane, or all faces of a box), x"},
        {"<wall>.force_y", "N", "... y"},
-       {"<wall>.force_z", "N", "... z"}});
+       {"<wall>.force_z", "N", "... z"},
+       {"<wall>.<face>.force_x", "N",
+        "contact force of the particles on one closed face of a box wall (face: xmin, xmax, "
+        "ymin, ymax, zmin, zmax; e.g. walls.zmin.force_z, the floor's load); the faces' forces "
+        "add up to <wall>.force_*, x"},
+       {"<wall>.<face>.force_y", "N", "... y"},
+       {"<wall>.<face>.force_z", "N", "... z"},
+       {"particle.<id>.x", "m",
+        "position of the particle with that id (the ids listed in monitor_particles), x"},
+       {"particle.<id>.y", "m", "... y"},
+       {"particle.<id>.z", "m", "... z"},
+       {"particle.<id>.vx", "m/s", "velocity of that particle, x"},
+       {"particle.<id>.vy", "m/s", "... y"},
+       {"particle.<id>.vz", "m/s", "... z"}});
 #endif
 #ifdef PARTITA_HAVE_FEM
   r.solvers.add(

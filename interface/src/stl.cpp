@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "partita/interface/error.hpp"
+#include "partita/interface/log.hpp"
 #include "partita/interface/output.hpp"
 
 namespace partita {
@@ -20,8 +21,9 @@ namespace partita {
 namespace {
 
 struct Soup {
-  std::vector<std::array<double, 9>> tris;  // three vertices per triangle
-  std::vector<int> lines;                   // source line of each facet (ASCII) or 0
+  std::vector<std::array<double, 9>> tris;     // three vertices per triangle
+  std::vector<int> lines;                      // source line of each facet (ASCII) or 0
+  std::vector<std::array<double, 3>> normals;  // each facet's stored normal (zero: none given)
 };
 
 [[noreturn]] void stl_error(const std::string& source, int line, const std::string& what) {
@@ -43,8 +45,15 @@ Soup parse_binary(const std::string& b, const std::string& source) {
   Soup s;
   s.tris.resize(n);
   s.lines.assign(n, 0);
+  s.normals.assign(n, {0.0, 0.0, 0.0});
   for (std::uint32_t t = 0; t < n; ++t) {
-    const char* p = b.data() + 84 + 50ull * t + 12;  // skip the normal
+    const char* nrm = b.data() + 84 + 50ull * t;
+    for (int k = 0; k < 3; ++k) {
+      float f;
+      std::memcpy(&f, nrm + 4 * k, 4);
+      s.normals[t][static_cast<std::size_t>(k)] = f;
+    }
+    const char* p = nrm + 12;
     for (int k = 0; k < 9; ++k) {
       float f;
       std::memcpy(&f, p + 4 * k, 4);
@@ -64,6 +73,7 @@ Soup parse_ascii(const std::string& b, const std::string& source) {
   int lineno = 0;
   enum class St { start, solid, facet, loop, endloop, done } st = St::start;
   std::array<double, 9> tri{};
+  std::array<double, 3> normal{};
   int nv = 0;
   int facet_line = 0;
   while (std::getline(in, line)) {
@@ -87,6 +97,20 @@ Soup parse_ascii(const std::string& b, const std::string& source) {
         }
         if (word != "facet") expect("'facet' or 'endsolid'");
         facet_line = lineno;
+        {  // "facet normal nx ny nz": the stored normal, where readable (else: none given)
+          normal = {0.0, 0.0, 0.0};
+          std::string kw;
+          std::array<double, 3> nrm{};
+          bool ok = static_cast<bool>(ls >> kw) && kw == "normal";
+          for (int k = 0; k < 3 && ok; ++k) {
+            std::string tok;
+            char* end = nullptr;
+            ok = static_cast<bool>(ls >> tok);
+            if (ok) nrm[static_cast<std::size_t>(k)] = std::strtod(tok.c_str(), &end);
+            ok = ok && end != tok.c_str() && *end == '\0';
+          }
+          if (ok) normal = nrm;
+        }
         st = St::facet;
         break;
       case St::facet:
@@ -121,6 +145,7 @@ Soup parse_ascii(const std::string& b, const std::string& source) {
         if (word != "endfacet") expect("'endfacet'");
         s.tris.push_back(tri);
         s.lines.push_back(facet_line);
+        s.normals.push_back(normal);
         st = St::solid;
         break;
       case St::done:
@@ -136,10 +161,70 @@ Soup parse_ascii(const std::string& b, const std::string& source) {
   return s;
 }
 
+// "3 (triangles 0, 5, 7)" or with the facets' lines: the first few of a list, for a message.
+std::string first_few(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t k = 0; k < items.size() && k < 5; ++k) out += (k ? ", " : "") + items[k];
+  if (items.size() > 5) out += ", ...";
+  return out;
+}
+
+// Orientation: the facets' stored normals against their vertex order (right-hand rule), and the
+// windings of neighbours (an edge shared by two triangles must run in opposite directions in
+// them, else one of them is flipped). Messages, empty when the orientation is consistent.
+std::vector<std::string> stl_orientation_warnings(const Soup& soup, const Mesh::Triangles& tris,
+                                                  const std::string& source) {
+  std::vector<std::string> warnings;
+  auto name = [&](std::size_t t) {
+    return soup.lines[t] ? "triangle " + std::to_string(t) + " (facet at line " +
+                               std::to_string(soup.lines[t]) + ")"
+                         : "triangle " + std::to_string(t);
+  };
+  std::vector<std::string> against;
+  for (std::size_t t = 0; t < soup.tris.size() && t < soup.normals.size(); ++t) {
+    const auto& v = soup.tris[t];
+    const Eigen::Vector3d n(soup.normals[t][0], soup.normals[t][1], soup.normals[t][2]);
+    if (!n.allFinite() || !(n.norm() > 0.0)) continue;  // no normal given: nothing to compare
+    const Eigen::Vector3d a(v[0], v[1], v[2]), b(v[3], v[4], v[5]), c(v[6], v[7], v[8]);
+    const Eigen::Vector3d w = (b - a).cross(c - a);
+    // contradicts: pointing to the other side (a normal within 60 degrees of the surface
+    // counts as neither: some writers store rough normals)
+    if (n.dot(w) < -0.5 * n.norm() * w.norm()) against.push_back(name(t));
+  }
+  if (!against.empty())
+    warnings.push_back(
+        source + ": " + std::to_string(against.size()) + " of " +
+        std::to_string(soup.tris.size()) +
+        " facets have a stored normal that points against their vertex order (the right-hand "
+        "rule gives the other side): " +
+        first_few(against) + "; readers that orient by the vertex order see these facets "
+        "flipped");
+  // directed edges: (from, to) -> the triangle that runs it; an edge run the same way by two
+  // triangles joins neighbours of opposite windings
+  std::map<std::pair<int, int>, int> directed;
+  std::vector<std::string> flipped;
+  for (Eigen::Index t = 0; t < tris.rows(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = tris(t, k), b = tris(t, (k + 1) % 3);
+      if (a == b) continue;
+      const auto [it, inserted] = directed.emplace(std::make_pair(a, b), static_cast<int>(t));
+      if (!inserted && it->second != static_cast<int>(t))
+        flipped.push_back(name(static_cast<std::size_t>(it->second)) + " and " +
+                          name(static_cast<std::size_t>(t)));
+    }
+  if (!flipped.empty())
+    warnings.push_back(
+        source + ": " + std::to_string(flipped.size()) +
+        " edges are shared by neighbours whose vertex orders disagree (each runs the edge the "
+        "same way, so one of them faces the other side): " +
+        first_few(flipped) + "; reorder the vertices of the flipped triangles");
+  return warnings;
+}
+
 }  // namespace
 
 Mesh parse_stl(const std::string& bytes, const std::string& source, const std::string& name,
-               double scale) {
+               double scale, std::vector<std::string>* warnings) {
   if (bytes.empty()) throw Error(source + ": the STL file is empty");
   if (!(scale > 0) || !std::isfinite(scale))
     throw Error(source + ": STL scale must be a positive number, got " + std::to_string(scale));
@@ -192,10 +277,17 @@ Mesh parse_stl(const std::string& bytes, const std::string& source, const std::s
   Mesh::Points P(static_cast<Eigen::Index>(pts.size()), 3);
   for (std::size_t i = 0; i < pts.size(); ++i)
     P.row(static_cast<Eigen::Index>(i)) << pts[i][0], pts[i][1], pts[i][2];
+  for (std::string& w : stl_orientation_warnings(soup, tris, source)) {
+    if (warnings)
+      warnings->push_back(std::move(w));
+    else
+      log::get("interface")->warn("{}", w);
+  }
   return Mesh(name, std::move(P), std::move(tris));
 }
 
-Mesh read_stl(const std::filesystem::path& file, const std::string& name, double scale) {
+Mesh read_stl(const std::filesystem::path& file, const std::string& name, double scale,
+              std::vector<std::string>* warnings) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
     throw Error("cannot open STL file '" + file.string() + "': no such file");
@@ -203,7 +295,7 @@ Mesh read_stl(const std::filesystem::path& file, const std::string& name, double
   if (!in) throw Error("cannot open STL file '" + file.string() + "'");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_stl(ss.str(), file.string(), name, scale);
+  return parse_stl(ss.str(), file.string(), name, scale, warnings);
 }
 
 void write_stl_binary(const std::filesystem::path& file, const Mesh& mesh) {

@@ -32,3 +32,23 @@ TEST_CASE("edit distance", "[interface][registry]") {
   CHECK(partita::nearest_name("aitkin", {"constant", "aitken", "iqn-ils"}) == "aitken");
   CHECK(partita::nearest_name("xyz", {"constant", "aitken"}).empty());
 }
+
+TEST_CASE("registry: documented quantity families match their members only", "[interface]") {
+  using partita::QuantityDoc;
+  using partita::quantity_matches;
+  const QuantityDoc mesh{"<mesh>.force_z", "N", ""}, face{"<wall>.<face>.force_z", "N", ""},
+      particle{"particle.<id>.z", "m", ""}, plain{"kinetic_energy", "J", ""};
+  CHECK(quantity_matches(mesh, "plate.force_z"));
+  CHECK_FALSE(quantity_matches(mesh, ".force_z"));
+  CHECK_FALSE(quantity_matches(mesh, "box.zmin.force_z"));  // one part, not two
+  CHECK_FALSE(quantity_matches(mesh, "plate.force_x"));
+  CHECK(quantity_matches(face, "box.zmin.force_z"));
+  CHECK_FALSE(quantity_matches(face, "box.force_z"));
+  CHECK_FALSE(quantity_matches(face, "box.zmin.force_zz"));
+  CHECK(quantity_matches(particle, "particle.17.z"));
+  CHECK_FALSE(quantity_matches(particle, "particle.17.vz"));
+  CHECK_FALSE(quantity_matches(particle, "particle..z"));
+  CHECK_FALSE(quantity_matches(particle, "grain.17.z"));
+  CHECK(quantity_matches(plain, "kinetic_energy"));
+  CHECK_FALSE(quantity_matches(plain, "kinetic_energy2"));
+}

@@ -103,3 +103,50 @@ TEST_CASE("STL errors are clear", "[interface][stl]") {
   CHECK_THROWS_WITH(partita::read_stl(d / "missing.stl"), Catch::Contains("no such file"));
   fs::remove_all(d);
 }
+
+TEST_CASE("stl: orientation that contradicts itself is reported, counted, first triangles named",
+          "[interface][stl]") {
+  // Two triangles of the unit square z = 0 sharing the edge (1,0)-(0,1); both wound
+  // counter-clockwise seen from +z (right-hand-rule normal +z) unless `flip` reverses the second.
+  auto square = [](const char* n0, const char* n1, bool flip) {
+    std::string s = "solid sq\n";
+    s += std::string("facet normal ") + n0 +
+         "\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
+    s += std::string("facet normal ") + n1 + "\nouter loop\n" +
+         (flip ? "vertex 1 0 0\nvertex 0 1 0\nvertex 1 1 0\n"
+               : "vertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\n") +
+         "endloop\nendfacet\nendsolid sq\n";
+    return s;
+  };
+  std::vector<std::string> w;
+  // consistent: nothing to say; a normal left at zero (not given) neither
+  (void)partita::parse_stl(square("0 0 1", "0 0 1", false), "ok.stl", "sq", 1.0, &w);
+  (void)partita::parse_stl(square("0 0 0", "0 0 1", false), "ok.stl", "sq", 1.0, &w);
+  CHECK(w.empty());
+  // the second facet's stored normal points against its vertex order
+  (void)partita::parse_stl(square("0 0 1", "0 0 -1", false), "normal.stl", "sq", 1.0, &w);
+  REQUIRE(w.size() == 1);
+  INFO(w[0]);
+  CHECK(w[0].find("normal.stl: 1 of 2 facets have a stored normal that points against") !=
+        std::string::npos);
+  CHECK(w[0].find("triangle 1 (facet at line 9)") != std::string::npos);
+  // the second triangle wound the other way (its normal agrees with its own order): the shared
+  // edge runs the same way in both
+  w.clear();
+  (void)partita::parse_stl(square("0 0 1", "0 0 -1", true), "winding.stl", "sq", 1.0, &w);
+  REQUIRE(w.size() == 1);
+  INFO(w[0]);
+  CHECK(w[0].find("winding.stl: 1 edges are shared by neighbours whose vertex orders disagree") !=
+        std::string::npos);
+  CHECK(w[0].find("triangle 0 (facet at line 2) and triangle 1 (facet at line 9)") !=
+        std::string::npos);
+  // a written mesh (normals from the vertex order, windings of a consistent plate) reads back
+  // without a word, in binary (float normals) as in ASCII
+  const fs::path d = tmpdir();
+  partita::write_stl_binary(d / "plate_b.stl", plate(6));
+  partita::write_stl_ascii(d / "plate_a.stl", plate(6));
+  w.clear();
+  (void)partita::read_stl(d / "plate_b.stl", "p", 1.0, &w);
+  (void)partita::read_stl(d / "plate_a.stl", "p", 1.0, &w);
+  CHECK(w.empty());
+}

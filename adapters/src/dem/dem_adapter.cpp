@@ -198,7 +198,12 @@ std::shared_ptr<Spec> make_spec() {
          "map of material name -> {youngs_modulus (Pa, required), poisson_ratio (required), "
          "density (kg/m^3, default 2500)}")
       .required();
-  s->list("interactions", "contact parameters of each pair of materials that can touch",
+  s->list("interactions",
+          "contact parameters of each pair of materials that can touch: the particles' material "
+          "with each wall's and mesh's, and with itself where two particles exist (or breakage "
+          "makes fragments; a single particle needs no interaction with itself). A pair that can "
+          "touch has no default: friction and restitution belong to the pair, not to either "
+          "material",
           interaction)
       .required();
   s->choice("damping",
@@ -223,8 +228,8 @@ std::shared_ptr<Spec> make_spec() {
   s->real("skin", "Verlet skin (default: 10 % of the largest radius)").unit("m").non_negative();
   s->real("lost_margin",
           "a particle farther than this outside the domain's bounding box (particles at the "
-          "start, walls of type box, meshes) stops the run as lost (default: the box's largest "
-          "edge)")
+          "start, box walls, the points of plane walls, meshes) stops the run as lost (default: "
+          "the box's largest edge, at least 5 largest particle diameters)")
       .unit("m")
       .positive();
   s->integer("sort_interval",
@@ -233,6 +238,13 @@ std::shared_ptr<Spec> make_spec() {
       .min(0)
       .def(10);
   s->section("breakage", "crushable particles (off when absent)", breakage);
+  s->integers("monitor_particles",
+              "ids of particles whose position and velocity are monitor quantities "
+              "particle.<id>.x|y|z [m] and particle.<id>.vx|vy|vz [m/s] (e.g. monitors: "
+              "[{name: ball, quantities: [granules.particle.1.z]}]); ids as in the particle file, "
+              "or 0, 1, ... in the order generated; a particle that breakage removed keeps its "
+              "last values")
+      .min(0);
   auto output = std::make_shared<Spec>("output", "files of this participant beyond the VTK series");
   output
       ->choice("particles_file",
@@ -424,6 +436,10 @@ DemAdapter::DemAdapter(const SolverContext& context)
 
     // Walls.
     int wi = 0;
+    // the box of the bounded geometry (box walls, meshes): particles absurdly far from it are
+    // refused at set-up (a unit slip in a particle file)
+    Eigen::Vector3d bound_lo = Eigen::Vector3d::Constant(1e300);
+    Eigen::Vector3d bound_hi = Eigen::Vector3d::Constant(-1e300);
     for (const Node& w : c["walls"].items()) {
       Wall wall;
       wall.name = w.has("name") ? w.string("name") : "wall" + std::to_string(wi);
@@ -434,6 +450,10 @@ DemAdapter::DemAdapter(const SolverContext& context)
         const Eigen::Vector3d n = w["plane"].vec3("normal");
         if (!(n.norm() > 0)) w["plane"]["normal"].fail("the normal must not be zero");
         wall.id = system_.add_plane(w["plane"].vec3("point"), n.normalized(), mid, v);
+        // an infinite plane bounds the domain on one side: its point counts (a sphere dropped
+        // on a plane has a domain from the plane up to the sphere)
+        domain_lo_ = domain_lo_.cwiseMin(w["plane"].vec3("point"));
+        domain_hi_ = domain_hi_.cwiseMax(w["plane"].vec3("point"));
       } else {
         unsigned faces = 0b111111;
         if (w.has("open"))
@@ -442,8 +462,11 @@ DemAdapter::DemAdapter(const SolverContext& context)
                                                    kFaces.begin()));
         const Eigen::Vector3d lo = w["box"].vec3("origin");
         wall.id = system_.add_box(lo, lo + w["box"].vec3("size"), mid, faces);
+        wall.faces = faces;
         domain_lo_ = domain_lo_.cwiseMin(lo);
         domain_hi_ = domain_hi_.cwiseMax(lo + w["box"].vec3("size"));
+        bound_lo = bound_lo.cwiseMin(lo);
+        bound_hi = bound_hi.cwiseMax(lo + w["box"].vec3("size"));
         if (v.norm() > 0) system_.set_wall_velocity(wall.id, v);
       }
       if (w.has("velocity_table")) {
@@ -485,32 +508,98 @@ DemAdapter::DemAdapter(const SolverContext& context)
       }
       if (m.has("stl")) {
         const std::filesystem::path f = resolve(m.string("stl"));
+        std::vector<std::string> warnings;
         try {
-          mesh = read_stl(f, cm.name, m.real("scale"));
+          mesh = read_stl(f, cm.name, m.real("scale"), &warnings);
         } catch (const Error& e) {
           m["stl"].fail(e.what());
         }
+        // The contacts are two-sided (a sphere touches a triangle from either side, pushed along
+        // centre - closest point): the vertex order decides only for a centre on the triangle.
+        for (const std::string& w : warnings)
+          log::get("adapters")
+              ->warn(
+                  "dem '{}', mesh '{}': {} (the DEM's mesh contacts are two-sided: the vertex "
+                  "order matters only where a sphere's centre reaches the triangle's plane, which "
+                  "then pushes it to the side of the right-hand-rule normal)",
+                  name_, cm.name, w);
       } else {
         mesh = rectangle(m["rectangle"], cm.name);
       }
       add_coupling_mesh(cm.name, mesh, material_id(m["material"]));
     }
-    // Every pair that can touch needs an interaction: particles with particles, walls and meshes.
-    std::vector<int> partners{pm};
+    // Every pair that can touch needs an interaction: particles with walls and meshes, and with
+    // each other where two particles exist (or fragments will: breakage). A single particle never
+    // touches itself, so its material needs no interaction with itself. (No default for a pair
+    // that can touch: friction and restitution belong to the pair, not to either material, and a
+    // default would give a bed contact parameters nobody chose.)
+    std::vector<int> partners;
+    if (system_.particle_count() >= 2 || c.has("breakage")) partners.push_back(pm);
     for (const Node& w : c["walls"].items()) partners.push_back(material_id(w["material"]));
     for (const Node& m : c["meshes"].items()) partners.push_back(material_id(m["material"]));
     for (int b : partners)
       if (!system_.contact_model().has_interaction(pm, b)) {
         const std::string& na = material_names[static_cast<std::size_t>(pm)];
         const std::string& nb = material_names[static_cast<std::size_t>(b)];
+        const std::string why =
+            b != pm ? "which can touch"
+            : system_.particle_count() >= 2
+                ? fmt::format("which can touch: the {} particles are of material '{}'",
+                              system_.particle_count(), na)
+                : "which can touch: breakage makes fragments of the particle";
         c["interactions"].fail("no interaction between materials '" + na + "' and '" + nb +
-                               "', which can touch; add {pair: [" + na + ", " + nb +
+                               "', " + why + "; add {pair: [" + na + ", " + nb +
                                "], friction: 0.3, restitution: 0.5}");
       }
     if (c.has("breakage")) add_breakage(c["breakage"]);
+    if (c.has("monitor_particles")) {
+      const dem::Particles& p = system_.particles();
+      const Node ids = c["monitor_particles"];
+      const std::vector<long> want = c.integers("monitor_particles");
+      for (std::size_t k = 0; k < want.size(); ++k) {
+        const auto it = std::find(p.id.begin(), p.id.end(), static_cast<std::int64_t>(want[k]));
+        if (it == p.id.end()) {
+          const auto [lo, hi] = std::minmax_element(p.id.begin(), p.id.end());
+          (ids.is_sequence() ? ids[k] : ids)
+              .fail(fmt::format("no particle has the id {}; the {} particles have ids {} .. {}",
+                                want[k], p.size(), p.size() ? *lo : 0, p.size() ? *hi : 0));
+        }
+        tracked_.push_back(want[k]);
+        tracked_index_.push_back(static_cast<std::size_t>(it - p.id.begin()));
+        tracked_last_.push_back({});
+      }
+    }
     // Validate the set-up now (interactions of every pair in use, the Rayleigh step).
     (void)system_.rayleigh_time_step();
     if (time_step_fraction_auto_) time_step_fraction_ = system_.time_step_fraction();
+
+    // A particle absurdly far from the box walls and meshes (more than kAbsurdFactor times their
+    // box's largest edge, at least 5 particle diameters, outside it): a unit slip in a particle
+    // file (880 m for 0.88 m), refused before the run rather than left to the neighbour grid.
+    for (const auto& m : meshes_dem_)
+      for (Eigen::Index i = 0; i < m.reference.rows(); ++i) {
+        bound_lo = bound_lo.cwiseMin(m.reference.row(i).transpose());
+        bound_hi = bound_hi.cwiseMax(m.reference.row(i).transpose());
+      }
+    if ((bound_lo.array() <= bound_hi.array()).all()) {
+      double d_max = 0.0;
+      for (const double r : system_.particles().radius) d_max = std::max(d_max, 2.0 * r);
+      const double far =
+          kAbsurdFactor * std::max((bound_hi - bound_lo).maxCoeff(), kLostDiameters * d_max);
+      const dem::Particles& p = system_.particles();
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const Eigen::Vector3d& x = p.position[i];
+        const double out = std::max((bound_lo - x).maxCoeff(), (x - bound_hi).maxCoeff());
+        if (out > far)
+          pn[pn.has("file") ? "file" : "generate"].fail(fmt::format(
+              "particle id {} (index {}) at ({:.6g}, {:.6g}, {:.6g}) m lies {:.4g} m outside the "
+              "domain of the walls and meshes [{:.4g} {:.4g} {:.4g}] .. [{:.4g} {:.4g} {:.4g}] "
+              "m, more than {:g} times its size: check the units of the particle positions (m; "
+              "e.g. 880 for 0.88) and the walls",
+              p.id[i], i, x.x(), x.y(), x.z(), out, bound_lo.x(), bound_lo.y(), bound_lo.z(),
+              bound_hi.x(), bound_hi.y(), bound_hi.z(), kAbsurdFactor));
+      }
+    }
 
     // The domain whose bounding box a particle must not leave by more than lost_margin.
     for (const auto& p : system_.particles().position) {
@@ -522,15 +611,20 @@ DemAdapter::DemAdapter(const SolverContext& context)
         domain_lo_ = domain_lo_.cwiseMin(m.reference.row(i).transpose());
         domain_hi_ = domain_hi_.cwiseMax(m.reference.row(i).transpose());
       }
-    lost_margin_ =
-        c.has("lost_margin") ? c.real("lost_margin") : (domain_hi_ - domain_lo_).maxCoeff();
+    lost_margin_given_ = c.has("lost_margin");
+    lost_margin_ = lost_margin_given_ ? c.real("lost_margin") : default_lost_margin();
   } catch (const dem::Error& e) {
     c.fail(std::string("DEM model of participant '") + context.name + "': " + e.what());
   }
+  // (meshes taken from other participants arrive later, through receive_mesh(): counted here)
   log::get("adapters")
       ->info(
-          "dem '{}': {} particles, {} walls, {} meshes, Rayleigh step {:.3e} s, time step {:.3e} s",
-          name_, system_.particle_count(), walls_.size(), meshes_dem_.size(),
+          "dem '{}': {} particles, {} walls, {} meshes{}, Rayleigh step {:.3e} s, time step "
+          "{:.3e} s",
+          name_, system_.particle_count(), walls_.size(), meshes_dem_.size() + requests_.size(),
+          requests_.empty() ? std::string()
+                            : fmt::format(" ({} handed over by other participants)",
+                                          requests_.size()),
           system_.rayleigh_time_step(), stable_time_step());
 }
 
@@ -738,6 +832,10 @@ void DemAdapter::read_restart(BinaryReader& in) {
   } catch (const dem::Error& e) {
     throw Error(in.source() + ": the DEM state of '" + name_ + "': " + e.what());
   }
+  // a state whose particles are not finite or lie beyond the domain (a damaged or foreign file)
+  // is refused here, with the particle, rather than by the neighbour grid at the first step
+  if (const std::string astray = particle_astray(true); !astray.empty())
+    throw Error(in.source() + ": the DEM state of '" + name_ + "' cannot be resumed: " + astray);
   in.expect_section("dem interface work");
   for (auto& cm : meshes_dem_) {
     Eigen::MatrixXd x, f;
@@ -789,18 +887,35 @@ void DemAdapter::receive_mesh(const std::string& name, const Mesh& mesh) {
         requests_[k].where.fail(std::string("cannot use this surface as a contact mesh: ") +
                                 e.what());
       }
-      if (!lost_margin_given_) lost_margin_ = (domain_hi_ - domain_lo_).maxCoeff();
+      if (!lost_margin_given_) lost_margin_ = default_lost_margin();
       return;
     }
   throw Error("dem '" + name_ + "' asked for no mesh '" + name + "'");
 }
 
-std::string DemAdapter::check_state() const {
+double DemAdapter::default_lost_margin() const {
+  double d_max = 0.0;
+  for (const double r : system_.particles().radius) d_max = std::max(d_max, 2.0 * r);
+  return std::max((domain_hi_ - domain_lo_).maxCoeff(), kLostDiameters * d_max);
+}
+
+std::string DemAdapter::check_state() const { return particle_astray(false); }
+
+std::string DemAdapter::particle_astray(bool restored) const {
   // the first particle (lowest index) that is not finite or lies beyond the margin, if any
   const std::ptrdiff_t astray = system_.first_particle_astray(domain_lo_, domain_hi_, lost_margin_);
   if (astray < 0) return {};
   const dem::Particles& p = system_.particles();
   const auto i = static_cast<std::size_t>(astray);
+  if (restored)
+    return fmt::format(
+        "particle id {} (index {}) at ({:.6g}, {:.6g}, {:.6g}) m with velocity ({:.6g}, {:.6g}, "
+        "{:.6g}) m/s is not finite or lies outside the domain [{:.4g} {:.4g} {:.4g}] .. [{:.4g} "
+        "{:.4g} {:.4g}] m by more than lost_margin = {:.3g} m (a damaged restart file, or one "
+        "of another case)",
+        p.id[i], i, p.position[i].x(), p.position[i].y(), p.position[i].z(), p.velocity[i].x(),
+        p.velocity[i].y(), p.velocity[i].z(), domain_lo_.x(), domain_lo_.y(), domain_lo_.z(),
+        domain_hi_.x(), domain_hi_.y(), domain_hi_.z(), lost_margin_);
   if (!p.position[i].allFinite() || !p.velocity[i].allFinite())
     return fmt::format(
         "particle {} has a non-finite position or velocity: the DEM step is unstable; lower "
@@ -810,9 +925,10 @@ std::string DemAdapter::check_state() const {
   const double out = std::max((domain_lo_ - x).maxCoeff(), (x - domain_hi_).maxCoeff());
   return fmt::format(
       "particle {} is lost: at ({:.4g}, {:.4g}, {:.4g}) m it lies {:.3g} m outside the "
-      "domain [{:.4g} {:.4g} {:.4g}] .. [{:.4g} {:.4g} {:.4g}] m (lost_margin {:.3g} m); a "
-      "wall or mesh lets particles through (an open face, an overlap too large for the time "
-      "step) or the run is diverging",
+      "domain [{:.4g} {:.4g} {:.4g}] .. [{:.4g} {:.4g} {:.4g}] m (walls, meshes and the "
+      "particles at the start) by more than lost_margin = {:.3g} m; a wall or mesh lets "
+      "particles through (an open face, an overlap too large for the time step) or the run is "
+      "diverging; if the particle may go that far, raise the participant's key lost_margin",
       p.id[i], x.x(), x.y(), x.z(), out, domain_lo_.x(), domain_lo_.y(), domain_lo_.z(),
       domain_hi_.x(), domain_hi_.y(), domain_hi_.z(), lost_margin_);
 }
@@ -846,6 +962,36 @@ std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::stri
   for (const auto& w : walls_) {
     const Eigen::Vector3d f = system_.wall_force(w.id);
     for (int k = 0; k < 3; ++k) v.push_back({w.name + ".force_" + xyz[k], "N", f(k)});
+    for (int face = 0; face < 6; ++face)  // a box wall's closed faces, each on its own
+      if (w.faces & (1u << face)) {
+        const Eigen::Vector3d ff =
+            system_.wall_face_force(w.id, face).value_or(Eigen::Vector3d(0.0, 0.0, 0.0));
+        for (int k = 0; k < 3; ++k)
+          v.push_back({w.name + "." + kFaces[static_cast<std::size_t>(face)] + ".force_" + xyz[k],
+                       "N", ff(k)});
+      }
+  }
+  if (!tracked_.empty()) {
+    const dem::Particles& p = system_.particles();
+    static constexpr const char* kState[] = {"x", "y", "z", "vx", "vy", "vz"};
+    for (std::size_t k = 0; k < tracked_.size(); ++k) {
+      const std::string prefix = "particle." + std::to_string(tracked_[k]) + ".";
+      bool asked = names.empty();
+      for (int c = 0; c < 6 && !asked; ++c) asked = wanted(prefix + kState[c]);
+      if (!asked) continue;
+      std::size_t& i = tracked_index_[k];
+      if (i >= p.size() || p.id[i] != tracked_[k])  // renumbered (or removed): find it again
+        i = static_cast<std::size_t>(std::find(p.id.begin(), p.id.end(), tracked_[k]) -
+                                     p.id.begin());
+      if (i < p.size())
+        for (int c = 0; c < 3; ++c) {
+          tracked_last_[k][static_cast<std::size_t>(c)] = p.position[i][c];
+          tracked_last_[k][static_cast<std::size_t>(c + 3)] = p.velocity[i][c];
+        }
+      for (int c = 0; c < 6; ++c)
+        v.push_back({prefix + kState[c], c < 3 ? "m" : "m/s",
+                     tracked_last_[k][static_cast<std::size_t>(c)]});
+    }
   }
   if (const dem::Breakage* b = breakage()) {
     const dem::BreakageCounters& c = b->counters();

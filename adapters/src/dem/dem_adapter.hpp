@@ -16,7 +16,9 @@
 //              see dem::TriangleMesh::triangle_forces)
 // interface_work(M or M_centres): the work the motion of M did on the particles (energy audit).
 // Monitors: kinetic_energy [J], M.force_x|y|z [N] (force of the particles on mesh M),
-// <wall>.force_x|y|z [N], particles, contacts_per_particle; with `breakage`: breakage.events,
+// particle.<id>.x|y|z [m] and .vx|vy|vz [m/s] for the ids in monitor_particles,
+// <wall>.force_x|y|z [N] (a box wall: all its faces), <wall>.<face>.force_x|y|z [N] (each closed
+// face of a box wall, faces xmin..zmax), particles, contacts_per_particle; with `breakage`: breakage.events,
 // .fragments, .fragment_mass [kg], .mass_lost [kg], .mass_restored [kg], .energy_released [J],
 // stable_time_step [s] (it falls as fragments appear; `auto` substeps follow it), and the grading
 // (cumulative mass passing per size) appended to <output>/<participant>_grading.csv at each
@@ -24,6 +26,8 @@
 // LAMMPS data file that particles: {file: ...} reads back bit for bit: <output>/<participant>.data
 // at finalize() (and <output>/particles/<participant>_<frame>.data at each output time).
 
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -84,6 +88,7 @@ class DemAdapter : public Solver {
   struct Wall {
     std::string name;
     int id = -1;
+    unsigned faces = 0;  // a box wall: its closed faces (bit k: kFaces[k]); 0: a plane wall
     bool moving = false;                                 // velocity from a table
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // times table(t)
     TimeTable table;
@@ -108,7 +113,8 @@ class DemAdapter : public Solver {
   std::vector<Wall> walls_;
   std::vector<InterfaceMesh> meshes_;
   std::vector<std::pair<std::string, std::string>> files_;
-  // the domain's bounding box (particles at the start, box walls, meshes) and the margin
+  // the domain's bounding box (particles at the start, box walls, plane points, meshes) and the
+  // margin
   Eigen::Vector3d domain_lo_ = Eigen::Vector3d::Constant(1e300);
   Eigen::Vector3d domain_hi_ = Eigen::Vector3d::Constant(-1e300);
   double lost_margin_ = 0.0;
@@ -118,11 +124,27 @@ class DemAdapter : public Solver {
   mutable std::size_t stable_for_count_ = kNoCount;
   mutable double stable_fraction_ = -1.0;
   bool lost_margin_given_ = false;
+  /// lost_margin when the case gives none: the domain's largest edge, and never below
+  /// kLostDiameters largest particle diameters (one sphere on a plane has a box of one height).
+  double default_lost_margin() const;
+  /// check_state()'s message for the first particle that is not finite or lies beyond the
+  /// domain and lost_margin (empty: none); restored: worded for a state read from a file.
+  std::string particle_astray(bool restored) const;
+  static constexpr double kLostDiameters = 5.0;
+  /// At set-up, a particle farther than kAbsurdFactor times the size of the box walls' and
+  /// meshes' domain outside it is refused (a unit slip: mm read as m is 1000).
+  static constexpr double kAbsurdFactor = 100.0;
   // meshes taken from other participants (meshes: [{from: participant.mesh}]), with materials
   std::vector<MeshRequest> requests_;
   std::vector<int> request_materials_;
   void add_coupling_mesh(const std::string& name, const Mesh& mesh, int material);
   int breakage_ = -1;  // hook index of the breakage model, -1: off
+  // monitor_particles: the ids whose position and velocity are monitor quantities
+  // particle.<id>.x|y|z|vx|vy|vz, the index where each was last found (ids are stable, indices
+  // change when the particles are renumbered) and its last state (kept once breakage removed it)
+  std::vector<std::int64_t> tracked_;
+  mutable std::vector<std::size_t> tracked_index_;
+  mutable std::vector<std::array<double, 6>> tracked_last_;
 };
 
 }  // namespace partita::adapters

@@ -1,6 +1,7 @@
 #include "partita/dem/cell_order.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace partita::dem {
 
@@ -14,12 +15,18 @@ bool CellOrder::compute(const Particles& p, double skin) {
     hi = hi.cwiseMax(p.position[i]);
     r_max = std::max(r_max, p.radius[i]);
   }
+  // a position that is not finite cannot be ordered (the neighbour list's build names it)
+  if (!lo.allFinite() || !hi.allFinite() || !(hi - lo).allFinite()) return false;
   double h = std::max(2.0 * r_max + std::max(skin, 0.0), 1e-12);
-  auto dim = [&](int k) { return static_cast<long>((hi[k] - lo[k]) / h) + 1; };
-  while (dim(0) * dim(1) * dim(2) > 4L * n + 64) h *= 1.26;
-  const long nx = dim(0), ny = dim(1), nz = dim(2);
+  // counted in doubles: a far particle cannot overflow the product, the cap always holds
+  auto dim = [&](int k) { return std::floor((hi[k] - lo[k]) / h) + 1.0; };
+  while (dim(0) * dim(1) * dim(2) > 4.0 * n + 64.0) h *= 1.26;
+  const long nx = static_cast<long>(dim(0)), ny = static_cast<long>(dim(1)),
+             nz = static_cast<long>(dim(2));
   auto cell = [&](double x, double o, long cells) {
-    return std::clamp(static_cast<long>((x - o) / h), 0L, cells - 1);
+    const double c = (x - o) / h;
+    if (!(c >= 0.0)) return 0L;  // also NaN
+    return c >= static_cast<double>(cells - 1) ? cells - 1 : static_cast<long>(c);
   };
   key_.resize(n);
   start_.reserve(4 * static_cast<std::size_t>(n) + 65);  // the most cells: no regrowth

@@ -128,6 +128,11 @@ LammpsData LammpsData::read(const std::string& path) {
   int line_no = 0;
   enum class Section { header, atoms, velocities, other } section = Section::header;
   std::unordered_map<std::int64_t, std::size_t> index_of;
+  // the Velocities section: where it starts and which atoms it gave (LAMMPS refuses a partial
+  // section: an atom without a line would start at rest without a word)
+  int velocities_line = 0;
+  std::vector<char> has_velocity;
+  std::size_t velocity_lines = 0;
   auto fail = [&](const std::string& what) {
     std::ostringstream msg;
     msg << "LAMMPS data " << path << ":" << line_no << ": " << what << " (line: '" << line << "')";
@@ -144,7 +149,12 @@ LammpsData LammpsData::read(const std::string& path) {
       continue;
     }
     if (s == "Velocities") {
+      if (velocities_line > 0)
+        fail("a second Velocities section (the first starts at line " +
+             std::to_string(velocities_line) + ")");
       section = Section::velocities;
+      velocities_line = line_no;
+      has_velocity.assign(d.size(), 0);
       continue;
     }
     if (std::isalpha(static_cast<unsigned char>(s[0]))) {
@@ -193,6 +203,13 @@ LammpsData LammpsData::read(const std::string& path) {
         fail("expected 'id vx vy vz wx wy wz'");
       const auto it = index_of.find(id);
       if (it == index_of.end()) fail("velocity for unknown atom id " + std::to_string(id));
+      if (it->second >= has_velocity.size())
+        fail("velocity for atom id " + std::to_string(id) +
+             ", which the Atoms section lists only after the Velocities section");
+      if (has_velocity[it->second])
+        fail("a second velocity line for atom id " + std::to_string(id));
+      has_velocity[it->second] = 1;
+      ++velocity_lines;
       d.velocity[it->second] = Eigen::Vector3d(v[0], v[1], v[2]);
       d.angular_velocity[it->second] = Eigen::Vector3d(v[3], v[4], v[5]);
     }
@@ -201,6 +218,17 @@ LammpsData LammpsData::read(const std::string& path) {
     std::ostringstream msg;
     msg << "LAMMPS data " << path << ": header says " << n_atoms << " atoms, the Atoms section has "
         << d.size();
+    throw Error(msg.str());
+  }
+  if (velocities_line > 0 && velocity_lines != d.size()) {
+    std::size_t first = 0;  // the first atom (in file order) without a velocity line
+    while (first < d.size() && first < has_velocity.size() && has_velocity[first]) ++first;
+    std::ostringstream msg;
+    msg << "LAMMPS data " << path << ":" << velocities_line << ": the Velocities section has "
+        << velocity_lines << " lines for " << d.size() << " atoms (atom id "
+        << (first < d.size() ? d.id[first] : 0)
+        << " has none); give one line 'id vx vy vz wx wy wz' per atom, as LAMMPS requires, or "
+           "leave the section out for particles at rest";
     throw Error(msg.str());
   }
   return d;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace partita::dem {
 
@@ -149,6 +150,43 @@ void NeighborList::read_build_references(BinaryReader& in) {
   in.array(mesh_candidates_, "mesh candidates");
 }
 
+void NeighborList::throw_absurd_extent(const Particles& p, const Eigen::Vector3d& lo,
+                                       const Eigen::Vector3d& hi, double natural, double cell) {
+  const std::size_t n = p.size();
+  std::ostringstream msg;
+  msg.precision(6);
+  // the particle to name: the first with a non-finite coordinate, else the one farthest from the
+  // particles' mean along the axis of the largest extent (the odd one out)
+  std::size_t worst = n;
+  for (std::size_t i = 0; i < n && worst == n; ++i)
+    if (!p.position[i].allFinite()) worst = i;
+  if (worst < n) {
+    msg << "particle id " << p.id[worst] << " (index " << worst << ") is at "
+        << vector_text(p.position[worst])
+        << ": a position that is not a finite number (a corrupt state, or a step that diverged)";
+    throw Error(msg.str());
+  }
+  int axis = 0;
+  (hi - lo).maxCoeff(&axis);
+  double mean = 0.0;
+  for (std::size_t i = 0; i < n; ++i) mean += p.position[i][axis] / static_cast<double>(n);
+  worst = 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if (std::abs(p.position[i][axis] - mean) > std::abs(p.position[worst][axis] - mean)) worst = i;
+  msg << "the particles span " << vector_text(lo) << " .. " << vector_text(hi) << " m, "
+      << (hi - lo).maxCoeff() / natural << " neighbour cells of " << natural
+      << " m (2 R_max + skin) along the widest axis";
+  if (cell > 0.0)
+    msg << "; with the cell count capped at 4 N + 64 (memory in proportion to the " << n
+        << " particles) the cells grow to " << cell
+        << " m and the neighbour search would compare nearly every pair";
+  msg << ": particle id " << p.id[worst] << " (index " << worst << ") at "
+      << vector_text(p.position[worst])
+      << " m lies far from the others (a unit slip in a particle file, e.g. mm read as m, or a "
+         "corrupt state)";
+  throw Error(msg.str());
+}
+
 // Calls visit(j) for every j > i within R_i + R_j + skin of i, cells in a fixed order.
 template <class Visit>
 void NeighborList::visit_pairs(const Particles& p, int i, Visit&& visit) const {
@@ -190,15 +228,22 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   }
   Eigen::Vector3d lo(lx, ly, lz), hi(hx, hy, hz);
   if (n == 0) lo = hi = Eigen::Vector3d::Zero();
-  double cell = std::max(2.0 * r_max + skin_, 1e-12);
+  const double natural = std::max(2.0 * r_max + skin_, 1e-12);
+  double cell = natural;
   const Eigen::Vector3d extent = hi - lo;
-  auto dims = [&](double h, int k) { return static_cast<int>(std::floor(extent[k] / h)) + 1; };
+  // (a NaN coordinate is left out of the box above and binned into cell 0; an infinite one, or
+  // a box too large for doubles, cannot be gridded: the state is corrupt or the step diverged)
+  if (!extent.allFinite()) throw_absurd_extent(p, lo, hi, natural, 0.0);
+  // The cell count is capped at max_cells (memory in proportion to the particles, whatever the
+  // extent: one particle 880 m away from a bed of millimetre grains would ask for 10^17 cells);
+  // above it the cells grow. Counted in doubles (no integer overflow), so the cap always holds.
+  auto dims = [&](double h, int k) { return std::floor(extent[k] / h) + 1.0; };
   const double max_cells = 4.0 * n + 64.0;
-  while (static_cast<double>(dims(cell, 0)) * dims(cell, 1) * dims(cell, 2) > max_cells)
-    cell *= 1.26;
+  while (dims(cell, 0) * dims(cell, 1) * dims(cell, 2) > max_cells) cell *= 1.26;
   grid_.origin = lo;
   grid_.inv_cell = 1.0 / cell;
-  grid_.nx = dims(cell, 0), grid_.ny = dims(cell, 1), grid_.nz = dims(cell, 2);
+  grid_.nx = static_cast<int>(dims(cell, 0)), grid_.ny = static_cast<int>(dims(cell, 1)),
+  grid_.nz = static_cast<int>(dims(cell, 2));
 
   // Counting sort of the particles into cells (ascending index within a cell). The cell arrays
   // get room for the most cells at once, so a growing grid does not reallocate them.
@@ -212,6 +257,15 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
     particle_cell_[i] = grid_.index(c[0], c[1], c[2]);
   });
   for (int i = 0; i < n; ++i) ++cell_start_[particle_cell_[i] + 1];
+  if (cell > natural && n >= kDegenerateMinParticles) {
+    // The cap grew the cells (a sparse or stretched cloud): the search visits about 27 sum_c n_c^2
+    // candidates. Far beyond the dense bed's few per particle (a bed gathered into a handful of
+    // cells by one particle far away), a build would take hours: the extent is absurd.
+    double visits = 0.0;
+    for (int c = 0; c < grid_.cells(); ++c)
+      visits += static_cast<double>(cell_start_[c + 1]) * cell_start_[c + 1];
+    if (visits > kDegenerateVisits * n) throw_absurd_extent(p, lo, hi, natural, cell);
+  }
   for (int c = 0; c < grid_.cells(); ++c) cell_start_[c + 1] += cell_start_[c];
   cell_items_.resize(n);
   counts_.assign(grid_.cells(), 0);

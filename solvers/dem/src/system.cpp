@@ -310,31 +310,45 @@ double System::rayleigh_time_step() const {
 
 double System::time_step_fraction() const {
   check_interactions();
-  std::vector<bool> used(model_.material_count(), false), partner(model_.material_count(), false);
-  for (int m : store_.core().material) used[m] = partner[m] = true;
-  for (const PlaneWall& p : walls_.planes()) partner[p.material] = true;
-  for (const TriangleMesh& m : meshes_) partner[m.material()] = true;
+  const std::vector<int> count = particles_per_material();
+  std::vector<bool> wall(model_.material_count(), false);
+  for (const PlaneWall& p : walls_.planes()) wall[p.material] = true;
+  for (const TriangleMesh& m : meshes_) wall[m.material()] = true;
   double f = 0.2;
   for (int a = 0; a < model_.material_count(); ++a)
     for (int b = 0; b < model_.material_count(); ++b)
-      if (used[a] && partner[b])
+      if (count[a] > 0 && can_touch(count, wall, a, b))
         f = std::min(
             f, RestitutionCalibration::time_step_fraction(model_.interaction(a, b).restitution));
   return f;
 }
 
+std::vector<int> System::particles_per_material() const {
+  std::vector<int> count(model_.material_count(), 0);
+  for (int m : store_.core().material) ++count[m];
+  return count;
+}
+
+// Particles of material a can touch material b: a wall or mesh of b, another particle of b, or,
+// for b = a, a second particle of a (a single particle never touches itself: no interaction of a
+// material with itself is needed for one sphere on a plane).
+bool System::can_touch(const std::vector<int>& count, const std::vector<bool>& wall, int a,
+                       int b) {
+  if (count[a] == 0) return false;
+  return wall[b] || (a == b ? count[a] >= 2 : count[b] > 0);
+}
+
 void System::check_interactions() const {
-  std::vector<bool> used(model_.material_count(), false), used_wall(model_.material_count(), false);
-  for (int m : store_.core().material) used[m] = true;
-  for (const PlaneWall& p : walls_.planes()) used_wall[p.material] = true;
-  for (const TriangleMesh& m : meshes_) used_wall[m.material()] = true;
+  const std::vector<int> count = particles_per_material();
+  std::vector<bool> wall(model_.material_count(), false);
+  for (const PlaneWall& p : walls_.planes()) wall[p.material] = true;
+  for (const TriangleMesh& m : meshes_) wall[m.material()] = true;
   for (int a = 0; a < model_.material_count(); ++a) {
-    if (!used[a]) continue;
     for (int b = 0; b < model_.material_count(); ++b) {
-      if (!(used[b] || used_wall[b]) || model_.has_interaction(a, b)) continue;
+      if (!can_touch(count, wall, a, b) || model_.has_interaction(a, b)) continue;
       std::ostringstream msg;
       msg << "no interaction between materials " << a << " and " << b
-          << " (both are in use); call add_interaction(" << a << ", " << b << ", ...)";
+          << " (they can touch); call add_interaction(" << a << ", " << b << ", ...)";
       throw Error(msg.str());
     }
   }

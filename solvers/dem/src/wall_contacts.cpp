@@ -72,6 +72,25 @@ Eigen::Vector3d WallContacts::wall_force(int wall) const {
   return wall_force_[wall];
 }
 
+std::optional<Eigen::Vector3d> WallContacts::face_force(int wall, int face) const {
+  (void)wall_force(wall);  // throws on an unknown id
+  if (face < 0 || face > 5) {
+    std::ostringstream msg;
+    msg << "face_force: unknown face " << face << "; faces are 0..5 (-x, +x, -y, +y, -z, +z)";
+    throw Error(msg.str());
+  }
+  // a box's face k is the plane of its wall with the normal +e_axis (k even) or -e_axis (k odd)
+  // (add_box() sets these normals exactly)
+  const int axis = face / 2;
+  const double sign = face % 2 == 0 ? 1.0 : -1.0;
+  for (std::size_t k = 0; k < planes_.size(); ++k) {
+    const PlaneWall& p = planes_[k];
+    if (p.wall != wall || p.normal[axis] != sign) continue;
+    return k < plane_force_.size() ? plane_force_[k] : Eigen::Vector3d::Zero();
+  }
+  return std::nullopt;
+}
+
 void WallContacts::resize(ParticleStore& store, std::size_t n) {
   const std::size_t np = planes_.size();
   store.set_width(h_shear_, np);

@@ -71,3 +71,40 @@ TEST_CASE("dem: a particle file that cannot be written is an error", "[dem][io]"
   const LammpsData d;
   CHECK_THROWS_AS(d.write("/nonexistent/dir/bed.data", "x"), Error);
 }
+
+TEST_CASE("dem: a partial Velocities section is refused with the file, line and counts",
+          "[dem][io]") {
+  const auto dir = std::filesystem::path(PARTITA_BINARY_DIR) / "test_output" / "dem";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "partial_velocities.data").string();
+  auto write = [&](const std::string& velocities) {
+    std::ofstream f(path);
+    f << "three atoms\n\n3 atoms\n1 atom types\n\nAtoms\n\n"
+         "1 1 0.002 2500 0 0 0.01\n2 1 0.002 2500 0.01 0 0.01\n3 1 0.002 2500 0.02 0 0.01\n"
+      << velocities;
+  };
+  // two lines for three atoms: refused (LAMMPS refuses it too), naming the section's line
+  write("\nVelocities\n\n1 0 0 -1 0 0 0\n3 0 0 -1 0 0 0\n");
+  try {
+    (void)LammpsData::read(path);
+    FAIL("a partial Velocities section was accepted");
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    INFO(m);
+    CHECK(m.find(path + ":12:") != std::string::npos);  // the line of the section's heading
+    CHECK(m.find("2 lines for 3 atoms") != std::string::npos);
+    CHECK(m.find("atom id 2 has none") != std::string::npos);
+  }
+  // a line given twice is not a line for each atom
+  write("\nVelocities\n\n1 0 0 -1 0 0 0\n1 0 0 -1 0 0 0\n3 0 0 -1 0 0 0\n");
+  CHECK_THROWS_WITH(LammpsData::read(path), Catch::Contains("second velocity line for atom id 1"));
+  // every atom: accepted; no section at all: every atom at rest
+  write("\nVelocities\n\n3 0 0 -3 0 0 0\n1 0 0 -1 0 0 0\n2 0 0 -2 0 0 0\n");
+  const LammpsData full = LammpsData::read(path);
+  REQUIRE(full.size() == 3);
+  for (std::size_t i = 0; i < 3; ++i) CHECK(full.velocity[i].z() == -static_cast<double>(i + 1));
+  write("");
+  const LammpsData rest = LammpsData::read(path);
+  REQUIRE(rest.size() == 3);
+  for (std::size_t i = 0; i < 3; ++i) CHECK(rest.velocity[i].norm() == 0.0);
+}

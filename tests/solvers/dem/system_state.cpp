@@ -193,6 +193,8 @@ TEST_CASE("dem: user errors throw partita::dem::Error with the value", "[dem][er
   CHECK_THROWS_WITH(sys.add_particle({0, 0, 0}, 1e-3, 3), Catch::Contains("unknown material id 3"));
   CHECK_THROWS_AS(sys.add_interaction(m, m, {0.3, 1.5, 0.0}), Error);
   sys.add_particle({0, 0, 0}, 1e-3, m);
+  // (one particle never touches itself: its material needs an interaction only with a second)
+  sys.add_particle({0.01, 0, 0}, 1e-3, m);
   CHECK_THROWS_WITH(sys.step(1e-6), Catch::Contains("add_interaction(0, 0"));
   sys.add_interaction(m, m, {0.3, 0.5, 0.0});
   const double dt_r = sys.rayleigh_time_step();

@@ -14,22 +14,35 @@
 
 namespace partita {
 
-/// One documented output quantity. `name` may start with a placeholder in angle brackets for a
-/// family of names ("<mesh>.force_z": one per mesh); quantity_matches() applies it.
+/// One documented output quantity. `name` may hold placeholders in angle brackets for a family
+/// of names ("<mesh>.force_z": one per mesh; "<wall>.<face>.force_z", "particle.<id>.z");
+/// quantity_matches() applies them.
 struct QuantityDoc {
   std::string name;
   std::string unit;  ///< SI unit; empty for a pure number
   std::string doc;
 };
 
-/// Whether a reported quantity name is one that `d` documents ("<x>" matches any text but '.').
+/// Whether a reported quantity name is one that `d` documents: the text outside the
+/// placeholders as it is, each "<x>" any non-empty text without '.' (up to the next '.').
 inline bool quantity_matches(const QuantityDoc& d, std::string_view name) {
-  if (d.name.empty() || d.name.front() != '<') return d.name == name;
-  const auto close = d.name.find('>');
-  if (close == std::string::npos) return false;
-  const std::string_view rest = std::string_view(d.name).substr(close + 1);
-  if (name.size() <= rest.size() || name.substr(name.size() - rest.size()) != rest) return false;
-  return name.substr(0, name.size() - rest.size()).find('.') == std::string_view::npos;
+  std::string_view pattern = d.name;
+  while (!pattern.empty()) {
+    if (pattern.front() != '<') {  // literal text up to the next placeholder
+      const std::size_t lit = std::min(pattern.find('<'), pattern.size());
+      if (name.substr(0, lit) != pattern.substr(0, lit)) return false;
+      pattern.remove_prefix(lit);
+      name.remove_prefix(lit);
+      continue;
+    }
+    const auto close = pattern.find('>');
+    if (close == std::string_view::npos) return false;
+    pattern.remove_prefix(close + 1);
+    const std::size_t span = std::min(name.find('.'), name.size());  // one dot-free part
+    if (span == 0) return false;
+    name.remove_prefix(span);
+  }
+  return name.empty();
 }
 
 template <class Factory>

@@ -3,7 +3,8 @@
 // bed files and the DEM's own final states):
 //   header lines "N atoms", "xlo xhi" / "ylo yhi" / "zlo zhi",
 //   "Atoms" section: id type diameter density x y z   (SI units; extra columns ignored)
-//   optional "Velocities" section: id vx vy vz wx wy wz
+//   optional "Velocities" section: id vx vy vz wx wy wz, one line per atom (a partial section
+//   is an error, as in LAMMPS: the atoms it leaves out would start at rest without a word)
 // Other sections are skipped; '#' starts a comment.
 
 #include <cstdint>
@@ -24,8 +25,8 @@ struct LammpsData {
   std::vector<double> diameter;
   std::vector<double> density;
   std::vector<Eigen::Vector3d> position;
-  std::vector<Eigen::Vector3d> velocity;          ///< zero where no Velocities line
-  std::vector<Eigen::Vector3d> angular_velocity;  ///< zero where no Velocities line
+  std::vector<Eigen::Vector3d> velocity;          ///< zero without a Velocities section
+  std::vector<Eigen::Vector3d> angular_velocity;  ///< zero without a Velocities section
 
   std::size_t size() const { return id.size(); }
   /// Throws Error (with file and line) on a missing file, malformed line or atom count mismatch.

@@ -13,6 +13,10 @@
 // are all checked every step); valid until a particle or plane has moved more than skin/2.
 // Cells are 2 R_max + skin wide (correct for any size distribution; with very wide ones the
 // cells hold many small particles). Vectors are reused: no allocation between rebuilds.
+// The grid has at most 4 N + 64 cells (memory in proportion to the particles, whatever their
+// extent); a sparser cloud gets wider cells. When that leaves a large set of particles in a
+// handful of cells (a bed and one particle hundreds of metres away: the search would compare
+// nearly every pair), or a position is infinite, build() throws Error naming the particle.
 
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
@@ -103,6 +107,17 @@ class NeighborList {
 
   template <class Visit>
   void visit_pairs(const Particles& p, int i, Visit&& visit) const;
+  /// Throws Error naming the particle that makes the extent [lo, hi] absurd (non-finite, or so
+  /// far from the others that the capped grid degenerates; cell: the grown cell, 0 if none).
+  [[noreturn]] static void throw_absurd_extent(const Particles& p, const Eigen::Vector3d& lo,
+                                               const Eigen::Vector3d& hi, double natural,
+                                               double cell);
+  // A grid grown by the cap is degenerate when the search would visit more than
+  // kDegenerateVisits candidates per particle (sum over the cells of n_c^2, over N; a dense bed
+  // at the natural cell: 1 to 10; a grain-size ratio of 10: about 1,500); below
+  // kDegenerateMinParticles an all-pairs search is cheap anyway.
+  static constexpr double kDegenerateVisits = 4096.0;
+  static constexpr int kDegenerateMinParticles = 8192;
   void build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes, double r_max);
 
   double skin_ = 0.0;

@@ -19,7 +19,8 @@
 // restored together; particles keep a stable 64-bit id (particles().id). Models that change the
 // particle set or add forces (breakage, ...) are StepHooks (add_hook()), called at fixed points
 // of every step (see step_hook.hpp).
-// The first step checks that every material pair in use has an interaction and builds the
+// The first step checks that every material pair that can touch has an interaction (a material
+// with itself only where two particles of it exist: one sphere needs none) and builds the
 // neighbour lists; adding particles, walls or meshes later is allowed (lists are rebuilt and the
 // contact histories of new contacts start at zero).
 //
@@ -66,6 +67,7 @@
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -231,6 +233,12 @@ class System {
   double potential_energy() const;
   /// Force the particles exerted on a wall (all its planes) in the last step [N].
   Eigen::Vector3d wall_force(int wall) const;
+  /// The part of wall_force() on one face of a box wall (face 0..5: -x, +x, -y, +y, -z, +z, the
+  /// bits of add_box()); std::nullopt for an open face. Not in the saved state: zero until the
+  /// first step after restore_state() / read_state().
+  std::optional<Eigen::Vector3d> wall_face_force(int wall, int face) const {
+    return walls_.face_force(wall, face);
+  }
   /// Total force the particles exerted on a mesh in the last step [N].
   Eigen::Vector3d mesh_force(int mesh) const;
   /// Force on each triangle (M x 3) / each vertex (N x 3, barycentric shares) in the last step.
@@ -278,6 +286,12 @@ class System {
  private:
   void prepare();
   void check_interactions() const;
+  /// Particles of each material.
+  std::vector<int> particles_per_material() const;
+  /// Whether particles of material a can touch material b (count: particles per material, wall:
+  /// materials of planes and meshes); a material touches itself only with two particles of it.
+  static bool can_touch(const std::vector<int>& count, const std::vector<bool>& wall, int a,
+                        int b);
   void check_mesh(int mesh, const char* what) const;
   void check_particle(std::size_t i, const char* what) const;
   void resize_histories();

@@ -19,6 +19,7 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -49,6 +50,11 @@ class WallContacts {
   /// The force the particles exerted on a wall in the last force pass; throws Error on an
   /// unknown id.
   Eigen::Vector3d wall_force(int wall) const;
+  /// The part of wall_force(wall) on face `face` of a box wall (0..5: -x, +x, -y, +y, -z, +z, as
+  /// add_box()); std::nullopt when the wall has no plane of that normal (an open face). For box
+  /// walls (a plane wall's only plane is face k when its normal is that axis direction).
+  /// Not part of the saved state: zero until the first force pass after read().
+  std::optional<Eigen::Vector3d> face_force(int wall, int face) const;
   /// The histories (N x planes().size(), particle-major).
   const std::vector<Eigen::Vector3d>& shear(const ParticleStore& store) const {
     return store.array<Eigen::Vector3d>(h_shear_);
