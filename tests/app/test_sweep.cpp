@@ -98,19 +98,36 @@ TEST_CASE("sweep: two jobs at once write the same files as one", "[app][sweep][s
 
 TEST_CASE("sweep: a failing variant is reported and the others go on", "[app][sweep][slow]") {
   const fs::path dir = scratch("failing");
-  // 2 cells is below the tube's minimum of 3: that variant stops at set-up
+  // one iteration per window, and an unconverged window is an error: that variant stops in its
+  // first window (a failure of the run, not of the input: the others go on)
   const auto r = partita::test::run_command(
       quote(PARTITA_EXECUTABLE) + " run " + quote(kCase.string()) +
-      " --set 'sweep.parameters[0]={key: participants.fluid.cells, values: [20, 2, 30], label: "
-      "cells}' --set participants.fluid.cells=20 --set participants.solid.cells=20 --output " +
-      quote(dir.string()));
+      " --set 'sweep.parameters[0]={key: coupling.max_iterations, values: [100, 1, 100], label: "
+      "iterations}' --set coupling.on_max_iterations=error --output " + quote(dir.string()));
   INFO(r.output);
   CHECK(r.status == 1);
   CHECK(r.output.find("1 of 3 variants failed") != std::string::npos);
   const auto rows = csv_lines(dir / "sweep.csv");
   REQUIRE(rows.size() == 4);
-  CHECK(rows[1].rfind("cells=20,20,ok,", 0) == 0);
+  CHECK(rows[1].rfind("iterations=100,100,ok,", 0) == 0);
   CHECK(rows[2].find("failed (exit 1)") != std::string::npos);
-  CHECK(rows[3].rfind("cells=30,30,", 0) == 0);
+  CHECK(rows[3].rfind("iterations=100,100,", 0) == 0);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("sweep: a value its key does not accept is refused before any variant runs",
+          "[app][sweep]") {
+  const fs::path dir = scratch("refused");
+  // 2 cells is below the tube's minimum of 3: refused at the value's line, nothing written
+  const auto r = partita::test::run_command(
+      quote(PARTITA_EXECUTABLE) + " run " + quote(kCase.string()) +
+      " --set 'sweep.parameters[0]={key: participants.fluid.cells, values: [20, 2, 30], label: "
+      "cells}' --set participants.fluid.cells=20 --set participants.solid.cells=20 --output " +
+      quote((dir / "out").string()));
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK(r.output.find("the swept value 2 of participants.fluid.cells") != std::string::npos);
+  CHECK(r.output.find("out of range") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "out"));
   fs::remove_all(dir);
 }
