@@ -113,6 +113,92 @@ fs::path CaseRun::newest_restart_file() const {
   return files.back().second;
 }
 
+// The file's layout after the magic, version and byte order; the same function writes and reads
+// (Archive: BinaryWriter or BinaryReader). Counts are written for the lists whose length the
+// file decides (monitors are checked against the case by the caller; the energy pairs' count
+// comes from the case).
+template <class Archive>
+void CaseRun::SavedRun::serialize_case(Archive& ar) {
+  ar.io(name);
+  ar.io(identity);
+  ar.io(window_size);
+}
+
+template <class Archive>
+void CaseRun::SavedRun::serialize_state(Archive& ar) {
+  ar.io(progress.windows_done);
+  ar.io(progress.frame);
+  ar.io(progress.next_output);
+  ar.io(iterations);
+  ar.io(unconverged_windows);
+  ar.io(max_window_iterations);
+  ar.io(imbalance_warnings);
+  ar.io_section("energy audit");
+  ar.io(energy_warnings);
+  for (Pair& p : pairs) {
+    ar.io(p.last_a);
+    ar.io(p.last_b);
+    ar.io(p.passed);
+    ar.io(p.over);
+  }
+  ar.io_section("csv");
+  ar.io(coupling_csv);
+  auto count = static_cast<std::uint64_t>(monitors.size());
+  ar.io(count);
+  if constexpr (Archive::reading) {
+    if (count > monitors.size()) ar.fail(fmt::format("{} monitors (found {})", monitors.size(), count));
+    monitors.resize(count);
+  }
+  for (auto& [monitor, text] : monitors) {
+    ar.io(monitor);
+    ar.io(text);
+  }
+  ar.io_section("vtk");
+  count = static_cast<std::uint64_t>(pvds.size());
+  ar.io(count);
+  if constexpr (Archive::reading) pvds.clear();
+  for (std::uint64_t i = 0; i < count; ++i) {
+    if constexpr (Archive::reading) pvds.emplace_back();
+    auto& [series, entries] = pvds[i];
+    ar.io(series);
+    auto n = static_cast<std::uint64_t>(entries.size());
+    ar.io(n);
+    if constexpr (Archive::reading) {
+      entries.clear();
+      for (std::uint64_t k = 0; k < n; ++k) {
+        double t = 0.0;
+        std::string f;
+        ar.io(t);
+        ar.io(f);
+        entries.emplace_back(t, std::move(f));
+      }
+    } else {
+      for (auto& [t, f] : entries) {
+        ar.io(t);
+        ar.io(f);
+      }
+    }
+  }
+}
+
+CaseRun::SavedRun CaseRun::saved_run(const Progress& progress) const {
+  SavedRun r;
+  r.name = name_;
+  r.identity = identity_;
+  r.window_size = window_size_;
+  r.progress = progress;
+  r.iterations = summary_.iterations;
+  r.unconverged_windows = summary_.unconverged_windows;
+  r.max_window_iterations = summary_.max_window_iterations;
+  r.imbalance_warnings = summary_.imbalance_warnings;
+  r.energy_warnings = summary_.energy_warnings;
+  for (const auto& p : energy_pairs_) r.pairs.push_back({p.last_a, p.last_b, p.passed, p.over});
+  r.coupling_csv = coupling_csv_.text();
+  for (const auto& m : monitors_) r.monitors.emplace_back(m.name, m.csv.text());
+  for (const auto& [series, pvd] : pvds_) r.pvds.emplace_back(series, pvd.entries());
+  return r;
+}
+
 void CaseRun::write_restart_file(const Progress& progress) {
   Stopwatch clock;
   const fs::path dir = output_dir_ / "restart";
@@ -124,41 +210,9 @@ void CaseRun::write_restart_file(const Progress& progress) {
     out.write(std::string(kMagic));
     out.write(kVersion);
     out.write(kByteOrder);
-    out.write(name_);
-    out.write(identity_);
-    out.write(window_size_);
-    out.write(progress.windows_done);
-    out.write(progress.frame);
-    out.write(progress.next_output);
-    out.write(static_cast<std::int64_t>(summary_.iterations));
-    out.write(static_cast<std::int64_t>(summary_.unconverged_windows));
-    out.write(summary_.max_window_iterations);
-    out.write(static_cast<std::int64_t>(summary_.imbalance_warnings));
-    out.section("energy audit");
-    out.write(static_cast<std::int64_t>(summary_.energy_warnings));
-    for (const auto& p : energy_pairs_) {
-      out.write(p.last_a);
-      out.write(p.last_b);
-      out.write(p.passed);
-      out.write(p.over);
-    }
-    out.section("csv");
-    out.write(coupling_csv_.text());
-    out.write(static_cast<std::uint64_t>(monitors_.size()));
-    for (const auto& m : monitors_) {
-      out.write(m.name);
-      out.write(m.csv.text());
-    }
-    out.section("vtk");
-    out.write(static_cast<std::uint64_t>(pvds_.size()));
-    for (const auto& [series, pvd] : pvds_) {
-      out.write(series);
-      out.write(static_cast<std::uint64_t>(pvd.entries().size()));
-      for (const auto& [t, f] : pvd.entries()) {
-        out.write(t);
-        out.write(f);
-      }
-    }
+    SavedRun run = saved_run(progress);
+    run.serialize_case(out);
+    run.serialize_state(out);
     scheme_->write_state(out);
     out.write(static_cast<std::uint64_t>(participants_.size()));
     for (const auto& p : participants_) {
@@ -216,64 +270,31 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
         fmt::format("{} has restart format version {}; this partita reads version {} "
                     "(resume with the partita that wrote it)",
                     path.string(), version, kVersion));
-  const std::string name = in.get_string();
-  const auto identity = in.get<std::uint64_t>();
-  if (name != name_ || identity != identity_)
+  SavedRun read;
+  read.pairs.resize(energy_pairs_.size());
+  read.monitors.resize(monitors_.size());
+  // the name, identity and window first: a file of another case is named as such, not as data
+  // out of place (serialize_case() holds what the rest depends on)
+  read.serialize_case(in);
+  if (read.name != name_ || read.identity != identity_)
     throw Error(fmt::format(
         "{} was written by {} whose participants or coupling differ from this case '{}': a run "
         "resumes only with the same participants and coupling sections (time and output may "
         "change)",
-        path.string(), name == name_ ? "a version of the case" : "case '" + name + "'", name_));
-  const auto window = in.get<double>();
-  if (window != window_size_)
+        path.string(), read.name == name_ ? "a version of the case" : "case '" + read.name + "'",
+        name_));
+  if (read.window_size != window_size_)
     throw Error(fmt::format("{} was written with time.window = {:.17g} s; this case has {:.17g} s",
-                            path.string(), window, window_size_));
-  // Nothing in the output folder changes until the whole file has been read and accepted: the
-  // CSV texts and the VTK series' entries wait here and are written at the end.
-  Progress read;
-  in.read(read.windows_done);
-  in.read(read.frame);
-  in.read(read.next_output);
-  if (read.windows_done < 0 || read.frame < 0 || !std::isfinite(read.next_output))
+                            path.string(), read.window_size, window_size_));
+  read.serialize_state(in);
+  if (read.progress.windows_done < 0 || read.progress.frame < 0 ||
+      !std::isfinite(read.progress.next_output))
     in.fail("a window count, a frame count and an output time");
-  RunSummary summary = summary_;
-  summary.iterations = static_cast<long>(in.get<std::int64_t>());
-  summary.unconverged_windows = static_cast<long>(in.get<std::int64_t>());
-  in.read(summary.max_window_iterations);
-  summary.imbalance_warnings = static_cast<long>(in.get<std::int64_t>());
-  in.expect_section("energy audit");
-  summary.energy_warnings = static_cast<long>(in.get<std::int64_t>());
-  std::vector<EnergyPair> pairs = energy_pairs_;
-  for (auto& p : pairs) {
-    in.read(p.last_a);
-    in.read(p.last_b);
-    in.read(p.passed);
-    in.read(p.over);
-  }
-  summary.windows = read.windows_done;
-  in.expect_section("csv");
-  std::string coupling_text = in.get_string();
-  const auto monitors = in.get<std::uint64_t>();
-  if (monitors != monitors_.size())
-    in.fail(fmt::format("{} monitors (found {})", monitors_.size(), monitors));
-  std::vector<std::string> monitor_texts;
-  for (auto& m : monitors_) {
-    if (in.get_string() != m.name) in.fail("the monitor '" + m.name + "'");
-    monitor_texts.push_back(in.get_string());
-  }
-  in.expect_section("vtk");
-  const auto series = in.get<std::uint64_t>();
-  std::vector<std::pair<std::string, std::vector<std::pair<double, std::string>>>> pvd_entries;
-  for (std::uint64_t i = 0; i < series; ++i) {
-    const std::string s = in.get_string();
-    const auto n = in.get<std::uint64_t>();
-    std::vector<std::pair<double, std::string>> entries;
-    for (std::uint64_t k = 0; k < n; ++k) {
-      const double t = in.get<double>();
-      entries.emplace_back(t, in.get_string());
-    }
-    pvd_entries.emplace_back(s, std::move(entries));
-  }
+  if (read.monitors.size() != monitors_.size())
+    in.fail(fmt::format("{} monitors (found {})", monitors_.size(), read.monitors.size()));
+  for (std::size_t i = 0; i < monitors_.size(); ++i)
+    if (read.monitors[i].first != monitors_[i].name)
+      in.fail("the monitor '" + monitors_[i].name + "'");
   scheme_->read_state(in);
   const auto participants = in.get<std::uint64_t>();
   if (participants != participants_.size())
@@ -283,24 +304,32 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
     p->read_restart(in);
   }
   in.expect_section("end");
-  if (read.windows_done >= window_count_)
+  if (read.progress.windows_done >= window_count_)
     throw Error(fmt::format(
         "{}: the restart point is window {} (t = {:.6g} s), and the case ends there (window "
         "{}): nothing to continue; raise time.end, e.g. --set time.end={:.6g}",
-        path.string(), read.windows_done,
-        static_cast<double>(read.windows_done) * window_size_, window_count_,
-        2.0 * static_cast<double>(read.windows_done) * window_size_));
+        path.string(), read.progress.windows_done,
+        static_cast<double>(read.progress.windows_done) * window_size_, window_count_,
+        2.0 * static_cast<double>(read.progress.windows_done) * window_size_));
 
   // Accepted: now the run's state and its files.
-  progress.windows_done = read.windows_done;
-  progress.frame = read.frame;
-  progress.next_output = read.next_output;
-  summary_ = summary;
-  energy_pairs_ = std::move(pairs);
-  coupling_csv_.restore_text(std::move(coupling_text));
+  progress = read.progress;
+  summary_.iterations = static_cast<long>(read.iterations);
+  summary_.unconverged_windows = static_cast<long>(read.unconverged_windows);
+  summary_.max_window_iterations = read.max_window_iterations;
+  summary_.imbalance_warnings = static_cast<long>(read.imbalance_warnings);
+  summary_.energy_warnings = static_cast<long>(read.energy_warnings);
+  summary_.windows = read.progress.windows_done;
+  for (std::size_t i = 0; i < energy_pairs_.size(); ++i) {
+    energy_pairs_[i].last_a = read.pairs[i].last_a;
+    energy_pairs_[i].last_b = read.pairs[i].last_b;
+    energy_pairs_[i].passed = read.pairs[i].passed;
+    energy_pairs_[i].over = read.pairs[i].over;
+  }
+  coupling_csv_.restore_text(std::move(read.coupling_csv));
   for (std::size_t i = 0; i < monitors_.size(); ++i)
-    monitors_[i].csv.restore_text(std::move(monitor_texts[i]));
-  for (auto& [s, entries] : pvd_entries) pvd(s).restore_entries(std::move(entries));
+    monitors_[i].csv.restore_text(std::move(read.monitors[i].second));
+  for (auto& [series, entries] : read.pvds) pvd(series).restore_entries(std::move(entries));
 }
 
 void CaseRun::check_window(std::int64_t window, double time, bool after_audit) {

@@ -128,6 +128,31 @@ class CaseRun {
     int frame = 0;
     double next_output = 0.0;
   };
+  // The run's own state in a restart file (after the magic, version and byte order), one
+  // serialise function for writing and reading: a reader fills a SavedRun, checks it against
+  // this case and only then applies it (nothing changes before the whole file is accepted).
+  struct SavedRun {
+    std::string name;
+    std::uint64_t identity = 0;
+    double window_size = 0.0;
+    Progress progress;
+    std::int64_t iterations = 0, unconverged_windows = 0, imbalance_warnings = 0;
+    std::int64_t energy_warnings = 0;
+    int max_window_iterations = 0;
+    struct Pair {
+      double last_a = 0.0, last_b = 0.0, passed = 0.0;
+      std::int64_t over = 0;
+    };
+    std::vector<Pair> pairs;  // sized from the case before reading (no count in the file)
+    std::string coupling_csv;
+    std::vector<std::pair<std::string, std::string>> monitors;  // name, CSV text
+    std::vector<std::pair<std::string, std::vector<std::pair<double, std::string>>>> pvds;
+    template <class Archive>
+    void serialize_case(Archive& ar);  // name, identity, window: checked before the rest
+    template <class Archive>
+    void serialize_state(Archive& ar);
+  };
+  SavedRun saved_run(const Progress& progress) const;
   void build_participants(const config::Node& root);
   void build_exchanges(const config::Node& coupling);
   void build_monitors(const config::Node& root);

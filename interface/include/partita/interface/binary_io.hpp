@@ -67,6 +67,13 @@ class BinaryWriter {
   /// Append the checksum table and footer (see above); nothing may be written after it.
   void finish();
 
+  /// One serialise function for writing and reading (`template <class Archive> void
+  /// serialize(Archive& ar)` with ar.io(x) and ar.io_section(name)): here io() writes.
+  static constexpr bool reading = false;
+  template <class T>
+  void io(const T& v) { write(v); }
+  void io_section(const std::string& name) { section(name); }
+
   bool good() const { return static_cast<bool>(out_); }
 
  private:
@@ -140,6 +147,12 @@ class BinaryReader {
                                  : std::string("other data")));
   }
   std::string bytes() { return get_string(); }
+
+  /// The reading side of a serialise function (see BinaryWriter::io): io() reads.
+  static constexpr bool reading = true;
+  template <class T>
+  void io(T& v) { read(v); }
+  void io_section(const std::string& name) { expect_section(name); }
 
   /// Check every section against the checksum table that BinaryWriter::finish() wrote, before
   /// anything is read: an Error naming the damaged section (or the missing table). Reads after
