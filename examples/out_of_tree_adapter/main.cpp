@@ -21,15 +21,11 @@ int main(int argc, char** argv) try {
     std::cout << "conformance: " << failures.size() << " failures\n";
     return failures.empty() ? 0 : 1;
   }
-  if (command != "run" || argc < 3) {
-    std::cerr << "usage: " << argv[0] << " run CASE.yaml [OUTPUT_DIR] | conformance\n";
-    return 2;
-  }
+  if (command != "run" || argc < 3) return std::cerr << "usage: run CASE.yaml [DIR] | conformance\n", 2;
   partita::coupling::RunOptions options;
   if (argc > 3) options.output_dir = argv[3];
   partita::coupling::CaseRun run(argv[2], registries, options);
   run.run();
-  std::cout << "finished; output in " << run.output_dir().string() << "\n";
   return 0;
 } catch (const partita::Error& e) {
   std::cerr << "error: " << e.what() << "\n";
