@@ -80,28 +80,36 @@ void Exchange::initialize() {
   start_is_end_ = true;  // start = end
 }
 
-void Exchange::write_state(BinaryWriter& out) const {
-  out.section("exchange " + label());
-  for (const Eigen::MatrixXd* m :
-       {&combined(), &sent_, &previous_, start_is_end_ ? &end_ : &start_, &end_})
-    out.write(*m);
+// The values carried between windows, one function for writing and reading: combined, sent,
+// previous (the sender's mesh), d_n and d_{n+1} (the receiver's). A writer whose d_n equals
+// d_{n+1} writes d_{n+1} twice; a reader gets them as two arrays.
+template <class Archive, class Self>
+void Exchange::serialize(Archive& ar, Self& x) {
+  ar.io_section("exchange " + x.label());
+  if constexpr (!Archive::reading) {
+    for (const Eigen::MatrixXd* m :
+         {&x.combined(), &x.sent_, &x.previous_, x.start_is_end_ ? &x.end_ : &x.start_, &x.end_})
+      ar.io(*m);
+  } else {
+    for (Eigen::MatrixXd* m : {&x.combined_, &x.sent_, &x.previous_, &x.start_, &x.end_})
+      ar.io(*m);
+    x.combined_is_sent_ = false;
+    x.start_is_end_ = false;
+    const Eigen::Index sender = x.from_points_;
+    const Eigen::Index receiver = x.target_mesh_->size();
+    for (const Eigen::MatrixXd* m : {&x.combined_, &x.sent_, &x.previous_})
+      if (m->rows() != sender || m->cols() != x.spec_.components)
+        ar.fail(fmt::format("{} x {} values of {} (the sender's mesh)", sender,
+                            x.spec_.components, x.label()));
+    for (const Eigen::MatrixXd* m : {&x.start_, &x.end_})
+      if (m->rows() != receiver || m->cols() != x.spec_.components)
+        ar.fail(fmt::format("{} x {} values of {} (the receiver's mesh)", receiver,
+                            x.spec_.components, x.label()));
+  }
 }
 
-void Exchange::read_state(BinaryReader& in) {
-  in.expect_section("exchange " + label());
-  for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) in.read(*m);
-  combined_is_sent_ = false;
-  start_is_end_ = false;
-  const Eigen::Index sender = from_points_;
-  const Eigen::Index receiver = target_mesh_->size();
-  for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_})
-    if (m->rows() != sender || m->cols() != spec_.components)
-      in.fail(fmt::format("{} x {} values of {} (the sender's mesh)", sender, spec_.components,
-                          label()));
-  for (const Eigen::MatrixXd* m : {&start_, &end_})
-    if (m->rows() != receiver || m->cols() != spec_.components)
-      in.fail(fmt::format("{} x {} values of {} (the receiver's mesh)", receiver, spec_.components,
-                          label()));
-}
+void Exchange::write_state(BinaryWriter& out) const { serialize(out, *this); }
+
+void Exchange::read_state(BinaryReader& in) { serialize(in, *this); }
 
 }  // namespace partita::coupling

@@ -94,6 +94,14 @@ class Exchange {
   /// Throws partita::Error if the stored values do not fit this exchange's meshes.
   void read_state(BinaryReader& in);
 
+ private:
+  /// write_state and read_state through one function (Archive: BinaryWriter with a const
+  /// Exchange, or BinaryReader).
+  template <class Archive, class Self>
+  static void serialize(Archive& ar, Self& x);
+
+ public:
+
   /// Wall time spent mapping [s].
   double mapping_seconds() const { return mapping_seconds_; }
 
