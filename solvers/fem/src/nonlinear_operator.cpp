@@ -2,11 +2,14 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
+#include <sstream>
 
 #include "block_assembler.hpp"
 #include "parallel_loop.hpp"
 #include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
+#include "partita/fem/inverted_element_error.hpp"
 #include "partita/fem/linear_elastic_law.hpp"
 #include "partita/fem/quadrature.hpp"
 
@@ -31,6 +34,30 @@ void add_material_stiffness(const Gradients& g, const Matrix9& a, double scale, 
   }
 }
 
+// The Cauchy stress of a point for output: a small-strain law returns sigma itself (used as P
+// by the operator), a finite-strain law P, whose Cauchy stress is sigma = P F^T / J.
+Mat3 cauchy_stress_of(const MaterialLaw& law, const Mat3& p, const Mat3& f) {
+  if (law.small_strain()) return p;
+  return p * f.transpose() / f.determinant();
+}
+
+// The largest entry |A_iJkL| of a law's tangent at rest (lambda + 2 mu for an isotropic law):
+// the scale of the stress error that a rounded F causes.
+double modulus_at_rest(const MaterialLaw& law) {
+  std::vector<double> state(static_cast<std::size_t>(law.state_size())), trial(state.size());
+  law.initialise_state(state);
+  MaterialResponse r;
+  law.evaluate(Mat3::Identity(), state, trial, r);
+  return r.tangent.cwiseAbs().maxCoeff();
+}
+
+// Round-off bound of the stress of a point: eps (|P| + 3 A_max |F|). F = I + grad u is held to
+// eps |F| (the identity dominates it at small strain), and the law's P = P(F) turns that into
+// an error of about |A| eps |F| per component (3 terms per component, of at most A_max each).
+double stress_round_off(const Mat3& p, const Mat3& f, double modulus) {
+  return std::numeric_limits<double>::epsilon() * (p.norm() + 3.0 * modulus * f.norm());
+}
+
 }  // namespace
 
 NonlinearOperator::NonlinearOperator(const Model& model)
@@ -48,12 +75,15 @@ NonlinearOperator::NonlinearOperator(const Model& model)
           std::make_shared<LinearElasticLaw>(model.material(static_cast<int>(r))));
     }
   }
+  std::vector<double> region_modulus;
+  for (const auto& law : region_laws_) region_modulus.push_back(modulus_at_rest(*law));
   ShapeVector n;
   ShapeGradient g;
   state_offset_.push_back(0);
   for (const auto& e : mesh_.elements()) {
     const MaterialLaw* law = region_laws_.at(static_cast<std::size_t>(e.region)).get();
     element_law_.push_back(law);
+    element_modulus_.push_back(region_modulus.at(static_cast<std::size_t>(e.region)));
     qp_offset_.push_back(weight_.size());
     const ElementCoordinates x = element_coordinates(mesh_, e);
     for (const auto& q : volume_rule(e.type, QuadratureUse::Stiffness)) {
@@ -100,7 +130,9 @@ void NonlinearOperator::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_in
     chunk_fe_.resize(std::min(ne, kChunk));
     chunk_ke_.resize(std::min(ne, kChunk));
     chunk_energy_.resize(std::min(ne, kChunk));
+    chunk_fabs_.resize(std::min(ne, kChunk));
   }
+  node_round_off_.setZero(static_cast<Eigen::Index>(mesh_.num_nodes()));
   for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
     const long n = static_cast<long>(std::min(ne - c0, kChunk));
     // A material law may throw (a radial return that does not converge: the Newton solver cuts
@@ -117,8 +149,26 @@ void NonlinearOperator::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_in
       }
       if (k != nullptr) assembler_->add(*k, el.node_span(), chunk_ke_[static_cast<std::size_t>(i)]);
       energy_ += chunk_energy_[static_cast<std::size_t>(i)];
+      const ElementVector& fa = chunk_fabs_[static_cast<std::size_t>(i)];
+      for (int a = 0; a < nn; ++a) node_round_off_[static_cast<Eigen::Index>(el.nodes[a])] += fa[a];
     }
   }
+  // r_eps = |a|, a_(n i) = sum_e sum_q |grad N_n| dP_q w_q for each of the 3 components of node n
+  round_off_ = std::sqrt(3.0) * node_round_off_.norm();
+}
+
+void NonlinearOperator::require_not_inverted(std::size_t e, double det_f) const {
+  if (det_f > 0.0) return;
+  const Element& el = mesh_.elements()[e];
+  Vec3 centre = Vec3::Zero();
+  const int nn = node_count(el.type);
+  for (int a = 0; a < nn; ++a) centre += mesh_.node(el.nodes[a]);
+  centre /= nn;
+  std::ostringstream msg;
+  msg << "element " << e << " (centre at (" << centre.x() << ", " << centre.y() << ", "
+      << centre.z() << ") m) is turned inside out: det F = " << det_f
+      << " <= 0 at one of its points";
+  throw InvertedElementError(msg.str());
 }
 
 void NonlinearOperator::evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u,
@@ -133,18 +183,21 @@ void NonlinearOperator::evaluate_chunk_element(std::size_t c0, long i, const Eig
   ElementVector& fe = chunk_fe_[static_cast<std::size_t>(i)];
   ElementMatrix& ke = chunk_ke_[static_cast<std::size_t>(i)];
   double& energy = chunk_energy_[static_cast<std::size_t>(i)];
+  ElementVector& fabs = chunk_fabs_[static_cast<std::size_t>(i)];
   energy = 0.0;
   fe.setZero(3 * nn);
+  fabs.setZero(nn);
   if (tangent) ke.setZero(3 * nn, 3 * nn);
   if (fbar_hex8_ && el.type == ElementType::Hex8) {
-    evaluate_fbar(e, ue, fe, tangent ? &ke : nullptr, energy);
+    evaluate_fbar(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
   } else {
-    evaluate_plain(e, ue, fe, tangent ? &ke : nullptr, energy);
+    evaluate_plain(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
   }
 }
 
 void NonlinearOperator::evaluate_plain(std::size_t e, const ElementDisplacements& ue,
-                                       ElementVector& fe, ElementMatrix* ke, double& energy) {
+                                       ElementVector& fe, ElementMatrix* ke, double& energy,
+                                       ElementVector& fabs) {
   const Element& el = mesh_.elements()[e];
   const int nn = node_count(el.type);
   const MaterialLaw& law = *element_law_[e];
@@ -154,6 +207,7 @@ void NonlinearOperator::evaluate_plain(std::size_t e, const ElementDisplacements
         gradients_.data() + gradient_offset_[q], nn, 3);
     // F = I + sum_a u_a (x) grad_X N_a
     const Mat3 f = Mat3::Identity() + ue.transpose() * g;
+    if (!law.small_strain()) require_not_inverted(e, f.determinant());
     const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
     law.evaluate(f, std::span<const double>(committed_).subspan(s0, ns),
                  std::span<double>(trial_).subspan(s0, ns), resp);
@@ -163,8 +217,11 @@ void NonlinearOperator::evaluate_plain(std::size_t e, const ElementDisplacements
     const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3> pg =
         g * (resp.stress.transpose() * w);
     for (int a = 0; a < nn; ++a) fe.segment<3>(3 * a) += pg.row(a).transpose();
-    // sigma = P F^T / J (for output)
-    const Mat3 sigma = resp.stress * f.transpose() / f.determinant();
+    // round-off bound of those: |grad N_a| dP w
+    const double dp = stress_round_off(resp.stress, f, element_modulus_[e]) * w;
+    for (int a = 0; a < nn; ++a) fabs[a] += g.row(a).norm() * dp;
+    // sigma = P F^T / J for output (small-strain laws: sigma itself)
+    const Mat3 sigma = cauchy_stress_of(law, resp.stress, f);
     const auto qi = static_cast<Eigen::Index>(q);
     cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);
     eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
@@ -174,7 +231,8 @@ void NonlinearOperator::evaluate_plain(std::size_t e, const ElementDisplacements
 }
 
 void NonlinearOperator::evaluate_fbar(std::size_t e, const ElementDisplacements& ue,
-                                      ElementVector& fe, ElementMatrix* ke, double& energy) {
+                                      ElementVector& fe, ElementMatrix* ke, double& energy,
+                                      ElementVector& fabs) {
   using Vec24 = Eigen::Matrix<double, 24, 1>;
   using Mat24 = Eigen::Matrix<double, 24, 24>;
   constexpr int kPoints = 8;
@@ -200,7 +258,7 @@ void NonlinearOperator::evaluate_fbar(std::size_t e, const ElementDisplacements&
     const auto g = gradient(q);
     f[q] = Mat3::Identity() + ue.transpose() * g;
     j[q] = f[q].determinant();
-    require_positive_jacobian("F-bar Hex8", j[q]);
+    require_not_inverted(e, j[q]);
     const Eigen::Matrix<double, 8, 3> dq = g * f[q].inverse();  // row a: (F^-T grad N_a)^T
     for (int a = 0; a < 8; ++a) d[q].segment<3>(3 * a) = dq.row(a).transpose();
     const double w = weight_[q0 + static_cast<std::size_t>(q)];
@@ -240,7 +298,7 @@ void NonlinearOperator::evaluate_fbar(std::size_t e, const ElementDisplacements&
                  std::span<double>(trial_).subspan(s0, ns), resp);
     const double w = weight_[qp];
     energy += resp.energy_density * w;
-    const Mat3 sigma = resp.stress * fb.transpose() / fb.determinant();
+    const Mat3 sigma = cauchy_stress_of(law, resp.stress, fb);
     const auto qi = static_cast<Eigen::Index>(qp);
     cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);
     eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
@@ -249,6 +307,9 @@ void NonlinearOperator::evaluate_fbar(std::size_t e, const ElementDisplacements&
     const double phi = (f[q].array() * resp.stress.array()).sum();
     const Vec24 ev = (d_bar - d[q]) / 3.0;
     fe.head<24>() += (w * s) * (c + phi * ev);
+    // round-off bound (as the plain element's, with F_bar)
+    const double dp = stress_round_off(resp.stress, fb, element_modulus_[e]) * w * s;
+    for (int a = 0; a < 8; ++a) fabs[a] += g.row(a).norm() * dp;
     if (ke == nullptr) continue;
     for (int i = 0; i < 3; ++i)
       for (int jj = 0; jj < 3; ++jj) fv[3 * i + jj] = f[q](i, jj);

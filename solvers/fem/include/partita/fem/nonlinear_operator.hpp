@@ -43,6 +43,7 @@ class NonlinearOperator final : public InternalForceOperator {
 
   void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) override;
   void commit() override { committed_ = trial_; }
+  double round_off() const override { return round_off_; }
   double strain_energy() const override { return energy_; }
   double plastic_work() const override;
   const std::vector<double>& committed_state() const override { return committed_; }
@@ -50,8 +51,9 @@ class NonlinearOperator final : public InternalForceOperator {
 
   std::size_t num_quadrature_points() const { return weight_.size(); }
   bool fbar_hex8() const { return fbar_hex8_; }
-  // Per quadrature point, at the last evaluate(): Cauchy stress sigma = P F^T / J (Voigt xx yy
-  // zz xy yz zx) and the equivalent plastic strain of the trial history.
+  // Per quadrature point, at the last evaluate(): Cauchy stress (Voigt xx yy zz xy yz zx):
+  // sigma = P F^T / J for finite-strain laws, the law's own sigma for small-strain laws
+  // (MaterialLaw::small_strain()), and the equivalent plastic strain of the trial history.
   const MatrixX6& cauchy_stress() const { return cauchy_; }
   const Eigen::VectorXd& equivalent_plastic_strain() const { return eqps_; }
   // Elements' first quadrature point index (num_elements + 1 entries).
@@ -62,10 +64,13 @@ class NonlinearOperator final : public InternalForceOperator {
   // One element's fe and, when ke != nullptr, ke (zeroed by the caller); adds its strain energy
   // to `energy`, writes the points' stresses and trial history (its own points only: elements
   // may be evaluated concurrently). Plain: the element's own rule; F-bar: Hex8.
+  // `fabs` (one entry per node) gets the element's round-off bound of its nodal forces.
   void evaluate_plain(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
-                      ElementMatrix* ke, double& energy);
+                      ElementMatrix* ke, double& energy, ElementVector& fabs);
   void evaluate_fbar(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
-                     ElementMatrix* ke, double& energy);
+                     ElementMatrix* ke, double& energy, ElementVector& fabs);
+  // Throws Error naming element e and where it is when det F <= 0 at one of its points.
+  void require_not_inverted(std::size_t e, double det_f) const;
   // Element c0 + i into slot i of the chunk buffers (ke only when `tangent`).
   void evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u, bool tangent);
   // Per-element results of one chunk of elements (evaluate() computes a chunk in parallel and
@@ -73,10 +78,13 @@ class NonlinearOperator final : public InternalForceOperator {
   std::vector<ElementVector> chunk_fe_;
   std::vector<ElementMatrix> chunk_ke_;
   std::vector<double> chunk_energy_;
+  std::vector<ElementVector> chunk_fabs_;
+  Eigen::VectorXd node_round_off_;  // per node: sum of the elements' round-off bounds
   const Mesh& mesh_;
   bool fbar_hex8_ = false;
   std::vector<std::shared_ptr<const MaterialLaw>> region_laws_;
   std::vector<const MaterialLaw*> element_law_;
+  std::vector<double> element_modulus_;       // per element: its law's largest |A| entry at rest
   std::vector<std::size_t> qp_offset_;        // per element
   std::vector<std::size_t> state_offset_;     // per quadrature point (+1)
   std::vector<double> gradients_;             // per qp: n x 3 dN/dX, row-major
@@ -84,6 +92,7 @@ class NonlinearOperator final : public InternalForceOperator {
   std::vector<double> weight_;                // per qp: det J w
   std::vector<double> committed_, trial_;
   double energy_ = 0.0;
+  double round_off_ = 0.0;
   MatrixX6 cauchy_;
   Eigen::VectorXd eqps_;
   std::unique_ptr<BlockAssembler> assembler_;

@@ -154,6 +154,12 @@ class StructuralSolver final : private StructuralSystem {
   // Newton iterations of the last step() or solve_static() of the nonlinear path (all load
   // steps, cut-backs and failed tries); 0 on the linear path and for central difference.
   int newton_iterations() const;
+  // Newton iterations, load steps and cut-backs of the nonlinear path as lines of text (the
+  // library does not log; the FEM adapter passes them to its logger at debug level).
+  void set_progress_callback(ProgressCallback progress) {
+    static_.set_progress(progress);
+    newmark_.set_progress(std::move(progress));
+  }
 
  private:
   using Factorisation = SparseFactorisation;
