@@ -1,5 +1,6 @@
 #include "partita/fem/material_contribution.hpp"
 
+#include <Eigen/LU>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -11,6 +12,7 @@
 #include "partita/fem/inverted_element_error.hpp"
 #include "partita/fem/linear_elastic_law.hpp"
 #include "partita/fem/quadrature.hpp"
+#include "partita/fem/shape_functions.hpp"
 
 namespace partita::fem {
 namespace {
@@ -60,7 +62,9 @@ double stress_round_off(const Mat3& p, const Mat3& f, double modulus) {
 }  // namespace
 
 MaterialContribution::MaterialContribution(const Model& model)
-    : mesh_(model.mesh()), fbar_hex8_(model.hex8_formulation() == Hex8Formulation::FBar) {
+    : mesh_(model.mesh()),
+      fbar_hex8_(model.hex8_formulation() == Hex8Formulation::FBar),
+      eas_hex8_(model.hex8_formulation() == Hex8Formulation::IncompatibleModes) {
   const std::size_t regions = std::max<std::size_t>(1, mesh_.region_names().size());
   for (std::size_t r = 0; r < regions; ++r) {
     const auto* law = model.material_law(static_cast<int>(r));
@@ -83,18 +87,53 @@ MaterialContribution::MaterialContribution(const Model& model)
     element_modulus_.push_back(region_modulus.at(static_cast<std::size_t>(e.region)));
     qp_offset_.push_back(weight_.size());
     const ElementCoordinates x = element_coordinates(mesh_, e);
-    for (const auto& q : volume_rule(e.type, QuadratureUse::Stiffness)) {
+    const bool eas = eas_hex8_ && e.type == ElementType::Hex8;
+    Mat3 j0_inv = Mat3::Identity();
+    double j0 = 0.0;
+    const std::vector<VolumeRulePoint>* rule = &volume_rule(e.type, QuadratureUse::Stiffness);
+    if (eas) {
+      // J0 = dX/dxi at the centre (column J: the element's half-extent along xi_J)
+      shape_functions(e.type, Vec3::Zero(), n, g);
+      const Mat3 jac0 = x.transpose() * g;
+      j0 = jac0.determinant();
+      if (!(j0 > 0.0)) {
+        throw Error("EAS Hex8: element with det J <= 0 at its centre (inverted or degenerate)");
+      }
+      j0_inv = jac0.inverse();
+      // thin: the thinnest direction less than half as thick as both others
+      const Vec3 extent = jac0.colwise().norm();
+      int thin = 0;
+      extent.minCoeff(&thin);
+      bool is_thin = true;
+      for (int d = 0; d < 3; ++d)
+        if (d != thin && !(2.0 * extent[thin] < extent[d])) is_thin = false;
+      if (is_thin) rule = &layered_hex_rule(thin);
+    }
+    eas_gradient_start_.push_back(eas_gradients_.size());
+    for (const auto& q : *rule) {
       const double det = physical_gradients(e.type, x, q.xi, n, g);
       weight_.push_back(det * q.weight);
       gradient_offset_.push_back(gradients_.size());
       for (Eigen::Index a = 0; a < g.rows(); ++a) {
         for (int d = 0; d < 3; ++d) gradients_.push_back(g(a, d));
       }
+      if (eas) {
+        // g_J = (j0 / j) xi_J (J0^-1)_J
+        for (int jj = 0; jj < 3; ++jj) {
+          for (int d = 0; d < 3; ++d) eas_gradients_.push_back(j0 / det * q.xi[jj] * j0_inv(jj, d));
+        }
+      }
       state_offset_.push_back(state_offset_.back() + static_cast<std::size_t>(law->state_size()));
     }
   }
   qp_offset_.push_back(weight_.size());
-  committed_.assign(state_offset_.back(), 0.0);
+  // the EAS elements' alpha (9 each) after the points' histories
+  std::size_t alpha_end = state_offset_.back();
+  for (const auto& e : mesh_.elements()) {
+    eas_offset_.push_back(alpha_end);
+    if (eas_hex8_ && e.type == ElementType::Hex8) alpha_end += 9;
+  }
+  committed_.assign(alpha_end, 0.0);
   for (std::size_t e = 0; e < element_law_.size(); ++e) {
     for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
       element_law_[e]->initialise_state(
@@ -180,7 +219,9 @@ void MaterialContribution::evaluate_chunk_element(std::size_t c0, long i, const 
   fe.setZero(3 * nn);
   fabs.setZero(nn);
   if (tangent) ke.setZero(3 * nn, 3 * nn);
-  if (fbar_hex8_ && el.type == ElementType::Hex8) {
+  if (eas_hex8_ && el.type == ElementType::Hex8) {
+    evaluate_eas(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
+  } else if (fbar_hex8_ && el.type == ElementType::Hex8) {
     evaluate_fbar(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
   } else {
     evaluate_plain(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
@@ -328,6 +369,104 @@ void MaterialContribution::evaluate_fbar(std::size_t e, const ElementDisplacemen
     h_bar_scale += hs;
   }
   if (ke != nullptr) ke->topLeftCorner<24, 24>() += h_bar_scale * h_bar;
+}
+
+void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacements& ue,
+                                        ElementVector& fe, ElementMatrix* ke, double& energy,
+                                        ElementVector& fabs) {
+  using Vec9 = Eigen::Matrix<double, 9, 1>;
+  using Mat9 = Eigen::Matrix<double, 9, 9>;
+  using Mat33 = Eigen::Matrix<double, 33, 33>;
+  using Vec33 = Eigen::Matrix<double, 33, 1>;
+  using Grad11 = Eigen::Matrix<double, 11, 3>;
+  constexpr int kMaxLocalIterations = 12;
+  const MaterialLaw& law = *element_law_[e];
+  const std::size_t q0 = qp_offset_[e], q1 = qp_offset_[e + 1];
+  const std::size_t a0 = eas_offset_[e];
+  // 11 "nodes": the 8 nodes, then the three enhanced modes (displacements alpha_J)
+  Eigen::Matrix<double, 11, 3> ux;
+  ux.topRows<8>() = ue.topRows(8);
+  Vec9 alpha = Eigen::Map<const Vec9>(committed_.data() + a0);
+  Grad11 gx;
+  Vec33 fx;
+  Mat33 kx;
+  MaterialResponse resp;
+  // One pass over the points at alpha: fx = int G^T P dV, kx = int G^T A G dV (11 nodes), the
+  // energy, the stresses, the trial histories, the round-off bounds; sets the stress scale
+  // sum |P| |G| w of h and the round-off bound of h, sum dP |g_J| w (as the nodes' fabs).
+  double scale = 0.0, h_round_off = 0.0;
+  auto pass = [&]() {
+    for (int jj = 0; jj < 3; ++jj) ux.row(8 + jj) = alpha.segment<3>(3 * jj).transpose();
+    fx.setZero();
+    kx.setZero();
+    fabs.setZero(8);
+    energy = 0.0;
+    scale = 0.0;
+    h_round_off = 0.0;
+    for (std::size_t q = q0; q < q1; ++q) {
+      gx.topRows<8>() = Eigen::Map<const Eigen::Matrix<double, 8, 3, Eigen::RowMajor>>(
+          gradients_.data() + gradient_offset_[q]);
+      gx.bottomRows<3>() = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+          eas_gradients_.data() + eas_gradient_start_[e] + 9 * (q - q0));
+      // F = I + sum_a u_a (x) grad_X N_a + sum_J alpha_J (x) g_J
+      const Mat3 f = Mat3::Identity() + ux.transpose() * gx;
+      if (!law.small_strain()) require_not_inverted(e, f.determinant());
+      const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
+      law.evaluate(f, std::span<const double>(committed_).subspan(s0, ns),
+                   std::span<double>(trial_).subspan(s0, ns), resp);
+      const double w = weight_[q];
+      // f_(a i) += P_iJ dG_a/dX_J w   (a over the 11 nodes)
+      const Grad11 pg = gx * (resp.stress.transpose() * w);
+      for (int a = 0; a < 11; ++a) fx.segment<3>(3 * a) += pg.row(a).transpose();
+      // K_(a i)(b k) += dG_a/dX_J A_iJkL dG_b/dX_L w
+      add_material_stiffness(gx, resp.tangent, w, kx);
+      scale += resp.stress.norm() * gx.norm() * w;
+      energy += resp.energy_density * w;
+      const double dp = stress_round_off(resp.stress, f, element_modulus_[e]) * w;
+      for (int a = 0; a < 8; ++a) fabs[a] += gx.row(a).norm() * dp;
+      h_round_off += gx.bottomRows<3>().norm() * dp;
+      const Mat3 sigma = cauchy_stress_of(law, resp.stress, f);
+      const auto qi = static_cast<Eigen::Index>(q);
+      cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2),
+          sigma(0, 2);
+      eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
+    }
+  };
+  // local Newton on h(alpha) = int G_alpha^T P dV = 0:  K_aa d_alpha = -h, from the committed
+  // alpha; each pass writes the energy, stresses and trial histories of its alpha, so the last
+  // one's stay
+  Eigen::PartialPivLU<Mat9> lu;
+  Vec9 h;
+  bool converged = false;
+  // converged: |h| <= 1e-10 of its scale, or at its round-off (F = I + grad u is rounded to
+  // eps |F|: at strains of 1e-8 that is 1e-8 of h's scale), or no longer decreasing within
+  // 1e-6 of its scale (round-off the bound does not cover)
+  double h_previous = 0.0;
+  for (int it = 0; it < kMaxLocalIterations && !converged; ++it) {
+    if (it > 0) alpha -= lu.solve(h);
+    pass();
+    h = fx.tail<9>();
+    lu.compute(kx.bottomRightCorner<9, 9>());
+    const double hn = h.norm();
+    converged = hn <= 1e-10 * scale + h_round_off || scale == 0.0 ||
+                (it > 0 && hn > 0.5 * h_previous && hn <= 1e-6 * scale);
+    h_previous = hn;
+  }
+  if (!converged) {
+    std::ostringstream msg;
+    msg << "EAS Hex8 element " << e << ": the enhanced strains did not converge in "
+        << kMaxLocalIterations << " local iterations";
+    throw Error(msg.str());
+  }
+  // f_e = f_u - K_ua K_aa^-1 h   (h ~ 0: the first-order correction of what is left); the trial
+  // alpha likewise alpha - K_aa^-1 h
+  const Vec9 d_alpha = lu.solve(h);
+  fe.head<24>() = fx.head<24>() - kx.topRightCorner<24, 9>() * d_alpha;
+  Eigen::Map<Vec9>(trial_.data() + a0) = alpha - d_alpha;
+  if (ke == nullptr) return;
+  // K_e = K_uu - K_ua K_aa^-1 K_au
+  const Eigen::Matrix<double, 9, 24> kaa_kau = lu.solve(kx.bottomLeftCorner<9, 24>());
+  ke->topLeftCorner<24, 24>() = kx.topLeftCorner<24, 24>() - kx.topRightCorner<24, 9>() * kaa_kau;
 }
 
 double MaterialContribution::dissipated_work() const {
