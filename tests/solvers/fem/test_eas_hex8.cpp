@@ -122,7 +122,7 @@ TEST_CASE("EAS Hex8: the condensed tangent equals finite differences", "[fem][no
 
 TEST_CASE(
     "EAS Hex8: a plate strip L/h = 100 with one element through the thickness bends as "
-    "Euler-Bernoulli; plain Hex8 locks",
+    "Euler-Bernoulli, where plain Hex8 locks",
     "[fem][nonlinear][eas]") {
   constexpr double l = 1.0, b = 0.05, h = 0.01, p = 10.0;
   const double eb = p * l * l * l / (3.0 * kE * b * h * h * h / 12.0);

@@ -148,7 +148,7 @@ TEST_CASE("newton: at small loads the four laws give the same tip deflection to 
 
 TEST_CASE(
     "newton: a perfectly plastic bar loaded 20 % above its limit load stops with the "
-    "limit-load message at the limit's load factor; below it converges",
+    "limit-load message at the limit's load factor, and below it converges",
     "[fem][nonlinear][newton][limit]") {
   // a bar in uniaxial tension (symmetry planes), sigma = P / A everywhere: it carries at most
   // P_L = sigma_y A, and yields all at once there

@@ -120,7 +120,7 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "operator contributions: Newmark conserves the energy of springs and structure; "
+    "operator contributions: Newmark conserves the energy of springs and structure, "
     "central difference takes a contribution without a tangent, Newmark names it",
     "[fem][nonlinear][contribution]") {
   // the bar under an end force applied suddenly at t = 0: it oscillates about the static state
