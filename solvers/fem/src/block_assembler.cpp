@@ -1,14 +1,19 @@
-#include "block_assembler.hpp"
+#include "partita/fem/block_assembler.hpp"
 
 #include <algorithm>
 
 namespace partita::fem {
 
-BlockAssembler::BlockAssembler(const Mesh& mesh) : num_nodes_(mesh.num_nodes()) {
+BlockAssembler::BlockAssembler(const Mesh& mesh,
+                               const std::vector<std::vector<std::size_t>>& extra_groups)
+    : num_nodes_(mesh.num_nodes()) {
   std::vector<std::vector<std::size_t>> adj(num_nodes_);
   for (const auto& e : mesh.elements()) {
     const auto nodes = e.node_span();
     for (auto i : nodes) adj[i].insert(adj[i].end(), nodes.begin(), nodes.end());
+  }
+  for (const auto& nodes : extra_groups) {
+    for (auto i : nodes) adj.at(i).insert(adj[i].end(), nodes.begin(), nodes.end());
   }
   offsets_.assign(num_nodes_ + 1, 0);
   for (std::size_t i = 0; i < num_nodes_; ++i) {

@@ -1,6 +1,8 @@
 #include "partita/fem/newmark_integrator.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "partita/fem/error.hpp"
@@ -68,6 +70,29 @@ class NewmarkProblem final : public NonlinearProblem {
           f1_ - w_.f_int - m * (w_.a1 + alpha * w_.v1) - beta_r * (s_.damping_stiffness() * w_.v1);
     }
     s_.dofs().gather_free(w_.rhs, r);
+    // F_ref = max(|F_1|, |f_int|, |F_1 - f_int - R_all|) (the last: the inertia and damping
+    // forces); r_eps = the operator's bound + eps (|F_1| + the inertia term's bound, whose
+    // a_1 = c0 (u_1 - u) - ... cancels digits: eps c0 m_max (|u_1| + |u|), m_max the largest
+    // absolute row sum of M)
+    {
+      const double eps = std::numeric_limits<double>::epsilon();
+      const double nf = f1_.norm(), ni = w_.f_int.norm();
+      double inertia2 = 0.0;  // (a loop, not an expression: no temporary vector per call)
+      for (Eigen::Index i = 0; i < f1_.size(); ++i) {
+        const double t = f1_[i] - w_.f_int[i] - w_.rhs[i];
+        inertia2 += t * t;
+      }
+      const double inertia = std::sqrt(inertia2);
+      if (w_.mass_row_max < 0.0) {
+        w_.mass_row_max = 0.0;
+        const Eigen::VectorXd rows = m.cwiseAbs() * Eigen::VectorXd::Ones(m.cols());
+        if (rows.size() > 0) w_.mass_row_max = rows.maxCoeff();
+      }
+      scales_.force = std::max({nf, ni, inertia});
+      scales_.round_off =
+          s_.internal_forces().round_off() +
+          eps * (nf + inertia + c0_ * w_.mass_row_max * (u1_.norm() + kin_.u.norm()));
+    }
     if (k == nullptr) return;
     // K = K_t + (c0 + alpha gamma c2) M + beta_R gamma c2 K0   (d v_1 / d u_1 = gamma c2)
     if (!add_scaled(w_.k_full, c0_ + alpha * gamma_ * c2_, m, w_.mass_pattern_checked,
@@ -78,6 +103,7 @@ class NewmarkProblem final : public NonlinearProblem {
       w_.k_full_foreign = true;
     s_.dofs().split(w_.k_full, *k, w_.k_fc);
   }
+  ResidualScales scales() const override { return scales_; }
 
  private:
   StructuralSystem& s_;
@@ -86,6 +112,7 @@ class NewmarkProblem final : public NonlinearProblem {
   Eigen::VectorXd& u1_;
   double gamma_, dt_, c0_ = 0, c2_ = 0, c3_ = 0;
   NewmarkIntegrator::Work& w_;
+  ResidualScales scales_;
 };
 
 }  // namespace
@@ -103,7 +130,7 @@ bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, doub
   system.apply_prescribed(t1, w.u1);
   system.dofs().gather_free(w.u1, w.x);
   NewmarkProblem problem(system, kin, w.f1, w.u1, beta_, gamma_, dt, w);
-  last_ = newton_.solve(problem, w.x, std::max(w.f1.norm(), 1e-300));
+  last_ = newton_.solve(problem, w.x, 0.0);
   step_iterations_ += last_.iterations;
   if (!last_.converged) return false;
   system.dofs().scatter_free(w.x, w.u1);
@@ -132,13 +159,23 @@ bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, doub
 void NewmarkIntegrator::step_with_cutback(StructuralSystem& system, Kinematics& kin, double dt,
                                           int depth) {
   if (try_step(system, kin, dt)) return;
+  if (progress_ && depth < newton_.options().max_cutbacks) {
+    std::ostringstream line;
+    line << "Newmark step at t = " << kin.time << " of " << dt << " s failed (" << last_.failure
+         << "); cut-back " << depth + 1 << ": two steps of " << 0.5 * dt << " s";
+    progress_(line.str());
+  }
   if (depth >= newton_.options().max_cutbacks) {
     std::ostringstream msg;
     msg << "Newmark Newton solver failed at t = " << kin.time << " with a step of " << dt
         << " s after " << depth << " cut-backs (halvings): " << last_.failure
-        << "; last residual |R| = " << last_.residual_norms.back() << " N (tolerance "
-        << newton_.options().force_tolerance * last_.reference_force
-        << " N). Use a smaller time step or check the material and supports";
+        << "; last residual |R| = "
+        << (last_.residual_norms.empty() ? 0.0 : last_.residual_norms.back()) << " N (tolerance "
+        << last_.tolerance << " N). "
+        << (last_.failure_kind == NewtonFailure::RoundOffStall
+                ? "The residual cannot go lower in double precision: raise force_tolerance or "
+                  "round_off_factor (smaller steps do not help)"
+                : "Use a smaller time step or check the material and supports");
     throw Error(msg.str());
   }
   step_with_cutback(system, kin, 0.5 * dt, depth + 1);

@@ -1,305 +1,111 @@
 #include "partita/fem/nonlinear_operator.hpp"
 
-#include <array>
-#include <cmath>
+#include <algorithm>
+#include <string>
 
-#include "block_assembler.hpp"
-#include "parallel_loop.hpp"
-#include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
-#include "partita/fem/linear_elastic_law.hpp"
-#include "partita/fem/quadrature.hpp"
 
 namespace partita::fem {
-namespace {
-
-// ke_(a i)(b k) += scale dN_a/dX_J A_iJkL dN_b/dX_L: the material part of a point's stiffness,
-// dF/du^T A dF/du with dF_iJ / du_bk = delta_ik dN_b/dX_J (g: n x 3 gradients).
-template <typename Gradients>
-void add_material_stiffness(const Gradients& g, const Matrix9& a, double scale, ElementMatrix& ke) {
-  Eigen::Matrix<double, 9, 3> ag;  // A_iJkL dN_b/dX_L for one node b: rows iJ, columns k
-  const auto nn = g.rows();
-  for (Eigen::Index b = 0; b < nn; ++b) {
-    for (int kk = 0; kk < 3; ++kk) {
-      ag.col(kk) = a.middleCols<3>(3 * kk) * g.row(b).transpose() * scale;
-    }
-    for (Eigen::Index a_node = 0; a_node < nn; ++a_node) {
-      for (int i = 0; i < 3; ++i) {
-        ke.block<1, 3>(3 * a_node + i, 3 * b) += g.row(a_node) * ag.middleRows<3>(3 * i);
-      }
-    }
-  }
-}
-
-}  // namespace
 
 NonlinearOperator::NonlinearOperator(const Model& model)
-    : mesh_(model.mesh()),
-      fbar_hex8_(model.hex8_formulation() == Hex8Formulation::FBar),
-      assembler_(std::make_unique<BlockAssembler>(model.mesh())) {
-  const std::size_t regions = std::max<std::size_t>(1, mesh_.region_names().size());
-  for (std::size_t r = 0; r < regions; ++r) {
-    const auto* law = model.material_law(static_cast<int>(r));
-    if (law != nullptr) {
-      // shared ownership is not exposed by Model: wrap the pointer without owning it
-      region_laws_.emplace_back(std::shared_ptr<const MaterialLaw>(), law);
-    } else {
-      region_laws_.push_back(
-          std::make_shared<LinearElasticLaw>(model.material(static_cast<int>(r))));
-    }
-  }
-  ShapeVector n;
-  ShapeGradient g;
-  state_offset_.push_back(0);
-  for (const auto& e : mesh_.elements()) {
-    const MaterialLaw* law = region_laws_.at(static_cast<std::size_t>(e.region)).get();
-    element_law_.push_back(law);
-    qp_offset_.push_back(weight_.size());
-    const ElementCoordinates x = element_coordinates(mesh_, e);
-    for (const auto& q : volume_rule(e.type, QuadratureUse::Stiffness)) {
-      const double det = physical_gradients(e.type, x, q.xi, n, g);
-      weight_.push_back(det * q.weight);
-      gradient_offset_.push_back(gradients_.size());
-      for (Eigen::Index a = 0; a < g.rows(); ++a) {
-        for (int d = 0; d < 3; ++d) gradients_.push_back(g(a, d));
-      }
-      state_offset_.push_back(state_offset_.back() + static_cast<std::size_t>(law->state_size()));
-    }
-  }
-  qp_offset_.push_back(weight_.size());
-  committed_.assign(state_offset_.back(), 0.0);
-  for (std::size_t e = 0; e < element_law_.size(); ++e) {
-    for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
-      element_law_[e]->initialise_state(
-          std::span<double>(committed_)
-              .subspan(state_offset_[q], state_offset_[q + 1] - state_offset_[q]));
-    }
-  }
-  trial_ = committed_;
-  cauchy_ = MatrixX6::Zero(static_cast<Eigen::Index>(weight_.size()), 6);
-  eqps_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(weight_.size()));
+    : mesh_(model.mesh()), assembler_(std::make_unique<BlockAssembler>(model.mesh())) {
+  auto material = std::make_unique<MaterialContribution>(model);
+  material_ = material.get();
+  contributions_.push_back(std::move(material));
 }
 
 NonlinearOperator::~NonlinearOperator() = default;
+
+void NonlinearOperator::add_contribution(std::unique_ptr<OperatorContribution> contribution) {
+  if (!contribution) throw Error("nonlinear operator: a null contribution was added");
+  auto groups = contribution->coupled_node_groups();
+  if (!groups.empty()) {
+    if (pattern_fixed_) {
+      throw Error("nonlinear operator: contribution '" + std::string(contribution->name()) +
+                  "' couples nodes beyond the mesh's elements and was added after a tangent was "
+                  "assembled (add such contributions before the first implicit solve)");
+    }
+    // pattern: the mesh's node adjacency plus every contribution's coupled node groups
+    for (const auto& c : contributions_) {
+      auto g = c->coupled_node_groups();
+      groups.insert(groups.end(), std::make_move_iterator(g.begin()),
+                    std::make_move_iterator(g.end()));
+    }
+    assembler_ = std::make_unique<BlockAssembler>(mesh_, groups);
+  }
+  contributions_.push_back(std::move(contribution));
+}
 
 void NonlinearOperator::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int,
                                  SparseMatrix* k) {
   f_int.setZero(u.size());
   if (k != nullptr) {
+    for (const auto& c : contributions_) {
+      if (!c->has_tangent()) {
+        throw Error("nonlinear operator: contribution '" + std::string(c->name()) +
+                    "' has no tangent: it works in central-difference (explicit) analyses only");
+      }
+    }
     if (k->nonZeros() == 0) *k = assembler_->make_matrix();
+    pattern_fixed_ = true;
     std::fill(k->valuePtr(), k->valuePtr() + k->nonZeros(), 0.0);
   }
-  energy_ = 0.0;
-  // Elements are evaluated a chunk at a time, the chunk's elements in parallel (each writes only
-  // its own quadrature points and its own slot of the chunk buffers), then added to f_int and K
-  // serially in element order: the sums are the same, bit for bit, on any number of threads.
-  constexpr std::size_t kChunk = 1024;
-  const auto& elements = mesh_.elements();
-  const std::size_t ne = elements.size();
-  if (chunk_fe_.size() < std::min(ne, kChunk)) {
-    chunk_fe_.resize(std::min(ne, kChunk));
-    chunk_ke_.resize(std::min(ne, kChunk));
-    chunk_energy_.resize(std::min(ne, kChunk));
-  }
-  for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
-    const long n = static_cast<long>(std::min(ne - c0, kChunk));
-    // A material law may throw (a radial return that does not converge: the Newton solver cuts
-    // the step back): the first element's exception comes out, as from a serial loop.
-    detail::parallel_for_first_error(
-        n, 32, [&](long i) { evaluate_chunk_element(c0, i, u, k != nullptr); });
-    for (long i = 0; i < n; ++i) {
-      const Element& el = elements[c0 + static_cast<std::size_t>(i)];
-      const int nn = node_count(el.type);
-      const ElementVector& fe = chunk_fe_[static_cast<std::size_t>(i)];
-      // f_int = sum_e A_e^T f_e
-      for (int a = 0; a < nn; ++a) {
-        f_int.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])) += fe.segment<3>(3 * a);
-      }
-      if (k != nullptr) assembler_->add(*k, el.node_span(), chunk_ke_[static_cast<std::size_t>(i)]);
-      energy_ += chunk_energy_[static_cast<std::size_t>(i)];
-    }
-  }
+  // f = sum_c f_c(u);  K = sum_c K_c(u)
+  for (const auto& c : contributions_) c->add(u, f_int, k, *assembler_);
 }
 
-void NonlinearOperator::evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u,
-                                               bool tangent) {
-  const std::size_t e = c0 + static_cast<std::size_t>(i);
-  const Element& el = mesh_.elements()[e];
-  const int nn = node_count(el.type);
-  ElementDisplacements ue(nn, 3);
-  for (int a = 0; a < nn; ++a) {
-    ue.row(a) = u.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])).transpose();
-  }
-  ElementVector& fe = chunk_fe_[static_cast<std::size_t>(i)];
-  ElementMatrix& ke = chunk_ke_[static_cast<std::size_t>(i)];
-  double& energy = chunk_energy_[static_cast<std::size_t>(i)];
-  energy = 0.0;
-  fe.setZero(3 * nn);
-  if (tangent) ke.setZero(3 * nn, 3 * nn);
-  if (fbar_hex8_ && el.type == ElementType::Hex8) {
-    evaluate_fbar(e, ue, fe, tangent ? &ke : nullptr, energy);
-  } else {
-    evaluate_plain(e, ue, fe, tangent ? &ke : nullptr, energy);
-  }
+void NonlinearOperator::commit() {
+  for (const auto& c : contributions_) c->commit();
 }
 
-void NonlinearOperator::evaluate_plain(std::size_t e, const ElementDisplacements& ue,
-                                       ElementVector& fe, ElementMatrix* ke, double& energy) {
-  const Element& el = mesh_.elements()[e];
-  const int nn = node_count(el.type);
-  const MaterialLaw& law = *element_law_[e];
-  MaterialResponse resp;
-  for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
-    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> g(
-        gradients_.data() + gradient_offset_[q], nn, 3);
-    // F = I + sum_a u_a (x) grad_X N_a
-    const Mat3 f = Mat3::Identity() + ue.transpose() * g;
-    const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
-    law.evaluate(f, std::span<const double>(committed_).subspan(s0, ns),
-                 std::span<double>(trial_).subspan(s0, ns), resp);
-    const double w = weight_[q];
-    energy += resp.energy_density * w;
-    // f_a,i += P_iJ dN_a/dX_J w
-    const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3> pg =
-        g * (resp.stress.transpose() * w);
-    for (int a = 0; a < nn; ++a) fe.segment<3>(3 * a) += pg.row(a).transpose();
-    // sigma = P F^T / J (for output)
-    const Mat3 sigma = resp.stress * f.transpose() / f.determinant();
-    const auto qi = static_cast<Eigen::Index>(q);
-    cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);
-    eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
-    // K_(a i)(b k) += dN_a/dX_J A_iJkL dN_b/dX_L w
-    if (ke != nullptr) add_material_stiffness(g, resp.tangent, w, *ke);
-  }
+double NonlinearOperator::round_off() const {
+  double r = 0.0;
+  for (const auto& c : contributions_) r += c->round_off();
+  return r;
 }
 
-void NonlinearOperator::evaluate_fbar(std::size_t e, const ElementDisplacements& ue,
-                                      ElementVector& fe, ElementMatrix* ke, double& energy) {
-  using Vec24 = Eigen::Matrix<double, 24, 1>;
-  using Mat24 = Eigen::Matrix<double, 24, 24>;
-  constexpr int kPoints = 8;
-  const MaterialLaw& law = *element_law_[e];
-  const std::size_t q0 = qp_offset_[e];
-  auto gradient = [&](int q) {
-    return Eigen::Map<const Eigen::Matrix<double, 8, 3, Eigen::RowMajor>>(
-        gradients_.data() + gradient_offset_[q0 + static_cast<std::size_t>(q)]);
-  };
-  // H = d^2 ln J / du du:  H_(a i)(b k) = -d_ak d_bi  with d_ai = (F^-T grad_X N_a)_i
-  auto hessian_ln_j = [](const Vec24& d, Mat24& h) {
-    for (int a = 0; a < 8; ++a)
-      for (int b = 0; b < 8; ++b)
-        h.block<3, 3>(3 * a, 3 * b) = -d.segment<3>(3 * b) * d.segment<3>(3 * a).transpose();
-  };
-  // Pass 1: F, J and d ln J / du at each point; J_bar = int J dV / V and its derivatives.
-  std::array<Mat3, kPoints> f;
-  std::array<double, kPoints> j;
-  std::array<Vec24, kPoints> d;
-  double volume = 0.0, jv = 0.0;
-  Vec24 d_bar = Vec24::Zero();
-  for (int q = 0; q < kPoints; ++q) {
-    const auto g = gradient(q);
-    f[q] = Mat3::Identity() + ue.transpose() * g;
-    j[q] = f[q].determinant();
-    require_positive_jacobian("F-bar Hex8", j[q]);
-    const Eigen::Matrix<double, 8, 3> dq = g * f[q].inverse();  // row a: (F^-T grad N_a)^T
-    for (int a = 0; a < 8; ++a) d[q].segment<3>(3 * a) = dq.row(a).transpose();
-    const double w = weight_[q0 + static_cast<std::size_t>(q)];
-    volume += w;
-    jv += w * j[q];
-    d_bar += (w * j[q]) * d[q];
-  }
-  const double j_bar = jv / volume;
-  d_bar /= jv;  // d ln J_bar = int J d dV / int J dV
-  Mat24 h_bar, h;
-  if (ke != nullptr) {
-    // d^2 ln J_bar = int J (d d^T + H) dV / int J dV - d_bar d_bar^T
-    h_bar = -d_bar * d_bar.transpose();
-    for (int q = 0; q < kPoints; ++q) {
-      hessian_ln_j(d[q], h);
-      h_bar +=
-          (weight_[q0 + static_cast<std::size_t>(q)] * j[q] / jv) * (h + d[q] * d[q].transpose());
-    }
-  }
-  // Pass 2: the law at F_bar. With dF_bar/du = B_bar = s (G + f e^T) (G = dF/du, f = vec F,
-  // e = (d_bar - d) / 3) and p = vec P_bar:
-  //   f_e += w s (G^T p + (F : P_bar) e)
-  //   K_e += w [s^2 (G^T A G + (G^T A f) e^T + e (G^T A^T f)^T + (f . A f) e e^T)
-  //             + s (e c^T + c e^T + (F : P_bar)(e e^T + (H_bar - H) / 3))],  c = G^T p,
-  // the rank-one terms written out so that a point costs about twice a plain one.
-  MaterialResponse resp;
-  Eigen::Matrix<double, 9, 1> fv, af, atf;
-  Vec24 c, ga, gat;
-  double h_bar_scale = 0.0;  // sum over the points of w s (F : P_bar) / 3
-  for (int q = 0; q < kPoints; ++q) {
-    const std::size_t qp = q0 + static_cast<std::size_t>(q);
-    const auto g = gradient(q);
-    const double s = std::cbrt(j_bar / j[q]);
-    const Mat3 fb = s * f[q];
-    const std::size_t s0 = state_offset_[qp], ns = state_offset_[qp + 1] - s0;
-    law.evaluate(fb, std::span<const double>(committed_).subspan(s0, ns),
-                 std::span<double>(trial_).subspan(s0, ns), resp);
-    const double w = weight_[qp];
-    energy += resp.energy_density * w;
-    const Mat3 sigma = resp.stress * fb.transpose() / fb.determinant();
-    const auto qi = static_cast<Eigen::Index>(qp);
-    cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);
-    eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
-    // c_bk = (P_bar grad N_b)_k = (G^T p)_bk;  phi = F : P_bar
-    for (int b = 0; b < 8; ++b) c.segment<3>(3 * b) = resp.stress * g.row(b).transpose();
-    const double phi = (f[q].array() * resp.stress.array()).sum();
-    const Vec24 ev = (d_bar - d[q]) / 3.0;
-    fe.head<24>() += (w * s) * (c + phi * ev);
-    if (ke == nullptr) continue;
-    for (int i = 0; i < 3; ++i)
-      for (int jj = 0; jj < 3; ++jj) fv[3 * i + jj] = f[q](i, jj);
-    af = resp.tangent * fv;
-    atf = resp.tangent.transpose() * fv;
-    // (G^T v)_bk = sum_J v_kJ dN_b/dX_J for a 9-vector v indexed 3 k + J
-    for (int b = 0; b < 8; ++b) {
-      for (int kk = 0; kk < 3; ++kk) {
-        ga[3 * b + kk] = g.row(b).dot(af.segment<3>(3 * kk));
-        gat[3 * b + kk] = g.row(b).dot(atf.segment<3>(3 * kk));
-      }
-    }
-    add_material_stiffness(g, resp.tangent, w * s * s, *ke);
-    const Vec24 left = (s * s) * ga + s * c, right = (s * s) * gat + s * c;
-    auto k24 = ke->topLeftCorner<24, 24>();
-    k24.noalias() += w * (left * ev.transpose() + ev * right.transpose());
-    k24.noalias() += (w * (s * s * fv.dot(af) + s * phi)) * (ev * ev.transpose());
-    // - (w s phi / 3) H at this point; + (w s phi / 3) H_bar collected below
-    const double hs = w * s * phi / 3.0;
-    for (int a = 0; a < 8; ++a)
-      for (int b = 0; b < 8; ++b)
-        k24.block<3, 3>(3 * a, 3 * b).noalias() +=
-            hs * d[q].segment<3>(3 * b) * d[q].segment<3>(3 * a).transpose();
-    h_bar_scale += hs;
-  }
-  if (ke != nullptr) ke->topLeftCorner<24, 24>() += h_bar_scale * h_bar;
+double NonlinearOperator::strain_energy() const {
+  double w = 0.0;
+  for (const auto& c : contributions_) w += c->stored_energy();
+  return w;
 }
 
 double NonlinearOperator::plastic_work() const {
-  double wp = 0.0;
-  // W_p = sum_q w_p(history_q) det J w
-  for (std::size_t e = 0; e < element_law_.size(); ++e) {
-    if (element_law_[e]->state_size() == 0) continue;
-    for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
-      wp += element_law_[e]->plastic_work_density(
-                std::span<const double>(committed_)
-                    .subspan(state_offset_[q], state_offset_[q + 1] - state_offset_[q])) *
-            weight_[q];
-    }
+  double w = 0.0;
+  for (const auto& c : contributions_) w += c->dissipated_work();
+  return w;
+}
+
+const std::vector<double>& NonlinearOperator::committed_state() const {
+  if (contributions_.size() == 1) return material_->committed_state();
+  state_.clear();
+  for (const auto& c : contributions_) {
+    const auto& s = c->committed_state();
+    state_.insert(state_.end(), s.begin(), s.end());
   }
-  return wp;
+  return state_;
 }
 
 void NonlinearOperator::set_committed_state(const std::vector<double>& state) {
-  if (state.size() != committed_.size()) {
-    throw Error("nonlinear operator: a quadrature-point history of " +
-                std::to_string(state.size()) + " values was given, this model has " +
-                std::to_string(committed_.size()) + " (state of another model?)");
+  if (contributions_.size() == 1) {
+    material_->set_committed_state(state);
+    return;
   }
-  committed_ = state;
-  trial_ = state;
+  std::size_t total = 0;
+  for (const auto& c : contributions_) total += c->committed_state().size();
+  if (state.size() != total) {
+    throw Error("nonlinear operator: a state of " + std::to_string(state.size()) +
+                " values was given, this model's contributions have " + std::to_string(total) +
+                " (state of another model?)");
+  }
+  std::size_t at = 0;
+  for (const auto& c : contributions_) {
+    const std::size_t n = c->committed_state().size();
+    c->set_committed_state(
+        std::vector<double>(state.begin() + static_cast<std::ptrdiff_t>(at),
+                            state.begin() + static_cast<std::ptrdiff_t>(at + n)));
+    at += n;
+  }
 }
 
 }  // namespace partita::fem

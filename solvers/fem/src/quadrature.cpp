@@ -22,6 +22,13 @@ Gauss1d gauss_legendre(int n) {
       const double a = std::sqrt(0.6);
       return {{-a, 0.0, a}, {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0}};
     }
+    case 6: {
+      constexpr std::array<double, 3> x = {0.2386191860831969, 0.6612093864662645,
+                                           0.9324695142031521};
+      constexpr std::array<double, 3> w = {0.4679139345726910, 0.3607615730481386,
+                                           0.1713244923791704};
+      return {{-x[2], -x[1], -x[0], x[0], x[1], x[2]}, {w[2], w[1], w[0], w[0], w[1], w[2]}};
+    }
     default: {  // 4 points
       const double a = std::sqrt(3.0 / 7.0 - 2.0 / 7.0 * std::sqrt(1.2));
       const double b = std::sqrt(3.0 / 7.0 + 2.0 / 7.0 * std::sqrt(1.2));
@@ -98,6 +105,28 @@ std::vector<FaceRulePoint> tri_rule_6() {
 }
 
 }  // namespace
+
+const std::vector<VolumeRulePoint>& layered_hex_rule(int thin) {
+  auto make = [](int t) {
+    const Gauss1d across = gauss_legendre(2), through = gauss_legendre(6);
+    const int a = (t + 1) % 3, b = (t + 2) % 3;
+    std::vector<VolumeRulePoint> r;
+    for (std::size_t k = 0; k < through.x.size(); ++k) {
+      for (std::size_t j = 0; j < across.x.size(); ++j) {
+        for (std::size_t i = 0; i < across.x.size(); ++i) {
+          Vec3 xi;
+          xi[a] = across.x[i];
+          xi[b] = across.x[j];
+          xi[t] = through.x[k];
+          r.push_back({xi, across.w[i] * across.w[j] * through.w[k]});
+        }
+      }
+    }
+    return r;
+  };
+  static const std::array<std::vector<VolumeRulePoint>, 3> rules = {make(0), make(1), make(2)};
+  return rules.at(static_cast<std::size_t>(thin));
+}
 
 const std::vector<VolumeRulePoint>& volume_rule(ElementType type, QuadratureUse use) {
   static const std::vector<VolumeRulePoint> hex2 = hex_rule(2);

@@ -1,6 +1,8 @@
 #include "partita/fem/static_integrator.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "partita/fem/error.hpp"
@@ -18,7 +20,14 @@ class StaticProblem final : public NonlinearProblem {
     s_.internal_forces().evaluate(u_, f_int_, k != nullptr ? &k_full_ : nullptr);
     s_.dofs().gather_free(f_ - f_int_, r);
     if (k != nullptr) s_.dofs().split(k_full_, *k, k_fc_);
+    // F_ref = max(|F|, |f_int|) over all dofs (f_int holds the reactions on the constrained
+    // ones); r_eps = the operator's round-off bound + eps |F|
+    const double nf = f_.norm(), ni = f_int_.norm();
+    scales_.force = std::max(nf, ni);
+    scales_.round_off =
+        s_.internal_forces().round_off() + std::numeric_limits<double>::epsilon() * nf;
   }
+  ResidualScales scales() const override { return scales_; }
 
  private:
   StructuralSystem& s_;
@@ -26,9 +35,64 @@ class StaticProblem final : public NonlinearProblem {
   Eigen::VectorXd& u_;
   Eigen::VectorXd f_int_;
   SparseMatrix k_full_, k_fc_;
+  ResidualScales scales_;
 };
 
 }  // namespace
+
+std::string StaticIntegrator::failure_message(const NewtonReport& rep, int step, double lambda,
+                                              double next, double t1, double stiffness_first,
+                                              double stiffness_last) const {
+  const NewtonOptions& o = newton_.options();
+  std::ostringstream msg;
+  // A limit load: the load factor had grown (converged increments), then no equilibrium was
+  // found beyond it with the increment halved max_cutbacks times, and Newton failed the way a
+  // limit point makes it fail: the tangent singular (no stiffness left), |R| stagnating or
+  // growing, trial points the material law rejects (return mappings far beyond the yield
+  // surface); or still converging too slowly after the secant stiffness d lambda / |du| of the
+  // converged increments had fallen below a fifth of the first's. Not for a stall at round-off
+  // or an inverted element (numerical or geometric trouble, not the load).
+  const double ratio = stiffness_first > 0.0 ? stiffness_last / stiffness_first : 1.0;
+  const bool limit_failure = rep.failure_kind == NewtonFailure::SingularTangent ||
+                             rep.failure_kind == NewtonFailure::Stagnation ||
+                             rep.failure_kind == NewtonFailure::Divergence ||
+                             rep.failure_kind == NewtonFailure::InadmissibleTrial ||
+                             (rep.failure_kind == NewtonFailure::SlowConvergence && ratio < 0.2);
+  if (lambda > 0.0 && limit_failure) {
+    msg << "limit load: the load factor no longer grows; the largest load factor reached is "
+        << lambda << " (0: the state at the start of the step, 1: the loads at t = " << t1
+        << "); the secant stiffness of the last converged increment was " << 100.0 * ratio
+        << " % of the first's, and no equilibrium was found beyond it in " << o.max_cutbacks
+        << " halvings of the increment (" << rep.failure
+        << "). The loads exceed what the structure can carry (a collapse, e.g. a plastic "
+           "mechanism): keep them below about "
+        << lambda << " times the applied ones, or prescribe a displacement instead";
+    return msg.str();
+  }
+  msg << "static Newton solver failed at load step " << step << " (load factor " << lambda << " -> "
+      << next << " of the step to t = " << t1 << ") after " << o.max_cutbacks
+      << " cut-backs: " << rep.failure
+      << "; last residual |R| = " << (rep.residual_norms.empty() ? 0.0 : rep.residual_norms.back())
+      << " N (tolerance " << rep.tolerance << " N).";
+  switch (rep.failure_kind) {
+    case NewtonFailure::RoundOffStall:
+      msg << " The residual cannot go lower in double precision: raise force_tolerance or "
+             "round_off_factor (more load steps do not help)";
+      break;
+    case NewtonFailure::InvertedElement:
+    case NewtonFailure::InadmissibleStart:
+      msg << " Elements turn inside out: refine the mesh there, use more load steps, or check "
+             "the loads and supports";
+      break;
+    case NewtonFailure::SingularTangent:
+      msg << " Check the supports (a rigid-body motion left free) and the material";
+      break;
+    default:
+      msg << " Use more load steps, a smaller time step, or check the material and supports";
+      break;
+  }
+  return msg.str();
+}
 
 void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t1) {
   reports_.clear();
@@ -50,7 +114,11 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
   }
   const int steps = std::max(1, newton_.options().load_steps);
   double lambda = 0.0, increment = 1.0 / steps;
+  const double min_increment = std::ldexp(increment, -newton_.options().max_cutbacks);
   int cutbacks = 0, step = 1;
+  // secant stiffness of the converged increments, d lambda / |du|: the first one and the
+  // last one (their ratio tells a limit load from a numerical difficulty)
+  double stiffness_first = -1.0, stiffness_last = -1.0;
   Eigen::VectorXd f_lambda, u_trial, x;
   while (lambda < 1.0) {
     double next = lambda + increment;
@@ -61,10 +129,8 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
     for (auto d : dofs.constrained_dofs()) u_trial[d] = u0[d] + next * (u_target[d] - u0[d]);
     dofs.gather_free(u_trial, x);
     StaticProblem problem(system, f_lambda, u_trial);
-    // force scale of the convergence test: the applied loads or the internal forces of the
-    // start (reactions included), whichever is larger
-    const double reference = std::max({f_lambda.norm(), internal_scale, 1e-300});
-    NewtonReport rep = newton_.solve(problem, x, reference);
+    // a lower bound of the force scale: the internal forces of the start (reactions included)
+    NewtonReport rep = newton_.solve(problem, x, internal_scale);
     reports_.push_back(rep);
     if (rep.converged) {
       dofs.scatter_free(x, u_trial);
@@ -72,23 +138,36 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
       Eigen::VectorXd f_int;
       system.internal_forces().evaluate(u_trial, f_int, nullptr);
       system.internal_forces().commit();
+      const double du = (u_trial - kin.u).norm();
+      if (du > 0.0) {
+        stiffness_last = (next - lambda) / du;
+        if (stiffness_first < 0.0) stiffness_first = stiffness_last;
+      }
       kin.external_work += 0.5 * (kin.f + f_lambda).dot(u_trial - kin.u);
       kin.u = u_trial;
       kin.f = f_lambda;
+      if (progress_) {
+        std::ostringstream line;
+        line << "load step " << step << ": load factor " << next << " converged in "
+             << rep.iterations << " Newton iterations";
+        progress_(line.str());
+      }
       lambda = next;
       cutbacks = 0;
       ++step;
       continue;
     }
-    if (++cutbacks > newton_.options().max_cutbacks) {
-      std::ostringstream msg;
-      msg << "static Newton solver failed at load step " << step << " (load factor " << lambda
-          << " -> " << next << " of the step to t = " << t1 << ") after "
-          << newton_.options().max_cutbacks << " cut-backs: " << rep.failure
-          << "; last residual |R| = " << rep.residual_norms.back() << " N (tolerance "
-          << newton_.options().force_tolerance * rep.reference_force
-          << " N). Use more load steps, a smaller time step, or check the material and supports";
-      throw Error(msg.str());
+    // the increment is halved down to 1/2^max_cutbacks of the initial one (a count of halvings
+    // in a row would let the load factor creep towards a limit point for ever)
+    if (++cutbacks > newton_.options().max_cutbacks || increment <= min_increment * (1.0 + 1e-12)) {
+      throw Error(failure_message(rep, step, lambda, next, t1, stiffness_first, stiffness_last));
+    }
+    if (progress_) {
+      std::ostringstream line;
+      line << "load step " << step << ": load factor " << lambda << " -> " << next << " failed ("
+           << rep.failure << "); cut-back " << cutbacks << " of " << newton_.options().max_cutbacks
+           << ", increment " << 0.5 * increment;
+      progress_(line.str());
     }
     increment *= 0.5;
   }

@@ -13,8 +13,8 @@
 #include <omp.h>
 #endif
 
-#include "block_assembler.hpp"
 #include "parallel_loop.hpp"
+#include "partita/fem/block_assembler.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/linear_elastic_operator.hpp"
 #include "partita/fem/quadrature.hpp"
@@ -99,6 +99,17 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
 }
 
 StructuralSolver::~StructuralSolver() = default;
+
+void StructuralSolver::add_contribution(std::unique_ptr<OperatorContribution> contribution) {
+  if (nonlinear_ == nullptr) {
+    throw Error(
+        "operator contributions need the nonlinear path (a material law such as neo-hooke or "
+        "j2-plasticity); this model is linear elastic");
+  }
+  nonlinear_->add_contribution(std::move(contribution));
+  refresh_internal_force();
+  acceleration_valid_ = false;
+}
 
 // ---------------------------------------------------------------- setup and assembly
 

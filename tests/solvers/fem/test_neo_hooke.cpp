@@ -78,6 +78,10 @@ TEST_CASE("neo-hooke uniaxial stretch by Newton: lateral stretch and force vs cl
 
   Model m(make_box_mesh({Vec3::Zero(), Vec3::Ones(), {2, 2, 2}, ElementType::Hex8}));
   m.set_material_law(law);
+  // plain Hex8 (exact for this homogeneous state): with the default EAS Hex8 the first trial of
+  // one 15 % stretch increment turns an element inside out through its enhanced modes and the
+  // increment is cut back once (the results are the same)
+  m.set_hex8_formulation(Hex8Formulation::Full);
   m.fix("xmin", {0});
   m.fix("ymin", {1});
   m.fix("zmin", {2});

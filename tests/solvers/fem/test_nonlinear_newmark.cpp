@@ -25,6 +25,10 @@ struct EnergyRun {
 EnergyRun released_bar(int per_period) {
   Model m(make_box_mesh({Vec3::Zero(), Vec3(1.0, 0.2, 0.2), {5, 1, 1}, ElementType::Hex8}));
   m.set_material_law(std::make_shared<NeoHookeLaw>(2.5e6, 0.45, 1100.0));
+  // plain Hex8, as this test was measured with: with the default EAS Hex8 the T/50 run's energy
+  // error grows from 1.1 % (first 5 periods) to 3.0 % (last 5) over 40 periods (T/100: 0.5 %,
+  // no growth), not yet understood (issue 27)
+  m.set_hex8_formulation(Hex8Formulation::Full);
   m.fix("xmin");
   m.add_traction("xmax", Vec3(3.0e5, 0, 0), [](double t) { return t <= 0.0 ? 1.0 : 0.0; });
   SolverOptions opt;

@@ -19,6 +19,9 @@ class InternalForceOperator {
   // f_int(u); K_t(u) as well when k != nullptr (k keeps its sparsity pattern once set).
   virtual void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) = 0;
   virtual void commit() = 0;
+  // Estimate of the round-off error of the f_int of the last evaluate() [N] (a norm over all
+  // dofs): what double precision allows a Newton residual to reach (see NewtonSolver).
+  virtual double round_off() const = 0;
   // Stored energy int W dV at the u of the last evaluate() [J].
   virtual double strain_energy() const = 0;
   // Plastic work int w_p dV of the committed history [J].

@@ -23,6 +23,7 @@ class J2PlasticityLaw final : public MaterialLaw {
                   HardeningCurve hardening);
 
   std::string_view name() const override { return "j2-plasticity"; }
+  bool small_strain() const override { return true; }
   double density() const override { return density_; }
   double dilatational_wave_speed() const override;
   double bulk_modulus() const override { return bulk_; }

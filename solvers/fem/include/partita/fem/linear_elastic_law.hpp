@@ -12,6 +12,7 @@ class LinearElasticLaw final : public MaterialLaw {
   explicit LinearElasticLaw(const Material& material);
 
   std::string_view name() const override { return "linear-elastic"; }
+  bool small_strain() const override { return true; }
   double density() const override { return material_.density; }
   double dilatational_wave_speed() const override;
   double bulk_modulus() const override;

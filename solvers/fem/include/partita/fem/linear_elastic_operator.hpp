@@ -10,6 +10,8 @@ class LinearElasticOperator final : public InternalForceOperator {
   explicit LinearElasticOperator(const SparseMatrix& k) : k_(k) {}
   void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) override;
   void commit() override {}
+  // eps |(|K| |u|)| of the last evaluate(): the bound of the error of the sum K u.
+  double round_off() const override;
   double strain_energy() const override { return energy_; }
   double plastic_work() const override { return 0.0; }
   const std::vector<double>& committed_state() const override { return empty_; }
@@ -18,6 +20,7 @@ class LinearElasticOperator final : public InternalForceOperator {
  private:
   const SparseMatrix& k_;
   double energy_ = 0.0;
+  Eigen::VectorXd u_;  // the u of the last evaluate() (for round_off(), computed on demand)
   std::vector<double> empty_;
 };
 

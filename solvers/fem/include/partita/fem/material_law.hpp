@@ -30,6 +30,10 @@ class MaterialLaw {
   // Bulk modulus K = lambda + 2/3 mu at rest [Pa].
   virtual double bulk_modulus() const = 0;
 
+  // True for the small-strain laws (eps = sym(F - I)): their `stress` is the Cauchy stress
+  // sigma itself, used as P by the operator; false for finite-strain laws, whose `stress` is P
+  // and whose Cauchy stress is P F^T / J.
+  virtual bool small_strain() const { return false; }
   // Number of history values per quadrature point (0 for elastic laws).
   virtual int state_size() const { return 0; }
   virtual void initialise_state(std::span<double> state) const;

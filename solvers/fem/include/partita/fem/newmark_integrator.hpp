@@ -22,6 +22,11 @@ class NewmarkIntegrator {
                     FactorThreading factor_threading = FactorThreading::Automatic);
   void step(StructuralSystem& system, Kinematics& kin, double dt);
   const NewtonReport& last_report() const { return last_; }
+  // Newton iterations and cut-backs as text (see ProgressCallback).
+  void set_progress(ProgressCallback progress) {
+    progress_ = progress;
+    newton_.set_progress(std::move(progress));
+  }
   // Newton iterations of the last step(), summed over its cut-back substeps and failed tries.
   int step_iterations() const { return step_iterations_; }
 
@@ -30,6 +35,7 @@ class NewmarkIntegrator {
   void step_with_cutback(StructuralSystem& system, Kinematics& kin, double dt, int depth);
   double beta_, gamma_;
   NewtonSolver newton_;
+  ProgressCallback progress_;
 
  public:
   // Work storage of a step, kept between steps (sized once, then reused: no allocation per step
@@ -41,6 +47,7 @@ class NewmarkIntegrator {
     bool mass_pattern_checked = false, mass_pattern_same = false;
     bool k0_pattern_checked = false, k0_pattern_same = false;
     bool k_full_foreign = false;  // k_full's pattern is a sum's, not the operator's
+    double mass_row_max = -1.0;   // largest absolute row sum of M (< 0: not computed yet)
   };
 
  private:

@@ -3,90 +3,65 @@
 #include <memory>
 #include <vector>
 
-#include "partita/fem/element_integrator.hpp"
+#include "partita/fem/block_assembler.hpp"
 #include "partita/fem/internal_force_operator.hpp"
-#include "partita/fem/material_law.hpp"
+#include "partita/fem/material_contribution.hpp"
 #include "partita/fem/model.hpp"
+#include "partita/fem/operator_contribution.hpp"
 
 namespace partita::fem {
 
-class BlockAssembler;
-
-// Total Lagrangian internal force and tangent, element by element from the material laws:
-//   F = I + sum_a u_a (x) grad_X N_a,   f_a,i = int_Omega0 P_iJ(F, history) dN_a/dX_J dV,
-//   K_(a i)(b k) = int_Omega0 dN_a/dX_J A_iJkL dN_b/dX_L dV.
-// Small-strain laws return sigma(sym(F - I)) as P, which makes this the linear-geometry
-// operator for them. Quadrature: the full (stiffness) rule of each element (Hex8 2x2x2, Hex20
-// 3x3x3, Tet4 1, Tet10 4 points). Plain displacement elements unless the model's Hex8
-// formulation is FBar; plain Hex8 locks in bending of thin parts and near-incompressible flow.
-// Regions without a law use a LinearElasticLaw of their Material.
-//
-// F-bar Hex8 (Hex8Formulation::FBar): at each point F_bar = (J_bar / J)^(1/3) F, J = det F,
-// J_bar = (1/V) int J dV the element's volume ratio (de Souza Neto, Peric, Dutko & Owen 1996,
-// Int. J. Solids Struct. 33, 3277-3296, use det F at the centre; the volume ratio makes a
-// homogeneous deformation exact on distorted elements too: the patch test). The isochoric part
-// of F_bar is that of F; its volume change is the element's mean: the volumetric energy sees
-// one dilatation per element (no volumetric locking). Internal force and tangent are the first
-// and second derivatives of Pi = int W(F_bar) dV (a variational form of F-bar), with
-//   d F_bar = s (d F + F (x) (d ln J_bar - d ln J) / 3),  s = (J_bar / J)^(1/3):
-//   f = int B_bar^T P_bar dV,  K = int B_bar^T A B_bar + s (e c^T + c e^T
-//        + (F : P_bar)(e e^T + (H_bar - H) / 3)) dV,
-// e = (d ln J_bar - d ln J) / 3, c = dF/du^T P_bar, H = d^2 ln J, H_bar = d^2 ln J_bar.
-// For a hyperelastic law K is the Hessian of Pi: symmetric, so the LDL^T Newton solver applies
-// unchanged, and the work of f_int is stored as int W(F_bar) dV (the energy balance closes).
-// de Souza Neto's own form, int sigma(F_bar) : grad_x(dv) dv, has an unsymmetric tangent and no
-// potential; it would need an LU factorisation and an energy monitor of its own.
+// The FE operator of the nonlinear path: a sum of contributions (as MFEM's NonlinearForm sums
+// its integrators),
+//   f(u) = sum_c f_c(u),   K(u) = sum_c K_c(u),
+// the first of them the material's internal force (MaterialContribution: element by element
+// from the material laws, see there); others (a rigid indenter's contact, a spring bed ...)
+// join with add_contribution() before the first evaluate(). The time integrators and the
+// Newton solver see only the sum (InternalForceOperator): a new contribution touches neither.
+// The tangent's sparsity pattern is the mesh's node adjacency plus the node groups the
+// contributions declare (OperatorContribution::coupled_node_groups()).
+// Energies: strain_energy() sums the contributions' stored energies, plastic_work() their
+// dissipated work; the committed state is the contributions' states one after the other (the
+// material's first, so a model without other contributions has the material's state only).
 class NonlinearOperator final : public InternalForceOperator {
  public:
   explicit NonlinearOperator(const Model& model);
   ~NonlinearOperator() override;
 
+  // Adds a contribution (after the material's). One that couples nodes beyond the mesh's
+  // elements must come before the first tangent is assembled (the pattern is fixed then).
+  void add_contribution(std::unique_ptr<OperatorContribution> contribution);
+  std::size_t num_contributions() const { return contributions_.size(); }
+  const OperatorContribution& contribution(std::size_t i) const { return *contributions_.at(i); }
+
+  // f = sum_c f_c(u); K = sum_c K_c(u) when k != nullptr (every contribution must offer one).
   void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) override;
-  void commit() override { committed_ = trial_; }
-  double strain_energy() const override { return energy_; }
+  void commit() override;
+  double round_off() const override;
+  double strain_energy() const override;
   double plastic_work() const override;
-  const std::vector<double>& committed_state() const override { return committed_; }
+  const std::vector<double>& committed_state() const override;
   void set_committed_state(const std::vector<double>& state) override;
 
-  std::size_t num_quadrature_points() const { return weight_.size(); }
-  bool fbar_hex8() const { return fbar_hex8_; }
-  // Per quadrature point, at the last evaluate(): Cauchy stress sigma = P F^T / J (Voigt xx yy
-  // zz xy yz zx) and the equivalent plastic strain of the trial history.
-  const MatrixX6& cauchy_stress() const { return cauchy_; }
-  const Eigen::VectorXd& equivalent_plastic_strain() const { return eqps_; }
-  // Elements' first quadrature point index (num_elements + 1 entries).
-  const std::vector<std::size_t>& element_qp_offsets() const { return qp_offset_; }
+  // The material's contribution and its per-point results (see MaterialContribution).
+  const MaterialContribution& material() const { return *material_; }
+  std::size_t num_quadrature_points() const { return material_->num_quadrature_points(); }
+  bool fbar_hex8() const { return material_->fbar_hex8(); }
+  const MatrixX6& cauchy_stress() const { return material_->cauchy_stress(); }
+  const Eigen::VectorXd& equivalent_plastic_strain() const {
+    return material_->equivalent_plastic_strain();
+  }
+  const std::vector<std::size_t>& element_qp_offsets() const {
+    return material_->element_qp_offsets();
+  }
 
  private:
-  using ElementDisplacements = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
-  // One element's fe and, when ke != nullptr, ke (zeroed by the caller); adds its strain energy
-  // to `energy`, writes the points' stresses and trial history (its own points only: elements
-  // may be evaluated concurrently). Plain: the element's own rule; F-bar: Hex8.
-  void evaluate_plain(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
-                      ElementMatrix* ke, double& energy);
-  void evaluate_fbar(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
-                     ElementMatrix* ke, double& energy);
-  // Element c0 + i into slot i of the chunk buffers (ke only when `tangent`).
-  void evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u, bool tangent);
-  // Per-element results of one chunk of elements (evaluate() computes a chunk in parallel and
-  // adds it to f_int and K in element order): sized once, reused.
-  std::vector<ElementVector> chunk_fe_;
-  std::vector<ElementMatrix> chunk_ke_;
-  std::vector<double> chunk_energy_;
   const Mesh& mesh_;
-  bool fbar_hex8_ = false;
-  std::vector<std::shared_ptr<const MaterialLaw>> region_laws_;
-  std::vector<const MaterialLaw*> element_law_;
-  std::vector<std::size_t> qp_offset_;        // per element
-  std::vector<std::size_t> state_offset_;     // per quadrature point (+1)
-  std::vector<double> gradients_;             // per qp: n x 3 dN/dX, row-major
-  std::vector<std::size_t> gradient_offset_;  // per qp: start in gradients_
-  std::vector<double> weight_;                // per qp: det J w
-  std::vector<double> committed_, trial_;
-  double energy_ = 0.0;
-  MatrixX6 cauchy_;
-  Eigen::VectorXd eqps_;
+  MaterialContribution* material_ = nullptr;  // contributions_[0]
+  std::vector<std::unique_ptr<OperatorContribution>> contributions_;
   std::unique_ptr<BlockAssembler> assembler_;
+  bool pattern_fixed_ = false;         // a tangent has been assembled with assembler_'s pattern
+  mutable std::vector<double> state_;  // committed_state() of several contributions
 };
 
 }  // namespace partita::fem

@@ -25,5 +25,9 @@ enum class QuadratureUse { Stiffness, Mass };
 //   (mass); Quad4 2x2, Quad8 3x3, Tri3 3 points degree 2, Tri6 6 points degree 4 (Dunavant).
 const std::vector<VolumeRulePoint>& volume_rule(ElementType type, QuadratureUse use);
 const std::vector<FaceRulePoint>& face_rule(FaceType type);
+// The EAS Hex8's rule for a thin element: 2 x 2 Gauss points across and 6 Gauss points through
+// the thin parametric direction `thin` (0: xi, 1: eta, 2: zeta). Six points integrate a fully
+// plastic section's moment int |z| dz to +2 % (2 points: +15 %, 5 points: -5.5 %).
+const std::vector<VolumeRulePoint>& layered_hex_rule(int thin);
 
 }  // namespace partita::fem

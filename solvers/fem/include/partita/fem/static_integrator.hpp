@@ -1,4 +1,5 @@
 #pragma once
+#include <string>
 #include <vector>
 
 #include "partita/fem/newton_solver.hpp"
@@ -11,8 +12,13 @@ namespace partita::fem {
 // constrained ones; u_c,0) to the target (F(t1), g(t1)) along
 //   F(lambda) = F_0 + lambda (F(t1) - F_0),  u_c(lambda) = u_c,0 + lambda (g(t1) - u_c,0),
 // lambda from 0 to 1 in NewtonOptions::load_steps increments; a failed increment is halved
-// (automatic cut-back), the history committed after each converged one. After max_cutbacks
-// halvings in a row it throws Error naming the load step, lambda, the residual and tolerance.
+// (automatic cut-back; the following increments keep the halved size), at most max_cutbacks
+// times in a row and never below 1/2^max_cutbacks of the initial increment; the history is
+// committed after each converged increment. After max_cutbacks
+// halvings in a row it throws Error: a limit load (the load factor had grown, then stopped with
+// a singular tangent, a stagnating or growing residual: the message gives the largest load
+// factor reached), or the load step, lambda, the residual, the tolerance and what the Newton
+// failure was (a stall at round-off, divergence, an inverted element ...).
 class StaticIntegrator {
  public:
   explicit StaticIntegrator(NewtonOptions options = {},
@@ -24,9 +30,17 @@ class StaticIntegrator {
   void solve(StructuralSystem& system, Kinematics& kin, double t1);
   // Reports of the Newton solves of the last solve() (converged increments and failures).
   const std::vector<NewtonReport>& reports() const { return reports_; }
+  // Newton iterations and cut-backs as text (see ProgressCallback).
+  void set_progress(ProgressCallback progress) {
+    progress_ = progress;
+    newton_.set_progress(std::move(progress));
+  }
 
  private:
+  std::string failure_message(const NewtonReport& rep, int step, double lambda, double next,
+                              double t1, double stiffness_first, double stiffness_last) const;
   NewtonSolver newton_;
+  ProgressCallback progress_;
   std::vector<NewtonReport> reports_;
 };
 

@@ -15,6 +15,7 @@
 #include "partita/fem/model.hpp"
 #include "partita/fem/newmark_integrator.hpp"
 #include "partita/fem/nonlinear_operator.hpp"
+#include "partita/fem/operator_contribution.hpp"
 #include "partita/fem/solver_options.hpp"
 #include "partita/fem/solver_state.hpp"
 #include "partita/fem/solver_timings.hpp"
@@ -154,6 +155,17 @@ class StructuralSolver final : private StructuralSystem {
   // Newton iterations of the last step() or solve_static() of the nonlinear path (all load
   // steps, cut-backs and failed tries); 0 on the linear path and for central difference.
   int newton_iterations() const;
+  // Adds a contribution to the FE operator beside the material's (OperatorContribution: a
+  // contact, a spring bed ...); nonlinear path only (a model with a material law), before the
+  // first step or solve. The static, Newmark and central-difference integrators see the sum.
+  // The Rayleigh K0 stays the material's tangent at rest.
+  void add_contribution(std::unique_ptr<OperatorContribution> contribution);
+  // Newton iterations, load steps and cut-backs of the nonlinear path as lines of text (the
+  // library does not log; the FEM adapter passes them to its logger at debug level).
+  void set_progress_callback(ProgressCallback progress) {
+    static_.set_progress(progress);
+    newmark_.set_progress(std::move(progress));
+  }
 
  private:
   using Factorisation = SparseFactorisation;

@@ -8,12 +8,15 @@
 
 namespace partita::fem {
 
-// Sparsity pattern of a 3-dof-per-node matrix from the mesh's node adjacency, and assembly of
-// element matrices straight into the compressed storage (no triplets).
+// Sparsity pattern of a 3-dof-per-node matrix from the mesh's node adjacency (and, optionally,
+// extra node groups coupled like an element's nodes: the FE operator's contributions beyond the
+// material's declare them), and assembly of element matrices straight into the compressed
+// storage (no triplets). Public because operator contributions add their tangents through it.
 // Column 3 j + c holds, for each neighbour i of node j (sorted), rows 3 i, 3 i + 1, 3 i + 2.
 class BlockAssembler {
  public:
-  explicit BlockAssembler(const Mesh& mesh);
+  explicit BlockAssembler(const Mesh& mesh,
+                          const std::vector<std::vector<std::size_t>>& extra_groups = {});
   // ndof x ndof matrix with the full pattern and zero values.
   SparseMatrix make_matrix() const;
   // A(3 a_g + r, 3 b_g + c) += Ke(3 a + r, 3 b + c) for the element's global nodes a_g, b_g.

@@ -1,0 +1,128 @@
+#pragma once
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "partita/fem/element_integrator.hpp"
+#include "partita/fem/material_law.hpp"
+#include "partita/fem/model.hpp"
+#include "partita/fem/operator_contribution.hpp"
+
+namespace partita::fem {
+
+// The material's contribution to the FE operator of the nonlinear path (NonlinearOperator sums
+// it with the others): total Lagrangian internal force and tangent, element by element from the
+// material laws, with the history of every quadrature point:
+//   F = I + sum_a u_a (x) grad_X N_a,   f_a,i = int_Omega0 P_iJ(F, history) dN_a/dX_J dV,
+//   K_(a i)(b k) = int_Omega0 dN_a/dX_J A_iJkL dN_b/dX_L dV.
+// Small-strain laws return sigma(sym(F - I)) as P, which makes this the linear-geometry
+// operator for them. Quadrature: the full (stiffness) rule of each element (Hex8 2x2x2, Hex20
+// 3x3x3, Tet4 1, Tet10 4 points). Plain displacement elements unless the model's Hex8
+// formulation is FBar; plain Hex8 locks in bending of thin parts and near-incompressible flow.
+// Regions without a law use a LinearElasticLaw of their Material.
+//
+// EAS Hex8 (Hex8Formulation::IncompatibleModes, the default: the nonlinear path's form of the
+// linear path's incompatible modes): enhanced assumed strain after Simo & Armero (IJNME 33,
+// 1992, 1413-1449) with the 9 modes of Simo, Armero & Taylor (CMAME 110, 1993, 359-386) and
+// Taylor, Beresford & Wilson's constant-Jacobian scaling (so that the patch test passes on
+// distorted elements):
+//   F = I + sum_a u_a (x) grad_X N_a + sum_J alpha_J (x) g_J,
+//   g_J(xi) = (j0 / j(xi)) xi_J (J0^-1)_J.   (J0 = dX/dxi, j0 = det J0 at the centre; row J)
+// The three g_J act as the gradients of three extra "nodes" whose 9 displacements alpha are
+// element unknowns: the element is the plain one of 11 nodes, its alpha found per element
+// (local Newton from the committed alpha, h(u, alpha) = int G^T P dV = 0) and condensed:
+//   f_e = f_u - K_ua K_aa^-1 h,   K_e = K_uu - K_ua K_aa^-1 K_au.
+// int g_J dV = 0 for any symmetric rule (the orthogonality that makes the patch test pass);
+// for small strains the element is Wilson's / Taylor's QM6 (Simo & Rifai 1990). No shear
+// locking in bending, no volumetric locking up to nu ~ 0.49. Rule: 2x2x2 Gauss; a thin element
+// (its thinnest direction less than half as thick as both others) gets 2x2 x 6 Gauss points
+// with 6 through the thickness, so that it yields from its surfaces inward (a fully plastic
+// section's moment integrated to +2 %, where 2 points overestimate it by 15 %).
+//
+// F-bar Hex8 (Hex8Formulation::FBar): at each point F_bar = (J_bar / J)^(1/3) F, J = det F,
+// J_bar = (1/V) int J dV the element's volume ratio (de Souza Neto, Peric, Dutko & Owen 1996,
+// Int. J. Solids Struct. 33, 3277-3296, use det F at the centre; the volume ratio makes a
+// homogeneous deformation exact on distorted elements too: the patch test). The isochoric part
+// of F_bar is that of F; its volume change is the element's mean: the volumetric energy sees
+// one dilatation per element (no volumetric locking). Internal force and tangent are the first
+// and second derivatives of Pi = int W(F_bar) dV (a variational form of F-bar), with
+//   d F_bar = s (d F + F (x) (d ln J_bar - d ln J) / 3),  s = (J_bar / J)^(1/3):
+//   f = int B_bar^T P_bar dV,  K = int B_bar^T A B_bar + s (e c^T + c e^T
+//        + (F : P_bar)(e e^T + (H_bar - H) / 3)) dV,
+// e = (d ln J_bar - d ln J) / 3, c = dF/du^T P_bar, H = d^2 ln J, H_bar = d^2 ln J_bar.
+// For a hyperelastic law K is the Hessian of Pi: symmetric, so the LDL^T Newton solver applies
+// unchanged, and the work of f_int is stored as int W(F_bar) dV (the energy balance closes).
+// de Souza Neto's own form, int sigma(F_bar) : grad_x(dv) dv, has an unsymmetric tangent and no
+// potential; it would need an LU factorisation and an energy monitor of its own.
+class MaterialContribution final : public OperatorContribution {
+ public:
+  explicit MaterialContribution(const Model& model);
+  ~MaterialContribution() override;
+
+  std::string_view name() const override { return "material"; }
+  void add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix* k,
+           const BlockAssembler& assembler) override;
+  void commit() override { committed_ = trial_; }
+  double round_off() const override { return round_off_; }
+  // int W dV at the u of the last add()
+  double stored_energy() const override { return energy_; }
+  // plastic work int w_p dV of the committed history
+  double dissipated_work() const override;
+  const std::vector<double>& committed_state() const override { return committed_; }
+  void set_committed_state(const std::vector<double>& state) override;
+
+  std::size_t num_quadrature_points() const { return weight_.size(); }
+  bool fbar_hex8() const { return fbar_hex8_; }
+  // Per quadrature point, at the last add(): Cauchy stress (Voigt xx yy zz xy yz zx):
+  // sigma = P F^T / J for finite-strain laws, the law's own sigma for small-strain laws
+  // (MaterialLaw::small_strain()), and the equivalent plastic strain of the trial history.
+  const MatrixX6& cauchy_stress() const { return cauchy_; }
+  const Eigen::VectorXd& equivalent_plastic_strain() const { return eqps_; }
+  // Elements' first quadrature point index (num_elements + 1 entries).
+  const std::vector<std::size_t>& element_qp_offsets() const { return qp_offset_; }
+
+ private:
+  using ElementDisplacements = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
+  // One element's fe and, when ke != nullptr, ke (zeroed by the caller); adds its strain energy
+  // to `energy`, writes the points' stresses and trial history (its own points only: elements
+  // may be evaluated concurrently). Plain: the element's own rule; F-bar: Hex8.
+  // `fabs` (one entry per node) gets the element's round-off bound of its nodal forces.
+  void evaluate_plain(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
+                      ElementMatrix* ke, double& energy, ElementVector& fabs);
+  void evaluate_fbar(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
+                     ElementMatrix* ke, double& energy, ElementVector& fabs);
+  void evaluate_eas(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
+                    ElementMatrix* ke, double& energy, ElementVector& fabs);
+  // Throws Error naming element e and where it is when det F <= 0 at one of its points.
+  void require_not_inverted(std::size_t e, double det_f) const;
+  // Element c0 + i into slot i of the chunk buffers (ke only when `tangent`).
+  void evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u, bool tangent);
+  // Per-element results of one chunk of elements (add() computes a chunk in parallel and adds
+  // it to f and K in element order): sized once, reused.
+  std::vector<ElementVector> chunk_fe_;
+  std::vector<ElementMatrix> chunk_ke_;
+  std::vector<double> chunk_energy_;
+  std::vector<ElementVector> chunk_fabs_;
+  Eigen::VectorXd node_round_off_;  // per node: sum of the elements' round-off bounds
+  const Mesh& mesh_;
+  bool fbar_hex8_ = false;
+  std::vector<std::shared_ptr<const MaterialLaw>> region_laws_;
+  std::vector<const MaterialLaw*> element_law_;
+  std::vector<double> element_modulus_;          // per element: its law's largest |A| entry at rest
+  std::vector<std::size_t> qp_offset_;           // per element
+  std::vector<std::size_t> state_offset_;        // per quadrature point (+1)
+  std::vector<double> gradients_;                // per qp: n x 3 dN/dX, row-major
+  std::vector<std::size_t> gradient_offset_;     // per qp: start in gradients_
+  std::vector<double> weight_;                   // per qp: det J w
+  bool eas_hex8_ = false;                        // Hex8 elements are EAS
+  std::vector<double> eas_gradients_;            // per EAS qp: the 3 x 3 rows g_J, row-major
+  std::vector<std::size_t> eas_offset_;          // per element: alpha's start in the state (EAS)
+  std::vector<std::size_t> eas_gradient_start_;  // per element: its first g_J in eas_gradients_
+  std::vector<double> committed_, trial_;
+  double energy_ = 0.0;
+  double round_off_ = 0.0;
+  MatrixX6 cauchy_;
+  Eigen::VectorXd eqps_;
+};
+
+}  // namespace partita::fem

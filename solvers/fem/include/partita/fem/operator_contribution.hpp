@@ -1,0 +1,53 @@
+#pragma once
+#include <cstddef>
+#include <string_view>
+#include <vector>
+
+#include "partita/fem/block_assembler.hpp"
+#include "partita/fem/types.hpp"
+
+namespace partita::fem {
+
+// One term of the FE operator of the nonlinear path, f(u) = sum_c f_c(u), K(u) = sum_c K_c(u)
+// (NonlinearOperator sums them, as MFEM's NonlinearForm sums its integrators): the material's
+// internal force (MaterialContribution) is one; a rigid indenter's contact force, a follower
+// load or a spring bed are others, added with NonlinearOperator::add_contribution() without
+// touching the Newton solver or the time integrators (static, Newmark, central difference),
+// which see only the sum.
+//
+// Call order:
+//   coupled_node_groups() once, when the operator builds its tangent's sparsity pattern;
+//   add(u, f, k, assembler) any number of times (Newton iterations, line searches, explicit
+//     steps): from the committed state, leaving a trial state for u;
+//   commit() when the step is accepted (the trial state becomes the committed one); a rejected
+//     step simply calls add() again;
+//   committed_state() / set_committed_state() for restart files, at any time between steps.
+class OperatorContribution {
+ public:
+  virtual ~OperatorContribution() = default;
+  virtual std::string_view name() const = 0;
+  // Groups of nodes whose dofs the tangent couples beyond the mesh's elements (each group as an
+  // element: every pair of its nodes); a contribution whose K_c couples only nodes that share
+  // an element, or a node with itself (contact with a rigid body), returns none.
+  virtual std::vector<std::vector<std::size_t>> coupled_node_groups() const { return {}; }
+  // f += f_c(u) over all dofs (node-major, 3 per node); when k != nullptr also k += K_c(u),
+  // added through `assembler` (whose pattern k has). May throw Error where u is inadmissible.
+  virtual void add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix* k,
+                   const BlockAssembler& assembler) = 0;
+  // False for a contribution that offers no tangent (explicit analyses only): the operator then
+  // refuses to assemble K for an implicit one, naming the contribution.
+  virtual bool has_tangent() const { return true; }
+  virtual void commit() {}
+  // Recoverable energy stored by the contribution at the u of the last add() [J] (the
+  // material's strain energy; a penalty contact's spring energy).
+  virtual double stored_energy() const { return 0.0; }
+  // Energy dissipated in the committed state [J] (plastic work; frictional work).
+  virtual double dissipated_work() const { return 0.0; }
+  // Round-off bound of the f_c of the last add() [N] (see NewtonSolver).
+  virtual double round_off() const { return 0.0; }
+  // The committed state, flattened (empty without history), and its restoration.
+  virtual const std::vector<double>& committed_state() const;
+  virtual void set_committed_state(const std::vector<double>& state);
+};
+
+}  // namespace partita::fem

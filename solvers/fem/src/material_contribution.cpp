@@ -1,0 +1,497 @@
+#include "partita/fem/material_contribution.hpp"
+
+#include <Eigen/LU>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "parallel_loop.hpp"
+#include "partita/fem/element_integrator.hpp"
+#include "partita/fem/error.hpp"
+#include "partita/fem/inverted_element_error.hpp"
+#include "partita/fem/linear_elastic_law.hpp"
+#include "partita/fem/quadrature.hpp"
+#include "partita/fem/shape_functions.hpp"
+
+namespace partita::fem {
+namespace {
+
+// ke_(a i)(b k) += scale dN_a/dX_J A_iJkL dN_b/dX_L: the material part of a point's stiffness,
+// dF/du^T A dF/du with dF_iJ / du_bk = delta_ik dN_b/dX_J (g: n x 3 gradients).
+template <typename Gradients, typename Matrix>
+void add_material_stiffness(const Gradients& g, const Matrix9& a, double scale, Matrix& ke) {
+  Eigen::Matrix<double, 9, 3> ag;  // A_iJkL dN_b/dX_L for one node b: rows iJ, columns k
+  const auto nn = g.rows();
+  for (Eigen::Index b = 0; b < nn; ++b) {
+    for (int kk = 0; kk < 3; ++kk) {
+      ag.col(kk) = a.middleCols<3>(3 * kk) * g.row(b).transpose() * scale;
+    }
+    for (Eigen::Index a_node = 0; a_node < nn; ++a_node) {
+      for (int i = 0; i < 3; ++i) {
+        ke.template block<1, 3>(3 * a_node + i, 3 * b) += g.row(a_node) * ag.middleRows<3>(3 * i);
+      }
+    }
+  }
+}
+
+// The Cauchy stress of a point for output: a small-strain law returns sigma itself (used as P
+// by the operator), a finite-strain law P, whose Cauchy stress is sigma = P F^T / J.
+Mat3 cauchy_stress_of(const MaterialLaw& law, const Mat3& p, const Mat3& f) {
+  if (law.small_strain()) return p;
+  return p * f.transpose() / f.determinant();
+}
+
+// The largest entry |A_iJkL| of a law's tangent at rest (lambda + 2 mu for an isotropic law):
+// the scale of the stress error that a rounded F causes.
+double modulus_at_rest(const MaterialLaw& law) {
+  std::vector<double> state(static_cast<std::size_t>(law.state_size())), trial(state.size());
+  law.initialise_state(state);
+  MaterialResponse r;
+  law.evaluate(Mat3::Identity(), state, trial, r);
+  return r.tangent.cwiseAbs().maxCoeff();
+}
+
+// Round-off bound of the stress of a point: eps (|P| + 3 A_max |F|). F = I + grad u is held to
+// eps |F| (the identity dominates it at small strain), and the law's P = P(F) turns that into
+// an error of about |A| eps |F| per component (3 terms per component, of at most A_max each).
+double stress_round_off(const Mat3& p, const Mat3& f, double modulus) {
+  return std::numeric_limits<double>::epsilon() * (p.norm() + 3.0 * modulus * f.norm());
+}
+
+}  // namespace
+
+MaterialContribution::MaterialContribution(const Model& model)
+    : mesh_(model.mesh()),
+      fbar_hex8_(model.hex8_formulation() == Hex8Formulation::FBar),
+      eas_hex8_(model.hex8_formulation() == Hex8Formulation::IncompatibleModes) {
+  const std::size_t regions = std::max<std::size_t>(1, mesh_.region_names().size());
+  for (std::size_t r = 0; r < regions; ++r) {
+    const auto* law = model.material_law(static_cast<int>(r));
+    if (law != nullptr) {
+      // shared ownership is not exposed by Model: wrap the pointer without owning it
+      region_laws_.emplace_back(std::shared_ptr<const MaterialLaw>(), law);
+    } else {
+      region_laws_.push_back(
+          std::make_shared<LinearElasticLaw>(model.material(static_cast<int>(r))));
+    }
+  }
+  std::vector<double> region_modulus;
+  for (const auto& law : region_laws_) region_modulus.push_back(modulus_at_rest(*law));
+  ShapeVector n;
+  ShapeGradient g;
+  state_offset_.push_back(0);
+  for (const auto& e : mesh_.elements()) {
+    const MaterialLaw* law = region_laws_.at(static_cast<std::size_t>(e.region)).get();
+    element_law_.push_back(law);
+    element_modulus_.push_back(region_modulus.at(static_cast<std::size_t>(e.region)));
+    qp_offset_.push_back(weight_.size());
+    const ElementCoordinates x = element_coordinates(mesh_, e);
+    const bool eas = eas_hex8_ && e.type == ElementType::Hex8;
+    Mat3 j0_inv = Mat3::Identity();
+    double j0 = 0.0;
+    const std::vector<VolumeRulePoint>* rule = &volume_rule(e.type, QuadratureUse::Stiffness);
+    if (eas) {
+      // J0 = dX/dxi at the centre (column J: the element's half-extent along xi_J)
+      shape_functions(e.type, Vec3::Zero(), n, g);
+      const Mat3 jac0 = x.transpose() * g;
+      j0 = jac0.determinant();
+      if (!(j0 > 0.0)) {
+        throw Error("EAS Hex8: element with det J <= 0 at its centre (inverted or degenerate)");
+      }
+      j0_inv = jac0.inverse();
+      // thin: the thinnest direction less than half as thick as both others
+      const Vec3 extent = jac0.colwise().norm();
+      int thin = 0;
+      extent.minCoeff(&thin);
+      bool is_thin = true;
+      for (int d = 0; d < 3; ++d)
+        if (d != thin && !(2.0 * extent[thin] < extent[d])) is_thin = false;
+      if (is_thin) rule = &layered_hex_rule(thin);
+    }
+    eas_gradient_start_.push_back(eas_gradients_.size());
+    for (const auto& q : *rule) {
+      const double det = physical_gradients(e.type, x, q.xi, n, g);
+      weight_.push_back(det * q.weight);
+      gradient_offset_.push_back(gradients_.size());
+      for (Eigen::Index a = 0; a < g.rows(); ++a) {
+        for (int d = 0; d < 3; ++d) gradients_.push_back(g(a, d));
+      }
+      if (eas) {
+        // g_J = (j0 / j) xi_J (J0^-1)_J
+        for (int jj = 0; jj < 3; ++jj) {
+          for (int d = 0; d < 3; ++d) eas_gradients_.push_back(j0 / det * q.xi[jj] * j0_inv(jj, d));
+        }
+      }
+      state_offset_.push_back(state_offset_.back() + static_cast<std::size_t>(law->state_size()));
+    }
+  }
+  qp_offset_.push_back(weight_.size());
+  // the EAS elements' alpha (9 each) after the points' histories
+  std::size_t alpha_end = state_offset_.back();
+  for (const auto& e : mesh_.elements()) {
+    eas_offset_.push_back(alpha_end);
+    if (eas_hex8_ && e.type == ElementType::Hex8) alpha_end += 9;
+  }
+  committed_.assign(alpha_end, 0.0);
+  for (std::size_t e = 0; e < element_law_.size(); ++e) {
+    for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
+      element_law_[e]->initialise_state(
+          std::span<double>(committed_)
+              .subspan(state_offset_[q], state_offset_[q + 1] - state_offset_[q]));
+    }
+  }
+  trial_ = committed_;
+  cauchy_ = MatrixX6::Zero(static_cast<Eigen::Index>(weight_.size()), 6);
+  eqps_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(weight_.size()));
+}
+
+MaterialContribution::~MaterialContribution() = default;
+
+void MaterialContribution::add(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k,
+                               const BlockAssembler& assembler) {
+  energy_ = 0.0;
+  // Elements are evaluated a chunk at a time, the chunk's elements in parallel (each writes only
+  // its own quadrature points and its own slot of the chunk buffers), then added to f_int and K
+  // serially in element order: the sums are the same, bit for bit, on any number of threads.
+  constexpr std::size_t kChunk = 1024;
+  const auto& elements = mesh_.elements();
+  const std::size_t ne = elements.size();
+  if (chunk_fe_.size() < std::min(ne, kChunk)) {
+    chunk_fe_.resize(std::min(ne, kChunk));
+    chunk_ke_.resize(std::min(ne, kChunk));
+    chunk_energy_.resize(std::min(ne, kChunk));
+    chunk_fabs_.resize(std::min(ne, kChunk));
+  }
+  node_round_off_.setZero(static_cast<Eigen::Index>(mesh_.num_nodes()));
+  for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
+    const long n = static_cast<long>(std::min(ne - c0, kChunk));
+    // A material law may throw (a radial return that does not converge: the Newton solver cuts
+    // the step back): the first element's exception comes out, as from a serial loop.
+    detail::parallel_for_first_error(
+        n, 32, [&](long i) { evaluate_chunk_element(c0, i, u, k != nullptr); });
+    for (long i = 0; i < n; ++i) {
+      const Element& el = elements[c0 + static_cast<std::size_t>(i)];
+      const int nn = node_count(el.type);
+      const ElementVector& fe = chunk_fe_[static_cast<std::size_t>(i)];
+      // f_int = sum_e A_e^T f_e
+      for (int a = 0; a < nn; ++a) {
+        f_int.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])) += fe.segment<3>(3 * a);
+      }
+      if (k != nullptr) assembler.add(*k, el.node_span(), chunk_ke_[static_cast<std::size_t>(i)]);
+      energy_ += chunk_energy_[static_cast<std::size_t>(i)];
+      const ElementVector& fa = chunk_fabs_[static_cast<std::size_t>(i)];
+      for (int a = 0; a < nn; ++a) node_round_off_[static_cast<Eigen::Index>(el.nodes[a])] += fa[a];
+    }
+  }
+  // r_eps = |a|, a_(n i) = sum_e sum_q |grad N_n| dP_q w_q for each of the 3 components of node n
+  round_off_ = std::sqrt(3.0) * node_round_off_.norm();
+}
+
+void MaterialContribution::require_not_inverted(std::size_t e, double det_f) const {
+  if (det_f > 0.0) return;
+  const Element& el = mesh_.elements()[e];
+  Vec3 centre = Vec3::Zero();
+  const int nn = node_count(el.type);
+  for (int a = 0; a < nn; ++a) centre += mesh_.node(el.nodes[a]);
+  centre /= nn;
+  std::ostringstream msg;
+  msg << "element " << e << " (centre at (" << centre.x() << ", " << centre.y() << ", "
+      << centre.z() << ") m) is turned inside out: det F = " << det_f
+      << " <= 0 at one of its points";
+  throw InvertedElementError(msg.str());
+}
+
+void MaterialContribution::evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u,
+                                                  bool tangent) {
+  const std::size_t e = c0 + static_cast<std::size_t>(i);
+  const Element& el = mesh_.elements()[e];
+  const int nn = node_count(el.type);
+  ElementDisplacements ue(nn, 3);
+  for (int a = 0; a < nn; ++a) {
+    ue.row(a) = u.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])).transpose();
+  }
+  ElementVector& fe = chunk_fe_[static_cast<std::size_t>(i)];
+  ElementMatrix& ke = chunk_ke_[static_cast<std::size_t>(i)];
+  double& energy = chunk_energy_[static_cast<std::size_t>(i)];
+  ElementVector& fabs = chunk_fabs_[static_cast<std::size_t>(i)];
+  energy = 0.0;
+  fe.setZero(3 * nn);
+  fabs.setZero(nn);
+  if (tangent) ke.setZero(3 * nn, 3 * nn);
+  if (eas_hex8_ && el.type == ElementType::Hex8) {
+    evaluate_eas(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
+  } else if (fbar_hex8_ && el.type == ElementType::Hex8) {
+    evaluate_fbar(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
+  } else {
+    evaluate_plain(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
+  }
+}
+
+void MaterialContribution::evaluate_plain(std::size_t e, const ElementDisplacements& ue,
+                                          ElementVector& fe, ElementMatrix* ke, double& energy,
+                                          ElementVector& fabs) {
+  const Element& el = mesh_.elements()[e];
+  const int nn = node_count(el.type);
+  const MaterialLaw& law = *element_law_[e];
+  MaterialResponse resp;
+  for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> g(
+        gradients_.data() + gradient_offset_[q], nn, 3);
+    // F = I + sum_a u_a (x) grad_X N_a
+    const Mat3 f = Mat3::Identity() + ue.transpose() * g;
+    if (!law.small_strain()) require_not_inverted(e, f.determinant());
+    const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
+    law.evaluate(f, std::span<const double>(committed_).subspan(s0, ns),
+                 std::span<double>(trial_).subspan(s0, ns), resp);
+    const double w = weight_[q];
+    energy += resp.energy_density * w;
+    // f_a,i += P_iJ dN_a/dX_J w
+    const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3> pg =
+        g * (resp.stress.transpose() * w);
+    for (int a = 0; a < nn; ++a) fe.segment<3>(3 * a) += pg.row(a).transpose();
+    // round-off bound of those: |grad N_a| dP w
+    const double dp = stress_round_off(resp.stress, f, element_modulus_[e]) * w;
+    for (int a = 0; a < nn; ++a) fabs[a] += g.row(a).norm() * dp;
+    // sigma = P F^T / J for output (small-strain laws: sigma itself)
+    const Mat3 sigma = cauchy_stress_of(law, resp.stress, f);
+    const auto qi = static_cast<Eigen::Index>(q);
+    cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);
+    eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
+    // K_(a i)(b k) += dN_a/dX_J A_iJkL dN_b/dX_L w
+    if (ke != nullptr) add_material_stiffness(g, resp.tangent, w, *ke);
+  }
+}
+
+void MaterialContribution::evaluate_fbar(std::size_t e, const ElementDisplacements& ue,
+                                         ElementVector& fe, ElementMatrix* ke, double& energy,
+                                         ElementVector& fabs) {
+  using Vec24 = Eigen::Matrix<double, 24, 1>;
+  using Mat24 = Eigen::Matrix<double, 24, 24>;
+  constexpr int kPoints = 8;
+  const MaterialLaw& law = *element_law_[e];
+  const std::size_t q0 = qp_offset_[e];
+  auto gradient = [&](int q) {
+    return Eigen::Map<const Eigen::Matrix<double, 8, 3, Eigen::RowMajor>>(
+        gradients_.data() + gradient_offset_[q0 + static_cast<std::size_t>(q)]);
+  };
+  // H = d^2 ln J / du du:  H_(a i)(b k) = -d_ak d_bi  with d_ai = (F^-T grad_X N_a)_i
+  auto hessian_ln_j = [](const Vec24& d, Mat24& h) {
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b)
+        h.block<3, 3>(3 * a, 3 * b) = -d.segment<3>(3 * b) * d.segment<3>(3 * a).transpose();
+  };
+  // Pass 1: F, J and d ln J / du at each point; J_bar = int J dV / V and its derivatives.
+  std::array<Mat3, kPoints> f;
+  std::array<double, kPoints> j;
+  std::array<Vec24, kPoints> d;
+  double volume = 0.0, jv = 0.0;
+  Vec24 d_bar = Vec24::Zero();
+  for (int q = 0; q < kPoints; ++q) {
+    const auto g = gradient(q);
+    f[q] = Mat3::Identity() + ue.transpose() * g;
+    j[q] = f[q].determinant();
+    require_not_inverted(e, j[q]);
+    const Eigen::Matrix<double, 8, 3> dq = g * f[q].inverse();  // row a: (F^-T grad N_a)^T
+    for (int a = 0; a < 8; ++a) d[q].segment<3>(3 * a) = dq.row(a).transpose();
+    const double w = weight_[q0 + static_cast<std::size_t>(q)];
+    volume += w;
+    jv += w * j[q];
+    d_bar += (w * j[q]) * d[q];
+  }
+  const double j_bar = jv / volume;
+  d_bar /= jv;  // d ln J_bar = int J d dV / int J dV
+  Mat24 h_bar, h;
+  if (ke != nullptr) {
+    // d^2 ln J_bar = int J (d d^T + H) dV / int J dV - d_bar d_bar^T
+    h_bar = -d_bar * d_bar.transpose();
+    for (int q = 0; q < kPoints; ++q) {
+      hessian_ln_j(d[q], h);
+      h_bar +=
+          (weight_[q0 + static_cast<std::size_t>(q)] * j[q] / jv) * (h + d[q] * d[q].transpose());
+    }
+  }
+  // Pass 2: the law at F_bar. With dF_bar/du = B_bar = s (G + f e^T) (G = dF/du, f = vec F,
+  // e = (d_bar - d) / 3) and p = vec P_bar:
+  //   f_e += w s (G^T p + (F : P_bar) e)
+  //   K_e += w [s^2 (G^T A G + (G^T A f) e^T + e (G^T A^T f)^T + (f . A f) e e^T)
+  //             + s (e c^T + c e^T + (F : P_bar)(e e^T + (H_bar - H) / 3))],  c = G^T p,
+  // the rank-one terms written out so that a point costs about twice a plain one.
+  MaterialResponse resp;
+  Eigen::Matrix<double, 9, 1> fv, af, atf;
+  Vec24 c, ga, gat;
+  double h_bar_scale = 0.0;  // sum over the points of w s (F : P_bar) / 3
+  for (int q = 0; q < kPoints; ++q) {
+    const std::size_t qp = q0 + static_cast<std::size_t>(q);
+    const auto g = gradient(q);
+    const double s = std::cbrt(j_bar / j[q]);
+    const Mat3 fb = s * f[q];
+    const std::size_t s0 = state_offset_[qp], ns = state_offset_[qp + 1] - s0;
+    law.evaluate(fb, std::span<const double>(committed_).subspan(s0, ns),
+                 std::span<double>(trial_).subspan(s0, ns), resp);
+    const double w = weight_[qp];
+    energy += resp.energy_density * w;
+    const Mat3 sigma = cauchy_stress_of(law, resp.stress, fb);
+    const auto qi = static_cast<Eigen::Index>(qp);
+    cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);
+    eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
+    // c_bk = (P_bar grad N_b)_k = (G^T p)_bk;  phi = F : P_bar
+    for (int b = 0; b < 8; ++b) c.segment<3>(3 * b) = resp.stress * g.row(b).transpose();
+    const double phi = (f[q].array() * resp.stress.array()).sum();
+    const Vec24 ev = (d_bar - d[q]) / 3.0;
+    fe.head<24>() += (w * s) * (c + phi * ev);
+    // round-off bound (as the plain element's, with F_bar)
+    const double dp = stress_round_off(resp.stress, fb, element_modulus_[e]) * w * s;
+    for (int a = 0; a < 8; ++a) fabs[a] += g.row(a).norm() * dp;
+    if (ke == nullptr) continue;
+    for (int i = 0; i < 3; ++i)
+      for (int jj = 0; jj < 3; ++jj) fv[3 * i + jj] = f[q](i, jj);
+    af = resp.tangent * fv;
+    atf = resp.tangent.transpose() * fv;
+    // (G^T v)_bk = sum_J v_kJ dN_b/dX_J for a 9-vector v indexed 3 k + J
+    for (int b = 0; b < 8; ++b) {
+      for (int kk = 0; kk < 3; ++kk) {
+        ga[3 * b + kk] = g.row(b).dot(af.segment<3>(3 * kk));
+        gat[3 * b + kk] = g.row(b).dot(atf.segment<3>(3 * kk));
+      }
+    }
+    add_material_stiffness(g, resp.tangent, w * s * s, *ke);
+    const Vec24 left = (s * s) * ga + s * c, right = (s * s) * gat + s * c;
+    auto k24 = ke->topLeftCorner<24, 24>();
+    k24.noalias() += w * (left * ev.transpose() + ev * right.transpose());
+    k24.noalias() += (w * (s * s * fv.dot(af) + s * phi)) * (ev * ev.transpose());
+    // - (w s phi / 3) H at this point; + (w s phi / 3) H_bar collected below
+    const double hs = w * s * phi / 3.0;
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b)
+        k24.block<3, 3>(3 * a, 3 * b).noalias() +=
+            hs * d[q].segment<3>(3 * b) * d[q].segment<3>(3 * a).transpose();
+    h_bar_scale += hs;
+  }
+  if (ke != nullptr) ke->topLeftCorner<24, 24>() += h_bar_scale * h_bar;
+}
+
+void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacements& ue,
+                                        ElementVector& fe, ElementMatrix* ke, double& energy,
+                                        ElementVector& fabs) {
+  using Vec9 = Eigen::Matrix<double, 9, 1>;
+  using Mat9 = Eigen::Matrix<double, 9, 9>;
+  using Mat33 = Eigen::Matrix<double, 33, 33>;
+  using Vec33 = Eigen::Matrix<double, 33, 1>;
+  using Grad11 = Eigen::Matrix<double, 11, 3>;
+  constexpr int kMaxLocalIterations = 12;
+  const MaterialLaw& law = *element_law_[e];
+  const std::size_t q0 = qp_offset_[e], q1 = qp_offset_[e + 1];
+  const std::size_t a0 = eas_offset_[e];
+  // 11 "nodes": the 8 nodes, then the three enhanced modes (displacements alpha_J)
+  Eigen::Matrix<double, 11, 3> ux;
+  ux.topRows<8>() = ue.topRows(8);
+  Vec9 alpha = Eigen::Map<const Vec9>(committed_.data() + a0);
+  Grad11 gx;
+  Vec33 fx;
+  Mat33 kx;
+  MaterialResponse resp;
+  // One pass over the points at alpha: fx = int G^T P dV, kx = int G^T A G dV (11 nodes), the
+  // energy, the stresses, the trial histories, the round-off bounds; sets the stress scale
+  // sum |P| |G| w of h and the round-off bound of h, sum dP |g_J| w (as the nodes' fabs).
+  double scale = 0.0, h_round_off = 0.0;
+  auto pass = [&]() {
+    for (int jj = 0; jj < 3; ++jj) ux.row(8 + jj) = alpha.segment<3>(3 * jj).transpose();
+    fx.setZero();
+    kx.setZero();
+    fabs.setZero(8);
+    energy = 0.0;
+    scale = 0.0;
+    h_round_off = 0.0;
+    for (std::size_t q = q0; q < q1; ++q) {
+      gx.topRows<8>() = Eigen::Map<const Eigen::Matrix<double, 8, 3, Eigen::RowMajor>>(
+          gradients_.data() + gradient_offset_[q]);
+      gx.bottomRows<3>() = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+          eas_gradients_.data() + eas_gradient_start_[e] + 9 * (q - q0));
+      // F = I + sum_a u_a (x) grad_X N_a + sum_J alpha_J (x) g_J
+      const Mat3 f = Mat3::Identity() + ux.transpose() * gx;
+      if (!law.small_strain()) require_not_inverted(e, f.determinant());
+      const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
+      law.evaluate(f, std::span<const double>(committed_).subspan(s0, ns),
+                   std::span<double>(trial_).subspan(s0, ns), resp);
+      const double w = weight_[q];
+      // f_(a i) += P_iJ dG_a/dX_J w   (a over the 11 nodes)
+      const Grad11 pg = gx * (resp.stress.transpose() * w);
+      for (int a = 0; a < 11; ++a) fx.segment<3>(3 * a) += pg.row(a).transpose();
+      // K_(a i)(b k) += dG_a/dX_J A_iJkL dG_b/dX_L w
+      add_material_stiffness(gx, resp.tangent, w, kx);
+      scale += resp.stress.norm() * gx.norm() * w;
+      energy += resp.energy_density * w;
+      const double dp = stress_round_off(resp.stress, f, element_modulus_[e]) * w;
+      for (int a = 0; a < 8; ++a) fabs[a] += gx.row(a).norm() * dp;
+      h_round_off += gx.bottomRows<3>().norm() * dp;
+      const Mat3 sigma = cauchy_stress_of(law, resp.stress, f);
+      const auto qi = static_cast<Eigen::Index>(q);
+      cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2),
+          sigma(0, 2);
+      eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
+    }
+  };
+  // local Newton on h(alpha) = int G_alpha^T P dV = 0:  K_aa d_alpha = -h, from the committed
+  // alpha; each pass writes the energy, stresses and trial histories of its alpha, so the last
+  // one's stay
+  Eigen::PartialPivLU<Mat9> lu;
+  Vec9 h;
+  bool converged = false;
+  // converged: |h| <= 1e-10 of its scale, or at its round-off (F = I + grad u is rounded to
+  // eps |F|: at strains of 1e-8 that is 1e-8 of h's scale), or no longer decreasing within
+  // 1e-6 of its scale (round-off the bound does not cover)
+  double h_previous = 0.0;
+  for (int it = 0; it < kMaxLocalIterations && !converged; ++it) {
+    if (it > 0) alpha -= lu.solve(h);
+    pass();
+    h = fx.tail<9>();
+    lu.compute(kx.bottomRightCorner<9, 9>());
+    const double hn = h.norm();
+    converged = hn <= 1e-10 * scale + h_round_off || scale == 0.0 ||
+                (it > 0 && hn > 0.5 * h_previous && hn <= 1e-6 * scale);
+    h_previous = hn;
+  }
+  if (!converged) {
+    std::ostringstream msg;
+    msg << "EAS Hex8 element " << e << ": the enhanced strains did not converge in "
+        << kMaxLocalIterations << " local iterations";
+    throw Error(msg.str());
+  }
+  // f_e = f_u - K_ua K_aa^-1 h   (h ~ 0: the first-order correction of what is left); the trial
+  // alpha likewise alpha - K_aa^-1 h
+  const Vec9 d_alpha = lu.solve(h);
+  fe.head<24>() = fx.head<24>() - kx.topRightCorner<24, 9>() * d_alpha;
+  Eigen::Map<Vec9>(trial_.data() + a0) = alpha - d_alpha;
+  if (ke == nullptr) return;
+  // K_e = K_uu - K_ua K_aa^-1 K_au
+  const Eigen::Matrix<double, 9, 24> kaa_kau = lu.solve(kx.bottomLeftCorner<9, 24>());
+  ke->topLeftCorner<24, 24>() = kx.topLeftCorner<24, 24>() - kx.topRightCorner<24, 9>() * kaa_kau;
+}
+
+double MaterialContribution::dissipated_work() const {
+  double wp = 0.0;
+  // W_p = sum_q w_p(history_q) det J w
+  for (std::size_t e = 0; e < element_law_.size(); ++e) {
+    if (element_law_[e]->state_size() == 0) continue;
+    for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
+      wp += element_law_[e]->plastic_work_density(
+                std::span<const double>(committed_)
+                    .subspan(state_offset_[q], state_offset_[q + 1] - state_offset_[q])) *
+            weight_[q];
+    }
+  }
+  return wp;
+}
+
+void MaterialContribution::set_committed_state(const std::vector<double>& state) {
+  if (state.size() != committed_.size()) {
+    throw Error("material contribution: a quadrature-point history of " +
+                std::to_string(state.size()) + " values was given, this model has " +
+                std::to_string(committed_.size()) + " (state of another model?)");
+  }
+  committed_ = state;
+  trial_ = state;
+}
+
+}  // namespace partita::fem
