@@ -79,7 +79,7 @@ TEST_CASE("dem participant: one sphere on a plane runs with the defaults",
   CHECK(lost.find("raise the participant's key lost_margin") != std::string::npos);
 }
 
-TEST_CASE("dem participant: a particle monitor follows its id; an unknown id is refused",
+TEST_CASE("dem participant: a particle monitor follows its id, and an unknown id is refused",
           "[adapters][dem][robustness]") {
   const fs::path dir = scratch("monitor");
   auto s = test::make_dem(test::small_bed_yaml("monitor_particles: [0, 5]\nsort_interval: 1\n"),

@@ -62,7 +62,7 @@ TEST_CASE("factor kernels: C -= A B^T to round-off, packed and in place the same
   }
 }
 
-TEST_CASE("factor kernels: the panel Cholesky gives L L^T = A; rows solved apart, the same bits",
+TEST_CASE("factor kernels: the panel Cholesky gives L L^T = A, and rows solved apart give the same bits",
           "[fem][linear-solver][threaded-factorisation]") {
   const FactorKernels& k = factor_kernels();
   std::vector<double> pack(static_cast<std::size_t>(kFactorPackSize));

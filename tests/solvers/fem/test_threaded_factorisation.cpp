@@ -152,7 +152,7 @@ TEST_CASE("threaded factorisation: a new pattern of the same size is analysed ag
   CHECK(relative_difference(x, exact) <= 1e-12);
 }
 
-TEST_CASE("threaded factorisation: automatic only for large factors; the plate agrees with Eigen",
+TEST_CASE("threaded factorisation: automatic only for large factors, and the plate agrees with Eigen",
           "[fem][linear-solver][threaded-factorisation][slow]") {
   if (!cholmod_available()) {
     WARN("built without CHOLMOD: the threaded factorisation works on CHOLMOD's analysis");
