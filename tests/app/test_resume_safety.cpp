@@ -34,7 +34,7 @@ const fs::path kSource = PARTITA_SOURCE_DIR;
 fs::path scratch(const std::string& name) { return partita::test::scratch_dir("resume", name); }
 
 partita::test::CommandResult partita_run(const std::string& args) {
-  return partita::test::run_command(quote(PARTITA_EXECUTABLE) + " " + args);
+  return partita::test::run_partita(args);
 }
 
 std::string read_all(const fs::path& p) { return partita::test::read_file(p); }

@@ -39,4 +39,11 @@ inline CommandResult run_command(const std::string& command) {
   return r;
 }
 
+#ifdef PARTITA_EXECUTABLE
+/// The partita executable of this build with `args` (already quoted where needed).
+inline CommandResult run_partita(const std::string& args) {
+  return run_command(quote(PARTITA_EXECUTABLE) + " " + args);
+}
+#endif
+
 }  // namespace partita::test

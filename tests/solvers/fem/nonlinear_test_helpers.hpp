@@ -125,4 +125,13 @@ inline double bisect(const std::function<double(double)>& g, double lo, double h
   return 0.5 * (lo + hi);
 }
 
+// Mean z-displacement of the face "xmax", positive downwards (a cantilever's tip deflection
+// under a load in -z).
+inline double tip_deflection(const StructuralSolver& s) {
+  double w = 0.0;
+  const auto& nodes = s.mesh().node_set("xmax");
+  for (auto n : nodes) w += s.displacement(n).z();
+  return -w / static_cast<double>(nodes.size());
+}
+
 }  // namespace partita::fem::test

@@ -16,6 +16,7 @@
 #include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
+using partita::fem::test::tip_deflection;
 
 namespace {
 
@@ -46,13 +47,6 @@ Model strip(std::shared_ptr<const MaterialLaw> law, double p, bool sliding,
   }
   m.add_traction("xmax", Vec3(0.0, 0.0, -p / (b * h)), [](double t) { return t; });
   return m;
-}
-
-double tip_deflection(const StructuralSolver& s) {
-  double w = 0.0;
-  const auto& nodes = s.mesh().node_set("xmax");
-  for (auto n : nodes) w += s.displacement(n).z();
-  return -w / static_cast<double>(nodes.size());
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
+using partita::fem::test::tip_deflection;
 
 namespace {
 
@@ -67,14 +68,6 @@ Model cantilever(Law l, double tip_load, ElementType type = ElementType::Hex20) 
   // P as a uniform shear traction on the end face, ramped with time
   m.add_traction("xmax", Vec3(0.0, 0.0, -tip_load / (kB * kH)), [](double t) { return t; });
   return m;
-}
-
-// Mean z-displacement of the end face.
-double tip_deflection(const StructuralSolver& s) {
-  double w = 0.0;
-  const auto& nodes = s.mesh().node_set("xmax");
-  for (auto n : nodes) w += s.displacement(n).z();
-  return -w / static_cast<double>(nodes.size());
 }
 
 // Solves with the default Newton options in `steps` load steps; returns the tip deflection.
