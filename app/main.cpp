@@ -1,5 +1,6 @@
 // partita: the command line. A thin main over the libraries:
 //   partita run CASE.yaml [--output DIR] [--threads N] [--log-level L] [--resume DIR]
+//   mpirun -n 1 partita run CASE --participant A : -n 1 partita run CASE --participant B
 //   partita check CASE.yaml
 //   partita list
 //   partita docs [NAME]
@@ -36,6 +37,7 @@
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/version.hpp"
+#include "distributed.hpp"
 #include "process.hpp"
 #include "sweep_runner.hpp"
 
@@ -190,6 +192,16 @@ int main(int argc, char** argv) {
   run->add_option("--resume", resume_dir,
                   "Continue the run whose output folder this is from its newest restart file "
                   "(DIR/restart/w<window>.bin), bit for bit; time.end may be raised with --set");
+  std::string participant;
+  double peer_timeout = 600.0;
+  run->add_option("--participant", participant,
+                  "Run only this participant, in this process, with the others in processes of "
+                  "their own (under mpirun, one process per participant: mpirun -n 1 partita run "
+                  "CASE --participant A : -n 1 partita run CASE --participant B)");
+  run->add_option("--peer-timeout", peer_timeout,
+                  "With --participant: the longest wait for another process's message [s] "
+                  "(default 600): a stuck process ends the run after it")
+      ->check(CLI::PositiveNumber);
   run->add_option("--set", overrides,
                   "Change a value of the case: KEY.PATH=VALUE with map keys joined by dots and "
                   "list elements as key[i] (e.g. time.end=0.01, "
@@ -244,6 +256,26 @@ int main(int argc, char** argv) {
       std::cout << "partita check: " << case_file << " is valid\n";
       return 0;
     }
+    if (!participant.empty()) {
+      partita::app::DistributedOptions d;
+      d.case_file = case_file;
+      d.run = options;
+      d.participant = participant;
+      d.peer_timeout = peer_timeout;
+      d.stop_signal = &g_stop_signal;
+      d.install_stop_handlers = install_stop_handlers;
+      d.on_finished = [&](const partita::coupling::CaseRun& c) {
+        plot_csv_files(c.output_dir());
+        run_scripts(c.scripts(), c.output_dir());
+        std::cout << "partita run: finished; output in " << c.output_dir().string() << "/\n";
+      };
+      return partita::app::run_distributed(registries, d);
+    }
+    if (partita::app::started_with_others())
+      throw partita::Error(
+          "this process was started by mpirun with others, without --participant: every process "
+          "would run the whole case; give each process its participant, e.g. mpirun -n 1 partita "
+          "run CASE --participant A : -n 1 partita run CASE --participant B");
     if (!no_sweep && resume_dir.empty() && partita::app::has_sweep(case_file, overrides)) {
       install_stop_handlers();
       partita::app::SweepOptions so;

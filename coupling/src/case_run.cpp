@@ -10,6 +10,7 @@
 
 #include "partita/coupling/explicit_scheme.hpp"
 #include "partita/coupling/progress_line.hpp"
+#include "partita/coupling/remote_participant.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/coupling/sweep.hpp"
 #include "plain_name.hpp"
@@ -71,6 +72,16 @@ void CaseRun::write_output(int frame, double time) {
 void CaseRun::run() {
   if (options_.check_only) return;
   auto logger = log::get("coupling");
+  if (serves()) {  // the controller runs the windows; this process answers for its participant
+    Stopwatch wall;
+    ParticipantServer server(*options_.distributed.controller, options_.stop_signal);
+    summary_.stopped_by_signal = server.serve(*served_);
+    summary_.wall_seconds = wall.seconds();
+    summary_.participant_seconds.emplace_back(served_->name(), served_->seconds());
+    logger->info("participant '{}' served the run: {:.3f} s in its solver of {:.3f} s",
+                 served_->name(), served_->seconds(), summary_.wall_seconds);
+    return;
+  }
   Stopwatch wall;
   const bool resume = !options_.resume_dir.empty();
   fs::path resume_file;
@@ -276,7 +287,11 @@ void CaseRun::run() {
         while (output_every_ > 0.0 && TimeWindow::reached(t, progress.next_output, window_size_))
           progress.next_output = static_cast<double>(progress.frame) * output_every_;
       }
-      const int signal = options_.stop_signal ? options_.stop_signal->load() : 0;
+      int signal = options_.stop_signal ? options_.stop_signal->load() : 0;
+      for (const auto& p : participants_)  // a signal to another participant's process
+        if (signal == 0) signal = p->stop_request();
+      if (signal != 0)
+        for (const auto& p : participants_) p->note_stop(signal);
       const bool restart_due =
           (restart_every_windows_ > 0 && (n + 1) % restart_every_windows_ == 0) ||
           (restart_every_seconds_ > 0.0 && since_restart.seconds() >= restart_every_seconds_) ||

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <set>
 
@@ -12,6 +13,7 @@
 
 #include "partita/coupling/explicit_scheme.hpp"
 #include "partita/coupling/progress_line.hpp"
+#include "partita/coupling/remote_participant.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/coupling/sweep.hpp"
 #include "plain_name.hpp"
@@ -80,6 +82,12 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     output_dir_ = options_.resume_dir;
   }
   identity_ = case_identity(root);
+  {
+    YAML::Emitter e;  // the whole case as parsed: comments, blank lines and quoting drop out
+    e << root.yaml();
+    case_hash_ = 1469598103934665603ull;
+    for (unsigned char c : std::string(e.c_str())) case_hash_ = (case_hash_ ^ c) * 1099511628211ull;
+  }
 
   const config::Node time = root["time"];
   window_size_ = time.real("window");
@@ -130,6 +138,7 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     }
 
   build_participants(root);
+  if (serves()) return;  // the controller builds the rest; this process serves its participant
   const config::Node coupling = root["coupling"];
   if (root.has("coupling")) {
     build_exchanges(coupling);
@@ -280,6 +289,12 @@ void CaseRun::build_participants(const config::Node& root) {
     }
   }
 
+  const auto& dist = options_.distributed;
+  if (!dist.participant.empty() &&
+      std::find(names.begin(), names.end(), dist.participant) == names.end())
+    throw Error("--participant " + dist.participant + ": the case has no participant '" +
+                dist.participant + "'; participants: " + join_names(names) +
+                did_you_mean(dist.participant, names));
   struct Built {
     std::string name;
     config::Node node;
@@ -303,6 +318,7 @@ void CaseRun::build_participants(const config::Node& root) {
       if (!spec->find("solver")) spec->string("solver", "the registered solver's name").required();
       validated = pn.validated(spec);
     }
+    if (!runs_here(name)) continue;  // another process builds it
     SolverContext ctx{name, validated, case_dir_, output_dir_, options_.threads};
     log::get("coupling")->debug("setting up participant '{}' ({})", name, entry.name);
     Stopwatch setup;
@@ -314,42 +330,80 @@ void CaseRun::build_participants(const config::Node& root) {
     built.push_back(Built{name, pn, entry.name, std::move(solver)});
   }
 
+  if (serves()) {
+    serve_handshake(built.front().solver, substeps, coupled);
+    return;
+  }
+  // The participants in other processes: their hellos (meshes and what they ask for).
+  std::vector<Hello> hellos;
+  for (const auto& [pname, channel] : dist.servers) hellos.push_back(receive_hello(*channel, pname, case_hash_));
+  for (const std::string& name : order) {
+    if (runs_here(name)) continue;
+    bool found = false;
+    for (const Hello& h : hellos) found = found || h.participant == name;
+    if (!found)
+      throw Error("participant '" + name + "' has no process: start one with ': -n 1 partita run " +
+                  "CASE --participant " + name + "' on the mpirun line");
+  }
+  // The meshes a participant offers others, wherever it runs.
+  auto offered = [&](const std::string& pname) -> const std::vector<InterfaceMesh>* {
+    for (const auto& b : built)
+      if (b.name == pname) return &b.solver->meshes();
+    for (const Hello& h : hellos)
+      if (h.participant == pname) return &h.meshes;
+    return nullptr;
+  };
+  auto find_offered = [&](const std::string& source, const std::string& receiver,
+                          const std::function<void(const std::string&)>& fail) -> const Mesh& {
+    const auto dot = source.find('.');
+    const std::string pname = source.substr(0, dot);
+    const std::string mname = dot == std::string::npos ? "" : source.substr(dot + 1);
+    const std::vector<InterfaceMesh>* from = offered(pname);
+    if (dot == std::string::npos || !from)
+      fail("'" + source + "' names no participant's mesh (participant.mesh); participants: " +
+           join_names(names) + did_you_mean(pname, names));
+    if (pname == receiver) fail("a participant cannot take a mesh from itself");
+    std::vector<std::string> known;
+    const InterfaceMesh* found = nullptr;
+    for (const auto& m : *from) {
+      known.push_back(m.mesh.name());
+      if (m.mesh.name() == mname) found = &m;
+    }
+    if (!found)
+      fail("participant '" + pname + "' has no mesh '" + mname + "'; its meshes: " +
+           join_names(known) + did_you_mean(mname, known));
+    if (found->mesh.num_triangles() == 0)
+      fail("mesh '" + source + "' has no triangles (a point set): a surface is needed");
+    return found->mesh;
+  };
+  std::vector<Ready> ready;
+  for (std::size_t i = 0; i < hellos.size(); ++i) {
+    std::vector<std::pair<std::string, Mesh>> meshes;
+    for (const auto& [rname, source] : hellos[i].mesh_requests)
+      meshes.emplace_back(rname, find_offered(source, hellos[i].participant, [&](const std::string& why) {
+                            ps[hellos[i].participant].fail(why);
+                          }));
+    ready.push_back(complete_handshake(*dist.servers[i].second, meshes));
+  }
+
   // Surfaces handed from one participant to another (an FE face as a DEM wall): once every
   // participant is built, before anyone's meshes() is used for the exchanges.
   for (auto& b : built)
-    for (const MeshRequest& req : b.solver->mesh_requests()) {
-      const auto dot = req.source.find('.');
-      const std::string pname = req.source.substr(0, dot);
-      const std::string mname = dot == std::string::npos ? "" : req.source.substr(dot + 1);
-      const Built* from = nullptr;
-      for (const auto& other : built)
-        if (other.name == pname) from = &other;
-      if (dot == std::string::npos || !from)
-        req.where.fail("'" + req.source + "' names no participant's mesh (participant.mesh); " +
-                       "participants: " + join_names(names) + did_you_mean(pname, names));
-      if (from == &b) req.where.fail("a participant cannot take a mesh from itself");
-      std::vector<std::string> known;
-      const InterfaceMesh* found = nullptr;
-      for (const auto& m : from->solver->meshes()) {
-        known.push_back(m.mesh.name());
-        if (m.mesh.name() == mname) found = &m;
-      }
-      if (!found)
-        req.where.fail("participant '" + pname + "' has no mesh '" + mname +
-                       "'; its meshes: " + join_names(known) + did_you_mean(mname, known));
-      if (found->mesh.num_triangles() == 0)
-        req.where.fail("mesh '" + req.source +
-                       "' has no triangles (a point set): a surface is needed");
-      b.solver->receive_mesh(req.name, found->mesh);
-    }
+    for (const MeshRequest& req : b.solver->mesh_requests())
+      b.solver->receive_mesh(
+          req.name, find_offered(req.source, b.name,
+                                 [&](const std::string& why) { req.where.fail(why); }));
 
-  for (auto& b : built) {
-    const std::string& name = b.name;
-    const config::Node& pn = b.node;
+  for (const std::string& name : order) {
+    const config::Node pn = ps[name];
+    auto b = std::find_if(built.begin(), built.end(), [&](const Built& x) { return x.name == name; });
     Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
     if (!coupled) s.automatic = true;  // alone: as many steps per window as its stability needs
     // A fixed number of substeps must not exceed the solver's stable time step.
-    const double stable = b.solver->stable_time_step();
+    std::size_t remote = 0;
+    while (b == built.end() && dist.servers[remote].first != name) ++remote;
+    const double stable =
+        b != built.end() ? b->solver->stable_time_step() : ready[remote].stable_time_step;
     if (!s.automatic && TimeWindow::longer_than(window_size_ / s.count, stable)) {
       const config::Node where = substeps.count(name) ? coupling["substeps"][name] : pn;
       where.fail(fmt::format(
@@ -358,14 +412,38 @@ void CaseRun::build_participants(const config::Node& root) {
           name, window_size_ / s.count, window_size_, s.count, stable, name,
           TimeWindow::substeps_for(window_size_, stable), name));
     }
-    participants_.push_back(std::make_unique<LocalParticipant>(name, std::move(b.solver), s));
+    if (b != built.end())
+      participants_.push_back(std::make_unique<LocalParticipant>(name, std::move(b->solver), s));
+    else
+      participants_.push_back(std::make_unique<RemoteParticipant>(name, *dist.servers[remote].second,
+                                                                  std::move(ready[remote])));
     if (coupled && participants_.back()->meshes().empty())
-      pn.fail("solver '" + b.solver_name + "' of participant '" + name +
+      pn.fail("solver '" + pn.string("solver") + "' of participant '" + name +
               "' exposes no coupling mesh");
     for (const auto& m : participants_.back()->meshes())
       check_plain_name(pn, m.mesh.name(),
                        "the mesh name '" + m.mesh.name() + "' of '" + name + "'");
   }
+}
+
+// A server's side of the handshake: say what it offers and asks for, take the meshes it asked
+// for, become the participant the controller talks to.
+void CaseRun::serve_handshake(std::unique_ptr<Solver>& solver,
+                              std::map<std::string, Substeps>& substeps, bool coupled) {
+  const std::string& name = options_.distributed.participant;
+  Hello h;
+  h.case_hash = case_hash_;
+  h.participant = name;
+  h.meshes = solver->meshes();
+  const std::vector<MeshRequest> requests = solver->mesh_requests();
+  for (const MeshRequest& r : requests) h.mesh_requests.emplace_back(r.name, r.source);
+  ParticipantServer server(*options_.distributed.controller, options_.stop_signal);
+  for (auto& [rname, mesh] : server.hello(h)) solver->receive_mesh(rname, mesh);
+  Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
+  if (!coupled) s.automatic = true;
+  auto local = std::make_unique<LocalParticipant>(name, std::move(solver), s);
+  served_ = local.get();
+  participants_.push_back(std::move(local));
 }
 
 void CaseRun::build_exchanges(const config::Node& coupling) {

@@ -74,6 +74,37 @@ void BinaryWriter::finish() {
   out_.write(footer.data(), static_cast<std::streamsize>(footer.size()));
 }
 
+BinaryWriter::Recording BinaryWriter::recording(const std::string& bytes) {
+  close_section();
+  finished_ = true;
+  if (bytes.size() != size_)
+    throw Error("internal: a recording of " + std::to_string(bytes.size()) +
+                " bytes from a writer that wrote " + std::to_string(size_));
+  Recording r;
+  for (std::size_t i = 0; i < sections_.size(); ++i) {
+    const Section& s = sections_[i];
+    const std::string marker_text = "§" + s.name;
+    const std::size_t marker = sizeof(std::uint64_t) + marker_text.size();
+    const bool is_marked = s.length >= marker &&
+                           bytes.compare(s.offset + sizeof(std::uint64_t), marker_text.size(),
+                                         marker_text) == 0;
+    if (i == 0 && s.offset == 0 && !is_marked) {  // the bytes before the first marker
+      r.header = bytes.substr(0, s.length);
+      continue;
+    }
+    r.sections.emplace_back(s.name, bytes.substr(s.offset + marker, s.length - marker));
+  }
+  return r;
+}
+
+void BinaryWriter::replay(const Recording& r) {
+  put(r.header.data(), r.header.size());
+  for (const auto& [name, b] : r.sections) {
+    section(name);
+    put(b.data(), b.size());
+  }
+}
+
 void BinaryReader::verify_checksums() {
   const std::streamoff start = in_.tellg();
   auto damaged = [&](const std::string& what) -> Error {
@@ -117,6 +148,7 @@ void BinaryReader::verify_checksums() {
   take(&count, 8);
   std::vector<char> buffer(std::size_t{1} << 20);
   std::uint64_t expected_offset = 0;
+  table_.clear();
   for (std::uint64_t i = 0; i < count; ++i) {
     std::uint64_t name_size = 0, offset = 0, length = 0;
     std::uint32_t crc = 0;
@@ -130,6 +162,7 @@ void BinaryReader::verify_checksums() {
     if (offset != expected_offset || length > table_offset - offset)
       throw damaged("its checksum table is damaged (section '" + name + "' out of place)");
     expected_offset = offset + length;
+    table_.emplace_back(name, static_cast<std::streamoff>(offset));
     in_.seekg(static_cast<std::streamoff>(offset));
     std::uint32_t sum = 0;
     for (std::uint64_t left = length; left > 0;) {

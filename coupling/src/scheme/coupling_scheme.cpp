@@ -37,7 +37,15 @@ void CouplingScheme::run_participant(Participant& p, const TimeWindow& window) {
   p.run_window(window, inputs_, outputs_);
 }
 
-void CouplingScheme::send_outputs(const Participant& p) {
+void CouplingScheme::run_all(const TimeWindow& window) {
+  for (Participant* p : participants_)
+    if (p->remote()) run_participant(*p, window);
+  for (Participant* p : participants_)
+    if (!p->remote()) run_participant(*p, window);
+}
+
+void CouplingScheme::send_outputs(Participant& p) {
+  p.finish_window();
   for (Exchange* e : exchanges_) {
     if (&e->from() != &p) continue;
     e->send_combined();  // sent = combined (a swap, no copy)

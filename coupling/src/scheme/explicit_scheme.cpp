@@ -16,7 +16,7 @@ WindowReport ExplicitScheme::run_window(const TimeWindow& window) {
       send_outputs(*p);
     }
   } else {
-    for (Participant* p : participants_) run_participant(*p, window);
+    run_all(window);
     for (Participant* p : participants_) send_outputs(*p);
   }
   return WindowReport{};

@@ -98,14 +98,19 @@ WindowReport ImplicitScheme::run_window(const TimeWindow& window) {
   for (int k = 1;; ++k) {
     for (Exchange* e : exchanges_) e->remember_previous();
     std::set<const Exchange*> sent;
-    for (Participant* p : participants_) {
-      run_participant(*p, window);
-      if (options_.serial && p != participants_.back()) {
-        send_outputs(*p);
-        for (Exchange* e : exchanges_)
-          if (&e->from() == p) sent.insert(e);
+    if (options_.serial) {
+      for (Participant* p : participants_) {
+        run_participant(*p, window);
+        if (p != participants_.back()) {
+          send_outputs(*p);
+          for (Exchange* e : exchanges_)
+            if (&e->from() == p) sent.insert(e);
+        }
       }
+    } else {
+      run_all(window);
     }
+    for (Participant* p : participants_) p->finish_window();
     // convergence: every measure on (previous iterate, new values) of its field
     bool converged = true;
     report.residuals.clear();

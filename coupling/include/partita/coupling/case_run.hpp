@@ -40,6 +40,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -52,6 +53,8 @@
 #include "partita/interface/output.hpp"
 
 namespace partita::coupling {
+
+class Channel;  // remote_participant.hpp
 
 struct RunOptions {
   std::filesystem::path output_dir;  ///< empty: out/<case name>/ relative to the current directory
@@ -69,6 +72,15 @@ struct RunOptions {
   /// Set (to the signal number) by a signal handler: the run finishes the current window,
   /// writes a restart file, flushes every CSV and returns (summary().stopped_by_signal).
   const std::atomic<int>* stop_signal = nullptr;
+  /// A run over several processes (remote_participant.hpp): `participant` is the one this
+  /// process runs (empty: all of them, in this process). The controller (the process that runs
+  /// the coupling core and writes the common files) has a channel to each other participant's
+  /// process in `servers`; every other process has `controller` and only serves its participant.
+  struct Distributed {
+    std::string participant;
+    std::vector<std::pair<std::string, Channel*>> servers;
+    Channel* controller = nullptr;
+  } distributed;
 };
 
 /// What run() measured.
@@ -109,6 +121,12 @@ class CaseRun {
   /// Post-processing scripts of the case (output.scripts), as paths; the caller runs them.
   const std::vector<std::filesystem::path>& scripts() const { return scripts_; }
   const std::string& name() const { return name_; }
+  /// A hash of the whole case as read (after --set), in a canonical form: comments, blank lines
+  /// and key order do not change it (the processes of a distributed run compare it).
+  std::uint64_t case_hash() const { return case_hash_; }
+  /// This process serves one participant for a controller in another process (run() answers
+  /// its requests until the run ends).
+  bool serves() const { return options_.distributed.controller != nullptr; }
   const RunSummary& summary() const { return summary_; }
   double window_size() const { return window_size_; }
   std::int64_t window_count() const { return window_count_; }
@@ -154,6 +172,11 @@ class CaseRun {
   };
   SavedRun saved_run(const Progress& progress) const;
   void build_participants(const config::Node& root);
+  void serve_handshake(std::unique_ptr<Solver>& solver, std::map<std::string, Substeps>& substeps,
+                       bool coupled);
+  bool runs_here(const std::string& participant) const {
+    return options_.distributed.participant.empty() || options_.distributed.participant == participant;
+  }
   void build_exchanges(const config::Node& coupling);
   void build_monitors(const config::Node& root);
   void check_sweep_values(const std::filesystem::path& case_file, const class Sweep& sweep) const;
@@ -181,6 +204,7 @@ class CaseRun {
   double output_every_ = 0.0;                               // 0: first and last frame only
   vtk::Options vtk_options_;                                // output.vtk
   std::vector<std::unique_ptr<Participant>> participants_;  // in scheme order
+  LocalParticipant* served_ = nullptr;  // the participant a server process runs
   std::vector<std::unique_ptr<Exchange>> exchanges_;
   std::unique_ptr<CouplingScheme> scheme_;
   std::vector<Monitor> monitors_;
@@ -190,6 +214,7 @@ class CaseRun {
   CsvSeries coupling_csv_;
   // restart files
   std::uint64_t identity_ = 0;  // hash of the case's participants and coupling sections
+  std::uint64_t case_hash_ = 0;  // hash of the whole case (canonical YAML)
   std::int64_t restart_every_windows_ = 0;
   double restart_every_seconds_ = 0.0;
   int restart_keep_ = 2;

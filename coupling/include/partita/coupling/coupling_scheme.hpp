@@ -58,10 +58,14 @@ class CouplingScheme {
   /// Run the window until it can be accepted (explicit: once; implicit: until converged).
   virtual WindowReport run_window(const TimeWindow& window) = 0;
 
-  /// Participant p takes the window; its outputs' combined() values are then set.
+  /// Participant p takes the window; its outputs' combined() values are set once
+  /// p.finish_window() returns (a participant in another process works in the meantime).
   void run_participant(Participant& p, const TimeWindow& window);
-  /// sent = combined; transmit (for every output of p).
-  void send_outputs(const Participant& p);
+  /// Every participant takes the window, at the same time where they can: the remote ones
+  /// are started first (a parallel scheme); finish with send_outputs() or finish_window().
+  void run_all(const TimeWindow& window);
+  /// Wait for p's window; sent = combined; transmit (for every output of p).
+  void send_outputs(Participant& p);
 
   std::vector<Participant*> participants_;
   std::vector<Exchange*> exchanges_;

@@ -89,6 +89,17 @@ class Participant {
   /// `inputs` and `outputs` come in the same order every window.
   virtual void run_window(const TimeWindow& window, std::span<const WindowInput> inputs,
                           std::span<WindowOutput> outputs) = 0;
+  /// Wait until the window of the last run_window() is done and its outputs are set (a
+  /// participant in another process works while the caller goes on; in process: nothing).
+  virtual void finish_window() {}
+  /// A signal the participant's process received (0: none): the run stops after the window.
+  virtual int stop_request() const { return 0; }
+  /// The run stops after this window because of `signal` (a participant in another process
+  /// then exits with 128 + signal, as this one does).
+  virtual void note_stop(int /*signal*/) {}
+  /// True for a participant that works in another process (a parallel scheme starts those
+  /// first, then works on the ones in this process).
+  virtual bool remote() const { return false; }
   /// Substeps for a window of `window_size` (throws where a fixed count has become too coarse).
   virtual int substeps(double window_size) const = 0;
   virtual double stable_time_step() const = 0;

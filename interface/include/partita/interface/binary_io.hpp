@@ -26,6 +26,7 @@
 #include <ostream>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -66,6 +67,21 @@ class BinaryWriter {
   void bytes(const std::string& b) { write(b); }
   /// Append the checksum table and footer (see above); nothing may be written after it.
   void finish();
+
+  /// What a writer wrote, split at its sections: the bytes before the first marker, then each
+  /// section's name and the bytes after its marker. A participant in another process writes its
+  /// restart data into memory and sends the recording; replay() writes it into the run's file
+  /// with the same bytes and checksum table as if written there.
+  struct Recording {
+    std::string header;
+    std::vector<std::pair<std::string, std::string>> sections;
+  };
+  /// Split `bytes`, everything this writer wrote to its stream (an std::ostringstream's str()),
+  /// at the sections it made; nothing may be written after it.
+  Recording recording(const std::string& bytes);
+  /// Write a recording as its writer wrote it: the header's bytes, then per section
+  /// section(name) and its bytes.
+  void replay(const Recording& r);
 
   /// One serialise function for writing and reading (`template <class Archive> void
   /// serialize(Archive& ar)` with ar.io(x) and ar.io_section(name)): here io() writes.
@@ -154,6 +170,24 @@ class BinaryReader {
   void io(T& v) { read(v); }
   void io_section(const std::string& name) { expect_section(name); }
 
+  /// The bytes from here up to the next section (in the verified checksum table) whose name
+  /// `stop` accepts, or up to the table; the position moves past them. Only after
+  /// verify_checksums() (the table says where sections start).
+  template <class Stop>
+  std::string raw_until(Stop stop) {
+    if (limit_ < 0) fail("a verified stream (internal: raw_until before verify_checksums)");
+    const std::streamoff here = in_.tellg();
+    std::streamoff to = limit_;
+    for (const auto& [name, offset] : table_)
+      if (offset > here && stop(name)) {
+        to = offset;
+        break;
+      }
+    std::string b(static_cast<std::size_t>(to - here), '\0');
+    raw(b.data(), b.size(), "a participant's data");
+    return b;
+  }
+
   /// Check every section against the checksum table that BinaryWriter::finish() wrote, before
   /// anything is read: an Error naming the damaged section (or the missing table). Reads after
   /// it end at the table. The stream position is kept.
@@ -208,6 +242,7 @@ class BinaryReader {
   std::istream& in_;
   std::string source_;
   std::streamoff limit_ = -1;  // where the data ends (the checksum table), once verified
+  std::vector<std::pair<std::string, std::streamoff>> table_;  // sections' names and offsets
 };
 
 }  // namespace partita

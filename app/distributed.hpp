@@ -1,0 +1,50 @@
+#pragma once
+// `partita run CASE --participant NAME` under mpirun: one process per participant, e.g.
+//
+//   mpirun -n 1 partita run CASE --participant plate : -n 1 partita run CASE --participant granules
+//
+// Every process reads the same case. The processes find each other by splitting
+// MPI_COMM_WORLD by participant (each participant one process); the process of rank 0 (the first
+// of the mpirun line) is the controller: it runs the coupling core (schemes, mapping,
+// accelerations, audits) and writes the run's common files (coupling.csv, the monitors'
+// CSV files and plots, restart files, the summary); every other process builds only its own
+// participant and answers the controller (coupling/remote_participant.hpp). Each process writes
+// its own participant's VTK files into the same output folder (a folder all processes see).
+//
+// Every wait for another process has a deadline (--peer-timeout, default 600 s): a peer that
+// is alive but stuck ends the run with a message naming it. A failure anywhere ends every
+// process with the failing participant's message; SIGINT/SIGTERM to any process ends the run
+// after the current window everywhere, with a restart file, exit status 128 + signal.
+
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "partita/coupling/case_run.hpp"
+#include "partita/coupling/registries.hpp"
+
+namespace partita::app {
+
+struct DistributedOptions {
+  std::filesystem::path case_file;
+  coupling::RunOptions run;  ///< as for a run in one process (distributed is set here)
+  std::string participant;   ///< the participant this process runs
+  double peer_timeout = 600.0;  ///< [s] the longest wait for a message from another process
+  std::atomic<int>* stop_signal = nullptr;
+  std::function<void()> install_stop_handlers;
+  /// Called on the controller after a run that finished (plots, scripts, the last line).
+  std::function<void(const coupling::CaseRun&)> on_finished;
+};
+
+/// Whether this partita can run participants in separate processes (built with MPI).
+bool distributed_available();
+
+/// Run this process's part of a distributed run; returns the exit status (0, 1, 128 + signal).
+int run_distributed(const coupling::Registries& registries, DistributedOptions options);
+
+/// True when this process was started by mpirun with others (OMPI_COMM_WORLD_SIZE > 1, or
+/// PMI_SIZE > 1): a run without --participant there would run the whole case in every process.
+bool started_with_others();
+
+}  // namespace partita::app

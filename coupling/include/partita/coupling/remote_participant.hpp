@@ -1,0 +1,146 @@
+#pragma once
+// Participants in other processes. The coupling core runs in one process (the controller: the
+// process of the first participant in the scheme order); every other participant runs in a
+// process of its own, which builds only its solver and answers the controller's requests
+// (ParticipantServer). On the controller such a participant is a RemoteParticipant: the same
+// Participant port as a LocalParticipant, whose calls become one request and one reply each.
+// The schemes, the mapping, the accelerations, the convergence measures, the audits and the
+// common output files stay on the controller, so a run gives the same bits in one process or
+// in several: the remote side runs the same LocalParticipant on the same inputs.
+//
+// The transport is a Channel (a link to one peer: send bytes, receive bytes with a deadline);
+// app/ implements it over MPI. Messages are BinaryWriter streams:
+//
+//   request   [u32 command] [arguments]
+//   reply     [u32 status: 0 ok, 1 failed] [ok: results | failed: the error text]
+//             [f64 solver seconds since the last reply] [i32 signal received (0: none)]
+//
+// Window exchange: one request and one reply per participant per window (per iteration of an
+// implicit scheme): the inputs at the window's ends go out, the outputs combined over the
+// substeps come back. run_window() only sends; finish_window() waits for the reply, so a
+// parallel scheme lets every remote participant work while the controller's own one does.
+//
+// Start-up (handshake), before the first window, each server sends
+//   hello: [partita version] [case hash] [participant] [meshes] [mesh requests]
+// and the controller answers with the meshes it asked for (another participant's surface),
+// after which the server sends its final meshes, stable step and restart support. A mismatch
+// (version, case, participant) is an error on both sides naming both.
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "partita/coupling/participant.hpp"
+
+namespace partita::coupling {
+
+/// A message link to one peer process.
+class Channel {
+ public:
+  virtual ~Channel() = default;
+  /// Queue `bytes` for the peer (returns before the peer has received them).
+  virtual void send(std::string bytes) = 0;
+  /// The peer's next message; waits at most deadline() seconds, then throws partita::Error
+  /// naming the peer and `what` was awaited.
+  virtual std::string receive(std::string_view what) = 0;
+  /// The peer, for messages ("participant 'granules' (rank 1)").
+  virtual std::string peer() const = 0;
+  /// The longest wait for one message [s].
+  virtual double deadline() const = 0;
+};
+
+/// What a server says about itself at start-up.
+struct Hello {
+  std::string version;
+  std::uint64_t case_hash = 0;
+  std::string participant;
+  std::vector<InterfaceMesh> meshes;
+  std::vector<std::pair<std::string, std::string>> mesh_requests;  // (name, participant.mesh)
+  std::string error;  // set when its set-up failed (then nothing else is)
+};
+
+/// The server's state after the handshake.
+struct Ready {
+  std::vector<InterfaceMesh> meshes;
+  bool supports_restart = false;
+  double stable_time_step = 0.0;
+  std::string error;
+};
+
+/// A participant in another process (see the file comment).
+class RemoteParticipant final : public Participant {
+ public:
+  RemoteParticipant(std::string name, Channel& channel, Ready ready);
+
+  const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
+  void initial_values(std::span<WindowOutput> outputs) override;
+  void run_window(const TimeWindow& window, std::span<const WindowInput> inputs,
+                  std::span<WindowOutput> outputs) override;
+  void finish_window() override;
+  int substeps(double window_size) const override;
+  double stable_time_step() const override;
+  void save_checkpoint() override;
+  void restore_checkpoint() override;
+  std::vector<MonitorValue> monitors() const override;
+  std::vector<MonitorValue> monitor_values(const std::vector<std::string>& names) const override;
+  std::string check_state() const override;
+  std::optional<double> interface_work(std::string_view mesh) const override;
+  void write_output(const OutputFrame& frame) override;
+  std::vector<std::pair<std::string, std::string>> output_files() const override;
+  bool supports_restart() const override { return supports_restart_; }
+  void write_restart(BinaryWriter& out) const override;
+  void read_restart(BinaryReader& in) override;
+  void finalize() override;
+  int stop_request() const override { return stop_request_; }
+  void note_stop(int signal) override { stop_request_ = signal; }
+  bool remote() const override { return true; }
+
+ private:
+  // One request, its reply (throws the server's error, naming the participant).
+  std::string call(const std::string& request, std::string_view what) const;
+  std::string read_reply(std::string_view what) const;
+  Channel& channel_;
+  std::vector<InterfaceMesh> meshes_;
+  bool supports_restart_ = false;
+  // A window sent, its reply not yet read: where its outputs go.
+  std::span<WindowOutput> pending_;
+  bool pending_window_ = false;
+  std::string scratch_;
+  mutable int stop_request_ = 0;
+  mutable double extra_seconds_ = 0.0;
+};
+
+/// The remote side: the start-up handshake and the loop that answers the controller's requests
+/// with a LocalParticipant, until the run ends (finalize: returns normally) or the controller
+/// aborts it (throws partita::Error with the controller's reason).
+class ParticipantServer {
+ public:
+  /// `stop_signal`: the process's signal flag, reported to the controller in every reply.
+  ParticipantServer(Channel& controller, const std::atomic<int>* stop_signal = nullptr);
+  /// Send the hello (the solver built and asking for meshes); returns the meshes received
+  /// for the requests, by request name.
+  std::vector<std::pair<std::string, Mesh>> hello(const Hello& h);
+  /// Send the set-up failure to the controller (instead of hello). Never throws.
+  void fail_setup(const std::string& error) noexcept;
+  /// Send the final meshes, then answer requests until the run ends; returns the signal that
+  /// stopped the run (0: none; the process exits with 128 + it, as the controller does).
+  int serve(LocalParticipant& p);
+
+ private:
+  Channel& controller_;
+  const std::atomic<int>* stop_signal_;
+};
+
+/// The controller's side of one server's handshake: its hello (checked against this process's
+/// version, case hash and the participant expected).
+Hello receive_hello(Channel& server, const std::string& participant, std::uint64_t case_hash);
+/// Send the meshes a server asked for, and receive its final state.
+Ready complete_handshake(Channel& server, const std::vector<std::pair<std::string, Mesh>>& meshes);
+/// Tell a server to stop (the run failed: at set-up or later): it throws partita::Error with
+/// `why` from hello() or serve(). Never throws.
+void abort_server(Channel& server, const std::string& why) noexcept;
+
+}  // namespace partita::coupling
