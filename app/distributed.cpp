@@ -199,8 +199,9 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
     if (o.install_stop_handlers) o.install_stop_handlers();
     c.run();
     if (const int signal = c.summary().stopped_by_signal; signal != 0) {
-      std::cout << "partita run: " << who << " stopped by signal " << signal << " after window "
-                << c.summary().windows << "\n";
+      std::cout << "partita run: " << who << " stopped by signal " << signal;
+      if (rank == 0) std::cout << " after window " << c.summary().windows;
+      std::cout << "\n";
       status = 128 + signal;
     } else if (rank == 0) {
       if (o.on_finished) o.on_finished(c);

@@ -147,14 +147,14 @@ std::string RemoteParticipant::read_reply(std::string_view what) const {
   const auto status = r.in.get<std::uint32_t>();
   if (status != 0) {
     const std::string error = r.in.get_string();
-    throw Error(fmt::format("participant '{}' ({}) failed: {}", name(), channel_.peer(), error));
+    throw Error(fmt::format("{} failed: {}", channel_.peer(), error));
   }
   // results, then the solver's seconds and a signal: the caller reads the results; the tail
   // is at the end of the bytes (fixed size), read here
   const std::string& all = r.stream.str();
   constexpr std::size_t tail = sizeof(double) + sizeof(std::int32_t);
   if (all.size() < sizeof(std::uint32_t) + tail)
-    throw Error("participant '" + name() + "' (" + channel_.peer() + ") sent a damaged reply");
+    throw Error(channel_.peer() + " sent a damaged reply");
   double seconds = 0.0;
   std::int32_t signal = 0;
   std::memcpy(&seconds, all.data() + all.size() - tail, sizeof(double));
@@ -211,7 +211,7 @@ void RemoteParticipant::run_window(const TimeWindow& window, std::span<const Win
     m.out.write(*o.label);
   }
   channel_.send(m.str());
-  pending_ = outputs;
+  pending_.assign(outputs.begin(), outputs.end());  // (no allocation after the first window)
   pending_window_ = true;
 }
 
@@ -330,8 +330,7 @@ Hello receive_hello(Channel& server, const std::string& participant, std::uint64
   Hello h;
   h.error = r.in.get_string();
   if (!h.error.empty())
-    throw Error(fmt::format("participant '{}' ({}) failed at set-up: {}", participant,
-                            server.peer(), h.error));
+    throw Error(fmt::format("{} failed at set-up: {}", server.peer(), h.error));
   h.version = r.in.get_string();
   h.case_hash = r.in.get<std::uint64_t>();
   h.participant = r.in.get_string();

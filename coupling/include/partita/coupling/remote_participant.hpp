@@ -46,7 +46,8 @@ class Channel {
   /// The peer's next message; waits at most deadline() seconds, then throws partita::Error
   /// naming the peer and `what` was awaited.
   virtual std::string receive(std::string_view what) = 0;
-  /// The peer, for messages ("participant 'granules' (rank 1)").
+  /// The peer, for messages: the participant it runs and where ("participant 'granules'
+  /// (rank 1)"); errors read "<peer> failed: ...".
   virtual std::string peer() const = 0;
   /// The longest wait for one message [s].
   virtual double deadline() const = 0;
@@ -105,8 +106,9 @@ class RemoteParticipant final : public Participant {
   Channel& channel_;
   std::vector<InterfaceMesh> meshes_;
   bool supports_restart_ = false;
-  // A window sent, its reply not yet read: where its outputs go.
-  std::span<WindowOutput> pending_;
+  // A window sent, its reply not yet read: where its outputs go (a copy: the caller's array
+  // may be reused for another participant meanwhile, as a parallel scheme does).
+  std::vector<WindowOutput> pending_;
   bool pending_window_ = false;
   std::string scratch_;
   mutable int stop_request_ = 0;
