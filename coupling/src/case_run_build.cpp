@@ -65,9 +65,10 @@ Participant* CaseRun::participant(const std::string& name) const {
 
 CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOptions options)
     : registries_(registries), options_(std::move(options)) {
-  const config::Node root =
-      config::Node::load_file(case_file, options_.overrides, options_.override_origins)
-          .validated(case_spec(registries));
+  const config::Node loaded =
+      config::Node::load_file(case_file, options_.overrides, options_.override_origins);
+  case_hash_ = coupling::case_hash(loaded);
+  const config::Node root = loaded.validated(case_spec(registries));
   name_ = root.string("case");
   check_plain_name(root["case"], name_, "the case name");
   case_dir_ = fs::absolute(case_file).parent_path();
@@ -82,12 +83,6 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     output_dir_ = options_.resume_dir;
   }
   identity_ = case_identity(root);
-  {
-    YAML::Emitter e;  // the whole case as parsed: comments, blank lines and quoting drop out
-    e << root.yaml();
-    case_hash_ = 1469598103934665603ull;
-    for (unsigned char c : std::string(e.c_str())) case_hash_ = (case_hash_ ^ c) * 1099511628211ull;
-  }
 
   const config::Node time = root["time"];
   window_size_ = time.real("window");
@@ -310,7 +305,16 @@ void CaseRun::build_participants(const config::Node& root) {
     check_plain_name(pn, name, "a participant name");
     if (!pn.is_map() || !pn.has("solver"))
       pn.fail("participant '" + name + "' needs 'solver: <name>'; known solvers: " +
-              join_names(registries_.solvers.names()));
+              join_names(registries_.solvers.names()) + ", or external");
+    if (pn.string("solver") == "external") {  // a program of its own (partita::mpi::ExternalParticipant)
+      if (runs_here(name))
+        pn["solver"].fail(
+            "participant '" + name + "' is an external program (solver: external), which joins a "
+            "run over MPI through partita::mpi::ExternalParticipant: run the other participants "
+            "with --participant and the program beside them, e.g. mpirun -n 1 partita run CASE "
+            "--participant OTHER : -n 1 ./program CASE");
+      continue;  // its keys are the program's own
+    }
     const auto& entry = registries_.solvers.get(pn["solver"]);
     config::Node validated = pn;
     if (entry.spec) {

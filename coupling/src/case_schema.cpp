@@ -160,7 +160,9 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
   root->section("time", "time windows", time).required();
   root->any("participants",
             "map of participant name -> {solver: <registered solver>, solver keys...}; solvers: " +
-                join_names(registries.solvers.names()))
+                join_names(registries.solvers.names()) +
+                "; or solver: external, a program with its own time loop that joins over MPI "
+                "(partita::mpi::ExternalParticipant)")
       .required();
   root->section("coupling",
                 "coupling scheme and exchanges (leave it out for a case of one participant: it "

@@ -132,6 +132,14 @@ std::vector<std::string> read_strings(BinaryReader& in) {
 
 }  // namespace
 
+std::uint64_t case_hash(const config::Node& loaded) {
+  YAML::Emitter e;
+  e << loaded.yaml();
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : std::string(e.c_str())) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The controller's side
 

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "partita/coupling/participant.hpp"
+#include "partita/interface/config.hpp"
 
 namespace partita::coupling {
 
@@ -52,6 +53,11 @@ class Channel {
   /// The longest wait for one message [s].
   virtual double deadline() const = 0;
 };
+
+/// The hash every process of a distributed run compares at start-up: FNV-1a of the case as loaded
+/// (with its --set overrides, before validation) and written back as YAML, so comments, blank
+/// lines and quoting do not count.
+std::uint64_t case_hash(const config::Node& loaded);
 
 /// What a server says about itself at start-up.
 struct Hello {

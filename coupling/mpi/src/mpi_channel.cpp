@@ -1,0 +1,108 @@
+#include "partita/mpi/mpi_channel.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <limits>
+#include <thread>
+
+#include <fmt/format.h>
+
+namespace partita::mpi {
+
+namespace {
+constexpr int kTag = 7341;
+constexpr int kName = 256;
+}  // namespace
+
+Membership join(MPI_Comm comm, const std::string& participant) {
+  Membership m;
+  MPI_Comm_rank(comm, &m.rank);
+  MPI_Comm_size(comm, &m.size);
+  std::vector<char> mine(kName, '\0'), all(static_cast<std::size_t>(kName) * m.size, '\0');
+  std::strncpy(mine.data(), participant.c_str(), kName - 1);
+  MPI_Allgather(mine.data(), kName, MPI_CHAR, all.data(), kName, MPI_CHAR, comm);
+  for (int r = 0; r < m.size; ++r)
+    m.participants.emplace_back(all.data() + static_cast<std::size_t>(r) * kName);
+  if (m.size < 2)
+    throw Error("participant '" + participant +
+                "': this process runs alone; start one process per participant with mpirun, "
+                "e.g. mpirun -n 1 partita run CASE --participant A : -n 1 partita run CASE "
+                "--participant B");
+  for (int r = 0; r < m.size; ++r)
+    for (int q = r + 1; q < m.size; ++q)
+      if (m.participants[r] == m.participants[q])
+        throw Error(fmt::format(
+            "participant '{}' is run by the processes of rank {} and {}: each participant runs "
+            "in one process (it uses threads: --threads)",
+            m.participants[r], r, q));
+  int color = 0;
+  while (m.participants[color] != participant) ++color;
+  MPI_Comm_split(comm, color, m.rank, &m.participant_comm);
+  return m;
+}
+
+MpiChannel::MpiChannel(MPI_Comm comm, int rank, std::string name, double deadline)
+    : comm_(comm), rank_(rank), name_(std::move(name)), deadline_(deadline) {}
+
+MpiChannel::~MpiChannel() { drain(2.0); }
+
+void MpiChannel::send(std::string bytes) {
+  if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw Error(fmt::format("a message of {} bytes to {} is above MPI's 2 GiB per message",
+                            bytes.size(), name_));
+  progress();
+  pending_.push_back({std::move(bytes), MPI_REQUEST_NULL});
+  Pending& p = pending_.back();
+  MPI_Isend(p.bytes.data(), static_cast<int>(p.bytes.size()), MPI_BYTE, rank_, kTag, comm_,
+            &p.request);
+}
+
+std::string MpiChannel::receive(std::string_view what) {
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  auto nap = std::chrono::microseconds(0);
+  MPI_Status status;
+  for (;;) {
+    int flag = 0;
+    MPI_Iprobe(rank_, kTag, comm_, &flag, &status);
+    if (flag) break;
+    progress();
+    const double waited = std::chrono::duration<double>(clock::now() - start).count();
+    if (waited > deadline_)
+      throw PeerTimeout(fmt::format(
+          "no message from {} for {:.0f} s while waiting for {} (--peer-timeout {:g}): that "
+          "process is stuck or gone",
+          name_, waited, what, deadline_));
+    if (waited < 1e-3) {
+      std::this_thread::yield();
+    } else {
+      nap = std::min(std::chrono::microseconds(1000), nap + std::chrono::microseconds(20));
+      std::this_thread::sleep_for(nap);
+    }
+  }
+  int count = 0;
+  MPI_Get_count(&status, MPI_BYTE, &count);
+  std::string bytes(static_cast<std::size_t>(count), '\0');
+  MPI_Recv(bytes.data(), count, MPI_BYTE, rank_, kTag, comm_, MPI_STATUS_IGNORE);
+  return bytes;
+}
+
+void MpiChannel::drain(double seconds) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!pending_.empty() && std::chrono::steady_clock::now() < until) {
+    progress();
+    if (!pending_.empty()) std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
+void MpiChannel::progress() {
+  while (!pending_.empty()) {
+    int done = 0;
+    MPI_Test(&pending_.front().request, &done, MPI_STATUS_IGNORE);
+    if (!done) return;
+    pending_.pop_front();
+  }
+}
+
+}  // namespace partita::mpi
