@@ -171,7 +171,7 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
   root->strings("plugins",
                 "solver plugins (shared libraries built against this partita) that the case "
                 "needs, loaded before it is read; paths relative to the case file; --plugin "
-                "libraries load first, a library named twice loads once (README: plugins)");
+                "libraries load first, a library named twice loads once (README: As a plugin)");
   root->section("sweep",
                 "a parametric sweep (partita run runs every variant; see partita docs case)",
                 Sweep::spec());
