@@ -233,7 +233,8 @@ TEST_CASE("plugins: each library partita refuses gives one clear error naming it
          {case_file.string() + ":1", "plugins", "expected a list of plugin libraries"});
   // without the plugin, the case's solver is unknown
   write(case_file, kOscillatorCase);
-  refuse("check " + quote(case_file.string()), {"unknown solver 'oscillator'"});
+  refuse("check " + quote(case_file.string()),
+         {"unknown solver 'oscillator'", "plugins: [LIB] in the case, or partita --plugin LIB"});
   fs::remove_all(dir);
 }
 
