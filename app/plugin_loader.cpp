@@ -2,8 +2,8 @@
 
 #include <dlfcn.h>
 
-#include <cstdlib>
 #include <cxxabi.h>
+#include <cstdlib>
 #include <memory>
 
 #include <CLI/CLI.hpp>
@@ -52,6 +52,23 @@ std::string explain_dlerror(std::string message) {
          "must link itself";
 }
 
+// Whether the library defines partita's own functions itself (it linked partita's static
+// libraries) rather than taking them from this executable: probed with the constructor of
+// partita::Error, which any code of partita's that throws pulls in, and partita::version().
+bool carries_partita(void* handle, void* entry_point) {
+  Dl_info plugin{};
+  if (!dladdr(entry_point, &plugin)) return false;
+  for (const char* name :
+       {"_ZN7partita5ErrorC1ERKNSt7__cxx1112basic_stringIcSt11char_traitsIcESaIcEEE",
+        "_ZN7partita5ErrorC2ERKNSt7__cxx1112basic_stringIcSt11char_traitsIcESaIcEEE",
+        "_ZN7partita7versionEv"}) {
+    Dl_info where{};
+    void* s = dlsym(handle, name);
+    if (s && dladdr(s, &where) && where.dli_fbase == plugin.dli_fbase) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 Plugins::Plugins(coupling::Registries& registries) : registries_(registries) {
@@ -64,8 +81,9 @@ void Plugins::load(const fs::path& library, const std::string& named_by) {
   const std::string who = "plugin " + library.string() + " (" + named_by + ")";
   std::error_code ec;
   if (!fs::exists(library, ec))
-    throw Error(who + ": no such file (a plugin is a shared library built against partita, "
-                      "e.g. build/libmy_solver.so; see partita docs case, key plugins)");
+    throw Error(who +
+                ": no such file (a plugin is a shared library built against partita, "
+                "e.g. build/libmy_solver.so; see partita docs case, key plugins)");
   if (!fs::is_regular_file(library, ec)) throw Error(who + ": not a file");
   const fs::path canonical = fs::canonical(library);
   for (const auto& l : loaded_)
@@ -92,18 +110,26 @@ void Plugins::load(const fs::path& library, const std::string& named_by) {
     }
     return s;
   };
-  const auto version_of = reinterpret_cast<coupling::PluginVersionFunction>(
-      symbol(PARTITA_PLUGIN_VERSION_SYMBOL));
-  const auto register_into = reinterpret_cast<coupling::PluginRegisterFunction>(
-      symbol(PARTITA_PLUGIN_REGISTER_SYMBOL));
+  const auto version_of =
+      reinterpret_cast<coupling::PluginVersionFunction>(symbol(PARTITA_PLUGIN_VERSION_SYMBOL));
+  const auto register_into =
+      reinterpret_cast<coupling::PluginRegisterFunction>(symbol(PARTITA_PLUGIN_REGISTER_SYMBOL));
   const char* text = version_of();
   const std::string built_against = text ? text : "(none)";  // before dlclose unmaps the text
   if (built_against != version()) {
     dlclose(handle);
-    throw Error(who + ": built against partita " + built_against +
-                ", but this is partita " + version() +
+    throw Error(who + ": built against partita " + built_against + ", but this is partita " +
+                version() +
                 ": rebuild the plugin against this partita (a plugin shares partita's C++ "
                 "classes, so only the version it was built against may load it)");
+  }
+
+  if (carries_partita(handle, reinterpret_cast<void*>(register_into))) {
+    dlclose(handle);
+    throw Error(who +
+                ": it carries its own copy of partita's libraries (it links "
+                "partita::interface or partita::coupling): link partita::plugin instead, "
+                "so that it uses the one partita of the executable that loads it");
   }
 
   // The plugin registers into registries of its own; they join partita's only when no name

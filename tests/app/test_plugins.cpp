@@ -31,7 +31,9 @@ fs::path broken(const std::string& variant) {
   return kPluginDir / ("libpartita_test_plugin_" + variant + ".so");
 }
 
-fs::path scratch(const std::string& name) { return partita::test::scratch_dir("plugins", name); }
+fs::path scratch(const std::string& name) {
+  return partita::test::scratch_dir("plugins", name);
+}
 
 partita::test::CommandResult partita_cmd(const std::string& args) {
   return partita::test::run_partita(args);
@@ -50,9 +52,13 @@ std::vector<double> last_row(const fs::path& csv) {
 }
 
 // m = 2 kg, z_0 = 10 mm at rest: z(t) = z_0 cos(sqrt(k/m) t).
-double exact_z(double k, double t) { return 0.01 * std::cos(std::sqrt(k / 2.0) * t); }
+double exact_z(double k, double t) {
+  return 0.01 * std::cos(std::sqrt(k / 2.0) * t);
+}
 
-void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
 
 const char* kOscillatorCase = R"(case: osc
 time: {window: 0.01, end: 1.0}
@@ -87,8 +93,8 @@ TEST_CASE("plugins: the stock partita lists, documents and runs a solver from --
 
   // the run: z(1 s) = z_0 cos(5), energy 1/2 k z_0^2 = 2.5 mJ, to round-off
   const fs::path dir = scratch("cli");
-  r = partita_cmd("run " + quote((kExample / "oscillator.yaml").string()) + plugin +
-                  " --output " + quote(dir.string()));
+  r = partita_cmd("run " + quote((kExample / "oscillator.yaml").string()) + plugin + " --output " +
+                  quote(dir.string()));
   INFO(r.output);
   REQUIRE(r.status == 0);
   auto row = last_row(dir / "motion.csv");
@@ -161,9 +167,9 @@ TEST_CASE("plugins: a sweep's variants run with the --plugin libraries", "[app][
   results:
     - {name: z_end, monitor: motion, column: spring.z}
 )");
-  const auto r = partita_cmd("run " + quote(case_file.string()) + " --plugin " +
-                             quote(kOscillator.string()) + " --jobs 2 --output " +
-                             quote((dir / "out").string()));
+  const auto r =
+      partita_cmd("run " + quote(case_file.string()) + " --plugin " + quote(kOscillator.string()) +
+                  " --jobs 2 --output " + quote((dir / "out").string()));
   INFO(r.output);
   REQUIRE(r.status == 0);
   std::ifstream in(dir / "out" / "sweep.csv");
@@ -214,14 +220,16 @@ TEST_CASE("plugins: each library partita refuses gives one clear error naming it
           "mapper 'nearest-neighbor' is already registered by partita itself"});
   refuse("list --plugin " + quote(broken("throws").string()),
          {broken("throws").string(), "its licence file is missing"});
+  refuse("list --plugin " + quote(broken("own_copy").string()),
+         {broken("own_copy").string(), "carries its own copy of partita",
+          "link partita::plugin instead"});
 
   // two libraries with the same solver name: the second is refused, naming the first
   const fs::path second = dir / "libsecond.so";
   fs::copy_file(kOscillator, second);
   refuse("list --plugin " + quote(kOscillator.string()) + " --plugin " + quote(second.string()),
-         {"plugin " + second.string(),
-          "solver 'oscillator' is already registered by plugin " +
-              fs::canonical(kOscillator).string()});
+         {"plugin " + second.string(), "solver 'oscillator' is already registered by plugin " +
+                                           fs::canonical(kOscillator).string()});
 
   // the case's list: a missing library names the case file's line; not a list is refused
   const fs::path case_file = dir / "osc.yaml";
