@@ -241,12 +241,13 @@ int main(int argc, char** argv) {
 #else
     options.threads = threads > 0 ? threads : 1;
 #endif
-    if (app.got_subcommand("check"))
+    if (app.got_subcommand("check")) {
       if (const auto mesh = partita::adapters::describe_mesh_file(case_file)) {
         std::cout << "partita check: " << *mesh << "\n";
         return 0;
       }
-    plugins.load_case(case_file, overrides);
+    }
+    plugins.load_case(case_file, overrides);  // a case file from here on
     if (app.got_subcommand("check")) {
       options.check_only = true;
       partita::coupling::CaseRun c(case_file, registries, options);
