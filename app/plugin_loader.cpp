@@ -154,7 +154,9 @@ void Plugins::load(const fs::path& library, const std::string& named_by) {
   });
   for_each_pair(added, registries_, [&](const auto& from, auto& into) {
     for (const auto& e : from.entries()) {
-      into.add(e.name, e.doc, e.factory, e.spec, e.quantities);
+      // the one-line doc says where the entry comes from (partita list, partita docs NAME)
+      into.add(e.name, e.doc + " [plugin " + canonical.filename().string() + "]", e.factory, e.spec,
+               e.quantities);
       origin_[key(from, e.name)] = "plugin " + canonical.string();
       names.push_back(key(from, e.name));
     }

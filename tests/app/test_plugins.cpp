@@ -81,7 +81,8 @@ TEST_CASE("plugins: the stock partita lists, documents and runs a solver from --
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK(r.output.find("oscillator") != std::string::npos);
-  CHECK(r.output.find("a mass on a spring along z") != std::string::npos);
+  CHECK(r.output.find("a mass on a spring along z [plugin libpartita_test_plugin_oscillator.so]") !=
+        std::string::npos);
   CHECK(r.output.find("tube1d-fluid") != std::string::npos);  // the built-in ones stay
   r = partita_cmd("docs oscillator" + plugin);
   INFO(r.output);
