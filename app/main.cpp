@@ -4,6 +4,7 @@
 //   partita check CASE.yaml
 //   partita list
 //   partita docs [NAME]
+// Every subcommand takes --plugin LIB (repeatable): a solver plugin (app/plugin_loader.hpp).
 // Exit status 0 on success; 1 with one clear message on any user error; 2 on usage errors;
 // 128 + N when signal N (SIGINT 130, SIGTERM 143) stopped a run (after a restart file).
 
@@ -38,6 +39,7 @@
 #include "partita/interface/log.hpp"
 #include "partita/interface/version.hpp"
 #include "distributed.hpp"
+#include "plugin_loader.hpp"
 #include "process.hpp"
 #include "sweep_runner.hpp"
 
@@ -217,11 +219,14 @@ int main(int argc, char** argv) {
                    "Change a value of the case before checking it: KEY.PATH=VALUE (list elements "
                    "as key[i])")
       ->take_all();
-  app.add_subcommand(
+  auto* lst = app.add_subcommand(
       "list", "List every registered solver, mapper, scheme, acceleration and convergence measure");
   auto* doc =
       app.add_subcommand("docs", "The parameter reference, generated from the declarations");
   doc->add_option("name", doc_name, "A registered name (see partita list), or 'case' (default)");
+  std::vector<std::string> plugin_files;
+  for (CLI::App* command : {&app, run, check, lst, doc})
+    partita::app::add_plugin_option(*command, plugin_files);
 
   try {
     app.parse(argc, argv);
@@ -231,7 +236,9 @@ int main(int argc, char** argv) {
 
   try {
     partita::log::set_level(partita::log::parse_level(log_level));
-    const Registries registries = make_registries();
+    Registries registries = make_registries();
+    partita::app::Plugins plugins(registries);
+    plugins.load_command_line(plugin_files);
     if (app.got_subcommand("list")) return list(registries);
     if (app.got_subcommand("docs")) return docs(registries, doc_name);
 
@@ -251,6 +258,9 @@ int main(int argc, char** argv) {
         std::cout << "partita check: " << *mesh << "\n";
         return 0;
       }
+    }
+    plugins.load_case(case_file, overrides);  // a case file from here on
+    if (app.got_subcommand("check")) {
       options.check_only = true;
       partita::coupling::CaseRun c(case_file, registries, options);
       std::cout << "partita check: " << case_file << " is valid\n";
@@ -286,6 +296,7 @@ int main(int argc, char** argv) {
       so.threads = options.threads;
       so.log_level = log_level;
       so.stop_signal = &g_stop_signal;
+      so.plugins = plugins.command_line();
       return partita::app::run_sweep(registries, so);
     }
     partita::coupling::CaseRun c(case_file, registries, options);
@@ -295,9 +306,11 @@ int main(int argc, char** argv) {
     if (const int signal = c.summary().stopped_by_signal; signal != 0) {
       std::cout << "partita run: stopped by signal " << signal << " after window "
                 << c.summary().windows << "; output in " << c.output_dir().string() << "/";
-      if (!c.summary().last_restart.empty())
+      if (!c.summary().last_restart.empty()) {
         std::cout << "; continue with: partita run " << case_file << " --resume "
                   << c.output_dir().string();
+        for (const auto& p : plugins.command_line()) std::cout << " --plugin " << p;
+      }
       std::cout << "\n";
       return 128 + signal;
     }

@@ -88,6 +88,10 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
       args.push_back("--set");
       args.push_back(o);
     }
+    for (const auto& p : options.plugins) {
+      args.push_back("--plugin");
+      args.push_back(p);
+    }
     std::error_code ec;
     fs::remove(vdir / "log.txt", ec);
     const pid_t pid = spawn(args, vdir / "log.txt");

@@ -19,6 +19,7 @@ struct SweepOptions {
   int jobs = 1;
   int threads = 1;  ///< threads of the whole sweep (shared by the jobs)
   std::string log_level = "info";
+  std::vector<std::string> plugins;  ///< the --plugin libraries (every variant gets them)
   const std::atomic<int>* stop_signal = nullptr;
 };
 

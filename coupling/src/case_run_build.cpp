@@ -315,6 +315,10 @@ void CaseRun::build_participants(const config::Node& root) {
             "--participant OTHER : -n 1 ./program CASE");
       continue;  // its keys are the program's own
     }
+    if (const std::string solver = pn["solver"].as_string(); !registries_.solvers.contains(solver))
+      pn["solver"].fail(registries_.solvers.unknown_message(solver) +
+                        " (a solver from a plugin needs its library: plugins: [LIB] in the case, "
+                        "or partita --plugin LIB)");
     const auto& entry = registries_.solvers.get(pn["solver"]);
     config::Node validated = pn;
     if (entry.spec) {

@@ -170,13 +170,32 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
                 coupling);
   root->list("monitors", "scalar time series", monitor);
   root->section("output", "VTK output", output);
+  root->strings("plugins",
+                "solver plugins (shared libraries built against this partita) that the case "
+                "needs, loaded before it is read; paths relative to the case file; --plugin "
+                "libraries load first, a library named twice loads once (README: As a plugin)");
   root->section("sweep",
                 "a parametric sweep (partita run runs every variant; see partita docs case)",
                 Sweep::spec());
   return root;
 }
 
-// ---------------------------------------------------------------------------------------------
-// Building
+std::vector<CasePlugin> case_plugins(const std::filesystem::path& case_file,
+                                     const std::vector<std::string>& overrides) {
+  const config::Node root = config::Node::load_file(case_file, overrides);
+  std::vector<CasePlugin> plugins;
+  if (!root.is_map() || !root.has("plugins")) return plugins;
+  const config::Node list = root["plugins"];
+  if (!list.is_sequence())
+    list.fail("expected a list of plugin libraries, e.g. [build/libmy_solver.so], found " +
+              list.describe());
+  const auto dir = std::filesystem::absolute(case_file).parent_path();
+  for (const config::Node& item : list.items()) {
+    if (!item.is_scalar() || item.as_string().empty())
+      item.fail("expected the path of a plugin library, found " + item.describe());
+    plugins.push_back({dir / item.as_string(), item});
+  }
+  return plugins;
+}
 
 }  // namespace partita::coupling

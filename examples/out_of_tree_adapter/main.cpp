@@ -10,8 +10,7 @@ int main(int argc, char** argv) try {
   partita::coupling::Registries registries;
   partita::coupling::register_builtin(registries);  // mappers, schemes, accelerations, ...
   partita::adapters::register_all(registries);      // the built-in solvers: dem, fem, tube1d
-  registries.solvers.add("oscillator", "a mass on a spring along z", OscillatorAdapter::create,
-                         OscillatorAdapter::spec(), OscillatorAdapter::quantities());
+  OscillatorAdapter::register_in(registries.solvers);
   const std::string command = argc > 1 ? argv[1] : "";
   if (command == "conformance") {
     const auto failures = partita::check_solver_contract(

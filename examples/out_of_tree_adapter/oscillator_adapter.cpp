@@ -31,6 +31,10 @@ std::vector<QuantityDoc> OscillatorAdapter::quantities() {
           {"energy", "J", "kinetic plus spring energy"}};
 }
 
+void OscillatorAdapter::register_in(Registry<SolverFactory>& solvers) {
+  solvers.add("oscillator", "a mass on a spring along z", create, spec(), quantities());
+}
+
 std::unique_ptr<Solver> OscillatorAdapter::create(const SolverContext& context) {
   const config::Node& c = context.config;
   return std::make_unique<OscillatorAdapter>(

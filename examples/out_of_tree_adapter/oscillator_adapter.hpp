@@ -17,6 +17,9 @@ class OscillatorAdapter final : public partita::Solver {
   static std::unique_ptr<partita::Solver> create(const partita::SolverContext& context);
   static std::shared_ptr<const partita::config::Spec> spec();
   static std::vector<partita::QuantityDoc> quantities();
+  /// Add "oscillator" to a solver registry (the one line both ways of using it share: main.cpp,
+  /// a partita with the solver built in; oscillator_plugin.cpp, the plugin for the stock partita).
+  static void register_in(partita::Registry<partita::SolverFactory>& solvers);
 
   const std::vector<partita::InterfaceMesh>& meshes() const override { return meshes_; }
   void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) override;

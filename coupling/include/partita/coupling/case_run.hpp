@@ -253,4 +253,17 @@ class CaseRun {
 /// The case file's schema (for validation and `partita docs`).
 std::shared_ptr<const config::Spec> case_spec(const Registries& registries);
 
+/// One library of the case's `plugins:` list: its path (relative ones taken from the case file's
+/// folder) and the node that names it (for messages).
+struct CasePlugin {
+  std::filesystem::path library;
+  config::Node where;
+};
+
+/// The case's `plugins:` list (with the --set overrides applied). Read before the case is
+/// validated, since the plugins add the solvers its participants name; the loading itself is
+/// the executable's (app/plugin_loader.cpp).
+std::vector<CasePlugin> case_plugins(const std::filesystem::path& case_file,
+                                     const std::vector<std::string>& overrides);
+
 }  // namespace partita::coupling

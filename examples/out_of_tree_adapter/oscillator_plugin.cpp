@@ -1,0 +1,13 @@
+// The oscillator as a plugin for the stock partita executable:
+//   partita run oscillator_plugin.yaml                    (the case lists the library: plugins:)
+//   partita run oscillator.yaml --plugin build/liboscillator_plugin.so
+//   partita list --plugin build/liboscillator_plugin.so    (and check, docs, --set, sweeps,
+//   --resume)
+// PARTITA_PLUGIN defines the library's entry point and records the partita version it is built
+// against (partita/coupling/plugin.hpp); the body adds the solver to the registries given.
+#include "oscillator_adapter.hpp"
+#include "partita/coupling/plugin.hpp"
+
+PARTITA_PLUGIN(registries) {
+  OscillatorAdapter::register_in(registries.solvers);
+}
