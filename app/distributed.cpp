@@ -104,7 +104,8 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
                                  : "internal error: " + std::string(e.what());
     if (rank == 0) {
       for (auto& ch : channels) coupling::abort_server(*ch, who + " stopped the run: " + what);
-    } else if (!built && !stuck) {
+    } else if (!built && !stuck &&
+               dynamic_cast<const coupling::StoppedByController*>(&e) == nullptr) {
       // the controller waits for this process's hello or final meshes: tell it, and wait for its
       // answer so that it can name this failure before every process ends
       coupling::ParticipantServer(*channels.front()).fail_setup(what);

@@ -431,7 +431,7 @@ std::vector<std::pair<std::string, Mesh>> ParticipantServer::hello(const Hello& 
   }
   Received r(controller_.receive("the meshes of the handshake"), controller_.peer());
   const auto c = static_cast<Command>(r.in.get<std::uint32_t>());
-  if (c == Command::abort) throw Error("stopping: " + r.in.get_string());
+  if (c == Command::abort) throw StoppedByController("stopping: " + r.in.get_string());
   if (c != Command::meshes) throw Error("the controller sent a damaged handshake");
   std::vector<std::pair<std::string, Mesh>> got;
   const auto n = r.in.get<std::uint64_t>();
@@ -464,7 +464,7 @@ int ParticipantServer::serve(LocalParticipant& p) {
     Received r(controller_.receive("its next request"), controller_.peer());
     const auto command = static_cast<Command>(r.in.get<std::uint32_t>());
     if (command == Command::abort)
-      throw Error("stopping: " + r.in.get_string());
+      throw StoppedByController("stopping: " + r.in.get_string());
     Message reply;
     reply.out.write(std::uint32_t{0});
     bool done = false;

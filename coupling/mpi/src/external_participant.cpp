@@ -210,30 +210,51 @@ void ExternalParticipant::initialize() {
           "MPI was initialised below MPI_THREAD_SERIALIZED; the API sends from a thread of its "
           "own: initialise MPI with MPI_Init_thread(..., MPI_THREAD_SERIALIZED, ...)");
   }
-  // The case as every process reads it: its hash, and this participant's substeps.
-  const config::Node loaded = config::Node::load_file(b.case_file_, b.options_.overrides);
-  b.case_hash_ = coupling::case_hash(loaded);
+  // Every process of the run joins first (a collective): a failure after it is told to the
+  // others, so that none waits for this process.
   const Membership m = join(b.options_.comm, b.participant_);
-  if (m.rank == 0)
-    throw UsageError("participant '" + b.participant_ +
-                     "' is an external program and the first process of the run; start partita "
-                     "first, it runs the coupling core: mpirun -n 1 partita run CASE "
-                     "--participant OTHER : -n 1 ./program CASE");
-  if (!loaded.has("participants") || !loaded["participants"].has(b.participant_))
-    throw UsageError("the case " + b.case_file_.string() + " has no participant '" +
-                     b.participant_ + "'");
-  if (loaded.has("coupling") && loaded["coupling"].has("substeps") &&
-      loaded["coupling"]["substeps"].has(b.participant_)) {
-    const config::Node s = loaded["coupling"]["substeps"][b.participant_];
-    if (s.as_string() == "auto")
-      b.substeps_.automatic = true;
-    else
-      b.substeps_.count = static_cast<int>(s.as_integer());
+  if (m.rank != 0)
+    b.channel_ = std::make_unique<MpiChannel>(
+        b.options_.comm, 0,
+        fmt::format("the controller, participant '{}' (rank 0)", m.participants[0]),
+        b.options_.peer_timeout);
+  try {
+    if (m.rank == 0)
+      throw UsageError("participant '" + b.participant_ +
+                       "' is an external program and the first process of the run; start "
+                       "partita first, it runs the coupling core: mpirun -n 1 partita run CASE "
+                       "--participant OTHER : -n 1 ./program CASE");
+    // The case as every process reads it: its hash, and this participant's substeps.
+    const config::Node loaded = config::Node::load_file(b.case_file_, b.options_.overrides);
+    b.case_hash_ = coupling::case_hash(loaded);
+    if (!loaded.has("participants") || !loaded["participants"].has(b.participant_))
+      throw UsageError("the case " + b.case_file_.string() + " has no participant '" +
+                       b.participant_ + "'");
+    if (loaded.has("coupling") && loaded["coupling"].has("substeps") &&
+        loaded["coupling"]["substeps"].has(b.participant_)) {
+      const config::Node s = loaded["coupling"]["substeps"][b.participant_];
+      if (s.as_string() == "auto")
+        b.substeps_.automatic = true;
+      else
+        b.substeps_.count = static_cast<int>(s.as_integer());
+    }
+  } catch (const std::exception& e) {
+    const std::string why = "participant '" + b.participant_ + "' (rank " +
+                            std::to_string(m.rank) + ", an external program): " + e.what();
+    if (m.rank == 0) {
+      for (int r = 1; r < m.size; ++r) {
+        MpiChannel other(b.options_.comm, r, "rank " + std::to_string(r), b.options_.peer_timeout);
+        coupling::abort_server(other, why);
+      }
+    } else {
+      coupling::ParticipantServer(*b.channel_).fail_setup(e.what());
+      try {
+        b.channel_->receive("the controller's answer to this failure");
+      } catch (...) {
+      }
+    }
+    throw;
   }
-  b.channel_ = std::make_unique<MpiChannel>(
-      b.options_.comm, 0, fmt::format("the controller, participant '{}' (rank 0)",
-                                      m.participants[0]),
-      b.options_.peer_timeout);
   b.thread_ = std::thread([&b] { serve(b); });
   b.wait_for_step();
 }

@@ -59,6 +59,11 @@ class Channel {
 /// lines and quoting do not count.
 std::uint64_t case_hash(const config::Node& loaded);
 
+/// Thrown on a server when the controller stopped the run (its reason in the message).
+struct StoppedByController : Error {
+  using Error::Error;
+};
+
 /// What a server says about itself at start-up.
 struct Hello {
   std::string version;

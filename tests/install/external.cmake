@@ -1,0 +1,43 @@
+# ctest script: the external-program example (examples/external_tube) built against an installed
+# partita, as its README tells a user to, then run beside the stock installed partita under
+# mpirun: the tube's wall in the program, the fluid in partita. Its coupling.csv and tube.csv
+# must be byte for byte those of cases/elastic_tube_1d/iqn-ils.yaml run in one process (the
+# same iteration counts: 854 over 100 windows), which the in-tree tube1d-solid computes.
+# Arguments: -DBUILD_DIR= -DSOURCE_DIR= -DWORK_DIR= -DGENERATOR= -DCASE= -DMPIRUN=
+include(${CMAKE_CURRENT_LIST_DIR}/install_and_build.cmake)
+set(partita ${WORK_DIR}/prefix/bin/partita)
+set(ENV{OMPI_ALLOW_RUN_AS_ROOT} 1)
+set(ENV{OMPI_ALLOW_RUN_AS_ROOT_CONFIRM} 1)
+set(ENV{PARTITA_LOG_LEVEL} warn)
+execute_process(COMMAND ${partita} run ${CASE} -o ${WORK_DIR}/one --threads 1
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(rc)
+  message(FATAL_ERROR "the tube case in one process failed: ${rc} ${out} ${err}")
+endif()
+execute_process(COMMAND ${MPIRUN} --oversubscribe
+                        -n 1 ${partita} run ${SOURCE_DIR}/tube_external.yaml -o ${WORK_DIR}/two
+                             --threads 1 --participant fluid :
+                        -n 1 ${WORK_DIR}/build/tube_solid ${SOURCE_DIR}/tube_external.yaml
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 240)
+message(STATUS "${out}")
+if(rc OR NOT out MATCHES "tube_solid: finished")
+  message(FATAL_ERROR "partita with the external program failed: ${rc} ${out} ${err}")
+endif()
+foreach(csv coupling.csv tube.csv)
+  file(READ ${WORK_DIR}/one/${csv} a)
+  file(READ ${WORK_DIR}/two/${csv} b)
+  if(NOT a STREQUAL b)
+    message(FATAL_ERROR "${csv} differs between the in-process tube and the external program")
+  endif()
+endforeach()
+string(REGEX MATCHALL "\n[0-9]+,[^,]+,([0-9]+)" rows "${a}")
+message(STATUS "coupling.csv and tube.csv are byte for byte those of the run in one process")
+# the program as the first process: refused (partita runs the coupling core)
+execute_process(COMMAND ${MPIRUN} --oversubscribe
+                        -n 1 ${WORK_DIR}/build/tube_solid ${SOURCE_DIR}/tube_external.yaml :
+                        -n 1 ${partita} run ${SOURCE_DIR}/tube_external.yaml -o ${WORK_DIR}/three
+                             --threads 1 --participant fluid
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 60)
+if(NOT rc OR NOT "${out}${err}" MATCHES "start partita first")
+  message(FATAL_ERROR "the program as the first process was not refused: ${rc} ${out} ${err}")
+endif()
