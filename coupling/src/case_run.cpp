@@ -350,6 +350,9 @@ void CaseRun::run() {
   accounted += summary_.mapping_seconds;
   summary_.core_seconds = std::max(0.0, summary_.wall_seconds - accounted);
 
+  for (const auto& p : participants_)
+    if (const std::string t = p->transport_summary(); !t.empty())
+      logger->info("participant '{}' in another process: {}", p->name(), t);
   std::string parts;
   for (const auto& [n, s] : summary_.participant_seconds)
     parts += fmt::format("{} {:.3f} s, ", n, s);

@@ -3,6 +3,7 @@
 // in remote_participant.hpp; each is written and read by one function pair here.
 #include "partita/coupling/remote_participant.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <sstream>
 
@@ -150,7 +151,10 @@ RemoteParticipant::RemoteParticipant(std::string name, Channel& channel, Ready r
       supports_restart_(ready.supports_restart) {}
 
 std::string RemoteParticipant::read_reply(std::string_view what) const {
+  Stopwatch wait;
   std::string bytes = channel_.receive(what);
+  wait_seconds_ += wait.seconds();
+  ++messages_;
   Received r(std::move(bytes), channel_.peer());
   const auto status = r.in.get<std::uint32_t>();
   if (status != 0) {
@@ -173,7 +177,9 @@ std::string RemoteParticipant::read_reply(std::string_view what) const {
 }
 
 std::string RemoteParticipant::call(const std::string& request, std::string_view what) const {
+  Stopwatch send;
   channel_.send(request);
+  wait_seconds_ += send.seconds();
   std::string reply = read_reply(what);
   const_cast<RemoteParticipant*>(this)->add_seconds(extra_seconds_);
   extra_seconds_ = 0.0;
@@ -218,7 +224,15 @@ void RemoteParticipant::run_window(const TimeWindow& window, std::span<const Win
     m.out.write(static_cast<std::int32_t>(o.components));
     m.out.write(*o.label);
   }
+  // What the run asks after a window, answered with the window's reply (one message each way
+  // per window): the monitors, the state check and the interface work it asked for before.
+  write_strings(m.out, cache_.monitor_names);
+  m.out.write(static_cast<std::uint8_t>(cache_.want_state));
+  write_strings(m.out, cache_.work_meshes);
+  cache_.valid = false;
+  Stopwatch send;
   channel_.send(m.str());
+  wait_seconds_ += send.seconds();
   pending_.assign(outputs.begin(), outputs.end());  // (no allocation after the first window)
   pending_window_ = true;
 }
@@ -230,6 +244,23 @@ void RemoteParticipant::finish_window() {
   add_seconds(extra_seconds_);
   extra_seconds_ = 0.0;
   for (WindowOutput& o : pending_) r.in.read(*o.combined);
+  cache_.monitors = read_monitors(r.in);
+  if (cache_.want_state) cache_.state = r.in.get_string();
+  cache_.work.clear();
+  for (std::size_t i = 0; i < cache_.work_meshes.size(); ++i) {
+    if (r.in.get<std::uint8_t>() != 0)
+      cache_.work.emplace_back(r.in.get<double>());
+    else
+      cache_.work.emplace_back(std::nullopt);
+  }
+  cache_.valid = true;
+}
+
+std::string RemoteParticipant::transport_summary() const {
+  // the remote solver's own time is in seconds(); the rest of the waits is the messages' way
+  // there and back (and the remote side's decoding and encoding)
+  return fmt::format("{} replies from {}, {:.3f} s waiting for them (its solver {:.3f} s of it)",
+                     messages_, channel_.peer(), wait_seconds_, seconds());
 }
 
 int RemoteParticipant::substeps(double window_size) const {
@@ -250,6 +281,7 @@ void RemoteParticipant::save_checkpoint() {
 }
 
 void RemoteParticipant::restore_checkpoint() {
+  cache_.valid = false;
   call(Message(Command::restore_checkpoint).str(), "the restoring of its checkpoint");
 }
 
@@ -260,6 +292,8 @@ std::vector<MonitorValue> RemoteParticipant::monitors() const {
 
 std::vector<MonitorValue> RemoteParticipant::monitor_values(
     const std::vector<std::string>& names) const {
+  if (cache_.valid && names == cache_.monitor_names) return cache_.monitors;
+  cache_.monitor_names = names;  // asked with every window from now on
   Message m(Command::monitor_values);
   write_strings(m.out, names);
   Received r(call(m.str(), "its monitor values"), channel_.peer());
@@ -267,11 +301,20 @@ std::vector<MonitorValue> RemoteParticipant::monitor_values(
 }
 
 std::string RemoteParticipant::check_state() const {
+  if (cache_.valid && cache_.want_state) return cache_.state;
+  cache_.want_state = true;
   Received r(call(Message(Command::check_state).str(), "its state check"), channel_.peer());
   return r.in.get_string();
 }
 
 std::optional<double> RemoteParticipant::interface_work(std::string_view mesh) const {
+  const auto at = std::find(cache_.work_meshes.begin(), cache_.work_meshes.end(), mesh);
+  if (cache_.valid && at != cache_.work_meshes.end())
+    return cache_.work[static_cast<std::size_t>(at - cache_.work_meshes.begin())];
+  if (at == cache_.work_meshes.end()) {
+    cache_.work_meshes.emplace_back(mesh);
+    cache_.valid = false;  // the cached answers no longer line up with the meshes
+  }
   Message m(Command::interface_work);
   m.out.write(std::string(mesh));
   Received r(call(m.str(), "its interface work"), channel_.peer());
@@ -318,6 +361,7 @@ void RemoteParticipant::read_restart(BinaryReader& in) {
   const std::string part = in.raw_until([](const std::string& section) {
     return section.rfind("participant ", 0) == 0 || section == "end";
   });
+  cache_.valid = false;
   Message m(Command::read_restart);
   m.out.write(in.source());
   m.out.write(part);
@@ -534,8 +578,19 @@ int ParticipantServer::serve(LocalParticipant& p) {
             outputs[i].label = &onames[3 * i + 2];
             outputs[i].combined = &combined[i];
           }
+          const auto monitor_names = read_strings(r.in);
+          const bool want_state = r.in.get<std::uint8_t>() != 0;
+          const auto work_meshes = read_strings(r.in);
           p.run_window(TimeWindow(size, index, 1), inputs, outputs);
           for (const auto& c : combined) reply.out.write(c);
+          write_monitors(reply.out, monitor_names.empty() ? std::vector<MonitorValue>{}
+                                                          : p.monitor_values(monitor_names));
+          if (want_state) reply.out.write(p.check_state());
+          for (const auto& mesh : work_meshes) {
+            const auto w = p.interface_work(mesh);
+            reply.out.write(static_cast<std::uint8_t>(w.has_value()));
+            if (w) reply.out.write(*w);
+          }
           break;
         }
         case Command::save_checkpoint:

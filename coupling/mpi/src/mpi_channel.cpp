@@ -74,7 +74,7 @@ std::string MpiChannel::receive(std::string_view what) {
           "no message from {} for {:.0f} s while waiting for {} (--peer-timeout {:g}): that "
           "process is stuck or gone",
           name_, waited, what, deadline_));
-    if (waited < 1e-3) {
+    if (waited < 1e-2) {  // the first 10 ms: yield only (a window of the other side is often shorter)
       std::this_thread::yield();
     } else {
       nap = std::min(std::chrono::microseconds(1000), nap + std::chrono::microseconds(20));

@@ -100,6 +100,8 @@ class Participant {
   /// True for a participant that works in another process (a parallel scheme starts those
   /// first, then works on the ones in this process).
   virtual bool remote() const { return false; }
+  /// What talking to it cost, for the run's summary ("": nothing to say, in process).
+  virtual std::string transport_summary() const { return {}; }
   /// Substeps for a window of `window_size` (throws where a fixed count has become too coarse).
   virtual int substeps(double window_size) const = 0;
   virtual double stable_time_step() const = 0;

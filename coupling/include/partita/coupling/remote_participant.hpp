@@ -109,6 +109,7 @@ class RemoteParticipant final : public Participant {
   int stop_request() const override { return stop_request_; }
   void note_stop(int signal) override { stop_request_ = signal; }
   bool remote() const override { return true; }
+  std::string transport_summary() const override;
 
  private:
   // One request, its reply (throws the server's error, naming the participant).
@@ -123,6 +124,20 @@ class RemoteParticipant final : public Participant {
   bool pending_window_ = false;
   std::string scratch_;
   mutable int stop_request_ = 0;
+  // The answers to the run's questions after a window, sent with the window's reply (valid until
+  // the remote state changes: the next window, a restored checkpoint, a restart read).
+  struct Cache {
+    std::vector<std::string> monitor_names;
+    bool want_state = false;
+    std::vector<std::string> work_meshes;
+    bool valid = false;
+    std::vector<MonitorValue> monitors;
+    std::string state;
+    std::vector<std::optional<double>> work;
+  };
+  mutable Cache cache_;
+  mutable double wait_seconds_ = 0.0;  // in the channel: sending, and waiting for replies
+  mutable long messages_ = 0;
   mutable double extra_seconds_ = 0.0;
 };
 

@@ -40,7 +40,7 @@ struct Membership {
 Membership join(MPI_Comm comm, const std::string& participant);
 
 /// One peer: non-blocking sends (each message's buffer lives until its send completes), receives
-/// that poll with a deadline (MPI_Iprobe; spinning at first, then sleeping in growing steps of up
+/// that poll with a deadline (MPI_Iprobe; yielding for the first 10 ms, then sleeping in growing steps of up
 /// to 1 ms, so a waiting process leaves its core to a working one).
 class MpiChannel final : public coupling::Channel {
  public:
