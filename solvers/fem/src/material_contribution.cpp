@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -164,12 +165,17 @@ void MaterialContribution::add(const Eigen::VectorXd& u, Eigen::VectorXd& f_int,
     chunk_fabs_.resize(std::min(ne, kChunk));
   }
   node_round_off_.setZero(static_cast<Eigen::Index>(mesh_.num_nodes()));
+  using Clock = std::chrono::steady_clock;
+  phase_seconds_ = {};
   for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
     const long n = static_cast<long>(std::min(ne - c0, kChunk));
     // A material law may throw (a radial return that does not converge: the Newton solver cuts
     // the step back): the first element's exception comes out, as from a serial loop.
+    const auto t0 = Clock::now();
     detail::parallel_for_first_error(
         n, 32, [&](long i) { evaluate_chunk_element(c0, i, u, k != nullptr); });
+    const auto t1 = Clock::now();
+    phase_seconds_.elements += std::chrono::duration<double>(t1 - t0).count();
     for (long i = 0; i < n; ++i) {
       const Element& el = elements[c0 + static_cast<std::size_t>(i)];
       const int nn = node_count(el.type);
@@ -183,6 +189,7 @@ void MaterialContribution::add(const Eigen::VectorXd& u, Eigen::VectorXd& f_int,
       const ElementVector& fa = chunk_fabs_[static_cast<std::size_t>(i)];
       for (int a = 0; a < nn; ++a) node_round_off_[static_cast<Eigen::Index>(el.nodes[a])] += fa[a];
     }
+    phase_seconds_.assembly += std::chrono::duration<double>(Clock::now() - t1).count();
   }
   // r_eps = |a|, a_(n i) = sum_e sum_q |grad N_n| dP_q w_q for each of the 3 components of node n
   round_off_ = std::sqrt(3.0) * node_round_off_.norm();

@@ -80,6 +80,13 @@ class MaterialContribution final : public OperatorContribution {
   const Eigen::VectorXd& equivalent_plastic_strain() const { return eqps_; }
   // Elements' first quadrature point index (num_elements + 1 entries).
   const std::vector<std::size_t>& element_qp_offsets() const { return qp_offset_; }
+  // Wall seconds of the last add(): the element loop (kinematics and the laws, on the OpenMP
+  // threads) and the assembly of the element vectors into f (and K). For bench/fem.
+  struct PhaseSeconds {
+    double elements = 0.0;
+    double assembly = 0.0;
+  };
+  const PhaseSeconds& last_add_seconds() const { return phase_seconds_; }
 
  private:
   using ElementDisplacements = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
@@ -123,6 +130,7 @@ class MaterialContribution final : public OperatorContribution {
   double round_off_ = 0.0;
   MatrixX6 cauchy_;
   Eigen::VectorXd eqps_;
+  PhaseSeconds phase_seconds_;
 };
 
 }  // namespace partita::fem
