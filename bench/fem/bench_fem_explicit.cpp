@@ -25,12 +25,12 @@
 // the assembly (the element forces into the global force), the contact (0: no indenter in the
 // model) and the rest (integrator update, commit of the histories). The shares come from the
 // last step evaluated again with the same state by a MaterialContribution of the bench (its
-// phase clock) and, for the law, by a copy of the model whose law is wrapped in a clock (the
-// clock's own cost calibrated and taken off). Nothing is asserted: read the figures as ratios on
-// a possibly shared machine.
+// phase clocks) and, for the law, its evaluations of that step recorded and replayed (CPU
+// seconds of the calling thread throughout: the machine may be shared). Nothing is asserted:
+// read the figures as ratios.
 //
 // usage: bench_fem_explicit [NXxNY] [--steps N] [--threads 1,2] [--lines linear,j2-eas,...]
-//                           [--no-shares]
+//                           [--no-shares] [--dump DIR]   (DIR/<line>_<threads>.f64: u at the end)
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -70,14 +70,6 @@ double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-int thread_id() {
-#ifdef _OPENMP
-  return omp_get_thread_num();
-#else
-  return 0;
-#endif
-}
-
 void set_threads(int t) {
 #ifdef _OPENMP
   omp_set_num_threads(t);
@@ -86,10 +78,18 @@ void set_threads(int t) {
 #endif
 }
 
-// A law wrapped in a clock: the seconds and calls of evaluate() per thread.
-class TimedLaw final : public MaterialLaw {
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// A law that counts its evaluations and records the inputs (F and the committed history) of the
+// first `cap` of them, for a replay on the CPU clock (one thread).
+class RecordingLaw final : public MaterialLaw {
  public:
-  explicit TimedLaw(std::shared_ptr<const MaterialLaw> law) : law_(std::move(law)) {}
+  RecordingLaw(std::shared_ptr<const MaterialLaw> law, std::size_t cap)
+      : law_(std::move(law)), cap_(cap) {}
   std::string_view name() const override { return law_->name(); }
   double density() const override { return law_->density(); }
   double dilatational_wave_speed() const override { return law_->dilatational_wave_speed(); }
@@ -99,11 +99,12 @@ class TimedLaw final : public MaterialLaw {
   void initialise_state(std::span<double> state) const override { law_->initialise_state(state); }
   void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
                 MaterialResponse& response) const override {
-    const auto t0 = Clock::now();
+    if (calls_ < cap_) {
+      f_.push_back(f);
+      committed_.insert(committed_.end(), committed.begin(), committed.end());
+    }
+    ++calls_;
     law_->evaluate(f, committed, trial, response);
-    Slot& s = slots_[static_cast<std::size_t>(thread_id()) % slots_.size()];
-    s.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
-    ++s.calls;
   }
   double plastic_work_density(std::span<const double> state) const override {
     return law_->plastic_work_density(state);
@@ -112,39 +113,36 @@ class TimedLaw final : public MaterialLaw {
     return law_->equivalent_plastic_strain(state);
   }
   void reset() const {
-    for (auto& s : slots_) s = Slot{};
+    calls_ = 0;
+    f_.clear();
+    committed_.clear();
   }
-  double seconds() const {
-    double t = 0.0;
-    for (const auto& s : slots_) t += s.seconds;
-    return t;
-  }
-  long calls() const {
-    long c = 0;
-    for (const auto& s : slots_) c += s.calls;
-    return c;
+  std::size_t calls() const { return calls_; }
+  // CPU seconds of one evaluation, the recorded ones replayed
+  double replay_seconds_per_call() const {
+    const std::size_t n = f_.size(), ns = static_cast<std::size_t>(law_->state_size());
+    if (n == 0) return 0.0;
+    std::vector<double> trial(ns);
+    MaterialResponse r;
+    double sink = 0.0;
+    const double c0 = thread_cpu_seconds();
+    for (std::size_t i = 0; i < n; ++i) {
+      law_->evaluate(f_[i], std::span<const double>(committed_).subspan(i * ns, ns), trial, r);
+      sink += r.stress(0, 0);
+    }
+    const double cpu = thread_cpu_seconds() - c0;
+    volatile double keep = sink;
+    (void)keep;
+    return cpu / static_cast<double>(n);
   }
 
  private:
-  struct alignas(64) Slot {
-    double seconds = 0.0;
-    long calls = 0;
-  };
   std::shared_ptr<const MaterialLaw> law_;
-  mutable std::array<Slot, 64> slots_{};
+  std::size_t cap_;
+  mutable std::size_t calls_ = 0;
+  mutable std::vector<Mat3> f_;
+  mutable std::vector<double> committed_;
 };
-
-// Seconds of one clock reading pair as TimedLaw takes it (taken off the law's time).
-double clock_pair_seconds() {
-  constexpr int n = 200000;
-  volatile double sink = 0.0;
-  const auto t0 = Clock::now();
-  for (int i = 0; i < n; ++i) {
-    const auto a = Clock::now();
-    sink = sink + std::chrono::duration<double>(Clock::now() - a).count();
-  }
-  return since(t0) / n;
-}
 
 struct Line {
   std::string name;
@@ -210,18 +208,13 @@ std::uint64_t state_hash(const SolverState& s) {
   return h;
 }
 
-double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 struct Run {
   std::uint64_t hash = 0;
   double step_seconds = 0.0, step_cpu = 0.0;  // per timed step (cpu: the calling thread's)
   double plastic_share = 0.0;
   SolverState before_last;  // the state before the last timed step (for the shares)
   Eigen::VectorXd u_last;   // the displacement after it
+  Eigen::VectorXd u;        // the displacement at the end
 };
 
 Run run(const Model& model, double dt, int steps, bool keep_state) {
@@ -234,18 +227,21 @@ Run run(const Model& model, double dt, int steps, bool keep_state) {
   Run r;
   const auto t0 = Clock::now();
   const double c0 = thread_cpu_seconds();
-  double saving = 0.0;  // the copy of the state before the last step, not timed
+  double saving = 0.0, saving_cpu = 0.0;  // the copy of the state before the last step: untimed
   for (int i = 0; i < steps; ++i) {
     if (keep_state && i + 1 == steps) {
       const auto ts = Clock::now();
+      const double cs = thread_cpu_seconds();
       r.before_last = solver.save_state();
+      saving_cpu = thread_cpu_seconds() - cs;
       saving = since(ts);
     }
     solver.step(dt);
   }
-  r.step_cpu = (thread_cpu_seconds() - c0 - saving) / steps;
+  r.step_cpu = (thread_cpu_seconds() - c0 - saving_cpu) / steps;
   r.step_seconds = (since(t0) - saving) / steps;
   r.hash = state_hash(solver.save_state());
+  r.u = solver.displacement();
   if (keep_state) r.u_last = solver.displacement();
   const Eigen::VectorXd eqps = solver.equivalent_plastic_strain();
   if (eqps.size() > 0) {
@@ -260,6 +256,7 @@ struct Options {
   std::vector<int> threads = {1, 2};
   std::vector<std::string> lines;
   bool shares = true;
+  std::string dump;  // folder: u after the timed steps of each line and thread count, raw doubles
 };
 
 std::vector<std::string> split(const std::string& s) {
@@ -277,9 +274,10 @@ struct Shares {
   double law_calls_per_element = 0.0;
 };
 
-// On a shared machine the wall clock counts the time other processes hold the core: the shares
-// are taken from ratios within one evaluation (the phase clocks, the law's clock) applied to CPU
-// seconds (of the step: the process's, 1 thread; of the evaluation: the thread's).
+// On a shared machine the wall clock counts the time other processes hold the core, so the
+// shares are CPU seconds of the calling thread (one thread): of the step, of the material's
+// add() at the last step's state (split into the element loop and the assembly by its phase
+// clocks), and of the law (its recorded evaluations replayed, times its evaluations).
 Shares shares_of(const Model& model, const Line& line, const Run& r, int repeats) {
   Shares sh;
   const double ne = static_cast<double>(model.mesh().num_elements());
@@ -302,31 +300,24 @@ Shares shares_of(const Model& model, const Line& line, const Run& r, int repeats
       }
     }
   }
-  auto timed = std::make_shared<TimedLaw>(make_law(line));
-  Model timed_model = model;
-  timed_model.set_material_law(timed);
-  double f_law = 0.0, best = 1e300;
+  auto recording = std::make_shared<RecordingLaw>(make_law(line), 200000);
+  Model recording_model = model;
+  recording_model.set_material_law(recording);
+  double law_cpu = 1e300;
   {
-    MaterialContribution mc(timed_model);
-    const double pair = clock_pair_seconds();
+    MaterialContribution mc(recording_model);
+    mc.set_committed_state(r.before_last.material_state);
+    f.setZero();
+    mc.add(r.u_last, f, nullptr, assembler);
+    sh.law_calls_per_element = static_cast<double>(recording->calls()) / ne;
     for (int i = 0; i < repeats; ++i) {
-      mc.set_committed_state(r.before_last.material_state);
-      f.setZero();
-      timed->reset();
-      const auto t0 = Clock::now();
-      mc.add(r.u_last, f, nullptr, assembler);
-      const double overhead = pair * static_cast<double>(timed->calls());
-      const double wall = since(t0) - overhead;
-      if (wall < best) {
-        best = wall;
-        f_law = (timed->seconds() - overhead) / wall;
-      }
-      sh.law_calls_per_element = static_cast<double>(timed->calls()) / ne;
+      law_cpu = std::min(law_cpu, recording->replay_seconds_per_call() *
+                                      static_cast<double>(recording->calls()));
     }
   }
   const double step = r.step_cpu;
-  sh.law = f_law * add_cpu / step;
-  sh.kinematics = (f_elements - f_law) * add_cpu / step;
+  sh.law = law_cpu / step;
+  sh.kinematics = (f_elements * add_cpu - law_cpu) / step;
   sh.assembly = f_assembly * add_cpu / step;
   sh.rest = 1.0 - (f_elements + f_assembly) * add_cpu / step;
   return sh;
@@ -352,12 +343,14 @@ int main(int argc, char** argv) {
       for (const auto& t : split(value())) opt.threads.push_back(std::max(1, std::atoi(t.c_str())));
     } else if (a == "--lines") {
       opt.lines = split(value());
+    } else if (a == "--dump") {
+      opt.dump = value();
     } else if (a == "--no-shares") {
       opt.shares = false;
     } else if (a == "-h" || a == "--help") {
       std::printf(
           "usage: bench_fem_explicit [NXxNY] [--steps N] [--threads 1,2] "
-          "[--lines linear,j2-eas,j2-plain,fj2-eas,fj2-plain] [--no-shares]\n");
+          "[--lines linear,j2-eas,j2-plain,fj2-eas,fj2-plain] [--no-shares] [--dump DIR]\n");
       return 0;
     } else if (std::sscanf(a.c_str(), "%dx%d", &opt.nx, &opt.ny) == 2 && opt.nx > 0 &&
                opt.ny > 0) {
@@ -391,9 +384,9 @@ int main(int argc, char** argv) {
     dt = std::min(dt, 0.9 * small.stable_time_step());
   }
   std::printf("   dt = %.4g s (0.9 x the stable step of the cell)\n\n", dt);
-  std::printf("  %-10s %7s %7s %11s %6s %9s %9s %8s %9s  %s\n", "line", "threads", "pts/el",
-              "el-steps/s", "(cpu)", "step ms", "plastic", "vs aim", "vs linear",
-              "hash of u, v, histories");
+  std::printf("  %-10s %7s %7s %11s %6s %12s %9s %9s %8s %9s  %s\n", "line", "threads",
+              "pts/el", "el-steps/s", "(cpu)", "per cpu-s", "step ms", "plastic", "vs aim",
+              "vs linear", "hash of u, v, histories");
   double linear_rate[3] = {0.0, 0.0, 0.0};
   struct ShareLine {
     std::string name;
@@ -418,11 +411,20 @@ int main(int argc, char** argv) {
       const double lin = t <= 2 ? linear_rate[t] : 0.0;
       char vs_linear[32] = "-";
       if (!l.linear && lin > 0.0) std::snprintf(vs_linear, sizeof vs_linear, "%.3f", rate / lin);
-      std::printf("  %-10s %7d %7.0f %11.3g %6.2f %9.2f %8.1f%% %8.3f %9s  %016llx\n",
-                  l.name.c_str(), t, pts, rate, r.step_cpu / r.step_seconds,
+      char per_cpu[32] = "-";
+      if (t == 1) std::snprintf(per_cpu, sizeof per_cpu, "%.3g", static_cast<double>(ne) / r.step_cpu);
+      std::printf("  %-10s %7d %7.0f %11.3g %6.2f %12s %9.2f %8.1f%% %8.3f %9s  %016llx\n",
+                  l.name.c_str(), t, pts, rate, r.step_cpu / r.step_seconds, per_cpu,
                   1e3 * r.step_seconds, 100.0 * r.plastic_share, rate / kAim, vs_linear,
                   static_cast<unsigned long long>(r.hash));
       std::fflush(stdout);
+      if (!opt.dump.empty()) {
+        const std::string path = opt.dump + "/" + l.name + "_" + std::to_string(t) + ".f64";
+        if (std::FILE* out = std::fopen(path.c_str(), "wb")) {
+          std::fwrite(r.u.data(), sizeof(double), static_cast<std::size_t>(r.u.size()), out);
+          std::fclose(out);
+        }
+      }
       if (keep) one = std::move(r);
     }
     if (opt.shares && !l.linear && one.u_last.size() > 0) {
@@ -444,8 +446,8 @@ int main(int argc, char** argv) {
     }
   }
   std::printf(
-      "\n  (cpu): the main thread's CPU over wall seconds (below 1 on 1 thread: other processes); vs "
-      "aim: element-steps/s over 1e6 (issue 27: 10^6 on 2 cores); vs linear: over the "
+      "\n  (cpu): the main thread's CPU over wall seconds (below 1 on 1 thread: other processes); "
+      "per cpu-s: element-steps per CPU second (1 thread: the rate on an idle core); vs aim: element-steps/s over 1e6 (issue 27: 10^6 on 2 cores); vs linear: over the "
       "linear-elastic explicit step (the linear path, K u) on as many threads; contact: no "
       "indenter in the model\n");
   return 0;
