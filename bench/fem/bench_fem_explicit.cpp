@@ -42,6 +42,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <time.h>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -86,12 +87,11 @@ double thread_cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// A law that counts its evaluations and records the inputs (F and the committed history) of the
-// first `cap` of them, for a replay on the CPU clock (one thread).
+// A law that counts its evaluations and records the inputs (F and the committed history) of
+// every stride-th of them, for a replay on the CPU clock (one thread).
 class RecordingLaw final : public MaterialLaw {
  public:
-  RecordingLaw(std::shared_ptr<const MaterialLaw> law, std::size_t cap)
-      : law_(std::move(law)), cap_(cap) {}
+  explicit RecordingLaw(std::shared_ptr<const MaterialLaw> law) : law_(std::move(law)) {}
   std::string_view name() const override { return law_->name(); }
   double density() const override { return law_->density(); }
   double dilatational_wave_speed() const override { return law_->dilatational_wave_speed(); }
@@ -115,7 +115,8 @@ class RecordingLaw final : public MaterialLaw {
   double equivalent_plastic_strain(std::span<const double> state) const override {
     return law_->equivalent_plastic_strain(state);
   }
-  void reset() const {
+  void reset(std::size_t stride) const {
+    stride_ = std::max<std::size_t>(1, stride);
     calls_ = 0;
     f_.clear();
     committed_.clear();
@@ -147,7 +148,7 @@ class RecordingLaw final : public MaterialLaw {
 
  private:
   void record(const Mat3& f, std::span<const double> committed, bool tangent) const {
-    if (calls_ < cap_) {
+    if (calls_ % stride_ == 0) {
       f_.push_back(f);
       committed_.insert(committed_.end(), committed.begin(), committed.end());
       tangent_.push_back(tangent ? 1 : 0);
@@ -155,8 +156,7 @@ class RecordingLaw final : public MaterialLaw {
     ++calls_;
   }
   std::shared_ptr<const MaterialLaw> law_;
-  std::size_t cap_;
-  mutable std::size_t calls_ = 0;
+  mutable std::size_t stride_ = 1, calls_ = 0;
   mutable std::vector<Mat3> f_;
   mutable std::vector<double> committed_;
   mutable std::vector<char> tangent_;
@@ -328,15 +328,21 @@ Shares shares_of(const Model& model, const Line& line, const Run& r, int repeats
       }
     }
   }
-  auto recording = std::make_shared<RecordingLaw>(make_law(line), 200000);
+  auto recording = std::make_shared<RecordingLaw>(make_law(line));
   Model recording_model = model;
   recording_model.set_material_law(recording);
   double law_cpu = 1e300;
   {
     MaterialContribution mc(recording_model);
-    mc.set_committed_state(r.before_last.material_state);
-    f.setZero();
-    mc.add(r.u_last, f, nullptr, assembler);
+    // once to count the calls (recording only the first), once recording about 2e5 of them
+    // spread over the step
+    for (int pass = 0; pass < 2; ++pass) {
+      recording->reset(pass == 0 ? std::numeric_limits<std::size_t>::max()
+                                 : std::max<std::size_t>(1, recording->calls() / 200000));
+      mc.set_committed_state(r.before_last.material_state);
+      f.setZero();
+      mc.add(r.u_last, f, nullptr, assembler);
+    }
     sh.law_calls_per_element = static_cast<double>(recording->calls()) / ne;
     for (int i = 0; i < repeats; ++i) {
       law_cpu = std::min(law_cpu, recording->replay_seconds_per_call() *
