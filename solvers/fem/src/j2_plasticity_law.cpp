@@ -19,8 +19,9 @@ double J2PlasticityLaw::dilatational_wave_speed() const {
   return std::sqrt((bulk_ + 4.0 / 3.0 * shear_) / density_);
 }
 
-void J2PlasticityLaw::evaluate(const Mat3& f, std::span<const double> committed,
-                               std::span<double> trial, MaterialResponse& r) const {
+void J2PlasticityLaw::evaluate_with(const Mat3& f, std::span<const double> committed,
+                                    std::span<double> trial, MaterialResponse& r,
+                                    bool with_tangent) const {
   const double g = shear_, k = bulk_;
   const double sqrt23 = std::sqrt(2.0 / 3.0);
   const Mat3 id = Mat3::Identity();
@@ -49,19 +50,34 @@ void J2PlasticityLaw::evaluate(const Mat3& f, std::span<const double> committed,
   // sigma = K tr(eps_e) I + s_tr - 2 G dg n
   const Mat3 s = s_tr - 2.0 * g * dg * n;
   r.stress = k * tr * id + s;
-  // C_ep = K 1(x)1 + 2 G theta (I_sym - 1/3 1(x)1) - 2 G theta_bar n(x)n
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      for (int a = 0; a < 3; ++a) {
-        for (int b = 0; b < 3; ++b) {
-          const double dij_ab = (i == j && a == b) ? 1.0 : 0.0;
-          const double isym =
-              0.5 * ((i == a && j == b ? 1.0 : 0.0) + (i == b && j == a ? 1.0 : 0.0));
-          r.tangent(3 * i + j, 3 * a + b) = k * dij_ab + 2.0 * g * theta * (isym - dij_ab / 3.0) -
-                                            2.0 * g * theta_bar * n(i, j) * n(a, b);
+  // C_ep = K 1(x)1 + 2 G theta (I_sym - 1/3 1(x)1) - 2 G theta_bar n(x)n, entry (3 i + j, 3 a + b)
+  // (the constant tensors once; each entry's operations in the order of the formula)
+  if (with_tangent) {
+    struct Constant {
+      Matrix9 one_one, deviator;  // 1(x)1 (d_ij d_ab), I_sym - 1/3 1(x)1
+    };
+    static const Constant c = [] {
+      Constant t;
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+          for (int a = 0; a < 3; ++a) {
+            for (int b = 0; b < 3; ++b) {
+              const double dij_ab = (i == j && a == b) ? 1.0 : 0.0;
+              const double isym =
+                  0.5 * ((i == a && j == b ? 1.0 : 0.0) + (i == b && j == a ? 1.0 : 0.0));
+              t.one_one(3 * i + j, 3 * a + b) = dij_ab;
+              t.deviator(3 * i + j, 3 * a + b) = isym - dij_ab / 3.0;
+            }
+          }
         }
       }
-    }
+      return t;
+    }();
+    Eigen::Matrix<double, 9, 1> nv;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) nv[3 * i + j] = n(i, j);
+    const double c_dev = 2.0 * g * theta, c_nn = 2.0 * g * theta_bar;
+    r.tangent = k * c.one_one + c_dev * c.deviator - (c_nn * nv) * nv.transpose();
   }
   const Mat3 eps_p = eps_p_n + dg * n;
   const Mat3 eps_e = eps - eps_p;

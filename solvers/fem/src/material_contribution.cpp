@@ -2,6 +2,8 @@
 
 #include <Eigen/LU>
 #include <array>
+#include <type_traits>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -18,12 +20,14 @@ namespace partita::fem {
 namespace {
 
 // ke_(a i)(b k) += scale dN_a/dX_J A_iJkL dN_b/dX_L: the material part of a point's stiffness,
-// dF/du^T A dF/du with dF_iJ / du_bk = delta_ik dN_b/dX_J (g: n x 3 gradients).
+// dF/du^T A dF/du with dF_iJ / du_bk = delta_ik dN_b/dX_J (g: n x 3 gradients); only the
+// columns of the nodes b >= first_b (the others are left as they are).
 template <typename Gradients, typename Matrix>
-void add_material_stiffness(const Gradients& g, const Matrix9& a, double scale, Matrix& ke) {
+void add_material_stiffness(const Gradients& g, const Matrix9& a, double scale, Matrix& ke,
+                            Eigen::Index first_b = 0) {
   Eigen::Matrix<double, 9, 3> ag;  // A_iJkL dN_b/dX_L for one node b: rows iJ, columns k
   const auto nn = g.rows();
-  for (Eigen::Index b = 0; b < nn; ++b) {
+  for (Eigen::Index b = first_b; b < nn; ++b) {
     for (int kk = 0; kk < 3; ++kk) {
       ag.col(kk) = a.middleCols<3>(3 * kk) * g.row(b).transpose() * scale;
     }
@@ -32,6 +36,16 @@ void add_material_stiffness(const Gradients& g, const Matrix9& a, double scale, 
         ke.template block<1, 3>(3 * a_node + i, 3 * b) += g.row(a_node) * ag.middleRows<3>(3 * i);
       }
     }
+  }
+}
+
+// The law at one point: with its tangent (implicit paths) or without it (explicit steps).
+void evaluate_point(const MaterialLaw& law, const Mat3& f, std::span<const double> committed,
+                    std::span<double> trial, bool tangent, MaterialResponse& r) {
+  if (tangent) {
+    law.evaluate(f, committed, trial, r);
+  } else {
+    law.evaluate_stress(f, committed, trial, r);
   }
 }
 
@@ -117,11 +131,24 @@ MaterialContribution::MaterialContribution(const Model& model)
       for (Eigen::Index a = 0; a < g.rows(); ++a) {
         for (int d = 0; d < 3; ++d) gradients_.push_back(g(a, d));
       }
+      // |grad N_a| for the round-off bounds (a reference-configuration constant), computed as
+      // the element loops did, on the same matrix types
+      const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> gm(
+          gradients_.data() + gradient_offset_.back(), g.rows(), 3);
+      for (Eigen::Index a = 0; a < g.rows(); ++a) gradient_norms_.push_back(gm.row(a).norm());
       if (eas) {
         // g_J = (j0 / j) xi_J (J0^-1)_J
         for (int jj = 0; jj < 3; ++jj) {
           for (int d = 0; d < 3; ++d) eas_gradients_.push_back(j0 / det * q.xi[jj] * j0_inv(jj, d));
         }
+        // the EAS loop's norms: its 11 x 3 gradients G, their 8 node rows, the 3 rows g_J
+        Eigen::Matrix<double, 11, 3> gx;
+        gx.topRows<8>() = gm.topRows<8>();
+        gx.bottomRows<3>() = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+            eas_gradients_.data() + eas_gradients_.size() - 9);
+        for (int a = 0; a < 8; ++a) gradient_norms_[gradient_norms_.size() - 8 + a] = gx.row(a).norm();
+        eas_norms_.push_back(gx.norm());
+        eas_norms_.push_back(gx.bottomRows<3>().norm());
       }
       state_offset_.push_back(state_offset_.back() + static_cast<std::size_t>(law->state_size()));
     }
@@ -151,6 +178,10 @@ MaterialContribution::~MaterialContribution() = default;
 void MaterialContribution::add(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k,
                                const BlockAssembler& assembler) {
   energy_ = 0.0;
+  if (k == nullptr) {
+    add_force_only(u, f_int);
+    return;
+  }
   // Elements are evaluated a chunk at a time, the chunk's elements in parallel (each writes only
   // its own quadrature points and its own slot of the chunk buffers), then added to f_int and K
   // serially in element order: the sums are the same, bit for bit, on any number of threads.
@@ -164,12 +195,20 @@ void MaterialContribution::add(const Eigen::VectorXd& u, Eigen::VectorXd& f_int,
     chunk_fabs_.resize(std::min(ne, kChunk));
   }
   node_round_off_.setZero(static_cast<Eigen::Index>(mesh_.num_nodes()));
+  using Clock = std::chrono::steady_clock;
+  phase_seconds_ = {};
   for (std::size_t c0 = 0; c0 < ne; c0 += kChunk) {
     const long n = static_cast<long>(std::min(ne - c0, kChunk));
     // A material law may throw (a radial return that does not converge: the Newton solver cuts
     // the step back): the first element's exception comes out, as from a serial loop.
-    detail::parallel_for_first_error(
-        n, 32, [&](long i) { evaluate_chunk_element(c0, i, u, k != nullptr); });
+    const auto t0 = Clock::now();
+    detail::parallel_for_first_error(n, 32, [&](long i) {
+      const auto slot = static_cast<std::size_t>(i);
+      evaluate_element(c0 + slot, u, chunk_fe_[slot], &chunk_ke_[slot], chunk_fabs_[slot],
+                       chunk_energy_[slot]);
+    });
+    const auto t1 = Clock::now();
+    phase_seconds_.elements += std::chrono::duration<double>(t1 - t0).count();
     for (long i = 0; i < n; ++i) {
       const Element& el = elements[c0 + static_cast<std::size_t>(i)];
       const int nn = node_count(el.type);
@@ -178,11 +217,12 @@ void MaterialContribution::add(const Eigen::VectorXd& u, Eigen::VectorXd& f_int,
       for (int a = 0; a < nn; ++a) {
         f_int.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])) += fe.segment<3>(3 * a);
       }
-      if (k != nullptr) assembler.add(*k, el.node_span(), chunk_ke_[static_cast<std::size_t>(i)]);
+      assembler.add(*k, el.node_span(), chunk_ke_[static_cast<std::size_t>(i)]);
       energy_ += chunk_energy_[static_cast<std::size_t>(i)];
       const ElementVector& fa = chunk_fabs_[static_cast<std::size_t>(i)];
       for (int a = 0; a < nn; ++a) node_round_off_[static_cast<Eigen::Index>(el.nodes[a])] += fa[a];
     }
+    phase_seconds_.assembly += std::chrono::duration<double>(Clock::now() - t1).count();
   }
   // r_eps = |a|, a_(n i) = sum_e sum_q |grad N_n| dP_q w_q for each of the 3 components of node n
   round_off_ = std::sqrt(3.0) * node_round_off_.norm();
@@ -202,29 +242,88 @@ void MaterialContribution::require_not_inverted(std::size_t e, double det_f) con
   throw InvertedElementError(msg.str());
 }
 
-void MaterialContribution::evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u,
-                                                  bool tangent) {
-  const std::size_t e = c0 + static_cast<std::size_t>(i);
+// ---- explicit steps: the force alone (issue 27, bench/fem/bench_fem_explicit) ----
+// All elements in one parallel loop, each into its own slice of flat buffers (no allocation:
+// the element vectors live on the stack), then the nodes in parallel, each node's sum over its
+// elements in element order: f_int, the round-off bounds and the energy have the bits of the
+// chunked loop of add() on any number of threads (every entry's additions in the same order),
+// without its serial assembly and a parallel region per chunk.
+void MaterialContribution::add_force_only(const Eigen::VectorXd& u, Eigen::VectorXd& f_int) {
+  using Clock = std::chrono::steady_clock;
+  const auto& elements = mesh_.elements();
+  const std::size_t ne = elements.size(), nodes = mesh_.num_nodes();
+  if (flat_offset_.size() != ne + 1) {
+    // element e's nodal values at flat_offset_[e] + a; per node, its (e, a) in element order
+    flat_offset_.assign(1, 0);
+    std::vector<std::size_t> count(nodes + 1, 0);
+    for (const auto& el : elements) {
+      const int nn = node_count(el.type);
+      flat_offset_.push_back(flat_offset_.back() + static_cast<std::size_t>(nn));
+      for (int a = 0; a < nn; ++a) ++count[el.nodes[a] + 1];
+    }
+    for (std::size_t n = 0; n < nodes; ++n) count[n + 1] += count[n];
+    node_incidence_offset_ = count;
+    node_incidence_.assign(flat_offset_.back(), 0);
+    for (std::size_t e = 0; e < ne; ++e) {
+      const int nn = node_count(elements[e].type);
+      for (int a = 0; a < nn; ++a)
+        node_incidence_[count[elements[e].nodes[a]]++] = flat_offset_[e] + static_cast<std::size_t>(a);
+    }
+    flat_fe_.assign(3 * flat_offset_.back(), 0.0);
+    flat_fabs_.assign(flat_offset_.back(), 0.0);
+    element_energy_.assign(ne, 0.0);
+  }
+  const auto t0 = Clock::now();
+  // A material law may throw: the first element's exception comes out, as from a serial loop.
+  detail::parallel_for_first_error(static_cast<long>(ne), 32, [&](long i) {
+    const auto e = static_cast<std::size_t>(i);
+    ElementVector fe, fabs;
+    evaluate_element(e, u, fe, nullptr, fabs, element_energy_[e]);
+    const std::size_t at = flat_offset_[e];
+    std::copy(fe.data(), fe.data() + fe.size(), flat_fe_.data() + 3 * at);
+    std::copy(fabs.data(), fabs.data() + fabs.size(), flat_fabs_.data() + at);
+  });
+  const auto t1 = Clock::now();
+  node_round_off_.setZero(static_cast<Eigen::Index>(nodes));
+  constexpr long kNodeBlock = 1024;
+  const long blocks = static_cast<long>((nodes + kNodeBlock - 1) / kNodeBlock);
+  detail::parallel_for_first_error(blocks, 2, [&](long b) {
+    const std::size_t n0 = static_cast<std::size_t>(b * kNodeBlock);
+    const std::size_t n1 = std::min(nodes, n0 + static_cast<std::size_t>(kNodeBlock));
+    for (std::size_t n = n0; n < n1; ++n) {
+      for (std::size_t j = node_incidence_offset_[n]; j < node_incidence_offset_[n + 1]; ++j) {
+        const std::size_t k = node_incidence_[j];
+        for (int c = 0; c < 3; ++c) f_int[static_cast<Eigen::Index>(3 * n) + c] += flat_fe_[3 * k + static_cast<std::size_t>(c)];
+        node_round_off_[static_cast<Eigen::Index>(n)] += flat_fabs_[k];
+      }
+    }
+  });
+  for (std::size_t e = 0; e < ne; ++e) energy_ += element_energy_[e];
+  round_off_ = std::sqrt(3.0) * node_round_off_.norm();
+  phase_seconds_.elements = std::chrono::duration<double>(t1 - t0).count();
+  phase_seconds_.assembly = std::chrono::duration<double>(Clock::now() - t1).count();
+}
+// ---- end explicit ----
+
+void MaterialContribution::evaluate_element(std::size_t e, const Eigen::VectorXd& u,
+                                            ElementVector& fe, ElementMatrix* ke,
+                                            ElementVector& fabs, double& energy) {
   const Element& el = mesh_.elements()[e];
   const int nn = node_count(el.type);
   ElementDisplacements ue(nn, 3);
   for (int a = 0; a < nn; ++a) {
     ue.row(a) = u.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a])).transpose();
   }
-  ElementVector& fe = chunk_fe_[static_cast<std::size_t>(i)];
-  ElementMatrix& ke = chunk_ke_[static_cast<std::size_t>(i)];
-  double& energy = chunk_energy_[static_cast<std::size_t>(i)];
-  ElementVector& fabs = chunk_fabs_[static_cast<std::size_t>(i)];
   energy = 0.0;
   fe.setZero(3 * nn);
   fabs.setZero(nn);
-  if (tangent) ke.setZero(3 * nn, 3 * nn);
+  if (ke != nullptr) ke->setZero(3 * nn, 3 * nn);
   if (eas_hex8_ && el.type == ElementType::Hex8) {
-    evaluate_eas(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
+    evaluate_eas(e, ue, fe, ke, energy, fabs);
   } else if (fbar_hex8_ && el.type == ElementType::Hex8) {
-    evaluate_fbar(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
+    evaluate_fbar(e, ue, fe, ke, energy, fabs);
   } else {
-    evaluate_plain(e, ue, fe, tangent ? &ke : nullptr, energy, fabs);
+    evaluate_plain(e, ue, fe, ke, energy, fabs);
   }
 }
 
@@ -235,31 +334,43 @@ void MaterialContribution::evaluate_plain(std::size_t e, const ElementDisplaceme
   const int nn = node_count(el.type);
   const MaterialLaw& law = *element_law_[e];
   MaterialResponse resp;
-  for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
-    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> g(
-        gradients_.data() + gradient_offset_[q], nn, 3);
-    // F = I + sum_a u_a (x) grad_X N_a
-    const Mat3 f = Mat3::Identity() + ue.transpose() * g;
-    if (!law.small_strain()) require_not_inverted(e, f.determinant());
-    const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
-    law.evaluate(f, std::span<const double>(committed_).subspan(s0, ns),
-                 std::span<double>(trial_).subspan(s0, ns), resp);
-    const double w = weight_[q];
-    energy += resp.energy_density * w;
-    // f_a,i += P_iJ dN_a/dX_J w
-    const Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3> pg =
-        g * (resp.stress.transpose() * w);
-    for (int a = 0; a < nn; ++a) fe.segment<3>(3 * a) += pg.row(a).transpose();
-    // round-off bound of those: |grad N_a| dP w
-    const double dp = stress_round_off(resp.stress, f, element_modulus_[e]) * w;
-    for (int a = 0; a < nn; ++a) fabs[a] += g.row(a).norm() * dp;
-    // sigma = P F^T / J for output (small-strain laws: sigma itself)
-    const Mat3 sigma = cauchy_stress_of(law, resp.stress, f);
-    const auto qi = static_cast<Eigen::Index>(q);
-    cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);
-    eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
-    // K_(a i)(b k) += dN_a/dX_J A_iJkL dN_b/dX_L w
-    if (ke != nullptr) add_material_stiffness(g, resp.tangent, w, *ke);
+  // N: the node count as a compile-time size (Hex8: fixed-size products, issue 27's explicit
+  // benchmark) or Eigen::Dynamic (the other elements)
+  auto points = [&]<int N>(std::integral_constant<int, N>) {
+    constexpr int kMax = N == Eigen::Dynamic ? kMaxElementNodes : N;
+    using Gradients = Eigen::Matrix<double, N, 3, Eigen::RowMajor, kMax, 3>;
+    const Eigen::Matrix<double, N, 3, 0, kMax, 3> un = ue.topRows(nn);
+    for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
+      const Eigen::Map<const Gradients> g(gradients_.data() + gradient_offset_[q], nn, 3);
+      // F = I + sum_a u_a (x) grad_X N_a
+      const Mat3 f = Mat3::Identity() + un.transpose() * g;
+      if (!law.small_strain()) require_not_inverted(e, f.determinant());
+      const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
+      evaluate_point(law, f, std::span<const double>(committed_).subspan(s0, ns),
+                     std::span<double>(trial_).subspan(s0, ns), ke != nullptr, resp);
+      const double w = weight_[q];
+      energy += resp.energy_density * w;
+      // f_a,i += P_iJ dN_a/dX_J w
+      const Eigen::Matrix<double, N, 3, 0, kMax, 3> pg = g * (resp.stress.transpose() * w);
+      for (int a = 0; a < nn; ++a) fe.segment<3>(3 * a) += pg.row(a).transpose();
+      // round-off bound of those: |grad N_a| dP w
+      const double dp = stress_round_off(resp.stress, f, element_modulus_[e]) * w;
+      const double* gn = gradient_norms_.data() + gradient_offset_[q] / 3;
+      for (int a = 0; a < nn; ++a) fabs[a] += gn[a] * dp;
+      // sigma = P F^T / J for output (small-strain laws: sigma itself)
+      const Mat3 sigma = cauchy_stress_of(law, resp.stress, f);
+      const auto qi = static_cast<Eigen::Index>(q);
+      cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2),
+          sigma(0, 2);
+      eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
+      // K_(a i)(b k) += dN_a/dX_J A_iJkL dN_b/dX_L w
+      if (ke != nullptr) add_material_stiffness(g, resp.tangent, w, *ke);
+    }
+  };
+  if (nn == 8) {
+    points(std::integral_constant<int, 8>{});
+  } else {
+    points(std::integral_constant<int, Eigen::Dynamic>{});
   }
 }
 
@@ -327,8 +438,8 @@ void MaterialContribution::evaluate_fbar(std::size_t e, const ElementDisplacemen
     const double s = std::cbrt(j_bar / j[q]);
     const Mat3 fb = s * f[q];
     const std::size_t s0 = state_offset_[qp], ns = state_offset_[qp + 1] - s0;
-    law.evaluate(fb, std::span<const double>(committed_).subspan(s0, ns),
-                 std::span<double>(trial_).subspan(s0, ns), resp);
+    evaluate_point(law, fb, std::span<const double>(committed_).subspan(s0, ns),
+                   std::span<double>(trial_).subspan(s0, ns), ke != nullptr, resp);
     const double w = weight_[qp];
     energy += resp.energy_density * w;
     const Mat3 sigma = cauchy_stress_of(law, resp.stress, fb);
@@ -395,10 +506,25 @@ void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacement
   // energy, the stresses, the trial histories, the round-off bounds; sets the stress scale
   // sum |P| |G| w of h and the round-off bound of h, sum dP |g_J| w (as the nodes' fabs).
   double scale = 0.0, h_round_off = 0.0;
+  // ---- explicit steps (no element tangent wanted; issue 27, bench/fem/bench_fem_explicit) ----
+  // Only K_aa of kx is assembled (the 3 enhanced "nodes", the same entries, the same bits: the
+  // local Newton is unchanged) and each point's tangent A is kept; the condensation's
+  // K_ua d_alpha = sum_q w G_u^T A_q (G_a d_alpha) is then one product per point (below)
+  // instead of K_ua assembled in every pass (its sums in another order: round-off of a
+  // correction that is itself ~1e-10 of f). A point's tangent: 648 bytes on the stack.
+  constexpr std::size_t kMaxExplicitPoints = 24;  // 2 x 2 x 6, the thin elements' rule
+  const bool explicit_step = ke == nullptr && q1 - q0 <= kMaxExplicitPoints;
+  std::array<Matrix9, kMaxExplicitPoints> point_tangent;
+  Mat9 kaa;
+  // ---- end explicit ----
   auto pass = [&]() {
     for (int jj = 0; jj < 3; ++jj) ux.row(8 + jj) = alpha.segment<3>(3 * jj).transpose();
     fx.setZero();
-    kx.setZero();
+    if (explicit_step) {
+      kaa.setZero();
+    } else {
+      kx.setZero();
+    }
     fabs.setZero(8);
     energy = 0.0;
     scale = 0.0;
@@ -419,12 +545,19 @@ void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacement
       const Grad11 pg = gx * (resp.stress.transpose() * w);
       for (int a = 0; a < 11; ++a) fx.segment<3>(3 * a) += pg.row(a).transpose();
       // K_(a i)(b k) += dG_a/dX_J A_iJkL dG_b/dX_L w
-      add_material_stiffness(gx, resp.tangent, w, kx);
-      scale += resp.stress.norm() * gx.norm() * w;
+      if (explicit_step) {
+        add_material_stiffness(gx.bottomRows<3>(), resp.tangent, w, kaa);
+        point_tangent[q - q0] = resp.tangent;
+      } else {
+        add_material_stiffness(gx, resp.tangent, w, kx);
+      }
+      const double* gn = gradient_norms_.data() + gradient_offset_[q] / 3;
+      const double* en = eas_norms_.data() + (eas_gradient_start_[e] / 9 + (q - q0)) * 2;
+      scale += resp.stress.norm() * en[0] * w;
       energy += resp.energy_density * w;
       const double dp = stress_round_off(resp.stress, f, element_modulus_[e]) * w;
-      for (int a = 0; a < 8; ++a) fabs[a] += gx.row(a).norm() * dp;
-      h_round_off += gx.bottomRows<3>().norm() * dp;
+      for (int a = 0; a < 8; ++a) fabs[a] += gn[a] * dp;
+      h_round_off += en[1] * dp;
       const Mat3 sigma = cauchy_stress_of(law, resp.stress, f);
       const auto qi = static_cast<Eigen::Index>(q);
       cauchy_.row(qi) << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2),
@@ -446,7 +579,11 @@ void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacement
     if (it > 0) alpha -= lu.solve(h);
     pass();
     h = fx.tail<9>();
-    lu.compute(kx.bottomRightCorner<9, 9>());
+    if (explicit_step) {
+      lu.compute(kaa);
+    } else {
+      lu.compute(kx.bottomRightCorner<9, 9>());
+    }
     const double hn = h.norm();
     converged = hn <= 1e-10 * scale + h_round_off || scale == 0.0 ||
                 (it > 0 && hn > 0.5 * h_previous && hn <= 1e-6 * scale);
@@ -461,12 +598,50 @@ void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacement
   // f_e = f_u - K_ua K_aa^-1 h   (h ~ 0: the first-order correction of what is left); the trial
   // alpha likewise alpha - K_aa^-1 h
   const Vec9 d_alpha = lu.solve(h);
-  fe.head<24>() = fx.head<24>() - kx.topRightCorner<24, 9>() * d_alpha;
   Eigen::Map<Vec9>(trial_.data() + a0) = alpha - d_alpha;
+  if (explicit_step) {
+    // K_ua d_alpha = sum_q w G_u^T dP_q,  dP = A_q : dF_q,  dF = sum_J d_alpha_J (x) g_J
+    fe.head<24>() = fx.head<24>();
+    Eigen::Matrix<double, 3, 3> d_rows;  // row J: d_alpha_J
+    for (int jj = 0; jj < 3; ++jj) d_rows.row(jj) = d_alpha.segment<3>(3 * jj).transpose();
+    for (std::size_t q = q0; q < q1; ++q) {
+      const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> ga(
+          eas_gradients_.data() + eas_gradient_start_[e] + 9 * (q - q0));
+      const Mat3 df = d_rows.transpose() * ga;
+      Eigen::Matrix<double, 9, 1> dfv;  // 3 k + L
+      for (int kk = 0; kk < 3; ++kk)
+        for (int ll = 0; ll < 3; ++ll) dfv[3 * kk + ll] = df(kk, ll);
+      const Eigen::Matrix<double, 9, 1> dpv = point_tangent[q - q0] * dfv;  // 3 i + J
+      Mat3 dp;
+      for (int i = 0; i < 3; ++i)
+        for (int jj = 0; jj < 3; ++jj) dp(i, jj) = dpv[3 * i + jj] * weight_[q];
+      const Eigen::Map<const Eigen::Matrix<double, 8, 3, Eigen::RowMajor>> gu(
+          gradients_.data() + gradient_offset_[q]);
+      const Eigen::Matrix<double, 8, 3> pg = gu * dp.transpose();
+      for (int a = 0; a < 8; ++a) fe.segment<3>(3 * a) -= pg.row(a).transpose();
+    }
+    return;
+  }
+  fe.head<24>() = fx.head<24>() - kx.topRightCorner<24, 9>() * d_alpha;
   if (ke == nullptr) return;
   // K_e = K_uu - K_ua K_aa^-1 K_au
   const Eigen::Matrix<double, 9, 24> kaa_kau = lu.solve(kx.bottomLeftCorner<9, 24>());
   ke->topLeftCorner<24, 24>() = kx.topLeftCorner<24, 24>() - kx.topRightCorner<24, 9>() * kaa_kau;
+}
+
+void MaterialContribution::commit() {
+  // Explicit steps commit every step, ~1 kB of history per element: the copy shared by the
+  // threads (issue 27's benchmark; a plain copy, the same bits).
+  constexpr std::size_t kBlock = 1 << 15;
+  const std::size_t n = trial_.size();
+  committed_.resize(n);
+  const auto blocks = static_cast<long>((n + kBlock - 1) / kBlock);
+  detail::parallel_for_first_error(blocks, 4, [&](long b) {
+    const std::size_t i0 = static_cast<std::size_t>(b) * kBlock, i1 = std::min(n, i0 + kBlock);
+    std::copy(trial_.begin() + static_cast<std::ptrdiff_t>(i0),
+              trial_.begin() + static_cast<std::ptrdiff_t>(i1),
+              committed_.begin() + static_cast<std::ptrdiff_t>(i0));
+  });
 }
 
 double MaterialContribution::dissipated_work() const {

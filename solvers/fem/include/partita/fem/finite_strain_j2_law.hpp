@@ -32,6 +32,11 @@ class FiniteStrainJ2Law final : public MaterialLaw {
   void initialise_state(std::span<double> state) const override;
   void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
                 MaterialResponse& response) const override;
+  // the stress alone: without the 18 return maps of the tangent's difference quotients
+  void evaluate_stress(const Mat3& f, std::span<const double> committed, std::span<double> trial,
+                       MaterialResponse& response) const override {
+    stress(f, committed, trial, response.stress, response.energy_density);
+  }
   double plastic_work_density(std::span<const double> state) const override { return state[7]; }
   double equivalent_plastic_strain(std::span<const double> state) const override {
     return state[6];

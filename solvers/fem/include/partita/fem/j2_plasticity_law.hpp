@@ -29,7 +29,14 @@ class J2PlasticityLaw final : public MaterialLaw {
   double bulk_modulus() const override { return bulk_; }
   int state_size() const override { return 14; }
   void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
-                MaterialResponse& response) const override;
+                MaterialResponse& response) const override {
+    evaluate_with(f, committed, trial, response, true);
+  }
+  // without the tangent loop (explicit steps)
+  void evaluate_stress(const Mat3& f, std::span<const double> committed, std::span<double> trial,
+                       MaterialResponse& response) const override {
+    evaluate_with(f, committed, trial, response, false);
+  }
   double plastic_work_density(std::span<const double> state) const override { return state[7]; }
   double equivalent_plastic_strain(std::span<const double> state) const override {
     return state[6];
@@ -37,6 +44,8 @@ class J2PlasticityLaw final : public MaterialLaw {
   const HardeningCurve& hardening() const { return hardening_; }
 
  private:
+  void evaluate_with(const Mat3& f, std::span<const double> committed, std::span<double> trial,
+                     MaterialResponse& response, bool with_tangent) const;
   double density_ = 0.0, bulk_ = 0.0, shear_ = 0.0;
   HardeningCurve hardening_;
 };

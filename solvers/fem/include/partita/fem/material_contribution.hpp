@@ -62,7 +62,8 @@ class MaterialContribution final : public OperatorContribution {
   std::string_view name() const override { return "material"; }
   void add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix* k,
            const BlockAssembler& assembler) override;
-  void commit() override { committed_ = trial_; }
+  // committed = trial (copied in blocks by the OpenMP threads)
+  void commit() override;
   double round_off() const override { return round_off_; }
   // int W dV at the u of the last add()
   double stored_energy() const override { return energy_; }
@@ -80,6 +81,13 @@ class MaterialContribution final : public OperatorContribution {
   const Eigen::VectorXd& equivalent_plastic_strain() const { return eqps_; }
   // Elements' first quadrature point index (num_elements + 1 entries).
   const std::vector<std::size_t>& element_qp_offsets() const { return qp_offset_; }
+  // Wall seconds of the last add(): the element loop (kinematics and the laws, on the OpenMP
+  // threads) and the assembly of the element vectors into f (and K). For bench/fem.
+  struct PhaseSeconds {
+    double elements = 0.0;
+    double assembly = 0.0;
+  };
+  const PhaseSeconds& last_add_seconds() const { return phase_seconds_; }
 
  private:
   using ElementDisplacements = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
@@ -95,8 +103,15 @@ class MaterialContribution final : public OperatorContribution {
                     ElementMatrix* ke, double& energy, ElementVector& fabs);
   // Throws Error naming element e and where it is when det F <= 0 at one of its points.
   void require_not_inverted(std::size_t e, double det_f) const;
-  // Element c0 + i into slot i of the chunk buffers (ke only when `tangent`).
-  void evaluate_chunk_element(std::size_t c0, long i, const Eigen::VectorXd& u, bool tangent);
+  // Element e's fe, fabs and energy, and ke when not null (each zeroed first).
+  void evaluate_element(std::size_t e, const Eigen::VectorXd& u, ElementVector& fe,
+                        ElementMatrix* ke, ElementVector& fabs, double& energy);
+  // add() without a tangent (explicit steps): elements, then nodes, in parallel.
+  void add_force_only(const Eigen::VectorXd& u, Eigen::VectorXd& f_int);
+  // add_force_only()'s buffers: element e's nodal values from flat_offset_[e] (fe: 3 each);
+  // per node n, node_incidence_[node_incidence_offset_[n] ...] its flat indices in element order
+  std::vector<std::size_t> flat_offset_, node_incidence_offset_, node_incidence_;
+  std::vector<double> flat_fe_, flat_fabs_, element_energy_;
   // Per-element results of one chunk of elements (add() computes a chunk in parallel and adds
   // it to f and K in element order): sized once, reused.
   std::vector<ElementVector> chunk_fe_;
@@ -113,16 +128,19 @@ class MaterialContribution final : public OperatorContribution {
   std::vector<std::size_t> state_offset_;        // per quadrature point (+1)
   std::vector<double> gradients_;                // per qp: n x 3 dN/dX, row-major
   std::vector<std::size_t> gradient_offset_;     // per qp: start in gradients_
+  std::vector<double> gradient_norms_;  // per qp: |dN_a/dX| of its nodes, from gradient_offset_ / 3
   std::vector<double> weight_;                   // per qp: det J w
   bool eas_hex8_ = false;                        // Hex8 elements are EAS
   std::vector<double> eas_gradients_;            // per EAS qp: the 3 x 3 rows g_J, row-major
   std::vector<std::size_t> eas_offset_;          // per element: alpha's start in the state (EAS)
   std::vector<std::size_t> eas_gradient_start_;  // per element: its first g_J in eas_gradients_
+  std::vector<double> eas_norms_;                // per EAS qp: |G| (11 x 3) and |g_J| (3 x 3)
   std::vector<double> committed_, trial_;
   double energy_ = 0.0;
   double round_off_ = 0.0;
   MatrixX6 cauchy_;
   Eigen::VectorXd eqps_;
+  PhaseSeconds phase_seconds_;
 };
 
 }  // namespace partita::fem

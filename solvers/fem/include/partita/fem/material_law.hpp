@@ -39,6 +39,13 @@ class MaterialLaw {
   virtual void initialise_state(std::span<double> state) const;
   virtual void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
                         MaterialResponse& response) const = 0;
+  // evaluate() without the tangent (response.tangent is left as it was; stress, energy and the
+  // trial history are those of evaluate(), bit for bit): what explicit steps call, which need
+  // no tangent. The default calls evaluate(); a law whose tangent costs much overrides it.
+  virtual void evaluate_stress(const Mat3& f, std::span<const double> committed,
+                               std::span<double> trial, MaterialResponse& response) const {
+    evaluate(f, committed, trial, response);
+  }
   // Plastic work per unit reference volume accumulated in a history [J/m^3] (0 if elastic).
   virtual double plastic_work_density(std::span<const double> state) const;
   // Equivalent plastic strain of a history (0 if elastic).
