@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 #include <cmath>
-#include <limits>
 
 #include "partita/fem/error.hpp"
 #include "partita/interface/log.hpp"
@@ -83,10 +82,11 @@ void append_rupture_monitors(const fem::StructuralSolver& solver,
                              const std::function<bool(const std::string&)>& wanted,
                              std::vector<MonitorValue>& out) {
   out.push_back({"failed_elements", "", static_cast<double>(solver.failed_elements())});
+  // -1 until an element fails (a monitor value must be finite: the core takes a non-finite one
+  // for a diverging run)
   if (wanted("first_failure_time")) {
     const auto first = solver.first_failure();
-    out.push_back({"first_failure_time", "s",
-                   first ? first->time : std::numeric_limits<double>::quiet_NaN()});
+    out.push_back({"first_failure_time", "s", first ? first->time : -1.0});
   }
   if (wanted("eroded_energy")) out.push_back({"eroded_energy", "J", solver.eroded_energy()});
   if (wanted("max_equivalent_plastic_strain"))

@@ -4,7 +4,7 @@
 //                       necking_strain, erosion}: fem::FailureCriterion
 //   mesh.box.regions   [{name, from, to}]: element regions of a box mesh (elements whose centre
 //                       lies in the box [from, to]; the rest stay in "all")
-// Monitors: failed_elements, first_failure_time [s] (NaN until an element fails),
+// Monitors: failed_elements, first_failure_time [s] (-1 until an element fails),
 // eroded_energy [J], max_equivalent_plastic_strain, and with two or more regions
 // <region>.plastic_work | strain_energy | kinetic_energy [J].
 
