@@ -111,17 +111,21 @@ TEST_CASE("rupture: erosion removes a failed element, the force drops, the energ
   // still holds (central difference: to O(dt^2); here within 1 % of W_ext).
   const double hardening = 2e9, eps_f = 0.02, area = 0.05 * 0.05, ramp = 0.04;
   const double sigma_max = 350e6;
-  Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(0.3, 0.05, 0.05), {3, 1, 1}, ElementType::Hex8});
-  mesh.assign_region_where("weak", [](const Vec3& c) { return c.x() > 0.1 && c.x() < 0.2; });
-  Model m(std::move(mesh));
-  m.set_material_law(steel(hardening));
-  m.set_failure_criterion("weak", FailureCriterion::constant(eps_f, true));
-  hold_symmetry_planes(m);
-  m.add_traction("xmax", Vec3(sigma_max, 0.0, 0.0), [ramp](double t) { return t / ramp; });
+  auto strip = [&] {
+    Mesh mesh =
+        make_box_mesh({Vec3::Zero(), Vec3(0.3, 0.05, 0.05), {3, 1, 1}, ElementType::Hex8});
+    mesh.assign_region_where("weak", [](const Vec3& c) { return c.x() > 0.1 && c.x() < 0.2; });
+    Model m(std::move(mesh));
+    m.set_material_law(steel(hardening));
+    m.set_failure_criterion("weak", FailureCriterion::constant(eps_f, true));
+    hold_symmetry_planes(m);
+    m.add_traction("xmax", Vec3(sigma_max, 0.0, 0.0), [ramp](double t) { return t / ramp; });
+    return m;
+  };
   SolverOptions opt;
   opt.integrator = Integrator::CentralDifference;
   opt.mass = MassType::Lumped;
-  StructuralSolver s(std::move(m), opt);
+  StructuralSolver s(strip(), opt);
   const double dt = 0.5 * s.stable_time_step();
   const double t_f = ramp * (kSy + hardening * eps_f) / sigma_max;
   double reaction_before = 0.0;
@@ -163,14 +167,7 @@ TEST_CASE("rupture: erosion removes a failed element, the force drops, the energ
   CHECK(parts.plastic_work[0] + parts.plastic_work[1] == Approx(s.plastic_work()).epsilon(1e-12));
   CHECK(parts.plastic_work[1] == 0.0);  // "weak" holds only the eroded element
   // the restored state continues bit for bit
-  Mesh mesh2 = make_box_mesh({Vec3::Zero(), Vec3(0.3, 0.05, 0.05), {3, 1, 1}, ElementType::Hex8});
-  mesh2.assign_region_where("weak", [](const Vec3& c) { return c.x() > 0.1 && c.x() < 0.2; });
-  Model m2(std::move(mesh2));
-  m2.set_material_law(steel(hardening));
-  m2.set_failure_criterion("weak", FailureCriterion::constant(eps_f, true));
-  hold_symmetry_planes(m2);
-  m2.add_traction("xmax", Vec3(sigma_max, 0.0, 0.0), [ramp](double t) { return t / ramp; });
-  StructuralSolver r(std::move(m2), opt);
+  StructuralSolver r(strip(), opt);
   r.restore_state(saved);
   CHECK(r.failed_elements() == 1);
   CHECK(r.first_failure()->time == first->time);
