@@ -551,6 +551,7 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         an["integrator"].fail("central-difference needs 'mass: lumped'");
       options.integrator = fem::Integrator::CentralDifference;
     }
+    check_failure_keys(mat, transient_ && options.integrator == fem::Integrator::CentralDifference);
     stable_step_factor_ = an.real("stable_step_factor");
     const std::string linear_solver = an.string("linear_solver");
     if (linear_solver == "cholmod") {

@@ -63,6 +63,21 @@ fem::FailureCriterion build_failure_criterion(const Node& material) {
   }
 }
 
+void check_failure_keys(const Node& material, bool explicit_dynamics) {
+  if (!material.has("failure")) return;
+  const std::string model = material.string("model");
+  if (model.rfind("j2-plasticity", 0) != 0)
+    material["failure"].fail("a failure criterion needs plastic strain: material.model '" + model +
+                             "' has none and would never fail; use j2-plasticity or "
+                             "j2-plasticity-finite-strain");
+  if (material["failure"].boolean("erosion") && !explicit_dynamics)
+    material["failure"]["erosion"].fail(
+        "element erosion works in central-difference analyses only (analysis: {type: "
+        "transient, integrator: central-difference, mass: lumped}): static and Newmark solves "
+        "would factorise a tangent whose eroded parts float free; set erosion: false to have "
+        "failures reported only");
+}
+
 void apply_box_regions(fem::Mesh& mesh, const Node& box) {
   if (!box.has("regions")) return;
   for (const Node& r : box["regions"].items()) {

@@ -23,6 +23,9 @@ std::shared_ptr<config::Spec> fem_failure_spec();
 std::shared_ptr<config::Spec> fem_box_region_spec();
 // The criterion of material.failure (none when the key is absent).
 fem::FailureCriterion build_failure_criterion(const config::Node& material);
+// material.failure's rules that the solver would also refuse, at the keys: a law with plastic
+// strain (j2-plasticity*), erosion only in central-difference analyses.
+void check_failure_keys(const config::Node& material, bool explicit_dynamics);
 // mesh.box.regions onto a box mesh (a region that holds no element is an error at its key).
 void apply_box_regions(fem::Mesh& mesh, const config::Node& box);
 void append_rupture_monitors(const fem::StructuralSolver& solver,
