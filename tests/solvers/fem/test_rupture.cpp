@@ -129,7 +129,9 @@ TEST_CASE("rupture: erosion removes a failed element, the force drops, the energ
   const double dt = 0.5 * s.stable_time_step();
   const double t_f = ramp * (kSy + hardening * eps_f) / sigma_max;
   double reaction_before = 0.0;
+  SolverState intact;  // a state some steps before the failure
   while (s.failed_elements() == 0 && s.time() < ramp) {
+    if (s.time() < 0.95 * t_f) intact = s.save_state();
     s.step(dt);
     if (s.failed_elements() == 0) reaction_before = -s.reaction("xmin").x();
   }
@@ -175,6 +177,15 @@ TEST_CASE("rupture: erosion removes a failed element, the force drops, the energ
   for (int k = 0; k < n; ++k) r.step(dt);
   CHECK(r.displacement() == s.displacement());
   CHECK(r.energy_balance() == s.energy_balance());
+  // rolled back to before the failure (an implicit coupling's restore): the element is back in
+  // the force and the mass, and it fails again at the same step
+  s.restore_state(intact);
+  CHECK(s.failed_elements() == 0);
+  CHECK(!s.element_eroded(1));
+  CHECK(s.eroded_energy() == 0.0);
+  while (s.failed_elements() == 0 && s.time() < ramp) s.step(dt);
+  CHECK(s.first_failure()->time == first->time);
+  CHECK(s.eroded_energy() == eroded_at_save);
 }
 
 TEST_CASE("rupture: erosion is refused where it is not supported, with the reason",
