@@ -10,6 +10,7 @@
 #include "partita/fem/state_io.hpp"
 
 #include "fem_output.hpp"
+#include "fem_rupture.hpp"
 #include "line_probe.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -44,6 +45,10 @@ std::shared_ptr<Spec> make_spec() {
       .unit("m")
       .positive();
   box->integer("wall_cells", "hollow box: cells through the wall thickness").min(1).def(1);
+  box->list("regions",
+            "element regions (parts: energies by part, the failed element's part); elements "
+            "whose centre lies in no listed box stay in region 'all'; a later box takes over",
+            fem_box_region_spec());
 
   auto mesh =
       std::make_shared<Spec>("mesh", "the finite element mesh: a box or a Gmsh 4.1 ASCII file");
@@ -106,6 +111,7 @@ std::shared_ptr<Spec> make_spec() {
                  "j2-plasticity: tabulated hardening instead of yield_stress and hardening_modulus "
                  "(piecewise linear, flat beyond the last point)",
                  hardening_point);
+  material->section("failure", "rupture (j2-plasticity)", fem_failure_spec());
 
   auto constraint = std::make_shared<Spec>("constraint", "a Dirichlet condition on a node set");
   constraint->string("set", "node set (box: all, xmin ... zmax; Gmsh: physical group names)")
@@ -152,11 +158,14 @@ std::shared_ptr<Spec> make_spec() {
   probe->reals("to", "end of the segment").unit("m").size(3).required();
   probe->integer("points", "points along the segment").min(2).def(50);
   probe->strings("fields", "what to sample (default: displacement)")
-      .choices({"displacement", "stress", "von_mises"});
+      .choices({"displacement", "stress", "von_mises", "equivalent_plastic_strain"});
 
   auto point = std::make_shared<Spec>(
       "point", "a point monitor: the displacement interpolated at a point of the model");
-  point->string("name", "monitor quantities <name>.displacement_x, _y, _z").required();
+  point->string("name",
+                "monitor quantities <name>.displacement_x, _y, _z (and, with a nonlinear "
+                "material, <name>.equivalent_plastic_strain: the mean of the element's points)")
+      .required();
   point->reals("at", "the point, in the reference configuration (inside or on the model)")
       .unit("m")
       .size(3)
@@ -404,7 +413,9 @@ fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
                 : e == "hex20" ? fem::ElementType::Hex20
                 : e == "tet4"  ? fem::ElementType::Tet4
                                : fem::ElementType::Tet10;
-    return fem::make_box_mesh(b);
+    fem::Mesh box_mesh = fem::make_box_mesh(b);
+    apply_box_regions(box_mesh, m["box"]);
+    return box_mesh;
   }
   std::filesystem::path file = m.string("gmsh");
   if (file.is_relative()) file = case_dir / file;
@@ -437,6 +448,7 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
                            mat.real("density")};
     fem::Model model(std::move(mesh), material);
     if (auto law = build_law(mat)) model.set_material_law(std::move(law));
+    model.set_failure_criterion(build_failure_criterion(mat));
     const std::string hex8 = c["mesh"].string("hex8");
     model.set_hex8_formulation(hex8 == "full"    ? fem::Hex8Formulation::Full
                                : hex8 == "f-bar" ? fem::Hex8Formulation::FBar
@@ -539,6 +551,7 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         an["integrator"].fail("central-difference needs 'mass: lumped'");
       options.integrator = fem::Integrator::CentralDifference;
     }
+    check_failure_keys(mat, transient_ && options.integrator == fem::Integrator::CentralDifference);
     stable_step_factor_ = an.real("stable_step_factor");
     const std::string linear_solver = an.string("linear_solver");
     if (linear_solver == "cholmod") {
@@ -634,7 +647,9 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
            p.has("fields") ? p.strings("fields") : std::vector<std::string>{"displacement"})
         fields.push_back(f == "stress"      ? LineProbe::Field::stress
                          : f == "von_mises" ? LineProbe::Field::von_mises
-                                            : LineProbe::Field::displacement);
+                         : f == "equivalent_plastic_strain"
+                             ? LineProbe::Field::equivalent_plastic_strain
+                             : LineProbe::Field::displacement);
       const std::string pname = p.string("name");
       for (const auto& other : probes_)
         if (other.name() == pname) p["name"].fail("probe name '" + pname + "' is used twice");
@@ -744,6 +759,7 @@ void FemAdapter::advance(double dt) {
     throw Error("fem '" + name_ + "' at t = " + fmt::format("{:.6g}", solver_->time()) +
                 " s: " + with_newton_keys(e.what()));
   }
+  failure_log_.after_step(*solver_, name_);
   // the work of each interface's loads over this step: 1/2 (f_k + f_k+1) . du
   du_ = solver_->displacement() - u_before_;
   for (auto& i : interfaces_) {
@@ -790,6 +806,7 @@ void FemAdapter::restore_checkpoint() {
   if (!has_checkpoint_)
     throw Error("fem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   solver_->restore_state(checkpoint_);
+  failure_log_.restored(*solver_);
   for (auto& i : interfaces_) i.audit = i.audit_checkpoint;
 }
 
@@ -855,6 +872,7 @@ void FemAdapter::read_restart(BinaryReader& in) {
     in.read(i.audit.tractions);
   }
   solver_->restore_state(s);
+  failure_log_.restored(*solver_);
 }
 
 void FemAdapter::write_output(const OutputFrame& frame) {
@@ -896,11 +914,16 @@ std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::stri
       m.push_back(
           {i.name + ".displacement_" + kComponents[static_cast<std::size_t>(k)], "m", d(k)});
   }
+  const Eigen::VectorXd eqps =
+      points_.empty() ? Eigen::VectorXd() : solver_->element_equivalent_plastic_strain();
   for (const auto& p : points_) {
     const Eigen::Vector3d d = locator_->interpolate(p.at, solver_->displacement());
     for (int k = 0; k < 3; ++k)
       m.push_back(
           {p.name + ".displacement_" + kComponents[static_cast<std::size_t>(k)], "m", d(k)});
+    if (eqps.size() > 0)
+      m.push_back({p.name + ".equivalent_plastic_strain", "",
+                   eqps[static_cast<Eigen::Index>(p.at.element)]});
   }
   // Minus the applied loads (gravity included): what the interfaces carry in static equilibrium.
   const Eigen::Vector3d applied = solver_->total_external_force() - solver_->total_coupling_force();
@@ -914,6 +937,7 @@ std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::stri
   if (wanted("external_work")) m.push_back({"external_work", "J", solver_->external_work()});
   if (wanted("damping_work")) m.push_back({"damping_work", "J", solver_->damping_work()});
   if (wanted("energy_balance")) m.push_back({"energy_balance", "J", solver_->energy_balance()});
+  append_rupture_monitors(*solver_, wanted, m);
   m.push_back({"newton_iterations", "", static_cast<double>(solver_->newton_iterations())});
   if (names.empty()) return m;
   std::vector<MonitorValue> out;

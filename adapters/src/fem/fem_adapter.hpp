@@ -13,13 +13,14 @@
 // Monitors: N.force_x|y|z (total interface force received [N]), static_reaction_z (the force the
 // interfaces must carry for static equilibrium: minus the sum of the applied loads, gravity
 // included [N]), max_displacement [m], kinetic_energy, strain_energy, plastic_work,
-// external_work, damping_work, energy_balance (external - strain - kinetic - plastic - damping)
-// [J].
+// external_work, damping_work, energy_balance (external - strain - kinetic - plastic - damping
+// - eroded) [J]; rupture and energies by part: see fem_rupture.hpp.
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "fem_rupture.hpp"
 #include "line_probe.hpp"
 #include "partita/fem/fem.hpp"
 #include "mesh_locator.hpp"
@@ -95,6 +96,7 @@ class FemAdapter : public Solver {
   };
   std::unique_ptr<MeshLocator> locator_;  // only with point monitors
   std::vector<PointMonitor> points_;
+  FailureLog failure_log_;  // logs the first failed element
 };
 
 }  // namespace partita::adapters

@@ -1,5 +1,7 @@
 #include "fem_output.hpp"
 
+#include <algorithm>
+
 namespace partita::adapters {
 
 std::uint8_t vtk_cell_type(fem::ElementType type) {
@@ -49,8 +51,32 @@ void write_fem_vtu(const fem::StructuralSolver& solver, const std::filesystem::p
   piece.point_active = {
       {"Vectors", "displacement"}, {"Tensors", "stress"}, {"Scalars", "von_mises"}};
   piece.cell_data = {DataArray::view("region", region.data(), ne)};
-  if (eqps.size() > 0)
+  // equivalent plastic strain: per cell (the mean of its points) and per point (the mean of
+  // the cells that share it); `failed` (1: failed, 2: eroded) with a failure criterion
+  Eigen::VectorXd eqps_nodes;
+  std::vector<std::int32_t> failed;
+  if (eqps.size() > 0) {
     piece.cell_data.push_back(DataArray::view("equivalent_plastic_strain", eqps.data(), ne));
+    eqps_nodes = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+    Eigen::VectorXd count = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
+    for (std::size_t e = 0; e < ne; ++e)
+      for (const std::size_t v : mesh.elements()[e].node_span()) {
+        eqps_nodes[static_cast<Eigen::Index>(v)] += eqps[static_cast<Eigen::Index>(e)];
+        count[static_cast<Eigen::Index>(v)] += 1.0;
+      }
+    eqps_nodes = eqps_nodes.cwiseQuotient(count.cwiseMax(1.0));
+    piece.point_data.push_back(
+        DataArray::view("equivalent_plastic_strain", eqps_nodes.data(), n));
+    bool criteria = false;
+    for (std::size_t r = 0; r < std::max<std::size_t>(1, mesh.region_names().size()); ++r)
+      criteria = criteria || solver.model().failure_criterion(static_cast<int>(r)).active();
+    if (criteria) {
+      failed.resize(ne);
+      for (std::size_t e = 0; e < ne; ++e)
+        failed[e] = solver.element_eroded(e) ? 2 : solver.element_failed(e) ? 1 : 0;
+      piece.cell_data.push_back(DataArray::view("failed", failed.data(), ne));
+    }
+  }
   vtk::write(path, piece, options);
 }
 

@@ -51,8 +51,14 @@ LineProbe::LineProbe(std::string name, const fem::Mesh& mesh, const fem::Vec3& f
 }
 
 std::string LineProbe::csv(const fem::StructuralSolver& solver) const {
-  const bool want_stress =
-      std::any_of(fields_.begin(), fields_.end(), [](Field f) { return f != Field::displacement; });
+  const bool want_stress = std::any_of(fields_.begin(), fields_.end(), [](Field f) {
+    return f == Field::stress || f == Field::von_mises;
+  });
+  const bool want_eqps = std::find(fields_.begin(), fields_.end(),
+                                   Field::equivalent_plastic_strain) != fields_.end();
+  Eigen::VectorXd eqps = want_eqps ? solver.element_equivalent_plastic_strain() : Eigen::VectorXd();
+  if (want_eqps && eqps.size() == 0)  // linear elastic: no plastic strain anywhere
+    eqps = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh_->num_elements()));
   const fem::MatrixX6 stress = want_stress ? solver.nodal_stress() : fem::MatrixX6();
   const Eigen::VectorXd& u = solver.displacement();
   std::string s = "s [m],x [m],y [m],z [m]";
@@ -62,6 +68,7 @@ std::string LineProbe::csv(const fem::StructuralSolver& solver) const {
     if (f == Field::stress)
       for (const char* c : voigt) s += std::string(",stress_") + c + " [Pa]";
     if (f == Field::von_mises) s += ",von_mises [Pa]";
+    if (f == Field::equivalent_plastic_strain) s += ",equivalent_plastic_strain";
   }
   s += "\n";
   fem::ShapeVector n;
@@ -89,6 +96,8 @@ std::string LineProbe::csv(const fem::StructuralSolver& solver) const {
         one.row(0) = sp;
         s += ",", append(s, fem::StructuralSolver::von_mises(one)(0));
       }
+      if (f == Field::equivalent_plastic_strain)
+        s += ",", append(s, eqps[static_cast<Eigen::Index>(p.element)]);
     }
     s += "\n";
   }

@@ -2,7 +2,8 @@
 // A line probe of an FE model: N points evenly along a segment, each located once in the
 // reference mesh (its element and local coordinates), then sampled at every output time:
 // displacement u(x) = sum_i N_i(xi) u_i, Cauchy stress by the same interpolation of the nodal
-// (element-averaged) stresses, von Mises of that stress. Written as one CSV per output time:
+// (element-averaged) stresses, von Mises of that stress, the equivalent plastic strain of the
+// element that holds the point (the mean of its quadrature points: constant per element). Written as one CSV per output time:
 // s [m] (the distance along the segment), x, y, z [m], then the fields.
 
 #include <filesystem>
@@ -15,7 +16,7 @@ namespace partita::adapters {
 
 class LineProbe {
  public:
-  enum class Field { displacement, stress, von_mises };
+  enum class Field { displacement, stress, von_mises, equivalent_plastic_strain };
 
   /// Locates `points` >= 2 points from `from` to `to` in `mesh`; throws fem::Error naming the
   /// first point that lies in no element (the segment leaves the model).

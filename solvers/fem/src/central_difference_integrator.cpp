@@ -1,6 +1,7 @@
 #include "partita/fem/central_difference_integrator.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "parallel_loop.hpp"
 #include "partita/fem/error.hpp"
@@ -23,11 +24,18 @@ void for_blocks(std::size_t n, Body body) {
 
 }  // namespace
 
+void CentralDifferenceIntegrator::load_mass(StructuralSystem& system) {
+  m_ = system.mass().diagonal();
+  // a massless node stays put: a = f / m_max_double ~ 0 (its velocity is zero, see the header)
+  for (Eigen::Index d = 0; d < m_.size(); ++d)
+    if (!(m_[d] > 0.0)) m_[d] = std::numeric_limits<double>::max();
+}
+
 void CentralDifferenceIntegrator::initialise(StructuralSystem& system, Kinematics& kin) {
   if (!system.lumped_mass()) {
     throw Error("central difference needs a lumped (diagonal) mass: set the mass to lumped");
   }
-  m_ = system.mass().diagonal();
+  load_mass(system);
   system.external_force(kin.time, kin.f);
   system.internal_forces().evaluate(kin.u, kin.f_int, nullptr);
   // a = M^-1 (F - f_int - beta K0 v) - alpha v on the free dofs
@@ -41,7 +49,7 @@ void CentralDifferenceIntegrator::initialise(StructuralSystem& system, Kinematic
 }
 
 void CentralDifferenceIntegrator::step(StructuralSystem& system, Kinematics& kin, double dt) {
-  if (m_.size() != kin.u.size()) m_ = system.mass().diagonal();
+  if (m_.size() != kin.u.size()) load_mass(system);
   const double alpha = system.mass_damping(), beta = system.stiffness_damping();
   const double t1 = kin.time + dt;
   // v_1/2 = v + dt/2 a;  u_1 = u + dt v_1/2

@@ -1,6 +1,7 @@
 #include "partita/fem/material_contribution.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <array>
 #include <type_traits>
 #include <chrono>
@@ -11,6 +12,7 @@
 #include "parallel_loop.hpp"
 #include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
+#include "partita/fem/failure_criterion.hpp"
 #include "partita/fem/inverted_element_error.hpp"
 #include "partita/fem/linear_elastic_law.hpp"
 #include "partita/fem/quadrature.hpp"
@@ -160,7 +162,30 @@ MaterialContribution::MaterialContribution(const Model& model)
     eas_offset_.push_back(alpha_end);
     if (eas_hex8_ && e.type == ElementType::Hex8) alpha_end += 9;
   }
+  // rupture: each element's failure time (-1: intact), then the eroded energy
+  element_failure_strain_.assign(mesh_.num_elements(), std::numeric_limits<double>::infinity());
+  element_erodes_.assign(mesh_.num_elements(), 0);
+  element_energy_.assign(mesh_.num_elements(), 0.0);
+  for (std::size_t e = 0; e < mesh_.num_elements(); ++e) {
+    const Element& el = mesh_.elements()[e];
+    const FailureCriterion& c = model.failure_criterion(el.region);
+    if (!c.active()) continue;
+    if (element_law_[e]->state_size() == 0) {
+      throw Error("region '" + mesh_.region_names().at(static_cast<std::size_t>(el.region)) +
+                  "': a failure criterion needs a law with plastic strain (j2-plasticity); '" +
+                  std::string(element_law_[e]->name()) + "' has none and would never fail");
+    }
+    element_failure_strain_[e] = c.failure_strain(failure_element_length(mesh_, el));
+    element_erodes_[e] = c.erosion ? 1 : 0;
+    erosion_ = erosion_ || c.erosion;
+    failure_offset_ = alpha_end;
+  }
+  if (failure_offset_ != kNoFailure) alpha_end += mesh_.num_elements() + 1;
   committed_.assign(alpha_end, 0.0);
+  if (failure_offset_ != kNoFailure) {
+    std::fill_n(committed_.begin() + static_cast<std::ptrdiff_t>(failure_offset_),
+                mesh_.num_elements(), -1.0);
+  }
   for (std::size_t e = 0; e < element_law_.size(); ++e) {
     for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
       element_law_[e]->initialise_state(
@@ -219,6 +244,7 @@ void MaterialContribution::add(const Eigen::VectorXd& u, Eigen::VectorXd& f_int,
       }
       assembler.add(*k, el.node_span(), chunk_ke_[static_cast<std::size_t>(i)]);
       energy_ += chunk_energy_[static_cast<std::size_t>(i)];
+      element_energy_[c0 + static_cast<std::size_t>(i)] = chunk_energy_[static_cast<std::size_t>(i)];
       const ElementVector& fa = chunk_fabs_[static_cast<std::size_t>(i)];
       for (int a = 0; a < nn; ++a) node_round_off_[static_cast<Eigen::Index>(el.nodes[a])] += fa[a];
     }
@@ -271,7 +297,7 @@ void MaterialContribution::add_force_only(const Eigen::VectorXd& u, Eigen::Vecto
     }
     flat_fe_.assign(3 * flat_offset_.back(), 0.0);
     flat_fabs_.assign(flat_offset_.back(), 0.0);
-    element_energy_.assign(ne, 0.0);
+    element_energy_.assign(ne, 0.0);  // (sized by the constructor already; kept for clarity)
   }
   const auto t0 = Clock::now();
   // A material law may throw: the first element's exception comes out, as from a serial loop.
@@ -318,6 +344,7 @@ void MaterialContribution::evaluate_element(std::size_t e, const Eigen::VectorXd
   fe.setZero(3 * nn);
   fabs.setZero(nn);
   if (ke != nullptr) ke->setZero(3 * nn, 3 * nn);
+  if (failure_offset_ != kNoFailure && eroded(e)) return;  // an eroded element: nothing
   if (eas_hex8_ && el.type == ElementType::Hex8) {
     evaluate_eas(e, ue, fe, ke, energy, fabs);
   } else if (fbar_hex8_ && el.type == ElementType::Hex8) {
@@ -649,6 +676,7 @@ double MaterialContribution::dissipated_work() const {
   // W_p = sum_q w_p(history_q) det J w
   for (std::size_t e = 0; e < element_law_.size(); ++e) {
     if (element_law_[e]->state_size() == 0) continue;
+    if (failure_offset_ != kNoFailure && eroded(e)) continue;  // in eroded_energy()
     for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
       wp += element_law_[e]->plastic_work_density(
                 std::span<const double>(committed_)
@@ -657,6 +685,61 @@ double MaterialContribution::dissipated_work() const {
     }
   }
   return wp;
+}
+
+double MaterialContribution::element_plastic_work(std::size_t e) const {
+  double wp = 0.0;
+  if (element_law_[e]->state_size() == 0) return wp;
+  for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
+    wp += element_law_[e]->plastic_work_density(std::span<const double>(committed_).subspan(
+              state_offset_[q], state_offset_[q + 1] - state_offset_[q])) *
+          weight_[q];
+  }
+  return wp;
+}
+
+double MaterialContribution::element_plastic_strain(std::size_t e) const {
+  double sum = 0.0;
+  for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
+    sum += element_law_[e]->equivalent_plastic_strain(std::span<const double>(committed_).subspan(
+        state_offset_[q], state_offset_[q + 1] - state_offset_[q]));
+  }
+  return sum / static_cast<double>(qp_offset_[e + 1] - qp_offset_[e]);
+}
+
+double MaterialContribution::failure_time(std::size_t e) const {
+  return failure_offset_ == kNoFailure ? -1.0 : committed_[failure_offset_ + e];
+}
+
+std::size_t MaterialContribution::num_failed() const {
+  std::size_t n = 0;
+  for (std::size_t e = 0; e < mesh_.num_elements(); ++e) n += failed(e) ? 1 : 0;
+  return n;
+}
+
+double MaterialContribution::eroded_energy() const {
+  return failure_offset_ == kNoFailure ? 0.0 : committed_[failure_offset_ + mesh_.num_elements()];
+}
+
+void MaterialContribution::add_eroded_energy(double w) {
+  if (failure_offset_ == kNoFailure) return;
+  const std::size_t i = failure_offset_ + mesh_.num_elements();
+  committed_[i] += w;
+  trial_[i] = committed_[i];
+}
+
+std::vector<std::size_t> MaterialContribution::update_failures(double time) {
+  std::vector<std::size_t> newly;
+  if (failure_offset_ == kNoFailure) return newly;
+  // failed when the committed mean eps_p over the element's points reaches eps_f
+  for (std::size_t e = 0; e < mesh_.num_elements(); ++e) {
+    if (failed(e) || !(element_plastic_strain(e) >= element_failure_strain_[e])) continue;
+    committed_[failure_offset_ + e] = trial_[failure_offset_ + e] = time;
+    newly.push_back(e);
+    // erosion: its strain energy (at the committed u) and plastic work leave with it
+    if (element_erodes_[e] != 0) add_eroded_energy(element_energy_[e] + element_plastic_work(e));
+  }
+  return newly;
 }
 
 void MaterialContribution::set_committed_state(const std::vector<double>& state) {

@@ -206,6 +206,22 @@ void Mesh::validate() const {
   }
 }
 
+std::size_t Mesh::assign_region_where(const std::string& name,
+                                      const std::function<bool(const Vec3&)>& pred) {
+  if (region_names_.empty()) region_names_.push_back("all");
+  const int r = add_region(name);
+  std::size_t moved = 0;
+  for (auto& e : elements_) {
+    Vec3 c = Vec3::Zero();
+    for (auto n : e.node_span()) c += nodes_[n];
+    if (pred(c / static_cast<double>(e.node_span().size()))) {
+      e.region = r;
+      ++moved;
+    }
+  }
+  return moved;
+}
+
 int Mesh::region(const std::string& name) const {
   auto it = std::find(region_names_.begin(), region_names_.end(), name);
   if (it == region_names_.end()) {

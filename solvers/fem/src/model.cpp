@@ -12,6 +12,15 @@ Model::Model(Mesh mesh, const Material& material) : mesh_(std::move(mesh)) {
   material.validate();
   materials_.assign(std::max<std::size_t>(1, mesh_.region_names().size()), material);
   laws_.assign(materials_.size(), nullptr);
+  failure_.assign(materials_.size(), FailureCriterion{});
+}
+
+void Model::set_failure_criterion(const FailureCriterion& criterion) {
+  std::fill(failure_.begin(), failure_.end(), criterion);
+}
+
+void Model::set_failure_criterion(const std::string& region, const FailureCriterion& criterion) {
+  failure_.at(static_cast<std::size_t>(mesh_.region(region))) = criterion;
 }
 
 void Model::set_material(const Material& material) {

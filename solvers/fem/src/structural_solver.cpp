@@ -71,6 +71,7 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
   coupling_force_ = Eigen::VectorXd::Zero(n);
   setup_dofs();
   if (model_.is_linear()) {
+    validate_failure_setup();
     assemble_stiffness();
     operator_ = std::make_unique<LinearElasticOperator>(k_);
   } else {
@@ -78,6 +79,7 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
     auto op = std::make_unique<NonlinearOperator>(model_);
     nonlinear_ = op.get();
     operator_ = std::move(op);
+    validate_failure_setup();
     if (options_.rayleigh_beta != 0.0) {
       // K0 = K_t(u = 0) with the initial history, symmetrised: the damping stiffness
       Eigen::VectorXd f0;
@@ -195,7 +197,9 @@ void StructuralSolver::assemble_mass() {
   } else {
     Eigen::VectorXd diag = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ndof_));
     Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
-    for (const auto& e : mesh().elements()) {
+    for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei) {
+      const Element& e = mesh().elements()[ei];
+      if (element_eroded(ei)) continue;  // erosion: the element's mass has left
       integrator_.lumped_mass(e.type, element_coordinates(mesh(), e), model_.density(e.region), m);
       for (int a = 0; a < node_count(e.type); ++a) {
         diag.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a])).array() += m[a];
@@ -452,6 +456,7 @@ void StructuralSolver::solve_static() {
   if (nonlinear_ != nullptr) {
     static_.solve(*this, kin_, kin_.time);
     refresh_internal_force();
+    update_failures();
     acceleration_valid_ = true;
     ++timings_.solves;
     timings_.solve += seconds_since(t0);
@@ -576,6 +581,7 @@ void StructuralSolver::step(double dt) {
       newmark_.step(*this, kin_, dt);
       refresh_internal_force();
     }
+    update_failures();
     ++steps_;
     ++timings_.solves;
     timings_.solve += seconds_since(t0);
@@ -745,8 +751,9 @@ double StructuralSolver::plastic_work() const {
 }
 
 double StructuralSolver::energy_balance() const {
-  // W_ext - (W_strain + E_kin + W_plastic + W_damping)
-  return external_work() - (strain_energy() + kinetic_energy() + plastic_work() + damping_work());
+  // W_ext - (W_strain + E_kin + W_plastic + W_damping + W_eroded)
+  return external_work() -
+         (strain_energy() + kinetic_energy() + plastic_work() + damping_work() + eroded_energy());
 }
 
 int StructuralSolver::newton_iterations() const {
@@ -943,6 +950,12 @@ void StructuralSolver::restore_state(const SolverState& s) {
   if (s.factor_dt > 0.0 && s.factor_dt != factor_dt_) {
     assemble_mass();  // K_eff needs M (assembled lazily at the first step)
     factorise_dynamic(s.factor_dt);
+  }
+  if (nonlinear_ != nullptr && nonlinear_->material().erosion() && mass_ready_) {
+    // the eroded elements of this state, not those of the last: the lumped mass again
+    mass_ready_ = false;
+    assemble_mass();
+    central_.invalidate_mass();
   }
   if (nonlinear_ != nullptr || options_.integrator == Integrator::CentralDifference) {
     refresh_internal_force();

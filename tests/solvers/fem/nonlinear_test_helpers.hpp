@@ -3,10 +3,13 @@
 #include <Eigen/Dense>
 #include <functional>
 #include <memory>
+#include <optional>
+#include <regex>
 #include <sstream>
 #include <string>
 
 #include "fem_test_helpers.hpp"
+#include "partita/fem/error.hpp"
 #include "partita/fem/internal_force_operator.hpp"
 #include "partita/fem/model.hpp"
 #include "partita/fem/newton_report.hpp"
@@ -132,6 +135,22 @@ inline double tip_deflection(const StructuralSolver& s) {
   const auto& nodes = s.mesh().node_set("xmax");
   for (auto n : nodes) w += s.displacement(n).z();
   return -w / static_cast<double>(nodes.size());
+}
+
+// step_static(1.0) of a load beyond a limit load: the largest load factor reached, read from the
+// limit-load message; nullopt when it converged or failed otherwise. `what` gets the message.
+inline std::optional<double> limit_load_factor(StructuralSolver& s, std::string& what) {
+  what.clear();
+  try {
+    s.step_static(1.0);
+  } catch (const Error& e) {
+    what = e.what();
+  }
+  std::smatch m;
+  if (what.find("limit load") == std::string::npos ||
+      !std::regex_search(what, m, std::regex("largest load factor reached is ([0-9.eE+-]+)")))
+    return std::nullopt;
+  return std::stod(m[1].str());
 }
 
 }  // namespace partita::fem::test

@@ -11,13 +11,18 @@ namespace partita::fem {
 // prescribed dofs: v_1 = (u_1 - u) / dt, a_1 = 0. The history is committed every step.
 // Stable for dt <= 2 / omega_max (see StructuralSolver::stable_time_step()). The state at full
 // steps (u, v, a) is all it needs: restoring it continues bit-identically.
+// A node without mass (one no element holds any more: erosion, or unused by the mesh) is held
+// where it is (a = 0: its mass is taken as the largest double).
 class CentralDifferenceIntegrator {
  public:
   void step(StructuralSystem& system, Kinematics& kin, double dt);
   // a = M^-1 (F - f_int(u) - C v) on the free dofs (start of a run).
   void initialise(StructuralSystem& system, Kinematics& kin);
+  // The system's mass changed (element erosion): read it again at the next step.
+  void invalidate_mass() { m_.resize(0); }
 
  private:
+  void load_mass(StructuralSystem& system);
   Eigen::VectorXd v_half_, f1_, u1_, m_, cv_;
 };
 

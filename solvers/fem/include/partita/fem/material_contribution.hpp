@@ -89,6 +89,32 @@ class MaterialContribution final : public OperatorContribution {
   };
   const PhaseSeconds& last_add_seconds() const { return phase_seconds_; }
 
+  // --- rupture (the model's FailureCriterion per region) and energies per element ---
+  // With a criterion in some region the committed state holds, after the points' histories and
+  // the EAS alphas, each element's failure time (-1: intact) and the eroded energy, so that
+  // restarts keep them. update_failures() (after a commit) marks the elements whose committed
+  // mean equivalent plastic strain reached their eps_f as failed at `time` and returns them;
+  // an element of a region with erosion then leaves the operator (no force, tangent or energy
+  // from the next add() on) and its strain energy and plastic work pass to eroded_energy().
+  bool has_failure_criteria() const { return failure_offset_ != kNoFailure; }
+  bool erosion() const { return erosion_; }
+  std::vector<std::size_t> update_failures(double time);
+  double failure_time(std::size_t e) const;  // -1 while intact
+  bool failed(std::size_t e) const { return failure_time(e) >= 0.0; }
+  bool eroded(std::size_t e) const { return element_erodes_[e] != 0 && failed(e); }
+  double failure_strain(std::size_t e) const { return element_failure_strain_[e]; }
+  std::size_t num_failed() const;
+  // strain energy and plastic work of the eroded elements at erosion, plus what the solver adds
+  // (the kinetic energy of their mass) [J]
+  double eroded_energy() const;
+  void add_eroded_energy(double w);
+  // committed mean equivalent plastic strain of element e
+  double element_plastic_strain(std::size_t e) const;
+  // int W dV of each element at the last add() (0 for eroded elements)
+  const std::vector<double>& element_strain_energy() const { return element_energy_; }
+  // committed plastic work of element e [J]
+  double element_plastic_work(std::size_t e) const;
+
  private:
   using ElementDisplacements = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
   // One element's fe and, when ke != nullptr, ke (zeroed by the caller); adds its strain energy
@@ -111,7 +137,7 @@ class MaterialContribution final : public OperatorContribution {
   // add_force_only()'s buffers: element e's nodal values from flat_offset_[e] (fe: 3 each);
   // per node n, node_incidence_[node_incidence_offset_[n] ...] its flat indices in element order
   std::vector<std::size_t> flat_offset_, node_incidence_offset_, node_incidence_;
-  std::vector<double> flat_fe_, flat_fabs_, element_energy_;
+  std::vector<double> flat_fe_, flat_fabs_;
   // Per-element results of one chunk of elements (add() computes a chunk in parallel and adds
   // it to f and K in element order): sized once, reused.
   std::vector<ElementVector> chunk_fe_;
@@ -138,6 +164,13 @@ class MaterialContribution final : public OperatorContribution {
   std::vector<double> committed_, trial_;
   double energy_ = 0.0;
   double round_off_ = 0.0;
+  // rupture: see update_failures()
+  static constexpr std::size_t kNoFailure = static_cast<std::size_t>(-1);
+  std::size_t failure_offset_ = kNoFailure;      // failure times' start in the state
+  bool erosion_ = false;                         // some region erodes
+  std::vector<double> element_failure_strain_;   // per element: eps_f (inf: none)
+  std::vector<char> element_erodes_;             // per element: its region erodes
+  std::vector<double> element_energy_;           // per element: int W dV at the last add()
   MatrixX6 cauchy_;
   Eigen::VectorXd eqps_;
   PhaseSeconds phase_seconds_;

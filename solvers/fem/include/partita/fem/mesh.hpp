@@ -28,6 +28,10 @@ class Mesh {
   void add_node_set(const std::string& name, std::vector<std::size_t> nodes);
   // The set of nodes whose position satisfies pred.
   void add_node_set_where(const std::string& name, const std::function<bool(const Vec3&)>& pred);
+  // Moves every element whose centroid (the mean of its nodes) satisfies pred into the region
+  // `name` (created if needed); returns how many moved. (Regions of a box mesh.)
+  std::size_t assign_region_where(const std::string& name,
+                                  const std::function<bool(const Vec3&)>& pred);
   // Drops nodes that no element uses and renumbers nodes, sets and faces.
   void remove_unused_nodes();
   // Replaces every face element by the matching local face of the volume element it lies on

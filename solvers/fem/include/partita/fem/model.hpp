@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "partita/fem/dirichlet_condition.hpp"
+#include "partita/fem/failure_criterion.hpp"
 #include "partita/fem/hex8_formulation.hpp"
 #include "partita/fem/load.hpp"
 #include "partita/fem/material.hpp"
@@ -38,6 +39,13 @@ class Model {
   // True when every region is linear elastic: the solver's factorise-once path applies.
   bool is_linear() const;
   double density(int region) const;
+  // Rupture: a failure criterion for every region / one region (none by default; see
+  // FailureCriterion). Needs a law with plastic strain (j2-plasticity) to ever fail.
+  void set_failure_criterion(const FailureCriterion& criterion);
+  void set_failure_criterion(const std::string& region, const FailureCriterion& criterion);
+  const FailureCriterion& failure_criterion(int region) const {
+    return failure_.at(static_cast<std::size_t>(region));
+  }
   void set_hex8_formulation(Hex8Formulation f) { hex8_ = f; }
   Hex8Formulation hex8_formulation() const { return hex8_; }
 
@@ -62,6 +70,7 @@ class Model {
   Mesh mesh_;
   std::vector<Material> materials_;
   std::vector<std::shared_ptr<const MaterialLaw>> laws_;  // per region; nullptr: linear elastic
+  std::vector<FailureCriterion> failure_;                 // per region
   Hex8Formulation hex8_ = Hex8Formulation::IncompatibleModes;
   std::vector<DirichletCondition> dirichlet_;
   std::vector<Load> loads_;

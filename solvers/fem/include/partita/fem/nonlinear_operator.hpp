@@ -45,6 +45,7 @@ class NonlinearOperator final : public InternalForceOperator {
 
   // The material's contribution and its per-point results (see MaterialContribution).
   const MaterialContribution& material() const { return *material_; }
+  MaterialContribution& material() { return *material_; }
   std::size_t num_quadrature_points() const { return material_->num_quadrature_points(); }
   bool fbar_hex8() const { return material_->fbar_hex8(); }
   const MatrixX6& cauchy_stress() const { return material_->cauchy_stress(); }

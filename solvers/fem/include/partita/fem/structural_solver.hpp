@@ -2,6 +2,7 @@
 #include <cstddef>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,12 +11,14 @@
 #include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/face_mesh.hpp"
+#include "partita/fem/failure_event.hpp"
 #include "partita/fem/face_quadrature_point.hpp"
 #include "partita/fem/linear_solver.hpp"
 #include "partita/fem/model.hpp"
 #include "partita/fem/newmark_integrator.hpp"
 #include "partita/fem/nonlinear_operator.hpp"
 #include "partita/fem/operator_contribution.hpp"
+#include "partita/fem/region_energies.hpp"
 #include "partita/fem/solver_options.hpp"
 #include "partita/fem/solver_state.hpp"
 #include "partita/fem/solver_timings.hpp"
@@ -132,8 +135,8 @@ class StructuralSolver final : private StructuralSystem {
   double external_work() const {
     return kin_.external_work;
   }  // sum 1/2 (F_n + F_n+1).(u_n+1 - u_n)
-  // external work - (strain + kinetic + plastic + damping) [J]: zero for an exact energy
-  // balance (prescribed displacements do work through the reactions, not counted here).
+  // external work - (strain + kinetic + plastic + damping + eroded) [J]: zero for an exact
+  // energy balance (prescribed displacements do work through the reactions, not counted here).
   double energy_balance() const;
   double max_displacement() const;    // max over nodes of |u|
   Vec3 total_coupling_force() const;  // sum of the coupling loads [N]
@@ -149,6 +152,23 @@ class StructuralSolver final : private StructuralSystem {
   Eigen::VectorXd equivalent_plastic_strain() const;
   // Mean over each element's quadrature points (one value per element; empty when linear).
   Eigen::VectorXd element_equivalent_plastic_strain() const;
+  // --- rupture and energies by part (structural_solver_failure.cpp) ---
+  // With a FailureCriterion in the model (nonlinear path), every step / static solve ends by
+  // marking the elements whose committed mean equivalent plastic strain reached their eps_f as
+  // failed at time(). With erosion (central difference only: static and Newmark refuse it at
+  // construction, as does stiffness-proportional damping, whose K0 would keep the element) a
+  // failed element leaves the internal force and the lumped mass; its strain energy, plastic
+  // work and the kinetic energy of its mass go to eroded_energy(); a node left without any
+  // element is held where it is. Operator contributions that hold surfaces (contact) can ask
+  // element_failed() to drop the faces of eroded elements.
+  std::size_t failed_elements() const;
+  bool element_failed(std::size_t element) const;
+  bool element_eroded(std::size_t element) const;
+  // The first element to fail (the earliest time; the lowest id among those of that step).
+  std::optional<FailureEvent> first_failure() const;
+  double eroded_energy() const;
+  RegionEnergies region_energies() const;
+  double max_equivalent_plastic_strain() const;  // over all quadrature points (0 if linear)
   // Newton reports of the last nonlinear static solve / Newmark step.
   const std::vector<NewtonReport>& static_reports() const { return static_.reports(); }
   const NewtonReport& newmark_report() const { return newmark_.last_report(); }
@@ -200,6 +220,8 @@ class StructuralSolver final : private StructuralSystem {
   void external_force(double t, Eigen::VectorXd& f) const override;
   void apply_prescribed(double t, Eigen::VectorXd& u) const override;
   void factorise_dynamic(double dt);
+  void validate_failure_setup() const;  // structural_solver_failure.cpp
+  void update_failures();               // after each step: see failed_elements()
 
   Model model_;
   SolverOptions options_;

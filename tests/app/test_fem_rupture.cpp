@@ -1,0 +1,125 @@
+// The FE adapter's rupture and energies-by-part keys (issue 27) from YAML
+// (tests/inputs/fem/strip_rupture.yaml): the first failure time against the closed form, the
+// log line naming the failed element's part, the per-part energies adding up to the totals,
+// and erosion keeping the energy balance.
+#include <catch2/catch.hpp>
+
+#include "../support/run_command.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+using partita::test::quote;
+
+namespace {
+
+struct Run {
+  std::string log;
+  std::vector<std::vector<double>> probe;  // the last frame of the line probe 
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+};
+
+Run run_strip(const std::vector<std::string>& sets) {
+  static int count = 0;
+  const fs::path dir = fs::temp_directory_path() / ("partita_rupture_" + std::to_string(::getpid()) +
+                                                    "_" + std::to_string(count++));
+  std::string cmd = quote(PARTITA_EXECUTABLE) + " run " +
+                    quote((fs::path(PARTITA_SOURCE_DIR) / "tests/inputs/fem/strip_rupture.yaml")
+                              .string()) +
+                    " --output " + quote(dir.string());
+  for (const auto& s : sets) cmd += " --set " + quote(s);
+  const auto r = partita::test::run_command(cmd);
+  INFO(cmd << "\n" << r.output);
+  REQUIRE(r.status == 0);
+  Run run;
+  run.log = r.output;
+  std::ifstream in(dir / "rupture.csv");
+  std::string line;
+  std::getline(in, line);
+  std::stringstream h(line);
+  for (std::string c; std::getline(h, c, ',');) run.header.push_back(c.substr(0, c.find(" [")));
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream s(line);
+    for (std::string c; std::getline(s, c, ',');) v.push_back(std::stod(c));
+    run.rows.push_back(v);
+  }
+  std::vector<fs::path> frames;
+  for (const auto& f : fs::directory_iterator(dir / "probes")) frames.push_back(f.path());
+  REQUIRE(!frames.empty());
+  std::sort(frames.begin(), frames.end());
+  std::ifstream probe(frames.back());
+  std::getline(probe, line);
+  REQUIRE(line == "s [m],x [m],y [m],z [m],equivalent_plastic_strain");
+  while (std::getline(probe, line)) {
+    std::vector<double> v;
+    std::stringstream s(line);
+    for (std::string c; std::getline(s, c, ',');) v.push_back(std::stod(c));
+    run.probe.push_back(v);
+  }
+  fs::remove_all(dir);
+  REQUIRE(!run.rows.empty());
+  return run;
+}
+
+std::size_t column(const Run& r, const std::string& name) {
+  for (std::size_t i = 0; i < r.header.size(); ++i)
+    if (r.header[i] == name) return i;
+  FAIL("no column " << name);
+  return 0;
+}
+
+}  // namespace
+
+TEST_CASE("fem adapter: a strip's first failure time, its log line and the energies by part",
+          "[app][fem][rupture]") {
+  const Run r = run_strip({});
+  const double t_f = 0.04 * (250e6 + 2e9 * 0.02) / 350e6;
+  const auto& last = r.rows.back();
+  CHECK(last[column(r, "strip.failed_elements")] == 3.0);
+  CHECK(last[column(r, "strip.first_failure_time")] == Approx(t_f).epsilon(0.02));
+  CHECK(r.rows.front()[column(r, "strip.first_failure_time")] == -1.0);
+  CHECK(r.log.find("first failure at t =") != std::string::npos);
+  CHECK(r.log.find("of part '") != std::string::npos);
+  // the point's element is the middle one: its mean eps_p, the largest (uniform strip)
+  CHECK(last[column(r, "strip.centre.equivalent_plastic_strain")] >= 0.02);
+  CHECK(last[column(r, "strip.max_equivalent_plastic_strain")] >=
+        last[column(r, "strip.centre.equivalent_plastic_strain")]);
+  // the line probe through the three elements' centres: each has failed, eps_p >= eps_f
+  REQUIRE(r.probe.size() == 3);
+  for (const auto& p : r.probe) CHECK(p[4] >= 0.02);
+  // the parts add up to the totals, at every recorded time
+  for (const auto& row : r.rows) {
+    for (const char* q : {"plastic_work", "kinetic_energy"}) {
+      const std::string s(q);
+      const double sum = row[column(r, "strip.left." + s)] + row[column(r, "strip.middle." + s)] +
+                         row[column(r, "strip.all." + s)];
+      CHECK(sum == Approx(row[column(r, "strip." + s)]).epsilon(1e-8).margin(1e-12));  // CSV digits
+    }
+  }
+  CHECK(std::abs(last[column(r, "strip.energy_balance")]) <
+        0.01 * last[column(r, "strip.external_work")]);
+}
+
+TEST_CASE("fem adapter: erosion from YAML removes the failed strip, the balance closes",
+          "[app][fem][rupture]") {
+  const Run r = run_strip({"participants.strip.material.failure.erosion=true"});
+  const auto& last = r.rows.back();
+  // the first failed element leaves; the rest flies off (and may fail later, or not)
+  CHECK(last[column(r, "strip.failed_elements")] >= 1.0);
+  CHECK(r.log.find("(eroded)") != std::string::npos);
+  CHECK(last[column(r, "strip.eroded_energy")] > 0.0);
+  CHECK(last[column(r, "strip.first_failure_time")] ==
+        Approx(0.04 * (250e6 + 2e9 * 0.02) / 350e6).epsilon(0.02));
+  CHECK(std::abs(last[column(r, "strip.energy_balance")]) <
+        0.01 * last[column(r, "strip.external_work")]);
+}

@@ -1,0 +1,206 @@
+// Rupture (issue 27): a failure strain per material, constant or Germanischer Lloyd's
+// element-size-dependent eps_f = eps_g + eps_e t / l_e, the first failed element reported, and
+// element erosion in explicit analyses with its energy kept in the balance.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <memory>
+
+#include "partita/fem/box_mesher.hpp"
+#include "partita/fem/error.hpp"
+#include "partita/fem/failure_criterion.hpp"
+#include "partita/fem/j2_plasticity_law.hpp"
+#include "partita/fem/structural_solver.hpp"
+
+using namespace partita::fem;
+
+namespace {
+
+constexpr double kE = 210e9, kNu = 0.3, kRho = 7850.0, kSy = 250e6;
+
+std::shared_ptr<const MaterialLaw> steel(double hardening) {
+  return std::make_shared<J2PlasticityLaw>(kE, kNu, kRho, HardeningCurve::linear(kSy, hardening));
+}
+
+// A strip L x w x t along x held by its three symmetry planes (x = 0, y = 0, z = 0): uniaxial
+// stress, the same in every element.
+Mesh strip_mesh(double length, double width, double thickness, int cells) {
+  return make_box_mesh(
+      {Vec3::Zero(), Vec3(length, width, thickness), {cells, 1, 1}, ElementType::Hex8});
+}
+void hold_symmetry_planes(Model& m) {
+  m.fix("xmin", {0});
+  m.fix("ymin", {1});
+  m.fix("zmin", {2});
+}
+
+}  // namespace
+
+TEST_CASE("rupture: the GL failure strain for two element sizes", "[fem][rupture]") {
+  // Hex8 cells of 0.1 x 0.1 x 0.01 m and 0.05 x 0.1 x 0.01 m in a 10 mm plate: l_e is the
+  // in-plane size sqrt(a_1 a_2) of the two largest extents, 0.1 m and sqrt(0.005) = 0.0707 m
+  const auto gl = FailureCriterion::germanischer_lloyd(0.01);
+  const Mesh coarse = strip_mesh(1.0, 0.1, 0.01, 10), fine = strip_mesh(1.0, 0.1, 0.01, 20);
+  const double l_coarse = failure_element_length(coarse, coarse.element(3));
+  const double l_fine = failure_element_length(fine, fine.element(3));
+  CHECK(l_coarse == Approx(0.1).epsilon(1e-12));
+  CHECK(l_fine == Approx(std::sqrt(0.05 * 0.1)).epsilon(1e-12));
+  // eps_f = 0.056 + 0.54 t / l_e
+  CHECK(gl.failure_strain(l_coarse) == Approx(0.056 + 0.54 * 0.01 / 0.1).epsilon(1e-12));
+  CHECK(gl.failure_strain(l_fine) == Approx(0.056 + 0.54 * 0.01 / std::sqrt(0.005)).epsilon(1e-12));
+  CHECK(gl.failure_strain(l_fine) > gl.failure_strain(l_coarse));  // smaller elements: later
+  // a tetrahedron: the edge of the regular tetrahedron of its volume
+  const Mesh tets = make_box_mesh({Vec3::Zero(), Vec3::Ones(), {1, 1, 1}, ElementType::Tet4});
+  CHECK(failure_element_length(tets, tets.element(0)) ==
+        Approx(std::cbrt(6.0 * std::sqrt(2.0) / 6.0)).epsilon(1e-12));
+  CHECK_THROWS_WITH(FailureCriterion::germanischer_lloyd(0.0), Catch::Contains("thickness"));
+  CHECK_THROWS_WITH(FailureCriterion::constant(-0.1), Catch::Contains("must be > 0"));
+}
+
+TEST_CASE("rupture: a strip pulled at a constant rate fails when eps_p reaches eps_f",
+          "[fem][rupture]") {
+  // u(L, t) = v t: eps = v t / L everywhere; uniaxial J2 with linear hardening H:
+  // eps_p = (eps - sigma_y / E) / (1 + H / E), so eps_p = eps_f at
+  //   t_f = (L / v) (eps_f (1 + H / E) + sigma_y / E).
+  // Quasi-static steps: one to 0.9 t_f (a failure before it would be seen there), then steps of
+  // dt = t_f / 500: the failure is seen at the end of the step that crosses t_f.
+  const double length = 1.0, v = 1.0, hardening = 1e9;
+  for (int cells : {10, 20}) {
+    for (bool gl : {false, true}) {
+      INFO(cells << " cells, " << (gl ? "GL" : "constant eps_f = 0.08"));
+      Model m(strip_mesh(length, 0.1, 0.01, cells));
+      m.set_material_law(steel(hardening));
+      const auto criterion =
+          gl ? FailureCriterion::germanischer_lloyd(0.01) : FailureCriterion::constant(0.08);
+      m.set_failure_criterion(criterion);
+      hold_symmetry_planes(m);
+      m.prescribe("xmax", 0, [v](double t) { return v * t; });
+      const double l_e = std::sqrt(length / cells * 0.1);
+      const double eps_f = gl ? 0.056 + 0.54 * 0.01 / l_e : 0.08;
+      const double t_f = length / v * (eps_f * (1.0 + hardening / kE) + kSy / kE);
+      StructuralSolver s(std::move(m));
+      const double dt = t_f / 500.0;
+      s.step_static(0.9 * t_f);
+      while (s.failed_elements() == 0 && s.time() < 2.0 * t_f) s.step_static(dt);
+      const auto first = s.first_failure();
+      REQUIRE(first.has_value());
+      CHECK(first->time >= t_f - 1e-9);
+      CHECK(first->time < t_f + dt + 1e-9);
+      CHECK(first->time == Approx(t_f).epsilon(0.005));
+      CHECK(first->failure_strain == Approx(eps_f).epsilon(1e-12));
+      CHECK(first->plastic_strain >= eps_f);
+      CHECK(first->region == "all");
+      // uniform: every element reaches eps_f within round-off of the same time (the first step
+      // that crosses t_f fails some, the next at most all)
+      CHECK(s.failed_elements() >= 1);
+      CHECK(s.max_equivalent_plastic_strain() == Approx(first->plastic_strain).epsilon(1e-9));
+      s.step_static(dt);
+      CHECK(s.failed_elements() == static_cast<std::size_t>(cells));
+    }
+  }
+}
+
+TEST_CASE("rupture: erosion removes a failed element, the force drops, the energy balances",
+          "[fem][rupture][explicit]") {
+  // A strip of three elements along x (0.3 x 0.05 x 0.05 m, symmetry planes), the middle one
+  // ("weak") failing at eps_p = 0.02, pulled by a traction ramped over T to 350 MPa (linear
+  // hardening H = 2 GPa: the force controls a stable state until failure). Nearly quasi-static
+  // (T = 40 ms: 170 elastic periods of the strip, 17 of its plastic mode, sqrt(H / rho)): it fails at sigma = sigma_y + H eps_f = 290 MPa, at
+  // t_f = T 290 / 350. Then the middle element leaves: the root's reaction drops to zero (the
+  // left element rings about zero), the right element flies off, and
+  //   W_ext = W_strain + E_kin + W_plastic + W_eroded
+  // still holds (central difference: to O(dt^2); here within 1 % of W_ext).
+  const double hardening = 2e9, eps_f = 0.02, area = 0.05 * 0.05, ramp = 0.04;
+  const double sigma_max = 350e6;
+  auto strip = [&] {
+    Mesh mesh =
+        make_box_mesh({Vec3::Zero(), Vec3(0.3, 0.05, 0.05), {3, 1, 1}, ElementType::Hex8});
+    mesh.assign_region_where("weak", [](const Vec3& c) { return c.x() > 0.1 && c.x() < 0.2; });
+    Model m(std::move(mesh));
+    m.set_material_law(steel(hardening));
+    m.set_failure_criterion("weak", FailureCriterion::constant(eps_f, true));
+    hold_symmetry_planes(m);
+    m.add_traction("xmax", Vec3(sigma_max, 0.0, 0.0), [ramp](double t) { return t / ramp; });
+    return m;
+  };
+  SolverOptions opt;
+  opt.integrator = Integrator::CentralDifference;
+  opt.mass = MassType::Lumped;
+  StructuralSolver s(strip(), opt);
+  const double dt = 0.5 * s.stable_time_step();
+  const double t_f = ramp * (kSy + hardening * eps_f) / sigma_max;
+  double reaction_before = 0.0;
+  SolverState intact;  // a state some steps before the failure
+  while (s.failed_elements() == 0 && s.time() < ramp) {
+    if (s.time() < 0.95 * t_f) intact = s.save_state();
+    s.step(dt);
+    if (s.failed_elements() == 0) reaction_before = -s.reaction("xmin").x();
+  }
+  const auto first = s.first_failure();
+  REQUIRE(first.has_value());
+  CHECK(first->region == "weak");
+  CHECK(first->element == 1);
+  CHECK(first->centroid.x() == Approx(0.15));
+  CHECK(first->time == Approx(t_f).epsilon(0.02));
+  CHECK(reaction_before == Approx((kSy + hardening * eps_f) * area).epsilon(0.02));
+  CHECK(s.element_eroded(1));
+  CHECK(s.eroded_energy() > 0.0);
+  // restart: the failed flags and the eroded energy are part of the committed state
+  const SolverState saved = s.save_state();
+  const double eroded_at_save = s.eroded_energy();
+  // after the failure: the mean reaction over the next 2 ms (about 25 periods of the left
+  // element ringing on its own) is ~0 beside the force it carried
+  double mean = 0.0;
+  int n = 0;
+  while (s.time() < first->time + 0.002) {
+    s.step(dt);
+    mean += -s.reaction("xmin").x();
+    ++n;
+  }
+  mean /= n;
+  CHECK(std::abs(mean) < 0.02 * reaction_before);
+  CHECK(s.failed_elements() == 1);
+  CHECK(std::abs(s.energy_balance()) < 0.01 * s.external_work());
+  // energies by part: the regions add up to the totals (the eroded element in neither)
+  const RegionEnergies parts = s.region_energies();
+  CHECK(parts.kinetic_energy[0] + parts.kinetic_energy[1] ==
+        Approx(s.kinetic_energy()).epsilon(1e-12));
+  CHECK(parts.strain_energy[0] + parts.strain_energy[1] ==
+        Approx(s.strain_energy()).epsilon(1e-12));
+  CHECK(parts.plastic_work[0] + parts.plastic_work[1] == Approx(s.plastic_work()).epsilon(1e-12));
+  CHECK(parts.plastic_work[1] == 0.0);  // "weak" holds only the eroded element
+  // the restored state continues bit for bit
+  StructuralSolver r(strip(), opt);
+  r.restore_state(saved);
+  CHECK(r.failed_elements() == 1);
+  CHECK(r.first_failure()->time == first->time);
+  CHECK(r.eroded_energy() == eroded_at_save);
+  for (int k = 0; k < n; ++k) r.step(dt);
+  CHECK(r.displacement() == s.displacement());
+  CHECK(r.energy_balance() == s.energy_balance());
+  // rolled back to before the failure (an implicit coupling's restore): the element is back in
+  // the force and the mass, and it fails again at the same step
+  s.restore_state(intact);
+  CHECK(s.failed_elements() == 0);
+  CHECK(!s.element_eroded(1));
+  CHECK(s.eroded_energy() == 0.0);
+  while (s.failed_elements() == 0 && s.time() < ramp) s.step(dt);
+  CHECK(s.first_failure()->time == first->time);
+  CHECK(s.eroded_energy() == eroded_at_save);
+}
+
+TEST_CASE("rupture: erosion is refused where it is not supported, with the reason",
+          "[fem][rupture]") {
+  Model m(strip_mesh(1.0, 0.1, 0.01, 2));
+  m.set_material_law(steel(0.0));
+  m.set_failure_criterion(FailureCriterion::constant(0.1, true));
+  hold_symmetry_planes(m);
+  CHECK_THROWS_WITH(StructuralSolver(m), Catch::Contains("central-difference"));
+  SolverOptions opt;
+  opt.integrator = Integrator::CentralDifference;
+  opt.mass = MassType::Lumped;
+  opt.rayleigh_beta = 1e-6;
+  CHECK_THROWS_WITH(StructuralSolver(m, opt), Catch::Contains("stiffness-proportional"));
+  Model linear(strip_mesh(1.0, 0.1, 0.01, 2));
+  linear.set_failure_criterion(FailureCriterion::constant(0.1));
+  CHECK_THROWS_WITH(StructuralSolver(linear), Catch::Contains("plastic strain"));
+}
