@@ -10,6 +10,7 @@ void CentralDifferenceIntegrator::initialise(StructuralSystem& system, Kinematic
   }
   m_ = system.mass().diagonal();
   system.external_force(kin.time, kin.f);
+  system.internal_forces().set_time(kin.time, 0.0);
   system.internal_forces().evaluate(kin.u, kin.f_int, nullptr);
   // a = M^-1 (F - f_int - beta K0 v) - alpha v on the free dofs
   kin.a.setZero();
@@ -29,6 +30,7 @@ void CentralDifferenceIntegrator::step(StructuralSystem& system, Kinematics& kin
   v_half_ = kin.v + 0.5 * dt * kin.a;
   u1_ = kin.u + dt * v_half_;
   system.apply_prescribed(t1, u1_);
+  system.internal_forces().set_time(t1, 1.0);  // a rigid indenter moves with the step
   system.internal_forces().evaluate(u1_, kin.f_int, nullptr);
   system.internal_forces().commit();
   system.external_force(t1, f1_);

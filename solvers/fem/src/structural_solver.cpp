@@ -70,7 +70,7 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
   kin_.f_int = Eigen::VectorXd::Zero(n);
   coupling_force_ = Eigen::VectorXd::Zero(n);
   setup_dofs();
-  if (model_.is_linear()) {
+  if (model_.is_linear() && !options_.nonlinear_path) {
     assemble_stiffness();
     operator_ = std::make_unique<LinearElasticOperator>(k_);
   } else {
@@ -104,9 +104,10 @@ void StructuralSolver::add_contribution(std::unique_ptr<OperatorContribution> co
   if (nonlinear_ == nullptr) {
     throw Error(
         "operator contributions need the nonlinear path (a material law such as neo-hooke or "
-        "j2-plasticity); this model is linear elastic");
+        "j2-plasticity, or SolverOptions::nonlinear_path); this model is on the linear path");
   }
   nonlinear_->add_contribution(std::move(contribution));
+  stable_step_ = -1.0;  // the contribution may lower it
   refresh_internal_force();
   acceleration_valid_ = false;
 }
@@ -809,6 +810,7 @@ double StructuralSolver::stable_time_step() const {
   std::vector<char> is_free(ndof_, 0);
   for (auto dof : dofs_.free_dofs()) is_free[static_cast<std::size_t>(dof)] = 1;
   double omega2 = 0.0;
+  Eigen::VectorXd nodal_mass = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh().num_nodes()));
   ElementMatrix ke;
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
   std::vector<int> free_local;
@@ -817,6 +819,7 @@ double StructuralSolver::stable_time_step() const {
     const auto& d = d_region[static_cast<std::size_t>(e.region)];
     (nonlinear_ != nullptr ? full : integrator_).stiffness(e.type, x, d, ke);
     integrator_.lumped_mass(e.type, x, model_.density(e.region), m);
+    for (int a = 0; a < node_count(e.type); ++a) nodal_mass[static_cast<Eigen::Index>(e.nodes[a])] += m[a];
     free_local.clear();
     for (int a = 0; a < node_count(e.type); ++a) {
       for (int c = 0; c < 3; ++c) {
@@ -839,6 +842,11 @@ double StructuralSolver::stable_time_step() const {
                              .eigenvalues()
                              .maxCoeff());
   }
+  // contributions (a penalty contact): omega_max^2 <= the elements' + theirs (Weyl's inequality
+  // for the sum of the two symmetric M^-1/2 K M^-1/2)
+  if (nonlinear_ != nullptr)
+    for (std::size_t c = 0; c < nonlinear_->num_contributions(); ++c)
+      omega2 += nonlinear_->contribution(c).max_frequency_squared(nodal_mass);
   stable_step_ = omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
   if (omega2 > 0.0 && options_.rayleigh_beta > 0.0) {
     // dt <= (2 / omega)(sqrt(1 + xi^2) - xi), xi = beta omega / 2: decreasing in omega, so the
@@ -858,6 +866,7 @@ void StructuralSolver::add_damping_force(const Eigen::VectorXd& v, double sign,
 }
 
 void StructuralSolver::refresh_internal_force() {
+  operator_->set_time(kin_.time, 0.0);  // the committed state (a rigid indenter where it is)
   operator_->evaluate(kin_.u, kin_.f_int, nullptr);
 }
 
