@@ -29,10 +29,12 @@ IndenterContact& add_contact(StructuralSolver& s, const std::string& face, Rigid
   return ref;
 }
 
-// A unit cube's closed surface (12 triangles, counter-clockwise seen from outside).
-TriangulatedShape unit_cube(double search) {
+// The closed surface of the box [lo, hi] (12 triangles, counter-clockwise seen from outside).
+TriangulatedShape box_surface(const Vec3& lo, const Vec3& hi, double search) {
   std::vector<Vec3> v;
-  for (int k = 0; k < 8; ++k) v.emplace_back(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+  for (int k = 0; k < 8; ++k)
+    v.emplace_back((k & 1) ? hi.x() : lo.x(), ((k >> 1) & 1) ? hi.y() : lo.y(),
+                   ((k >> 2) & 1) ? hi.z() : lo.z());
   std::vector<std::array<int, 3>> t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6},
                                        {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},
                                        {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
@@ -73,7 +75,7 @@ TEST_CASE("rigid shapes: signed distances and outward normals", "[fem][contact]"
 
 TEST_CASE("triangulated shape: a cube's signed distance, inside and out, by the grid",
           "[fem][contact]") {
-  const TriangulatedShape cube = unit_cube(0.2);
+  const TriangulatedShape cube = box_surface(Vec3::Zero(), Vec3::Ones(), 0.2);
   auto s = cube.distance(Vec3(0.5, 0.5, 0.9));  // inside, 0.1 below the top
   CHECK(s.gap == Approx(-0.1));
   CHECK(s.normal.z() == Approx(1.0));
@@ -86,9 +88,7 @@ TEST_CASE("triangulated shape: a cube's signed distance, inside and out, by the 
   CHECK(s.gap == Approx(-0.03));
   CHECK(cube.distance(Vec3(0.5, 0.5, 0.5)).gap == Approx(0.2));  // deeper than the search
   CHECK(cube.distance(Vec3(3, 3, 3)).gap == Approx(0.2));
-  // against the analytic distance of a box at random points within the search radius
-  const SphereShape unit(Vec3::Zero(), 1.0);
-  (void)unit;
+  // against the analytic distance of a box at scattered points within the search radius
   int checked = 0;
   for (int i = 0; i < 2000; ++i) {
     const Vec3 x(-0.2 + 1.4 * ((i * 37) % 101) / 100.0, -0.2 + 1.4 * ((i * 53) % 97) / 96.0,
@@ -121,7 +121,7 @@ TEST_CASE("velocity table: its displacement is the exact integral", "[fem][conta
 // rollers: uniaxial stress, and in series with it the penalty springs, sum k_n = f E A / h:
 //   F = delta / (H / (E A) + h / (f E A)).
 // The support reaction equals the force on the punch.
-TEST_CASE("flat punch on a block: reaction equals the punch force, uniaxial stiffness",
+TEST_CASE("flat punch on a block: reaction equals the punch force, uniaxial stiffness (plane and STL-like surface)",
           "[fem][contact]") {
   const double e = 70e9, nu = 0.3, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0;
   BoxSpec b;
@@ -134,9 +134,17 @@ TEST_CASE("flat punch on a block: reaction equals the punch force, uniaxial stif
   SolverOptions o;
   o.nonlinear_path = true;
   StructuralSolver s(std::move(model), o);
-  // the punch's face at z = H, moving down at delta per second
-  auto plane = std::make_shared<PlaneShape>(Vec3(0, 0, height), Vec3(0, 0, -1));
-  IndenterContact& c = add_contact(s, "zmax", RigidIndenter(plane, VelocityTable({{0.0, Vec3(0, 0, -delta)}})),
+  // the punch's face at z = H, moving down at delta per second: a plane, or a closed
+  // triangulated box wider than the block (its bottom face the punch's)
+  std::shared_ptr<const RigidShape> punch;
+  if (GENERATE(false, true)) {
+    punch = std::make_shared<TriangulatedShape>(box_surface(
+        Vec3(-side, -side, height), Vec3(2 * side, 2 * side, height + side), 10 * delta));
+  } else {
+    punch = std::make_shared<PlaneShape>(Vec3(0, 0, height), Vec3(0, 0, -1));
+  }
+  INFO("punch: " << punch->kind());
+  IndenterContact& c = add_contact(s, "zmax", RigidIndenter(punch, VelocityTable({{0.0, Vec3(0, 0, -delta)}})),
                                    {factor, 0.0, 1.0});
   s.step_static(1.0);
   const double area = side * side, h = height / 8;
