@@ -3,7 +3,10 @@
 // is offered as a moving mesh, and bad input is refused with the key named.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
+#include <unistd.h>
 
 #include "partita/adapters/register_all.hpp"
 #include "partita/coupling/case_run.hpp"
@@ -13,12 +16,12 @@ using namespace partita;
 
 namespace {
 
-std::unique_ptr<Solver> make_fem(const std::string& yaml) {
+std::unique_ptr<Solver> make_fem(const std::string& yaml, const std::filesystem::path& dir = ".") {
   coupling::Registries r;
   coupling::register_builtin(r);
   adapters::register_all(r);
   const auto& e = r.solvers.get("fem");
-  SolverContext ctx{"block", config::Node::load_string(yaml).validated(e.spec), ".", ".", 1};
+  SolverContext ctx{"block", config::Node::load_string(yaml).validated(e.spec), dir, dir, 1};
   return e.factory(ctx);
 }
 
@@ -113,4 +116,47 @@ constraints: [{set: zmin, fix: [x, y, z]}]
   CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1], face: zmax, "
                            "motion: {}}")),
              Catch::Contains("velocity"));
+}
+
+// A closed STL box as a flat punch (shape: surface) pressed by delta into a column on rollers
+// (static): uniaxial stress in series with the penalty springs, F = delta / (H/(EA) + h/(f E A)).
+TEST_CASE("fem indenter: an STL surface pressed into a column, static", "[adapters][fem][contact]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("partita_stl_punch_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  {
+    // the box [-1, 3] x [-1, 3] x [0, 1] cm, wider than the column, above its top (z = 4 cm)
+    std::ofstream stl(dir / "punch.stl");
+    stl << "solid punch\n";
+    const double v[8][3] = {{-1, -1, 0}, {3, -1, 0}, {-1, 3, 0}, {3, 3, 0},
+                            {-1, -1, 1}, {3, -1, 1}, {-1, 3, 1}, {3, 3, 1}};
+    const int t[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                          {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+    for (const auto& tri : t) {
+      stl << "facet normal 0 0 0\nouter loop\n";
+      for (int k : tri) stl << "vertex " << v[k][0] << " " << v[k][1] << " " << v[k][2] << "\n";
+      stl << "endloop\nendfacet\n";
+    }
+    stl << "endsolid punch\n";
+  }
+  const double e = 70e9, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0;
+  auto s = make_fem(R"(
+mesh: {box: {origin: [0, 0, 0], size: [0.02, 0.02, 0.04], cells: [4, 4, 8]}}
+material: {youngs_modulus: 70e9, poisson_ratio: 0.3, density: 2700}
+constraints: [{set: zmin, fix: [z]}, {set: xmin, fix: [x]}, {set: ymin, fix: [y]}]
+analysis: {type: static}
+indenters:
+  - {name: punch, shape: surface, stl: punch.stl, scale: 0.01, position: [0, 0, 0.04],
+     search_radius: 1.0e-3, face: zmax, penalty: {factor: 10}, motion: {velocity: [0, 0, -2.0e-5]}}
+)",
+                    dir);
+  s->advance(1.0);
+  const double area = side * side, h = height / 8;
+  const double exact = delta / (height / (e * area) + h / (factor * e * area));
+  CHECK(monitor(*s, "punch.force_z") == Approx(exact).epsilon(1e-9));
+  CHECK(monitor(*s, "punch.z") == Approx(0.04 - delta));
+  CHECK(monitor(*s, "punch.contact_nodes") == 25.0);
+  CHECK(monitor(*s, "punch.work") == Approx(0.5 * exact * delta).epsilon(1e-9));
+  CHECK(std::abs(monitor(*s, "energy_balance")) < 1e-9 * exact * delta);
+  fs::remove_all(dir);
 }
