@@ -68,5 +68,6 @@ TEST_CASE("mesh hand-over: a rigid indenter's sphere sinks into a granular bed",
   CHECK(csv.rows[40][col.at("granules.ball.force_z")] == 0.0);  // t = 4 ms: above the bed
   const auto mean = csv.mean_over_last(0.3);
   CHECK(mean.at("granules.ball.force_z") > 0.0);  // the bed resists
+  CHECK(fs::exists(dir / "vtk" / "block_ball.pvd"));  // the indenter's surface, frame by frame
   fs::remove_all(dir);
 }

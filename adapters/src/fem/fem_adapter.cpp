@@ -892,6 +892,13 @@ void FemAdapter::write_output(const OutputFrame& frame) {
   const std::string file = fmt::format("{}_fem_{:06d}.vtu", frame.prefix, frame.index);
   write_fem_vtu(*solver_, frame.vtk_directory / file, frame.vtk);
   files_ = {{"fem", file}};
+  for (const auto& ind : indenters_) {  // the indenters' surfaces where they are
+    if (!ind.has_surface) continue;
+    const std::string f = fmt::format("{}_{}_{:06d}.vtp", frame.prefix, ind.name, frame.index);
+    for (const auto& m : meshes_)
+      if (m.mesh.name() == ind.name) write_indenter_vtp(frame.vtk_directory / f, m, *ind.contact, frame.vtk);
+    files_.emplace_back(ind.name, f);
+  }
   for (const auto& p : probes_)
     write_file_atomically(frame.vtk_directory.parent_path() / "probes" /
                               fmt::format("{}_{}_{:06d}.csv", frame.prefix, p.name(), frame.index),

@@ -10,6 +10,7 @@
 #include "partita/fem/sphere_shape.hpp"
 #include "partita/fem/triangulated_shape.hpp"
 #include "partita/interface/error.hpp"
+#include "partita/interface/output.hpp"
 #include "partita/interface/stl.hpp"
 
 namespace partita::adapters {
@@ -224,6 +225,14 @@ IndenterBuild build_indenter(const Node& n, const fem::Model& model,
     b.surface.writes.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});
   }
   return b;
+}
+
+void write_indenter_vtp(const std::filesystem::path& file, const InterfaceMesh& surface,
+                        const fem::IndenterContact& contact, const vtk::Options& options) {
+  const Eigen::RowVector3d d = contact.indenter().displacement().transpose();
+  const Mesh::Points moved = surface.mesh.points().rowwise() + d;
+  write_vtp(file, surface.mesh, {{"displacement", d.replicate(surface.mesh.size(), 1)}}, {}, &moved,
+            options);
 }
 
 void add_indenter_monitors(const std::string& name, const Eigen::Vector3d& reference,

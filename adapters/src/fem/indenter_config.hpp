@@ -22,6 +22,7 @@
 #include "partita/fem/indenter_contact.hpp"
 #include "partita/fem/model.hpp"
 #include "partita/interface/config.hpp"
+#include "partita/interface/vtk_xml.hpp"
 #include "partita/interface/solver.hpp"
 
 namespace partita::adapters {
@@ -43,6 +44,11 @@ struct IndenterBuild {
 // Errors name the key (node.fail).
 IndenterBuild build_indenter(const config::Node& node, const fem::Model& model,
                              const std::filesystem::path& case_dir, bool explicit_steps);
+
+// The indenter's surface where it is now, with its displacement, as VTK PolyData (a frame of the
+// series <participant>_<name>).
+void write_indenter_vtp(const std::filesystem::path& file, const InterfaceMesh& surface,
+                        const fem::IndenterContact& contact, const vtk::Options& options);
 
 // The monitor quantities of one indenter (see the file comment).
 void add_indenter_monitors(const std::string& name, const Eigen::Vector3d& reference,
