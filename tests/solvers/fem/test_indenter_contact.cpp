@@ -6,6 +6,7 @@
 #include <memory>
 #include <numbers>
 
+#include "partita/fem/block_assembler.hpp"
 #include "partita/fem/box_mesher.hpp"
 #include "partita/fem/capsule_shape.hpp"
 #include "partita/fem/error.hpp"
@@ -343,4 +344,80 @@ TEST_CASE("friction: a punch pressed and dragged sideways slips at mu times the 
   CHECK(c.dissipated_work() - d2 == Approx(slipping).epsilon(2e-3));
   CHECK(c.indenter().work() - w2 == Approx(slipping).epsilon(2e-3));
   CHECK(s.reaction("zmin").x() == Approx(f.x()).epsilon(1e-6));
+}
+
+// The contact's tangent against central differences of its force: exact for a plane (normal
+// penalty, and friction in stick: k_t (I - n n^T)); for a sphere the left-out curvature term
+// k_n g dn/dx is of relative size |g| / R (2e-3 here), relative to the stiffest column.
+TEST_CASE("indenter contact: tangent against finite differences", "[fem][contact]") {
+  BoxSpec b;
+  b.size = Vec3(0.02, 0.02, 0.01);
+  b.cells = {4, 4, 2};
+  const Model model(make_box_mesh(b), Material{70e9, 0.3, 2700});
+  const BlockAssembler assembler(model.mesh());
+  const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
+  struct Case {
+    std::shared_ptr<const RigidShape> shape;
+    double mu, tolerance;
+  };
+  const double r = 0.05;
+  for (const Case& c : {Case{std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0.1, 0.2, -1)), 0.0, 1e-6},
+                        Case{std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0.1, 0.2, -1)), 0.5, 1e-6},
+                        Case{std::make_shared<SphereShape>(Vec3(0.01, 0.01, 0.01 + r - 1e-4), r), 0.0, 1e-2}}) {
+    IndenterContact contact("t", model, "zmax",
+                            RigidIndenter(c.shape, VelocityTable({{0.0, Vec3(1e-6, 0, 0)}})),
+                            {1.0, c.mu, 1.0});
+    contact.set_time(1.0, 1.0);
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index i = 0; i < n; ++i) u[i] = 1e-7 * std::sin(1.3 * static_cast<double>(i));
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+    SparseMatrix k = assembler.make_matrix();
+    contact.add(u, f, &k, assembler);
+    REQUIRE(contact.active_nodes() > 0);
+    const Eigen::MatrixXd kd(k);
+    const double scale = kd.colwise().norm().maxCoeff();  // k_n of the stiffest node
+    const double h = 1e-10;
+    double worst = 0.0;
+    for (auto node : contact.nodes()) {
+      for (int comp = 0; comp < 3; ++comp) {
+        const Eigen::Index j = 3 * static_cast<Eigen::Index>(node) + comp;
+        Eigen::VectorXd up = u, um = u, fp = Eigen::VectorXd::Zero(n), fm = fp;
+        up[j] += h;
+        um[j] -= h;
+        contact.add(up, fp, nullptr, assembler);
+        contact.add(um, fm, nullptr, assembler);
+        const Eigen::VectorXd column = (fp - fm) / (2 * h);
+        worst = std::max(worst, (column - kd.col(j)).norm() / scale);
+      }
+    }
+    INFO(c.shape->kind() << ", mu " << c.mu << ": worst relative column error " << worst);
+    CHECK(worst < c.tolerance);
+  }
+}
+
+// Newmark (implicit, Newton with the contact's tangent): the flat punch driven slowly (a ramp of
+// T = 10 ms, long beside the column's period of about 30 us) carries the static force of the
+// column and penalty springs in series within 1 %, and the energy the punch put in is the
+// column's strain + kinetic + penalty energy within 1 %.
+TEST_CASE("flat punch, Newmark: quasi-static force and energy", "[fem][contact]") {
+  const double e = 70e9, nu = 0.3, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0, t = 0.01;
+  BoxSpec b;
+  b.size = Vec3(side, side, height);
+  b.cells = {2, 2, 8};
+  Model model(make_box_mesh(b), Material{e, nu, 2700});
+  model.fix("zmin", {2});
+  model.fix("xmin", {0});
+  model.fix("ymin", {1});
+  SolverOptions o;
+  o.nonlinear_path = true;
+  StructuralSolver s(std::move(model), o);
+  auto plane = std::make_shared<PlaneShape>(Vec3(0, 0, height), Vec3(0, 0, -1));
+  IndenterContact& c = add_contact(
+      s, "zmax", RigidIndenter(plane, VelocityTable({{0.0, Vec3(0, 0, -delta / t)}, {t, Vec3(0, 0, -delta / t)}, {t * 1.0001, Vec3::Zero()}})),
+      {factor, 0.0, 1.0});
+  for (int k = 0; k < 200; ++k) s.step(t / 200);
+  const double area = side * side, h = height / 8;
+  const double exact = delta / (height / (e * area) + h / (factor * e * area));
+  CHECK(c.contact_force().z() == Approx(exact).epsilon(0.01));
+  CHECK(c.indenter().work() == Approx(s.strain_energy() + s.kinetic_energy()).epsilon(0.01));
 }
