@@ -102,6 +102,19 @@ TEST_CASE("triangulated shape: a cube's signed distance, inside and out, by the 
   }
   CHECK(checked > 500);
   CHECK(cube.max_cell_triangles() < 12);  // the grid narrows the search
+  // a finer surface: the sphere's 320 triangles; a query tests a few of them, and the signed
+  // distance is the sphere's within the polyhedron's sagitta (up to about 0.016 R on the
+  // icosphere's largest triangles; 0.02 R allowed)
+  const SphereShape ball(Vec3(1, 2, 3), 1.0);
+  const auto tri = ball.triangulate();
+  const TriangulatedShape hull(tri.vertices, tri.triangles, 0.1);
+  CHECK(hull.max_cell_triangles() < 32);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 dir = Vec3(std::sin(0.7 * i), std::cos(1.3 * i), std::sin(2.1 * i + 0.3)).normalized();
+    const Vec3 x = ball.centre() + (1.0 + 0.05 * std::sin(0.37 * i)) * dir;
+    REQUIRE(hull.distance(x).gap == Approx(ball.distance(x).gap).margin(0.02));
+    REQUIRE(hull.distance(x).normal.dot(dir) > 0.9);
+  }
   CHECK_THROWS_WITH(TriangulatedShape({Vec3::Zero()}, {{0, 0, 1}}, 0.1),
                     Catch::Contains("refers to vertex 1"));
 }
