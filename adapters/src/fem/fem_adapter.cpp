@@ -299,8 +299,9 @@ std::shared_ptr<Spec> make_spec() {
           interface);
   s->section("analysis", "analysis type and time integration", analysis);
   s->list("indenters",
-          "rigid indenters in penalty contact with an FE face (part of this model's operator: "
-          "the model takes the nonlinear path, element by element, even when linear elastic)",
+          "rigid indenters in penalty contact with an FE face (part of this model's operator; a "
+          "linear-elastic model keeps its fast K u in central difference, and takes the "
+          "nonlinear path, element by element, in static and Newmark analyses)",
           indenter_spec());
   return s;
 }
@@ -581,8 +582,11 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     options.newton.max_cutbacks = static_cast<int>(nl.integer("max_cutbacks"));
     options.newton.max_line_search_steps = static_cast<int>(nl.integer("line_search_steps"));
     options.newton.energy_line_search = nl.string("line_search") == "energy";
-    // rigid indenters are contributions of the nonlinear path's operator
-    if (!c["indenters"].items().empty()) options.nonlinear_path = true;
+    // rigid indenters are contributions of the FE operator: the nonlinear path's, or on the
+    // linear path K u plus them (central difference only)
+    if (!c["indenters"].items().empty() &&
+        !(model.is_linear() && options.integrator == fem::Integrator::CentralDifference))
+      options.nonlinear_path = true;
     solver_ = std::make_unique<fem::StructuralSolver>(std::move(model), options);
     // Newton iterations, load steps and cut-backs of the nonlinear path, at debug level (a
     // line per Newton iteration: microseconds beside the factorisation of the tangent)

@@ -16,6 +16,7 @@
 #include "parallel_loop.hpp"
 #include "partita/fem/block_assembler.hpp"
 #include "partita/fem/error.hpp"
+#include "partita/fem/linear_contribution_operator.hpp"
 #include "partita/fem/linear_elastic_operator.hpp"
 #include "partita/fem/quadrature.hpp"
 #include "partita/fem/shape_functions.hpp"
@@ -101,12 +102,22 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
 StructuralSolver::~StructuralSolver() = default;
 
 void StructuralSolver::add_contribution(std::unique_ptr<OperatorContribution> contribution) {
-  if (nonlinear_ == nullptr) {
+  if (nonlinear_ != nullptr) {
+    nonlinear_->add_contribution(std::move(contribution));
+  } else if (options_.integrator == Integrator::CentralDifference) {
+    // the linear path's explicit steps: K u (one sparse product) plus the contributions
+    if (linear_sum_ == nullptr) {
+      auto op = std::make_unique<LinearContributionOperator>(k_, mesh());
+      linear_sum_ = op.get();
+      operator_ = std::move(op);
+    }
+    linear_sum_->add_contribution(std::move(contribution));
+  } else {
     throw Error(
-        "operator contributions need the nonlinear path (a material law such as neo-hooke or "
-        "j2-plasticity, or SolverOptions::nonlinear_path); this model is on the linear path");
+        "operator contributions on a linear-elastic model need central difference, or the "
+        "nonlinear path (SolverOptions::nonlinear_path, or a material law) for static and "
+        "Newmark analyses: the linear path factorises K once");
   }
-  nonlinear_->add_contribution(std::move(contribution));
   stable_step_ = -1.0;  // the contribution may lower it
   refresh_internal_force();
   acceleration_valid_ = false;
@@ -738,6 +749,8 @@ double StructuralSolver::kinetic_energy() const {
 }
 double StructuralSolver::strain_energy() const {
   if (nonlinear_ != nullptr) return nonlinear_->strain_energy();
+  // 1/2 u.K u plus the contributions' stored energy, at the last evaluation (kin_.u)
+  if (linear_sum_ != nullptr) return linear_sum_->strain_energy();
   return 0.5 * kin_.u.dot(k_ * kin_.u);
 }
 
@@ -847,6 +860,7 @@ double StructuralSolver::stable_time_step() const {
   if (nonlinear_ != nullptr)
     for (std::size_t c = 0; c < nonlinear_->num_contributions(); ++c)
       omega2 += nonlinear_->contribution(c).max_frequency_squared(nodal_mass);
+  if (linear_sum_ != nullptr) omega2 += linear_sum_->max_frequency_squared(nodal_mass);
   stable_step_ = omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
   if (omega2 > 0.0 && options_.rayleigh_beta > 0.0) {
     // dt <= (2 / omega)(sqrt(1 + xi^2) - xi), xi = beta omega / 2: decreasing in omega, so the
