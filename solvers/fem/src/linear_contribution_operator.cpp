@@ -59,29 +59,12 @@ double LinearContributionOperator::max_frequency_squared(const Eigen::VectorXd& 
 }
 
 const std::vector<double>& LinearContributionOperator::committed_state() const {
-  state_.clear();
-  for (const auto& c : contributions_) {
-    const auto& s = c->committed_state();
-    state_.insert(state_.end(), s.begin(), s.end());
-  }
+  gather_committed_states(contributions_, state_);
   return state_;
 }
 
 void LinearContributionOperator::set_committed_state(const std::vector<double>& state) {
-  std::size_t total = 0;
-  for (const auto& c : contributions_) total += c->committed_state().size();
-  if (state.size() != total) {
-    throw Error("linear operator: a state of " + std::to_string(state.size()) +
-                " values was given, this model's contributions have " + std::to_string(total) +
-                " (state of another model?)");
-  }
-  std::size_t at = 0;
-  for (const auto& c : contributions_) {
-    const std::size_t n = c->committed_state().size();
-    c->set_committed_state(std::vector<double>(state.begin() + static_cast<std::ptrdiff_t>(at),
-                                               state.begin() + static_cast<std::ptrdiff_t>(at + n)));
-    at += n;
-  }
+  scatter_committed_states(contributions_, state, "linear operator");
 }
 
 }  // namespace partita::fem

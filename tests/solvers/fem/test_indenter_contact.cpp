@@ -42,6 +42,21 @@ TriangulatedShape box_surface(const Vec3& lo, const Vec3& hi, double search) {
   return TriangulatedShape(v, t, search);
 }
 
+// An elastic column side x side x height on rollers (zmin fixed in z, xmin in x, ymin in y),
+// cells x cells x 8 Hex8, E = 70 GPa, on the nonlinear path (static and Newmark contact).
+StructuralSolver column_on_rollers(double side, double height, int cells, double e) {
+  BoxSpec b;
+  b.size = Vec3(side, side, height);
+  b.cells = {cells, cells, 8};
+  Model model(make_box_mesh(b), Material{e, 0.3, 2700});
+  model.fix("zmin", {2});
+  model.fix("xmin", {0});
+  model.fix("ymin", {1});
+  SolverOptions o;
+  o.nonlinear_path = true;
+  return StructuralSolver(std::move(model), o);
+}
+
 }  // namespace
 
 TEST_CASE("rigid shapes: signed distances and outward normals", "[fem][contact]") {
@@ -137,17 +152,8 @@ TEST_CASE("velocity table: its displacement is the exact integral", "[fem][conta
 // The support reaction equals the force on the punch.
 TEST_CASE("flat punch on a block: reaction equals the punch force, uniaxial stiffness (plane and STL-like surface)",
           "[fem][contact]") {
-  const double e = 70e9, nu = 0.3, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0;
-  BoxSpec b;
-  b.size = Vec3(side, side, height);
-  b.cells = {4, 4, 8};
-  Model model(make_box_mesh(b), Material{e, nu, 2700});
-  model.fix("zmin", {2});
-  model.fix("xmin", {0});
-  model.fix("ymin", {1});
-  SolverOptions o;
-  o.nonlinear_path = true;
-  StructuralSolver s(std::move(model), o);
+  const double e = 70e9, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0;
+  StructuralSolver s = column_on_rollers(side, height, 4, e);
   // the punch's face at z = H, moving down at delta per second: a plane, or a closed
   // triangulated box wider than the block (its bottom face the punch's)
   std::shared_ptr<const RigidShape> punch;
@@ -416,17 +422,8 @@ TEST_CASE("indenter contact: tangent against finite differences", "[fem][contact
 // column and penalty springs in series within 1 %, and the energy the punch put in is the
 // column's strain + kinetic + penalty energy within 1 %.
 TEST_CASE("flat punch, Newmark: quasi-static force and energy", "[fem][contact]") {
-  const double e = 70e9, nu = 0.3, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0, t = 0.01;
-  BoxSpec b;
-  b.size = Vec3(side, side, height);
-  b.cells = {2, 2, 8};
-  Model model(make_box_mesh(b), Material{e, nu, 2700});
-  model.fix("zmin", {2});
-  model.fix("xmin", {0});
-  model.fix("ymin", {1});
-  SolverOptions o;
-  o.nonlinear_path = true;
-  StructuralSolver s(std::move(model), o);
+  const double e = 70e9, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0, t = 0.01;
+  StructuralSolver s = column_on_rollers(side, height, 2, e);
   auto plane = std::make_shared<PlaneShape>(Vec3(0, 0, height), Vec3(0, 0, -1));
   IndenterContact& c = add_contact(
       s, "zmax", RigidIndenter(plane, VelocityTable({{0.0, Vec3(0, 0, -delta / t)}, {t, Vec3(0, 0, -delta / t)}, {t * 1.0001, Vec3::Zero()}})),

@@ -1,5 +1,6 @@
 #pragma once
 #include <cstddef>
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -60,5 +61,12 @@ class OperatorContribution {
   virtual const std::vector<double>& committed_state() const;
   virtual void set_committed_state(const std::vector<double>& state);
 };
+
+// The committed states of several contributions, one after the other (an operator's state), and
+// its split back into them; `owner` names the operator in the error for a state of another size.
+void gather_committed_states(const std::vector<std::unique_ptr<OperatorContribution>>& contributions,
+                             std::vector<double>& state);
+void scatter_committed_states(const std::vector<std::unique_ptr<OperatorContribution>>& contributions,
+                              const std::vector<double>& state, std::string_view owner);
 
 }  // namespace partita::fem
