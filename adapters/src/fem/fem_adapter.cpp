@@ -11,6 +11,7 @@
 
 #include "fem_output.hpp"
 #include "fem_rupture.hpp"
+#include "indenter_config.hpp"
 #include "line_probe.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -306,6 +307,11 @@ std::shared_ptr<Spec> make_spec() {
           "displacement and received force are monitor quantities)",
           interface);
   s->section("analysis", "analysis type and time integration", analysis);
+  s->list("indenters",
+          "rigid indenters in penalty contact with an FE face (part of this model's operator; a "
+          "linear-elastic model keeps its fast K u in central difference, and takes the "
+          "nonlinear path, element by element, in static and Newmark analyses)",
+          indenter_spec());
   return s;
 }
 
@@ -589,6 +595,11 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     options.newton.max_cutbacks = static_cast<int>(nl.integer("max_cutbacks"));
     options.newton.max_line_search_steps = static_cast<int>(nl.integer("line_search_steps"));
     options.newton.energy_line_search = nl.string("line_search") == "energy";
+    // rigid indenters are contributions of the FE operator: the nonlinear path's, or on the
+    // linear path K u plus them (central difference only)
+    if (!c["indenters"].items().empty() &&
+        !(model.is_linear() && options.integrator == fem::Integrator::CentralDifference))
+      options.nonlinear_path = true;
     solver_ = std::make_unique<fem::StructuralSolver>(std::move(model), options);
     // Newton iterations, load steps and cut-backs of the nonlinear path, at debug level (a
     // line per Newton iteration: microseconds beside the factorisation of the tangent)
@@ -684,6 +695,20 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
             pname, p.vec3("at").x(), p.vec3("at").y(), p.vec3("at").z()));
       points_.push_back({pname, *at});
     }
+    // --- rigid indenters (indenter_config.cpp) ---
+    for (const Node& n : c["indenters"].items()) {
+      IndenterBuild b = build_indenter(
+          n, solver_->model(), context.case_dir,
+          transient_ && options.integrator == fem::Integrator::CentralDifference);
+      for (const auto& other : indenters_)
+        if (other.name == b.name) n["name"].fail("indenter name '" + b.name + "' is used twice");
+      for (const auto& i : interfaces_)
+        if (i.name == b.name)
+          n["name"].fail("'" + b.name + "' names an interface already: give the indenter another name");
+      indenters_.push_back({b.name, b.reference, b.contact.get(), b.has_surface});
+      if (b.has_surface) meshes_.push_back(std::move(b.surface));
+      solver_->add_contribution(std::move(b.contact));
+    }
     if (!transient_) solver_->solve_static();
   } catch (const fem::Error& e) {
     c.fail(std::string("FEM model of participant '") + context.name +
@@ -741,6 +766,16 @@ void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen:
 }
 
 void FemAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
+  for (const auto& ind : indenters_) {
+    if (!ind.has_surface || ind.name != mesh) continue;
+    if (data != "displacement")
+      throw Error("fem '" + name_ + "' writes only 'displacement' on indenter mesh '" + ind.name + "'");
+    // a translation: every vertex moves with the indenter
+    for (const auto& m : meshes_)
+      if (m.mesh.name() == ind.name)
+        values = ind.contact->indenter().displacement().transpose().replicate(m.mesh.size(), 1);
+    return;
+  }
   bool quadrature = false;
   const Interface& i = interfaces_[find_interface(mesh, &quadrature)];
   if (quadrature || data != "displacement")
@@ -879,6 +914,13 @@ void FemAdapter::write_output(const OutputFrame& frame) {
   const std::string file = fmt::format("{}_fem_{:06d}.vtu", frame.prefix, frame.index);
   write_fem_vtu(*solver_, frame.vtk_directory / file, frame.vtk);
   files_ = {{"fem", file}};
+  for (const auto& ind : indenters_) {  // the indenters' surfaces where they are
+    if (!ind.has_surface) continue;
+    const std::string f = fmt::format("{}_{}_{:06d}.vtp", frame.prefix, ind.name, frame.index);
+    for (const auto& m : meshes_)
+      if (m.mesh.name() == ind.name) write_indenter_vtp(frame.vtk_directory / f, m, *ind.contact, frame.vtk);
+    files_.emplace_back(ind.name, f);
+  }
   for (const auto& p : probes_)
     write_file_atomically(frame.vtk_directory.parent_path() / "probes" /
                               fmt::format("{}_{}_{:06d}.csv", frame.prefix, p.name(), frame.index),
@@ -936,7 +978,14 @@ std::vector<MonitorValue> FemAdapter::monitor_values(const std::vector<std::stri
   if (wanted("plastic_work")) m.push_back({"plastic_work", "J", solver_->plastic_work()});
   if (wanted("external_work")) m.push_back({"external_work", "J", solver_->external_work()});
   if (wanted("damping_work")) m.push_back({"damping_work", "J", solver_->damping_work()});
-  if (wanted("energy_balance")) m.push_back({"energy_balance", "J", solver_->energy_balance()});
+  // rigid indenters: their monitors; the work they do on the structure enters its balance
+  double indenter_work = 0.0;
+  for (const auto& ind : indenters_) {
+    add_indenter_monitors(ind.name, ind.reference, *ind.contact, m);
+    indenter_work += ind.contact->indenter().work();
+  }
+  if (wanted("energy_balance"))
+    m.push_back({"energy_balance", "J", solver_->energy_balance() + indenter_work});
   append_rupture_monitors(*solver_, wanted, m);
   m.push_back({"newton_iterations", "", static_cast<double>(solver_->newton_iterations())});
   if (names.empty()) return m;

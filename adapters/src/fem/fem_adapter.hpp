@@ -13,8 +13,11 @@
 // Monitors: N.force_x|y|z (total interface force received [N]), static_reaction_z (the force the
 // interfaces must carry for static equilibrium: minus the sum of the applied loads, gravity
 // included [N]), max_displacement [m], kinetic_energy, strain_energy, plastic_work,
-// external_work, damping_work, energy_balance (external - strain - kinetic - plastic - damping
-// - eroded) [J]; rupture and energies by part: see fem_rupture.hpp.
+// external_work, damping_work, energy_balance (external + indenters' work - strain - kinetic -
+// plastic - damping - eroded) [J]; rupture and energies by part: see fem_rupture.hpp; each rigid
+// indenter's quantities (indenter_config.hpp). A bounded indenter (sphere, capsule, surface) also
+// offers its surface as the mesh <name>, which writes "displacement" (its translation at every
+// vertex): a DEM takes it with `from: <fem>.<name>`.
 
 #include <memory>
 #include <string>
@@ -97,6 +100,14 @@ class FemAdapter : public Solver {
   std::unique_ptr<MeshLocator> locator_;  // only with point monitors
   std::vector<PointMonitor> points_;
   FailureLog failure_log_;  // logs the first failed element
+  // rigid indenters (indenters:, see indenter_config.hpp); the solver owns the contacts
+  struct Indenter {
+    std::string name;
+    Eigen::Vector3d reference;  // its `position`: the monitors' N.x, N.y, N.z at rest
+    const fem::IndenterContact* contact = nullptr;
+    bool has_surface = false;  // offers the mesh <name> (writes "displacement")
+  };
+  std::vector<Indenter> indenters_;
 };
 
 }  // namespace partita::adapters

@@ -37,6 +37,7 @@ void CentralDifferenceIntegrator::initialise(StructuralSystem& system, Kinematic
   }
   load_mass(system);
   system.external_force(kin.time, kin.f);
+  system.internal_forces().set_time(kin.time, 0.0);
   system.internal_forces().evaluate(kin.u, kin.f_int, nullptr);
   // a = M^-1 (F - f_int - beta K0 v) - alpha v on the free dofs
   kin.a.setZero();
@@ -62,6 +63,7 @@ void CentralDifferenceIntegrator::step(StructuralSystem& system, Kinematics& kin
     u1_.segment(b, m) = kin.u.segment(b, m) + dt * v_half_.segment(b, m);
   });
   system.apply_prescribed(t1, u1_);
+  system.internal_forces().set_time(t1, 1.0);  // a rigid indenter moves with the step
   system.internal_forces().evaluate(u1_, kin.f_int, nullptr);
   system.internal_forces().commit();
   system.external_force(t1, f1_);

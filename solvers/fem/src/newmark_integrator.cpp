@@ -128,6 +128,7 @@ bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, doub
   w.u1 = kin.u;
   system.external_force(t1, w.f1);
   system.apply_prescribed(t1, w.u1);
+  system.internal_forces().set_time(t1, 1.0);  // a rigid indenter moves with the step
   system.dofs().gather_free(w.u1, w.x);
   NewmarkProblem problem(system, kin, w.f1, w.u1, beta_, gamma_, dt, w);
   last_ = newton_.solve(problem, w.x, 0.0);

@@ -78,11 +78,7 @@ double NonlinearOperator::plastic_work() const {
 
 const std::vector<double>& NonlinearOperator::committed_state() const {
   if (contributions_.size() == 1) return material_->committed_state();
-  state_.clear();
-  for (const auto& c : contributions_) {
-    const auto& s = c->committed_state();
-    state_.insert(state_.end(), s.begin(), s.end());
-  }
+  gather_committed_states(contributions_, state_);
   return state_;
 }
 
@@ -91,21 +87,7 @@ void NonlinearOperator::set_committed_state(const std::vector<double>& state) {
     material_->set_committed_state(state);
     return;
   }
-  std::size_t total = 0;
-  for (const auto& c : contributions_) total += c->committed_state().size();
-  if (state.size() != total) {
-    throw Error("nonlinear operator: a state of " + std::to_string(state.size()) +
-                " values was given, this model's contributions have " + std::to_string(total) +
-                " (state of another model?)");
-  }
-  std::size_t at = 0;
-  for (const auto& c : contributions_) {
-    const std::size_t n = c->committed_state().size();
-    c->set_committed_state(
-        std::vector<double>(state.begin() + static_cast<std::ptrdiff_t>(at),
-                            state.begin() + static_cast<std::ptrdiff_t>(at + n)));
-    at += n;
-  }
+  scatter_committed_states(contributions_, state, "nonlinear operator");
 }
 
 }  // namespace partita::fem

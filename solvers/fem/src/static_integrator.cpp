@@ -108,6 +108,7 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
   double internal_scale = 0.0;  // |f_int(u_0)| over all dofs: the loads and the reactions
   {
     Eigen::VectorXd f_int;
+    system.internal_forces().set_time(t1, 0.0);
     system.internal_forces().evaluate(u0, f_int, nullptr);
     for (auto d : dofs.free_dofs()) f0[d] = f_int[d];
     internal_scale = f_int.norm();
@@ -128,6 +129,8 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
     u_trial = kin.u;
     for (auto d : dofs.constrained_dofs()) u_trial[d] = u0[d] + next * (u_target[d] - u0[d]);
     dofs.gather_free(u_trial, x);
+    // a rigid indenter ramps with the loads, from its committed position to that of t1
+    system.internal_forces().set_time(t1, next);
     StaticProblem problem(system, f_lambda, u_trial);
     // a lower bound of the force scale: the internal forces of the start (reactions included)
     NewtonReport rep = newton_.solve(problem, x, internal_scale);

@@ -16,6 +16,7 @@
 #include "parallel_loop.hpp"
 #include "partita/fem/block_assembler.hpp"
 #include "partita/fem/error.hpp"
+#include "partita/fem/linear_contribution_operator.hpp"
 #include "partita/fem/linear_elastic_operator.hpp"
 #include "partita/fem/quadrature.hpp"
 #include "partita/fem/shape_functions.hpp"
@@ -70,7 +71,7 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
   kin_.f_int = Eigen::VectorXd::Zero(n);
   coupling_force_ = Eigen::VectorXd::Zero(n);
   setup_dofs();
-  if (model_.is_linear()) {
+  if (model_.is_linear() && !options_.nonlinear_path) {
     validate_failure_setup();
     assemble_stiffness();
     operator_ = std::make_unique<LinearElasticOperator>(k_);
@@ -103,12 +104,23 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
 StructuralSolver::~StructuralSolver() = default;
 
 void StructuralSolver::add_contribution(std::unique_ptr<OperatorContribution> contribution) {
-  if (nonlinear_ == nullptr) {
+  if (nonlinear_ != nullptr) {
+    nonlinear_->add_contribution(std::move(contribution));
+  } else if (options_.integrator == Integrator::CentralDifference) {
+    // the linear path's explicit steps: K u (one sparse product) plus the contributions
+    if (linear_sum_ == nullptr) {
+      auto op = std::make_unique<LinearContributionOperator>(k_, mesh());
+      linear_sum_ = op.get();
+      operator_ = std::move(op);
+    }
+    linear_sum_->add_contribution(std::move(contribution));
+  } else {
     throw Error(
-        "operator contributions need the nonlinear path (a material law such as neo-hooke or "
-        "j2-plasticity); this model is linear elastic");
+        "operator contributions on a linear-elastic model need central difference, or the "
+        "nonlinear path (SolverOptions::nonlinear_path, or a material law) for static and "
+        "Newmark analyses: the linear path factorises K once");
   }
-  nonlinear_->add_contribution(std::move(contribution));
+  stable_step_ = -1.0;  // the contribution may lower it
   refresh_internal_force();
   acceleration_valid_ = false;
 }
@@ -743,6 +755,8 @@ double StructuralSolver::kinetic_energy() const {
 }
 double StructuralSolver::strain_energy() const {
   if (nonlinear_ != nullptr) return nonlinear_->strain_energy();
+  // 1/2 u.K u plus the contributions' stored energy, at the last evaluation (kin_.u)
+  if (linear_sum_ != nullptr) return linear_sum_->strain_energy();
   return 0.5 * kin_.u.dot(k_ * kin_.u);
 }
 
@@ -816,6 +830,7 @@ double StructuralSolver::stable_time_step() const {
   std::vector<char> is_free(ndof_, 0);
   for (auto dof : dofs_.free_dofs()) is_free[static_cast<std::size_t>(dof)] = 1;
   double omega2 = 0.0;
+  Eigen::VectorXd nodal_mass = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh().num_nodes()));
   ElementMatrix ke;
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
   std::vector<int> free_local;
@@ -824,6 +839,7 @@ double StructuralSolver::stable_time_step() const {
     const auto& d = d_region[static_cast<std::size_t>(e.region)];
     (nonlinear_ != nullptr ? full : integrator_).stiffness(e.type, x, d, ke);
     integrator_.lumped_mass(e.type, x, model_.density(e.region), m);
+    for (int a = 0; a < node_count(e.type); ++a) nodal_mass[static_cast<Eigen::Index>(e.nodes[a])] += m[a];
     free_local.clear();
     for (int a = 0; a < node_count(e.type); ++a) {
       for (int c = 0; c < 3; ++c) {
@@ -846,6 +862,12 @@ double StructuralSolver::stable_time_step() const {
                              .eigenvalues()
                              .maxCoeff());
   }
+  // contributions (a penalty contact): omega_max^2 <= the elements' + theirs (Weyl's inequality
+  // for the sum of the two symmetric M^-1/2 K M^-1/2)
+  if (nonlinear_ != nullptr)
+    for (std::size_t c = 0; c < nonlinear_->num_contributions(); ++c)
+      omega2 += nonlinear_->contribution(c).max_frequency_squared(nodal_mass);
+  if (linear_sum_ != nullptr) omega2 += linear_sum_->max_frequency_squared(nodal_mass);
   stable_step_ = omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
   if (omega2 > 0.0 && options_.rayleigh_beta > 0.0) {
     // dt <= (2 / omega)(sqrt(1 + xi^2) - xi), xi = beta omega / 2: decreasing in omega, so the
@@ -865,6 +887,7 @@ void StructuralSolver::add_damping_force(const Eigen::VectorXd& v, double sign,
 }
 
 void StructuralSolver::refresh_internal_force() {
+  operator_->set_time(kin_.time, 0.0);  // the committed state (a rigid indenter where it is)
   operator_->evaluate(kin_.u, kin_.f_int, nullptr);
 }
 

@@ -19,6 +19,10 @@ class InternalForceOperator {
   // f_int(u); K_t(u) as well when k != nullptr (k keeps its sparsity pattern once set).
   virtual void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) = 0;
   virtual void commit() = 0;
+  // The time of the next evaluations: `fraction` of the way from the committed time to t (see
+  // OperatorContribution::set_time; integrators call it before evaluating a step). Only time-
+  // dependent terms (a moving rigid indenter) use it.
+  virtual void set_time(double /*t*/, double /*fraction*/) {}
   // Estimate of the round-off error of the f_int of the last evaluate() [N] (a norm over all
   // dofs): what double precision allows a Newton residual to reach (see NewtonSolver).
   virtual double round_off() const = 0;

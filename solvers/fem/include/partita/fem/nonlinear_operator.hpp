@@ -37,6 +37,9 @@ class NonlinearOperator final : public InternalForceOperator {
   // f = sum_c f_c(u); K = sum_c K_c(u) when k != nullptr (every contribution must offer one).
   void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) override;
   void commit() override;
+  void set_time(double t, double fraction) override {
+    for (const auto& c : contributions_) c->set_time(t, fraction);
+  }
   double round_off() const override;
   double strain_energy() const override;
   double plastic_work() const override;

@@ -1,5 +1,6 @@
 #pragma once
 #include <cstddef>
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -17,6 +18,8 @@ namespace partita::fem {
 //
 // Call order:
 //   coupled_node_groups() once, when the operator builds its tangent's sparsity pattern;
+//   set_time(t, fraction) before the add()s of a step (a contribution that moves with time, a
+//     rigid indenter, places itself there from its committed state);
 //   add(u, f, k, assembler) any number of times (Newton iterations, line searches, explicit
 //     steps): from the committed state, leaving a trial state for u;
 //   commit() when the step is accepted (the trial state becomes the committed one); a rejected
@@ -30,6 +33,15 @@ class OperatorContribution {
   // element: every pair of its nodes); a contribution whose K_c couples only nodes that share
   // an element, or a node with itself (contact with a rigid body), returns none.
   virtual std::vector<std::vector<std::size_t>> coupled_node_groups() const { return {}; }
+  // The configuration the next add()s are at: `fraction` of the way from the step's start to t
+  // (the static integrator's load factor; 1 in dynamics). fraction 0 marks a step's start: the
+  // committed state itself, whose time the following fractions count from. Only contributions
+  // that depend on time (a moving rigid body) use it.
+  virtual void set_time(double /*t*/, double /*fraction*/) {}
+  // A bound of the largest eigenvalue of M^-1 K_c (K_c this contribution's stiffness, M the
+  // lumped mass, per node: nodal_mass) [1/s^2]: the explicit solver adds it to the elements'
+  // omega_max^2 for its stable step. 0: the contribution does not lower it.
+  virtual double max_frequency_squared(const Eigen::VectorXd& /*nodal_mass*/) const { return 0.0; }
   // f += f_c(u) over all dofs (node-major, 3 per node); when k != nullptr also k += K_c(u),
   // added through `assembler` (whose pattern k has). May throw Error where u is inadmissible.
   virtual void add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix* k,
@@ -49,5 +61,12 @@ class OperatorContribution {
   virtual const std::vector<double>& committed_state() const;
   virtual void set_committed_state(const std::vector<double>& state);
 };
+
+// The committed states of several contributions, one after the other (an operator's state), and
+// its split back into them; `owner` names the operator in the error for a state of another size.
+void gather_committed_states(const std::vector<std::unique_ptr<OperatorContribution>>& contributions,
+                             std::vector<double>& state);
+void scatter_committed_states(const std::vector<std::unique_ptr<OperatorContribution>>& contributions,
+                              const std::vector<double>& state, std::string_view owner);
 
 }  // namespace partita::fem

@@ -37,6 +37,12 @@ struct SolverOptions {
   // The numeric factorisation of a CHOLMOD factor (linear_solver.hpp): the linear path's K_ff and
   // K_eff, and Newton's tangents.
   FactorThreading factor_threading = FactorThreading::Automatic;
+  // The nonlinear path (NonlinearOperator: element by element, a sum of OperatorContributions)
+  // even for a linear-elastic model, so that contributions such as a rigid indenter's contact
+  // can be added (the linear path's K u has no slot for them). Regions without a law use the
+  // small-strain LinearElasticLaw (the same Hex8 modes, as EAS); explicit steps cost more than
+  // the linear path's sparse product.
+  bool nonlinear_path = false;
 };
 
 }  // namespace partita::fem

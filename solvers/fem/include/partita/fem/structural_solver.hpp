@@ -13,6 +13,7 @@
 #include "partita/fem/face_mesh.hpp"
 #include "partita/fem/failure_event.hpp"
 #include "partita/fem/face_quadrature_point.hpp"
+#include "partita/fem/linear_contribution_operator.hpp"
 #include "partita/fem/linear_solver.hpp"
 #include "partita/fem/model.hpp"
 #include "partita/fem/newmark_integrator.hpp"
@@ -176,8 +177,10 @@ class StructuralSolver final : private StructuralSystem {
   // steps, cut-backs and failed tries); 0 on the linear path and for central difference.
   int newton_iterations() const;
   // Adds a contribution to the FE operator beside the material's (OperatorContribution: a
-  // contact, a spring bed ...); nonlinear path only (a model with a material law), before the
-  // first step or solve. The static, Newmark and central-difference integrators see the sum.
+  // contact, a spring bed ...), before the first step or solve. Nonlinear path: the static,
+  // Newmark and central-difference integrators see the sum. Linear path: central difference
+  // only (K u plus the contributions, LinearContributionOperator); static and Newmark there need
+  // SolverOptions::nonlinear_path.
   // The Rayleigh K0 stays the material's tangent at rest.
   void add_contribution(std::unique_ptr<OperatorContribution> contribution);
   // Newton iterations, load steps and cut-backs of the nonlinear path as lines of text (the
@@ -254,6 +257,7 @@ class StructuralSolver final : private StructuralSystem {
   Kinematics kin_;
   std::unique_ptr<InternalForceOperator> operator_;
   NonlinearOperator* nonlinear_ = nullptr;  // operator_ on the nonlinear path
+  LinearContributionOperator* linear_sum_ = nullptr;  // operator_: linear path + contributions
   StaticIntegrator static_;
   NewmarkIntegrator newmark_;
   CentralDifferenceIntegrator central_;

@@ -1,0 +1,216 @@
+#include "partita/fem/indenter_contact.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "partita/fem/element_integrator.hpp"
+#include "partita/fem/error.hpp"
+#include "partita/fem/quadrature.hpp"
+
+namespace partita::fem {
+namespace {
+
+// Area of a face element: its corners' polygon (two triangles for a quadrilateral).
+double corner_area(const Mesh& mesh, const SurfaceElement& s) {
+  const auto& x0 = mesh.node(s.nodes[0]);
+  const auto& x1 = mesh.node(s.nodes[1]);
+  const auto& x2 = mesh.node(s.nodes[2]);
+  if (corner_count(s.type) == 3) return 0.5 * (x1 - x0).cross(x2 - x0).norm();
+  const auto& x3 = mesh.node(s.nodes[3]);
+  return 0.5 * (x2 - x0).cross(x3 - x1).norm();
+}
+
+double element_volume(const Mesh& mesh, const Element& e) {
+  const ElementCoordinates x = element_coordinates(mesh, e);
+  ShapeVector n;
+  ShapeGradient g;
+  double v = 0.0;
+  for (const auto& q : volume_rule(e.type, QuadratureUse::Stiffness))
+    v += physical_gradients(e.type, x, q.xi, n, g) * q.weight;
+  return v;
+}
+
+}  // namespace
+
+IndenterContact::IndenterContact(std::string name, const Model& model, const std::string& face,
+                                 RigidIndenter indenter, IndenterContactOptions options)
+    : name_(std::move(name)), mesh_(model.mesh()), indenter_(std::move(indenter)), options_(options) {
+  if (!(options_.penalty_factor > 0.0) || !std::isfinite(options_.penalty_factor))
+    throw Error("contact '" + name_ + "': the penalty factor must be > 0");
+  if (!(options_.friction >= 0.0) || !std::isfinite(options_.friction))
+    throw Error("contact '" + name_ + "': the friction coefficient must be >= 0");
+  if (!(options_.tangential_factor > 0.0))
+    throw Error("contact '" + name_ + "': the tangential penalty factor must be > 0");
+  const auto& elements = mesh_.face(face);  // throws, listing the faces, if unknown
+  nodes_ = mesh_.face_nodes(face);
+  // node -> elements, to find the volume element each face element bounds
+  std::vector<std::vector<std::size_t>> node_elements(mesh_.num_nodes());
+  for (std::size_t e = 0; e < mesh_.num_elements(); ++e)
+    for (auto n : mesh_.element(e).node_span()) node_elements[n].push_back(e);
+  std::vector<double> k(mesh_.num_nodes(), 0.0);
+  for (const auto& s : elements) {
+    const int corners = corner_count(s.type);
+    std::size_t owner = mesh_.num_elements();
+    for (auto e : node_elements[s.nodes[0]]) {
+      const auto en = mesh_.element(e).node_span();
+      bool all = true;
+      for (int c = 1; c < corners && all; ++c)
+        all = std::find(en.begin(), en.end(), s.nodes[static_cast<std::size_t>(c)]) != en.end();
+      if (all) {
+        owner = e;
+        break;
+      }
+    }
+    if (owner == mesh_.num_elements())
+      throw Error("contact '" + name_ + "': a face element of '" + face +
+                  "' bounds no volume element (a face read from a file that is not the mesh's?)");
+    const Element& el = mesh_.element(owner);
+    const double area = corner_area(mesh_, s);
+    const double h = element_volume(mesh_, el) / area;
+    // k_n += factor E (A_f / n_f) / h_f
+    const double modulus = model.material(el.region).youngs_modulus;
+    const auto nf = static_cast<double>(node_count(s.type));
+    for (auto n : s.node_span()) k[n] += options_.penalty_factor * modulus * (area / nf) / h;
+  }
+  for (auto n : nodes_) k_normal_.push_back(k[n]);
+  if (options_.friction > 0.0) {
+    ft_committed_.assign(nodes_.size(), Vec3::Zero());
+    ft_trial_ = ft_committed_;
+    u_committed_ = ft_committed_;
+    u_trial_ = ft_committed_;
+  }
+}
+
+void IndenterContact::set_time(double t, double fraction) {
+  if (fraction == 0.0) step_start_ = indenter_.time();
+  indenter_.move_to(fraction == 1.0   ? t
+                    : fraction == 0.0 ? indenter_.time()
+                                      : step_start_ + fraction * (t - step_start_));
+}
+
+void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix* k,
+                          const BlockAssembler& assembler) {
+  const Vec3 d = indenter_.trial_displacement();
+  const Vec3 dd = d - indenter_.displacement();
+  const RigidShape& shape = indenter_.shape();
+  const bool friction = options_.friction > 0.0;
+  energy_ = 0.0;
+  friction_work_trial_ = 0.0;
+  active_ = 0;
+  double round_off2 = 0.0;
+  Vec3 on_body = Vec3::Zero();
+  ElementMatrix ke(3, 3);
+  for (std::size_t j = 0; j < nodes_.size(); ++j) {
+    const std::size_t node = nodes_[j];
+    const auto at = 3 * static_cast<Eigen::Index>(node);
+    const Vec3 ui = u.segment<3>(at);
+    if (friction) u_trial_[j] = ui;
+    const ShapeDistance s = shape.distance(mesh_.node(node) + ui - d);
+    if (!(s.gap < 0.0)) {
+      if (friction) ft_trial_[j].setZero();
+      continue;
+    }
+    ++active_;
+    const double kn = k_normal_[j];
+    const Vec3& n = s.normal;
+    // p = -k_n g n on the node;  f_int += -p;  W = 1/2 k_n g^2
+    const Vec3 p = -kn * s.gap * n;
+    Vec3 force = p;
+    energy_ += 0.5 * kn * s.gap * s.gap;
+    if (k != nullptr) ke = kn * n * n.transpose();
+    if (friction) {
+      const double kt = options_.tangential_factor * kn;
+      const Mat3 tangent_projector = Mat3::Identity() - n * n.transpose();
+      // du_t = (I - n n^T)((u - u_c) - (d - d_c));  f_t,trial = P(f_t,c) - k_t du_t
+      const Vec3 du_t = tangent_projector * ((ui - u_committed_[j]) - dd);
+      Vec3 ft_old = tangent_projector * ft_committed_[j];
+      if (ft_old.norm() > 0.0) ft_old *= ft_committed_[j].norm() / ft_old.norm();
+      Vec3 ft = ft_old - kt * du_t;
+      const double limit = options_.friction * p.norm(), trial = ft.norm();
+      if (trial > limit) {
+        // return to the cone: f_t = mu |p| t, t = f_t,trial / |f_t,trial|
+        const Vec3 t = ft / trial;
+        ft = limit * t;
+        friction_work_trial_ += limit * (trial - limit) / kt;
+        if (k != nullptr) ke += kt * limit / trial * (tangent_projector - t * t.transpose());
+      } else if (k != nullptr) {
+        ke += kt * tangent_projector;
+      }
+      ft_trial_[j] = ft;
+      energy_ += 0.5 * ft.squaredNorm() / kt;
+      force += ft;
+    }
+    f.segment<3>(at) -= force;
+    on_body -= force;
+    const double scale = kn * (mesh_.node(node).norm() + ui.norm() + d.norm() + std::abs(s.gap)) +
+                         force.norm();
+    round_off2 += scale * scale;
+    if (k != nullptr) assembler.add(*k, std::span<const std::size_t>(&node, 1), ke);
+  }
+  force_on_body_ = on_body;
+  round_off_ = std::numeric_limits<double>::epsilon() * std::sqrt(round_off2);
+  indenter_.set_contact_force(on_body);
+}
+
+void IndenterContact::commit() {
+  indenter_.commit();
+  if (options_.friction > 0.0) {
+    ft_committed_ = ft_trial_;
+    u_committed_ = u_trial_;
+    friction_work_ += friction_work_trial_;
+    friction_work_trial_ = 0.0;
+  }
+}
+
+double IndenterContact::max_frequency_squared(const Eigen::VectorXd& nodal_mass) const {
+  const double kfactor = std::max(1.0, options_.friction > 0.0 ? options_.tangential_factor : 0.0);
+  const double mb = indenter_.is_free() ? indenter_.mass() : 0.0;
+  double node_max = 0.0, body = 0.0;
+  for (std::size_t j = 0; j < nodes_.size(); ++j) {
+    const double m = nodal_mass[static_cast<Eigen::Index>(nodes_[j])];
+    if (!(m > 0.0)) continue;
+    const double kmax = kfactor * k_normal_[j];
+    // Gershgorin rows of M^-1/2 K_c M^-1/2: node k/m_i + k/sqrt(m_i m_b); body sum of the same
+    // with 1/m_b
+    const double cross = mb > 0.0 ? kmax / std::sqrt(m * mb) : 0.0;
+    node_max = std::max(node_max, kmax / m + cross);
+    if (mb > 0.0) body += kmax / mb + cross;
+  }
+  return std::max(node_max, body);
+}
+
+const std::vector<double>& IndenterContact::committed_state() const {
+  state_.assign(RigidIndenter::kStateSize, 0.0);
+  indenter_.write_state(state_);
+  if (options_.friction > 0.0) {
+    state_.push_back(friction_work_);
+    for (std::size_t j = 0; j < nodes_.size(); ++j)
+      for (const Vec3* v : {&ft_committed_[j], &u_committed_[j]})
+        state_.insert(state_.end(), v->data(), v->data() + 3);
+  }
+  return state_;
+}
+
+void IndenterContact::set_committed_state(const std::vector<double>& state) {
+  const std::size_t expected =
+      RigidIndenter::kStateSize + (options_.friction > 0.0 ? 1 + 6 * nodes_.size() : 0);
+  if (state.size() != expected)
+    throw Error("contact '" + name_ + "': a state of " + std::to_string(state.size()) +
+                " values was given, it keeps " + std::to_string(expected));
+  indenter_.read_state(std::span<const double>(state.data(), RigidIndenter::kStateSize));
+  if (options_.friction > 0.0) {
+    const double* p = state.data() + RigidIndenter::kStateSize;
+    friction_work_ = *p++;
+    for (std::size_t j = 0; j < nodes_.size(); ++j) {
+      for (Vec3* v : {&ft_committed_[j], &u_committed_[j]})
+        for (int c = 0; c < 3; ++c) (*v)[c] = *p++;
+    }
+    ft_trial_ = ft_committed_;
+    u_trial_ = u_committed_;
+  }
+  force_on_body_ = indenter_.contact_force();
+}
+
+}  // namespace partita::fem

@@ -1,0 +1,436 @@
+// Rigid indenters in contact with FE surfaces (issue 27): the shapes' signed distances, the
+// driven motion's exact integral, Hertz's sphere on an elastic block, a flat punch's reaction, a
+// free mass dropped on a free block (momentum and energy), friction's dissipation and restart.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include "partita/fem/block_assembler.hpp"
+#include "partita/fem/box_mesher.hpp"
+#include "partita/fem/capsule_shape.hpp"
+#include "partita/fem/error.hpp"
+#include "partita/fem/indenter_contact.hpp"
+#include "partita/fem/plane_shape.hpp"
+#include "partita/fem/sphere_shape.hpp"
+#include "partita/fem/structural_solver.hpp"
+#include "partita/fem/triangulated_shape.hpp"
+#include "partita/fem/velocity_table.hpp"
+
+using namespace partita::fem;
+
+namespace {
+
+// Adds a contact to the solver and returns it (the solver owns it).
+IndenterContact& add_contact(StructuralSolver& s, const std::string& face, RigidIndenter indenter,
+                             IndenterContactOptions options = {}) {
+  auto c = std::make_unique<IndenterContact>("indenter", s.model(), face, std::move(indenter), options);
+  IndenterContact& ref = *c;
+  s.add_contribution(std::move(c));
+  return ref;
+}
+
+// The closed surface of the box [lo, hi] (12 triangles, counter-clockwise seen from outside).
+TriangulatedShape box_surface(const Vec3& lo, const Vec3& hi, double search) {
+  std::vector<Vec3> v;
+  for (int k = 0; k < 8; ++k)
+    v.emplace_back((k & 1) ? hi.x() : lo.x(), ((k >> 1) & 1) ? hi.y() : lo.y(),
+                   ((k >> 2) & 1) ? hi.z() : lo.z());
+  std::vector<std::array<int, 3>> t = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6},
+                                       {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},
+                                       {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  return TriangulatedShape(v, t, search);
+}
+
+// An elastic column side x side x height on rollers (zmin fixed in z, xmin in x, ymin in y),
+// cells x cells x 8 Hex8, E = 70 GPa, on the nonlinear path (static and Newmark contact).
+StructuralSolver column_on_rollers(double side, double height, int cells, double e) {
+  BoxSpec b;
+  b.size = Vec3(side, side, height);
+  b.cells = {cells, cells, 8};
+  Model model(make_box_mesh(b), Material{e, 0.3, 2700});
+  model.fix("zmin", {2});
+  model.fix("xmin", {0});
+  model.fix("ymin", {1});
+  SolverOptions o;
+  o.nonlinear_path = true;
+  return StructuralSolver(std::move(model), o);
+}
+
+}  // namespace
+
+TEST_CASE("rigid shapes: signed distances and outward normals", "[fem][contact]") {
+  const SphereShape sphere(Vec3(1, 2, 3), 0.5);
+  auto s = sphere.distance(Vec3(1, 2, 3.2));
+  CHECK(s.gap == Approx(-0.3));
+  CHECK(s.normal.z() == Approx(1.0));
+  const CapsuleShape capsule(Vec3::Zero(), Vec3(0, 0, 2), 2.0, 0.5);
+  s = capsule.distance(Vec3(0.7, 0, 0.9));  // beside the cylinder
+  CHECK(s.gap == Approx(0.2));
+  CHECK(s.normal.x() == Approx(1.0));
+  s = capsule.distance(Vec3(0, 0, 1.3));  // inside the cap at +a: 0.3 from its centre
+  CHECK(s.gap == Approx(-0.2));
+  CHECK(s.normal.z() == Approx(1.0));
+  const PlaneShape plane(Vec3(0, 0, 1), Vec3(0, 0, -2));
+  CHECK(plane.distance(Vec3(5, 5, 0.75)).gap == Approx(0.25));
+  CHECK(plane.distance(Vec3(5, 5, 1.1)).gap == Approx(-0.1));
+  // the triangulations are closed and outward: volume by the divergence theorem
+  for (const RigidShape* shape : {static_cast<const RigidShape*>(&sphere),
+                                  static_cast<const RigidShape*>(&capsule)}) {
+    const auto tri = shape->triangulate();
+    double volume = 0.0;
+    for (const auto& t : tri.triangles)
+      volume += tri.vertices[t[0]].dot(tri.vertices[t[1]].cross(tri.vertices[t[2]])) / 6.0;
+    const double exact = shape == &sphere ? 4.0 / 3.0 * std::numbers::pi * 0.125
+                                          : std::numbers::pi * 0.25 * 2.0 + 4.0 / 3.0 * std::numbers::pi * 0.125;
+    CHECK(volume == Approx(exact).epsilon(0.05));  // inscribed polyhedra: a few % less
+    CHECK(volume < exact);
+  }
+  CHECK_THROWS_WITH(SphereShape(Vec3::Zero(), -1.0), Catch::Contains("radius must be > 0"));
+}
+
+TEST_CASE("triangulated shape: a cube's signed distance, inside and out, by the grid",
+          "[fem][contact]") {
+  const TriangulatedShape cube = box_surface(Vec3::Zero(), Vec3::Ones(), 0.2);
+  auto s = cube.distance(Vec3(0.5, 0.5, 0.9));  // inside, 0.1 below the top
+  CHECK(s.gap == Approx(-0.1));
+  CHECK(s.normal.z() == Approx(1.0));
+  s = cube.distance(Vec3(1.05, 0.5, 0.5));  // outside, 0.05 beyond x = 1
+  CHECK(s.gap == Approx(0.05));
+  CHECK(s.normal.x() == Approx(1.0));
+  s = cube.distance(Vec3(1.05, 1.05, 1.05));  // outside a corner (vertex pseudo-normal)
+  CHECK(s.gap == Approx(0.05 * std::sqrt(3.0)));
+  s = cube.distance(Vec3(0.95, 0.97, 0.5));  // inside near an edge (edge pseudo-normal)
+  CHECK(s.gap == Approx(-0.03));
+  CHECK(cube.distance(Vec3(0.5, 0.5, 0.5)).gap == Approx(0.2));  // deeper than the search
+  CHECK(cube.distance(Vec3(3, 3, 3)).gap == Approx(0.2));
+  // against the analytic distance of a box at scattered points within the search radius
+  int checked = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 x(-0.2 + 1.4 * ((i * 37) % 101) / 100.0, -0.2 + 1.4 * ((i * 53) % 97) / 96.0,
+                 -0.2 + 1.4 * ((i * 71) % 89) / 88.0);
+    const Vec3 q = (x - Vec3::Constant(0.5)).cwiseAbs() - Vec3::Constant(0.5);
+    const double exact = q.cwiseMax(0.0).norm() + std::min(q.maxCoeff(), 0.0);
+    if (std::abs(exact) >= 0.19) continue;
+    ++checked;
+    REQUIRE(cube.distance(x).gap == Approx(exact).margin(1e-12));
+  }
+  CHECK(checked > 500);
+  CHECK(cube.max_cell_triangles() < 12);  // the grid narrows the search
+  // a finer surface: the sphere's 320 triangles; a query tests a few of them, and the signed
+  // distance is the sphere's within the polyhedron's sagitta (up to about 0.016 R on the
+  // icosphere's largest triangles; 0.02 R allowed)
+  const SphereShape ball(Vec3(1, 2, 3), 1.0);
+  const auto tri = ball.triangulate();
+  const TriangulatedShape hull(tri.vertices, tri.triangles, 0.1);
+  CHECK(hull.max_cell_triangles() < 32);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 dir = Vec3(std::sin(0.7 * i), std::cos(1.3 * i), std::sin(2.1 * i + 0.3)).normalized();
+    const Vec3 x = ball.centre() + (1.0 + 0.05 * std::sin(0.37 * i)) * dir;
+    REQUIRE(hull.distance(x).gap == Approx(ball.distance(x).gap).margin(0.02));
+    REQUIRE(hull.distance(x).normal.dot(dir) > 0.9);
+  }
+  CHECK_THROWS_WITH(TriangulatedShape({Vec3::Zero()}, {{0, 0, 1}}, 0.1),
+                    Catch::Contains("refers to vertex 1"));
+}
+
+TEST_CASE("velocity table: its displacement is the exact integral", "[fem][contact]") {
+  const VelocityTable v({{0.0, Vec3(0, 0, 0)}, {1.0, Vec3(0, 0, -2)}, {3.0, Vec3(1, 0, -2)}});
+  CHECK(v.velocity(0.5).z() == Approx(-1.0));
+  CHECK(v.displacement(1.0).z() == Approx(-1.0));             // triangle: 1/2 1 2
+  CHECK(v.displacement(3.0).z() == Approx(-5.0));             // + 2 x 2
+  CHECK(v.displacement(4.0).z() == Approx(-7.0));             // held after the last row
+  CHECK(v.displacement(3.0).x() == Approx(1.0));              // 1/2 2 1
+  CHECK(v.displacement(2.0).x() == Approx(0.25));             // 1/2 1 0.5
+  CHECK_THROWS_WITH(VelocityTable({{1.0, Vec3::Zero()}, {1.0, Vec3::Zero()}}),
+                    Catch::Contains("times must increase"));
+}
+
+// A frictionless rigid flat punch (a plane) driven by delta into the top of an elastic column on
+// rollers: uniaxial stress, and in series with it the penalty springs, sum k_n = f E A / h:
+//   F = delta / (H / (E A) + h / (f E A)).
+// The support reaction equals the force on the punch.
+TEST_CASE("flat punch on a block: reaction equals the punch force, uniaxial stiffness (plane and STL-like surface)",
+          "[fem][contact]") {
+  const double e = 70e9, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0;
+  StructuralSolver s = column_on_rollers(side, height, 4, e);
+  // the punch's face at z = H, moving down at delta per second: a plane, or a closed
+  // triangulated box wider than the block (its bottom face the punch's)
+  std::shared_ptr<const RigidShape> punch;
+  if (GENERATE(false, true)) {
+    punch = std::make_shared<TriangulatedShape>(box_surface(
+        Vec3(-side, -side, height), Vec3(2 * side, 2 * side, height + side), 10 * delta));
+  } else {
+    punch = std::make_shared<PlaneShape>(Vec3(0, 0, height), Vec3(0, 0, -1));
+  }
+  INFO("punch: " << punch->kind());
+  IndenterContact& c = add_contact(s, "zmax", RigidIndenter(punch, VelocityTable({{0.0, Vec3(0, 0, -delta)}})),
+                                   {factor, 0.0, 1.0});
+  s.step_static(1.0);
+  const double area = side * side, h = height / 8;
+  const double exact = delta / (height / (e * area) + h / (factor * e * area));
+  const Vec3 on_punch = c.contact_force();
+  CHECK(on_punch.z() == Approx(exact).epsilon(1e-9));
+  CHECK(s.reaction("zmin").z() == Approx(on_punch.z()).epsilon(1e-9));
+  CHECK(std::abs(on_punch.x()) < 1e-9 * exact);
+  CHECK(c.active_nodes() == 25);
+  // the indenter's work equals the stored energy (elastic + penalty) in a static ramp of one step
+  CHECK(c.indenter().work() == Approx(0.5 * exact * delta).epsilon(1e-9));
+  CHECK(s.strain_energy() == Approx(0.5 * exact * delta).epsilon(1e-9));
+}
+
+// Hertz: a rigid sphere of radius R pressed by delta into an elastic half-space carries
+//   F = 4/3 E* sqrt(R) delta^(3/2),  E* = E / (1 - nu^2)
+// (Johnson, Contact Mechanics, 1985, eq. 4.23). Quarter model of a block 20 R wide and deep
+// (its rigid base stiffens it by about 0.7 a / H: 0.5 % at delta = 0.02 R), graded from cells of
+// R / 40 under the sphere; symmetry planes x = 0 and y = 0; penalty factor 100 (penetration
+// about h / (100 a) of delta). Quasi-static: the sphere driven down, a static solve per point.
+TEST_CASE("Hertz: a rigid sphere pressed into an elastic block", "[fem][contact][hertz]") {
+  const double e = 1e9, nu = 0.3, r = 0.01, size = 20 * r;
+  const int n = 22;
+  BoxSpec b;
+  b.origin = Vec3(0, 0, -size);
+  b.size = Vec3(size, size, size);
+  b.cells = {n, n, n};
+  Mesh mesh = make_box_mesh(b);
+  // cells of h0 = R / 40 up to 0.2 R, then growing geometrically to the block's size
+  const double h0 = r / 40.0;
+  const int fine = 8;
+  double ratio = 1.1;
+  auto reach = [&](double q) {
+    return fine * h0 + h0 * q * (std::pow(q, n - fine) - 1.0) / (q - 1.0);
+  };
+  for (int it = 0; it < 200; ++it) ratio *= std::pow(size / reach(ratio), 0.02);
+  auto grade = [&](double x) {  // x in [0, size] on the uniform grid -> graded
+    const double s = x / size * n;
+    const int i = static_cast<int>(std::floor(s + 1e-9));
+    if (i <= fine) return s * h0;
+    const double k = s - fine;
+    return fine * h0 + h0 * ratio * (std::pow(ratio, k) - 1.0) / (ratio - 1.0);
+  };
+  for (std::size_t i = 0; i < mesh.num_nodes(); ++i) {
+    const Vec3 x = mesh.node(i);
+    mesh.set_node(i, Vec3(grade(x.x()), grade(x.y()), -grade(-x.z())));
+  }
+  Model model(std::move(mesh), Material{e, nu, 1000});
+  model.fix("zmin", {0, 1, 2});
+  model.fix("xmin", {0});
+  model.fix("ymin", {1});
+  SolverOptions o;
+  o.nonlinear_path = true;
+  StructuralSolver s(std::move(model), o);
+  // the sphere touching the surface at the origin, driven down at R per second
+  auto sphere = std::make_shared<SphereShape>(Vec3(0, 0, r), r);
+  IndenterContact& c = add_contact(s, "zmax", RigidIndenter(sphere, VelocityTable({{0.0, Vec3(0, 0, -r)}})),
+                                   {100.0, 0.0, 1.0});
+  const double e_star = e / (1 - nu * nu);
+  double t = 0.0;
+  for (double ratio_d : {0.005, 0.01, 0.015, 0.02}) {
+    s.step_static(ratio_d - t);
+    t = ratio_d;
+    const double delta = -c.indenter().displacement().z();
+    const double hertz = 4.0 / 3.0 * e_star * std::sqrt(r) * std::pow(delta, 1.5);
+    const double f = 4.0 * c.contact_force().z();  // quarter model
+    INFO("delta/R = " << ratio_d << ": F = " << f << " N, Hertz " << hertz << " N, ratio "
+                      << f / hertz << ", nodes in contact " << c.active_nodes());
+    WARN("delta/R = " << ratio_d << ": F/F_Hertz = " << f / hertz);
+    CHECK(f == Approx(hertz).epsilon(0.03));
+  }
+}
+
+// A free rigid sphere (mass m, velocity v0) meets a free elastic block (no supports, no gravity,
+// no damping): central difference. The momentum of sphere + block is conserved (the contact
+// forces on nodes and body are equal and opposite at the same instants), and so is the energy
+// (kinetic of both + strain + penalty) to the integrator's accuracy.
+TEST_CASE("free mass dropped on a free block: momentum and energy conserved", "[fem][contact][drop]") {
+  const double e = 210e9, nu = 0.3, rho = 7850, side = 0.1, r = 0.05, m = 2.0, v0 = 2.0;
+  BoxSpec b;
+  b.size = Vec3(side, side, side);
+  b.cells = {6, 6, 6};
+  SolverOptions o;
+  // the nonlinear path (EAS elements, a sum of contributions) or the linear path (K u plus the
+  // contact: LinearContributionOperator)
+  o.nonlinear_path = GENERATE(true, false);
+  INFO("nonlinear path " << o.nonlinear_path);
+  o.mass = MassType::Lumped;
+  o.integrator = Integrator::CentralDifference;
+  StructuralSolver s(Model(make_box_mesh(b), Material{e, nu, rho}), o);
+  const double dt_elements = s.stable_time_step();
+  auto sphere = std::make_shared<SphereShape>(Vec3(0.5 * side, 0.5 * side, side + r + 1e-6), r);
+  IndenterContact& c = add_contact(s, "zmax", RigidIndenter(sphere, m, Vec3(0, 0, -v0), Vec3::Zero()));
+  const double dt = 0.9 * s.stable_time_step();
+  CHECK(s.stable_time_step() < dt_elements);  // the penalty springs lower it
+  // lumped mass of the uniform Hex8 grid: each element gives each of its nodes rho V_e / 8
+  Eigen::VectorXd nodal_mass = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(s.mesh().num_nodes()));
+  const double cell = std::pow(side / 6, 3);
+  for (const auto& el : s.mesh().elements())
+    for (auto nd : el.node_span()) nodal_mass[static_cast<Eigen::Index>(nd)] += rho * cell / 8;
+  auto momentum = [&] {
+    double p = m * c.indenter().velocity().z();
+    for (Eigen::Index i = 0; i < nodal_mass.size(); ++i) p += nodal_mass[i] * s.velocity()[3 * i + 2];
+    return p;
+  };
+  auto energy = [&] {
+    return c.indenter().kinetic_energy() + s.kinetic_energy() + s.strain_energy();
+  };
+  const double p0 = momentum(), e0 = energy();
+  CHECK(p0 == Approx(-m * v0));
+  CHECK(e0 == Approx(0.5 * m * v0 * v0));
+  double max_force = 0.0, max_p_error = 0.0, max_e_error = 0.0;
+  SolverState mid;
+  bool saved = false;
+  int steps_in_contact = 0;
+  for (int k = 0; k < 4000; ++k) {
+    s.step(dt);
+    max_force = std::max(max_force, c.contact_force().z());
+    if (c.active_nodes() > 0) ++steps_in_contact;
+    if (!saved && steps_in_contact == 10) {
+      mid = s.save_state();
+      saved = true;
+    }
+    max_p_error = std::max(max_p_error, std::abs(momentum() - p0));
+    max_e_error = std::max(max_e_error, std::abs(energy() - e0));
+    if (steps_in_contact > 0 && c.active_nodes() == 0 && c.indenter().velocity().z() > 0 &&
+        k > 50 + steps_in_contact)
+      break;
+  }
+  INFO("peak force " << max_force << " N, " << steps_in_contact << " steps in contact, rebound "
+                     << c.indenter().velocity().z() << " m/s");
+  WARN("drop: " << steps_in_contact << " steps in contact, rebound " << c.indenter().velocity().z()
+                 << " m/s, max |dP| / (m v0) = " << max_p_error / (m * v0)
+                 << ", max |dE| / E0 = " << max_e_error / e0);
+  CHECK(steps_in_contact > 20);
+  CHECK(c.indenter().velocity().z() > 0.0);  // it rebounds
+  CHECK(max_p_error < 0.01 * m * v0);
+  CHECK(max_e_error < 0.01 * e0);
+  // the sphere's lost kinetic energy went into the block: its momentum, the same as lost
+  const double block_p = momentum() - m * c.indenter().velocity().z();
+  CHECK(block_p == Approx(-m * v0 - m * c.indenter().velocity().z()).epsilon(0.01));
+  // the sphere's work on the structure equals what the sphere lost (to the integrator's accuracy)
+  CHECK(c.indenter().work() ==
+        Approx(0.5 * m * v0 * v0 - c.indenter().kinetic_energy()).epsilon(0.01));
+  // restart mid-contact: restoring the state and stepping again gives the same bits
+  const auto after = s.save_state();
+  const Vec3 d_after = c.indenter().displacement(), v_after = c.indenter().velocity();
+  s.restore_state(mid);
+  while (s.time() < after.time - 0.5 * dt) s.step(dt);
+  CHECK(s.displacement() == after.displacement);
+  CHECK(c.indenter().displacement() == d_after);
+  CHECK(c.indenter().velocity() == v_after);
+}
+
+// Friction: a block sliding under a driven plane that presses it and drags it sideways. The
+// frictional force on the punch is mu times the normal force once it slips, and the dissipated
+// work is that force times the slip.
+TEST_CASE("friction: a punch pressed and dragged sideways slips at mu times the normal force",
+          "[fem][contact][friction]") {
+  const double e = 70e9, nu = 0.3, side = 0.02, height = 0.02, delta = 1e-5, slide = 1e-4, mu = 0.3;
+  BoxSpec b;
+  b.size = Vec3(side, side, height);
+  b.cells = {4, 4, 4};
+  Model model(make_box_mesh(b), Material{e, nu, 2700});
+  model.fix("zmin", {0, 1, 2});
+  SolverOptions o;
+  o.nonlinear_path = true;
+  StructuralSolver s(std::move(model), o);
+  auto plane = std::make_shared<PlaneShape>(Vec3(0, 0, height), Vec3(0, 0, -1));
+  // pressed down by delta in [0, 1], then dragged along x by `slide` in [1, 2]
+  const VelocityTable path({{0.0, Vec3(0, 0, -delta)},
+                            {1.0, Vec3(0, 0, -delta)},
+                            {1.0 + 1e-9, Vec3(slide, 0, 0)},
+                            {2.0, Vec3(slide, 0, 0)}});
+  IndenterContact& c = add_contact(s, "zmax", RigidIndenter(plane, path), {10.0, mu, 1.0});
+  s.step_static(1.0);
+  const double normal = c.contact_force().z();
+  CHECK(normal > 0.0);
+  CHECK(std::abs(c.contact_force().x()) < 1e-9 * normal);
+  // pressing alone: the surface spreads under the punch (Poisson), its edge nodes slip a little
+  CHECK(c.dissipated_work() < 1e-2 * normal * delta);
+  const int steps = 8;
+  const double dx = slide / steps;
+  double w2 = 0.0, d2 = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    s.step_static(1.0 / steps);
+    if (k == 1) {
+      w2 = c.indenter().work();
+      d2 = c.dissipated_work();
+    }
+  }
+  const Vec3 f = c.contact_force();
+  INFO("normal " << f.z() << " N, tangential " << f.x() << " N");
+  // the block's surface drags the punch back: -x on the punch, mu times the normal force
+  CHECK(-f.x() == Approx(mu * f.z()).epsilon(2e-3));
+  // in steady slip every node slides with the punch: dissipated mu F_n dx per step, the work
+  // the punch does
+  const double slipping = (steps - 2) * dx * mu * f.z();
+  CHECK(c.dissipated_work() - d2 == Approx(slipping).epsilon(2e-3));
+  CHECK(c.indenter().work() - w2 == Approx(slipping).epsilon(2e-3));
+  CHECK(s.reaction("zmin").x() == Approx(f.x()).epsilon(1e-6));
+}
+
+// The contact's tangent against central differences of its force: exact for a plane (normal
+// penalty, and friction in stick: k_t (I - n n^T)); for a sphere the left-out curvature term
+// k_n g dn/dx is of relative size |g| / R (2e-3 here), relative to the stiffest column.
+TEST_CASE("indenter contact: tangent against finite differences", "[fem][contact]") {
+  BoxSpec b;
+  b.size = Vec3(0.02, 0.02, 0.01);
+  b.cells = {4, 4, 2};
+  const Model model(make_box_mesh(b), Material{70e9, 0.3, 2700});
+  const BlockAssembler assembler(model.mesh());
+  const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
+  struct Case {
+    std::shared_ptr<const RigidShape> shape;
+    double mu, tolerance;
+  };
+  const double r = 0.05;
+  for (const Case& c : {Case{std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0.1, 0.2, -1)), 0.0, 1e-6},
+                        Case{std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0.1, 0.2, -1)), 0.5, 1e-6},
+                        Case{std::make_shared<SphereShape>(Vec3(0.01, 0.01, 0.01 + r - 1e-4), r), 0.0, 1e-2}}) {
+    IndenterContact contact("t", model, "zmax",
+                            RigidIndenter(c.shape, VelocityTable({{0.0, Vec3(1e-6, 0, 0)}})),
+                            {1.0, c.mu, 1.0});
+    contact.set_time(1.0, 1.0);
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index i = 0; i < n; ++i) u[i] = 1e-7 * std::sin(1.3 * static_cast<double>(i));
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+    SparseMatrix k = assembler.make_matrix();
+    contact.add(u, f, &k, assembler);
+    REQUIRE(contact.active_nodes() > 0);
+    const Eigen::MatrixXd kd(k);
+    const double scale = kd.colwise().norm().maxCoeff();  // k_n of the stiffest node
+    const double h = 1e-10;
+    double worst = 0.0;
+    for (auto node : contact.nodes()) {
+      for (int comp = 0; comp < 3; ++comp) {
+        const Eigen::Index j = 3 * static_cast<Eigen::Index>(node) + comp;
+        Eigen::VectorXd up = u, um = u, fp = Eigen::VectorXd::Zero(n), fm = fp;
+        up[j] += h;
+        um[j] -= h;
+        contact.add(up, fp, nullptr, assembler);
+        contact.add(um, fm, nullptr, assembler);
+        const Eigen::VectorXd column = (fp - fm) / (2 * h);
+        worst = std::max(worst, (column - kd.col(j)).norm() / scale);
+      }
+    }
+    INFO(c.shape->kind() << ", mu " << c.mu << ": worst relative column error " << worst);
+    CHECK(worst < c.tolerance);
+  }
+}
+
+// Newmark (implicit, Newton with the contact's tangent): the flat punch driven slowly (a ramp of
+// T = 10 ms, long beside the column's period of about 30 us) carries the static force of the
+// column and penalty springs in series within 1 %, and the energy the punch put in is the
+// column's strain + kinetic + penalty energy within 1 %.
+TEST_CASE("flat punch, Newmark: quasi-static force and energy", "[fem][contact]") {
+  const double e = 70e9, side = 0.02, height = 0.04, delta = 2e-5, factor = 10.0, t = 0.01;
+  StructuralSolver s = column_on_rollers(side, height, 2, e);
+  auto plane = std::make_shared<PlaneShape>(Vec3(0, 0, height), Vec3(0, 0, -1));
+  IndenterContact& c = add_contact(
+      s, "zmax", RigidIndenter(plane, VelocityTable({{0.0, Vec3(0, 0, -delta / t)}, {t, Vec3(0, 0, -delta / t)}, {t * 1.0001, Vec3::Zero()}})),
+      {factor, 0.0, 1.0});
+  for (int k = 0; k < 200; ++k) s.step(t / 200);
+  const double area = side * side, h = height / 8;
+  const double exact = delta / (height / (e * area) + h / (factor * e * area));
+  CHECK(c.contact_force().z() == Approx(exact).epsilon(0.01));
+  CHECK(c.indenter().work() == Approx(s.strain_energy() + s.kinetic_energy()).epsilon(0.01));
+}
