@@ -132,7 +132,7 @@ case "$SCENARIO" in
     ;;
   signal)
     case_file=$HERE/../../cases/uniaxial_compaction/steel.yaml
-    sets=(--set time.end=0.004 --set output.every=5e-4)
+    sets=(--set time.end=0.02 --set output.every=2e-3)  # long enough to be under way at the signal
     "$P" run "$case_file" -o one --threads 1 "${sets[@]}" > one.log 2>&1 || { cat one.log; fail "one process"; }
     distributed plate granules two "$case_file" "${sets[@]}" > two.log 2>&1 &
     launcher=$!
