@@ -707,6 +707,9 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
           n["name"].fail("'" + b.name + "' names an interface already: give the indenter another name");
       indenters_.push_back({b.name, b.reference, b.contact.get(), b.has_surface});
       if (b.has_surface) meshes_.push_back(std::move(b.surface));
+      // an eroded element's nodes leave the surface the indenter touches
+      b.contact->set_detached(
+          [s = solver_.get()](std::size_t node) { return s->node_detached(node); });
       solver_->add_contribution(std::move(b.contact));
     }
     if (!transient_) solver_->solve_static();

@@ -108,7 +108,7 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
     const Vec3 ui = u.segment<3>(at);
     if (friction) u_trial_[j] = ui;
     const ShapeDistance s = shape.distance(mesh_.node(node) + ui - d);
-    if (!(s.gap < 0.0)) {
+    if (!(s.gap < 0.0) || (detached_ && detached_(node))) {  // apart, or eroded away
       if (friction) ft_trial_[j].setZero();
       continue;
     }

@@ -76,6 +76,28 @@ bool StructuralSolver::element_eroded(std::size_t element) const {
          nonlinear_->material().eroded(element);
 }
 
+bool StructuralSolver::node_detached(std::size_t node) const {
+  if (nonlinear_ == nullptr || !nonlinear_->material().has_failure_criteria()) return false;
+  const Mesh& mesh = model_.mesh();
+  if (node_element_offset_.empty()) {
+    std::vector<std::size_t> count(mesh.num_nodes() + 1, 0);
+    for (const auto& el : mesh.elements())
+      for (int a = 0; a < node_count(el.type); ++a) ++count[el.nodes[a] + 1];
+    for (std::size_t n = 0; n < mesh.num_nodes(); ++n) count[n + 1] += count[n];
+    node_element_offset_ = count;
+    node_elements_.assign(count.back(), 0);
+    for (std::size_t e = 0; e < mesh.num_elements(); ++e) {
+      const Element& el = mesh.elements()[e];
+      for (int a = 0; a < node_count(el.type); ++a) node_elements_[count[el.nodes[a]]++] = e;
+    }
+  }
+  const std::size_t from = node_element_offset_[node], to = node_element_offset_[node + 1];
+  if (from == to) return false;
+  for (std::size_t i = from; i < to; ++i)
+    if (!element_eroded(node_elements_[i])) return false;
+  return true;
+}
+
 std::optional<FailureEvent> StructuralSolver::first_failure() const {
   if (nonlinear_ == nullptr || !nonlinear_->material().has_failure_criteria()) return {};
   const MaterialContribution& material = nonlinear_->material();

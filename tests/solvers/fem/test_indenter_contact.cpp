@@ -434,3 +434,37 @@ TEST_CASE("flat punch, Newmark: quasi-static force and energy", "[fem][contact]"
   CHECK(c.contact_force().z() == Approx(exact).epsilon(0.01));
   CHECK(c.indenter().work() == Approx(s.strain_energy() + s.kinetic_energy()).epsilon(0.01));
 }
+
+// Erosion takes nodes off the contact surface: a node whose elements have all eroded touches
+// nothing (set_detached, wired to StructuralSolver::node_detached by the FEM adapter).
+TEST_CASE("indenter contact: detached nodes take no contact force", "[fem][contact][rupture]") {
+  BoxSpec b;
+  b.size = Vec3(0.02, 0.02, 0.01);
+  b.cells = {4, 4, 2};
+  const Model model(make_box_mesh(b), Material{70e9, 0.3, 2700});
+  const BlockAssembler assembler(model.mesh());
+  const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
+  // a plane 10 um into the whole top face (5 x 5 nodes)
+  IndenterContact contact(
+      "t", model, "zmax",
+      RigidIndenter(std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0, 0, -1)),
+                    VelocityTable({{0.0, Vec3::Zero()}})),
+      {1.0, 0.0, 1.0});
+  contact.set_time(1.0, 1.0);
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd f_all = Eigen::VectorXd::Zero(n);
+  contact.add(u, f_all, nullptr, assembler);
+  REQUIRE(contact.active_nodes() == 25);
+  // the nodes with x > 0.012 (two columns of 5) gone: 15 left, the others' forces unchanged
+  contact.set_detached([&](std::size_t node) { return model.mesh().node(node).x() > 0.012; });
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  contact.add(u, f, nullptr, assembler);
+  CHECK(contact.active_nodes() == 15);
+  for (std::size_t node = 0; node < model.mesh().num_nodes(); ++node) {
+    const auto at = 3 * static_cast<Eigen::Index>(node);
+    if (model.mesh().node(node).x() > 0.012)
+      CHECK(f.segment<3>(at).norm() == 0.0);
+    else
+      CHECK(f.segment<3>(at) == f_all.segment<3>(at));
+  }
+}

@@ -144,6 +144,9 @@ TEST_CASE("rupture: erosion removes a failed element, the force drops, the energ
   CHECK(reaction_before == Approx((kSy + hardening * eps_f) * area).epsilon(0.02));
   CHECK(s.element_eroded(1));
   CHECK(s.eroded_energy() > 0.0);
+  // its nodes are all shared with the intact neighbours: none has left the structure
+  for (std::size_t node = 0; node < s.model().mesh().num_nodes(); ++node)
+    CHECK(!s.node_detached(node));
   // restart: the failed flags and the eroded energy are part of the committed state
   const SolverState saved = s.save_state();
   const double eroded_at_save = s.eroded_energy();
@@ -203,4 +206,40 @@ TEST_CASE("rupture: erosion is refused where it is not supported, with the reaso
   Model linear(strip_mesh(1.0, 0.1, 0.01, 2));
   linear.set_failure_criterion(FailureCriterion::constant(0.1));
   CHECK_THROWS_WITH(StructuralSolver(linear), Catch::Contains("plastic strain"));
+}
+
+TEST_CASE("rupture: the nodes of an eroded end element leave the structure",
+          "[fem][rupture][explicit]") {
+  // The strip of the test above with its last element (x > 0.2, under the pulled face) weak:
+  // once it erodes, the 4 nodes of the free end belong to no intact element (node_detached,
+  // which takes them off an indenter's contact surface); the 4 at x = 0.2 stay.
+  Mesh mesh = make_box_mesh({Vec3::Zero(), Vec3(0.3, 0.05, 0.05), {3, 1, 1}, ElementType::Hex8});
+  mesh.assign_region_where("weak", [](const Vec3& c) { return c.x() > 0.2; });
+  Model m(std::move(mesh));
+  m.set_material_law(steel(2e9));
+  m.set_failure_criterion("weak", FailureCriterion::constant(0.02, true));
+  hold_symmetry_planes(m);
+  m.add_traction("xmax", Vec3(350e6, 0.0, 0.0), [](double t) { return t / 0.04; });
+  SolverOptions opt;
+  opt.integrator = Integrator::CentralDifference;
+  opt.mass = MassType::Lumped;
+  StructuralSolver s(std::move(m), opt);
+  const double dt = 0.5 * s.stable_time_step();
+  for (std::size_t node = 0; node < s.model().mesh().num_nodes(); ++node)
+    CHECK(!s.node_detached(node));
+  while (s.failed_elements() == 0 && s.time() < 0.04) s.step(dt);
+  REQUIRE(s.element_eroded(2));
+  int detached = 0, kept = 0;
+  for (std::size_t node = 0; node < s.model().mesh().num_nodes(); ++node) {
+    const double x = s.model().mesh().node(node).x();
+    if (x > 0.25) {
+      CHECK(s.node_detached(node));
+      ++detached;
+    } else {
+      CHECK(!s.node_detached(node));
+      ++kept;
+    }
+  }
+  CHECK(detached == 4);
+  CHECK(kept == 12);
 }

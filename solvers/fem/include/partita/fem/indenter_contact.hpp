@@ -1,4 +1,5 @@
 #pragma once
+#include <functional>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -74,6 +75,12 @@ class IndenterContact final : public OperatorContribution {
   const std::vector<double>& committed_state() const override;
   void set_committed_state(const std::vector<double>& state) override;
 
+  /// Nodes that have left the surface (every element around them eroded: the solver's
+  /// node_detached()) take no contact force; default: none.
+  void set_detached(std::function<bool(std::size_t node)> detached) {
+    detached_ = std::move(detached);
+  }
+
   const RigidIndenter& indenter() const { return indenter_; }
   // Force of the last add() on the indenter [N] (after commit(): the committed one).
   const Vec3& contact_force() const { return force_on_body_; }
@@ -97,6 +104,7 @@ class IndenterContact final : public OperatorContribution {
   std::size_t active_ = 0;
   mutable std::vector<double> state_;
   double step_start_ = 0.0;  // committed time at the last set_time(t, 0)
+  std::function<bool(std::size_t)> detached_;
 };
 
 }  // namespace partita::fem

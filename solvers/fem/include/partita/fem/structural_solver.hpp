@@ -165,6 +165,9 @@ class StructuralSolver final : private StructuralSystem {
   std::size_t failed_elements() const;
   bool element_failed(std::size_t element) const;
   bool element_eroded(std::size_t element) const;
+  /// True when every element around `node` is eroded: the node has left the structure (and its
+  /// surfaces: an indenter no longer touches it).
+  bool node_detached(std::size_t node) const;
   // The first element to fail (the earliest time; the lowest id among those of that step).
   std::optional<FailureEvent> first_failure() const;
   double eroded_energy() const;
@@ -269,6 +272,8 @@ class StructuralSolver final : private StructuralSystem {
   Work work_;
 
   SolverTimings timings_;
+  // node_detached(): each node's elements (built at the first call)
+  mutable std::vector<std::size_t> node_element_offset_, node_elements_;
 };
 
 }  // namespace partita::fem
