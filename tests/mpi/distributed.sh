@@ -31,6 +31,15 @@ cd "$WORK"
 
 fail() { echo "FAILED: $*" >&2; exit 1; }
 
+# wait until the run in two/ is under way: its second VTK frame (the CSV files are flushed only
+# every 2 s; frames are written as they come)
+under_way() {
+  for _ in $(seq 1 600); do
+    compgen -G "two/vtk/*_000001.vt?" > /dev/null && return
+    sleep 0.05
+  done
+}
+
 # the pid of the partita process (not mpirun's, whose command line names it too) of participant $1
 participant_pid() {
   local p
@@ -110,10 +119,7 @@ case "$SCENARIO" in
     case_file=$HERE/../../cases/uniaxial_compaction/steel.yaml
     distributed plate granules two "$case_file" --set time.end=1.0 > two.log 2>&1 &
     launcher=$!
-    for _ in $(seq 1 600); do  # until the run is under way (its first rows)
-      [ -s two/coupling.csv ] && [ "$(wc -l < two/coupling.csv)" -gt 2 ] && break
-      sleep 0.1
-    done
+    under_way
     pid=$(participant_pid granules)
     [ -n "$pid" ] || fail "no process runs participant granules"
     kill -9 "$pid"
@@ -136,10 +142,7 @@ case "$SCENARIO" in
     "$P" run "$case_file" -o one --threads 1 "${sets[@]}" > one.log 2>&1 || { cat one.log; fail "one process"; }
     distributed plate granules two "$case_file" "${sets[@]}" > two.log 2>&1 &
     launcher=$!
-    for _ in $(seq 1 600); do
-      [ -s two/coupling.csv ] && [ "$(wc -l < two/coupling.csv)" -gt 2 ] && break
-      sleep 0.1
-    done
+    under_way
     pid=$(participant_pid granules)
     [ -n "$pid" ] || fail "no process runs participant granules"
     kill -INT "$pid"

@@ -21,6 +21,14 @@ using namespace partita::fem;
 
 namespace {
 
+// An aluminium block 20 x 20 x 10 mm of 4 x 4 x 2 cells (the contribution-level tests).
+Model small_block() {
+  BoxSpec b;
+  b.size = Vec3(0.02, 0.02, 0.01);
+  b.cells = {4, 4, 2};
+  return Model(make_box_mesh(b), Material{70e9, 0.3, 2700});
+}
+
 // Adds a contact to the solver and returns it (the solver owns it).
 IndenterContact& add_contact(StructuralSolver& s, const std::string& face, RigidIndenter indenter,
                              IndenterContactOptions options = {}) {
@@ -372,10 +380,7 @@ TEST_CASE("friction: a punch pressed and dragged sideways slips at mu times the 
 // penalty, and friction in stick: k_t (I - n n^T)); for a sphere the left-out curvature term
 // k_n g dn/dx is of relative size |g| / R (2e-3 here), relative to the stiffest column.
 TEST_CASE("indenter contact: tangent against finite differences", "[fem][contact]") {
-  BoxSpec b;
-  b.size = Vec3(0.02, 0.02, 0.01);
-  b.cells = {4, 4, 2};
-  const Model model(make_box_mesh(b), Material{70e9, 0.3, 2700});
+  const Model model = small_block();
   const BlockAssembler assembler(model.mesh());
   const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
   struct Case {
@@ -438,10 +443,7 @@ TEST_CASE("flat punch, Newmark: quasi-static force and energy", "[fem][contact]"
 // Erosion takes nodes off the contact surface: a node whose elements have all eroded touches
 // nothing (set_detached, wired to StructuralSolver::node_detached by the FEM adapter).
 TEST_CASE("indenter contact: detached nodes take no contact force", "[fem][contact][rupture]") {
-  BoxSpec b;
-  b.size = Vec3(0.02, 0.02, 0.01);
-  b.cells = {4, 4, 2};
-  const Model model(make_box_mesh(b), Material{70e9, 0.3, 2700});
+  const Model model = small_block();
   const BlockAssembler assembler(model.mesh());
   const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
   // a plane 10 um into the whole top face (5 x 5 nodes)
