@@ -44,7 +44,7 @@ struct Message {
   BinaryWriter out{stream};
   explicit Message(Command c) { out.write(static_cast<std::uint32_t>(c)); }
   Message() = default;
-  std::string str() const { return stream.str(); }
+  std::string str() { return std::move(stream).str(); }  // the bytes, moved out (once)
 };
 
 // A message received: a BinaryReader over its bytes.
@@ -155,30 +155,32 @@ std::string RemoteParticipant::read_reply(std::string_view what) const {
   std::string bytes = channel_.receive(what);
   wait_seconds_ += wait.seconds();
   ++messages_;
-  Received r(std::move(bytes), channel_.peer());
-  const auto status = r.in.get<std::uint32_t>();
+  // [u32 status] [results | error text] [f64 seconds] [i32 signal]: the results are returned
+  // in the same string (no copy), the rest read in place
+  constexpr std::size_t head = sizeof(std::uint32_t), tail = sizeof(double) + sizeof(std::int32_t);
+  if (bytes.size() < head) throw Error(channel_.peer() + " sent a damaged reply");
+  std::uint32_t status = 0;
+  std::memcpy(&status, bytes.data(), head);
   if (status != 0) {
-    const std::string error = r.in.get_string();
-    throw Error(fmt::format("{} failed: {}", channel_.peer(), error));
+    Received r(std::move(bytes), channel_.peer());
+    r.in.get<std::uint32_t>();
+    throw Error(fmt::format("{} failed: {}", channel_.peer(), r.in.get_string()));
   }
-  // results, then the solver's seconds and a signal: the caller reads the results; the tail
-  // is at the end of the bytes (fixed size), read here
-  const std::string& all = r.stream.str();
-  constexpr std::size_t tail = sizeof(double) + sizeof(std::int32_t);
-  if (all.size() < sizeof(std::uint32_t) + tail)
-    throw Error(channel_.peer() + " sent a damaged reply");
+  if (bytes.size() < head + tail) throw Error(channel_.peer() + " sent a damaged reply");
   double seconds = 0.0;
   std::int32_t signal = 0;
-  std::memcpy(&seconds, all.data() + all.size() - tail, sizeof(double));
-  std::memcpy(&signal, all.data() + all.size() - sizeof(std::int32_t), sizeof(std::int32_t));
+  std::memcpy(&seconds, bytes.data() + bytes.size() - tail, sizeof(double));
+  std::memcpy(&signal, bytes.data() + bytes.size() - sizeof(std::int32_t), sizeof(std::int32_t));
   extra_seconds_ += seconds;
   if (signal != 0) stop_request_ = signal;
-  return all.substr(sizeof(std::uint32_t), all.size() - sizeof(std::uint32_t) - tail);
+  bytes.resize(bytes.size() - tail);
+  bytes.erase(0, head);
+  return bytes;
 }
 
-std::string RemoteParticipant::call(const std::string& request, std::string_view what) const {
+std::string RemoteParticipant::call(std::string request, std::string_view what) const {
   Stopwatch send;
-  channel_.send(request);
+  channel_.send(std::move(request));
   wait_seconds_ += send.seconds();
   std::string reply = read_reply(what);
   const_cast<RemoteParticipant*>(this)->add_seconds(extra_seconds_);

@@ -113,7 +113,7 @@ class RemoteParticipant final : public Participant {
 
  private:
   // One request, its reply (throws the server's error, naming the participant).
-  std::string call(const std::string& request, std::string_view what) const;
+  std::string call(std::string request, std::string_view what) const;
   std::string read_reply(std::string_view what) const;
   Channel& channel_;
   std::vector<InterfaceMesh> meshes_;
