@@ -267,6 +267,11 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (!participant.empty()) {
+      if (!no_sweep && resume_dir.empty() && partita::app::has_sweep(case_file, overrides))
+        throw partita::Error(
+            "--participant " + participant + ": " + case_file +
+            " has a sweep section; a sweep runs its variants each in one process (run it "
+            "without --participant), or give --no-sweep to run the case as written in processes");
       partita::app::DistributedOptions d;
       d.case_file = case_file;
       d.run = options;
