@@ -10,6 +10,8 @@
 #include <set>
 #include <string>
 
+#include <unistd.h>
+
 #include "../support/vtk_read.hpp"
 #include "dem_adapter_support.hpp"
 #include "partita/interface/error.hpp"
@@ -22,10 +24,23 @@ namespace {
 
 const vtk::Format kFormats[] = {vtk::Format::ascii, vtk::Format::binary, vtk::Format::zlib};
 
+// The scratch folders, removed when the test program ends.
+struct Scratch {
+  std::vector<fs::path> dirs;
+  ~Scratch() {
+    std::error_code ec;
+    for (const auto& d : dirs) fs::remove_all(d, ec);
+  }
+};
+Scratch g_scratch;
+
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("partita_test_adapter_output_" + name);
+  // the process id in the name: two suites running at once (two checkouts) never share it
+  const fs::path dir = fs::temp_directory_path() / ("partita_test_adapter_output_" + name + "_" +
+                                                    std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
+  g_scratch.dirs.push_back(dir);
   return dir;
 }
 
