@@ -125,6 +125,48 @@ void write_strings(BinaryWriter& out, const std::vector<std::string>& v) {
   for (const auto& s : v) out.write(s);
 }
 
+// What a participant writes (its outputs' names, shapes and combination), in requests.
+void write_outputs(BinaryWriter& out, std::span<const WindowOutput> outputs) {
+  out.write(static_cast<std::uint64_t>(outputs.size()));
+  for (const WindowOutput& o : outputs) {
+    out.write(*o.mesh);
+    out.write(*o.data);
+    out.write(static_cast<std::uint8_t>(o.combines == WriterCombines::average));
+    out.write(static_cast<std::int64_t>(o.points));
+    out.write(static_cast<std::int32_t>(o.components));
+    out.write(*o.label);
+  }
+}
+
+// The server's side of write_outputs(): the descriptors with their names and value storage,
+// kept between requests (no allocation once the shapes are known).
+struct OutputSlots {
+  std::vector<std::string> names;  // mesh, data, label per output
+  std::vector<Eigen::MatrixXd> combined;
+  std::vector<WindowOutput> outputs;
+  void read(BinaryReader& in) {
+    const auto n = static_cast<std::size_t>(in.get<std::uint64_t>());
+    names.resize(3 * n);
+    combined.resize(n);
+    outputs.assign(n, {});
+    for (std::size_t i = 0; i < n; ++i) {
+      WindowOutput& o = outputs[i];
+      names[3 * i] = in.get_string();
+      names[3 * i + 1] = in.get_string();
+      o.combines = in.get<std::uint8_t>() ? WriterCombines::average : WriterCombines::last;
+      o.points = in.get<std::int64_t>();
+      o.components = in.get<std::int32_t>();
+      names[3 * i + 2] = in.get_string();
+    }
+    for (std::size_t i = 0; i < n; ++i) {  // (names is sized: the pointers stay valid)
+      outputs[i].mesh = &names[3 * i];
+      outputs[i].data = &names[3 * i + 1];
+      outputs[i].label = &names[3 * i + 2];
+      outputs[i].combined = &combined[i];
+    }
+  }
+};
+
 std::vector<std::string> read_strings(BinaryReader& in) {
   std::vector<std::string> v(in.get<std::uint64_t>());
   for (auto& s : v) s = in.get_string();
@@ -190,14 +232,7 @@ std::string RemoteParticipant::call(std::string request, std::string_view what) 
 
 void RemoteParticipant::initial_values(std::span<WindowOutput> outputs) {
   Message m(Command::initial_values);
-  m.out.write(static_cast<std::uint64_t>(outputs.size()));
-  for (const WindowOutput& o : outputs) {
-    m.out.write(*o.mesh);
-    m.out.write(*o.data);
-    m.out.write(static_cast<std::int64_t>(o.points));
-    m.out.write(static_cast<std::int32_t>(o.components));
-    m.out.write(*o.label);
-  }
+  write_outputs(m.out, outputs);
   Received r(call(m.str(), "its initial values"), channel_.peer());
   for (WindowOutput& o : outputs) r.in.read(*o.combined);
 }
@@ -217,15 +252,7 @@ void RemoteParticipant::run_window(const TimeWindow& window, std::span<const Win
     if (!in.start_is_end && in.sees == ReaderSees::linear) m.out.write(*in.start);
     m.out.write(*in.end);
   }
-  m.out.write(static_cast<std::uint64_t>(outputs.size()));
-  for (const WindowOutput& o : outputs) {
-    m.out.write(*o.mesh);
-    m.out.write(*o.data);
-    m.out.write(static_cast<std::uint8_t>(o.combines == WriterCombines::average));
-    m.out.write(static_cast<std::int64_t>(o.points));
-    m.out.write(static_cast<std::int32_t>(o.components));
-    m.out.write(*o.label);
-  }
+  write_outputs(m.out, outputs);
   // What the run asks after a window, answered with the window's reply (one message each way
   // per window): the monitors, the state check and the interface work it asked for before.
   write_strings(m.out, cache_.monitor_names);
@@ -500,10 +527,10 @@ int ParticipantServer::serve(LocalParticipant& p) {
   }
   // What run_window() hands the participant, kept between windows (no allocation after the
   // first window but the messages themselves).
-  std::vector<std::string> names;
-  std::vector<Eigen::MatrixXd> starts, ends, combined;
+  std::vector<std::string> names;  // mesh, data per input
+  std::vector<Eigen::MatrixXd> starts, ends;
   std::vector<WindowInput> inputs;
-  std::vector<WindowOutput> outputs;
+  OutputSlots slots;
   double reported_seconds = 0.0;
   int stopped_by = 0;
   for (;;) {
@@ -517,25 +544,9 @@ int ParticipantServer::serve(LocalParticipant& p) {
     try {
       switch (command) {
         case Command::initial_values: {
-          const auto n = r.in.get<std::uint64_t>();
-          names.assign(3 * n, {});
-          combined.resize(n);
-          outputs.assign(n, {});
-          for (std::uint64_t i = 0; i < n; ++i) {
-            names[3 * i] = r.in.get_string();
-            names[3 * i + 1] = r.in.get_string();
-            outputs[i].points = r.in.get<std::int64_t>();
-            outputs[i].components = r.in.get<std::int32_t>();
-            names[3 * i + 2] = r.in.get_string();
-          }
-          for (std::uint64_t i = 0; i < n; ++i) {
-            outputs[i].mesh = &names[3 * i];
-            outputs[i].data = &names[3 * i + 1];
-            outputs[i].label = &names[3 * i + 2];
-            outputs[i].combined = &combined[i];
-          }
-          p.initial_values(outputs);
-          for (const auto& c : combined) reply.out.write(c);
+          slots.read(r.in);
+          p.initial_values(slots.outputs);
+          for (const auto& c : slots.combined) reply.out.write(c);
           break;
         }
         case Command::run_window: {
@@ -555,36 +566,18 @@ int ParticipantServer::serve(LocalParticipant& p) {
               r.in.read(starts[i]);
             r.in.read(ends[i]);
           }
-          const auto no = r.in.get<std::uint64_t>();
-          std::vector<std::string> onames(3 * no);
-          combined.resize(no);
-          outputs.assign(no, {});
-          for (std::uint64_t i = 0; i < no; ++i) {
-            onames[3 * i] = r.in.get_string();
-            onames[3 * i + 1] = r.in.get_string();
-            outputs[i].combines =
-                r.in.get<std::uint8_t>() ? WriterCombines::average : WriterCombines::last;
-            outputs[i].points = r.in.get<std::int64_t>();
-            outputs[i].components = r.in.get<std::int32_t>();
-            onames[3 * i + 2] = r.in.get_string();
-          }
+          slots.read(r.in);
           for (std::uint64_t i = 0; i < ni; ++i) {
             inputs[i].mesh = &names[2 * i];
             inputs[i].data = &names[2 * i + 1];
             inputs[i].start = &starts[i];
             inputs[i].end = &ends[i];
           }
-          for (std::uint64_t i = 0; i < no; ++i) {
-            outputs[i].mesh = &onames[3 * i];
-            outputs[i].data = &onames[3 * i + 1];
-            outputs[i].label = &onames[3 * i + 2];
-            outputs[i].combined = &combined[i];
-          }
           const auto monitor_names = read_strings(r.in);
           const bool want_state = r.in.get<std::uint8_t>() != 0;
           const auto work_meshes = read_strings(r.in);
-          p.run_window(TimeWindow(size, index, 1), inputs, outputs);
-          for (const auto& c : combined) reply.out.write(c);
+          p.run_window(TimeWindow(size, index, 1), inputs, slots.outputs);
+          for (const auto& c : slots.combined) reply.out.write(c);
           write_monitors(reply.out, monitor_names.empty() ? std::vector<MonitorValue>{}
                                                           : p.monitor_values(monitor_names));
           if (want_state) reply.out.write(p.check_state());
