@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "partita/fem/error.hpp"
@@ -88,11 +89,16 @@ double HardeningCurve::return_map_increment(double g, double trial_norm, double 
   const double sqrt23 = std::sqrt(2.0 / 3.0);
   const double f_tr = trial_norm - sqrt23 * yield_stress(alpha_n);
   double dg = f_tr / (2.0 * g + 2.0 / 3.0 * slope(alpha_n));
+  // converged at 1e-13 of the yield stress, or at the round-off of |s_tr| - 2 G dg when the trial
+  // stress is over ~100 yield stresses (an element crushed by a contact: a fixed tolerance below
+  // that round-off was never met)
+  const double tolerance =
+      std::max(1e-13 * sigma0_, 8.0 * std::numeric_limits<double>::epsilon() * trial_norm);
   for (int it = 0;; ++it) {
     const double alpha = alpha_n + sqrt23 * dg;
     // r(dg) = |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg)
     const double res = trial_norm - 2.0 * g * dg - sqrt23 * yield_stress(alpha);
-    if (std::abs(res) <= 1e-13 * sigma0_) return dg;
+    if (std::abs(res) <= tolerance) return dg;
     if (it == 50) {
       std::ostringstream msg;
       msg << "j2-plasticity: the radial return did not converge (residual " << res
