@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 
 #include "dem_adapter_support.hpp"
@@ -193,4 +194,41 @@ TEST_CASE("dem participant: two particles of one material need its self-interact
   CHECK_THROWS_WITH(test::make_dem(ball_yaml("two.data"), dir, dir),
                     Catch::Contains("no interaction between materials 'steel' and 'steel', which "
                                     "can touch: the 2 particles are of material 'steel'"));
+}
+
+TEST_CASE("dem participant: a packing generated in several boxes fills each to the porosity",
+          "[adapters][dem][robustness]") {
+  const fs::path dir = scratch("boxes");
+  // two disjoint 1 cm cells 5 mm apart (the cells of a cellular structure) and one box holding
+  // the first: each box holds about (1 - n) V / V_grain
+  // granules, and the two boxes get different packings (seeds seed and seed + 1)
+  auto yaml = [](const std::string& generate) {
+    return "solver: dem\n"
+           "materials: {glass: {youngs_modulus: 200 MPa, poisson_ratio: 0.23, density: 400},\n"
+           "            steel: {youngs_modulus: 250 GPa, poisson_ratio: 0.3, density: 7850}}\n"
+           "interactions: [{pair: [glass, glass]}, {pair: [glass, steel]}]\n"
+           "particles: {material: glass, generate: {" +
+           generate +
+           ", diameters: [2 mm], porosity: 0.6, seed: 3}}\n"
+           "walls: [{plane: {point: [0, 0, 0], normal: [0, 0, 1]}, material: steel}]\n"
+           "monitor_particles: [0]\n";
+  };
+  auto two = test::make_dem(
+      yaml("boxes: [{origin: [0, 0, 0], size: [0.01, 0.01, 0.01]}, "
+           "{origin: [0.015, 0, 0], size: [0.01, 0.01, 0.01]}]"),
+      dir, dir);
+  auto one = test::make_dem(yaml("box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.01]}"), dir, dir);
+  const double n_two = monitor(*two, "particles"), n_one = monitor(*one, "particles");
+  const double expected = 0.4 * 1e-6 / (std::numbers::pi / 6.0 * 8e-9);  // 47.7 per box
+  CHECK(n_one == Approx(expected).epsilon(0.05));
+  CHECK(n_two == Approx(2.0 * expected).epsilon(0.05));
+  // the first box is generated as the single box is (same seed): the same first granule
+  CHECK(monitor(*two, "particle.0.x") == monitor(*one, "particle.0.x"));
+  // mass: every granule has the same size, so the mass is the count times one granule's
+  CHECK(monitor(*two, "mass") == Approx(n_two * 400.0 * std::numbers::pi / 6.0 * 8e-9));
+  // box and boxes together are refused
+  CHECK_THROWS_WITH(
+      test::make_dem(yaml("box: {origin: [0, 0, 0], size: [0.01, 0.01, 0.01]}, boxes: []"), dir,
+                     dir),
+      Catch::Contains("boxes"));
 }

@@ -65,8 +65,13 @@ std::shared_ptr<Spec> make_spec() {
   box->reals("size", "edge lengths").unit("m").size(3).min(0.0, true).required();
 
   auto generate = std::make_shared<Spec>(
-      "generate", "fill a box with a size distribution to a target porosity");
-  generate->section("box", "the region to fill", box).required();
+      "generate", "fill a box (or several) with a size distribution to a target porosity");
+  generate->section("box", "the region to fill", box);
+  generate->list("boxes",
+                 "several regions, each filled alone to the porosity with the same distribution "
+                 "(e.g. the cells of a cellular structure); box i uses the seed seed + i",
+                 box);
+  generate->one_of({"box", "boxes"});
   generate->reals("diameters", "particle diameters").unit("m").min(0.0, true).required();
   generate->reals("fractions", "share of each diameter (any positive scale; default: equal)")
       .min(0.0, true);
@@ -354,9 +359,12 @@ DemAdapter::DemAdapter(const SolverContext& context)
     const int pm = material_id(pn["material"]);
     if (pn.has("generate")) {
       const Node g = pn["generate"];
+      std::vector<Node> regions;
+      if (g.has("box"))
+        regions.push_back(g["box"]);
+      else
+        for (const Node& b : g["boxes"].items()) regions.push_back(b);
       dem::PackingSpec ps;
-      ps.lo = g["box"].vec3("origin");
-      ps.hi = ps.lo + g["box"].vec3("size");
       ps.diameters = g.reals("diameters");
       ps.fractions =
           g.has("fractions") ? g.reals("fractions") : std::vector<double>(ps.diameters.size(), 1.0);
@@ -367,7 +375,6 @@ DemAdapter::DemAdapter(const SolverContext& context)
       ps.basis = g.string("basis") == "mass" ? dem::PackingSpec::Basis::mass
                                              : dem::PackingSpec::Basis::number;
       ps.porosity = g.real("porosity");
-      ps.seed = static_cast<std::uint64_t>(g.integer("seed"));
       // N = (1 - porosity) V_box / V_mean, V_mean the mean particle volume of the distribution
       // (by number: sum f_i V_i / sum f_i; by mass = by volume: 1 / sum (f_i / sum f) / V_i).
       {
@@ -380,16 +387,18 @@ DemAdapter::DemAdapter(const SolverContext& context)
           inverse += ps.fractions[i] / fsum / v;
         }
         const double v_mean = ps.basis == dem::PackingSpec::Basis::mass ? 1.0 / inverse : by_number;
-        const Eigen::Vector3d size = ps.hi - ps.lo;
-        const double estimate = (1.0 - ps.porosity) * size.prod() / v_mean;
+        double volume = 0.0;
+        for (const Node& b : regions) volume += b.vec3("size").prod();
+        const double estimate = (1.0 - ps.porosity) * volume / v_mean;
         const double limit = g.real("max_particles");
         if (!(estimate <= limit))
           g.fail(fmt::format(
-              "this box ({:.4g} x {:.4g} x {:.4g} m) filled to porosity {:.3g} holds about {:.3g} "
-              "particles, more than max_particles = {:.3g}; check the box size and diameters "
+              "{} ({:.4g} m^3 in all) filled to porosity {:.3g} holds about {:.3g} "
+              "particles, more than max_particles = {:.3g}; check the box sizes and diameters "
               "(units: a box of 5012 m instead of 0.05 m is a typical slip), or raise "
               "max_particles",
-              size.x(), size.y(), size.z(), ps.porosity, estimate, limit));
+              regions.size() == 1 ? std::string("this box") : fmt::format("these {} boxes", regions.size()),
+              volume, ps.porosity, estimate, limit));
         if (estimate > 1e5)
           log::get("adapters")
               ->info("dem '{}': generating about {:.3g} particles (this may take a while)", name_,
@@ -407,16 +416,24 @@ DemAdapter::DemAdapter(const SolverContext& context)
                 "(target {:.3g})",
                 name, sweep, overlap, ps.max_overlap);
       };
-      dem::Packing packing;
-      try {
-        packing = dem::PackingGenerator::generate(ps);
-      } catch (const dem::Error& e) {
-        g.fail(std::string("cannot generate the packing: ") + e.what());
+      const auto seed = static_cast<std::uint64_t>(g.integer("seed"));
+      for (std::size_t b = 0; b < regions.size(); ++b) {
+        ps.lo = regions[b].vec3("origin");
+        ps.hi = ps.lo + regions[b].vec3("size");
+        ps.seed = seed + b;
+        dem::Packing packing;
+        try {
+          packing = dem::PackingGenerator::generate(ps);
+        } catch (const dem::Error& e) {
+          regions[b].fail(std::string("cannot generate the packing: ") + e.what());
+        }
+        system_.add_particles(packing.positions, packing.radii, pm);
+        log::get("adapters")
+            ->info("dem '{}': generated {} particles{}, porosity {:.3f}, largest overlap {:.2e} m",
+                   name_, packing.radii.size(),
+                   regions.size() == 1 ? std::string() : fmt::format(" in box {}", b + 1),
+                   packing.porosity, packing.max_overlap);
       }
-      system_.add_particles(packing.positions, packing.radii, pm);
-      log::get("adapters")
-          ->info("dem '{}': generated {} particles, porosity {:.3f}, largest overlap {:.2e} m",
-                 name_, packing.radii.size(), packing.porosity, packing.max_overlap);
     } else {
       const std::filesystem::path f = resolve(pn.string("file"));
       if (!std::filesystem::exists(f))
