@@ -19,6 +19,29 @@ void register_all(coupling::Registries& r) {
       "dem", "native DEM: Hertz-Mindlin spheres, walls, STL meshes as coupling interfaces",
       DemAdapter::create, DemAdapter::spec(),
       {{"kinetic_energy", "J", "translational plus rotational kinetic energy of the particles"},
+       {"elastic_energy", "J", "elastic energy stored in the contacts (normal and tangential)"},
+       {"friction_work", "J",
+        "energy dissipated by Coulomb sliding in all contacts since the start (the capped "
+        "tangential force's work on the relative motion plus the spring energy the cap released)"},
+       {"damping_work", "J",
+        "energy dissipated by viscous contact damping (normal, tangential) and rolling "
+        "resistance since the start"},
+       {"breakage_energy", "J",
+        "mechanical energy (kinetic, potential, contact) before minus after the changes of the "
+        "particle set (breakage) since the start"},
+       {"stiffening_work", "J",
+        "energy the tangential springs lost without work (Mindlin's stiffness changing with the "
+        "overlap, the history turned with the contact); negative: energy the law created"},
+       {"gravity_work", "J", "work of gravity on the particles since the start"},
+       {"wall_work", "J", "work of all walls and meshes on the particles since the start"},
+       {"<wall>.work", "J", "work of one wall's motion on the particles since the start"},
+       {"<mesh>.work", "J",
+        "work of one mesh's motion on the particles since the start (a coupled FE surface: what "
+        "the structure did on the granules)"},
+       {"energy_balance_error", "",
+        "(wall_work + gravity_work - dKE - d elastic_energy - friction_work - damping_work - "
+        "breakage_energy - stiffening_work) / (initial KE + initial elastic energy + the works' "
+        "magnitudes); KE with velocity Verlet's half-step term"},
        {"particles", "", "number of particles"},
        {"mass", "kg", "total mass of the particles"},
        {"breakage.events", "", "particles broken so far (with breakage on)"},

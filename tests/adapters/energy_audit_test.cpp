@@ -73,6 +73,13 @@ TEST_CASE("energy audit: a wall driven into a sphere does the work of its elasti
   // the wall did exactly that work (trapezoidal sum over the steps)
   CHECK(s->interface_work("plate").value() == Approx(ke).epsilon(1e-3));
   CHECK(s->interface_work("plate_centres").value() == s->interface_work("plate").value());
+  // the DEM's own accounting: the mesh's work (contact forces times the wall's velocity at the
+  // contact points) against the sphere's energy, and the balance
+  CHECK(monitor(*s, "plate.work") == Approx(2.0 * m * V * V).epsilon(0.01));
+  CHECK(monitor(*s, "plate.work") == Approx(ke).epsilon(1e-3));
+  CHECK(monitor(*s, "wall_work") == monitor(*s, "plate.work"));
+  CHECK(monitor(*s, "damping_work") == 0.0);  // restitution 1
+  CHECK(std::abs(monitor(*s, "energy_balance_error")) < 1e-3);
   CHECK_THROWS_WITH(s->interface_work("plates"), Catch::Contains("no mesh 'plates'"));
 }
 

@@ -971,14 +971,32 @@ std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::stri
   }
   if (wanted("contacts_per_particle"))
     v.push_back({"contacts_per_particle", "", system_.mean_contacts_per_particle()});
+  // the DEM's energy accounting (dem::System::energies(), cumulative since the first step)
+  const dem::System::Energies& en = system_.energies();
+  v.push_back({"friction_work", "J", en.friction});
+  v.push_back({"damping_work", "J", en.damping});
+  v.push_back({"breakage_energy", "J", en.breakage});
+  v.push_back({"stiffening_work", "J", en.stiffening});
+  v.push_back({"gravity_work", "J", en.gravity});
+  double walls_work = 0.0;
+  for (const double w : en.wall_work) walls_work += w;
+  for (const double w : en.mesh_work) walls_work += w;
+  v.push_back({"wall_work", "J", walls_work});
+  if (wanted("elastic_energy")) v.push_back({"elastic_energy", "J", system_.elastic_energy()});
+  if (wanted("energy_balance_error"))
+    v.push_back({"energy_balance_error", "", system_.energy_balance_error()});
   const char* xyz[] = {"x", "y", "z"};
   for (const auto& m : meshes_dem_) {
     const Eigen::Vector3d f = system_.mesh_force(m.id);
     for (int k = 0; k < 3; ++k) v.push_back({m.name + ".force_" + xyz[k], "N", f(k)});
+    const auto id = static_cast<std::size_t>(m.id);
+    v.push_back({m.name + ".work", "J", id < en.mesh_work.size() ? en.mesh_work[id] : 0.0});
   }
   for (const auto& w : walls_) {
     const Eigen::Vector3d f = system_.wall_force(w.id);
     for (int k = 0; k < 3; ++k) v.push_back({w.name + ".force_" + xyz[k], "N", f(k)});
+    const auto id = static_cast<std::size_t>(w.id);
+    v.push_back({w.name + ".work", "J", id < en.wall_work.size() ? en.wall_work[id] : 0.0});
     for (int face = 0; face < 6; ++face)  // a box wall's closed faces, each on its own
       if (w.faces & (1u << face)) {
         const Eigen::Vector3d ff =

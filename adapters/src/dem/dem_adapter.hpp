@@ -15,7 +15,11 @@
 //              force is lumped from its vertices' (continuous as contacts cross triangle edges:
 //              see dem::TriangleMesh::triangle_forces)
 // interface_work(M or M_centres): the work the motion of M did on the particles (energy audit).
-// Monitors: kinetic_energy [J], M.force_x|y|z [N] (force of the particles on mesh M),
+// Monitors: kinetic_energy [J], the energy accounting (dem::System::energies(), cumulative
+// since the first step) friction_work, damping_work, breakage_energy, stiffening_work,
+// gravity_work, wall_work (all walls and meshes), M.work and <wall>.work [J], elastic_energy [J]
+// and energy_balance_error [-] (each a pass over the particles: computed when asked for),
+// M.force_x|y|z [N] (force of the particles on mesh M),
 // particle.<id>.x|y|z [m] and .vx|vy|vz [m/s] for the ids in monitor_particles,
 // <wall>.force_x|y|z [N] (a box wall: all its faces), <wall>.<face>.force_x|y|z [N] (each closed
 // face of a box wall, faces xmin..zmax), particles, contacts_per_particle; with `breakage`: breakage.events,

@@ -25,11 +25,12 @@ std::int64_t feature_key(int mesh, int type, int index) {
 //    only if no accepted face has it as an edge; a vertex only if no accepted face or edge has
 //    it; and any contact only if its normal differs from all accepted ones (a sphere cannot
 //    touch two surfaces with the same normal: coplanar neighbours sharing the point).
-template <bool Load>
+template <bool Load, bool Energy>
 void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
                             const std::vector<TriangleMesh>& meshes, const ContactModel& model,
                             const Row& row, double dt, bool update_history, Eigen::Vector3d& f,
-                            Eigen::Vector3d& t, double& load) {
+                            Eigen::Vector3d& t, double& load, DissipationSums* sums,
+                            WallDissipation* wd) {
   struct Candidate {
     int mesh, triangle, type, feature;
     TriangleClosestPoint cp;
@@ -172,13 +173,28 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     const double cr = r - 0.5 * delta;
     const PairParameters& pp = model.pair(q.material, m.material());
     Eigen::Vector3d fw, ft;
+    DissipativeParts parts;
     const double fn = hertz_mindlin(pp, delta, r, q.m, k.normal, q.v - v_wall, cr * q.w, shear, dt,
-                                    update_history, fw, ft);
+                                    update_history, fw, ft, Energy ? &parts : nullptr);
     f += fw;
     t -= cr * k.normal.cross(ft);
+    if constexpr (Energy) {  // (as WallContacts::Pass::add_forces())
+      sums->fd += parts.damping;
+      sums->td -= cr * k.normal.cross(parts.damping_t);
+      sums->ff += parts.friction;
+      sums->tf -= cr * k.normal.cross(parts.friction);
+      wd->damping += parts.damping.dot(v_wall);
+      wd->friction += parts.friction.dot(v_wall);
+      wd->spring += parts.spring;
+      wd->stiffening += parts.stiffening;
+    }
     if (pp.rolling_friction > 0.0) {
       const double wn = q.w.norm();
-      if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * r / wn) * q.w;
+      if (wn > 0.0) {
+        const Eigen::Vector3d tr = (pp.rolling_friction * std::abs(fn) * r / wn) * q.w;
+        t -= tr;
+        if constexpr (Energy) sums->td -= tr;
+      }
     }
     if constexpr (Load) {  // mesh: R* = R
       const double kw = pp.e_star / r;
@@ -198,14 +214,26 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
   row.count = na;
 }
 
-template void MeshContacts::evaluate<false>(int, const Particle&, const NeighborList&,
-                                            const std::vector<TriangleMesh>&, const ContactModel&,
-                                            const Row&, double, bool, Eigen::Vector3d&,
-                                            Eigen::Vector3d&, double&);
-template void MeshContacts::evaluate<true>(int, const Particle&, const NeighborList&,
-                                           const std::vector<TriangleMesh>&, const ContactModel&,
-                                           const Row&, double, bool, Eigen::Vector3d&,
-                                           Eigen::Vector3d&, double&);
+template void MeshContacts::evaluate<false, false>(int, const Particle&, const NeighborList&,
+                                                   const std::vector<TriangleMesh>&,
+                                                   const ContactModel&, const Row&, double, bool,
+                                                   Eigen::Vector3d&, Eigen::Vector3d&, double&,
+                                                   DissipationSums*, WallDissipation*);
+template void MeshContacts::evaluate<false, true>(int, const Particle&, const NeighborList&,
+                                                   const std::vector<TriangleMesh>&,
+                                                   const ContactModel&, const Row&, double, bool,
+                                                   Eigen::Vector3d&, Eigen::Vector3d&, double&,
+                                                   DissipationSums*, WallDissipation*);
+template void MeshContacts::evaluate<true, false>(int, const Particle&, const NeighborList&,
+                                                   const std::vector<TriangleMesh>&,
+                                                   const ContactModel&, const Row&, double, bool,
+                                                   Eigen::Vector3d&, Eigen::Vector3d&, double&,
+                                                   DissipationSums*, WallDissipation*);
+template void MeshContacts::evaluate<true, true>(int, const Particle&, const NeighborList&,
+                                                   const std::vector<TriangleMesh>&,
+                                                   const ContactModel&, const Row&, double, bool,
+                                                   Eigen::Vector3d&, Eigen::Vector3d&, double&,
+                                                   DissipationSums*, WallDissipation*);
 
 // Each contact's reaction shared among its triangle's vertices with the barycentric weights of
 // the contact point, particles in order (a fixed summation order); then each triangle's force

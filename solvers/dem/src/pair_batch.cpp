@@ -69,13 +69,16 @@ namespace batch_avx512 {
 
 namespace {
 
-constexpr PairBatchKernels sse2_set{"sse2", 2, &batch_sse2::forces<false>,
-                                    &batch_sse2::forces<true>};
+constexpr PairBatchKernels sse2_set{"sse2", 2, &batch_sse2::forces<false, false>,
+                                    &batch_sse2::forces<true, false>,
+    &batch_sse2::forces<false, true>, &batch_sse2::forces<true, true>};
 #if PARTITA_DEM_WIDE_KERNELS
-constexpr PairBatchKernels avx2_set{"avx2", 4, &batch_avx2::forces<false>,
-                                    &batch_avx2::forces<true>};
-constexpr PairBatchKernels avx512_set{"avx512", 8, &batch_avx512::forces<false>,
-                                      &batch_avx512::forces<true>};
+constexpr PairBatchKernels avx2_set{"avx2", 4, &batch_avx2::forces<false, false>,
+                                    &batch_avx2::forces<true, false>,
+    &batch_avx2::forces<false, true>, &batch_avx2::forces<true, true>};
+constexpr PairBatchKernels avx512_set{"avx512", 8, &batch_avx512::forces<false, false>,
+                                      &batch_avx512::forces<true, false>,
+    &batch_avx512::forces<false, true>, &batch_avx512::forces<true, true>};
 #endif
 
 }  // namespace

@@ -71,6 +71,7 @@ std::size_t System::add_particle(const Eigen::Vector3d& x, double radius, int ma
                                  const Eigen::Vector3d& v, const Eigen::Vector3d& w,
                                  std::int64_t id) {
   sync_particles();
+  note_set_change();
   const std::size_t index = store_.size();
   if (!(radius > 0.0) || !std::isfinite(radius)) {
     std::ostringstream msg;
@@ -127,6 +128,7 @@ void System::set_particle_velocity(std::size_t i, const Eigen::Vector3d& v,
                                    const Eigen::Vector3d& w) {
   check_particle(i, "set_particle_velocity");
   sync_particles();
+  note_set_change();
   store_.core().velocity[i] = v;
   store_.core().angular_velocity[i] = w;
   forces_valid_ = false;
@@ -142,6 +144,7 @@ void System::set_particle_mass(std::size_t i, double mass, double inertia) {
     throw Error(msg.str());
   }
   sync_particles();
+  note_set_change();
   store_.core().mass[i] = mass;
   store_.core().inertia[i] = inertia;
   forces_valid_ = false;
@@ -157,6 +160,7 @@ void System::remove_particles(const std::vector<char>& remove) {
     throw Error(msg.str());
   }
   if (std::none_of(remove.begin(), remove.end(), [](char c) { return c != 0; })) return;
+  note_set_change();
   store_.remove(remove, new_of_old_);
   // pair and mesh histories follow their particles; the lists are rebuilt before the next use
   neighbors_.renumber(new_of_old_, static_cast<int>(store_.size()));
@@ -421,6 +425,42 @@ void System::rebuild_lists() {
 
 int System::set_partition() {
   return partition_.update(static_cast<int>(store_.size()), max_threads(), neighbors_);
+}
+
+}  // namespace partita::dem
+
+namespace partita::dem {
+
+// Energy accounting across a change of the particle set between steps (energies().breakage):
+// the mechanical energy KE + PE + E_el just before the first change after a step (the lists are
+// still those of the last pass) ...
+void System::note_set_change() {
+  if (!energy_tracking_ || !energies_.started || set_change_pending_) return;
+  set_change_before_ =
+      kinetic_energy() + half_step_term(energy_dt_) + potential_energy() + elastic_energy();
+  set_change_pending_ = true;
+}
+
+// ... and after it, at the next step once the lists are built for the new set: the difference
+// left the mechanical energy with the change (a particle broken into fragments: what the fragment
+// model does not give back as their motion and contacts).
+void System::settle_set_change() {
+  if (!set_change_pending_) return;
+  set_change_pending_ = false;
+  energies_.breakage += set_change_before_ - (kinetic_energy() + half_step_term(energy_dt_) +
+                                              potential_energy() + elastic_energy());
+}
+
+double System::energy_balance_error() const {
+  const Energies& e = energies_;
+  if (!e.started) return 0.0;
+  double in = e.gravity, scale = e.kinetic_start + e.elastic_start + std::abs(e.gravity);
+  for (const double w : e.wall_work) in += w, scale += std::abs(w);
+  for (const double w : e.mesh_work) in += w, scale += std::abs(w);
+  const double stored = (kinetic_energy() + half_step_term(energy_dt_) - e.kinetic_start) +
+                        (elastic_energy() - e.elastic_start);
+  const double residual = in - stored - e.friction - e.damping - e.breakage - e.stiffening;
+  return scale > 0.0 ? residual / scale : 0.0;
 }
 
 }  // namespace partita::dem

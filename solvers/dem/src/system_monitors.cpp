@@ -51,6 +51,22 @@ double System::kinetic_energy() const {
   });
 }
 
+double System::half_step_term(double dt) const {
+  const Particles& p = store_.core();
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+  const double h = 0.5 * dt, h2 = 0.125 * dt * dt;
+  auto term = [&](std::ptrdiff_t i, const Eigen::Vector3d& f, const Eigen::Vector3d& t,
+                  const Eigen::Vector3d& v, const Eigen::Vector3d& w) {
+    return h * (f.dot(v) + t.dot(w)) +
+           h2 * (f.squaredNorm() / p.mass[i] + t.squaredNorm() / p.inertia[i]);
+  };
+  if (const PackedParticle* q = verlet_.ahead())
+    return ordered_sum(n, [&](std::ptrdiff_t i) { return term(i, q[i].f, q[i].t, q[i].v, q[i].w); });
+  return ordered_sum(n, [&](std::ptrdiff_t i) {
+    return term(i, p.force[i], p.torque[i], p.velocity[i], p.angular_velocity[i]);
+  });
+}
+
 double System::potential_energy() const {
   sync_particles();
   const Particles& p = store_.core();

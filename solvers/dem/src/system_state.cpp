@@ -131,6 +131,15 @@ void System::write_body(BinaryWriter& w) const {
   w.value(static_cast<std::int32_t>(builds_since_sort_));
   w.value(static_cast<std::int64_t>(sorts_));
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].write_state(w);
+  // the energies (format version 3)
+  const Energies& e = energies_;
+  for (const double v : {e.friction, e.damping, e.breakage, e.gravity, e.stiffening, e.kinetic_start,
+                         e.elastic_start, set_change_before_, energy_dt_})
+    w.value(v);
+  w.value(static_cast<char>(e.started));
+  w.value(static_cast<char>(set_change_pending_));
+  w.array(e.wall_work);
+  w.array(e.mesh_work);
   w.value(end_tag);
 }
 
@@ -169,6 +178,15 @@ void System::read_body(BinaryReader& r) {
   builds_since_sort_ = r.value<std::int32_t>("the builds since the last sort");
   sorts_ = static_cast<long>(r.value<std::int64_t>("the sort count"));
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].read_state(r);
+  Energies& e = energies_;
+  for (double* v : {&e.friction, &e.damping, &e.breakage, &e.gravity, &e.stiffening,
+                    &e.kinetic_start,
+                    &e.elastic_start, &set_change_before_, &energy_dt_})
+    r.value(*v, "the energies");
+  e.started = r.value<char>("the energy flag") != 0;
+  set_change_pending_ = r.value<char>("the set change flag") != 0;
+  r.array(e.wall_work, "the wall work");
+  r.array(e.mesh_work, "the mesh work");
   r.expect(end_tag, "the end tag");
 }
 

@@ -54,6 +54,25 @@ void System::step(double dt) {
     compute_forces(dt, false, 0.0, false);
     forces_valid_ = true;
   }
+  if (energy_tracking_) {  // (outside the timed loops: once, and after a change of the set)
+    Energies& e = energies_;
+    if (!e.started) {
+      e.started = true;
+      energy_dt_ = dt;
+      e.kinetic_start = kinetic_energy() + half_step_term(dt);
+      e.elastic_start = elastic_energy();
+    }
+    settle_set_change();
+    if (dt != energy_dt_) {  // the half-step term of the state now, at the new step
+      e.kinetic_start += half_step_term(dt) - half_step_term(energy_dt_);
+      energy_dt_ = dt;
+    }
+    if (e.wall_work.size() != static_cast<std::size_t>(walls_.wall_count()))
+      e.wall_work.resize(static_cast<std::size_t>(walls_.wall_count()), 0.0);
+    if (e.mesh_work.size() != meshes_.size()) e.mesh_work.resize(meshes_.size(), 0.0);
+    verlet_.moved();  // (elastic_energy() brought the store's copies up to date: they fall
+                      // behind again with this step)
+  }
   // (the mesh loops of a step run on the threads for large meshes: the scale case's plate has
   // 160,083 vertices, a serial pass over them each step would limit the thread scaling)
   for (TriangleMesh& m : meshes_) {
@@ -103,7 +122,7 @@ void System::step(double dt) {
 #pragma omp parallel if (parts > 1) num_threads(parts)
     evaluate_forces(dt, true, half, true);
     if (profiling_) record_fused_pass(fork, now_ns(), parts);
-    reduce_wall_and_mesh_forces();
+    reduce_wall_and_mesh_forces(dt, true);
   } else {
     const VelocityVerlet::Pass verlet = verlet_.pass(p);
 #pragma omp parallel if (parts > 1) num_threads(parts)
@@ -128,7 +147,7 @@ void System::step(double dt) {
       rebuild_lists();
       compute_forces(dt, true, half, true);
     } else {
-      reduce_wall_and_mesh_forces();
+      reduce_wall_and_mesh_forces(dt, true);
     }
   }
   // the next step's bound starts from this one's (fused: the distances from the build positions
@@ -188,6 +207,7 @@ void System::start_sums(int i) {
   q.f = store_.core().mass[i] * gravity_;
   q.t.setZero();
   if (track_load_) load_[i] = 0.0;
+  if (energy_tracking_) dissipation_[i].clear();
 }
 
 // Clears the per-part flags of the load limits, sizes the per-part motion maxima (no allocation
@@ -209,6 +229,14 @@ void System::start_load_pass(int parts) {
     if (sc.tasks.size() >= size) continue;
     sc.tasks.resize(size + size / 4);  // (headroom: lists grow a little between builds)
     sc.forces.resize(size + size / 4);
+    if (energy_tracking_) sc.energy.resize(size + size / 4);
+  }
+  if (energy_tracking_) {  // (no allocation while the sizes hold)
+    for (PairScratch& sc : pair_scratch_)
+      if (sc.energy.size() < sc.tasks.size()) sc.energy.resize(sc.tasks.size());
+    dissipation_.resize(store_.size());
+    block_energy_.resize((store_.size() + block_size - 1) / block_size);
+    cross_energy_.resize(partition_.cross_pairs.size());
   }
 }
 
@@ -245,7 +273,7 @@ void System::compute_forces(double dt, bool update_history, double kick, bool st
     }
     evaluate_forces(dt, update_history, kick);
   }
-  reduce_wall_and_mesh_forces();
+  reduce_wall_and_mesh_forces(dt, kick > 0.0 && update_history);
 }
 
 // Called inside a parallel region. Each particle's force is a sum in a fixed order, whatever the
@@ -256,22 +284,29 @@ void System::compute_forces(double dt, bool update_history, double kick, bool st
 // directly when j is its own; pairs reaching into a later part (cross pairs) are evaluated first,
 // each once, into its cross_force, then added by both owners in the same place of their sums.
 void System::evaluate_forces(double dt, bool update_history, double kick, bool drift) {
-  auto run = [&]<bool Drift>() {
+  // the energies are those of a step (a kick and the histories' update)
+  const bool energy = energy_tracking_ && kick > 0.0 && update_history;
+  auto run = [&]<bool Drift, bool Energy>() {
     if (track_load_)
       if (h_load_limit_ >= 0)
-        evaluate_forces_impl<true, true, Drift>(dt, update_history, kick);
+        evaluate_forces_impl<true, true, Drift, Energy>(dt, update_history, kick);
       else
-        evaluate_forces_impl<true, false, Drift>(dt, update_history, kick);
+        evaluate_forces_impl<true, false, Drift, Energy>(dt, update_history, kick);
     else
-      evaluate_forces_impl<false, false, Drift>(dt, update_history, kick);
+      evaluate_forces_impl<false, false, Drift, Energy>(dt, update_history, kick);
   };
   if (drift)
-    run.template operator()<true>();
+    if (energy)
+      run.template operator()<true, true>();
+    else
+      run.template operator()<true, false>();
+  else if (energy)
+    run.template operator()<false, true>();
   else
-    run.template operator()<false>();
+    run.template operator()<false, false>();
 }
 
-template <bool Load, bool Limit, bool Drift>
+template <bool Load, bool Limit, bool Drift, bool Energy>
 void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   Particles& p = store_.core();
   const NeighborList& nl = neighbors_;
@@ -291,7 +326,11 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   const int* const offsets = nl.offsets_.data();
   const int* const neighbors = nl.neighbors_.data();
   const int np = walls.np;
-  const PairBatchKernel batch = Load ? pair_batch_kernels().with_load : pair_batch_kernels().plain;
+  const PairBatchKernels& kernels = pair_batch_kernels();
+  const PairBatchKernel batch = Energy ? (Load ? kernels.with_load_energy : kernels.plain_energy)
+                                       : (Load ? kernels.with_load : kernels.plain);
+  DissipationSums* const diss = Energy ? dissipation_.data() : nullptr;
+  PairEnergy* const cross_energy = Energy ? cross_energy_.data() : nullptr;
   // Drift: the integrator's first half of particle i (with kick = dt/2) and the start of its
   // force sums, as the loop before the pass does it (step(), which knows that no particle can
   // have moved beyond the skin)
@@ -302,6 +341,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     q.f = mass[i] * gravity;
     q.t.setZero();
     if constexpr (Load) load[i] = 0.0;
+    if constexpr (Energy) diss[i].clear();
   };
   // step profile: this thread's clock at the phases (the barriers are explicit for that)
   ThreadMarks* const marks = profiling_ ? &marks_[thread_num()] : nullptr;
@@ -333,6 +373,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     for (int ch = 0; ch < chunks; ++ch) {
       PairTask chunk_tasks[cross_chunk];
       PairForce chunk_forces[cross_chunk];
+      PairEnergy chunk_energy[Energy ? cross_chunk : 1];
       const int k0 = ch * cross_chunk, k1 = std::min(n_cross, k0 + cross_chunk);
       int n_touch = 0;
       for (int k = k0; k < k1; ++k) {
@@ -351,7 +392,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         n_touch += touch ? 1 : 0;
       }
       batch(chunk_tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
-            chunk_forces);
+            chunk_forces, chunk_energy);
       const PairForce* o = chunk_forces;
       for (int k = k0; k < k1; ++k) {
         ThreadPartition::CrossForce& cf = tp.cross_force[k];
@@ -360,6 +401,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         cf.torque_i = Eigen::Vector3d(o->ti[0], o->ti[1], o->ti[2]);
         cf.torque_j = Eigen::Vector3d(o->tj[0], o->tj[1], o->tj[2]);
         if constexpr (Load) cf.load = o->load;
+        if constexpr (Energy) cross_energy[k] = chunk_energy[o - chunk_forces];
         ++o;
       }
     }
@@ -380,6 +422,14 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       packed[j].f -= cf.force_i;
       packed[j].t += cf.torque_j;
       if constexpr (Load) load[j] = std::max(load[j], cf.load);
+      if constexpr (Energy) {
+        const PairEnergy& e = cross_energy[c];
+        DissipationSums& dj = diss[j];
+        dj.fd -= Eigen::Map<const Eigen::Vector3d>(e.fd);
+        dj.td += Eigen::Map<const Eigen::Vector3d>(e.tdj);
+        dj.ff -= Eigen::Map<const Eigen::Vector3d>(e.ff);
+        dj.tf += Eigen::Map<const Eigen::Vector3d>(e.tfj);
+      }
     }
     int cross = tp.cross_out_begin[part];
     const int lo = tp.begin(part), hi = tp.begin(part + 1);
@@ -393,6 +443,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
     int mesh_row = mesh.rows > 0 ? mesh.first_row(lo) : 0;  // the next particle near a mesh
     PairTask* const tasks = pair_scratch_[part].tasks.data();
     PairForce* const forces = pair_scratch_[part].forces.data();
+    PairEnergy* const energies = Energy ? pair_scratch_[part].energy.data() : nullptr;
     int row_first[block_size + 1];  // where each row's touching pairs start in tasks
     int row_cross[block_size];      // each row's first cross pair (slot)
     for (int b = lo / block_size; b * block_size < hi; ++b) {
@@ -437,7 +488,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       }
       row_first[i_end - i_begin] = n_touch;
       batch(tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
-            forces);
+            forces, energies);
+      BlockEnergy block_e;  // (Energy) this block's energies: powers x dt, spring energies
       for (int i = i_begin; i < i_end; ++i) {
         PackedParticle& qi = packed[i];
         Eigen::Vector3d f = qi.f;
@@ -455,22 +507,53 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
             load_i = std::max(load_i, o.load);
             load[tasks[k].j] = std::max(load[tasks[k].j], o.load);
           }
+          if constexpr (Energy) {
+            const PairEnergy& e = energies[k];
+            DissipationSums& di = diss[i];
+            DissipationSums& dj = diss[tasks[k].j];
+            const Eigen::Map<const Eigen::Vector3d> fd(e.fd), ff(e.ff);
+            di.fd += fd;
+            di.td += Eigen::Map<const Eigen::Vector3d>(e.tdi);
+            di.ff += ff;
+            di.tf += Eigen::Map<const Eigen::Vector3d>(e.tfi);
+            dj.fd -= fd;
+            dj.td += Eigen::Map<const Eigen::Vector3d>(e.tdj);
+            dj.ff -= ff;
+            dj.tf += Eigen::Map<const Eigen::Vector3d>(e.tfj);
+            block_e.friction += e.spring;
+            block_e.stiffening += e.stiffening;
+          }
         }
         for (int s = row_cross[i - i_begin]; s < offsets[i + 1]; ++s) {  // already evaluated
-          const ThreadPartition::CrossForce& cf = tp.cross_force[cross++];
+          const int c = cross++;
+          const ThreadPartition::CrossForce& cf = tp.cross_force[c];
           if (cf.touching) {
             f += cf.force_i, t += cf.torque_i;
             if constexpr (Load) load_i = std::max(load_i, cf.load);
+            if constexpr (Energy) {
+              const PairEnergy& e = cross_energy[c];
+              DissipationSums& di = diss[i];
+              di.fd += Eigen::Map<const Eigen::Vector3d>(e.fd);
+              di.td += Eigen::Map<const Eigen::Vector3d>(e.tdi);
+              di.ff += Eigen::Map<const Eigen::Vector3d>(e.ff);
+              di.tf += Eigen::Map<const Eigen::Vector3d>(e.tfi);
+              block_e.friction += e.spring;
+              block_e.stiffening += e.stiffening;
+            }
           }
         }
-        walls.add_forces<Load>(i, qi, mass[i], material[i], np <= 64 ? nl.plane_mask_[i] : 0,
-                               model_, dt, update_history, f, t, load_i, block_wall);
+        WallDissipation wd;  // (Energy) i's wall and mesh contacts
+        walls.add_forces<Load, Energy>(i, qi, mass[i], material[i],
+                                       np <= 64 ? nl.plane_mask_[i] : 0, model_, dt,
+                                       update_history, f, t, load_i, block_wall,
+                                       Energy ? &diss[i] : nullptr, &wd);
         if (mesh_row < mesh.rows && mesh.particle[mesh_row] == i) {
           // own accumulators: f and t keep their registers
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
           const MeshContacts::Particle q{qi.x, qi.r, qi.v, mass[i], qi.w, material[i]};
-          MeshContacts::evaluate<Load>(i, q, nl, meshes_, model_, mesh.row(mesh_row++), dt,
-                                       update_history, fm, tm, load_i);
+          MeshContacts::evaluate<Load, Energy>(i, q, nl, meshes_, model_, mesh.row(mesh_row++),
+                                               dt, update_history, fm, tm, load_i,
+                                               Energy ? &diss[i] : nullptr, &wd);
           f += fm;
           t += tm;
         }
@@ -486,8 +569,17 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           speed2 = std::max(speed2, qi.v.squaredNorm());
           accel2 = std::max(accel2, f.squaredNorm() / (mass[i] * mass[i]));
           extent = std::max(extent, qi.x.cwiseAbs().maxCoeff());
+          if constexpr (Energy) {  // powers at the end-of-step velocities (Energies)
+            const DissipationSums& di = diss[i];
+            block_e.damping += (wd.damping - (di.fd.dot(qi.v) + di.td.dot(qi.w))) * dt;
+            block_e.friction += (wd.friction - (di.ff.dot(qi.v) + di.tf.dot(qi.w))) * dt +
+                                wd.spring;
+            block_e.gravity += mass[i] * gravity.dot(qi.v) * dt;
+            block_e.stiffening += wd.stiffening;
+          }
         }
       }
+      if constexpr (Energy) block_energy_[b] = block_e;
     }
     if (reached) load_reached_[part] = 1;
     part_motion_[part] = {speed2, accel2, extent};
@@ -495,9 +587,30 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   if (marks) marks->rows = now_ns();
 }
 
-void System::reduce_wall_and_mesh_forces() {
+void System::reduce_wall_and_mesh_forces(double dt, bool work) {
   const int n = static_cast<int>(store_.size());
   walls_.reduce(n);
+  work = work && energy_tracking_;
+  if (work) {  // the step's energies: block sums in order, the walls' and meshes' work
+    Energies& e = energies_;
+    for (const BlockEnergy& b : block_energy_) {
+      e.damping += b.damping;
+      e.friction += b.friction;
+      e.gravity += b.gravity;
+      e.stiffening += b.stiffening;
+    }
+    walls_.add_work(dt, e.wall_work);
+    // each contact's force on its particle times the mesh's velocity at the contact point
+    // (barycentric), particles in order
+    mesh_contacts_.for_each_contact([&](int, const MeshContactRecord& rec, const Eigen::Vector3d&) {
+      const TriangleMesh& m = meshes_[rec.mesh];
+      const auto& tri = m.triangle(rec.triangle);
+      const Eigen::Vector3d v_wall = rec.barycentric[0] * m.velocity_[tri[0]] +
+                                     rec.barycentric[1] * m.velocity_[tri[1]] +
+                                     rec.barycentric[2] * m.velocity_[tri[2]];
+      e.mesh_work[static_cast<std::size_t>(rec.mesh)] += rec.force.dot(v_wall) * dt;
+    });
+  }
   // Mesh forces: particles in order (MeshContacts::reduce).
   if (meshes_.empty()) return;
   mesh_contacts_.reduce(meshes_);

@@ -103,14 +103,18 @@ void check_against_scalar(const ContactModel& model, const Contacts& c, bool upd
     for (int a = 0; a < 3; ++a) e.f[a] = f[a], e.ti[a] = ti[a], e.tj[a] = tj[a];
     e.load = load;
   }
-  // the batch, in pieces of every length up to 2 x lanes + 1 (partly filled vectors)
+  // the batch, in pieces of every length up to 2 x lanes + 1 (partly filled vectors); the
+  // kernels with the energy parts give the same forces
+  for (const bool with_energy : {false, true}) {
   std::vector<Eigen::Vector3d> shear_batch = c.shear;
   std::vector<PairForce> got(static_cast<std::size_t>(n));
-  const PairBatchKernel kernel = Load ? set.with_load : set.plain;
+  std::vector<PairEnergy> energy(static_cast<std::size_t>(n));
+  const PairBatchKernel kernel = with_energy ? (Load ? set.with_load_energy : set.plain_energy)
+                                             : (Load ? set.with_load : set.plain);
   for (int k = 0, piece = 1; k < n; k += piece, piece = piece % (2 * set.lanes + 1) + 1) {
     const int m = std::min(piece, n - k);
     kernel(c.tasks.data() + k, m, c.packed.data(), c.mass.data(), c.material.data(), model,
-           shear_batch.data(), dt, update_history, got.data() + k);
+           shear_batch.data(), dt, update_history, got.data() + k, energy.data() + k);
   }
   int differ = 0;
   for (int k = 0; k < n; ++k) {
@@ -123,6 +127,7 @@ void check_against_scalar(const ContactModel& model, const Contacts& c, bool upd
       UNSCOPED_INFO("pair " << k << " differs: f " << expected[k].f[0] << " / " << got[k].f[0]);
   }
   CHECK(differ == 0);
+  }
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "partita/dem/interaction.hpp"
 #include "partita/dem/material.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -76,17 +77,44 @@ class ContactModel {
   bool dirty_ = true;
 };
 
+/// The dissipative parts of one contact's force in a force pass (energy accounting, System's
+/// energies()): the dissipation is their power at the end-of-step velocities, which the integrator's
+/// kick computes per particle (see System::Energies).
+///   damping   normal damping force (F_n - F_elastic) n (with no tension: -F_elastic n where
+///             the clamp acts) + tangential damping -gamma_t v_t while sticking
+///   damping_t its tangential part (the caller's torques: -cr n x damping_t)
+///   friction  the tangential force of a step in which it reached the Coulomb cap mu F_n (sliding:
+///             all of it; zero while sticking)
+///   spring    the tangential spring energy the cap released in that step:
+///             1/2 S_t (|xi_before|^2 - |xi_after|^2), xi_before the history before this step's
+///             increment; 0 while sticking
+///   stiffening  minus the energy the tangential spring gained in the step without work: its
+///             stiffness S_t = 8 G* sqrt(R* delta) changed with the overlap at a fixed history,
+///             1/2 (S_t(delta + v_n dt) - S_t(delta)) |xi_before|^2, and the history lost its
+///             part along the new normal, + 1/2 S_t (xi_before . n)^2 (Mindlin's incremental law
+///             is not conservative: the spring's energy changes when the overlap changes or the
+///             contact turns under a tangential load)
+struct DissipativeParts {
+  Eigen::Vector3d damping = Eigen::Vector3d::Zero();
+  Eigen::Vector3d damping_t = Eigen::Vector3d::Zero();
+  Eigen::Vector3d friction = Eigen::Vector3d::Zero();
+  double spring = 0.0;
+  double stiffening = 0.0;  ///< what the spring lost without work (below)
+};
+
 /// Hertz-Mindlin force on body i from body j (or a wall) for one contact with overlap delta > 0.
 ///   n      unit normal pointing from j (or the wall) to i
 ///   v_rel  v_i - v_j at the centres (wall: v_i - velocity of the wall at the contact point)
 ///   w_arm  cr_i omega_i + cr_j omega_j with cr = R - delta/2 (wall: cr_i omega_i)
 ///   shear  tangential displacement history, updated in place when update_history
 /// Returns the normal force magnitude F_n; writes the total force on i and its tangential part.
+/// parts (not null): also the dissipative parts (DissipativeParts); the force is the same bits.
 PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, double r_eff,
                                         double m_eff, const Eigen::Vector3d& n,
                                         const Eigen::Vector3d& v_rel, const Eigen::Vector3d& w_arm,
                                         Eigen::Vector3d& shear, double dt, bool update_history,
-                                        Eigen::Vector3d& force, Eigen::Vector3d& f_tangential) {
+                                        Eigen::Vector3d& force, Eigen::Vector3d& f_tangential,
+                                        DissipativeParts* parts = nullptr) {
   // Normal: F_n = 4/3 E* sqrt(R*) delta^(3/2) - gamma_n v_n, S_n = 2 E* sqrt(R* delta),
   // gamma_n = 2 zeta sqrt(S_n m*) (v_n < 0 while approaching).
   const double a = std::sqrt(r_eff * delta);  // contact radius
@@ -98,6 +126,13 @@ PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, d
   f_n -= gamma_n * v_n;
   if (p.no_tension && f_n < 0.0) f_n = 0.0;
   force = f_n * n;
+  if (parts) {
+    parts->damping = (f_n - (2.0 / 3.0) * s_n * delta) * n;
+    parts->damping_t.setZero();
+    parts->friction.setZero();
+    parts->spring = 0.0;
+    parts->stiffening = 0.0;
+  }
   if (p.friction <= 0.0) {
     f_tangential.setZero();
     shear.setZero();
@@ -111,11 +146,22 @@ PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, d
   //   xi = -F_t/S_t. LIGGGHTS variant: the test is on the spring force alone and the damping is
   //   added unchecked while sticking (which lets F_t exceed the cap at the start of a contact).
   const Eigen::Vector3d v_t = v_rel - v_n * n + n.cross(w_arm);
+  const double before2 = parts ? shear.squaredNorm() : 0.0;
+  const double xn_before = parts ? shear.dot(n) : 0.0;
   if (update_history) {
     shear += v_t * dt;
     shear -= shear.dot(n) * n;
   }
   const double k_t = 8.0 * p.g_star * a;
+  // (energy) what the spring's energy did without work over the step: its stiffness changed
+  // with the overlap (from S_t(delta + v_n dt) to S_t(delta) at the history before the step) and
+  // the history lost its part along the new normal
+  double stiffening = 0.0;
+  if (parts) {
+    const double delta_before = std::max(0.0, delta + v_n * dt);
+    const double k_before = 8.0 * p.g_star * std::sqrt(r_eff * delta_before);
+    stiffening = 0.5 * (k_before - k_t) * before2 + 0.5 * k_t * xn_before * xn_before;
+  }
   if (p.cap_total_tangential) {
     f_tangential = -k_t * shear - (gamma_n * p.st_over_sn_sqrt) * v_t;
     const double ft2 = f_tangential.squaredNorm();
@@ -123,7 +169,16 @@ PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, d
     if (ft2 > cap * cap) {
       f_tangential *= cap / std::sqrt(ft2);
       if (update_history) shear = f_tangential / (-k_t);
+      if (parts) {
+        parts->friction = f_tangential;
+        parts->spring = 0.5 * k_t * (before2 - shear.squaredNorm());
+      }
+    } else if (parts) {
+      parts->spring = 0.0;
+      parts->damping_t = -(gamma_n * p.st_over_sn_sqrt) * v_t;
+      parts->damping += parts->damping_t;
     }
+    if (parts) parts->stiffening = stiffening;
     force += f_tangential;
     return f_n;
   }
@@ -137,9 +192,18 @@ PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, d
     } else {
       f_tangential.setZero();
     }
+    if (parts) {
+      parts->friction = f_tangential;
+      parts->spring = 0.5 * k_t * (before2 - shear.squaredNorm());
+    }
   } else {
     f_tangential = -k_t * shear - (gamma_n * p.st_over_sn_sqrt) * v_t;
+    if (parts) {
+      parts->damping_t = -(gamma_n * p.st_over_sn_sqrt) * v_t;
+      parts->damping += parts->damping_t;
+    }
   }
+  if (parts) parts->stiffening = stiffening;
   force += f_tangential;
   return f_n;
 }

@@ -16,6 +16,7 @@
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
 #include "partita/dem/contact_model.hpp"
+#include "partita/dem/energy_sums.hpp"
 #include "partita/dem/mesh_contact_record.hpp"
 #include "partita/dem/neighbor_list.hpp"
 #include "partita/dem/triangle_mesh.hpp"
@@ -101,12 +102,14 @@ class MeshContacts {
   }
 
   /// Adds the mesh contact forces and torques of particle i (candidates from `lists`) to f and t,
-  /// updates its row; Load: also the largest F_n (E*/R*)^2 into load (R* = R).
-  template <bool Load>
+  /// updates its row; Load: also the largest F_n (E*/R*)^2 into load (R* = R); Energy: the
+  /// dissipative parts into sums and wd (energy_sums.hpp).
+  template <bool Load, bool Energy = false>
   static void evaluate(int i, const Particle& q, const NeighborList& lists,
                        const std::vector<TriangleMesh>& meshes, const ContactModel& model,
                        const Row& row, double dt, bool update_history, Eigen::Vector3d& f,
-                       Eigen::Vector3d& t, double& load);
+                       Eigen::Vector3d& t, double& load, DissipationSums* sums = nullptr,
+                       WallDissipation* wd = nullptr);
   /// The meshes' triangle and vertex forces from the contacts of the last pass.
   void reduce(std::vector<TriangleMesh>& meshes) const;
 

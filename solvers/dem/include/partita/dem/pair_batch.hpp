@@ -42,19 +42,36 @@ struct PairForce {
   double load;
 };
 
+/// The dissipative parts of a pair's force (energy kernels only; DissipativeParts): damping force
+/// on i and the damping torques on i and j (with rolling resistance), friction force on i and its
+/// torques, and the spring energy the friction cap released.
+struct PairEnergy {
+  double fd[3];
+  double tdi[3];
+  double tdj[3];
+  double ff[3];
+  double tfi[3];
+  double tfj[3];
+  double spring;
+  double stiffening;
+};
+
 /// Evaluates the touching pairs tasks[0, n) into out[0, n) and updates their histories
 /// shear[tasks[k].s] as PairContacts::force() does for a pair known to overlap (the caller marks
-/// their slots touching). mass and material: the store's arrays.
+/// their slots touching). mass and material: the store's arrays. energy: the dissipative parts
+/// into energy[0, n) (the energy kernels; ignored by the others).
 using PairBatchKernel = void (*)(const PairTask* tasks, int n, const PackedParticle* packed,
                                  const double* mass, const int* material, const ContactModel& model,
                                  Eigen::Vector3d* shear, double dt, bool update_history,
-                                 PairForce* out);
+                                 PairForce* out, PairEnergy* energy);
 
 struct PairBatchKernels {
   const char* name;  ///< "avx512", "avx2" or "sse2"
   int lanes;
   PairBatchKernel plain;
   PairBatchKernel with_load;  ///< also writes PairForce::load
+  PairBatchKernel plain_energy;      ///< plain + PairEnergy
+  PairBatchKernel with_load_energy;  ///< with_load + PairEnergy
 };
 
 /// The widest kernel set this CPU runs (or the one PARTITA_DEM_PAIR_KERNELS names, if the CPU

@@ -43,6 +43,7 @@
 #include "partita/dem/cell_order.hpp"
 #include "partita/dem/contact_model.hpp"
 #include "partita/dem/damping_model.hpp"
+#include "partita/dem/energy_sums.hpp"
 #include "partita/dem/interaction.hpp"
 #include "partita/dem/material.hpp"
 #include "partita/dem/mesh_contact_record.hpp"
@@ -231,6 +232,45 @@ class System {
   double elastic_energy() const;
   /// Gravitational potential energy -sum m g.x [J].
   double potential_energy() const;
+  /// Cumulative energies since the first step (energy accounting; on by default,
+  /// set_energy_tracking()). Powers are taken at the end-of-step velocities of velocity Verlet
+  /// (the kick's v_{n+1}, omega_{n+1}: F_{n+1} . v_{n+1} dt summed over the steps is the
+  /// trapezoidal work of the integrator, exactly), so the balance
+  ///   sum(wall_work) + sum(mesh_work) + gravity
+  ///     = (KE - kinetic_start) + (E_el - elastic_start) + friction + damping + breakage
+  ///       + stiffening
+  /// closes up to the trapezoidal rule's error on the contact springs (energy_balance_error()),
+  /// where KE is taken with the integrator's half-step term: KE + sum dt/2 (F.v + T.omega) +
+  /// dt^2/8 (|F|^2/m + |T|^2/I) (F, T the forces of the last pass), for which velocity Verlet's
+  /// identity KE_N - KE_0 = sum_k F_k.v_k dt + B_0 - B_N holds exactly. [J]
+  struct Energies {
+    double friction = 0.0;  ///< Coulomb sliding: power of the capped tangential forces on the
+                            ///< relative motion + the spring energy the cap released
+    double damping = 0.0;   ///< viscous normal and tangential contact damping, rolling resistance
+    double breakage = 0.0;  ///< mechanical energy (KE + PE + E_el) before minus after changes of
+                            ///< the particle set between steps (breakage, removal, insertion)
+    double gravity = 0.0;   ///< work of gravity on the particles
+    /// Mindlin's tangential springs: minus the energy they gained as their stiffness grew with
+    /// the overlap at a fixed history (DissipativeParts::stiffening; mostly negative while a bed
+    /// is loaded: energy the incremental law creates)
+    double stiffening = 0.0;
+    std::vector<double> wall_work;  ///< per wall: work of its motion on the particles
+    std::vector<double> mesh_work;  ///< per mesh: work of its vertices' motion on the particles
+    double kinetic_start = 0.0;     ///< kinetic energy (with the half-step term) at the first
+                                    ///< step (and shifted where the step changed)
+    double elastic_start = 0.0;     ///< contact elastic energy at the first step
+    bool started = false;
+  };
+  /// Turns the energy accounting on (default) or off (the force pass then skips it).
+  void set_energy_tracking(bool on) { energy_tracking_ = on; }
+  bool energy_tracking() const { return energy_tracking_; }
+  const Energies& energies() const { return energies_; }
+  /// (sum(wall_work) + sum(mesh_work) + gravity - dKE - dE_el - friction - damping - breakage
+  /// - stiffening)
+  /// / (kinetic_start + elastic_start + |gravity| + sum |wall_work| + sum |mesh_work|); 0 before
+  /// the first step. Takes a pass over the particles and contacts (kinetic and elastic energy).
+  double energy_balance_error() const;
+
   /// Force the particles exerted on a wall (all its planes) in the last step [N].
   Eigen::Vector3d wall_force(int wall) const;
   /// The part of wall_force() on one face of a box wall (face 0..5: -x, +x, -y, +y, -z, +z, the
@@ -313,9 +353,15 @@ class System {
   // integrator's first half (step(); kick = dt/2), each particle just before a row reads it
   void evaluate_forces(double dt, bool update_history, double kick, bool drift = false);
   // Load: record the contact loads; Limit: compare them with a hook's limits; Drift: as drift
-  template <bool Load, bool Limit, bool Drift>
+  template <bool Load, bool Limit, bool Drift, bool Energy>
   void evaluate_forces_impl(double dt, bool update_history, double kick);
-  void reduce_wall_and_mesh_forces();  // wall totals and mesh forces of the last pass
+  // wall totals and mesh forces of the last pass; work: with the step's kick (the pass's
+  // energies into energies_)
+  void reduce_wall_and_mesh_forces(double dt = 0.0, bool work = false);
+  // energy accounting: the mechanical energy before a change of the particle set (taken once,
+  // at the first change after a step) and its comparison after the next step's force pass
+  void note_set_change();
+  void settle_set_change();
   void start_load_pass(int parts);
   void write_body(BinaryWriter& out) const;
   void read_body(BinaryReader& in);
@@ -350,12 +396,26 @@ class System {
     double speed2 = 0.0, accel2 = 0.0, extent = 0.0;
   };
   std::vector<PartMotion> part_motion_;
+  // energy accounting (energies()): per particle the dissipative force sums of the pass, per
+  // block of particles the pass's energies, per cross pair its dissipative parts
+  bool energy_tracking_ = true;
+  Energies energies_;
+  std::vector<DissipationSums> dissipation_;
+  std::vector<BlockEnergy> block_energy_;
+  std::vector<PairEnergy> cross_energy_;
+  bool set_change_pending_ = false;
+  double energy_dt_ = 0.0;  // the step the energies' half-step term is taken for
+  // sum_i dt/2 (F.v + T.omega) + dt^2/8 (|F|^2/m + |T|^2/I) with the forces of the last pass:
+  // what velocity Verlet's kinetic energy still owes the forces' trapezoidal work (Energies)
+  double half_step_term(double dt) const;
+  double set_change_before_ = 0.0;  // KE + PE + E_el before the pending change
   // per part, the force pass's lists of a block of rows (pair_batch.hpp): its touching pairs,
   // their forces, where each row's pairs start and where its cross pairs start; sized by
   // start_load_pass() for the largest block (no allocation while the lists keep their size)
   struct PairScratch {
     std::vector<PairTask> tasks;
     std::vector<PairForce> forces;
+    std::vector<PairEnergy> energy;  // (energy accounting)
   };
   std::vector<PairScratch> pair_scratch_;
 

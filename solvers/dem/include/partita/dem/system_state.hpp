@@ -32,7 +32,8 @@ class SystemState {
  public:
   // 2: mesh contact histories as rows of the particles near a mesh (MeshContacts), after the
   // particle store, which no longer has the four mesh arrays of version 1
-  static constexpr std::uint32_t format_version = 2;
+  // 3: the cumulative energies (System::energies()) after the hooks' state
+  static constexpr std::uint32_t format_version = 3;
 
   double time() const { return time_; }
   long step_count() const { return steps_; }

@@ -12,6 +12,7 @@
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
 #include "partita/dem/contact_model.hpp"
+#include "partita/dem/energy_sums.hpp"
 #include "partita/dem/packed_particle.hpp"
 #include "partita/dem/particle_store.hpp"
 #include "partita/dem/plane_wall.hpp"
@@ -64,6 +65,14 @@ class WallContacts {
   void resize(ParticleStore& store, std::size_t n);
   /// Wall totals from the block sums of n particles (fixed order: blocks, then planes).
   void reduce(std::size_t n);
+  /// Adds to work[wall] the work the walls' motion did on the particles in the last pass over a
+  /// step dt: -F_plane . v_plane dt per plane (F_plane the particles' force on it, after
+  /// reduce()).
+  void add_work(double dt, std::vector<double>& work) const {
+    for (std::size_t k = 0; k < planes_.size(); ++k)
+      work[static_cast<std::size_t>(planes_[k].wall)] -=
+          plane_force_[k].dot(planes_[k].velocity) * dt;
+  }
 
   /// What one force pass reads and writes, taken once per pass: raw pointers and the plane
   /// count, which the kernel's loop keeps in registers (a member vector's size would be reloaded
@@ -82,13 +91,15 @@ class WallContacts {
     }
     /// Forces of the planes near particle i (mass mi, material material_i; bit k of `mask`: plane
     /// k; every plane when there are more than 64) added to f and t, their reactions to `block`;
-    /// Load: the largest contact load F_n (E*/R)^2 into load.
-    template <bool Load>
+    /// Load: the largest contact load F_n (E*/R)^2 into load. Energy: the dissipative parts
+    /// into sums and wd (see energy_sums.hpp).
+    template <bool Load, bool Energy = false>
     PARTITA_DEM_INLINE void add_forces(int i, const PackedParticle& qi, const double& mi,
                                        const int& material_i, std::uint64_t mask,
                                        const ContactModel& model, double dt, bool update_history,
                                        Eigen::Vector3d& f, Eigen::Vector3d& t, double& load,
-                                       Eigen::Vector3d* block) const;
+                                       Eigen::Vector3d* block, DissipationSums* sums = nullptr,
+                                       WallDissipation* wd = nullptr) const;
   };
   Pass pass(ParticleStore& store) {
     return Pass{planes_.data(), static_cast<int>(planes_.size()),
@@ -110,11 +121,12 @@ class WallContacts {
   std::vector<Eigen::Vector3d> plane_force_;  // per plane: reduce()'s sums over the blocks
 };
 
-template <bool Load>
+template <bool Load, bool Energy>
 PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(
     int i, const PackedParticle& qi, const double& mi, const int& material_i, std::uint64_t mask,
     const ContactModel& model, double dt, bool update_history, Eigen::Vector3d& f,
-    Eigen::Vector3d& t, double& load, Eigen::Vector3d* block) const {
+    Eigen::Vector3d& t, double& load, Eigen::Vector3d* block, DissipationSums* sums,
+    WallDissipation* wd) const {
   const double ri = qi.r;
   for (int k = 0; k < np; ++k) {
     if (np <= 64) {  // jump to the next plane near i
@@ -132,13 +144,28 @@ PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(
     const PairParameters& pp = model.pair(material_i, w.material);
     const double cr = ri - 0.5 * delta;
     Eigen::Vector3d fw, ft;
+    DissipativeParts parts;
     const double fn = hertz_mindlin(pp, delta, ri, mi, w.normal, qi.v - w.velocity, cr * qi.w, sh,
-                                    dt, update_history, fw, ft);
+                                    dt, update_history, fw, ft, Energy ? &parts : nullptr);
     f += fw;
     t -= cr * w.normal.cross(ft);
+    if constexpr (Energy) {
+      sums->fd += parts.damping;
+      sums->td -= cr * w.normal.cross(parts.damping_t);
+      sums->ff += parts.friction;
+      sums->tf -= cr * w.normal.cross(parts.friction);
+      wd->damping += parts.damping.dot(w.velocity);
+      wd->friction += parts.friction.dot(w.velocity);
+      wd->spring += parts.spring;
+      wd->stiffening += parts.stiffening;
+    }
     if (pp.rolling_friction > 0.0) {
       const double wn = qi.w.norm();
-      if (wn > 0.0) t -= (pp.rolling_friction * std::abs(fn) * ri / wn) * qi.w;
+      if (wn > 0.0) {
+        const Eigen::Vector3d tr = (pp.rolling_friction * std::abs(fn) * ri / wn) * qi.w;
+        t -= tr;
+        if constexpr (Energy) sums->td -= tr;
+      }
     }
     if constexpr (Load) {  // wall: R* = R
       const double kw = pp.e_star / ri;
