@@ -34,4 +34,12 @@ inline double monitor_value(const Solver& s, const std::string& name) {
   return 0.0;
 }
 
+/// The interface mesh of that name; fails the test when the solver has none.
+inline const InterfaceMesh& find_mesh(const Solver& s, const std::string& name) {
+  for (const auto& m : s.meshes())
+    if (m.mesh.name() == name) return m;
+  FAIL("no mesh " << name);
+  return s.meshes().front();
+}
+
 }  // namespace partita::test

@@ -10,6 +10,7 @@
 #include "partita/fem/state_io.hpp"
 
 #include "fem_output.hpp"
+#include "fem_panel_config.hpp"
 #include "fem_rupture.hpp"
 #include "indenter_config.hpp"
 #include "line_probe.hpp"
@@ -51,9 +52,10 @@ std::shared_ptr<Spec> make_spec() {
             "whose centre lies in no listed box stay in region 'all'; a later box takes over",
             fem_box_region_spec());
 
-  auto mesh =
-      std::make_shared<Spec>("mesh", "the finite element mesh: a box or a Gmsh 4.1 ASCII file");
+  auto mesh = std::make_shared<Spec>(
+      "mesh", "the finite element mesh: a box, a cellular panel or a Gmsh 4.1 ASCII file");
   mesh->section("box", "structured box", box);
+  mesh->section("panel", "structured cellular panel (double-hull section)", fem_panel_spec());
   mesh->string(
       "gmsh",
       "Gmsh 4.1 ASCII .msh file (physical groups become named faces and node sets), relative "
@@ -61,7 +63,7 @@ std::shared_ptr<Spec> make_spec() {
   mesh->real("scale", "factor applied to the Gmsh coordinates (e.g. 1.0e-3 for a file in mm)")
       .positive()
       .def(1.0);
-  mesh->choice("element", "element type of the box mesh (Gmsh files carry their own)",
+  mesh->choice("element", "element type of the box or panel mesh (Gmsh files carry their own)",
                {"hex8", "hex20", "tet4", "tet10"})
       .def("hex8");
   mesh->choice("hex8",
@@ -74,7 +76,7 @@ std::shared_ptr<Spec> make_spec() {
                "(J_bar/J)^(1/3) F, no volumetric locking, still stiff in bending of thin plates)",
                {"incompatible-modes", "full", "f-bar"})
       .def("incompatible-modes");
-  mesh->one_of({"box", "gmsh"});
+  mesh->one_of({"box", "panel", "gmsh"});
 
   auto hardening_point =
       std::make_shared<Spec>("hardening_point", "a point of the hardening curve");
@@ -115,7 +117,10 @@ std::shared_ptr<Spec> make_spec() {
   material->section("failure", "rupture (j2-plasticity)", fem_failure_spec());
 
   auto constraint = std::make_shared<Spec>("constraint", "a Dirichlet condition on a node set");
-  constraint->string("set", "node set (box: all, xmin ... zmax; Gmsh: physical group names)")
+  constraint
+      ->string("set",
+               "node set (box: all, xmin ... zmax; panel: all, outer, inner, xmin ... ymax, "
+               "cell_<i>_<j>; Gmsh: physical group names)")
       .required();
   constraint->strings("fix", "components held at zero").choices(kComponents);
   constraint->choice("component", "component of a prescribed displacement", kComponents);
@@ -131,7 +136,10 @@ std::shared_ptr<Spec> make_spec() {
 
   auto load = std::make_shared<Spec>(
       "load", "a load: pressure, traction or total force on a face, or gravity");
-  load->string("face", "face name (box: xmin ... zmax; Gmsh: physical surface names)");
+  load->string(
+      "face",
+      "face name (box: xmin ... zmax; panel: outer, inner, xmin ... ymax, cell_<i>_<j>; Gmsh: "
+      "physical surface names)");
   load->real("pressure",
              "uniform pressure, positive pushing into the body (against the outward normal)")
       .unit("Pa");
@@ -379,6 +387,12 @@ std::shared_ptr<const fem::MaterialLaw> build_law(const Node& mat) {
 }
 
 fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
+  const std::string e = m.string("element");
+  const fem::ElementType element = e == "hex8"    ? fem::ElementType::Hex8
+                                   : e == "hex20" ? fem::ElementType::Hex20
+                                   : e == "tet4"  ? fem::ElementType::Tet4
+                                                  : fem::ElementType::Tet10;
+  if (m.has("panel")) return build_panel_mesh(m["panel"], element, kMaxBoxCells);
   if (m.has("box")) {
     fem::BoxSpec b;
     b.origin = m["box"].vec3("origin");
@@ -414,11 +428,7 @@ fem::Mesh build_mesh(const Node& m, const std::filesystem::path& case_dir) {
     } else if (m["box"].has("wall_cells")) {
       m["box"]["wall_cells"].fail("wall_cells applies to a hollow box only: add wall_thickness");
     }
-    const std::string e = m.string("element");
-    b.element = e == "hex8"    ? fem::ElementType::Hex8
-                : e == "hex20" ? fem::ElementType::Hex20
-                : e == "tet4"  ? fem::ElementType::Tet4
-                               : fem::ElementType::Tet10;
+    b.element = element;
     fem::Mesh box_mesh = fem::make_box_mesh(b);
     apply_box_regions(box_mesh, m["box"]);
     return box_mesh;

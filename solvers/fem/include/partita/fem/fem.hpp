@@ -13,6 +13,7 @@
 #include "partita/fem/linear_solver.hpp"
 #include "partita/fem/model.hpp"
 #include "partita/fem/neo_hooke_law.hpp"
+#include "partita/fem/panel_mesher.hpp"
 #include "partita/fem/plane_shape.hpp"
 #include "partita/fem/rigid_indenter.hpp"
 #include "partita/fem/sphere_shape.hpp"
