@@ -120,6 +120,7 @@ void CaseRun::run() {
     }
     m.csv = CsvSeries(output_dir_ / (m.name + ".csv"), "time", "s", mc);
   }
+  if (energy_) energy_csv_ = CsvSeries(output_dir_ / "energy.csv", "time", "s", energy_->columns());
   // The quantities each participant must report, asked for once per window, and where each
   // monitor column finds its value: (participant slot, position in what the solver returned),
   // the position remembered from the last window and checked by name (no search per window
@@ -135,19 +136,36 @@ void CaseRun::run() {
     const std::string* name;
     std::size_t at = 0;
   };
-  std::vector<std::vector<Column>> columns_of(monitors_.size());
+  // the monitors' columns, then the energy balance's terms (asked with the same request)
+  std::vector<std::vector<Column>> columns_of(monitors_.size() + (energy_ ? 1 : 0));
+  auto ask = [&](std::size_t list, const std::pair<Participant*, std::string>& pq) {
+    const auto& p = pq.first;  // not a structured binding: clang 14 cannot capture those
+    const auto& q = pq.second;
+    auto it = std::find_if(wanted.begin(), wanted.end(), [&](const Asked& a) { return a.p == p; });
+    if (it == wanted.end()) it = wanted.insert(wanted.end(), Asked{p, {}, {}});
+    it->names.push_back(q);
+    columns_of[list].push_back({static_cast<std::size_t>(it - wanted.begin()), &q});
+  };
   for (std::size_t mi = 0; mi < monitors_.size(); ++mi)
-    for (const auto& pq : monitors_[mi].quantities) {
-      const auto& p = pq.first;  // not a structured binding: clang 14 cannot capture those
-      const auto& q = pq.second;
-      auto it =
-          std::find_if(wanted.begin(), wanted.end(), [&](const Asked& a) { return a.p == p; });
-      if (it == wanted.end()) it = wanted.insert(wanted.end(), Asked{p, {}, {}});
-      it->names.push_back(q);
-      columns_of[mi].push_back({static_cast<std::size_t>(it - wanted.begin()), &q});
+    for (const auto& pq : monitors_[mi].quantities) ask(mi, pq);
+  if (energy_)
+    for (const auto& pq : energy_terms_) ask(monitors_.size(), pq);
+  std::vector<double> monitor_row, energy_row;
+  auto values_of = [&](std::vector<Column>& cols, std::vector<double>& out) {
+    out.clear();
+    for (Column& c : cols) {
+      const std::vector<MonitorValue>& got = wanted[c.asked].values;
+      if (c.at >= got.size() || got[c.at].name != *c.name) {
+        // the last value of that name, as the search before (NaN where the solver gave none)
+        c.at = got.size();
+        for (std::size_t k = 0; k < got.size(); ++k)
+          if (got[k].name == *c.name) c.at = k;
+      }
+      out.push_back(c.at < got.size() ? got[c.at].value : std::nan(""));
     }
-  std::vector<double> monitor_row;
-  auto record_monitors = [&](double t, std::int64_t window) {
+  };
+  // coupling_created: the interfaces' net created energy [J] (the energy audit's pairs)
+  auto record_monitors = [&](double t, std::int64_t window, double coupling_created) {
     for (Asked& a : wanted) {
       Stopwatch clock;  // the solver computes its quantities: its time, not the core's
       a.values = a.p->monitor_values(a.names);
@@ -161,26 +179,37 @@ void CaseRun::run() {
               window, t, a.p->name(), mv.name, mv.value, mv.unit));
     }
     for (std::size_t mi = 0; mi < monitors_.size(); ++mi) {
-      monitor_row.clear();
-      for (Column& c : columns_of[mi]) {
-        const std::vector<MonitorValue>& got = wanted[c.asked].values;
-        if (c.at >= got.size() || got[c.at].name != *c.name) {
-          // the last value of that name, as the search before (NaN where the solver gave none)
-          c.at = got.size();
-          for (std::size_t k = 0; k < got.size(); ++k)
-            if (got[k].name == *c.name) c.at = k;
-        }
-        monitor_row.push_back(c.at < got.size() ? got[c.at].value : std::nan(""));
-      }
+      values_of(columns_of[mi], monitor_row);
       Stopwatch csv_clock;  // formatting the row: output time, not the core's
       monitors_[mi].csv.record(t, monitor_row);
       summary_.output_seconds += csv_clock.seconds();
     }
+    if (!energy_) return;
+    values_of(columns_of.back(), monitor_row);
+    const EnergyBalance::Row b = energy_->evaluate(monitor_row, coupling_created, energy_row);
+    Stopwatch csv_clock;
+    energy_csv_.record(t, energy_row);
+    summary_.output_seconds += csv_clock.seconds();
+    summary_.max_energy_balance_error =
+        std::max(summary_.max_energy_balance_error, std::abs(b.error));
+    if (!energy_->exceeded(b)) return;
+    const std::string what = fmt::format(
+        "window {} (t = {:.6g} s): the energy balance is off by {:.3g} (energy.tolerance {:.3g}): "
+        "{}{}; check that the energy section names every input, store and loss of the system, "
+        "and the exchanges (the balance audit in coupling.csv)",
+        window, t, b.error, energy_->settings().tolerance, energy_->describe(b),
+        energy_->settings().coupling_column && !energy_->settings().count_coupling
+            ? fmt::format("; the coupling created {:.4g} J of it", coupling_created)
+            : std::string());
+    if (energy_->settings().stop) throw Error(what);
+    if (summary_.energy_balance_warnings++ == 0)
+      logger->warn("{}; further windows are counted in the summary", what);
   };
   auto flush_all = [&] {
     Stopwatch clock;
     coupling_csv_.flush();
     for (auto& m : monitors_) m.csv.flush();
+    if (energy_) energy_csv_.flush();
     summary_.output_seconds += clock.seconds();
   };
 
@@ -218,11 +247,12 @@ void CaseRun::run() {
     if (!resume) {
       scheme_->initialize();
       check_window(0, 0.0);
-      record_monitors(0.0, 0);
+      record_monitors(0.0, 0, energy_ ? coupling_created() : 0.0);
       write_output(progress.frame++, 0.0);
     }
     TimeWindow window(window_size_, 0, 1);
     std::vector<double> row;  // coupling.csv's row of the window
+    std::vector<EnergyAudit> audits;  // of the energy audit's pairs, this window
     for (std::int64_t n = progress.windows_done; n < window_count_; ++n) {
       window = TimeWindow(window_size_, n, 1);
       const WindowReport r = scheme_->advance(window);
@@ -238,8 +268,15 @@ void CaseRun::run() {
       row.assign({t, static_cast<double>(r.iterations)});  // keeps its capacity
       row.insert(row.end(), r.residuals.begin(), r.residuals.end());
       row.insert(row.end(), imbalance.begin(), imbalance.end());
-      for (auto& p : energy_pairs_) {
-        const EnergyAudit a = audit_energy(p);
+      audits.clear();
+      double created = 0.0;
+      for (const auto& p : energy_pairs_) {
+        audits.push_back(audit_energy(p));
+        created += audits.back().created();
+      }
+      for (std::size_t pi = 0; pi < energy_pairs_.size(); ++pi) {
+        EnergyPair& p = energy_pairs_[pi];
+        const EnergyAudit a = audits[pi];
         row.insert(row.end(), {a.on_a, a.on_b, a.created()});
         p.passed += std::abs(a.on_a - p.last_a) + std::abs(a.on_b - p.last_b);
         p.last_a = a.on_a;
@@ -258,7 +295,7 @@ void CaseRun::run() {
             kEnergyAuditWindows);
         if (energy_stop_) {
           coupling_csv_.record(static_cast<double>(n + 1), row);
-          record_monitors(t, n + 1);
+          record_monitors(t, n + 1, created);
           throw Error(what);
         }
         if (summary_.energy_warnings++ == 0)
@@ -279,7 +316,7 @@ void CaseRun::run() {
       Stopwatch csv_clock;
       coupling_csv_.record(static_cast<double>(n + 1), row);
       summary_.output_seconds += csv_clock.seconds();
-      record_monitors(t, n + 1);
+      record_monitors(t, n + 1, created);
       const bool last = n + 1 == window_count_;
       if ((output_every_ > 0.0 && TimeWindow::reached(t, progress.next_output, window_size_)) ||
           last) {
@@ -333,6 +370,7 @@ void CaseRun::run() {
   Stopwatch close_clock;
   coupling_csv_.close();
   for (auto& m : monitors_) m.csv.close();
+  if (energy_) energy_csv_.close();
   summary_.output_seconds += close_clock.seconds();
   for (auto& p : participants_) {
     Stopwatch sc;
@@ -374,6 +412,12 @@ void CaseRun::run() {
       summary_.imbalance_warnings
           ? fmt::format("; {} windows with an exchange off balance", summary_.imbalance_warnings)
           : std::string());
+  if (energy_)
+    logger->info("energy balance: largest |error| {:.3g}{}", summary_.max_energy_balance_error,
+                 summary_.energy_balance_warnings
+                     ? fmt::format(", {} windows beyond energy.tolerance {:.3g}",
+                                   summary_.energy_balance_warnings, energy_->settings().tolerance)
+                     : std::string());
 }
 
 }  // namespace partita::coupling

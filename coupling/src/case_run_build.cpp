@@ -188,6 +188,7 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
   }
   std::erase_if(energy_pairs_,
                 [](const EnergyPair& p) { return p.a_meshes.empty() || p.b_meshes.empty(); });
+  build_energy_balance(root);
 }
 
 CaseRun::~CaseRun() = default;
@@ -455,8 +456,6 @@ void CaseRun::serve_handshake(std::unique_ptr<Solver>& solver,
 }
 
 void CaseRun::build_exchanges(const config::Node& coupling) {
-  std::vector<std::string> names;
-  for (const auto& p : participants_) names.push_back(p->name());
   const std::vector<config::Node> items = coupling["exchanges"].items();
   if (items.empty()) coupling["exchanges"].fail("a coupled case needs at least one exchange");
 
@@ -466,10 +465,7 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
   };
   auto resolve = [&](const config::Node& n) {
     const auto [pname, mname] = split_dot(n, "a mesh");
-    Participant* p = participant(pname);
-    if (!p)
-      n.fail("unknown participant '" + pname + "'; participants: " + join_names(names) +
-             did_you_mean(pname, names));
+    Participant* p = named_participant(n, pname);
     std::vector<std::string> meshes;
     for (const auto& m : p->meshes()) meshes.push_back(m.mesh.name());
     const InterfaceMesh* m = p->find_mesh(mname);
@@ -535,13 +531,80 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
     exchanges_.push_back(std::make_unique<Exchange>(
         data, Exchange::End{from.p, from.mesh->mesh.name()},
         Exchange::End{to.p, to.mesh->mesh.name()}, *ws, std::move(mapper), rsee, wc));
+    if (const double scale = item.real("scale"); scale != 1.0) {
+      exchanges_.back()->set_scale(scale);
+      log::get("coupling")
+          ->warn("{}: exchange {} multiplies what arrives by {} (scale: for testing audits only)",
+                 item["scale"].location().str(), exchanges_.back()->label(), scale);
+    }
   }
+}
+
+Participant* CaseRun::named_participant(const config::Node& n, const std::string& name) const {
+  if (Participant* p = participant(name)) return p;
+  std::vector<std::string> names;
+  for (const auto& p : participants_) names.push_back(p->name());
+  n.fail("unknown participant '" + name + "'; participants: " + join_names(names) +
+         did_you_mean(name, names));
+}
+
+CaseRun::NamedQuantity CaseRun::resolve_quantity(const config::Node& q) const {
+  const auto [pname, quantity] = split_dot(q, "a quantity");
+  Participant* p = named_participant(q, pname);
+  std::vector<std::string> known;
+  std::string unit;
+  for (const auto& v : p->monitors()) {
+    known.push_back(v.name);
+    if (v.name == quantity) unit = v.unit;
+  }
+  if (std::find(known.begin(), known.end(), quantity) == known.end())
+    q.fail("participant '" + pname + "' reports no quantity '" + quantity + "'; it reports: " +
+           (known.empty() ? "nothing" : join_names(known)) + did_you_mean(quantity, known));
+  return {p, quantity, unit};
+}
+
+// The items of a list of strings (a single string is a list of one), each with its node.
+static std::vector<config::Node> string_items(const config::Node& list) {
+  if (!list.is_sequence()) return {list};
+  return list.items();
+}
+
+void CaseRun::build_energy_balance(const config::Node& root) {
+  if (!root.has("energy")) return;
+  const config::Node en = root["energy"];
+  std::vector<EnergyBalance::Term> terms;
+  std::set<std::string> seen;
+  for (const auto& [key, role] : {std::pair{"inputs", EnergyBalance::Role::input},
+                                  std::pair{"stored", EnergyBalance::Role::stored},
+                                  std::pair{"dissipated", EnergyBalance::Role::dissipated}}) {
+    if (!en.has(key)) continue;
+    for (const config::Node& q : string_items(en[key])) {
+      const NamedQuantity nq = resolve_quantity(q);
+      const std::string full = nq.participant->name() + "." + nq.quantity;
+      if (nq.unit != "J")
+        q.fail("'" + full + "' is in " + (nq.unit.empty() ? "no unit" : nq.unit) +
+               ": an energy term must be an energy or a work in J");
+      if (!seen.insert(full).second)
+        q.fail("'" + full + "' is named twice in the energy section: each term counts once");
+      terms.push_back({role, nq.participant->name(), nq.quantity, nq.unit});
+      energy_terms_.emplace_back(nq.participant, nq.quantity);
+    }
+  }
+  EnergyBalance::Settings s;
+  if (en.has("tolerance")) s.tolerance = en.real("tolerance");
+  s.stop = en.string("on_exceeded") == "stop";
+  if (en.has("floor")) s.floor = en.real("floor");
+  s.coupling_column = !energy_pairs_.empty();
+  s.count_coupling = en.string("coupling") == "counted";
+  if (s.count_coupling && energy_pairs_.empty())
+    en["coupling"].fail(
+        "no pair of participants reports the work through its interfaces (the energy audit), "
+        "so there is no coupling term to count; leave out coupling: counted");
+  energy_ = std::make_unique<EnergyBalance>(std::move(terms), s);
 }
 
 void CaseRun::build_monitors(const config::Node& root) {
   if (!root.has("monitors")) return;
-  std::vector<std::string> names;
-  for (const auto& p : participants_) names.push_back(p->name());
   std::set<std::string> files;
   for (const config::Node& m : root["monitors"].items()) {
     Monitor mon;
@@ -551,21 +614,9 @@ void CaseRun::build_monitors(const config::Node& root) {
           "a monitor name becomes DIR/<name>.csv: it must be non-empty, without '/', and not "
           "'coupling'");
     if (!files.insert(mon.name).second) m["name"].fail("two monitors are named '" + mon.name + "'");
-    const config::Node qn = m["quantities"];
-    const std::vector<std::string> qs = m.strings("quantities");
-    for (std::size_t i = 0; i < qs.size(); ++i) {
-      const config::Node q = qn.is_sequence() ? qn[i] : qn;
-      const auto [pname, quantity] = split_dot(q, "a quantity");
-      Participant* p = participant(pname);
-      if (!p)
-        q.fail("unknown participant '" + pname + "'; participants: " + join_names(names) +
-               did_you_mean(pname, names));
-      std::vector<std::string> known;
-      for (const auto& v : p->monitors()) known.push_back(v.name);
-      if (std::find(known.begin(), known.end(), quantity) == known.end())
-        q.fail("participant '" + pname + "' reports no quantity '" + quantity + "'; it reports: " +
-               (known.empty() ? "nothing" : join_names(known)) + did_you_mean(quantity, known));
-      mon.quantities.emplace_back(p, quantity);
+    for (const config::Node& q : string_items(m["quantities"])) {
+      const NamedQuantity nq = resolve_quantity(q);
+      mon.quantities.emplace_back(nq.participant, nq.quantity);
     }
     monitors_.push_back(std::move(mon));
   }

@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kMagic = "partita restart file";
-constexpr std::uint32_t kVersion = 3;  // 2: the energy audit; 3: section checksums
+constexpr std::uint32_t kVersion = 4;  // 2: the energy audit; 3: section checksums; 4: the
+                                       // energy balance
 constexpr std::uint32_t kByteOrder = 0x01020304u;
 
 // DIR/restart/w000000001234.bin -> 1234; -1 for other names.
@@ -141,6 +142,12 @@ void CaseRun::SavedRun::serialize_state(Archive& ar) {
     ar.io(p.passed);
     ar.io(p.over);
   }
+  ar.io_section("energy balance");
+  ar.io(energy_started);
+  ar.io(energy_initial);
+  ar.io(energy_balance_warnings);
+  ar.io(max_energy_balance_error);
+  ar.io(energy_csv);
   ar.io_section("csv");
   ar.io(coupling_csv);
   auto count = static_cast<std::uint64_t>(monitors.size());
@@ -195,6 +202,13 @@ CaseRun::SavedRun CaseRun::saved_run(const Progress& progress) const {
   for (const auto& p : energy_pairs_) r.pairs.push_back({p.last_a, p.last_b, p.passed, p.over});
   r.coupling_csv = coupling_csv_.text();
   for (const auto& m : monitors_) r.monitors.emplace_back(m.name, m.csv.text());
+  if (energy_) {
+    r.energy_started = energy_->started() ? 1 : 0;
+    r.energy_initial = energy_->initial();
+    r.energy_csv = energy_csv_.text();
+  }
+  r.energy_balance_warnings = summary_.energy_balance_warnings;
+  r.max_energy_balance_error = summary_.max_energy_balance_error;
   for (const auto& [series, pvd] : pvds_) r.pvds.emplace_back(series, pvd.entries());
   return r;
 }
@@ -295,6 +309,14 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
   for (std::size_t i = 0; i < monitors_.size(); ++i)
     if (read.monitors[i].first != monitors_[i].name)
       in.fail("the monitor '" + monitors_[i].name + "'");
+  // the energy balance's columns as the run started (a run that started without an energy
+  // section starts its balance here: its initial value is then this window's)
+  const auto header = [](const std::string& text) { return text.substr(0, text.find('\n')); };
+  if (energy_ && !read.energy_csv.empty() && header(read.energy_csv) != header(energy_csv_.text()))
+    throw Error(fmt::format(
+        "{}: the run started with another energy section (energy.csv columns: {}; now: {}): "
+        "resume with the energy section it started with",
+        path.string(), header(read.energy_csv), header(energy_csv_.text())));
   scheme_->read_state(in);
   const auto participants = in.get<std::uint64_t>();
   if (participants != participants_.size())
@@ -329,6 +351,12 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
   coupling_csv_.restore_text(std::move(read.coupling_csv));
   for (std::size_t i = 0; i < monitors_.size(); ++i)
     monitors_[i].csv.restore_text(std::move(read.monitors[i].second));
+  summary_.energy_balance_warnings = static_cast<long>(read.energy_balance_warnings);
+  summary_.max_energy_balance_error = read.max_energy_balance_error;
+  if (energy_ && !read.energy_csv.empty()) {
+    energy_->restore(read.energy_started != 0, read.energy_initial);
+    energy_csv_.restore_text(std::move(read.energy_csv));
+  }
   for (auto& [series, entries] : read.pvds) pvd(series).restore_entries(std::move(entries));
 }
 
@@ -409,6 +437,12 @@ CaseRun::EnergyAudit CaseRun::audit_energy(const EnergyPair& pair) const {
   for (const auto& m : pair.a_meshes) a.on_a += pair.a->interface_work(m).value_or(0.0);
   for (const auto& m : pair.b_meshes) a.on_b += pair.b->interface_work(m).value_or(0.0);
   return a;
+}
+
+double CaseRun::coupling_created() const {
+  double created = 0.0;
+  for (const auto& p : energy_pairs_) created += audit_energy(p).created();
+  return created;
 }
 
 }  // namespace partita::coupling

@@ -57,6 +57,12 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
                "how a subcycling writer's substep values make the window's value",
                {"average", "last"})
       .def("average");
+  exchange
+      ->real("scale",
+             "FOR TESTING AUDITS ONLY: multiply what arrives by this factor (a deliberately "
+             "broken exchange: the balance and energy audits must then report it)")
+      .positive()
+      .def(1.0);
 
   auto coupling = std::make_shared<Spec>("coupling", "how the participants advance together");
   coupling->string("scheme", "coupling scheme; known: " + join_names(registries.schemes.names()))
@@ -114,6 +120,39 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
   monitor->string("name", "file name without .csv").required();
   monitor->strings("quantities", "participant.quantity of each column").required();
 
+  auto energy = std::make_shared<Spec>(
+      "energy",
+      "the energy balance of the whole coupled system, DIR/energy.csv at every window: the "
+      "named monitor quantities (participant.quantity, in J) by role, their sums and `energy "
+      "balance error [-]` = (stored + dissipated - inputs - initial) / scale, initial = the same "
+      "sum at t = 0, scale = max(sum |inputs|, sum |stored| + sum |dissipated|, floor)");
+  energy->strings("inputs",
+                  "work put into the system (an indenter's work, an applied load's work, "
+                  "gravity's work), e.g. [plate.indenter.work]");
+  energy->strings("stored", "energy held (kinetic, elastic, potential)").required();
+  energy->strings("dissipated",
+                  "energy lost (plastic work, friction, damping, breakage, contact)");
+  energy
+      ->choice("coupling",
+               "the net energy the coupling's interfaces created (the energy audit's pairs, "
+               "column `coupling created`; a lossless coupling creates none): reported, so that "
+               "it shows in the error, or counted as an input (the error then measures the "
+               "participants' own balances only)",
+               {"reported", "counted"})
+      .def("reported");
+  energy->real("tolerance", "bound on |energy balance error|: beyond it warn once, or stop")
+      .positive();
+  energy
+      ->choice("on_exceeded", "beyond the tolerance: warn once and count the windows, or stop",
+               {"warn", "stop"})
+      .def("warn");
+  energy
+      ->real("floor",
+             "smallest scale of the error (keeps round-off at rest from reading as an error); "
+             "default none")
+      .unit("J")
+      .positive();
+
   auto output = std::make_shared<Spec>("output", "VTK output under DIR/vtk");
   output->real("every", "simulated time between frames (default: first and last frame only)")
       .unit("s")
@@ -169,6 +208,7 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
                 "then steps alone, as many steps per window as its stable time step needs)",
                 coupling);
   root->list("monitors", "scalar time series", monitor);
+  root->section("energy", "energy balance of the whole system (DIR/energy.csv)", energy);
   root->section("output", "VTK output", output);
   root->strings("plugins",
                 "solver plugins (shared libraries built against this partita) that the case "

@@ -24,6 +24,11 @@
 //     on_max_iterations: accept                  # or error
 //   monitors:
 //     - {name: outlet, quantities: [fluid.outlet_pressure, solid.outlet_area]}
+//   energy:                                      # DIR/energy.csv (energy_balance.hpp)
+//     inputs: [plate.indenter.work]
+//     stored: [plate.kinetic_energy, plate.strain_energy]
+//     dissipated: [plate.plastic_work]
+//     tolerance: 0.02
 //   output: {every: 0.1, restart: {every_windows: 100}}
 //
 // The phases live in their own files: the schema (case_schema.cpp), building a run from a
@@ -46,6 +51,7 @@
 #include <vector>
 
 #include "partita/coupling/coupling_scheme.hpp"
+#include "partita/coupling/energy_balance.hpp"
 #include "partita/coupling/exchange.hpp"
 #include "partita/coupling/participant.hpp"
 #include "partita/coupling/registries.hpp"
@@ -100,6 +106,8 @@ struct RunSummary {
   std::filesystem::path last_restart;  ///< the newest restart file written (empty: none)
   long imbalance_warnings = 0;         ///< windows where an exchange's balance exceeded the limit
   long energy_warnings = 0;            ///< windows where the coupling created too much energy
+  long energy_balance_warnings = 0;    ///< windows with |energy balance error| over its bound
+  double max_energy_balance_error = 0.0;  ///< largest |energy balance error| (energy section)
   double mean_iterations() const {
     return windows > 0 ? static_cast<double>(iterations) / windows : 0.0;
   }
@@ -164,6 +172,11 @@ class CaseRun {
     std::vector<Pair> pairs;  // sized from the case before reading (no count in the file)
     std::string coupling_csv;
     std::vector<std::pair<std::string, std::string>> monitors;  // name, CSV text
+    std::uint8_t energy_started = 0;  // the energy balance: its initial value, its CSV text
+    double energy_initial = 0.0;      // ("" without an energy section)
+    std::int64_t energy_balance_warnings = 0;
+    double max_energy_balance_error = 0.0;
+    std::string energy_csv;
     std::vector<std::pair<std::string, std::vector<std::pair<double, std::string>>>> pvds;
     template <class Archive>
     void serialize_case(Archive& ar);  // name, identity, window: checked before the rest
@@ -179,6 +192,15 @@ class CaseRun {
   }
   void build_exchanges(const config::Node& coupling);
   void build_monitors(const config::Node& root);
+  void build_energy_balance(const config::Node& root);
+  // participant.quantity named by a node, checked against what the participant reports
+  struct NamedQuantity {
+    Participant* participant;
+    std::string quantity, unit;
+  };
+  NamedQuantity resolve_quantity(const config::Node& q) const;
+  // the participant of that name, or an error at n naming the participants
+  Participant* named_participant(const config::Node& n, const std::string& name) const;
   void check_sweep_values(const std::filesystem::path& case_file, const class Sweep& sweep) const;
   void write_output(int frame, double time);
 
@@ -246,8 +268,14 @@ class CaseRun {
     double created() const { return on_a + on_b; }
   };
   EnergyAudit audit_energy(const EnergyPair& pair) const;
+  double coupling_created() const;  // sum over the pairs of the energy created [J]
   double energy_tolerance_ = 0.5;  // created / passed that stops the run (or warns)
   bool energy_stop_ = true;
+  // the energy balance of the whole system (the case's energy section; null without one), its
+  // terms as (participant, quantity) in its order, DIR/energy.csv
+  std::unique_ptr<EnergyBalance> energy_;
+  std::vector<std::pair<Participant*, std::string>> energy_terms_;
+  CsvSeries energy_csv_;
 };
 
 /// The case file's schema (for validation and `partita docs`).

@@ -5,7 +5,8 @@
 //   sender:   its window value (averaged or last over its substeps: the participant's side,
 //             participant.hpp) arrives in combined(); an implicit scheme may replace it by an
 //             accelerated value — sent();
-//   mapping:  received = M sent (the mapper; identity when none) — transmit();
+//   mapping:  received = M sent (the mapper; identity when none) — transmit(); times a
+//             factor where a test breaks the exchange on purpose (set_scale());
 //   receiver: gets the window's start value d_n and the newest value d_{n+1} on its own mesh
 //             (window_input()) and sees them in time as it subcycles (its side again). Where no
 //             new value came yet (first participant of a serial scheme, parallel explicit
@@ -102,6 +103,11 @@ class Exchange {
 
  public:
 
+  /// FOR TESTING AUDITS ONLY: transmit() multiplies what arrives by `factor` (a deliberately
+  /// broken exchange, the case key `scale`; 1: the plain mapping, the default).
+  void set_scale(double factor) { scale_ = factor; }
+  double scale() const { return scale_; }
+
   /// Wall time spent mapping [s].
   double mapping_seconds() const { return mapping_seconds_; }
 
@@ -122,6 +128,7 @@ class Exchange {
   Eigen::MatrixXd start_, end_;
   bool start_is_end_ = false;  // d_n = d_{n+1}: start_'s own values are stale
   double mapping_seconds_ = 0.0;
+  double scale_ = 1.0;
 };
 
 }  // namespace partita::coupling

@@ -1,0 +1,256 @@
+// The energy balance of a whole coupled system (the case's energy section, DIR/energy.csv) on two
+// test participants with exact books (oscillator_participants.hpp): a damped mass pushed by a
+// constant force and held by a massless spring of another participant. Conservation of energy is
+// the reference: kinetic + elastic + damping work = initial energy + applied work, so the only
+// imbalance is what the coupling creates (an explicit scheme's lag: a fraction of a percent here)
+// or what a broken exchange loses.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "ode_participant.hpp"
+#include "oscillator_participants.hpp"
+#include "partita/coupling/case_run.hpp"
+#include "partita/interface/error.hpp"
+
+using namespace partita;
+using namespace partita::coupling;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path base() {
+  return fs::temp_directory_path() / ("partita_energy_balance_test_" + std::to_string(::getpid()));
+}
+
+fs::path scratch(const std::string& name) {
+  fs::path d = base() / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+struct RemoveScratch {
+  ~RemoveScratch() {
+    std::error_code ec;
+    fs::remove_all(base(), ec);
+  }
+};
+
+Registries registries() {
+  Registries r = test::test_registries();
+  test::add_oscillator_solvers(r);
+  return r;
+}
+
+// m = 1 kg, k = 100 N/m on each side, c = 0.5 N s/m, f = 2 N, v0 = 1 m/s: E0 = 1/2 m v0^2 = 0.5 J.
+std::string oscillator_case(const std::string& force_exchange_extra = "",
+                            const std::string& energy_extra = "", double end = 0.5) {
+  std::ostringstream s;
+  s << "case: oscillators\n"
+       "time: {window: 1.0e-4, end: "
+    << end
+    << "}\n"
+       "participants:\n"
+       "  mass: {solver: test-mass, mass: 1.0, stiffness: 100, damping: 0.5, force: 2.0, v0: 1.0}\n"
+       "  spring: {solver: test-spring, stiffness: 100}\n"
+       "coupling:\n"
+       "  scheme: explicit-serial\n"
+       "  exchanges:\n"
+       "    - {data: displacement, from: mass.point, to: spring.point}\n"
+       "    - {data: force, from: spring.point, to: mass.point"
+    << force_exchange_extra
+    << "}\n"
+       "energy:\n"
+       "  inputs: [mass.applied_work]\n"
+       "  stored: [mass.kinetic_energy, mass.elastic_energy, spring.elastic_energy]\n"
+       "  dissipated: [mass.damping_work]\n"
+    << energy_extra;
+  return s.str();
+}
+
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  std::vector<double> column(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    REQUIRE(it != header.end());
+    std::vector<double> c;
+    for (const auto& r : rows) c.push_back(r[static_cast<std::size_t>(it - header.begin())]);
+    return c;
+  }
+};
+
+Table read_csv(const fs::path& p) {
+  Table t;
+  std::ifstream in(p);
+  std::string line, cell;
+  std::getline(in, line);
+  std::stringstream h(line);
+  while (std::getline(h, cell, ',')) t.header.push_back(cell);
+  while (std::getline(in, line)) {
+    std::stringstream r(line);
+    std::vector<double> row;
+    while (std::getline(r, cell, ',')) row.push_back(std::stod(cell));
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Run a case; its energy.csv.
+Table run_case(const std::string& name, const std::string& text, RunOptions o = {}) {
+  const fs::path dir = scratch(name);
+  const fs::path file = dir / "case.yaml";
+  std::ofstream(file) << text;
+  const fs::path out = !o.resume_dir.empty() ? o.resume_dir : dir / "out";
+  if (o.resume_dir.empty()) o.output_dir = out;
+  const Registries r = registries();
+  CaseRun run(file, r, o);
+  run.run();
+  return read_csv(out / "energy.csv");
+}
+
+double max_abs(const std::vector<double>& v) {
+  double m = 0.0;
+  for (const double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+std::string error_of(const std::string& text) {
+  const fs::path dir = scratch("error");
+  std::ofstream(dir / "case.yaml") << text;
+  RunOptions o;
+  o.output_dir = dir / "out";
+  o.check_only = true;
+  const Registries r = registries();
+  try {
+    CaseRun run(dir / "case.yaml", r, o);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+}  // namespace
+
+TEST_CASE("energy balance: a coupled oscillator closes within 2 %, a scaled exchange does not",
+          "[coupling][case][energy]") {
+  RemoveScratch cleanup;
+  SECTION("the exchange as it is: the balance closes, the coupling's lag is all of the error") {
+    const Table t = run_case("plain", oscillator_case());
+    REQUIRE(t.header.front() == "time [s]");
+    REQUIRE(t.rows.size() == 5001);  // t = 0 and 5000 windows
+    const auto error = t.column("energy balance error [-]");
+    const auto initial = t.column("initial [J]");
+    const auto inputs = t.column("inputs [J]");
+    const auto held = t.column("stored + dissipated [J]");
+    const auto created = t.column("coupling created [J]");
+    CHECK(initial.front() == Approx(0.5).epsilon(1e-12));  // 1/2 m v0^2
+    CHECK(error.front() == 0.0);
+    INFO("largest |error| " << max_abs(error));
+    CHECK(max_abs(error) <= 0.02);
+    CHECK(max_abs(error) > 0.0);  // the explicit scheme's lag creates a little
+    // the participants' books are exact: what is off is what the coupling created
+    double off = 0.0;
+    for (std::size_t i = 0; i < t.rows.size(); ++i)
+      off = std::max(off, std::abs(held[i] - inputs[i] - initial[i] - created[i]));
+    CHECK(off <= 1e-8 * initial.front());  // the CSV's 10 digits
+    // the terms add up to the sums
+    const auto ke = t.column("stored mass.kinetic_energy [J]");
+    const auto damping = t.column("dissipated mass.damping_work [J]");
+    CHECK(damping.back() > 0.0);
+    CHECK(t.column("input mass.applied_work [J]").back() == inputs.back());
+    CHECK(ke.back() + t.column("stored mass.elastic_energy [J]").back() +
+              t.column("stored spring.elastic_energy [J]").back() + damping.back() ==
+          Approx(held.back()).epsilon(1e-9));  // CSV: 10 digits
+  }
+  SECTION("the coupling counted as an input: the participants' own books close to round-off") {
+    const Table t = run_case("counted", oscillator_case("", "  coupling: counted\n"));
+    CHECK(max_abs(t.column("energy balance error [-]")) <= 1e-10);
+    CHECK(std::find(t.header.begin(), t.header.end(), "input coupling created [J]") !=
+          t.header.end());
+  }
+  SECTION("forces scaled by 0.9: the balance fails, and the coupling column holds the loss") {
+    // The mass feels 0.9 of the spring's pull, the spring stores 1/2 k x^2: the system gains
+    // 0.1 * 1/2 k x^2, up to about 0.1 * 1/2 (k / (k + 0.9 k)) * 0.5 J / 0.5 J = 5 % of the scale.
+    const Table t = run_case("scaled", oscillator_case(", scale: 0.9"));
+    const double worst = max_abs(t.column("energy balance error [-]"));
+    INFO("largest |error| " << worst);
+    CHECK(worst > 0.02);
+    CHECK(worst < 0.08);
+    // what the error shows is what the coupling created (reported, not counted)
+    const Table c = run_case("scaled-counted", oscillator_case(", scale: 0.9", "  coupling: counted\n"));
+    CHECK(max_abs(c.column("energy balance error [-]")) <= 1e-10);
+  }
+  SECTION("with a tolerance and on_exceeded: stop the scaled run stops with a diagnosis") {
+    try {
+      run_case("stop", oscillator_case(", scale: 0.9", "  tolerance: 0.02\n  on_exceeded: stop\n"));
+      FAIL("the run did not stop");
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      INFO(what);
+      CHECK(what.find("the energy balance is off by") != std::string::npos);
+      CHECK(what.find("energy.tolerance 0.02") != std::string::npos);
+      CHECK(what.find("the coupling created") != std::string::npos);
+    }
+    // the rows up to the stop are on disk
+    const Table t = read_csv(base() / "stop" / "out" / "energy.csv");
+    CHECK(t.rows.size() > 1);
+    CHECK(std::abs(t.column("energy balance error [-]").back()) > 0.02);
+  }
+}
+
+TEST_CASE("energy balance: a resumed run writes the same energy.csv as a run straight through",
+          "[coupling][case][energy]") {
+  RemoveScratch cleanup;
+  const std::string restart = "output: {restart: {at_end: true}}\n";
+  run_case("straight", oscillator_case("", restart, 0.02));
+  run_case("part", oscillator_case("", restart, 0.01));
+  const fs::path part = base() / "part" / "out";
+  RunOptions o;
+  o.resume_dir = part;
+  run_case("resumed", oscillator_case("", restart, 0.02), o);
+  const std::string straight = read_text(base() / "straight" / "out" / "energy.csv");
+  CHECK(!straight.empty());
+  CHECK(read_text(part / "energy.csv") == straight);
+}
+
+TEST_CASE("energy balance: unknown or unfit terms are clear errors at the key",
+          "[coupling][case][energy]") {
+  RemoveScratch cleanup;
+  std::string c = oscillator_case();
+  c.replace(c.find("mass.kinetic_energy"), 19, "mass.kinetic_enrgy");
+  std::string e = error_of(c);
+  INFO(e);
+  CHECK(e.find("case.yaml:") != std::string::npos);
+  CHECK(e.find("energy.stored") != std::string::npos);
+  CHECK(e.find("reports no quantity 'kinetic_enrgy'") != std::string::npos);
+  CHECK(e.find("did you mean 'kinetic_energy'") != std::string::npos);
+
+  c = oscillator_case();
+  c.replace(c.find("mass.damping_work"), 17, "mass.x");
+  e = error_of(c);
+  CHECK(e.find("'mass.x' is in m") != std::string::npos);
+
+  c = oscillator_case();
+  c.replace(c.find("[mass.applied_work]"), 19, "[mass.applied_work, mass.applied_work]");
+  e = error_of(c);
+  CHECK(e.find("named twice") != std::string::npos);
+
+  c = oscillator_case();
+  c.replace(c.find("spring.elastic_energy"), 21, "sprin.elastic_energy");
+  e = error_of(c);
+  CHECK(e.find("unknown participant 'sprin'") != std::string::npos);
+  CHECK(e.find("did you mean 'spring'") != std::string::npos);
+}
