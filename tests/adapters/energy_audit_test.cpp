@@ -72,7 +72,8 @@ TEST_CASE("energy audit: a wall driven into a sphere does the work of its elasti
   CHECK(ke == Approx(2.0 * m * V * V).epsilon(0.01));
   // the wall did exactly that work (trapezoidal sum over the steps)
   CHECK(s->interface_work("plate").value() == Approx(ke).epsilon(1e-3));
-  CHECK(s->interface_work("plate_centres").value() == s->interface_work("plate").value());
+  // the centres read only "attached", which moves nothing: the work is the vertex mesh's
+  CHECK_FALSE(s->interface_work("plate_centres").has_value());
   // the DEM's own accounting: the mesh's work (contact forces times the wall's velocity at the
   // contact points) against the sphere's energy, and the balance
   CHECK(monitor(*s, "plate.work") == Approx(2.0 * m * V * V).epsilon(0.01));

@@ -684,8 +684,15 @@ std::size_t DemAdapter::find(std::string_view mesh, bool* centres) const {
 void DemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
   bool centres = false;
   CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
+  if (centres && data == "attached") {
+    for (Eigen::Index t = 0; t < values.rows(); ++t)
+      system_.set_triangle_active(cm.id, static_cast<int>(t), values(t, 0) >= 0.5);
+    return;
+  }
   if (centres || data != "displacement")
-    throw Error("dem '" + name_ + "' reads only 'displacement' on mesh '" + cm.name + "'");
+    throw Error("dem '" + name_ + "' reads 'displacement' on mesh '" + cm.name +
+                "' and 'attached' on '" + cm.name + "_centres', not '" + std::string(data) +
+                "' on '" + std::string(mesh) + "'");
   // x = X + d: the vertices follow the other side's displacement (no allocation: same size).
   cm.positions = cm.reference + values;
   system_.set_vertex_positions(cm.id, cm.positions);
@@ -761,7 +768,11 @@ void DemAdapter::advance(double dt) {
 
 std::optional<double> DemAdapter::interface_work(std::string_view mesh) const {
   bool centres = false;
-  return meshes_dem_[find(mesh, &centres)].audit.work;
+  const CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
+  // what M_centres reads ("attached") moves nothing: the motion's work is M's alone (counted
+  // once when a case exchanges on both)
+  if (centres) return std::nullopt;
+  return cm.audit.work;
 }
 
 void DemAdapter::save_checkpoint() {
@@ -884,6 +895,9 @@ void DemAdapter::add_coupling_mesh(const std::string& name, const Mesh& mesh, in
   centres.mesh.set_weights(cm.areas);  // each centre stands for its triangle's area
   centres.writes.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
   centres.writes.push_back(DataSpec{"traction", 3, "Pa", DataKind::intensive});
+  // a triangle whose value is below 1/2 leaves the contacts (its surface has gone: the face of
+  // an eroded FE element, FemAdapter's N_centres)
+  centres.reads.push_back(DataSpec{"attached", 1, "", DataKind::intensive});
   meshes_.push_back(std::move(vertices));
   meshes_.push_back(std::move(centres));
   for (Eigen::Index i = 0; i < cm.reference.rows(); ++i) {

@@ -14,7 +14,10 @@
 //              force / triangle area (the seed's route, Algorithm 1 of seed 000); a triangle's
 //              force is lumped from its vertices' (continuous as contacts cross triangle edges:
 //              see dem::TriangleMesh::triangle_forces)
-// interface_work(M or M_centres): the work the motion of M did on the particles (energy audit).
+//              It reads "attached" [-]: a triangle whose value is below 1/2 leaves the contacts
+//              (an eroded FE element's face: FemAdapter's N_centres writes it).
+// interface_work(M): the work the motion of M did on the particles (energy audit); none on
+// M_centres (what it reads moves nothing).
 // Monitors: kinetic_energy [J], the energy accounting (dem::System::energies(), cumulative
 // since the first step) friction_work, damping_work, breakage_energy, stiffening_work,
 // gravity_work, wall_work (all walls and meshes), M.work and <wall>.work [J], elastic_energy [J]
@@ -22,13 +25,14 @@
 // M.force_x|y|z [N] (force of the particles on mesh M),
 // particle.<id>.x|y|z [m] and .vx|vy|vz [m/s] for the ids in monitor_particles,
 // <wall>.force_x|y|z [N] (a box wall: all its faces), <wall>.<face>.force_x|y|z [N] (each closed
-// face of a box wall, faces xmin..zmax), particles, contacts_per_particle; with `breakage`: breakage.events,
-// .fragments, .fragment_mass [kg], .mass_lost [kg], .mass_restored [kg], .energy_released [J],
-// stable_time_step [s] (it falls as fragments appear; `auto` substeps follow it), and the grading
-// (cumulative mass passing per size) appended to <output>/<participant>_grading.csv at each
-// output time. With output: {particles_file: end | every-output} the particles are written as a
-// LAMMPS data file that particles: {file: ...} reads back bit for bit: <output>/<participant>.data
-// at finalize() (and <output>/particles/<participant>_<frame>.data at each output time).
+// face of a box wall, faces xmin..zmax), particles, contacts_per_particle; with `breakage`:
+// breakage.events, .fragments, .fragment_mass [kg], .mass_lost [kg], .mass_restored [kg],
+// .energy_released [J], stable_time_step [s] (it falls as fragments appear; `auto` substeps follow
+// it), and the grading (cumulative mass passing per size) appended to
+// <output>/<participant>_grading.csv at each output time. With output: {particles_file: end |
+// every-output} the particles are written as a LAMMPS data file that particles: {file: ...} reads
+// back bit for bit: <output>/<participant>.data at finalize() (and
+// <output>/particles/<participant>_<frame>.data at each output time).
 
 #include <array>
 #include <cstdint>

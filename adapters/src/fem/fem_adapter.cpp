@@ -181,7 +181,7 @@ std::shared_ptr<Spec> make_spec() {
       .required();
 
   auto interface = std::make_shared<Spec>("interface", "a coupling interface on a face");
-  interface->string("name", "interface name: meshes <name> (nodes) and <name>_quadrature (quadrature points)")
+  interface->string("name", "interface name: meshes <name> (nodes), <name>_quadrature (quadrature points) and <name>_centres (writes 'attached' per triangle of <name>: 0 once its element is eroded)")
       .required();
   interface->string("face", "the face it lies on").required();
 
@@ -651,6 +651,18 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         qx.row(static_cast<Eigen::Index>(q)) = qps[q].position.transpose();
         itf.qp_weights.push_back(qps[q].weight);
       }
+      // the triangles' centroids and the element under each (for "attached")
+      Mesh::Points centroids(static_cast<Eigen::Index>(fm.triangles.size()), 3);
+      for (std::size_t t = 0; t < fm.triangles.size(); ++t) {
+        centroids.row(static_cast<Eigen::Index>(t)).setZero();
+        for (int v : fm.triangles[t])
+          centroids.row(static_cast<Eigen::Index>(t)) += fm.positions.row(v) / 3.0;
+        itf.triangle_elements.push_back(
+            fm.cell_elements[static_cast<std::size_t>(fm.triangle_cells[t])]);
+      }
+      InterfaceMesh centres;
+      centres.mesh = Mesh(itf.name + "_centres", centroids);
+      centres.writes.push_back(DataSpec{"attached", 1, "", DataKind::intensive});
       InterfaceMesh quad;
       quad.mesh = Mesh(itf.name + "_quadrature", qx);
       quad.mesh.set_weights(Eigen::Map<const Eigen::VectorXd>(
@@ -660,6 +672,7 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       itf.tractions = Eigen::MatrixX3d::Zero(qx.rows(), 3);
       meshes_.push_back(std::move(nodes));
       meshes_.push_back(std::move(quad));
+      meshes_.push_back(std::move(centres));
       interfaces_.push_back(std::move(itf));
     }
     for (const Node& p : c["probes"].items()) {
@@ -733,11 +746,13 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
              transient_ ? "transient" : "static");
 }
 
-std::size_t FemAdapter::find_interface(std::string_view mesh, bool* quadrature) const {
+std::size_t FemAdapter::find_interface(std::string_view mesh, Part* part) const {
   for (std::size_t k = 0; k < interfaces_.size(); ++k) {
     const auto& i = interfaces_[k];
-    if (mesh == i.name || mesh == i.name + "_quadrature") {
-      *quadrature = mesh != i.name;
+    if (mesh == i.name || mesh == i.name + "_quadrature" || mesh == i.name + "_centres") {
+      *part = mesh == i.name                ? Part::nodes
+              : mesh == i.name + "_centres" ? Part::centres
+                                            : Part::quadrature;
       return k;
     }
   }
@@ -761,13 +776,13 @@ void FemAdapter::apply_nodal_forces() {
 }
 
 void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
-  bool quadrature = false;
-  Interface& i = interfaces_[find_interface(mesh, &quadrature)];
-  if (quadrature && data == "traction") {
+  Part part = Part::nodes;
+  Interface& i = interfaces_[find_interface(mesh, &part)];
+  if (part == Part::quadrature && data == "traction") {
     i.tractions = values;
     i.has_tractions = true;
     solver_->set_face_tractions_at_quadrature_points(i.face, i.tractions);
-  } else if (!quadrature && data == "force") {
+  } else if (part == Part::nodes && data == "force") {
     i.nodal_forces = values;
     i.has_forces = true;
     apply_nodal_forces();
@@ -789,10 +804,20 @@ void FemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
         values = ind.contact->indenter().displacement().transpose().replicate(m.mesh.size(), 1);
     return;
   }
-  bool quadrature = false;
-  const Interface& i = interfaces_[find_interface(mesh, &quadrature)];
-  if (quadrature || data != "displacement")
-    throw Error("fem '" + name_ + "' writes only 'displacement' on mesh '" + i.name + "'");
+  Part part = Part::nodes;
+  const Interface& i = interfaces_[find_interface(mesh, &part)];
+  if (part == Part::centres && data == "attached") {
+    // 1 while the element under the triangle is in the structure, 0 once eroded
+    values.resize(static_cast<Eigen::Index>(i.triangle_elements.size()), 1);
+    for (std::size_t t = 0; t < i.triangle_elements.size(); ++t)
+      values(static_cast<Eigen::Index>(t), 0) =
+          solver_->element_eroded(i.triangle_elements[t]) ? 0.0 : 1.0;
+    return;
+  }
+  if (part != Part::nodes || data != "displacement")
+    throw Error("fem '" + name_ + "' writes 'displacement' on mesh '" + i.name +
+                "' and 'attached' on '" + i.name + "_centres', not '" + std::string(data) +
+                "' on '" + std::string(mesh) + "'");
   values = solver_->displacements(i.nodes);
 }
 
@@ -834,8 +859,8 @@ void FemAdapter::advance(double dt) {
 }
 
 std::optional<double> FemAdapter::interface_work(std::string_view mesh) const {
-  bool quadrature = false;
-  return interfaces_[find_interface(mesh, &quadrature)].audit.work;
+  Part part = Part::nodes;
+  return interfaces_[find_interface(mesh, &part)].audit.work;
 }
 
 double FemAdapter::stable_time_step() const {

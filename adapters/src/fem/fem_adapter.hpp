@@ -10,6 +10,10 @@
 //                 reads "force" [N] (nodal forces: the conservative coupling input)
 //   N_quadrature  the face's surface quadrature points: reads "traction" [Pa] (the seed's
 //                 route: tractions at the quadrature points, integrated with the face rule)
+//   N_centres     the centroids of the triangles of N, in their order: writes "attached" [-],
+//                 1 while the element under the triangle is in the structure, 0 once it is
+//                 eroded (a DEM that took N as a wall reads it on its N_centres and drops the
+//                 triangle from its contacts: granules pass where the hull has ruptured)
 // Monitors: N.force_x|y|z (total interface force received [N]), static_reaction_z (the force the
 // interfaces must carry for static equilibrium: minus the sum of the applied loads, gravity
 // included [N]), max_displacement [m], kinetic_energy, strain_energy, plastic_work,
@@ -62,6 +66,7 @@ class FemAdapter : public Solver {
     std::string face;
     std::vector<std::size_t> nodes;  // global node ids of the face mesh
     std::vector<double> qp_weights;  // area of each quadrature point [m^2]
+    std::vector<std::size_t> triangle_elements;  // the volume element under each triangle
     Eigen::MatrixX3d nodal_forces;   // last "force" read
     Eigen::MatrixX3d tractions;      // last "traction" read
     bool has_forces = false;
@@ -75,8 +80,10 @@ class FemAdapter : public Solver {
       Eigen::MatrixX3d tractions;  // tractions of the last step (empty: none)
     } audit, audit_checkpoint;
   };
-  /// Index into interfaces_ of the coupling mesh `mesh` (nodes or quadrature); throws if unknown.
-  std::size_t find_interface(std::string_view mesh, bool* quadrature) const;
+  enum class Part { nodes, quadrature, centres };  // the meshes N, N_quadrature, N_centres
+  /// Index into interfaces_ of the coupling mesh `mesh` (and which of its meshes); throws if
+  /// unknown.
+  std::size_t find_interface(std::string_view mesh, Part* part) const;
   void apply_nodal_forces();
 
   std::string name_;

@@ -56,6 +56,7 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
   for (int k = nl.mesh_offsets_[i]; k < nl.mesh_offsets_[i + 1]; ++k) {
     const MeshCandidate mc = nl.mesh_candidates_[k];
     const TriangleMesh& m = meshes[mc.mesh];
+    if (!m.triangle_active(mc.triangle)) continue;  // its surface has gone
     Candidate& c = cand[nc];  // cand[max_candidates] is scratch once the array is full
     c.cp = m.closest_point(mc.triangle, x);
     c.dist2 = (x - c.cp.point).squaredNorm();

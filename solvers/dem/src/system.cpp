@@ -282,6 +282,11 @@ void System::set_vertex_positions(int mesh, const Eigen::Ref<const Eigen::Matrix
   set_vertex_velocities(mesh, v);
 }
 
+void System::set_triangle_active(int mesh, int triangle, bool active) {
+  check_mesh(mesh, "set_triangle_active");
+  meshes_[mesh].set_triangle_active(triangle, active);
+}
+
 void System::set_vertex_velocities(int mesh, const Eigen::Ref<const Eigen::MatrixX3d>& v) {
   check_mesh(mesh, "set_vertex_velocities");
   TriangleMesh& m = meshes_[mesh];

@@ -83,16 +83,36 @@ TriangleMesh::TriangleMesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
   for (int e = 0; e < ne; ++e) edge_opposite_offset_[e + 1] += edge_opposite_offset_[e];
   for (int v = 0; v < nv; ++v) vertex_neighbor_offset_[v + 1] += vertex_neighbor_offset_[v];
   edge_opposite_.resize(edge_opposite_offset_[ne]);
+  edge_opposite_triangle_.resize(edge_opposite_.size());
   vertex_neighbor_.resize(vertex_neighbor_offset_[nv]);
+  vertex_neighbor_edge_.resize(vertex_neighbor_.size());
   std::vector<int> fill(edge_opposite_offset_.begin(), edge_opposite_offset_.end() - 1);
   for (std::size_t t = 0; t < triangles_.size(); ++t)
-    for (int k = 0; k < 3; ++k)
-      edge_opposite_[fill[triangle_edges_[t][k]]++] = triangles_[t][(k + 2) % 3];
+    for (int k = 0; k < 3; ++k) {
+      const int at = fill[triangle_edges_[t][k]]++;
+      edge_opposite_[at] = triangles_[t][(k + 2) % 3];
+      edge_opposite_triangle_[at] = static_cast<int>(t);
+    }
   fill.assign(vertex_neighbor_offset_.begin(), vertex_neighbor_offset_.end() - 1);
-  for (const auto& e : edges_) {
-    vertex_neighbor_[fill[e[0]]++] = e[1];
-    vertex_neighbor_[fill[e[1]]++] = e[0];
+  for (int e = 0; e < ne; ++e) {
+    vertex_neighbor_edge_[fill[edges_[e][0]]] = e;
+    vertex_neighbor_[fill[edges_[e][0]]++] = edges_[e][1];
+    vertex_neighbor_edge_[fill[edges_[e][1]]] = e;
+    vertex_neighbor_[fill[edges_[e][1]]++] = edges_[e][0];
   }
+  active_.assign(triangles_.size(), 1);
+}
+
+void TriangleMesh::set_triangle_active(int t, bool active) {
+  if (t < 0 || t >= triangle_count()) {
+    std::ostringstream msg;
+    msg << "set_triangle_active: triangle " << t << " of a mesh of " << triangle_count()
+        << " triangles";
+    throw Error(msg.str());
+  }
+  if ((active_[t] != 0) == active) return;
+  active_[t] = active ? 1 : 0;
+  inactive_ += active ? -1 : 1;
 }
 
 bool TriangleMesh::feature_is_local_closest(int t, const TriangleClosestPoint& cp,
@@ -110,6 +130,7 @@ bool TriangleMesh::feature_is_local_closest(int t, const TriangleClosestPoint& c
     const int e = triangle_edges_[t][cp.local_index];
     const Eigen::Vector3d& a = position_[edges_[e][0]];
     for (int k = edge_opposite_offset_[e]; k < edge_opposite_offset_[e + 1]; ++k) {
+      if (!triangle_active(edge_opposite_triangle_[k])) continue;
       const Eigen::Vector3d w = position_[edge_opposite_[k]] - a;
       if (d.dot(w) > tol * dn * w.norm()) return false;
     }
@@ -117,7 +138,15 @@ bool TriangleMesh::feature_is_local_closest(int t, const TriangleClosestPoint& c
   }
   const int v = triangles_[t][cp.local_index];
   const Eigen::Vector3d& a = position_[v];
+  // (an edge only of inactive triangles is no part of the surface)
+  const auto edge_active = [&](int e) {
+    if (inactive_ == 0) return true;
+    for (int k = edge_opposite_offset_[e]; k < edge_opposite_offset_[e + 1]; ++k)
+      if (active_[edge_opposite_triangle_[k]] != 0) return true;
+    return false;
+  };
   for (int k = vertex_neighbor_offset_[v]; k < vertex_neighbor_offset_[v + 1]; ++k) {
+    if (!edge_active(vertex_neighbor_edge_[k])) continue;
     const Eigen::Vector3d w = position_[vertex_neighbor_[k]] - a;
     if (d.dot(w) > tol * dn * w.norm()) return false;
   }

@@ -45,28 +45,16 @@ IndenterContact::IndenterContact(std::string name, const Model& model, const std
     throw Error("contact '" + name_ + "': the tangential penalty factor must be > 0");
   const auto& elements = mesh_.face(face);  // throws, listing the faces, if unknown
   nodes_ = mesh_.face_nodes(face);
-  // node -> elements, to find the volume element each face element bounds
-  std::vector<std::vector<std::size_t>> node_elements(mesh_.num_nodes());
-  for (std::size_t e = 0; e < mesh_.num_elements(); ++e)
-    for (auto n : mesh_.element(e).node_span()) node_elements[n].push_back(e);
+  std::vector<std::size_t> owners;  // the volume element each face element bounds
+  try {
+    owners = mesh_.face_owners(face);
+  } catch (const Error& e) {
+    throw Error("contact '" + name_ + "': " + e.what());
+  }
   std::vector<double> k(mesh_.num_nodes(), 0.0);
-  for (const auto& s : elements) {
-    const int corners = corner_count(s.type);
-    std::size_t owner = mesh_.num_elements();
-    for (auto e : node_elements[s.nodes[0]]) {
-      const auto en = mesh_.element(e).node_span();
-      bool all = true;
-      for (int c = 1; c < corners && all; ++c)
-        all = std::find(en.begin(), en.end(), s.nodes[static_cast<std::size_t>(c)]) != en.end();
-      if (all) {
-        owner = e;
-        break;
-      }
-    }
-    if (owner == mesh_.num_elements())
-      throw Error("contact '" + name_ + "': a face element of '" + face +
-                  "' bounds no volume element (a face read from a file that is not the mesh's?)");
-    const Element& el = mesh_.element(owner);
+  for (std::size_t f = 0; f < elements.size(); ++f) {
+    const auto& s = elements[f];
+    const Element& el = mesh_.element(owners[f]);
     const double area = corner_area(mesh_, s);
     const double h = element_volume(mesh_, el) / area;
     // k_n += factor E (A_f / n_f) / h_f

@@ -270,4 +270,33 @@ std::vector<std::size_t> Mesh::face_nodes(const std::string& name) const {
   return ids;
 }
 
+std::vector<std::size_t> Mesh::face_owners(const std::string& name) const {
+  const auto& faces = face(name);  // throws, listing the faces, if unknown
+  // node -> elements, to find the volume element each face element bounds
+  std::vector<std::vector<std::size_t>> node_elements(nodes_.size());
+  for (std::size_t e = 0; e < elements_.size(); ++e)
+    for (auto n : elements_[e].node_span()) node_elements[n].push_back(e);
+  std::vector<std::size_t> owners;
+  owners.reserve(faces.size());
+  for (const auto& s : faces) {
+    const int corners = corner_count(s.type);
+    std::size_t owner = elements_.size();
+    for (auto e : node_elements[s.nodes[0]]) {
+      const auto en = elements_[e].node_span();
+      bool all = true;
+      for (int c = 1; c < corners && all; ++c)
+        all = std::find(en.begin(), en.end(), s.nodes[static_cast<std::size_t>(c)]) != en.end();
+      if (all) {
+        owner = e;
+        break;
+      }
+    }
+    if (owner == elements_.size())
+      throw Error("a face element of '" + name +
+                  "' bounds no volume element (a face read from a file that is not the mesh's?)");
+    owners.push_back(owner);
+  }
+  return owners;
+}
+
 }  // namespace partita::fem

@@ -358,7 +358,9 @@ FaceMesh StructuralSolver::face_mesh(const std::string& face) const {
         fm.triangles.push_back({v[4], v[6], v[7]});
         break;
     }
+    fm.triangle_cells.resize(fm.triangles.size(), static_cast<int>(fm.cells.size()) - 1);
   }
+  fm.cell_elements = mesh().face_owners(face);
   return fm;
 }
 

@@ -328,3 +328,75 @@ TEST_CASE("dem: mesh contact rows exist only for particles near a mesh and follo
   for (std::size_t i = 0; i < sys.particle_count(); ++i)  // the first layer is now at the end
     CHECK((sys.particles().position[i].z() < 2 * R) == (i >= 25));
 }
+
+TEST_CASE("dem: a particle falls through where mesh triangles are taken out, beside one held",
+          "[dem][mesh]") {
+  // The square [-4R, 4R]^2 in 2 x 2 cells of 4R; particle A rests over the middle of cell
+  // (0, 0), particle B over cell (1, 1), under gravity. With cell (0, 0)'s two triangles taken
+  // out, A falls freely (z = R - g t^2 / 2) and B stays held (overlap << R).
+  System sys = test::single_material(E, NU, RHO, 0.5, 0.4);
+  const double g = 9.81;
+  sys.set_gravity({0, 0, -g});
+  sys.add_particle({-2 * R, -2 * R, R}, R, 0, {0, 0, 0});
+  sys.add_particle({2 * R, 2 * R, R}, R, 0, {0, 0, 0});
+  Eigen::MatrixX3d v;
+  TriangleMesh::Triangles t;
+  triangulated_plane(4.0 * R, 2, v, t);
+  const int mesh = sys.add_mesh(v, t, 0);
+  CHECK(sys.mesh(mesh).inactive_triangle_count() == 0);
+  sys.set_triangle_active(mesh, 0, false);  // cell (0, 0): triangles 0 and 1
+  sys.set_triangle_active(mesh, 1, false);
+  sys.set_triangle_active(mesh, 1, false);  // twice: counted once
+  CHECK(sys.mesh(mesh).inactive_triangle_count() == 2);
+  CHECK_FALSE(sys.mesh(mesh).triangle_active(0));
+  CHECK(sys.mesh(mesh).triangle_active(2));
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  const int steps = static_cast<int>(0.03 / dt);
+  for (int s = 0; s < steps; ++s) sys.step(dt);
+  const double time = steps * dt;
+  const auto& p = sys.particles();
+  const int a = p.position[0].x() < 0.0 ? 0 : 1;  // A: over cell (0, 0)
+  CHECK(p.position[a].z() == Approx(R - 0.5 * g * time * time).epsilon(1e-6));
+  CHECK(p.position[1 - a].z() == Approx(R).epsilon(1e-3));
+  CHECK(sys.mesh_force(mesh).z() == Approx(-test::sphere_mass(R, RHO) * g).epsilon(1e-2));
+  CHECK_THROWS_AS(sys.set_triangle_active(mesh, 8, false), Error);
+}
+
+TEST_CASE("dem: the rim of a hole in a mesh acts by its edge", "[dem][mesh]") {
+  // Over cell (0, 0) of the 2 x 2 square, 0.5 R from its edge x = 0 with cell (1, 0): the face
+  // below is the mesh's nearest feature; once cell (0, 0) is taken out, the edge x = 0 of cell
+  // (1, 0) is (the rim of the hole), and no feature of the removed triangles is.
+  Eigen::MatrixX3d v;
+  TriangleMesh::Triangles t;
+  triangulated_plane(4.0 * R, 2, v, t);
+  TriangleMesh m(v, t, 0);
+  const Eigen::Vector3d p(-0.5 * R, -2.0 * R, 0.5 * R);
+  // the features that are local closest points within reach 2 R of p: (triangle, feature)
+  const auto features = [&] {
+    std::vector<std::pair<int, int>> out;
+    for (int k = 0; k < m.triangle_count(); ++k) {
+      if (!m.triangle_active(k)) continue;
+      const auto cp = m.closest_point(k, p);
+      if ((cp.point - p).norm() < 2 * R && m.feature_is_local_closest(k, cp, p))
+        out.emplace_back(k, static_cast<int>(cp.feature));
+    }
+    return out;
+  };
+  const auto before = features();
+  REQUIRE(before.size() == 1);
+  CHECK(before[0].second == TriangleClosestPoint::face);
+  CHECK(before[0].first < 2);  // a triangle of cell (0, 0)
+  m.set_triangle_active(0, false);
+  m.set_triangle_active(1, false);
+  const auto after = features();
+  REQUIRE(after.size() >= 1);
+  for (const auto& [k, feature] : after) {
+    CHECK(k >= 2);
+    CHECK(feature == TriangleClosestPoint::edge);
+    const auto cp = m.closest_point(k, p);
+    CHECK(cp.point.x() == Approx(0.0).margin(1e-15));
+  }
+  m.set_triangle_active(0, true);
+  m.set_triangle_active(1, true);
+  CHECK(features() == before);
+}

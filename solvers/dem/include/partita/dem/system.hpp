@@ -179,6 +179,8 @@ class System {
   void set_vertex_positions(int mesh, const Eigen::Ref<const Eigen::MatrixX3d>& positions,
                             const Eigen::Ref<const Eigen::MatrixX3d>& velocities);
   void set_vertex_velocities(int mesh, const Eigen::Ref<const Eigen::MatrixX3d>& velocities);
+  /// Takes a triangle out of (or back into) the contacts: TriangleMesh::triangle_active().
+  void set_triangle_active(int mesh, int triangle, bool active);
   int mesh_count() const { return static_cast<int>(meshes_.size()); }
   const TriangleMesh& mesh(int mesh) const;
 

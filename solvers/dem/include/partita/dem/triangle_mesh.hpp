@@ -43,6 +43,14 @@ class TriangleMesh {
   const std::array<int, 3>& triangle_edges(int t) const { return triangle_edges_[t]; }
   const std::array<int, 2>& edge(int e) const { return edges_[e]; }
 
+  /// Whether triangle t takes part in contacts (all do at first). A caller takes out a triangle
+  /// whose surface is gone (the face of an eroded FE element): no contact detects it, its edges
+  /// and vertices act only through the active triangles that share them (the rim of a hole),
+  /// and a particle passes where it was.
+  bool triangle_active(int t) const { return inactive_ == 0 || active_[t] != 0; }
+  void set_triangle_active(int t, bool active);
+  int inactive_triangle_count() const { return inactive_; }
+
   /// Closest point of triangle t to p (Ericson, Real-Time Collision Detection, 5.1.5).
   TriangleClosestPoint closest_point(int t, const Eigen::Vector3d& p) const;
 
@@ -50,7 +58,8 @@ class TriangleMesh {
   /// closest point of every other triangle sharing that edge or vertex, i.e. whether p lies in
   /// the region of the mesh surface that the feature is nearest to. A point over the middle of
   /// a flat mesh is nearest to one face only; the edges and vertices of the other triangles
-  /// within reach are not contacts. Faces are always local closest points.
+  /// within reach are not contacts. Faces are always local closest points. Inactive triangles
+  /// are no part of the surface here.
   bool feature_is_local_closest(int t, const TriangleClosestPoint& cp,
                                 const Eigen::Vector3d& p) const;
 
@@ -88,6 +97,10 @@ class TriangleMesh {
   // [e] .. edge_opposite_offset_[e + 1]); the vertices joined to vertex v by an edge, likewise.
   std::vector<int> edge_opposite_offset_, edge_opposite_;
   std::vector<int> vertex_neighbor_offset_, vertex_neighbor_;
+  // the triangle of each edge_opposite_ entry, the edge of each vertex_neighbor_ entry
+  std::vector<int> edge_opposite_triangle_, vertex_neighbor_edge_;
+  std::vector<char> active_;          // per triangle (see triangle_active())
+  int inactive_ = 0;                  // triangles not active
   std::vector<double> vertex_share_;  // 1 / the number of triangles that have the vertex
   Eigen::MatrixX3d triangle_force_;
   Eigen::MatrixX3d vertex_force_;

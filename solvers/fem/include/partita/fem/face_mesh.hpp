@@ -20,6 +20,8 @@ struct FaceMesh {
   // Linear triangles over all face nodes (Quad4 -> 2, Quad8 -> 6, Tri3 -> 1, Tri6 -> 4),
   // outward, as indices into nodes.
   std::vector<std::array<int, 3>> triangles;
+  std::vector<int> triangle_cells;         // the cell each triangle lies on
+  std::vector<std::size_t> cell_elements;  // the volume element each cell bounds (global id)
 };
 
 }  // namespace partita::fem

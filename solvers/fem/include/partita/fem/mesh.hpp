@@ -63,6 +63,9 @@ class Mesh {
   std::vector<std::string> face_names() const;
   // Sorted unique nodes of a face.
   std::vector<std::size_t> face_nodes(const std::string& name) const;
+  // The volume element each surface element of a face bounds (the first element that has its
+  // corners), in the face's order. Throws Error for a surface element that bounds none.
+  std::vector<std::size_t> face_owners(const std::string& name) const;
 
  private:
   std::vector<Vec3> nodes_;
