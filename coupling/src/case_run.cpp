@@ -19,14 +19,6 @@
 
 namespace partita::coupling {
 
-// The energy audit acts when the coupling has created more than the tolerated share of the work
-// that passed for this many windows in a row: the lag of the explicit schemes makes single
-// windows exceed it when a contact starts (the granules landing on an FE floor, a plate reaching
-// the granules: 1-2 windows at up to 100 %, of 1e-14..1e-8 J), while an unstable coupling keeps
-// creating energy (the undamped rubber plate: 0.66 at window 300, 0.92-0.97 from 500 on). The
-// stable seed-000 cases stay below 0.2 (0.08-0.2 over the first 10 windows, < 0.02 after 100).
-constexpr int kEnergyAuditWindows = 20;
-
 namespace fs = std::filesystem;
 
 PvdSeries& CaseRun::pvd(const std::string& series) {
@@ -69,6 +61,37 @@ void CaseRun::write_output(int frame, double time) {
   summary_.output_seconds += clock.seconds();
 }
 
+void CaseRun::open_csv_files() {
+  std::vector<std::pair<std::string, std::string>> columns = {{"time", "s"}, {"iterations", ""}};
+  for (const auto& c : scheme_->residual_columns()) columns.push_back(c);
+  for (const Exchange* e : audited_) columns.emplace_back("imbalance " + e->label(), "");
+  for (const auto& p : energy_pairs_) {
+    columns.emplace_back("work on " + p.a->name() + " by " + p.b->name(), "J");
+    columns.emplace_back("work on " + p.b->name() + " by " + p.a->name(), "J");
+    columns.emplace_back("energy created " + p.label, "J");
+  }
+  coupling_csv_ = CsvSeries(output_dir_ / "coupling.csv", "window", "", columns);
+  for (auto& m : monitors_) {
+    std::vector<std::pair<std::string, std::string>> mc;
+    for (const auto& [p, q] : m.quantities) {
+      std::string unit;  // only that quantity: monitors() would compute every one (energies)
+      for (const auto& v : p->monitor_values({q}))
+        if (v.name == q) unit = v.unit;
+      mc.emplace_back(p->name() + "." + q, unit);
+    }
+    m.csv = CsvSeries(output_dir_ / (m.name + ".csv"), "time", "s", mc);
+  }
+  if (energy_) energy_csv_ = CsvSeries(output_dir_ / "energy.csv", "time", "s", energy_->columns());
+}
+
+void CaseRun::flush_csv_files() {
+  Stopwatch clock;
+  coupling_csv_.flush();
+  for (auto& m : monitors_) m.csv.flush();
+  if (energy_) energy_csv_.flush();
+  summary_.output_seconds += clock.seconds();
+}
+
 void CaseRun::run() {
   if (options_.check_only) return;
   auto logger = log::get("coupling");
@@ -101,126 +124,15 @@ void CaseRun::run() {
     summary_.output_seconds += clock.seconds();
   }
 
-  std::vector<std::pair<std::string, std::string>> columns = {{"time", "s"}, {"iterations", ""}};
-  for (const auto& c : scheme_->residual_columns()) columns.push_back(c);
-  for (const Exchange* e : audited_) columns.emplace_back("imbalance " + e->label(), "");
-  for (const auto& p : energy_pairs_) {
-    columns.emplace_back("work on " + p.a->name() + " by " + p.b->name(), "J");
-    columns.emplace_back("work on " + p.b->name() + " by " + p.a->name(), "J");
-    columns.emplace_back("energy created " + p.label, "J");
-  }
-  coupling_csv_ = CsvSeries(output_dir_ / "coupling.csv", "window", "", columns);
-  for (auto& m : monitors_) {
-    std::vector<std::pair<std::string, std::string>> mc;
-    for (const auto& [p, q] : m.quantities) {
-      std::string unit;  // only that quantity: monitors() would compute every one (energies)
-      for (const auto& v : p->monitor_values({q}))
-        if (v.name == q) unit = v.unit;
-      mc.emplace_back(p->name() + "." + q, unit);
-    }
-    m.csv = CsvSeries(output_dir_ / (m.name + ".csv"), "time", "s", mc);
-  }
-  if (energy_) energy_csv_ = CsvSeries(output_dir_ / "energy.csv", "time", "s", energy_->columns());
-  // The quantities each participant must report, asked for once per window, and where each
-  // monitor column finds its value: (participant slot, position in what the solver returned),
-  // the position remembered from the last window and checked by name (no search per window
-  // unless a solver changes the order of its answer).
-  struct Asked {
-    Participant* p;
-    std::vector<std::string> names;
-    std::vector<MonitorValue> values;
-  };
-  std::vector<Asked> wanted;
-  struct Column {
-    std::size_t asked;
-    const std::string* name;
-    std::size_t at = 0;
-  };
-  // the monitors' columns, then the energy balance's terms (asked with the same request)
-  std::vector<std::vector<Column>> columns_of(monitors_.size() + (energy_ ? 1 : 0));
-  auto ask = [&](std::size_t list, const std::pair<Participant*, std::string>& pq) {
-    const auto& p = pq.first;  // not a structured binding: clang 14 cannot capture those
-    const auto& q = pq.second;
-    auto it = std::find_if(wanted.begin(), wanted.end(), [&](const Asked& a) { return a.p == p; });
-    if (it == wanted.end()) it = wanted.insert(wanted.end(), Asked{p, {}, {}});
-    it->names.push_back(q);
-    columns_of[list].push_back({static_cast<std::size_t>(it - wanted.begin()), &q});
-  };
-  for (std::size_t mi = 0; mi < monitors_.size(); ++mi)
-    for (const auto& pq : monitors_[mi].quantities) ask(mi, pq);
-  if (energy_)
-    for (const auto& pq : energy_terms_) ask(monitors_.size(), pq);
-  std::vector<double> monitor_row, energy_row;
-  auto values_of = [&](std::vector<Column>& cols, std::vector<double>& out) {
-    out.clear();
-    for (Column& c : cols) {
-      const std::vector<MonitorValue>& got = wanted[c.asked].values;
-      if (c.at >= got.size() || got[c.at].name != *c.name) {
-        // the last value of that name, as the search before (NaN where the solver gave none)
-        c.at = got.size();
-        for (std::size_t k = 0; k < got.size(); ++k)
-          if (got[k].name == *c.name) c.at = k;
-      }
-      out.push_back(c.at < got.size() ? got[c.at].value : std::nan(""));
-    }
-  };
-  // coupling_created: the interfaces' net created energy [J] (the energy audit's pairs)
-  auto record_monitors = [&](double t, std::int64_t window, double coupling_created) {
-    for (Asked& a : wanted) {
-      Stopwatch clock;  // the solver computes its quantities: its time, not the core's
-      a.values = a.p->monitor_values(a.names);
-      a.p->add_seconds(clock.seconds());
-      for (const auto& mv : a.values)
-        if (!std::isfinite(mv.value))
-          throw Error(fmt::format(
-              "window {} (t = {:.6g} s): participant '{}' reports {} = {} {}: the run is "
-              "diverging; reduce time.window or the substep size, add damping, or check the "
-              "materials and loads",
-              window, t, a.p->name(), mv.name, mv.value, mv.unit));
-    }
-    for (std::size_t mi = 0; mi < monitors_.size(); ++mi) {
-      values_of(columns_of[mi], monitor_row);
-      Stopwatch csv_clock;  // formatting the row: output time, not the core's
-      monitors_[mi].csv.record(t, monitor_row);
-      summary_.output_seconds += csv_clock.seconds();
-    }
-    if (!energy_) return;
-    values_of(columns_of.back(), monitor_row);
-    const EnergyBalance::Row b = energy_->evaluate(monitor_row, coupling_created, energy_row);
-    Stopwatch csv_clock;
-    energy_csv_.record(t, energy_row);
-    summary_.output_seconds += csv_clock.seconds();
-    summary_.max_energy_balance_error =
-        std::max(summary_.max_energy_balance_error, std::abs(b.error));
-    if (!energy_->exceeded(b)) return;
-    const std::string what = fmt::format(
-        "window {} (t = {:.6g} s): the energy balance is off by {:.3g} (energy.tolerance {:.3g}): "
-        "{}{}; check that the energy section names every input, store and loss of the system, "
-        "and the exchanges (the balance audit in coupling.csv)",
-        window, t, b.error, energy_->settings().tolerance, energy_->describe(b),
-        energy_->settings().coupling_column && !energy_->settings().count_coupling
-            ? fmt::format("; the coupling created {:.4g} J of it", coupling_created)
-            : std::string());
-    if (energy_->settings().stop) throw Error(what);
-    if (summary_.energy_balance_warnings++ == 0)
-      logger->warn("{}; further windows are counted in the summary", what);
-  };
-  auto flush_all = [&] {
-    Stopwatch clock;
-    coupling_csv_.flush();
-    for (auto& m : monitors_) m.csv.flush();
-    if (energy_) energy_csv_.flush();
-    summary_.output_seconds += clock.seconds();
-  };
-
-  Progress progress;
-  progress.next_output = output_every_;
+  open_csv_files();
+  progress_ = Progress{};
+  progress_.next_output = output_every_;
   if (!resume) {
-    flush_all();  // the headers
+    flush_csv_files();  // the headers
   } else {
-    read_restart_file(resume_file, progress);
+    read_restart_file(resume_file, progress_);
     fs::create_directories(output_dir_ / "vtk");
-    summary_.resumed_from = progress.windows_done;
+    summary_.resumed_from = progress_.windows_done;
   }
 
   logger->info(
@@ -234,126 +146,43 @@ void CaseRun::run() {
         return join_names(n);
       }(),
       output_dir_.string(),
-      resume ? fmt::format("; resumed after window {} from {}", progress.windows_done,
+      resume ? fmt::format("; resumed after window {} from {}", progress_.windows_done,
                            resume_file.filename().string())
              : std::string());
 
-  const std::string blocker = restart_blocker();
+  // The run advances window by window; all else it does after a window is an observer's
+  // (window_observer.hpp, case_run_observers.cpp), also for the initial state (window 0).
+  const std::vector<std::unique_ptr<WindowObserver>> observers = window_observers();
+  auto notify = [&](FinishedWindow& w) {
+    for (const auto& o : observers) o->observe(w);
+  };
   ProgressLine progress_line(window_count_);
-  Stopwatch since_flush, since_restart;
-  double flush_interval = 2.0;  // [s]
-  bool warned_imbalance = false;
   try {
     if (!resume) {
       scheme_->initialize();
-      check_window(0, 0.0);
-      record_monitors(0.0, 0, energy_ ? coupling_created() : 0.0);
-      write_output(progress.frame++, 0.0);
+      FinishedWindow initial;
+      notify(initial);
     }
-    TimeWindow window(window_size_, 0, 1);
-    std::vector<double> row;  // coupling.csv's row of the window
-    std::vector<EnergyAudit> audits;  // of the energy audit's pairs, this window
-    for (std::int64_t n = progress.windows_done; n < window_count_; ++n) {
-      window = TimeWindow(window_size_, n, 1);
+    for (std::int64_t n = progress_.windows_done; n < window_count_; ++n) {
+      const TimeWindow window(window_size_, n, 1);
       const WindowReport r = scheme_->advance(window);
-      const double t = window.end();
-      progress.windows_done = n + 1;
+      progress_.windows_done = n + 1;
       summary_.windows = n + 1;
       summary_.iterations += r.iterations;
       summary_.max_window_iterations = std::max(summary_.max_window_iterations, r.iterations);
       if (!r.converged) ++summary_.unconverged_windows;
-      // the audit first: where its totals are finite, the check need not read the values again
-      const std::vector<double>& imbalance = audit_balance();
-      check_window(n + 1, t, true);
-      row.assign({t, static_cast<double>(r.iterations)});  // keeps its capacity
-      row.insert(row.end(), r.residuals.begin(), r.residuals.end());
-      row.insert(row.end(), imbalance.begin(), imbalance.end());
-      audits.clear();
-      double created = 0.0;
-      for (const auto& p : energy_pairs_) {
-        audits.push_back(audit_energy(p));
-        created += audits.back().created();
-      }
-      for (std::size_t pi = 0; pi < energy_pairs_.size(); ++pi) {
-        EnergyPair& p = energy_pairs_[pi];
-        const EnergyAudit a = audits[pi];
-        row.insert(row.end(), {a.on_a, a.on_b, a.created()});
-        p.passed += std::abs(a.on_a - p.last_a) + std::abs(a.on_b - p.last_b);
-        p.last_a = a.on_a;
-        p.last_b = a.on_b;
-        p.over = a.created() > energy_tolerance_ * p.passed ? p.over + 1 : 0;
-        if (p.over < kEnergyAuditWindows) continue;
-        const std::string what = fmt::format(
-            "window {} (t = {:.6g} s): the coupling between '{}' and '{}' has created {:.4g} J, "
-            "{:.0f} % of the {:.4g} J that passed through their interface (work on '{}' {:.4g} J, "
-            "on '{}' {:.4g} J; a lossless interface creates none), more than "
-            "coupling.energy_tolerance {:.3g} for {} windows in a row: the coupled run is "
-            "unstable; shorten time.window, add damping to the structure (e.g. "
-            "analysis.rayleigh.beta) or use an implicit scheme",
-            n + 1, t, p.a->name(), p.b->name(), a.created(), 100.0 * a.created() / p.passed,
-            p.passed, p.a->name(), a.on_a, p.b->name(), a.on_b, energy_tolerance_,
-            kEnergyAuditWindows);
-        if (energy_stop_) {
-          coupling_csv_.record(static_cast<double>(n + 1), row);
-          record_monitors(t, n + 1, created);
-          throw Error(what);
-        }
-        if (summary_.energy_warnings++ == 0)
-          logger->warn("{}; further windows are counted in the summary", what);
-      }
-      for (std::size_t i = 0; i < imbalance.size(); ++i)
-        if (imbalance[i] > balance_tolerance_) {
-          ++summary_.imbalance_warnings;
-          if (!warned_imbalance)
-            logger->warn(
-                "window {} (t = {:.6g} s): exchange {} arrives off by {:.3g} of what was sent "
-                "(coupling.balance_tolerance {:.3g}); the mapper does not conserve its total: use "
-                "a conservative constraint or mapper (area-balanced for tractions); further "
-                "windows are counted in the summary",
-                n + 1, t, audited_[i]->label(), imbalance[i], balance_tolerance_);
-          warned_imbalance = true;
-        }
-      Stopwatch csv_clock;
-      coupling_csv_.record(static_cast<double>(n + 1), row);
-      summary_.output_seconds += csv_clock.seconds();
-      record_monitors(t, n + 1, created);
-      const bool last = n + 1 == window_count_;
-      if ((output_every_ > 0.0 && TimeWindow::reached(t, progress.next_output, window_size_)) ||
-          last) {
-        write_output(progress.frame++, t);
-        while (output_every_ > 0.0 && TimeWindow::reached(t, progress.next_output, window_size_))
-          progress.next_output = static_cast<double>(progress.frame) * output_every_;
-      }
-      int signal = options_.stop_signal ? options_.stop_signal->load() : 0;
-      for (const auto& p : participants_)  // a signal to another participant's process
-        if (signal == 0) signal = p->stop_request();
-      if (signal != 0)
-        for (const auto& p : participants_) p->note_stop(signal);
-      const bool restart_due =
-          (restart_every_windows_ > 0 && (n + 1) % restart_every_windows_ == 0) ||
-          (restart_every_seconds_ > 0.0 && since_restart.seconds() >= restart_every_seconds_) ||
-          (last && restart_at_end_) || signal != 0;
-      if (restart_due) {
-        if (blocker.empty()) {
-          write_restart_file(progress);
-          since_restart.restart();
-        } else if (signal != 0) {
-          logger->warn("no restart file: {}", blocker);
-        }
-      }
-      // CSV files are rewritten whole at each flush (always complete on disk): flush every 2 s,
-      // or less often once a flush takes longer than 2 % of the interval (very long runs)
-      if (since_flush.seconds() > flush_interval) {
-        Stopwatch flush_clock;
-        flush_all();
-        flush_interval = std::max(2.0, 50.0 * flush_clock.seconds());
-        since_flush.restart();
-      }
-      progress_line.update(n + 1, t, r.iterations);
-      if (signal != 0) {
-        summary_.stopped_by_signal = signal;
+      FinishedWindow w;
+      w.window = n + 1;
+      w.time = window.end();
+      w.report = &r;
+      w.last = n + 1 == window_count_;
+      notify(w);
+      progress_line.update(n + 1, w.time, r.iterations);
+      if (w.signal != 0) {
+        summary_.stopped_by_signal = w.signal;
         progress_line.finish();
-        logger->warn("stopped by signal {} after window {} (t = {:.6g} s){}", signal, n + 1, t,
+        logger->warn("stopped by signal {} after window {} (t = {:.6g} s){}", w.signal, n + 1,
+                     w.time,
                      summary_.last_restart.empty()
                          ? std::string()
                          : "; continue with: partita run CASE --resume " + output_dir_.string());
@@ -362,11 +191,11 @@ void CaseRun::run() {
     }
   } catch (...) {
     progress_line.finish();
-    flush_all();  // the complete rows so far stay readable
+    flush_csv_files();  // the complete rows so far stay readable
     throw;
   }
   progress_line.finish();
-  flush_all();
+  flush_csv_files();
   Stopwatch close_clock;
   coupling_csv_.close();
   for (auto& m : monitors_) m.csv.close();

@@ -32,8 +32,10 @@
 //   output: {every: 0.1, restart: {every_windows: 100}}
 //
 // The phases live in their own files: the schema (case_schema.cpp), building a run from a
-// case (case_run_build.cpp), the run window by window (case_run.cpp), restart files and the
-// checks after a window (case_run_restart.cpp).
+// case (case_run_build.cpp), the run window by window (case_run.cpp), what is done after each
+// window, each an observer of it (case_run_observers.cpp: the audits, the health check,
+// coupling.csv, monitors and the energy balance, VTK output, signals, restart files, flushes),
+// restart files and the checks (case_run_restart.cpp).
 //
 // Restart files: DIR/restart/w<window>.bin hold the complete state after a window (every
 // participant's solver, the exchanges' values, the acceleration's history, the CSV rows and
@@ -55,6 +57,7 @@
 #include "partita/coupling/exchange.hpp"
 #include "partita/coupling/participant.hpp"
 #include "partita/coupling/registries.hpp"
+#include "partita/coupling/window_observer.hpp"
 #include "partita/interface/config.hpp"
 #include "partita/interface/output.hpp"
 
@@ -203,6 +206,22 @@ class CaseRun {
   Participant* named_participant(const config::Node& n, const std::string& name) const;
   void check_sweep_values(const std::filesystem::path& case_file, const class Sweep& sweep) const;
   void write_output(int frame, double time);
+  void open_csv_files();   // coupling.csv, the monitors' and energy.csv (their headers)
+  void flush_csv_files();
+
+  // The observers of a finished window (window_observer.hpp), in case_run_observers.cpp;
+  // window_observers() builds them in the order they act.
+  class BalanceAuditObserver;
+  class HealthCheckObserver;
+  class CouplingCsvObserver;
+  class MonitorObserver;
+  class EnergyBalanceObserver;
+  class EnergyAuditObserver;
+  class VtkObserver;
+  class StopRequestObserver;
+  class RestartObserver;
+  class FlushObserver;
+  std::vector<std::unique_ptr<WindowObserver>> window_observers();
 
   // Restart files and run-time checks (case_run_restart.cpp)
   void write_restart_file(const Progress& progress);
@@ -233,6 +252,7 @@ class CaseRun {
   std::vector<std::pair<std::string, PvdSeries>> pvds_;  // series name -> .pvd
   PvdSeries& pvd(const std::string& series);
   RunSummary summary_;
+  Progress progress_;  // what run() carries from window to window besides the solvers
   CsvSeries coupling_csv_;
   // restart files
   std::uint64_t identity_ = 0;  // hash of the case's participants and coupling sections
