@@ -19,6 +19,9 @@
 //   fj2-eas    finite-strain J2 (j2-plasticity-finite-strain), EAS Hex8 (only when named in
 //              --lines: minutes a step at the default size; try 80x80)
 //   fj2-plain  finite-strain J2, plain Hex8
+//   j2-reduced  small-strain J2, reduced Hex8 (Hex8Formulation::Reduced: one point in the plane,
+//              6 through the thickness, hourglass stabilisation; issue 27's explicit plate element)
+//   fj2-reduced finite-strain J2, reduced Hex8
 // Printed per line: element-steps per second (elements x steps / wall seconds of the timed
 // steps), points per element, law evaluations per element-step (EAS: points x local passes),
 // the share of plastic points at the end, the ratio to the aim (1e6 element-steps/s on 2 cores,
@@ -167,6 +170,7 @@ struct Line {
   std::string name;
   bool linear = false, finite = false, eas = false;
   bool by_default = true;
+  bool reduced = false;  // the reduced Hex8 (Hex8Formulation::Reduced)
 };
 
 // fj2-eas only when named: its law's tangent (18 return maps a point, the EAS local Newton
@@ -174,8 +178,10 @@ struct Line {
 const std::vector<Line> kLines = {{"linear", true, false, false, true},
                                   {"j2-eas", false, false, true, true},
                                   {"j2-plain", false, false, false, true},
+                                  {"j2-reduced", false, false, false, true, true},
                                   {"fj2-eas", false, true, true, false},
-                                  {"fj2-plain", false, true, false, true}};
+                                  {"fj2-plain", false, true, false, true},
+                                  {"fj2-reduced", false, true, false, true, true}};
 
 std::shared_ptr<const MaterialLaw> make_law(const Line& line) {
   if (line.finite)
@@ -188,8 +194,9 @@ Model plate_model(int nx, int ny, const Line& line, std::shared_ptr<const Materi
       {Vec3::Zero(), Vec3(nx * kCell, ny * kCell, kThick), {nx, ny, 1}, ElementType::Hex8});
   Model model(mesh, Material{kE, kNu, kRho});
   if (!line.linear) model.set_material_law(std::move(law));
-  model.set_hex8_formulation(line.eas || line.linear ? Hex8Formulation::IncompatibleModes
-                                                     : Hex8Formulation::Full);
+  model.set_hex8_formulation(line.reduced                ? Hex8Formulation::Reduced
+                             : line.eas || line.linear ? Hex8Formulation::IncompatibleModes
+                                                       : Hex8Formulation::Full);
   for (const char* edge : {"xmin", "xmax", "ymin", "ymax"}) model.fix(edge);
   return model;
 }
@@ -385,7 +392,7 @@ int main(int argc, char** argv) {
     } else if (a == "-h" || a == "--help") {
       std::printf(
           "usage: bench_fem_explicit [NXxNY] [--steps N] [--threads 1,2] "
-          "[--lines linear,j2-eas,j2-plain,fj2-eas,fj2-plain] [--no-shares] [--dump DIR]\n");
+          "[--lines linear,j2-eas,j2-plain,j2-reduced,fj2-eas,fj2-plain,fj2-reduced] [--no-shares] [--dump DIR]\n");
       return 0;
     } else if (std::sscanf(a.c_str(), "%dx%d", &opt.nx, &opt.ny) == 2 && opt.nx > 0 &&
                opt.ny > 0) {
@@ -402,7 +409,7 @@ int main(int argc, char** argv) {
   }
   for (const auto& n : opt.lines) {
     if (std::none_of(kLines.begin(), kLines.end(), [&](const Line& l) { return l.name == n; })) {
-      std::fprintf(stderr, "unknown line '%s' (linear, j2-eas, j2-plain, fj2-eas, fj2-plain)\n",
+      std::fprintf(stderr, "unknown line '%s' (linear, j2-eas, j2-plain, j2-reduced, fj2-eas, fj2-plain, fj2-reduced)\n",
                    n.c_str());
       return 2;
     }

@@ -3,6 +3,8 @@
 #include <array>
 #include <cmath>
 
+#include "partita/fem/error.hpp"
+
 namespace partita::fem {
 namespace {
 
@@ -126,6 +128,24 @@ const std::vector<VolumeRulePoint>& layered_hex_rule(int thin) {
   };
   static const std::array<std::vector<VolumeRulePoint>, 3> rules = {make(0), make(1), make(2)};
   return rules.at(static_cast<std::size_t>(thin));
+}
+
+const std::vector<VolumeRulePoint>& thickness_line_rule(int thin, int points) {
+  auto make = [](int t, int n) {
+    const Gauss1d through = gauss_legendre(n);
+    std::vector<VolumeRulePoint> r;
+    for (std::size_t k = 0; k < through.x.size(); ++k) {
+      Vec3 xi = Vec3::Zero();
+      xi[t] = through.x[k];
+      r.push_back({xi, 4.0 * through.w[k]});
+    }
+    return r;
+  };
+  static const std::array<std::vector<VolumeRulePoint>, 6> rules = {
+      make(0, 2), make(1, 2), make(2, 2), make(0, 6), make(1, 6), make(2, 6)};
+  if (thin < 0 || thin > 2 || (points != 2 && points != 6))
+    throw Error("thickness_line_rule: direction 0, 1 or 2 and 2 or 6 points");
+  return rules[static_cast<std::size_t>(thin + (points == 6 ? 3 : 0))];
 }
 
 const std::vector<VolumeRulePoint>& volume_rule(ElementType type, QuadratureUse use) {

@@ -57,6 +57,20 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
   if (options_.integrator == Integrator::CentralDifference && options_.mass != MassType::Lumped) {
     throw Error("the central-difference integrator needs a lumped mass (mass: lumped)");
   }
+  if (model_.hex8_formulation() == Hex8Formulation::Reduced) {
+    if (options_.integrator != Integrator::CentralDifference)
+      throw Error(
+          "the reduced Hex8 (hex8: reduced) is an element of central-difference analyses (its "
+          "internal force has no tangent); static and Newmark analyses use the EAS Hex8 "
+          "(hex8: incompatible-modes)");
+    if (options_.rayleigh_beta != 0.0)
+      throw Error(
+          "the reduced Hex8 (hex8: reduced) has no tangent for the stiffness-proportional "
+          "Rayleigh damping's K0: use mass-proportional damping (rayleigh.alpha) with it");
+    // the element exists on the nonlinear path (element by element, LinearElasticLaw where the
+    // model is linear elastic)
+    options_.nonlinear_path = true;
+  }
   if (model_.is_linear() && model_.hex8_formulation() == Hex8Formulation::FBar) {
     throw Error(
         "the F-bar Hex8 is an element of the nonlinear path (neo-hooke, j2-plasticity, ...); a "
@@ -96,6 +110,7 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
   for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
     kin_.u[dofs_.constrained_dofs()[k]] = uc[static_cast<Eigen::Index>(k)];
   evaluate_external_force(0.0, kin_.f);
+  setup_mass_scaling();
   if (nonlinear_ != nullptr || options_.integrator == Integrator::CentralDifference) {
     refresh_internal_force();
   }
@@ -203,8 +218,8 @@ void StructuralSolver::assemble_mass() {
     m_ = assembler.make_matrix();
     // M = sum_e A_e^T M_e A_e
     assemble_elements(mesh(), assembler, m_, [&](const Element& e, ElementMatrix& m) {
-      integrator_.consistent_mass(e.type, element_coordinates(mesh(), e), model_.density(e.region),
-                                  m);
+      const auto ei = static_cast<std::size_t>(&e - mesh().elements().data());
+      integrator_.consistent_mass(e.type, element_coordinates(mesh(), e), element_density(ei), m);
     });
   } else {
     Eigen::VectorXd diag = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ndof_));
@@ -212,7 +227,7 @@ void StructuralSolver::assemble_mass() {
     for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei) {
       const Element& e = mesh().elements()[ei];
       if (element_eroded(ei)) continue;  // erosion: the element's mass has left
-      integrator_.lumped_mass(e.type, element_coordinates(mesh(), e), model_.density(e.region), m);
+      integrator_.lumped_mass(e.type, element_coordinates(mesh(), e), element_density(ei), m);
       for (int a = 0; a < node_count(e.type); ++a) {
         diag.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a])).array() += m[a];
       }
@@ -799,13 +814,13 @@ Eigen::VectorXd StructuralSolver::element_equivalent_plastic_strain() const {
   return out;
 }
 
-double StructuralSolver::stable_time_step() const {
-  if (stable_step_ > 0.0) return stable_step_;
+const std::vector<double>& StructuralSolver::element_frequencies_squared() const {
+  if (!element_omega2_.empty() || mesh().num_elements() == 0) return element_omega2_;
   // Element eigenvalue bound (Irons 1970; Hughes, The Finite Element Method, 2000, section
   // 9.3): with a lumped mass, omega_max^2 of the mesh <= max_e lambda_max(M_e^-1 K_e), K_e and M_e
   // restricted to the element's free dofs (a constrained dof is zero in every mode). K_e is the
   // element stiffness at rest: the linear-elastic one (Hex8 as the path integrates it) or, for
-  // a law, the elasticity tensor of its tangent at F = I. dt_crit = 2 / omega_max.
+  // a law, the elasticity tensor of its tangent at F = I.
   const ElementIntegrator full(Hex8Formulation::Full);
   std::vector<Matrix6> d_region;
   for (std::size_t r = 0; r < std::max<std::size_t>(1, mesh().region_names().size()); ++r) {
@@ -831,17 +846,16 @@ double StructuralSolver::stable_time_step() const {
   }
   std::vector<char> is_free(ndof_, 0);
   for (auto dof : dofs_.free_dofs()) is_free[static_cast<std::size_t>(dof)] = 1;
-  double omega2 = 0.0;
-  Eigen::VectorXd nodal_mass = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh().num_nodes()));
+  element_omega2_.assign(mesh().num_elements(), 0.0);
   ElementMatrix ke;
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
   std::vector<int> free_local;
-  for (const auto& e : mesh().elements()) {
+  for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei) {
+    const Element& e = mesh().elements()[ei];
     const ElementCoordinates x = element_coordinates(mesh(), e);
     const auto& d = d_region[static_cast<std::size_t>(e.region)];
     (nonlinear_ != nullptr ? full : integrator_).stiffness(e.type, x, d, ke);
     integrator_.lumped_mass(e.type, x, model_.density(e.region), m);
-    for (int a = 0; a < node_count(e.type); ++a) nodal_mass[static_cast<Eigen::Index>(e.nodes[a])] += m[a];
     free_local.clear();
     for (int a = 0; a < node_count(e.type); ++a) {
       for (int c = 0; c < 3; ++c) {
@@ -859,10 +873,79 @@ double StructuralSolver::stable_time_step() const {
         a(i, j) = ke(li, lj) / std::sqrt(m[li / 3] * m[lj / 3]);
       }
     }
-    omega2 =
-        std::max(omega2, Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a, Eigen::EigenvaluesOnly)
-                             .eigenvalues()
-                             .maxCoeff());
+    element_omega2_[ei] = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a, Eigen::EigenvaluesOnly)
+                              .eigenvalues()
+                              .maxCoeff();
+  }
+  return element_omega2_;
+}
+
+void StructuralSolver::setup_mass_scaling() {
+  const double target = options_.mass_scaling_time_step;
+  if (!(target >= 0.0) || !std::isfinite(target))
+    throw Error("mass scaling: the target time step must be a finite number >= 0 s (0: off), got " +
+                std::to_string(target));
+  if (target == 0.0) return;
+  if (options_.integrator != Integrator::CentralDifference)
+    throw Error(
+        "mass scaling is for central-difference analyses (it raises the explicit stable step); "
+        "Newmark and static analyses have no stable-step limit: remove the target time step");
+  // s_e = (target / dt_e)^2 = target^2 omega_e^2 / 4 where dt_e = 2 / omega_e < target
+  const auto& omega2 = element_frequencies_squared();
+  mass_scale_.assign(mesh().num_elements(), 1.0);
+  element_mass_.assign(mesh().num_elements(), 0.0);
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
+  for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei) {
+    const Element& e = mesh().elements()[ei];
+    mass_scale_[ei] = std::max(1.0, 0.25 * target * target * omega2[ei]);
+    integrator_.lumped_mass(e.type, element_coordinates(mesh(), e), model_.density(e.region), m);
+    element_mass_[ei] = m.head(node_count(e.type)).sum();
+  }
+  mass_ready_ = false;
+  stable_step_ = -1.0;
+}
+
+std::size_t StructuralSolver::mass_scaled_elements() const {
+  return static_cast<std::size_t>(
+      std::count_if(mass_scale_.begin(), mass_scale_.end(), [](double s) { return s > 1.0; }));
+}
+
+double StructuralSolver::physical_mass() const {
+  double total = 0.0;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
+  for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei) {
+    if (element_eroded(ei)) continue;
+    if (!element_mass_.empty()) {
+      total += element_mass_[ei];
+      continue;
+    }
+    const Element& e = mesh().elements()[ei];
+    integrator_.lumped_mass(e.type, element_coordinates(mesh(), e), model_.density(e.region), m);
+    total += m.head(node_count(e.type)).sum();
+  }
+  return total;
+}
+
+double StructuralSolver::added_mass() const {
+  double added = 0.0;
+  for (std::size_t ei = 0; ei < mass_scale_.size(); ++ei)
+    if (!element_eroded(ei)) added += (mass_scale_[ei] - 1.0) * element_mass_[ei];
+  return added;
+}
+
+double StructuralSolver::stable_time_step() const {
+  if (stable_step_ > 0.0) return stable_step_;
+  // dt_crit = 2 / omega_max, omega_max^2 <= max_e omega_e^2 / s_e (the scaled masses)
+  const auto& omega2_e = element_frequencies_squared();
+  double omega2 = 0.0;
+  for (std::size_t ei = 0; ei < omega2_e.size(); ++ei)
+    omega2 = std::max(omega2, omega2_e[ei] / mass_scale_factor(ei));
+  Eigen::VectorXd nodal_mass = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh().num_nodes()));
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
+  for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei) {
+    const Element& e = mesh().elements()[ei];
+    integrator_.lumped_mass(e.type, element_coordinates(mesh(), e), element_density(ei), m);
+    for (int a = 0; a < node_count(e.type); ++a) nodal_mass[static_cast<Eigen::Index>(e.nodes[a])] += m[a];
   }
   // contributions (a penalty contact): omega_max^2 <= the elements' + theirs (Weyl's inequality
   // for the sum of the two symmetric M^-1/2 K M^-1/2)

@@ -161,11 +161,11 @@ RegionEnergies StructuralSolver::region_energies() const {
     if (!mass_ready_ || element_eroded(e)) continue;
     // 1/2 v_e^T M_e v_e (its share of the assembled mass)
     if (options_.mass == MassType::Lumped) {
-      integrator_.lumped_mass(el.type, x, model_.density(el.region), m_lumped);
+      integrator_.lumped_mass(el.type, x, element_density(e), m_lumped);
       for (int a = 0; a < nn; ++a)
         out.kinetic_energy[r] += 0.5 * m_lumped[a] * v_e.segment<3>(3 * a).squaredNorm();
     } else {
-      integrator_.consistent_mass(el.type, x, model_.density(el.region), m_e);
+      integrator_.consistent_mass(el.type, x, element_density(e), m_e);
       out.kinetic_energy[r] += 0.5 * v_e.dot(m_e * v_e);
     }
   }

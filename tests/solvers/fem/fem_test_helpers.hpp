@@ -158,6 +158,22 @@ inline bool axial_kick_grows(StructuralSolver& s, double dt, int steps) {
   return !s.displacement().allFinite() || !(s.max_displacement() < 1e3 * u0);
 }
 
+// The 1D (uniaxial-strain) wave speed sqrt((lambda + 2 mu) / rho).
+inline double dilatational_speed(double e, double nu, double rho) {
+  const double lambda = e * nu / ((1 + nu) * (1 - 2 * nu)), mu = e / (2 * (1 + nu));
+  return std::sqrt((lambda + 2 * mu) / rho);
+}
+
+// Rod [0, L] x [0, a]^2 of n Hex8 along x in uniaxial strain (y and z fixed everywhere), so
+// that waves travel along x at c_d = dilatational_speed() (1D wave equation); for a >= L / n
+// each element's stable step (its free dofs are axial) is (L / n) / c_d exactly.
+inline Model uniaxial_rod(double length, int n, double a, const Material& material) {
+  Model m(make_box_mesh({Vec3::Zero(), Vec3(length, a, a), {n, 1, 1}, ElementType::Hex8}),
+          material);
+  m.fix("all", {1, 2});
+  return m;
+}
+
 /// run() (a solve, returning x) on 1, 2, 3 and 4 threads, three times each, gives the bits of
 /// `reference`; the thread count is restored afterwards.
 template <class Run>

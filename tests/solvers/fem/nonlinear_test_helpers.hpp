@@ -12,6 +12,7 @@
 #include "partita/fem/error.hpp"
 #include "partita/fem/internal_force_operator.hpp"
 #include "partita/fem/model.hpp"
+#include "partita/fem/nonlinear_operator.hpp"
 #include "partita/fem/newton_report.hpp"
 #include "partita/fem/structural_solver.hpp"
 
@@ -151,6 +152,32 @@ inline std::optional<double> limit_load_factor(StructuralSolver& s, std::string&
       !std::regex_search(what, m, std::regex("largest load factor reached is ([0-9.eE+-]+)")))
     return std::nullopt;
   return std::stod(m[1].str());
+}
+
+// Patch test of a model's operator: u = (F0 - I) X gives every quadrature point the law's
+// stress at F0 (to 1e-10) and leaves the interior nodes (those of 8 elements) in equilibrium
+// (to 1e-9 of |f|).
+inline void check_homogeneous_patch(const Model& m, const Mat3& f0, const MaterialLaw& law) {
+  NonlinearOperator op(m);
+  Eigen::VectorXd u(3 * static_cast<Eigen::Index>(m.mesh().num_nodes())), f;
+  for (std::size_t n = 0; n < m.mesh().num_nodes(); ++n)
+    u.segment<3>(3 * static_cast<Eigen::Index>(n)) = (f0 - Mat3::Identity()) * m.mesh().node(n);
+  op.evaluate(u, f, nullptr);
+  std::vector<double> none(static_cast<std::size_t>(law.state_size())), trial(none.size());
+  law.initialise_state(none);
+  MaterialResponse r;
+  law.evaluate(f0, none, trial, r);
+  const Mat3 sigma =
+      law.small_strain() ? r.stress : Mat3(r.stress * f0.transpose() / f0.determinant());
+  Eigen::Matrix<double, 1, 6> exact;
+  exact << sigma(0, 0), sigma(1, 1), sigma(2, 2), sigma(0, 1), sigma(1, 2), sigma(0, 2);
+  for (Eigen::Index q = 0; q < op.cauchy_stress().rows(); ++q)
+    CHECK((op.cauchy_stress().row(q) - exact).norm() < 1e-10 * exact.norm());
+  std::vector<int> count(m.mesh().num_nodes(), 0);
+  for (const auto& e : m.mesh().elements())
+    for (auto n : e.node_span()) ++count[n];
+  for (std::size_t n = 0; n < m.mesh().num_nodes(); ++n)
+    if (count[n] == 8) CHECK(f.segment<3>(3 * static_cast<Eigen::Index>(n)).norm() < 1e-9 * f.norm());
 }
 
 }  // namespace partita::fem::test

@@ -14,18 +14,10 @@ namespace {
 
 constexpr double kE = 210e9, kNu = 0.3, kRho = 7800.0;
 
-double dilatational_speed() {
-  const double lambda = kE * kNu / ((1 + kNu) * (1 - 2 * kNu)), mu = kE / (2 * (1 + kNu));
-  return std::sqrt((lambda + 2 * mu) / kRho);
-}
+double dilatational_speed() { return test::dilatational_speed(kE, kNu, kRho); }
 
-// Rod [0, L] x [0, a]^2 of n Hex8 along x in uniaxial strain (y and z fixed everywhere), so
-// that waves travel along x at c_d = sqrt((lambda + 2 mu) / rho) (1D wave equation).
 Model rod(double length, int n, double a = 0.01) {
-  Model m(make_box_mesh({Vec3::Zero(), Vec3(length, a, a), {n, 1, 1}, ElementType::Hex8}),
-          Material{kE, kNu, kRho});
-  m.fix("all", {1, 2});
-  return m;
+  return test::uniaxial_rod(length, n, a, Material{kE, kNu, kRho});
 }
 
 SolverOptions explicit_options() {

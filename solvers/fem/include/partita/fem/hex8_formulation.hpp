@@ -20,6 +20,13 @@ namespace partita::fem {
 //     volume ratio J_bar = v / V in place of det F at the centre), internal force and tangent
 //     the derivatives of int W(F_bar) dV (see MaterialContribution); still locks in bending of
 //     thin parts. The linear path rejects it (its incompatible-mode Hex8 does not lock).
-enum class Hex8Formulation { IncompatibleModes, Full, FBar };
+//   Reduced: the explicit plate element (central difference only: no tangent): one point in the
+//     plane and a line of Gauss points through the thickness (6 in plate-like elements, 2 in
+//     others),
+//     hourglass stabilisation of the two modes the line does not see (xi eta and xi eta zeta,
+//     Flanagan & Belytschko 1981's projection, stiffnesses of Belytschko & Bindeman 1993's
+//     assumed-strain kind) and one enhanced thickness strain against Poisson thickness locking
+//     (updated once per step). See MaterialContribution.
+enum class Hex8Formulation { IncompatibleModes, Full, FBar, Reduced };
 
 }  // namespace partita::fem

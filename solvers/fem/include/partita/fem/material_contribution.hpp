@@ -127,6 +127,12 @@ class MaterialContribution final : public OperatorContribution {
                      ElementMatrix* ke, double& energy, ElementVector& fabs);
   void evaluate_eas(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
                     ElementMatrix* ke, double& energy, ElementVector& fabs);
+  // the reduced Hex8 (force only: central difference)
+  void evaluate_reduced(std::size_t e, const ElementDisplacements& ue, ElementVector& fe,
+                        ElementMatrix* ke, double& energy, ElementVector& fabs);
+  // appends an element's hourglass vectors and stiffnesses, its enhanced mode to reduced_data_ (after its points' weights)
+  void setup_reduced_hex8(const ElementCoordinates& x, int thickness_axis,
+                          const Mat3& j0_inv, const Vec3& elastic);
   // Throws Error naming element e and where it is when det F <= 0 at one of its points.
   void require_not_inverted(std::size_t e, double det_f) const;
   // Element e's fe, fabs and energy, and ke when not null (each zeroed first).
@@ -161,6 +167,16 @@ class MaterialContribution final : public OperatorContribution {
   std::vector<std::size_t> eas_offset_;          // per element: alpha's start in the state (EAS)
   std::vector<std::size_t> eas_gradient_start_;  // per element: its first g_J in eas_gradients_
   std::vector<double> eas_norms_;                // per EAS qp: |G| (11 x 3) and |g_J| (3 x 3)
+  // reduced Hex8 (Hex8Formulation::Reduced): per element from reduced_start_[e]
+  // (kReducedData doubles): gamma_1, gamma_4 (8 each), K_1, K_4 (3 x 3, row-major), c (the
+  // thickness coordinate's gradient at the centre), n = c / |c|, the transverse-shear rows
+  // c_eta, c_xi (8 x 3 each, row-major), mu V / 3, 1 / K_beta_beta; per point (j0 / j) zeta;
+  // its beta at eas_offset_[e] in the state
+  static constexpr std::size_t kReducedData = 8 + 8 + 9 + 9 + 3 + 3 + 24 + 24 + 1 + 1;
+  bool reduced_hex8_ = false;
+  std::vector<double> reduced_data_;
+  std::vector<std::size_t> reduced_start_;
+  std::vector<double> reduced_point_scale_;
   std::vector<double> committed_, trial_;
   double energy_ = 0.0;
   double round_off_ = 0.0;

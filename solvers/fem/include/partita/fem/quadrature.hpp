@@ -29,5 +29,9 @@ const std::vector<FaceRulePoint>& face_rule(FaceType type);
 // the thin parametric direction `thin` (0: xi, 1: eta, 2: zeta). Six points integrate a fully
 // plastic section's moment int |z| dz to +2 % (2 points: +15 %, 5 points: -5.5 %).
 const std::vector<VolumeRulePoint>& layered_hex_rule(int thin);
+// The reduced Hex8's rule (Hex8Formulation::Reduced): `points` Gauss points (2 or 6) on the
+// line through the centre along the parametric direction `thin`, each weighted for the whole
+// cross-section (4 w_k): one point in the plane, several through the thickness.
+const std::vector<VolumeRulePoint>& thickness_line_rule(int thin, int points);
 
 }  // namespace partita::fem

@@ -43,6 +43,15 @@ struct SolverOptions {
   // small-strain LinearElasticLaw (the same Hex8 modes, as EAS); explicit steps cost more than
   // the linear path's sparse product.
   bool nonlinear_path = false;
+  // Mass scaling of central-difference analyses (0: off), as crash analysts use it for
+  // quasi-static runs (LS-DYNA's DT2MS < 0, Abaqus/Explicit's fixed mass scaling to a target
+  // increment): every element whose stable step dt_e (the element eigenvalue bound of
+  // stable_time_step(), unscaled density, free dofs) is below this target gets its density
+  // scaled by s_e = (target / dt_e)^2, which raises its dt_e to the target. The lumped mass,
+  // kinetic energy, energy balance, energies by part and the stable step all use the scaled
+  // mass; body forces (gravity) keep the physical density, so a quasi-static run keeps its
+  // static loads. StructuralSolver::added_mass() reports what was added. [s]
+  double mass_scaling_time_step = 0.0;
 };
 
 }  // namespace partita::fem

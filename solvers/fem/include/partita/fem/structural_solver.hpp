@@ -173,6 +173,14 @@ class StructuralSolver final : private StructuralSystem {
   double eroded_energy() const;
   RegionEnergies region_energies() const;
   double max_equivalent_plastic_strain() const;  // over all quadrature points (0 if linear)
+  // --- mass scaling (SolverOptions::mass_scaling_time_step) ---
+  // Element e's density factor s_e >= 1 (1 without mass scaling).
+  double mass_scale_factor(std::size_t element) const {
+    return mass_scale_.empty() ? 1.0 : mass_scale_[element];
+  }
+  std::size_t mass_scaled_elements() const;  // elements with s_e > 1
+  double physical_mass() const;  // sum of rho V over the elements not eroded [kg]
+  double added_mass() const;     // sum of (s_e - 1) rho V over the elements not eroded [kg]
   // Newton reports of the last nonlinear static solve / Newmark step.
   const std::vector<NewtonReport>& static_reports() const { return static_.reports(); }
   const NewtonReport& newmark_report() const { return newmark_.last_report(); }
@@ -226,6 +234,14 @@ class StructuralSolver final : private StructuralSystem {
   void external_force(double t, Eigen::VectorXd& f) const override;
   void apply_prescribed(double t, Eigen::VectorXd& u) const override;
   void factorise_dynamic(double dt);
+  // the density element e's mass is built with: the model's times its mass-scaling factor
+  double element_density(std::size_t e) const {
+    return model_.density(mesh().elements()[e].region) * mass_scale_factor(e);
+  }
+  // per element: lambda_max(M_e^-1 K_e) on its free dofs with the physical density (0 when it
+  // has none), computed once (stable_time_step() and the mass scaling)
+  const std::vector<double>& element_frequencies_squared() const;
+  void setup_mass_scaling();
   void validate_failure_setup() const;  // structural_solver_failure.cpp
   void update_failures();               // after each step: see failed_elements()
 
@@ -245,6 +261,9 @@ class StructuralSolver final : private StructuralSystem {
   std::unique_ptr<Factorisation> static_factor_, dynamic_factor_;
   double factor_dt_ = -1.0;
   mutable double stable_step_ = -1.0;        // cached stable_time_step()
+  mutable std::vector<double> element_omega2_;  // element_frequencies_squared()
+  std::vector<double> mass_scale_;              // per element s_e (empty: no mass scaling)
+  std::vector<double> element_mass_;            // per element rho V (with mass scaling)
   mutable Eigen::VectorXd prescribed_work_;  // apply_prescribed()'s buffer
 
   // loads
