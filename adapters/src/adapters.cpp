@@ -21,7 +21,8 @@ void register_all(coupling::Registries& r) {
       {{"kinetic_energy", "J", "translational plus rotational kinetic energy of the particles"},
        {"elastic_energy", "J", "elastic energy stored in the contacts (normal and tangential)"},
        {"friction_work", "J",
-        "energy dissipated by Coulomb sliding in all contacts since the start (the capped "
+        "(with energy_accounting: true, as the monitors down to energy_balance_error) energy "
+        "dissipated by Coulomb sliding in all contacts since the start (the capped "
         "tangential force's work on the relative motion plus the spring energy the cap released)"},
        {"damping_work", "J",
         "energy dissipated by viscous contact damping (normal, tangential) and rolling "

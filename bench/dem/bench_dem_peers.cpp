@@ -6,6 +6,7 @@
 //
 // usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] [--scaling]
 //                        [--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N] [--breakage]
+//                        [--energy]  (the energy accounting on: System::set_energy_tracking)
 // --scaling: the large bed (unless --case names another) on 1, 2, 4, ... threads up to the
 // machine's processors (and that number), then the speed-up over 1 thread of each (issue 16's
 // aim: 12x at 16 threads; 9.7x measured when it was filed); particles renumbered in cell order
@@ -56,6 +57,9 @@ struct Case {
   double liggghts_1, liggghts_2;  // recorded particle-steps/s (RESULTS.md)
 };
 
+// --energy: the energy accounting on (System::set_energy_tracking)
+bool g_energy = false;
+
 System make_system(const LammpsData& d, double width, bool shuffle, int sort_interval,
                    bool breakage) {
   System sys;
@@ -95,6 +99,7 @@ System make_system(const LammpsData& d, double width, bool shuffle, int sort_int
   sys.add_plane({0, 0, 0}, {0, 1, 0}, wall);
   sys.add_plane({0, width, 0}, {0, -1, 0}, wall);
   sys.add_plane({0, 0, 0}, {0, 0, 1}, wall);
+  sys.set_energy_tracking(g_energy);
   return sys;
 }
 
@@ -236,6 +241,8 @@ int main(int argc, char** argv) {
       sort_given = true;
     } else if (arg == "--profile") {
       profile = true;
+    } else if (arg == "--energy") {
+      g_energy = true;
     } else if (arg == "--breakage") {
       breakage = true;
     } else if (arg == "--vtk") {
@@ -243,7 +250,7 @@ int main(int argc, char** argv) {
     } else {
       std::cerr << "usage: bench_dem_peers [--data DIR] [--case small|large|all] [--threads 1,2] "
                    "[--scaling] [--profile] [--quick] [--vtk DIR] [--no-peer] [--shuffle] "
-                   "[--sort N] [--breakage]\n"
+                   "[--sort N] [--breakage] [--energy]\n"
                    "  --no-peer: do not run LIGGGHTS; ratios use the recorded figures\n"
                    "  --scaling: the large bed on 1, 2, 4, ... threads up to the processors, and "
                    "the speed-up of each over 1 thread\n"

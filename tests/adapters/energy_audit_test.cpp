@@ -49,7 +49,7 @@ TEST_CASE("energy audit: a wall driven into a sphere does the work of its elasti
       "meshes: [{name: plate, rectangle: {origin: [0.005, 0.005, " +
       std::to_string(z0 + 0.5 * d + gap) +
       "], size: [0.01, 0.01], cells: [2, 2]}, material: steel}]\n"
-      "gravity: [0, 0, 0]\n";
+      "gravity: [0, 0, 0]\nenergy_accounting: true\n";
   auto s = make("dem", yaml, dir);
   const Mesh& plate = s->meshes().at(0).mesh;
   REQUIRE(plate.name() == "plate");

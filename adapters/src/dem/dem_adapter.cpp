@@ -231,6 +231,11 @@ std::shared_ptr<Spec> make_spec() {
       .range(0.0, 1.0)
       .min(0.0, true);
   s->real("skin", "Verlet skin (default: 10 % of the largest radius)").unit("m").non_negative();
+  s->boolean("energy_accounting",
+             "cumulative energies (monitors friction_work, damping_work, breakage_energy, "
+             "stiffening_work, gravity_work, wall_work, <wall>.work, <mesh>.work, "
+             "elastic_energy, energy_balance_error); costs ~40 % of the DEM's step on a settled "
+             "bed (bench/README.md) (default false)");
   s->real("lost_margin",
           "a particle farther than this outside the domain's bounding box (particles at the "
           "start, box walls, the points of plane walls, meshes) stops the run as lost (default: "
@@ -349,6 +354,7 @@ DemAdapter::DemAdapter(const SolverContext& context)
                                                                 : dem::DampingModel::calibrated);
     system_.set_gravity(c.vec3("gravity"));
     if (c.has("skin")) system_.set_skin(c.real("skin"));
+    system_.set_energy_tracking(c.has("energy_accounting") && c.boolean("energy_accounting"));
     system_.set_sort_interval(static_cast<int>(c.integer("sort_interval")));
     particles_file_ = c["output"].string("particles_file");
     time_step_fraction_auto_ = !c.has("time_step_fraction");
@@ -985,8 +991,11 @@ std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::stri
   }
   if (wanted("contacts_per_particle"))
     v.push_back({"contacts_per_particle", "", system_.mean_contacts_per_particle()});
-  // the DEM's energy accounting (dem::System::energies(), cumulative since the first step)
+  // the DEM's energy accounting (dem::System::energies(), cumulative since the first step; with
+  // energy_accounting: true)
   const dem::System::Energies& en = system_.energies();
+  const bool energies = system_.energy_tracking();
+  if (energies) {
   v.push_back({"friction_work", "J", en.friction});
   v.push_back({"damping_work", "J", en.damping});
   v.push_back({"breakage_energy", "J", en.breakage});
@@ -999,18 +1008,21 @@ std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::stri
   if (wanted("elastic_energy")) v.push_back({"elastic_energy", "J", system_.elastic_energy()});
   if (wanted("energy_balance_error"))
     v.push_back({"energy_balance_error", "", system_.energy_balance_error()});
+  }
   const char* xyz[] = {"x", "y", "z"};
   for (const auto& m : meshes_dem_) {
     const Eigen::Vector3d f = system_.mesh_force(m.id);
     for (int k = 0; k < 3; ++k) v.push_back({m.name + ".force_" + xyz[k], "N", f(k)});
     const auto id = static_cast<std::size_t>(m.id);
-    v.push_back({m.name + ".work", "J", id < en.mesh_work.size() ? en.mesh_work[id] : 0.0});
+    if (energies)
+      v.push_back({m.name + ".work", "J", id < en.mesh_work.size() ? en.mesh_work[id] : 0.0});
   }
   for (const auto& w : walls_) {
     const Eigen::Vector3d f = system_.wall_force(w.id);
     for (int k = 0; k < 3; ++k) v.push_back({w.name + ".force_" + xyz[k], "N", f(k)});
     const auto id = static_cast<std::size_t>(w.id);
-    v.push_back({w.name + ".work", "J", id < en.wall_work.size() ? en.wall_work[id] : 0.0});
+    if (energies)
+      v.push_back({w.name + ".work", "J", id < en.wall_work.size() ? en.wall_work[id] : 0.0});
     for (int face = 0; face < 6; ++face)  // a box wall's closed faces, each on its own
       if (w.faces & (1u << face)) {
         const Eigen::Vector3d ff =

@@ -179,16 +179,7 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
                                     update_history, fw, ft, Energy ? &parts : nullptr);
     f += fw;
     t -= cr * k.normal.cross(ft);
-    if constexpr (Energy) {  // (as WallContacts::Pass::add_forces())
-      sums->fd += parts.damping;
-      sums->td -= cr * k.normal.cross(parts.damping_t);
-      sums->ff += parts.friction;
-      sums->tf -= cr * k.normal.cross(parts.friction);
-      wd->damping += parts.damping.dot(v_wall);
-      wd->friction += parts.friction.dot(v_wall);
-      wd->spring += parts.spring;
-      wd->stiffening += parts.stiffening;
-    }
+    if constexpr (Energy) add_wall_parts(parts, k.normal, cr, v_wall, *sums, *wd);
     if (pp.rolling_friction > 0.0) {
       const double wn = q.w.norm();
       if (wn > 0.0) {

@@ -495,6 +495,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         Eigen::Vector3d f = qi.f;
         Eigen::Vector3d t = qi.t;
         double load_i = Load ? load[i] : 0.0;
+        // (Energy) i's dissipative sums, held here for its row (the pairs (k, i), k < i, are in)
+        DissipationSums di;
+        if constexpr (Energy) di = diss[i];
         for (int k = row_first[i - i_begin]; k < row_first[i - i_begin + 1]; ++k) {
           const PairForce& o = forces[k];
           const Eigen::Map<const Eigen::Vector3d> fij(o.f), ti(o.ti), tj(o.tj);
@@ -509,7 +512,6 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           }
           if constexpr (Energy) {
             const PairEnergy& e = energies[k];
-            DissipationSums& di = diss[i];
             DissipationSums& dj = diss[tasks[k].j];
             const Eigen::Map<const Eigen::Vector3d> fd(e.fd), ff(e.ff);
             di.fd += fd;
@@ -532,7 +534,6 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
             if constexpr (Load) load_i = std::max(load_i, cf.load);
             if constexpr (Energy) {
               const PairEnergy& e = cross_energy[c];
-              DissipationSums& di = diss[i];
               di.fd += Eigen::Map<const Eigen::Vector3d>(e.fd);
               di.td += Eigen::Map<const Eigen::Vector3d>(e.tdi);
               di.ff += Eigen::Map<const Eigen::Vector3d>(e.ff);
@@ -545,15 +546,13 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         WallDissipation wd;  // (Energy) i's wall and mesh contacts
         walls.add_forces<Load, Energy>(i, qi, mass[i], material[i],
                                        np <= 64 ? nl.plane_mask_[i] : 0, model_, dt,
-                                       update_history, f, t, load_i, block_wall,
-                                       Energy ? &diss[i] : nullptr, &wd);
+                                       update_history, f, t, load_i, block_wall, &di, &wd);
         if (mesh_row < mesh.rows && mesh.particle[mesh_row] == i) {
           // own accumulators: f and t keep their registers
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
           const MeshContacts::Particle q{qi.x, qi.r, qi.v, mass[i], qi.w, material[i]};
           MeshContacts::evaluate<Load, Energy>(i, q, nl, meshes_, model_, mesh.row(mesh_row++),
-                                               dt, update_history, fm, tm, load_i,
-                                               Energy ? &diss[i] : nullptr, &wd);
+                                               dt, update_history, fm, tm, load_i, &di, &wd);
           f += fm;
           t += tm;
         }
@@ -570,7 +569,6 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           accel2 = std::max(accel2, f.squaredNorm() / (mass[i] * mass[i]));
           extent = std::max(extent, qi.x.cwiseAbs().maxCoeff());
           if constexpr (Energy) {  // powers at the end-of-step velocities (Energies)
-            const DissipationSums& di = diss[i];
             block_e.damping += (wd.damping - (di.fd.dot(qi.v) + di.td.dot(qi.w))) * dt;
             block_e.friction += (wd.friction - (di.ff.dot(qi.v) + di.tf.dot(qi.w))) * dt +
                                 wd.spring;

@@ -34,6 +34,13 @@ void square(double size, double cx, double cy, double z, Eigen::MatrixX3d& v,
     }
 }
 
+// One material, no gravity, the energy accounting on.
+System energy_system(double restitution, double friction) {
+  System sys = test::single_material(E, NU, RHO, restitution, friction);
+  sys.set_energy_tracking(true);
+  return sys;
+}
+
 }  // namespace
 
 TEST_CASE("dem energy: a sphere sliding on a plane loses 2/7 of its kinetic energy to friction",
@@ -41,7 +48,7 @@ TEST_CASE("dem energy: a sphere sliding on a plane loses 2/7 of its kinetic ener
   // Thrown without spin along a plane with friction mu: it slides until v = 5/7 v0 and rolls on;
   // the friction work is 1/2 m v0^2 - (1/2 m v^2 + 1/2 I w^2) = 2/7 (1/2 m v0^2).
   const double mu = 0.3, v0 = 0.2, g = 9.81;
-  System sys = test::single_material(E, NU, RHO, 0.5, mu);
+  System sys = energy_system(0.5, mu);
   sys.set_gravity({0, 0, -g});
   const double m = test::sphere_mass(R, RHO);
   const double e_star = E / (2.0 * (1.0 - NU * NU));  // sphere on a plane of its material
@@ -68,7 +75,7 @@ TEST_CASE("dem energy: an impact with restitution e dissipates 1/2 m v^2 (1 - e^
           "[dem][energy]") {
   const double v = 0.5;
   for (const double e : {0.3, 0.5, 0.8}) {
-    System sys = test::single_material(E, NU, RHO, e, 0.0);
+    System sys = energy_system(e, 0.0);
     const double m = test::sphere_mass(R, RHO);
     sys.add_particle({0, 0, R + 1e-6}, R, 0, {0, 0, -v});
     const int wall = sys.add_plane({0, 0, 0}, {0, 0, 1}, 0);
@@ -92,7 +99,7 @@ TEST_CASE("dem energy: a mesh pressing a sphere onto a plane does the work store
   // A flat mesh moves down at constant V onto a sphere resting on a plane, no gravity: its work
   // goes into the two Hertz contacts (in series, force F: E_el = sum 2/5 F delta_k) and their
   // damping (small at V << impact speeds); the balance closes.
-  System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
+  System sys = energy_system(0.5, 0.3);
   sys.add_particle({0, 0, R}, R, 0);
   sys.add_plane({0, 0, 0}, {0, 0, 1}, 0);
   Eigen::MatrixX3d x;
@@ -128,7 +135,7 @@ TEST_CASE("dem energy: a particle replaced by lighter fragments takes their miss
           "[dem][energy]") {
   // A free sphere at v is replaced (between steps) by two inscribed half-radius spheres at the
   // same velocity: 1/4 of the mass stays, 3/4 m v^2 / 2 leaves with the change (breakage).
-  System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
+  System sys = energy_system(0.5, 0.3);
   const Eigen::Vector3d v(0.3, -0.1, 0.2);
   sys.add_particle({0, 0, 0}, R, 0, v);
   sys.add_particle({5 * R, 0, 0}, R, 0);  // a bystander at rest
@@ -160,7 +167,7 @@ TEST_CASE("dem energy: a packing compressed by a mesh under gravity balances its
   auto run = [&](int threads) {
     const int before = max_threads();
     set_num_threads(threads);
-    System sys = test::single_material(E, NU, RHO, 0.5, 0.4);
+    System sys = energy_system(0.5, 0.4);
     sys.set_gravity({0, 0, -9.81});
     sys.add_particles(pk.positions, pk.radii, 0);
     sys.add_box(lo, hi, 0, 0b011111);
@@ -204,7 +211,7 @@ TEST_CASE("dem energy: a packing compressed by a mesh under gravity balances its
 }
 
 TEST_CASE("dem energy: the energies are part of the saved state", "[dem][energy]") {
-  System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
+  System sys = energy_system(0.5, 0.3);
   sys.set_gravity({0, 0, -9.81});
   sys.add_particle({0, 0, R - 1e-6}, R, 0, {0.1, 0, 0});
   sys.add_plane({0, 0, 0}, {0, 0, 1}, 0);

@@ -5,7 +5,10 @@
 // energies of the pass, summed over the blocks in a fixed order after it (the same bits on any
 // number of threads).
 
+#include "partita/dem/contact_model.hpp"
+
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace partita::dem {
 
@@ -27,6 +30,21 @@ struct DissipationSums {
 struct WallDissipation {
   double damping = 0.0, friction = 0.0, spring = 0.0, stiffening = 0.0;
 };
+
+/// A wall or mesh contact's dissipative parts (normal n, arm cr, the wall's velocity at the
+/// contact point v_wall) into the particle's sums and its wall terms.
+PARTITA_DEM_INLINE void add_wall_parts(const DissipativeParts& parts, const Eigen::Vector3d& n,
+                                       double cr, const Eigen::Vector3d& v_wall,
+                                       DissipationSums& sums, WallDissipation& wd) {
+  sums.fd += parts.damping;
+  sums.td -= cr * n.cross(parts.damping_t);
+  sums.ff += parts.friction;
+  sums.tf -= cr * n.cross(parts.friction);
+  wd.damping += parts.damping.dot(v_wall);
+  wd.friction += parts.friction.dot(v_wall);
+  wd.spring += parts.spring;
+  wd.stiffening += parts.stiffening;
+}
 
 /// Per block of particles, one pass: dissipation by damping and friction and the work of gravity
 /// [J] (kick: power at the end-of-step velocities times dt).

@@ -234,8 +234,8 @@ class System {
   double elastic_energy() const;
   /// Gravitational potential energy -sum m g.x [J].
   double potential_energy() const;
-  /// Cumulative energies since the first step (energy accounting; on by default,
-  /// set_energy_tracking()). Powers are taken at the end-of-step velocities of velocity Verlet
+  /// Cumulative energies since the first step (energy accounting; off by default: it costs
+  /// ~40 % of a step on a settled bed, bench/README.md; set_energy_tracking()). Powers are taken at the end-of-step velocities of velocity Verlet
   /// (the kick's v_{n+1}, omega_{n+1}: F_{n+1} . v_{n+1} dt summed over the steps is the
   /// trapezoidal work of the integrator, exactly), so the balance
   ///   sum(wall_work) + sum(mesh_work) + gravity
@@ -263,7 +263,8 @@ class System {
     double elastic_start = 0.0;     ///< contact elastic energy at the first step
     bool started = false;
   };
-  /// Turns the energy accounting on (default) or off (the force pass then skips it).
+  /// Turns the energy accounting on or off (default; the force pass then skips it). Turn it on
+  /// before the first step: the energies count from the first step taken with it on.
   void set_energy_tracking(bool on) { energy_tracking_ = on; }
   bool energy_tracking() const { return energy_tracking_; }
   const Energies& energies() const { return energies_; }
@@ -400,7 +401,7 @@ class System {
   std::vector<PartMotion> part_motion_;
   // energy accounting (energies()): per particle the dissipative force sums of the pass, per
   // block of particles the pass's energies, per cross pair its dissipative parts
-  bool energy_tracking_ = true;
+  bool energy_tracking_ = false;
   Energies energies_;
   std::vector<DissipationSums> dissipation_;
   std::vector<BlockEnergy> block_energy_;

@@ -149,16 +149,7 @@ PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(
                                     dt, update_history, fw, ft, Energy ? &parts : nullptr);
     f += fw;
     t -= cr * w.normal.cross(ft);
-    if constexpr (Energy) {
-      sums->fd += parts.damping;
-      sums->td -= cr * w.normal.cross(parts.damping_t);
-      sums->ff += parts.friction;
-      sums->tf -= cr * w.normal.cross(parts.friction);
-      wd->damping += parts.damping.dot(w.velocity);
-      wd->friction += parts.friction.dot(w.velocity);
-      wd->spring += parts.spring;
-      wd->stiffening += parts.stiffening;
-    }
+    if constexpr (Energy) add_wall_parts(parts, w.normal, cr, w.velocity, *sums, *wd);
     if (pp.rolling_friction > 0.0) {
       const double wn = qi.w.norm();
       if (wn > 0.0) {
