@@ -242,7 +242,9 @@ class System {
   /// closes up to the trapezoidal rule's error on the contact springs (energy_balance_error()),
   /// where KE is taken with the integrator's half-step term: KE + sum dt/2 (F.v + T.omega) +
   /// dt^2/8 (|F|^2/m + |T|^2/I) (F, T the forces of the last pass), for which velocity Verlet's
-  /// identity KE_N - KE_0 = sum_k F_k.v_k dt + B_0 - B_N holds exactly. [J]
+  /// identity KE_N - KE_0 = sum_k F_k.v_k dt + B_0 - B_N holds exactly, + dt/2 sum F_c . v_wall
+  /// over the wall and mesh contacts (the walls' work over half a step that sum_k F_k.v_wall dt
+  /// counts beyond the trapezoidal rule). [J]
   struct Energies {
     double friction = 0.0;  ///< Coulomb sliding: power of the capped tangential forces on the
                             ///< relative motion + the spring energy the cap released
@@ -407,7 +409,8 @@ class System {
   bool set_change_pending_ = false;
   double energy_dt_ = 0.0;  // the step the energies' half-step term is taken for
   // sum_i dt/2 (F.v + T.omega) + dt^2/8 (|F|^2/m + |T|^2/I) with the forces of the last pass:
-  // what velocity Verlet's kinetic energy still owes the forces' trapezoidal work (Energies)
+  // what velocity Verlet's kinetic energy still owes the forces' trapezoidal work, + dt/2 sum
+  // F_c . v_wall over the wall and mesh contacts (Energies)
   double half_step_term(double dt) const;
   double set_change_before_ = 0.0;  // KE + PE + E_el before the pending change
   // per part, the force pass's lists of a block of rows (pair_batch.hpp): its touching pairs,
