@@ -233,8 +233,8 @@ class System {
   /// Gravitational potential energy -sum m g.x [J].
   double potential_energy() const;
   /// Cumulative energies since the first step (energy accounting; off by default: it costs
-  /// ~55 % of the CPU of a step on a settled bed, bench/README.md; set_energy_tracking()). Powers are taken at the end-of-step velocities of velocity Verlet
-  /// (the kick's v_{n+1}, omega_{n+1}: F_{n+1} . v_{n+1} dt summed over the steps is the
+  /// ~55 % of the CPU of a step on a settled bed, bench/README.md; set_energy_tracking()).
+  /// Powers are taken at the end-of-step velocities of velocity Verlet (the kick's v_{n+1}, omega_{n+1}: F_{n+1} . v_{n+1} dt summed over the steps is the
   /// trapezoidal work of the integrator, exactly), so the balance
   ///   sum(wall_work) + sum(mesh_work) + gravity
   ///     = (KE - kinetic_start) + (E_el - elastic_start) + friction + damping + breakage
