@@ -234,8 +234,8 @@ std::shared_ptr<Spec> make_spec() {
   s->boolean("energy_accounting",
              "cumulative energies (monitors friction_work, damping_work, breakage_energy, "
              "stiffening_work, gravity_work, wall_work, <wall>.work, <mesh>.work, "
-             "elastic_energy, energy_balance_error); costs ~40 % of the DEM's step on a settled "
-             "bed (bench/README.md) (default false)");
+             "elastic_energy, energy_balance_error); costs ~55 % of the CPU of a DEM step on a "
+             "settled bed (bench/README.md) (default false)");
   s->real("lost_margin",
           "a particle farther than this outside the domain's bounding box (particles at the "
           "start, box walls, the points of plane walls, meshes) stops the run as lost (default: "

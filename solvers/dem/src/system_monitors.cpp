@@ -60,11 +60,24 @@ double System::half_step_term(double dt) const {
     return h * (f.dot(v) + t.dot(w)) +
            h2 * (f.squaredNorm() / p.mass[i] + t.squaredNorm() / p.inertia[i]);
   };
-  if (const PackedParticle* q = verlet_.ahead())
-    return ordered_sum(n, [&](std::ptrdiff_t i) { return term(i, q[i].f, q[i].t, q[i].v, q[i].w); });
-  return ordered_sum(n, [&](std::ptrdiff_t i) {
-    return term(i, p.force[i], p.torque[i], p.velocity[i], p.angular_velocity[i]);
+  // the walls' and meshes' side: the work of the last pass's contact forces over half a step of
+  // the walls' motion, which the steps' sum F_k . v_wall dt counts beyond the trapezoidal rule
+  double walls = walls_.power();
+  mesh_contacts_.for_each_contact([&](int, const MeshContactRecord& rec, const Eigen::Vector3d&) {
+    const TriangleMesh& m = meshes_[rec.mesh];
+    const auto& tri = m.triangle(rec.triangle);
+    walls += rec.force.dot(rec.barycentric[0] * m.velocity_[tri[0]] +
+                           rec.barycentric[1] * m.velocity_[tri[1]] +
+                           rec.barycentric[2] * m.velocity_[tri[2]]);
   });
+  walls *= h;
+  if (const PackedParticle* q = verlet_.ahead())
+    return walls + ordered_sum(n, [&](std::ptrdiff_t i) {
+             return term(i, q[i].f, q[i].t, q[i].v, q[i].w);
+           });
+  return walls + ordered_sum(n, [&](std::ptrdiff_t i) {
+           return term(i, p.force[i], p.torque[i], p.velocity[i], p.angular_velocity[i]);
+         });
 }
 
 double System::potential_energy() const {

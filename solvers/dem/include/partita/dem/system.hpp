@@ -235,8 +235,8 @@ class System {
   /// Gravitational potential energy -sum m g.x [J].
   double potential_energy() const;
   /// Cumulative energies since the first step (energy accounting; off by default: it costs
-  /// ~40 % of a step on a settled bed, bench/README.md; set_energy_tracking()). Powers are taken at the end-of-step velocities of velocity Verlet
-  /// (the kick's v_{n+1}, omega_{n+1}: F_{n+1} . v_{n+1} dt summed over the steps is the
+  /// ~55 % of the CPU of a step on a settled bed, bench/README.md; set_energy_tracking()).
+  /// Powers are taken at the end-of-step velocities of velocity Verlet (the kick's v_{n+1}, omega_{n+1}: F_{n+1} . v_{n+1} dt summed over the steps is the
   /// trapezoidal work of the integrator, exactly), so the balance
   ///   sum(wall_work) + sum(mesh_work) + gravity
   ///     = (KE - kinetic_start) + (E_el - elastic_start) + friction + damping + breakage
@@ -244,7 +244,9 @@ class System {
   /// closes up to the trapezoidal rule's error on the contact springs (energy_balance_error()),
   /// where KE is taken with the integrator's half-step term: KE + sum dt/2 (F.v + T.omega) +
   /// dt^2/8 (|F|^2/m + |T|^2/I) (F, T the forces of the last pass), for which velocity Verlet's
-  /// identity KE_N - KE_0 = sum_k F_k.v_k dt + B_0 - B_N holds exactly. [J]
+  /// identity KE_N - KE_0 = sum_k F_k.v_k dt + B_0 - B_N holds exactly, + dt/2 sum F_c . v_wall
+  /// over the wall and mesh contacts (the walls' work over half a step that sum_k F_k.v_wall dt
+  /// counts beyond the trapezoidal rule). [J]
   struct Energies {
     double friction = 0.0;  ///< Coulomb sliding: power of the capped tangential forces on the
                             ///< relative motion + the spring energy the cap released
@@ -409,7 +411,8 @@ class System {
   bool set_change_pending_ = false;
   double energy_dt_ = 0.0;  // the step the energies' half-step term is taken for
   // sum_i dt/2 (F.v + T.omega) + dt^2/8 (|F|^2/m + |T|^2/I) with the forces of the last pass:
-  // what velocity Verlet's kinetic energy still owes the forces' trapezoidal work (Energies)
+  // what velocity Verlet's kinetic energy still owes the forces' trapezoidal work, + dt/2 sum
+  // F_c . v_wall over the wall and mesh contacts (Energies)
   double half_step_term(double dt) const;
   double set_change_before_ = 0.0;  // KE + PE + E_el before the pending change
   // per part, the force pass's lists of a block of rows (pair_batch.hpp): its touching pairs,

@@ -68,6 +68,13 @@ class WallContacts {
   /// Adds to work[wall] the work the walls' motion did on the particles in the last pass over a
   /// step dt: -F_plane . v_plane dt per plane (F_plane the particles' force on it, after
   /// reduce()).
+  /// The power of the walls' motion on the particles in the last pass, sum -F_plane . v_plane.
+  double power() const {
+    double p = 0.0;
+    for (std::size_t k = 0; k < planes_.size(); ++k)
+      p -= plane_force_[k].dot(planes_[k].velocity);
+    return p;
+  }
   void add_work(double dt, std::vector<double>& work) const {
     for (std::size_t k = 0; k < planes_.size(); ++k)
       work[static_cast<std::size_t>(planes_[k].wall)] -=
