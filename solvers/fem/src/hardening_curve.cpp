@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <sstream>
 
 #include "partita/fem/error.hpp"
@@ -89,20 +88,18 @@ double HardeningCurve::return_map_increment(double g, double trial_norm, double 
   const double sqrt23 = std::sqrt(2.0 / 3.0);
   const double f_tr = trial_norm - sqrt23 * yield_stress(alpha_n);
   double dg = f_tr / (2.0 * g + 2.0 / 3.0 * slope(alpha_n));
-  // converged at 1e-13 of the yield stress, or at the round-off of |s_tr| - 2 G dg when the trial
-  // stress is over ~100 yield stresses (an element crushed by a contact: a fixed tolerance below
-  // that round-off was never met)
-  const double tolerance =
-      std::max(1e-13 * sigma0_, 8.0 * std::numeric_limits<double>::epsilon() * trial_norm);
   for (int it = 0;; ++it) {
     const double alpha = alpha_n + sqrt23 * dg;
     // r(dg) = |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg)
     const double res = trial_norm - 2.0 * g * dg - sqrt23 * yield_stress(alpha);
-    if (std::abs(res) <= tolerance) return dg;
+    if (std::abs(res) <= 1e-13 * sigma0_) return dg;
     if (it == 50) {
       std::ostringstream msg;
       msg << "j2-plasticity: the radial return did not converge (residual " << res
-          << " Pa after 50 iterations)";
+          << " Pa after 50 iterations; the trial stress was " << trial_norm / sigma0_
+          << " times the yield stress: a strain increment that large in one step means an element "
+             "crushed at once, e.g. by a contact that starts deep inside the structure, or a "
+             "diverging step)";
       throw Error(msg.str());
     }
     dg += res / (2.0 * g + 2.0 / 3.0 * slope(alpha));
