@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Remove every N-th granule of a particle file (LAMMPS data as partita writes it): the step
 between fill.yaml (the bed pressed to the cavities' top by the lid, 8 kN on the lid: too dense)
-and relax.yaml (the thinned bed relaxes under the lid held at the cavities' top).
+and the relaxation (fill.yaml again, reading the thinned file, the lid held at the cavities'
+top: README.md).
 
 Usage: thin.py IN.data OUT.data N      (the shipped settled.data: N = 33, 3 % of the granules)"""
 import sys
