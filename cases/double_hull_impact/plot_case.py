@@ -3,9 +3,10 @@
 coarse.yaml), filled with granules and, optionally, against the empty hull (empty.yaml,
 coarse_empty.yaml).
 
-Usage: plot_case.py FILLED_DIR [EMPTY_DIR] [--out DIR]
+Usage: plot_case.py FILLED_DIR [EMPTY_DIR] [--out DIR] [--driven DIR]
   FILLED_DIR, EMPTY_DIR: the runs' output folders (bow.csv, parts.csv, granules.csv, energy.csv,
-  vtk/); PNGs go to DIR (default FILLED_DIR). The case test calls it as `plot_case.py OUT` with the
+  vtk/); PNGs go to DIR (default FILLED_DIR). --driven DIR: for a collision run (a free bow,
+  collision.yaml), the driven run of the same hull it is compared with (the collision_* keys). The case test calls it as `plot_case.py OUT` with the
   filled run alone (checks.yaml: {script: plot_case.py, key: ...}).
 
 Writes force_penetration.png, energy.png, inner_deflection.png, section_<k>.png (k = 1, 2, 3: the
@@ -37,6 +38,13 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
                           them, at the last output frame (from the DEM's mesh files vtk/granules_cXX
                           or the interface files vtk/granules_interface_cXX); footprint_fraction_90:
                           that area over the cavity faces' total
+  collision_initial_kinetic_energy_J, collision_max_penetration_m, collision_absorbed_J (the
+                          bow's kinetic energy lost by its deepest row), collision_final_kinetic_energy_J
+                          for a run whose bow is free (hull.bow.kinetic_energy > 0 at the start);
+                          with --driven DIR also driven_penetration_at_absorbed_m (the penetration at
+                          which the driven run's indenter work reached collision_absorbed_J) and
+                          collision_over_driven_penetration (their ratio: 1 when the striker meets the
+                          same force-penetration curve, the energy method of collision analysis)
 A missing file or column skips its item with a note on stderr (plot_case: ...), never a traceback."""
 import csv
 import os
@@ -305,6 +313,38 @@ def milestones(run, suffix):
             key("inner_yield_penetration" + suffix + "_m", float(run.pen[hit[0]]))
             if w is not None:
                 key("energy_to_inner_yield" + suffix + "_J", float(w[hit[0]]))
+
+
+def collision(run, driven):
+    """A free bow: how deep it went and how much of its kinetic energy the section absorbed; with
+    a driven run of the same hull, the penetration at which the driven bow had done that work."""
+    if not run.has("hull.bow.kinetic_energy"):
+        note(f"{run.label}: no column hull.bow.kinetic_energy (collision keys skipped)")
+        return
+    ke = run.at("hull.bow.kinetic_energy")
+    if ke[0] <= 0.0:
+        return  # a driven bow: no collision keys
+    pen = run.at("hull.bow.penetration")
+    deepest = int(np.argmax(pen))
+    absorbed = float(ke[0] - ke[deepest])
+    key("collision_initial_kinetic_energy_J", float(ke[0]))
+    key("collision_max_penetration_m", float(pen[deepest]))
+    key("collision_absorbed_J", absorbed)
+    key("collision_final_kinetic_energy_J", float(ke[-1]))
+    if driven is None:
+        return
+    w = driven.work()
+    if w is None:
+        note("driven run: no hull.bow.work (driven_penetration_at_absorbed_m skipped)")
+        return
+    w = np.maximum.accumulate(w)
+    if absorbed > w[-1]:
+        note(f"the driven run did {w[-1]:.4g} J, less than the collision's {absorbed:.4g} J: "
+             "too short for the comparison")
+        return
+    reached = float(np.interp(absorbed, w, driven.pen))
+    key("driven_penetration_at_absorbed_m", reached)
+    key("collision_over_driven_penetration", float(pen[deepest]) / reached)
 
 
 def filled_over_empty(filled, empty):
@@ -632,12 +672,14 @@ def guarded(what, f, *args):
 
 
 def main():
-    args, outdir = [], None
+    args, outdir, driven_dir = [], None, None
     argv = sys.argv[1:]
     while argv:
         a = argv.pop(0)
         if a == "--out" and argv:
             outdir = argv.pop(0)
+        elif a == "--driven" and argv:
+            driven_dir = argv.pop(0)
         elif a in ("-h", "--help") or a.startswith("--"):
             sys.exit(__doc__)
         else:
@@ -652,6 +694,12 @@ def main():
             sys.exit(f"plot_case: {e}")
     filled = runs[0]
     empty = runs[1] if len(runs) > 1 else None
+    driven = None
+    if driven_dir:
+        try:
+            driven = Run(driven_dir, "driven")
+        except (RuntimeError, OSError) as e:
+            sys.exit(f"plot_case: --driven: {e}")
     outdir = outdir or args[0]
     os.makedirs(outdir, exist_ok=True)
 
@@ -665,6 +713,7 @@ def main():
         guarded(f"forces and milestones ({run.label})", milestones, run, "_" + run.label)
     if empty:
         guarded("filled_over_empty_min", filled_over_empty, filled, empty)
+    guarded("collision keys", collision, filled, driven)
     if filled.has("granules.breakage.events"):
         key("broken_granules", float(filled.at("granules.breakage.events")[-1]), "{:.0f}")
     else:

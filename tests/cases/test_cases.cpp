@@ -3,7 +3,9 @@
 // column over the last fraction of the rows with another column's mean, a value, or a bound, or
 // reads "key=value" lines printed by a post-processing script of the case folder; `max_abs_of`
 // takes the largest |value| of a column over every row instead (e.g. the energy balance error of
-// energy.csv at every output time).
+// energy.csv at every output time). A script check's `args` are passed after the run's output
+// folder; `{out:NAME}` stands for the output folder of the earlier run NAME of the same file (a
+// comparison of two runs, e.g. a collision against the driven run of the same structure).
 
 #include <catch2/catch.hpp>
 
@@ -16,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -112,12 +115,26 @@ TEST_CASE("cases: shortened runs meet their reference values", "[cases][slow]") 
     const fs::path checks = dir.path() / "checks.yaml";
     if (!fs::exists(checks)) continue;
     const YAML::Node doc = YAML::LoadFile(checks.string());
+    // a script's `args` may name an earlier run's output folder as {out:NAME}: that folder is
+    // kept until the end of the folder's runs
+    auto run_named = [](const std::string& a) {  // "{out:NAME}" -> NAME, else ""
+      return a.size() > 6 && a.rfind("{out:", 0) == 0 && a.back() == '}' ? a.substr(5, a.size() - 6)
+                                                                         : std::string();
+    };
+    std::set<std::string> referenced;
+    for (const YAML::Node& run : doc["runs"])
+      for (const YAML::Node& check : run["checks"])
+        for (const YAML::Node& arg : check["args"])
+          if (const std::string n = run_named(arg.as<std::string>()); !n.empty()) referenced.insert(n);
+    auto out_of = [](const std::string& name) {
+      return fs::temp_directory_path() /
+             ("partita_case_" + name + "_" + std::to_string(::getpid()));
+    };
     for (const YAML::Node& run : doc["runs"]) {
       const std::string name = run["name"].as<std::string>();
       DYNAMIC_SECTION(dir.path().filename().string() << "/" << name) {
         ++runs;
-        const fs::path out =
-            fs::temp_directory_path() / ("partita_case_" + name + "_" + std::to_string(::getpid()));
+        const fs::path out = out_of(name);
         fs::remove_all(out);
         std::string cmd =
             quote(PARTITA_EXECUTABLE) + " run " +
@@ -138,9 +155,20 @@ TEST_CASE("cases: shortened runs meet their reference values", "[cases][slow]") 
         };
         for (const YAML::Node& check : run["checks"]) {
           if (check["script"]) {
-            const auto [st, text] = shell(
+            std::string script_cmd =
                 python + " " + quote((dir.path() / check["script"].as<std::string>()).string()) +
-                " " + quote(out.string()));
+                " " + quote(out.string());
+            for (const YAML::Node& arg : check["args"]) {
+              std::string a = arg.as<std::string>();
+              if (const std::string other_run = run_named(a); !other_run.empty()) {
+                const fs::path other = out_of(other_run);
+                INFO("checks.yaml: " << a << " names a run that must come earlier in the file");
+                REQUIRE(fs::is_directory(other));
+                a = other.string();
+              }
+              script_cmd += " " + quote(a);
+            }
+            const auto [st, text] = shell(script_cmd);
             INFO("script output:\n" << text);
             REQUIRE(st == 0);
             const auto kv = key_values(text);
@@ -176,7 +204,12 @@ TEST_CASE("cases: shortened runs meet their reference values", "[cases][slow]") 
                   "mean of " + col + " over the last " + std::to_string(over) + " of " + file,
                   column_mean);
         }
-        fs::remove_all(out);
+        // an output a later run reads stays until that run is done with it
+        if (!referenced.count(name)) fs::remove_all(out);
+        for (const YAML::Node& check : run["checks"])
+          for (const YAML::Node& arg : check["args"])
+            if (const std::string n = run_named(arg.as<std::string>()); !n.empty())
+              fs::remove_all(out_of(n));
       }
     }
   }

@@ -48,7 +48,7 @@ std::shared_ptr<Spec> indenter_spec() {
   auto s = std::make_shared<Spec>(
       "indenter",
       "a rigid body that translates and touches the nodes of an FE face (penalty contact)");
-  s->string("name", "monitors <name>.x, .vx, .force_x, .penetration, .work, .contact_energy, "
+  s->string("name", "monitors <name>.x, .vx, .force_x, .penetration, .work, .kinetic_energy, .contact_energy, "
                     ".friction_work ...; the moving mesh <name> (sphere, capsule, surface)")
       .required();
   s->choice("shape",
@@ -246,6 +246,7 @@ void add_indenter_monitors(const std::string& name, const Eigen::Vector3d& refer
     out.push_back({name + ".force_" + kAxes[k], "N", contact.contact_force()[k]});
   out.push_back({name + ".penetration", "m", body.penetration()});
   out.push_back({name + ".work", "J", body.work()});
+  out.push_back({name + ".kinetic_energy", "J", body.kinetic_energy()});  // 0 when driven
   out.push_back({name + ".contact_energy", "J", contact.stored_energy()});
   out.push_back({name + ".friction_work", "J", contact.dissipated_work()});
   out.push_back({name + ".contact_nodes", "", static_cast<double>(contact.active_nodes())});
