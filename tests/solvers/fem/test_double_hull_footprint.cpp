@@ -1,13 +1,14 @@
 // Issue 29's check of the empty double hull (cases/double_hull_impact): before the first contact
 // spreads, the force of the rigid capsule indenter at small penetration against the same hull
 // loaded by a prescribed displacement of the indenter's footprint (within 10 %), and that force
-// against plate theory (bounded between the clamped plate's plastic collapse under a
-// concentrated load and its elastic point-load stiffness).
+// against plate theory (bounded between a plate's plastic collapse load under a
+// concentrated load and the clamped plate's elastic point-load stiffness).
 //
-// Run (1): the capsule (R = 30 mm, axis z) driven at a constant speed v into the outer plate's
-// middle cell (IndenterContact, penalty). Run (2): no indenter; the nodes of the outer face that
-// run (1) had in contact get the displacement the indenter's surface imposes,
-//   u_z(r, t) = max(0, delta(t) - (R - sqrt(R^2 - r^2))),  delta(t) = v t - g0,
+// Run (1): the capsule (R = 30 mm, axis z) driven into the outer plate's middle cell from rest at
+// the face, ramped to a constant speed v (IndenterContact, penalty). Run (2): no indenter; the
+// nodes of the outer face that run (1) had in contact get the displacement the indenter's
+// surface imposes,
+//   u_z(r, t) = max(0, delta(t) - (R - sqrt(R^2 - r^2))),  delta(t) the tip's travel,
 // r the node's in-plane distance from the axis (frictionless contact: the in-plane components
 // stay free). Same mesh, material, mass scaling, speed and time step.
 #include <catch2/catch.hpp>
@@ -177,17 +178,18 @@ RunResult run_prescribed(const HullSetup& h, const std::vector<std::size_t>& nod
 
 // Plate theory for the middle cell (a square plate of clear span a = 118 mm, t = 2 mm):
 //  - elastic, clamped edges, concentrated load at the centre: w = alpha P a^2 / D with
-//    alpha = 0.00560 (Timoshenko & Woinowsky-Krieger, Theory of Plates and Shells, 1959, table
-//    for clamped rectangular plates under a central load, b/a = 1), D = E t^3 / (12 (1 - nu^2)).
-//    The model is geometrically linear (small-strain J2: eps = sym(F - I)), so its elastic-plastic
-//    tangent never exceeds the elastic one and P(delta) <= k_el delta (the webs are less than a
-//    clamp, the mesh a little stiffer than the continuum: an estimate, with a wide margin here);
+//    alpha = 0.00560 (Timoshenko & Woinowsky-Krieger, Theory of Plates and Shells, 1959, the
+//    table of clamped rectangular plates under a central load, b/a = 1), D = E t^3 / (12 (1 -
+//    nu^2)). The model is geometrically linear (small-strain J2: eps = sym(F - I)), so its
+//    elastic-plastic tangent never exceeds the elastic one and P(delta) <= k_el delta (the webs
+//    hold less than a clamp, the mesh is a little stiffer than the continuum: an estimate, with
+//    a wide margin here);
 //  - plastic collapse under a concentrated load: P = 2 pi M0 for a simply supported plate of any
-//    shape (the fan mechanism; Tresca and von Mises alike), 4 pi M0 clamped, M0 = sigma_y t^2 / 4
-//    (Jones, Structural Impact, 1989, ch. 2). Once the centre's deflection is past the elastic
-//    deflection at that load (4 pi M0 / k_el = 1.5 mm) the force is above the simply supported
-//    value 2 pi M0, which any rotational restraint by the neighbouring cells and the hardening
-//    past the Lueders plateau (eps_p > 0.015) only raise.
+//    shape (the fan mechanism, Tresca's yield condition, which von Mises's does not undercut),
+//    4 pi M0 clamped, M0 = sigma_y t^2 / 4 (Jones, Structural Impact, 1989, ch. 2). Past the
+//    elastic deflection at the clamped collapse load (4 pi M0 / k_el = 1.5 mm) the force is
+//    above the simply supported value 2 pi M0, which the webs' and neighbours' rotational
+//    restraint and the hardening past the Lueders plateau (eps_p > 0.015) only raise.
 double elastic_point_stiffness() {
   const double a = kSpacing - kThickness;
   const double d = kYoung * std::pow(kThickness, 3) / (12.0 * (1.0 - kPoisson * kPoisson));
@@ -263,7 +265,7 @@ TEST_CASE("double hull: the indenter's force against a prescribed footprint disp
 // The numbers of cases/double_hull_impact/README.md ("Check: indenter against a prescribed
 // footprint"): half the speed, the geometric footprint prescribed instead of the nodes in
 // contact, the case's 3 x 3 hull with 20 and 10 mm elements, the finite-strain J2 law. Hidden
-// (about 3 minutes on one core): ./build/tests/partita_tests "[double_hull_readme]" -s
+// (about 7 minutes on one core): ./build/tests/partita_tests "[double_hull_readme]"
 TEST_CASE("double hull: footprint check on the case's hulls (README numbers)",
           "[.][double_hull_readme]") {
   const std::vector<double> checks = {0.002, 0.004, 0.006};
