@@ -265,7 +265,7 @@ TEST_CASE("double hull: the indenter's force against a prescribed footprint disp
 // The numbers of cases/double_hull_impact/README.md ("Check: indenter against a prescribed
 // footprint"): half the speed, the geometric footprint prescribed instead of the nodes in
 // contact, the case's 3 x 3 hull with 20 and 10 mm elements, the finite-strain J2 law. Hidden
-// (about 7 minutes on one core): ./build/tests/partita_tests "[double_hull_readme]"
+// (2.7 min of one core): ./build/tests/partita_tests "[double_hull_readme]"
 TEST_CASE("double hull: footprint check on the case's hulls (README numbers)",
           "[.][double_hull_readme]") {
   const std::vector<double> checks = {0.002, 0.004, 0.006};
