@@ -229,8 +229,9 @@ template void MeshContacts::evaluate<true, true>(int, const Particle&, const Nei
 
 // Each contact's reaction shared among its triangle's vertices with the barycentric weights of
 // the contact point, particles in order (a fixed summation order); then each triangle's force
-// from its vertices' (each vertex's force shared equally among its triangles): continuous as a
-// contact moves across triangles, sums preserved (see TriangleMesh::triangle_forces).
+// from its vertices' (each vertex's force shared equally among its active triangles; a triangle
+// taken out gets none): continuous as a contact moves across triangles, sums preserved (see
+// TriangleMesh::triangle_forces).
 // Every step, after the force pass. The contacts' scatter to the vertices is serial (a fixed
 // order); clearing the vertices and the triangles' shares run in parallel on large meshes (the
 // scale case's plate: 160,083 vertices, 105,800 triangles, every DEM step).
@@ -246,6 +247,10 @@ void MeshContacts::reduce(std::vector<TriangleMesh>& meshes) const {
   });
   for (TriangleMesh& m : meshes)
     detail::parallel_pass(m.triangle_count(), [&](int t) {
+      if (!m.triangle_active(t)) {  // taken out: its vertices' forces go to the active ones
+        m.triangle_force_.row(t).setZero();
+        return;
+      }
       const auto& tri = m.triangle(t);
       m.triangle_force_.row(t) = m.vertex_share_[tri[0]] * m.vertex_force_.row(tri[0]) +
                                  m.vertex_share_[tri[1]] * m.vertex_force_.row(tri[1]) +

@@ -211,6 +211,12 @@ void NeighborList::visit_pairs(const Particles& p, int i, Visit&& visit) const {
 
 void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& planes,
                          std::vector<TriangleMesh>& meshes) {
+  search(p, planes, meshes);
+  for (TriangleMesh& m : meshes) m.position_at_build_ = m.position_;
+}
+
+void NeighborList::search(const Particles& p, const std::vector<PlaneWall>& planes,
+                          const std::vector<TriangleMesh>& meshes) {
   ++builds_;
   const int n = static_cast<int>(p.size());
   // Grid over the particles' bounding box, cells 2 R_max + skin wide (at most ~4 N cells).
@@ -327,8 +333,8 @@ void NeighborList::build(const Particles& p, const std::vector<PlaneWall>& plane
   valid_ = true;
 }
 
-void NeighborList::build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes,
-                                         double r_max) {
+void NeighborList::build_mesh_candidates(const Particles& p,
+                                         const std::vector<TriangleMesh>& meshes, double r_max) {
   const int n = static_cast<int>(p.size());
   mesh_candidates_.clear();
   if (meshes.empty()) {  // no offsets per particle either
@@ -400,7 +406,6 @@ void NeighborList::build_mesh_candidates(const Particles& p, std::vector<Triangl
     int k = mesh_offsets_[i];
     visit(i, [&](MeshCandidate mc) { mesh_candidates_[k++] = mc; });
   }
-  for (TriangleMesh& m : meshes) m.position_at_build_ = m.position_;
 }
 
 }  // namespace partita::dem

@@ -94,7 +94,6 @@ double System::elastic_energy() const {
   const Particles& p = store_.core();
   const std::vector<Eigen::Vector3d>& plane_shear = walls_.shear(store_);
   const std::vector<PlaneWall>& planes = walls_.planes();
-  const NeighborList& nl = neighbors_;
   double e = 0.0;
   const int n = static_cast<int>(p.size());
   const Eigen::Vector3d no_shear = Eigen::Vector3d::Zero();
@@ -105,14 +104,20 @@ double System::elastic_energy() const {
     return hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
                                 p.radius[i] * p.radius[j] / rsum, shear);
   };
-  if (lists_current_ && nl.offsets_.size() == p.size() + 1) {
-    for (int i = 0; i < n; ++i)
-      for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s)
-        e += pair_energy(i, nl.neighbors_[s], pairs_.shear(s));
-  } else {  // before the first step: no lists yet, all pairs (no tangential history either)
-    for (int i = 0; i < n; ++i)
-      for (int j = i + 1; j < n; ++j) e += pair_energy(i, j, no_shear);
-  }
+  // The contacts of the last force pass, with their histories. Without lists for the present
+  // particles (before the first step, or after a change of the particle set until the next step)
+  // the pairs of the moment from a scratch neighbour search (skin 0: the touching pairs), without
+  // tangential histories; the meshes' contacts then are the last pass's (the particles still
+  // there; what settle_set_change() reads too) or, before the first pass, those of the moment,
+  // found as the first pass will find them (the force pass's own selection: a face, edge or vertex
+  // shared by several triangles counted once), without histories (new contacts have none).
+  const bool current = lists_current_ && neighbors_.offsets_.size() == p.size() + 1;
+  NeighborList scratch;
+  if (!current) scratch.search(p, planes, meshes_);
+  const NeighborList& nl = current ? neighbors_ : scratch;
+  for (int i = 0; i < n; ++i)
+    for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s)
+      e += pair_energy(i, nl.neighbors_[s], current ? pairs_.shear(s) : no_shear);
   const std::size_t np = planes.size();
   const bool have_shear = plane_shear.size() == p.size() * np;
   for (int i = 0; i < n; ++i)
@@ -122,11 +127,16 @@ double System::elastic_energy() const {
       e += hertz_elastic_energy(model_.pair(p.material[i], planes[k].material), delta, p.radius[i],
                                 have_shear ? plane_shear[i * np + k] : no_shear);
     }
-  mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec,
-                                      const Eigen::Vector3d& shear) {
+  auto mesh_energy = [&](int i, const MeshContactRecord& rec, const Eigen::Vector3d& shear) {
     e +=
         hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta, rec.r_eff, shear);
-  });
+  };
+  if (current || steps_ > 0)
+    mesh_contacts_.for_each_contact(mesh_energy);
+  else
+    MeshContacts::for_each_contact_now(
+        p, nl, meshes_, model_,
+        [&](int i, const MeshContactRecord& rec) { mesh_energy(i, rec, no_shear); });
   return e;
 }
 

@@ -65,11 +65,12 @@ TriangleMesh::TriangleMesh(const Eigen::Ref<const Eigen::MatrixX3d>& vertices,
   }
   triangle_force_ = Eigen::MatrixX3d::Zero(triangle_count(), 3);
   vertex_force_ = Eigen::MatrixX3d::Zero(nv, 3);
-  vertex_share_.assign(nv, 0.0);
+  vertex_triangles_.assign(nv, 0);
   for (const auto& tri : triangles_)
-    for (int v : tri) vertex_share_[v] += 1.0;
-  for (double& s : vertex_share_)
-    if (s > 0.0) s = 1.0 / s;
+    for (int v : tri) ++vertex_triangles_[v];
+  vertex_share_.assign(nv, 0.0);
+  for (int v = 0; v < nv; ++v)
+    if (vertex_triangles_[v] > 0) vertex_share_[v] = 1.0 / vertex_triangles_[v];
 
   // Topology for the local-closest test: opposite vertices of each edge, neighbours of each
   // vertex (compressed rows).
@@ -113,6 +114,12 @@ void TriangleMesh::set_triangle_active(int t, bool active) {
   if ((active_[t] != 0) == active) return;
   active_[t] = active ? 1 : 0;
   inactive_ += active ? -1 : 1;
+  // a vertex's force is shared among the active triangles that have it (a vertex with force
+  // has one: the contacts touch active triangles only)
+  for (int v : triangles_[t]) {
+    vertex_triangles_[v] += active ? 1 : -1;
+    vertex_share_[v] = vertex_triangles_[v] > 0 ? 1.0 / vertex_triangles_[v] : 0.0;
+  }
 }
 
 bool TriangleMesh::feature_is_local_closest(int t, const TriangleClosestPoint& cp,

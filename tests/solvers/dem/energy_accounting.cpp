@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <tuple>
 
 using namespace partita::dem;
 
@@ -227,4 +228,95 @@ TEST_CASE("dem energy: the energies are part of the saved state", "[dem][energy]
   CHECK(sys.energies().gravity == a.gravity);
   CHECK(sys.energies().wall_work == a.wall_work);
   CHECK(a.friction > 0.0);
+}
+
+TEST_CASE("dem energy: a sphere pressed into a mesh holds the Hertz energy before the first step, "
+          "its face, edge or vertex counted once",
+          "[dem][energy][mesh]") {
+  // A sphere of radius R pressed by delta into a mesh of its own material (E* = E / (2 (1 -
+  // nu^2)), R* = R) stores 8/15 E* sqrt(R) delta^(5/2), the integral of the Hertz force
+  // 4/3 E* sqrt(R) d^(3/2) over the overlap. Before the first step no force pass has run (the
+  // mesh contacts are found for the energy as the pass will find them); after the first step
+  // the accounting's start value holds the first pass's contacts: both give the Hertz energy.
+  const double e_star = E / (2.0 * (1.0 - NU * NU)), delta = 1e-5;
+  const double hertz = 8.0 / 15.0 * e_star * std::sqrt(R) * std::pow(delta, 2.5);
+  const double s = 4 * R;  // the flat square: 2 x 2 cells of side s/2, 8 triangles, at z = 0
+  Eigen::MatrixX3d flat;
+  TriangleMesh::Triangles flat_t;
+  square(s, 0.0, 0.0, 0.0, flat, flat_t);
+  // a roof: two faces rising at 1 in 5 to a ridge along y at x = 0 (each face two triangles;
+  // the ridge is an edge of one triangle of each face)
+  const double L = 4 * R, h = 0.2 * L;
+  Eigen::MatrixX3d roof(6, 3);
+  roof << -L, -L, 0, 0, -L, h, L, -L, 0, -L, L, 0, 0, L, h, L, L, 0;
+  TriangleMesh::Triangles roof_t(4, 3);
+  roof_t << 0, 1, 4, 0, 4, 3, 1, 2, 5, 1, 5, 4;
+  struct Placement {
+    const char* what;
+    const Eigen::MatrixX3d* vertices;
+    const TriangleMesh::Triangles* triangles;
+    Eigen::Vector3d point;   // the touching point of the mesh
+    Eigen::Vector3d normal;  // from it towards the sphere's centre
+  };
+  const Eigen::Vector3d up(0, 0, 1);
+  const Eigen::Vector3d out = Eigen::Vector3d(-1, -1, 1).normalized();
+  const Placement cases[] = {
+      {"inside a face", &flat, &flat_t, {-0.1 * s, -0.4 * s, 0}, up},
+      {"on the diagonal edge of two coplanar triangles", &flat, &flat_t, {-0.25 * s, -0.25 * s, 0},
+       up},
+      {"on the edge between two cells", &flat, &flat_t, {0, -0.3 * s, 0}, up},
+      {"on the vertex of six coplanar triangles", &flat, &flat_t, {0, 0, 0}, up},
+      {"beyond the corner vertex of the square", &flat, &flat_t, {-0.5 * s, -0.5 * s, 0}, out},
+      {"on the ridge of a roof (an edge of two faces at an angle)", &roof, &roof_t,
+       {0, -0.3 * L, h}, up},
+  };
+  for (const Placement& c : cases) {
+    System sys = energy_system(0.5, 0.3);
+    const Eigen::Vector3d centre = c.point + (R - delta) * c.normal;
+    sys.add_particle(centre, R, 0);
+    sys.add_mesh(*c.vertices, *c.triangles, 0);
+    const double before = sys.elastic_energy();
+    const double dt = 0.1 * sys.rayleigh_time_step();
+    sys.step(dt);
+    const double first_pass = sys.energies().elastic_start;
+    INFO(c.what << ": elastic energy before the first step " << before << " J, at the first pass "
+                << first_pass << " J, Hertz " << hertz << " J");
+    CHECK(before == Approx(hertz).epsilon(1e-12));
+    CHECK(first_pass == Approx(hertz).epsilon(1e-12));
+    CHECK(sys.mesh_force(0).norm() > 0.0);  // (the first pass found the contact too)
+  }
+}
+
+TEST_CASE("dem energy: the elastic energy before the first step leaves the run as it was",
+          "[dem][energy][mesh]") {
+  // Asking for the energy before the first step (a scratch search of the contacts) changes
+  // nothing in what the steps compute: the same bits with and without the question.
+  auto run = [](bool ask) {
+    System sys = energy_system(0.5, 0.3);
+    sys.set_gravity({0, 0, -9.81});
+    const Packing pk = test::two_size_packing(Eigen::Vector3d::Zero(),
+                                              Eigen::Vector3d(6e-3, 6e-3, 4e-3), 1.6e-3, 1.2e-3,
+                                              0.6, 5);
+    sys.add_particles(pk.positions, pk.radii, 0);
+    Eigen::MatrixX3d x;
+    TriangleMesh::Triangles t;
+    square(6e-3, 3e-3, 3e-3, 0.1e-3, x, t);  // a floor that overlaps the lowest spheres
+    const int mesh = sys.add_mesh(x, t, 0);
+    double e0 = 0.0;
+    if (ask) e0 = sys.elastic_energy();
+    const double dt = 0.1 * sys.rayleigh_time_step();
+    sys.run(200, dt);
+    return std::make_tuple(e0, sys.particles().position, sys.mesh_force(mesh),
+                           sys.energies().elastic_start);
+  };
+  const auto [e_asked, x_asked, f_asked, start_asked] = run(true);
+  const auto [e_not, x_not, f_not, start_not] = run(false);
+  INFO("elastic energy before the first step " << e_asked << " J, at the first pass "
+                                               << start_asked << " J");
+  CHECK(e_asked > 0.0);
+  CHECK(e_asked == Approx(start_asked).epsilon(1e-12));  // the same contacts
+  CHECK(start_asked == start_not);
+  CHECK(f_asked == f_not);
+  REQUIRE(x_asked.size() == x_not.size());
+  for (std::size_t i = 0; i < x_asked.size(); ++i) CHECK(x_asked[i] == x_not[i]);
 }

@@ -358,7 +358,21 @@ TEST_CASE("dem: a particle falls through where mesh triangles are taken out, bes
   const int a = p.position[0].x() < 0.0 ? 0 : 1;  // A: over cell (0, 0)
   CHECK(p.position[a].z() == Approx(R - 0.5 * g * time * time).epsilon(1e-6));
   CHECK(p.position[1 - a].z() == Approx(R).epsilon(1e-3));
-  CHECK(sys.mesh_force(mesh).z() == Approx(-test::sphere_mass(R, RHO) * g).epsilon(1e-2));
+  const double weight = test::sphere_mass(R, RHO) * g;
+  CHECK(sys.mesh_force(mesh).z() == Approx(-weight).epsilon(1e-2));
+  // The triangle forces: B rests on the diagonal (vertices 4 and 8) of cell (1, 1), half its
+  // weight on each by the lever rule. The middle vertex 4 has eight triangles, six of them
+  // active: each active one gets W/2 / 6 from it, the two removed ones nothing (their surface is
+  // gone); the corner vertex 8 gives W/2 / 2 to each triangle of cell (1, 1). Triangles: cell
+  // (0, 0) 0, 1; (1, 0) 2, 3; (0, 1) 4, 5; (1, 1) 6, 7.
+  const Eigen::MatrixX3d& ft = sys.triangle_forces(mesh);
+  const double f = sys.mesh_force(mesh).z();  // (B's contact force: W while it rests)
+  CHECK(ft.row(0).norm() == 0.0);
+  CHECK(ft.row(1).norm() == 0.0);
+  for (int k = 2; k < 6; ++k) CHECK(ft(k, 2) == Approx(f / 12.0).epsilon(1e-9));
+  for (int k = 6; k < 8; ++k) CHECK(ft(k, 2) == Approx(f / 3.0).epsilon(1e-9));
+  CHECK((ft.colwise().sum() - sys.vertex_forces(mesh).colwise().sum()).norm() <=
+        1e-12 * weight);
   CHECK_THROWS_AS(sys.set_triangle_active(mesh, 8, false), Error);
 }
 

@@ -19,6 +19,7 @@
 #include "partita/dem/energy_sums.hpp"
 #include "partita/dem/mesh_contact_record.hpp"
 #include "partita/dem/neighbor_list.hpp"
+#include "partita/dem/particles.hpp"
 #include "partita/dem/triangle_mesh.hpp"
 
 #include <algorithm>
@@ -99,6 +100,33 @@ class MeshContacts {
         const std::size_t s = static_cast<std::size_t>(slot_[r] + c);
         visit(particle_[r], record_[s], shear_[s]);
       }
+  }
+
+  /// Calls visit(i, record) for every contact the particles would have with the meshes at their
+  /// present positions, found as the force pass finds them (evaluate(): features counted once),
+  /// from the candidates of `lists` (built for these positions, e.g. a scratch search()), without
+  /// tangential histories and without storing anything; particles in order. For the contacts
+  /// before the first force pass (System::elastic_energy()), when the rows hold none yet.
+  template <class Visit>
+  static void for_each_contact_now(const Particles& p, const NeighborList& lists,
+                                   const std::vector<TriangleMesh>& meshes,
+                                   const ContactModel& model, Visit&& visit) {
+    if (meshes.empty()) return;
+    const int n = static_cast<int>(p.size());
+    const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+    for (int i = 0; i < n; ++i) {
+      if (lists.mesh_offsets_[i + 1] == lists.mesh_offsets_[i]) continue;
+      int count = 0;
+      std::int64_t key[max_contacts];
+      Eigen::Vector3d shear[max_contacts];
+      MeshContactRecord records[max_contacts];
+      const Row row{count, max_contacts, key, shear, records};
+      const Particle q{p.position[i], p.radius[i], zero, p.mass[i], zero, p.material[i]};
+      Eigen::Vector3d f = Eigen::Vector3d::Zero(), t = Eigen::Vector3d::Zero();
+      double load = 0.0;
+      evaluate<false>(i, q, lists, meshes, model, row, 0.0, false, f, t, load);
+      for (int c = 0; c < count; ++c) visit(i, records[c]);
+    }
   }
 
   /// Adds the mesh contact forces and torques of particle i (candidates from `lists`) to f and t,

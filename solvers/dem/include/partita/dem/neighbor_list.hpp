@@ -63,6 +63,12 @@ class NeighborList {
   /// of the previous build that are still listed).
   void build(const Particles& particles, const std::vector<PlaneWall>& planes,
              std::vector<TriangleMesh>& meshes);
+  /// The same lists for the current positions without marking the meshes' positions at the
+  /// build (build() = search() + that mark): for a scratch list that looks at the contacts of
+  /// the moment and leaves the meshes as they are (System::elastic_energy() before the first
+  /// step).
+  void search(const Particles& particles, const std::vector<PlaneWall>& planes,
+              const std::vector<TriangleMesh>& meshes);
   /// After the caller renumbered the particles (old index i is now new_of_old[i]): rewrites the
   /// pair rows in the new numbering (slot_sources(): a pair's old slot and whether its order
   /// flipped), so that the next build() finds the pairs again. The lists must be rebuilt before
@@ -118,7 +124,8 @@ class NeighborList {
   // kDegenerateMinParticles an all-pairs search is cheap anyway.
   static constexpr double kDegenerateVisits = 4096.0;
   static constexpr int kDegenerateMinParticles = 8192;
-  void build_mesh_candidates(const Particles& p, std::vector<TriangleMesh>& meshes, double r_max);
+  void build_mesh_candidates(const Particles& p, const std::vector<TriangleMesh>& meshes,
+                             double r_max);
 
   double skin_ = 0.0;
   long builds_ = 0;

@@ -230,7 +230,12 @@ class System {
   /// Kinetic energy, translational + rotational [J].
   double kinetic_energy() const;
   /// Elastic energy stored in all contacts (Hertz 8/15 E* sqrt(R*) delta^(5/2) + tangential
-  /// springs) at the current positions [J].
+  /// springs) at the current positions [J]: the contacts of the last force pass with their
+  /// tangential springs. Before the first step the contacts of the moment, particle pairs, planes
+  /// and mesh features alike, found by a scratch neighbour search as the first pass will find
+  /// them (a mesh's face, edge or vertex counted once), without tangential springs (new contacts
+  /// have none); after a change of the particle set, until the next step, the pairs likewise and
+  /// the mesh contacts of the last pass. The System's state is not changed.
   double elastic_energy() const;
   /// Gravitational potential energy -sum m g.x [J].
   double potential_energy() const;

@@ -66,10 +66,11 @@ class TriangleMesh {
   /// Force exerted by the particles on each vertex / triangle in the last step [N]. A contact's
   /// force goes to the vertices of its triangle with the barycentric weights of the contact
   /// point (exact lever rule); a triangle's force is the sum of its vertices' forces, each shared
-  /// equally among the triangles that have the vertex. Both sum to the total, and both change
-  /// continuously as a contact moves across a triangle edge (a contact's whole force put on the
-  /// triangle it touches would jump from one triangle to the next: a traction field built on
-  /// that made the implicit FEM/DEM windows of the rubber plate stall, 7.8 iterations instead of
+  /// equally among the active triangles that have the vertex (a triangle taken out gets none:
+  /// its surface is gone, the rim of the hole carries the force). Both sum to the total, and both
+  /// change continuously as a contact moves across a triangle edge (a contact's whole force put
+  /// on the triangle it touches would jump from one triangle to the next: a traction field built
+  /// on that made the implicit FEM/DEM windows of the rubber plate stall, 7.8 iterations instead of
   /// 2.1; see cases/uniaxial_compaction/README.md).
   const Eigen::MatrixX3d& triangle_forces() const { return triangle_force_; }
   const Eigen::MatrixX3d& vertex_forces() const { return vertex_force_; }
@@ -99,9 +100,10 @@ class TriangleMesh {
   std::vector<int> vertex_neighbor_offset_, vertex_neighbor_;
   // the triangle of each edge_opposite_ entry, the edge of each vertex_neighbor_ entry
   std::vector<int> edge_opposite_triangle_, vertex_neighbor_edge_;
-  std::vector<char> active_;          // per triangle (see triangle_active())
-  int inactive_ = 0;                  // triangles not active
-  std::vector<double> vertex_share_;  // 1 / the number of triangles that have the vertex
+  std::vector<char> active_;           // per triangle (see triangle_active())
+  int inactive_ = 0;                   // triangles not active
+  std::vector<int> vertex_triangles_;  // the number of active triangles that have the vertex
+  std::vector<double> vertex_share_;   // 1 / that number (0 for none)
   Eigen::MatrixX3d triangle_force_;
   Eigen::MatrixX3d vertex_force_;
   int material_ = 0;
