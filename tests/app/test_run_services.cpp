@@ -50,15 +50,7 @@ std::size_t lines(const fs::path& p) {
   return static_cast<std::size_t>(std::count(t.begin(), t.end(), '\n'));
 }
 
-// Every file of the run that a user reads: the CSV files and everything under vtk/.
-std::set<std::string> result_files(const fs::path& dir) {
-  std::set<std::string> files;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().extension() == ".csv") files.insert(e.path().filename().string());
-  for (const auto& e : fs::directory_iterator(dir / "vtk"))
-    files.insert("vtk/" + e.path().filename().string());
-  return files;
-}
+using partita::test::result_files;
 
 void require_identical_results(const fs::path& a, const fs::path& b) {
   const auto fa = result_files(a), fb = result_files(b);
