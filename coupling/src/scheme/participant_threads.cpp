@@ -1,10 +1,12 @@
 #include "participant_threads.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <csignal>
 #include <stdexcept>
 
 #include <pthread.h>
+#include <strings.h>
 
 #include "partita/interface/error.hpp"
 
@@ -64,7 +66,36 @@ class BlockSignals {
   sigset_t before_;
 };
 
+constexpr std::chrono::microseconds kSpin{200};
+
+// Spin, or sleep at once: OMP_WAIT_POLICY=PASSIVE (case-insensitive) asks for the latter.
+bool passive_wait() {
+  const char* policy = std::getenv("OMP_WAIT_POLICY");
+  return policy != nullptr && strcasecmp(policy, "passive") == 0;
+}
+
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#else
+  std::this_thread::yield();
+#endif
+}
+
 }  // namespace
+
+template <class Ready>
+bool ParticipantThreads::spin(Ready ready) const {
+  if (spin_.count() == 0) return ready();
+  const auto until = std::chrono::steady_clock::now() + spin_;
+  for (;;) {
+    for (int i = 0; i < 64; ++i) {
+      if (ready()) return true;
+      cpu_relax();
+    }
+    if (std::chrono::steady_clock::now() >= until) return ready();
+  }
+}
 
 void rethrow_from(const Participant& p, std::exception_ptr e) {
   try {
@@ -82,31 +113,36 @@ void ParticipantThreads::start(std::size_t jobs) {
   omp_threads_.assign(jobs, 1);
   for (int i = 0; i < k; ++i) omp_threads_[i] = std::max(1, n / k + (i < n % k ? 1 : 0));
   errors_.assign(jobs, nullptr);
+  spin_ = passive_wait() ? std::chrono::nanoseconds(0) : std::chrono::nanoseconds(kSpin);
   const BlockSignals blocked;
   threads_.reserve(jobs - 1);
-  const std::uint64_t seen = generation_;  // the windows before these workers are not theirs
+  const std::uint64_t seen = generation_.load();  // the windows before these are not theirs
   for (std::size_t i = 0; i + 1 < jobs; ++i)
     threads_.emplace_back([this, i, seen] { work(i, seen); });
 }
 
 void ParticipantThreads::work(std::size_t i, std::uint64_t seen) {
   omp_set_threads(omp_threads_[i + 1]);
+  const auto ready = [&] {
+    return stopping_.load(std::memory_order_acquire) ||
+           generation_.load(std::memory_order_acquire) != seen;
+  };
   for (;;) {
-    {
+    if (!spin(ready)) {
       std::unique_lock<std::mutex> lock(mutex_);
-      start_.wait(lock, [&] { return stopping_ || generation_ != seen; });
-      if (stopping_) return;
-      seen = generation_;
+      start_.wait(lock, ready);
     }
+    if (stopping_.load(std::memory_order_acquire)) return;
+    seen = generation_.load(std::memory_order_acquire);  // window_, jobs_ are this window's
     const Job& job = jobs_[i + 1];
     try {
       job.participant->run_window(*window_, job.inputs, job.outputs);
     } catch (...) {
       errors_[i + 1] = std::current_exception();
     }
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (--pending_ == 0) done_.notify_one();
+    if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) {
+      const std::lock_guard<std::mutex> lock(mutex_);  // (the caller may be about to sleep)
+      done_.notify_one();
     }
   }
 }
@@ -126,12 +162,12 @@ void ParticipantThreads::run_window(const TimeWindow& window, std::span<const Jo
   }
   if (jobs.size() != threads_.size() + 1)
     throw std::logic_error("ParticipantThreads::run_window: a different number of participants");
+  window_ = &window;  // (published by the release below; no worker reads them until then)
+  jobs_ = jobs;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    window_ = &window;
-    jobs_ = jobs;
-    pending_ = threads_.size();
-    ++generation_;
+    const std::lock_guard<std::mutex> lock(mutex_);  // (a worker may be about to sleep)
+    pending_.store(threads_.size(), std::memory_order_relaxed);
+    generation_.fetch_add(1, std::memory_order_release);
   }
   start_.notify_all();
   {
@@ -142,9 +178,10 @@ void ParticipantThreads::run_window(const TimeWindow& window, std::span<const Jo
       errors_[0] = std::current_exception();
     }
   }
-  {
+  const auto finished = [&] { return pending_.load(std::memory_order_acquire) == 0; };
+  if (!spin(finished)) {
     std::unique_lock<std::mutex> lock(mutex_);
-    done_.wait(lock, [&] { return pending_ == 0; });
+    done_.wait(lock, finished);
   }
   std::exception_ptr first;
   std::ptrdiff_t failed = -1;
@@ -161,14 +198,14 @@ void ParticipantThreads::run_window(const TimeWindow& window, std::span<const Jo
 void ParticipantThreads::stop() {
   if (threads_.empty()) return;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    stopping_.store(true, std::memory_order_release);
   }
   start_.notify_all();
   for (std::thread& t : threads_) t.join();
   threads_.clear();
   errors_.clear();
-  stopping_ = false;
+  stopping_.store(false);
 }
 
 }  // namespace partita::coupling

@@ -18,7 +18,15 @@
 //
 // Signals: the workers block the asynchronous ones (SIGINT, SIGTERM, ...): a stop request is
 // handled by the calling thread, and the run stops after the window, as without threads.
+//
+// Waiting: as OpenMP's threads do, a worker waiting for the next window and the caller waiting for
+// the workers spin for a while (kSpin, 200 us: longer than the core's work between two windows
+// of a light case), then sleep on a condition variable; with OMP_WAIT_POLICY=PASSIVE they sleep
+// at once (a loaded machine, the test suite). A sleeping thread's wake-up costs a scheduler
+// round trip (10-50 us on an idle machine, milliseconds on a loaded one), twice a window.
 
+#include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
@@ -71,11 +79,16 @@ class ParticipantThreads {
   std::vector<std::thread> threads_;
   std::vector<int> omp_threads_;
   std::vector<std::exception_ptr> errors_;  // per job, this window's
-  std::mutex mutex_;
+  // Spin on ready() for up to spin_ (true: it held), else false: sleep on a condition.
+  template <class Ready>
+  bool spin(Ready ready) const;
+
+  std::chrono::nanoseconds spin_{0};
+  std::mutex mutex_;  // for the condition variables (the atomics below change under it too)
   std::condition_variable start_, done_;
-  std::uint64_t generation_ = 0;  // windows handed out (a worker runs each new one once)
-  std::size_t pending_ = 0;       // workers still in this window
-  bool stopping_ = false;
+  std::atomic<std::uint64_t> generation_{0};  // windows handed out (a worker runs each once)
+  std::atomic<std::size_t> pending_{0};       // workers still in this window
+  std::atomic<bool> stopping_{false};
   // this window's (set under the mutex before generation_ moves on)
   const TimeWindow* window_ = nullptr;
   std::span<const Job> jobs_;
