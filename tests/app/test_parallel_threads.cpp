@@ -65,6 +65,22 @@ TEST_CASE("parallel schemes on threads write the bytes of the participants one a
   }
 }
 
+TEST_CASE("parallel schemes on threads share --threads N: N / k each, the first N mod k one more",
+          "[app][threads]") {
+  const fs::path dir = scratch("share");
+  const std::string c = quote((kSource / "cases/elastic_tube_1d/iqn-ils.yaml").string()) +
+                        " --set coupling.scheme=implicit-parallel --set time.end=0.03 "
+                        "--log-level info --output " + quote(dir.string());
+  // (--threads 2: 1, 1 above; each run also plots its CSV files, a few seconds)
+  for (const auto& [threads, share] : {std::pair<int, std::string>{1, "1, 1"}, {3, "2, 1"}}) {
+    const auto r = partita::test::run_partita("run " + c + " --threads " + std::to_string(threads));
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    CHECK(r.output.find("on threads, OpenMP threads " + share + ":") != std::string::npos);
+  }
+  fs::remove_all(dir);
+}
+
 TEST_CASE("parallel schemes on threads: a participant that fails stops the run naming it",
           "[app][threads][errors]") {
   // the tube with an explicit coupling is unstable: the fluid's Newton iteration fails
