@@ -195,6 +195,7 @@ void CaseRun::run() {
     throw;
   }
   progress_line.finish();
+  scheme_->stop_threads();  // the participants' threads (a concurrent parallel scheme)
   flush_csv_files();
   Stopwatch close_clock;
   coupling_csv_.close();
@@ -215,6 +216,8 @@ void CaseRun::run() {
   }
   for (auto& e : exchanges_) summary_.mapping_seconds += e->mapping_seconds();
   accounted += summary_.mapping_seconds;
+  summary_.overlap_seconds = scheme_->overlap_seconds();
+  accounted -= summary_.overlap_seconds;  // counted twice above: both participants worked
   summary_.core_seconds = std::max(0.0, summary_.wall_seconds - accounted);
 
   for (const auto& p : participants_)
@@ -223,6 +226,12 @@ void CaseRun::run() {
   std::string parts;
   for (const auto& [n, s] : summary_.participant_seconds)
     parts += fmt::format("{} {:.3f} s, ", n, s);
+  if (const std::vector<int> omp = scheme_->concurrent_omp_threads(); !omp.empty()) {
+    std::string each;
+    for (const int t : omp) each += fmt::format("{}{}", each.empty() ? "" : ", ", t);
+    parts += fmt::format("(at the same time on threads, OpenMP threads {}: overlap -{:.3f} s), ",
+                         each, summary_.overlap_seconds);
+  }
   logger->info(
       "summary: {} windows, {} iterations (mean {:.2f}, max {}{}); wall {:.3f} s = {}mapping "
       "{:.3f} s, "

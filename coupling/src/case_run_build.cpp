@@ -144,6 +144,12 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     for (auto& e : exchanges_) ctx.exchanges.push_back(e.get());
     const auto& entry = registries_.schemes.get(coupling["scheme"]);
     scheme_ = entry.factory(ctx);
+    if (coupling.has("concurrent") && coupling.boolean("concurrent") && !scheme_->parallel())
+      coupling["concurrent"].fail(
+          "scheme '" + scheme_->name() +
+          "' runs its participants one after the other (each reads what the one before it "
+          "wrote in the window); 'concurrent' applies to explicit-parallel and implicit-parallel");
+    scheme_->set_concurrent(coupling.boolean("concurrent"));
   } else {
     // A single-solver case: the participant steps through the windows alone (no exchanges).
     scheme_ = std::make_unique<ExplicitScheme>(std::vector<Participant*>{participants_[0].get()},

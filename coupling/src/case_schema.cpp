@@ -94,6 +94,13 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
                {"error", "accept"})
       .def("accept");
   coupling
+      ->boolean("concurrent",
+                "parallel schemes (explicit-parallel, implicit-parallel): the participants of "
+                "this process take each window at the same time, each on a thread of its own, "
+                "sharing the --threads (2 participants, --threads 4: 2 OpenMP threads each); "
+                "false: one after the other; the results are the same bits either way")
+      .def(true);
+  coupling
       ->real("balance_tolerance",
              "warn when an exchange's total (a force's sum, or a traction's or other field's "
              "integral over point weights) arrives after mapping off by more than this fraction "

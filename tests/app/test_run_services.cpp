@@ -50,15 +50,7 @@ std::size_t lines(const fs::path& p) {
   return static_cast<std::size_t>(std::count(t.begin(), t.end(), '\n'));
 }
 
-// Every file of the run that a user reads: the CSV files and everything under vtk/.
-std::set<std::string> result_files(const fs::path& dir) {
-  std::set<std::string> files;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().extension() == ".csv") files.insert(e.path().filename().string());
-  for (const auto& e : fs::directory_iterator(dir / "vtk"))
-    files.insert("vtk/" + e.path().filename().string());
-  return files;
-}
+using partita::test::result_files;
 
 void require_identical_results(const fs::path& a, const fs::path& b) {
   const auto fa = result_files(a), fb = result_files(b);
@@ -168,14 +160,19 @@ TEST_CASE("restart: a damaged, foreign or missing restart file is a clear error"
   fs::remove_all(dir);
 }
 
-TEST_CASE("SIGINT: the window ends, CSV files are complete, a restart file continues the run",
-          "[app][signal]") {
+namespace {
+
+// The tube (IQN-ILS) interrupted by SIGINT after about a second, then resumed; `scheme`: the
+// coupling scheme (a parallel one runs its participants on threads: the signal reaches the main
+// thread, the workers finish the window).
+void sigint_round_trip(const std::string& scheme) {
   const fs::path dir = scratch("signal");
   const std::string case_file = (kSource / "cases/elastic_tube_1d/iqn-ils.yaml").string();
   const std::string log = (dir / "log.txt").string();
   // a long run (10^4 windows), interrupted after about a second
   std::vector<std::string> args = {PARTITA_EXECUTABLE, "run",      case_file,   "--set",
-                                   "time.end=100",     "--output", dir.string()};
+                                   "time.end=100",     "--output", dir.string(), "--set",
+                                   "coupling.scheme=" + scheme};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -212,11 +209,21 @@ TEST_CASE("SIGINT: the window ends, CSV files are complete, a restart file conti
   // continue for 5 more windows
   const double end = 0.01 * static_cast<double>(rows + 5);
   const auto r = partita_run("run " + quote(case_file) + " --set time.end=" + std::to_string(end) +
-                             " --resume " + quote(dir.string()));
+                             " --set coupling.scheme=" + scheme + " --resume " + quote(dir.string()));
   INFO(r.output);
   CHECK(r.status == 0);
   CHECK(lines(dir / "coupling.csv") == rows + 5 + 1);
   fs::remove_all(dir);
+}
+
+}  // namespace
+
+TEST_CASE("SIGINT: the window ends, CSV files are complete, a restart file continues the run",
+          "[app][signal]") {
+  SECTION("implicit-serial") { sigint_round_trip("implicit-serial"); }
+  SECTION("implicit-parallel, the participants on threads") {
+    sigint_round_trip("implicit-parallel");
+  }
 }
 
 TEST_CASE(

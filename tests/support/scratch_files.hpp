@@ -1,11 +1,12 @@
 #pragma once
 // Files for the tests that drive the partita executable: a fresh scratch folder per test and
-// process, and a file's bytes. Header-only, beside run_command.hpp.
+// process, a file's bytes, and the result files of a run. Header-only, beside run_command.hpp.
 
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -26,6 +27,16 @@ inline std::string read_file(const std::filesystem::path& p) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+/// Every file of a run's folder that a user reads: the CSV files and everything under vtk/.
+inline std::set<std::string> result_files(const std::filesystem::path& dir) {
+  std::set<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".csv") files.insert(e.path().filename().string());
+  for (const auto& e : std::filesystem::directory_iterator(dir / "vtk"))
+    files.insert("vtk/" + e.path().filename().string());
+  return files;
 }
 
 }  // namespace partita::test

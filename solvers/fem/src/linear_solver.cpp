@@ -3,6 +3,7 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cstring>
+#include <mutex>
 
 #include "partita/fem/error.hpp"
 #include "supernodal_factorize.hpp"
@@ -144,6 +145,19 @@ class EigenLdlt final : public SparseFactorisation::Impl {
 #ifdef PARTITA_HAS_CHOLMOD
 // ---------------------------------------------------------------- CHOLMOD, supernodal L L^T
 
+// One CHOLMOD call at a time in the process: its supernodal factorisation and solve call the
+// system BLAS, and Debian's serial OpenBLAS gives wrong results now and then when two threads
+// call it at once (bench_blas_threads, bench/README.md); its analysis calls METIS, whose random
+// generator is one static state. Two solvers in one process may run at the same time (the
+// participants of a parallel coupling scheme, each on a thread of its own). Uncontended, the lock
+// costs nanoseconds against the call's microseconds; contended, the calls wait for each other.
+namespace {
+std::mutex& cholmod_mutex() {
+  static std::mutex m;
+  return m;
+}
+}  // namespace
+
 class Cholmod final : public SparseFactorisation::Impl {
  public:
   Cholmod(FillOrdering ordering, bool indefinite_ok) : indefinite_ok_(indefinite_ok) {
@@ -182,7 +196,10 @@ class Cholmod final : public SparseFactorisation::Impl {
   void analyze(const SparseMatrix& a) override {
     cholmod_free_factor(&l_, &c_);
     cholmod_sparse view = lower_view(a);
-    l_ = cholmod_analyze(&view, &c_);
+    {
+      const std::lock_guard<std::mutex> lock(cholmod_mutex());
+      l_ = cholmod_analyze(&view, &c_);
+    }
     if (l_ == nullptr || c_.status < CHOLMOD_OK) {
       throw Error("CHOLMOD: the symbolic analysis failed (status " + std::to_string(c_.status) +
                   (c_.status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "") + ")");
@@ -222,7 +239,11 @@ class Cholmod final : public SparseFactorisation::Impl {
       positive_definite = failed < 0;
     } else {
       cholmod_sparse view = lower_view(a);
-      const int ok = cholmod_factorize(&view, l_, &c_);
+      int ok = 0;
+      {
+        const std::lock_guard<std::mutex> lock(cholmod_mutex());
+        ok = cholmod_factorize(&view, l_, &c_);
+      }
       if (c_.status == CHOLMOD_OUT_OF_MEMORY)
         throw Error("CHOLMOD: out of memory in the factorisation");
       positive_definite = ok && c_.status != CHOLMOD_NOT_POSDEF && l_->minor >= l_->n;
@@ -267,7 +288,12 @@ class Cholmod final : public SparseFactorisation::Impl {
     rhs.xtype = CHOLMOD_REAL;
     rhs.dtype = CHOLMOD_DOUBLE;
     // x_, y_, e_ are allocated on the first call and reused while the size is the same
-    if (!cholmod_solve2(CHOLMOD_A, l_, &rhs, nullptr, &x_, nullptr, &y_, &e_, &c_)) {
+    bool solved = false;
+    {
+      const std::lock_guard<std::mutex> lock(cholmod_mutex());
+      solved = cholmod_solve2(CHOLMOD_A, l_, &rhs, nullptr, &x_, nullptr, &y_, &e_, &c_);
+    }
+    if (!solved) {
       throw Error("CHOLMOD: the solve failed (status " + std::to_string(c_.status) + ")");
     }
     x.resize(b.size());

@@ -103,6 +103,10 @@ struct RunSummary {
   double mapping_seconds = 0.0;
   double output_seconds = 0.0;         ///< VTK frames, restart files, CSV rows and flushes, and the
                                        ///< removal of an earlier run's VTK files from the folder
+  /// Of the participants' seconds, those that passed while another participant of this process
+  /// worked too (a parallel scheme on threads, coupling.concurrent): wall = participants -
+  /// overlap + mapping + output + core.
+  double overlap_seconds = 0.0;
   double core_seconds = 0.0;           ///< the rest: scheme, acceleration, time interpolation
   std::int64_t resumed_from = -1;      ///< windows done by the restart file resumed (-1: none)
   int stopped_by_signal = 0;           ///< the signal that stopped the run early (0: none)

@@ -33,7 +33,9 @@ class CouplingScheme {
  public:
   /// Participants in scheme order; exchanges between them. Not owned.
   CouplingScheme(std::vector<Participant*> participants, std::vector<Exchange*> exchanges);
-  virtual ~CouplingScheme() = default;
+  virtual ~CouplingScheme();  // joins the participants' threads
+  CouplingScheme(const CouplingScheme&) = delete;
+  CouplingScheme& operator=(const CouplingScheme&) = delete;
 
   /// Initial data of every exchange: the writer's initial value before the first window, mapped.
   void initialize();
@@ -43,6 +45,24 @@ class CouplingScheme {
 
   /// Registered name.
   virtual std::string name() const = 0;
+  /// True for a scheme whose participants take a window from the same inputs (they can run at
+  /// the same time: explicit-parallel, implicit-parallel).
+  virtual bool parallel() const { return false; }
+
+  /// A parallel scheme runs the participants of this process at the same time, each on a
+  /// thread of its own (participant_threads.hpp; the default), or one after the other (false).
+  /// The results are the same bits either way. No effect on a serial scheme.
+  void set_concurrent(bool concurrent) { concurrent_ = concurrent; }
+  bool concurrent() const { return concurrent_; }
+  /// Join the participants' threads (after the last window; the destructor does it too).
+  void stop_threads();
+  /// Seconds of the participants' own time (Participant::seconds()) that passed while another
+  /// participant of this process worked too: the sum of the participants' seconds minus this
+  /// is what they took of the wall time.
+  double overlap_seconds() const { return overlap_seconds_; }
+  /// OpenMP threads of each participant running at the same time (in scheme order among
+  /// this process's participants; empty until a concurrent window ran; kept by stop_threads()).
+  std::vector<int> concurrent_omp_threads() const;
   /// Columns (name, unit) of the per-window residuals in coupling.csv.
   virtual std::vector<std::pair<std::string, std::string>> residual_columns() const { return {}; }
 
@@ -62,7 +82,9 @@ class CouplingScheme {
   /// p.finish_window() returns (a participant in another process works in the meantime).
   void run_participant(Participant& p, const TimeWindow& window);
   /// Every participant takes the window, at the same time where they can: the remote ones
-  /// are started first (a parallel scheme); finish with send_outputs() or finish_window().
+  /// are started first, then those of this process, on threads where concurrent() (a parallel
+  /// scheme); finish with send_outputs() or finish_window(). An error of a participant of this
+  /// process names it (every one finishes the window first when they run at the same time).
   void run_all(const TimeWindow& window);
   /// Wait for p's window; sent = combined; transmit (for every output of p).
   void send_outputs(Participant& p);
@@ -71,9 +93,20 @@ class CouplingScheme {
   std::vector<Exchange*> exchanges_;
 
  private:
-  // What run_participant() hands over (sized once: no allocation per window).
-  std::vector<WindowInput> inputs_;
-  std::vector<WindowOutput> outputs_;
+  // Participant i's inputs and outputs in slots_[i] (from the exchanges).
+  void gather(std::size_t i);
+  std::size_t index_of(const Participant& p) const;
+
+  // What run_participant() hands over, per participant (sized once: no allocation per window).
+  struct Slot {
+    std::vector<WindowInput> inputs;
+    std::vector<WindowOutput> outputs;
+  };
+  std::vector<Slot> slots_;
+  bool concurrent_ = true;
+  struct Threads;  // the participants' threads and their jobs (scheme/participant_threads.hpp)
+  std::unique_ptr<Threads> threads_;  // made by the first concurrent window
+  double overlap_seconds_ = 0.0;
 };
 
 }  // namespace partita::coupling

@@ -6,7 +6,8 @@
 //   for k = 1, 2, ...:
 //     serial:   participants in order; all but the last send at once; the last one's outputs
 //               are H(x_k), x_k being what the first participants read
-//     parallel: all participants run from x_k; all outputs form H(x_k)
+//     parallel: all participants run from x_k (at the same time, each on a thread: see
+//               set_concurrent()); all outputs form H(x_k)
 //     measures on every measured field: previous iterate vs new values
 //     all hold (or k = max_iterations, policy accept/error): send H(x_k), accept the window
 //     else: x_{k+1} = acceleration(x_k, H(x_k)) on the accelerated fields (the others: their
@@ -47,6 +48,7 @@ class ImplicitScheme : public CouplingScheme {
   std::string name() const override {
     return options_.serial ? "implicit-serial" : "implicit-parallel";
   }
+  bool parallel() const override { return !options_.serial; }
   std::vector<std::pair<std::string, std::string>> residual_columns() const override;
   const Acceleration* acceleration() const { return acceleration_.get(); }
   void write_state(BinaryWriter& out) const override;
