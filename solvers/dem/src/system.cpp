@@ -446,14 +446,24 @@ void System::note_set_change() {
   set_change_pending_ = true;
 }
 
-// ... and after it, at the next step once the lists are built for the new set: the difference
-// left the mechanical energy with the change (a particle broken into fragments: what the fragment
-// model does not give back as their motion and contacts).
-void System::settle_set_change() {
+// ... and after it, at the start of the next step once the lists are built for the new set (and
+// the forces, where the change made them stale): the difference left the mechanical energy with
+// the change (a particle broken into fragments: what the fragment model does not give back as
+// their motion and contacts). A change made by a hook (breakage's fragments) is booked
+// provisionally at the end of its step already, so that the energies read after the step (a
+// coupling window's audit) hold it: elastic_energy() then counts the contacts the next step
+// starts from (the pairs with the histories the list build hands on, the mesh contacts of the
+// last pass); what the next step's start still changes (a force pass the change made due: the
+// fragments' mesh contacts, the new forces' half-step term) is booked with it.
+void System::settle_set_change(bool provisional) {
   if (!set_change_pending_) return;
-  set_change_pending_ = false;
-  energies_.breakage += set_change_before_ - (kinetic_energy() + half_step_term(energy_dt_) +
-                                              potential_energy() + elastic_energy());
+  const double after =
+      kinetic_energy() + half_step_term(energy_dt_) + potential_energy() + elastic_energy();
+  energies_.breakage += set_change_before_ - after;
+  if (provisional)
+    set_change_before_ = after;  // (the next step's start books its own change from here)
+  else
+    set_change_pending_ = false;
 }
 
 double System::energy_balance_error() const {

@@ -106,18 +106,34 @@ double System::elastic_energy() const {
   };
   // The contacts of the last force pass, with their histories. Without lists for the present
   // particles (before the first step, or after a change of the particle set until the next step)
-  // the pairs of the moment from a scratch neighbour search (skin 0: the touching pairs), without
-  // tangential histories; the meshes' contacts then are the last pass's (the particles still
-  // there; what settle_set_change() reads too) or, before the first pass, those of the moment,
-  // found as the first pass will find them (the force pass's own selection: a face, edge or vertex
-  // shared by several triangles counted once), without histories (new contacts have none).
-  const bool current = lists_current_ && neighbors_.offsets_.size() == p.size() + 1;
+  // the pairs of the moment from a scratch neighbour search (skin 0: the touching pairs), each
+  // with the history the next list build will hand it (that of a pair the renumbered rows still
+  // hold; none for a new pair); the meshes' contacts then are the last pass's (the particles
+  // still there, as the next pass starts from them) or, before the first pass, those of the
+  // moment, found as the first pass will find them (the force pass's own selection: a face, edge
+  // or vertex shared by several triangles counted once), without histories (new contacts have
+  // none). So the energy after a change is the one the next step starts from.
+  const NeighborList& lists = neighbors_;
+  const bool current = lists_current_ && lists.offsets_.size() == p.size() + 1;
   NeighborList scratch;
   if (!current) scratch.search(p, planes, meshes_);
-  const NeighborList& nl = current ? neighbors_ : scratch;
+  const NeighborList& nl = current ? lists : scratch;
+  const int kept_rows = current || pairs_.slot_count() != lists.neighbors_.size()
+                            ? 0
+                            : static_cast<int>(lists.offsets_.size()) - 1;
+  auto kept_shear = [&](int i, int j) -> const Eigen::Vector3d& {
+    if (i >= kept_rows) return no_shear;
+    const auto first = lists.neighbors_.begin() + lists.offsets_[i];
+    const auto last = lists.neighbors_.begin() + lists.offsets_[i + 1];
+    const auto at = std::lower_bound(first, last, j);
+    if (at == last || *at != j) return no_shear;
+    return pairs_.shear(static_cast<std::size_t>(at - lists.neighbors_.begin()));
+  };
   for (int i = 0; i < n; ++i)
-    for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s)
-      e += pair_energy(i, nl.neighbors_[s], current ? pairs_.shear(s) : no_shear);
+    for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
+      const int j = nl.neighbors_[s];
+      e += pair_energy(i, j, current ? pairs_.shear(s) : kept_shear(i, j));
+    }
   const std::size_t np = planes.size();
   const bool have_shear = plane_shear.size() == p.size() * np;
   for (int i = 0; i < n; ++i)

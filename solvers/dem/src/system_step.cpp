@@ -159,6 +159,10 @@ void System::step(double dt) {
   time_ += dt;
   ++steps_;
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].end_of_step(*this, dt);
+  // a change of the particle set by a hook (breakage's fragments) is booked now, so that the
+  // energies read after this step (a coupling window's audit) hold it; the next step's start
+  // books what it still changes (System::settle_set_change())
+  settle_set_change(true);
   if (profiling_) {
     const double wall = 1e-9 * static_cast<double>(now_ns() - profile_start);
     ++profile_.steps;

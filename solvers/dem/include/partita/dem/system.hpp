@@ -371,7 +371,7 @@ class System {
   // energy accounting: the mechanical energy before a change of the particle set (taken once,
   // at the first change after a step) and its comparison after the next step's force pass
   void note_set_change();
-  void settle_set_change();
+  void settle_set_change(bool provisional = false);
   void start_load_pass(int parts);
   void write_body(BinaryWriter& out) const;
   void read_body(BinaryReader& in);
