@@ -9,6 +9,88 @@
 
 namespace partita::fem {
 
+namespace {
+
+// sum_n c_n Y^n = i I + y Y + y2 Y^2 for a traceless symmetric Y, through Cayley-Hamilton
+// (Y^3 = j2 Y + j3 I, j2 = 1/2 tr Y^2, j3 = det Y): the powers are carried as the three
+// coefficients of I, Y and Y^2, Y^n+1 = Y Y^n. No eigenvectors, so equal and nearly equal
+// eigenvalues need no special case.
+struct SeriesCoefficients {
+  double i = 0.0, y = 0.0, y2 = 0.0;
+};
+
+template <class Coefficient>
+SeriesCoefficients traceless_series(double j2, double j3, int terms, Coefficient c) {
+  SeriesCoefficients s{c(0), 0.0, 0.0};
+  double p = 0.0, q = 1.0, r = 0.0;  // Y^1
+  for (int n = 1; n <= terms; ++n) {
+    const double cn = c(n);
+    s.i += cn * p;
+    s.y += cn * q;
+    s.y2 += cn * r;
+    const double p1 = r * j3, q1 = p + r * j2;
+    r = q;
+    p = p1;
+    q = q1;
+  }
+  return s;
+}
+
+// The series bounds, on rho >= the spectral radius of Y (sqrt(2/3) |Y| for a traceless Y):
+// terms N of ln(I + Y) = sum (-1)^(n+1) Y^n / n such that the tail, below
+// rho^(N+1) / ((N+1) (1 - rho)), is under 2^-56 rho (the eigen-decomposition's own round-off is
+// ~1e-16 of b_e); of exp(Y) = sum Y^n / n! such that rho^(N+1) / (N+1)! / (1 - rho / (N+2)) is
+// under 2^-56. (The coefficients of Y^n in the basis I, Y, Y^2 grow at most as n^2 rho^n for
+// repeated eigenvalues: the margin 2^-56 ~ 1.4e-17 against 1e-16 covers it at the N used.)
+constexpr double kSeriesTolerance = 0x1p-56;
+int log_terms(double rho) {
+  int n = 1;
+  double t = rho * rho;  // rho^(n+1)
+  const double bound = kSeriesTolerance * rho * (1.0 - rho);
+  while (t > bound * (n + 1) && n < 60) {
+    ++n;
+    t *= rho;
+  }
+  return n;
+}
+int exp_terms(double rho) {
+  int n = 1;
+  double t = rho * rho / 2.0;  // rho^(n+1) / (n+1)!
+  while (t > kSeriesTolerance * (1.0 - rho / (n + 2)) && n < 60) {
+    ++n;
+    t *= rho / (n + 1);
+  }
+  return n;
+}
+
+// 1 / n!, n = 0 ... 60
+constexpr std::array<double, 61> kInverseFactorial = [] {
+  std::array<double, 61> v{};
+  v[0] = 1.0;
+  for (std::size_t n = 1; n < v.size(); ++n) v[n] = v[n - 1] / static_cast<double>(n);
+  return v;
+}();
+
+// (-1)^(n+1) / n, n = 1 ... 60 (0 at n = 0): the coefficients of ln(I + Y)
+constexpr std::array<double, 61> kLogCoefficient = [] {
+  std::array<double, 61> v{};
+  for (std::size_t n = 1; n < v.size(); ++n)
+    v[n] = ((n % 2) != 0 ? 1.0 : -1.0) / static_cast<double>(n);
+  return v;
+}();
+
+inline double spectral_radius_bound(double j2) {
+  return std::sqrt(4.0 / 3.0 * j2);  // sqrt(2/3) |Y|, |Y|^2 = 2 j2
+}
+
+// b_e_tr = F C_p_n^-1 F^T, after the check det F > 0
+Mat3 trial_elastic_left_cauchy_green(const Mat3& f, std::span<const double> committed) {
+  require_positive_jacobian("j2-plasticity-finite-strain", f.determinant());
+  return f * unpack_symmetric(committed.subspan(0, 6)) * f.transpose();
+}
+
+}  // namespace
+
 FiniteStrainJ2Law::FiniteStrainJ2Law(double e, double nu, double rho, HardeningCurve hardening)
     : density_(rho), hardening_(std::move(hardening)) {
   validate_isotropic_constants("j2-plasticity-finite-strain", e, nu, rho);
@@ -28,12 +110,71 @@ void FiniteStrainJ2Law::initialise_state(std::span<double> state) const {
 
 void FiniteStrainJ2Law::stress(const Mat3& f, std::span<const double> committed,
                                std::span<double> trial, Mat3& p, double& energy) const {
-  const double j = f.determinant();
-  require_positive_jacobian("j2-plasticity-finite-strain", j);
+  const Mat3 be_tr = trial_elastic_left_cauchy_green(f, committed);
   const double g = shear_, k = bulk_;
   const double alpha_n = committed[6];
-  // b_e_tr = F C_p_n^-1 F^T = sum lambda_a^2 n_a n_a
-  const Mat3 be_tr = f * unpack_symmetric(committed.subspan(0, 6)) * f.transpose();
+  const Mat3 id = Mat3::Identity();
+  // b_e_tr = c (I + Y), c = tr(b_e_tr) / 3, Y traceless
+  const double c = be_tr.trace() / 3.0;
+  const Mat3 y = (be_tr - c * id) / c;
+  const Mat3 y2 = y * y;
+  const double j2 = 0.5 * y2.trace();
+  const double rho = spectral_radius_bound(j2);
+  if (!(rho <= kSeriesRadius)) {
+    spectral_stress(f, committed, trial, p, energy);
+    return;
+  }
+  // eps_tr = 1/2 ln b_e_tr = 1/2 (ln c I + ln(I + Y)); ln(I + Y) = l_i I + l_y Y + l_y2 Y^2
+  const SeriesCoefficients l =
+      traceless_series(j2, y.determinant(), log_terms(rho),
+                       [](int n) { return kLogCoefficient[static_cast<std::size_t>(n)]; });
+  // tr eps_tr = 1/2 (3 ln c + 3 l_i + 2 j2 l_y2); dev eps_tr = 1/2 (l_y Y + l_y2 dev Y^2)
+  const double tr = 0.5 * (3.0 * std::log(c) + 3.0 * l.i + 2.0 * j2 * l.y2);
+  const Mat3 y2_dev = y2 - (2.0 * j2 / 3.0) * id;
+  const Mat3 e_dev = 0.5 * (l.y * y + l.y2 * y2_dev);
+  // small-strain radial return on the log strains (coaxial with b_e_tr)
+  const Mat3 s_tr = 2.0 * g * e_dev;
+  const double s_norm = s_tr.norm();
+  double dg = 0.0;
+  if (s_norm - std::sqrt(2.0 / 3.0) * hardening_.yield_stress(alpha_n) > 0.0)
+    dg = hardening_.return_map_increment(g, s_norm, alpha_n);
+  // tau = K tr(eps) I + s_tr - 2 G dg n = K tr I + theta s_tr;  dev eps_e = theta dev eps_tr
+  const double theta = dg > 0.0 ? 1.0 - 2.0 * g * dg / s_norm : 1.0;
+  const Mat3 tau = (k * tr) * id + theta * s_tr;
+  const Mat3 finv = f.inverse();
+  p = tau * finv.transpose();
+  // W = 1/2 K tr(eps_e)^2 + G |dev eps_e|^2
+  energy = 0.5 * k * tr * tr + g * theta * theta * e_dev.squaredNorm();
+  trial[6] = alpha_n + std::sqrt(2.0 / 3.0) * dg;
+  if (dg > 0.0) {
+    // b_e = exp(2 eps_e) = exp(2/3 tr) exp(D), D = 2 theta dev eps_tr;  C_p^-1 = F^-1 b_e F^-T
+    const Mat3 d = (2.0 * theta) * e_dev;
+    const Mat3 d2 = d * d;
+    const double j2d = 0.5 * d2.trace();
+    const SeriesCoefficients x = traceless_series(
+        j2d, d.determinant(), exp_terms(spectral_radius_bound(j2d)),
+        [](int n) { return kInverseFactorial[static_cast<std::size_t>(n)]; });
+    const Mat3 be = std::exp(2.0 / 3.0 * tr) * (x.i * id + x.y * d + x.y2 * d2);
+    pack_symmetric(finv * be * finv.transpose(), trial.subspan(0, 6));
+    // w_p += 1/2 (tau_n + tau_n+1) : d eps_p,  d eps_p = dg n,  n = s_tr / |s_tr|
+    trial[7] = committed[7] + 0.5 * dg / s_norm *
+                                  ((unpack_symmetric(committed.subspan(8, 6)) + tau).array() *
+                                   s_tr.array())
+                                      .sum();
+  } else {
+    // elastic: b_e = b_e_tr, so C_p^-1 = F^-1 b_e_tr F^-T = C_p_n^-1
+    std::copy_n(committed.begin(), 6, trial.begin());
+    trial[7] = committed[7];
+  }
+  pack_symmetric(tau, trial.subspan(8, 6));
+}
+
+void FiniteStrainJ2Law::spectral_stress(const Mat3& f, std::span<const double> committed,
+                                        std::span<double> trial, Mat3& p, double& energy) const {
+  // b_e_tr = sum lambda_a^2 n_a n_a
+  const Mat3 be_tr = trial_elastic_left_cauchy_green(f, committed);
+  const double g = shear_, k = bulk_;
+  const double alpha_n = committed[6];
   const Eigen::SelfAdjointEigenSolver<Mat3> eig(be_tr);
   const Vec3 eps_tr = 0.5 * eig.eigenvalues().array().log().matrix();  // ln lambda_a
   const Mat3& dirs = eig.eigenvectors();
@@ -69,7 +210,6 @@ void FiniteStrainJ2Law::stress(const Mat3& f, std::span<const double> committed,
       0.5 * ((unpack_symmetric(committed.subspan(8, 6)) + tau).array() * deps_p.array()).sum();
   pack_symmetric(tau, trial.subspan(8, 6));
 }
-
 void FiniteStrainJ2Law::evaluate(const Mat3& f, std::span<const double> committed,
                                  std::span<double> trial, MaterialResponse& r) const {
   stress(f, committed, trial, r.stress, r.energy_density);

@@ -18,6 +18,14 @@ namespace partita::fem {
 // Tangent: dP/dF by central differences of the return map (perturbation h = 1e-7 on each
 // F_kL; Miehe, CMAME 134 (1996) 223-240): accurate to ~1e-9 relative, so Newton converges
 // quadratically down to that level.
+// Evaluation: with b_e_tr = c (I + Y), c = tr(b_e_tr) / 3, the log and exp are power series
+// of the traceless Y (and of the deviatoric elastic strain after the return), reduced to
+// a I + b Y + c Y^2 by Cayley-Hamilton: no eigen-decomposition, exact for equal principal
+// stretches, as many terms as keep the tail under ~1e-17 (a handful for metals, whose elastic
+// strains are ~1e-3); an elastic step keeps C_p^-1 as it was (b_e = b_e_tr). Beyond a
+// spectral radius of Y of kSeriesRadius (large elastic strains, e.g. a rubber-like E / sigma_y)
+// the principal-space return through Eigen's eigen-solver (spectral_stress) is used. The two
+// agree to round-off (test_finite_strain_j2_fast.cpp).
 // History (14 values): C_p^-1 (xx yy zz xy yz zx), alpha, w_p, tau (xx yy zz xy yz zx).
 class FiniteStrainJ2Law final : public MaterialLaw {
  public:
@@ -37,6 +45,14 @@ class FiniteStrainJ2Law final : public MaterialLaw {
                        MaterialResponse& response) const override {
     stress(f, committed, trial, response.stress, response.energy_density);
   }
+  // The same return in principal space through an eigen-decomposition of b_e_tr (Eigen's
+  // iterative solver): the path beyond the series' bound, public as the reference the tests
+  // compare the series path with. P and W at F from the committed history; writes the trial
+  // history.
+  void spectral_stress(const Mat3& f, std::span<const double> committed, std::span<double> trial,
+                       Mat3& p, double& energy) const;
+  // The series path's bound on the spectral radius of the traceless part of b_e_tr / c.
+  static constexpr double kSeriesRadius = 0.25;
   double plastic_work_density(std::span<const double> state) const override { return state[7]; }
   double equivalent_plastic_strain(std::span<const double> state) const override {
     return state[6];
