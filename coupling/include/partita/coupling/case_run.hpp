@@ -181,10 +181,9 @@ class CaseRun {
     double max_energy_balance_error = 0.0;
     std::string energy_csv;
     std::vector<std::pair<std::string, std::vector<std::pair<double, std::string>>>> pvds;
-    template <class Archive>
-    void serialize_case(Archive& ar);  // name, identity, window: checked before the rest
-    template <class Archive>
-    void serialize_state(Archive& ar);
+    // Written and read by the same functions (StateArchive: state_archive.hpp).
+    void serialize_case(StateArchive& ar);  // name, identity, window: checked before the rest
+    void serialize_state(StateArchive& ar);
   };
   SavedRun saved_run(const Progress& progress) const;
   void build_participants(const config::Node& root);

@@ -26,8 +26,7 @@
 #include "partita/interface/solver.hpp"
 
 namespace partita {
-class BinaryWriter;
-class BinaryReader;
+class StateArchive;
 }  // namespace partita
 
 namespace partita::coupling {
@@ -90,18 +89,10 @@ class Exchange {
   /// sent = previous = combined, transmitted, start = end.
   void initialize();
 
-  /// Restart files: the values carried between windows (sent, combined, previous, start, end).
-  void write_state(BinaryWriter& out) const;
-  /// Throws partita::Error if the stored values do not fit this exchange's meshes.
-  void read_state(BinaryReader& in);
-
- private:
-  /// write_state and read_state through one function (Archive: BinaryWriter with a const
-  /// Exchange, or BinaryReader).
-  template <class Archive, class Self>
-  static void serialize(Archive& ar, Self& x);
-
- public:
+  /// Restart files, written and read by this one function: the values carried between
+  /// windows (combined, sent, previous, start, end). Reading throws partita::Error if the
+  /// stored values do not fit this exchange's meshes.
+  void serialize(StateArchive& ar);
 
   /// FOR TESTING AUDITS ONLY: transmit() multiplies what arrives by `factor` (a deliberately
   /// broken exchange, the case key `scale`; 1: the plain mapping, the default).
