@@ -44,7 +44,12 @@ WindowOutput Exchange::window_output() {
 }
 
 WindowInput Exchange::window_input() const {
-  return WindowInput{&to_.mesh, &data_, reader_sees_, &start_, &end_, start_is_end_};
+  WindowInput in{&to_.mesh, &data_, reader_sees_, &start_, &end_, start_is_end_};
+  if (mapped_by_receiver_) {  // end = scale M sent (transmit()); start = scale M sent_start_
+    in.sent_end = &sent_;
+    if (sent_start_known_) in.sent_start = &sent_start_;
+  }
+  return in;
 }
 
 Eigen::MatrixXd& Exchange::sent() {
@@ -99,6 +104,7 @@ void Exchange::serialize(StateArchive& ar) {
   for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) ar.io(*m);
   combined_is_sent_ = false;
   start_is_end_ = false;
+  sent_start_known_ = false;  // d_n's values before the mapping are not in the file
   const Eigen::Index receiver = target_mesh_->size();
   for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_})
     if (m->rows() != from_points_ || m->cols() != spec_.components)
