@@ -98,11 +98,17 @@ void CaseRun::run() {
   if (serves()) {  // the controller runs the windows; this process answers for its participant
     Stopwatch wall;
     ParticipantServer server(*options_.distributed.controller, options_.stop_signal);
-    summary_.stopped_by_signal = server.serve(*served_);
+    summary_.stopped_by_signal =
+        server.serve(*served_, [this](std::size_t exchange, const InterfaceMesh& from,
+                                      const InterfaceMesh& to) {
+          return server_mapping(exchange, from, to);
+        });
     summary_.wall_seconds = wall.seconds();
     summary_.participant_seconds.emplace_back(served_->name(), served_->seconds());
-    logger->info("participant '{}' served the run: {:.3f} s in its solver of {:.3f} s",
-                 served_->name(), served_->seconds(), summary_.wall_seconds);
+    logger->info(
+        "participant '{}' served the run: {:.3f} s in its solver, {:.3f} s mapping what it read, "
+        "of {:.3f} s",
+        served_->name(), served_->seconds(), server.mapping_seconds(), summary_.wall_seconds);
     return;
   }
   Stopwatch wall;

@@ -133,7 +133,10 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     }
 
   build_participants(root);
-  if (serves()) return;  // the controller builds the rest; this process serves its participant
+  if (serves()) {  // the controller builds the rest; this process serves its participant
+    if (root.has("coupling")) served_coupling_ = root["coupling"];  // (the mappers it runs)
+    return;
+  }
   const config::Node coupling = root["coupling"];
   if (root.has("coupling")) {
     build_exchanges(coupling);
@@ -517,19 +520,10 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
       if (&e->to() == to.p && e->to_mesh() == to.mesh->mesh.name() && e->data() == data)
         item.fail("'" + data + "' on " + to.p->name() + "." + to.mesh->mesh.name() +
                   " already has a sender (" + e->label() + ")");
-    Constraint constraint =
-        ws->kind == DataKind::extensive ? Constraint::conservative : Constraint::consistent;
-    if (item.has("constraint"))
-      constraint = item.string("constraint") == "conservative" ? Constraint::conservative
-                                                               : Constraint::consistent;
-    std::unique_ptr<Mapper> mapper =
-        create_mapper(registries_.mappers, MapperContext{item["mapper"], constraint});
-    Stopwatch setup;
-    mapper->compute(from.mesh->mesh, to.mesh->mesh);
-    if (setup.seconds() > 1.0)
-      log::get("coupling")
-          ->info("set-up of the mapping of '{}' {}.{} -> {}.{}: {:.1f} s", data, from.p->name(),
-                 from.mesh->mesh.name(), to.p->name(), to.mesh->mesh.name(), setup.seconds());
+    std::unique_ptr<Mapper> mapper = exchange_mapper(
+        item, *ws, from.mesh->mesh, to.mesh->mesh,
+        fmt::format("'{}' {}.{} -> {}.{}", data, from.p->name(), from.mesh->mesh.name(),
+                    to.p->name(), to.mesh->mesh.name()));
     const ReaderSees rsee =
         item.string("reader_sees") == "constant" ? ReaderSees::constant : ReaderSees::linear;
     const WriterCombines wc =
@@ -543,7 +537,57 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
           ->warn("{}: exchange {} multiplies what arrives by {} (scale: for testing audits only)",
                  item["scale"].location().str(), exchanges_.back()->label(), scale);
     }
+    Exchange& e = *exchanges_.back();
+    e.set_map_on(item.string("map_on") == "sender" ? MapOn::sender : MapOn::receiver);
+    // A receiver in another process maps what it reads on its side (it is sent the sender's
+    // values); this process maps it as well, for the checks, audits and restart files. (An
+    // external program, which maps nothing, is sent mapped values.)
+    if (auto* remote = dynamic_cast<RemoteParticipant*>(to.p);
+        remote && remote->maps_inputs() && e.map_on() == MapOn::receiver) {
+      remote->prepare_mapping(static_cast<std::size_t>(&item - items.data()), e.to_mesh(), data,
+                              *from.mesh);
+      e.set_mapped_by_receiver(true);
+    }
   }
+}
+
+std::unique_ptr<Mapper> CaseRun::exchange_mapper(const config::Node& item, const DataSpec& ws,
+                                                 const Mesh& from, const Mesh& to,
+                                                 const std::string& label) const {
+  Constraint constraint =
+      ws.kind == DataKind::extensive ? Constraint::conservative : Constraint::consistent;
+  if (item.has("constraint"))
+    constraint = item.string("constraint") == "conservative" ? Constraint::conservative
+                                                             : Constraint::consistent;
+  std::unique_ptr<Mapper> mapper =
+      create_mapper(registries_.mappers, MapperContext{item["mapper"], constraint});
+  Stopwatch setup;
+  mapper->compute(from, to);
+  if (setup.seconds() > 1.0)
+    log::get("coupling")->info("set-up of the mapping of {}: {:.1f} s", label, setup.seconds());
+  return mapper;
+}
+
+// A server's side of an exchange it maps: the same mapper as the controller's, from the same
+// case item and the same meshes (the sender's handed over by the controller, bit for bit).
+ServerMapping CaseRun::server_mapping(std::size_t exchange, const InterfaceMesh& from,
+                                      const InterfaceMesh& to) const {
+  const std::vector<config::Node> items = served_coupling_["exchanges"].items();
+  if (exchange >= items.size())
+    throw Error(fmt::format("the controller asked for the mapping of exchange {} of {}", exchange,
+                            items.size()));
+  const config::Node& item = items[exchange];
+  const std::string data = item.string("data");
+  const auto ws = std::find_if(from.writes.begin(), from.writes.end(),
+                               [&](const DataSpec& d) { return d.name == data; });
+  if (ws == from.writes.end())
+    item["data"].fail("the sender's mesh '" + from.mesh.name() + "' does not write '" + data + "'");
+  ServerMapping m;
+  m.mapper = exchange_mapper(item, *ws, from.mesh, to.mesh,
+                             fmt::format("'{}' {} -> {}.{} (on the receiver's side)", data,
+                                         item.string("from"), served_->name(), to.mesh.name()));
+  m.scale = item.real("scale");
+  return m;
 }
 
 Participant* CaseRun::named_participant(const config::Node& n, const std::string& name) const {

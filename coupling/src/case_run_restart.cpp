@@ -10,6 +10,7 @@
 #include "partita/coupling/case_run.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/binary_io.hpp"
+#include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
@@ -115,18 +116,16 @@ fs::path CaseRun::newest_restart_file() const {
 }
 
 // The file's layout after the magic, version and byte order; the same function writes and reads
-// (Archive: BinaryWriter or BinaryReader). Counts are written for the lists whose length the
+// (StateArchive). Counts are written for the lists whose length the
 // file decides (monitors are checked against the case by the caller; the energy pairs' count
 // comes from the case).
-template <class Archive>
-void CaseRun::SavedRun::serialize_case(Archive& ar) {
+void CaseRun::SavedRun::serialize_case(StateArchive& ar) {
   ar.io(name);
   ar.io(identity);
   ar.io(window_size);
 }
 
-template <class Archive>
-void CaseRun::SavedRun::serialize_state(Archive& ar) {
+void CaseRun::SavedRun::serialize_state(StateArchive& ar) {
   ar.io(progress.windows_done);
   ar.io(progress.frame);
   ar.io(progress.next_output);
@@ -134,7 +133,7 @@ void CaseRun::SavedRun::serialize_state(Archive& ar) {
   ar.io(unconverged_windows);
   ar.io(max_window_iterations);
   ar.io(imbalance_warnings);
-  ar.io_section("energy audit");
+  ar.section("energy audit");
   ar.io(energy_warnings);
   for (Pair& p : pairs) {
     ar.io(p.last_a);
@@ -142,17 +141,17 @@ void CaseRun::SavedRun::serialize_state(Archive& ar) {
     ar.io(p.passed);
     ar.io(p.over);
   }
-  ar.io_section("energy balance");
+  ar.section("energy balance");
   ar.io(energy_started);
   ar.io(energy_initial);
   ar.io(energy_balance_warnings);
   ar.io(max_energy_balance_error);
   ar.io(energy_csv);
-  ar.io_section("csv");
+  ar.section("csv");
   ar.io(coupling_csv);
   auto count = static_cast<std::uint64_t>(monitors.size());
   ar.io(count);
-  if constexpr (Archive::reading) {
+  if (ar.reading()) {
     if (count > monitors.size()) ar.fail(fmt::format("{} monitors (found {})", monitors.size(), count));
     monitors.resize(count);
   }
@@ -160,17 +159,17 @@ void CaseRun::SavedRun::serialize_state(Archive& ar) {
     ar.io(monitor);
     ar.io(text);
   }
-  ar.io_section("vtk");
+  ar.section("vtk");
   count = static_cast<std::uint64_t>(pvds.size());
   ar.io(count);
-  if constexpr (Archive::reading) pvds.clear();
+  if (ar.reading()) pvds.clear();
   for (std::uint64_t i = 0; i < count; ++i) {
-    if constexpr (Archive::reading) pvds.emplace_back();
+    if (ar.reading()) pvds.emplace_back();
     auto& [series, entries] = pvds[i];
     ar.io(series);
     auto n = static_cast<std::uint64_t>(entries.size());
     ar.io(n);
-    if constexpr (Archive::reading) {
+    if (ar.reading()) {
       entries.clear();
       for (std::uint64_t k = 0; k < n; ++k) {
         double t = 0.0;
@@ -225,9 +224,10 @@ void CaseRun::write_restart_file(const Progress& progress) {
     out.write(kVersion);
     out.write(kByteOrder);
     SavedRun run = saved_run(progress);
-    run.serialize_case(out);
-    run.serialize_state(out);
-    scheme_->write_state(out);
+    StateArchive ar(out);
+    run.serialize_case(ar);
+    run.serialize_state(ar);
+    scheme_->serialize(ar);
     out.write(static_cast<std::uint64_t>(participants_.size()));
     for (const auto& p : participants_) {
       out.section("participant " + p->name());
@@ -289,7 +289,8 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
   read.monitors.resize(monitors_.size());
   // the name, identity and window first: a file of another case is named as such, not as data
   // out of place (serialize_case() holds what the rest depends on)
-  read.serialize_case(in);
+  StateArchive ar(in);
+  read.serialize_case(ar);
   if (read.name != name_ || read.identity != identity_)
     throw Error(fmt::format(
         "{} was written by {} whose participants or coupling differ from this case '{}': a run "
@@ -300,7 +301,7 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
   if (read.window_size != window_size_)
     throw Error(fmt::format("{} was written with time.window = {:.17g} s; this case has {:.17g} s",
                             path.string(), read.window_size, window_size_));
-  read.serialize_state(in);
+  read.serialize_state(ar);
   if (read.progress.windows_done < 0 || read.progress.frame < 0 ||
       !std::isfinite(read.progress.next_output))
     in.fail("a window count, a frame count and an output time");
@@ -317,7 +318,7 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
         "{}: the run started with another energy section (energy.csv columns: {}; now: {}): "
         "resume with the energy section it started with",
         path.string(), header(read.energy_csv), header(energy_csv_.text())));
-  scheme_->read_state(in);
+  scheme_->serialize(ar);
   const auto participants = in.get<std::uint64_t>();
   if (participants != participants_.size())
     in.fail(fmt::format("{} participants (found {})", participants_.size(), participants));

@@ -58,6 +58,15 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
                {"average", "last"})
       .def("average");
   exchange
+      ->choice("map_on",
+               "which participant's process computes the mapping when participants run as "
+               "processes of their own (--participant): receiver: the sender's values travel and "
+               "the receiver maps them; sender: the values travel mapped to the receiver's mesh. "
+               "Choose the side whose mesh is the smaller to travel. The numbers are the same "
+               "either way (and in one process, where it changes nothing)",
+               {"receiver", "sender"})
+      .def("receiver");
+  exchange
       ->real("scale",
              "FOR TESTING AUDITS ONLY: multiply what arrives by this factor (a deliberately "
              "broken exchange: the balance and energy audits must then report it)")

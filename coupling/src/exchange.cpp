@@ -1,10 +1,12 @@
 #include "partita/coupling/exchange.hpp"
 
+#include <utility>
+
 #include <fmt/format.h>
 
 #include "elementwise.hpp"
 #include "partita/coupling/stopwatch.hpp"
-#include "partita/interface/binary_io.hpp"
+#include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -42,7 +44,12 @@ WindowOutput Exchange::window_output() {
 }
 
 WindowInput Exchange::window_input() const {
-  return WindowInput{&to_.mesh, &data_, reader_sees_, &start_, &end_, start_is_end_};
+  WindowInput in{&to_.mesh, &data_, reader_sees_, &start_, &end_, start_is_end_};
+  if (mapped_by_receiver_) {  // end = scale M sent (transmit()); start = scale M sent_start_
+    in.sent_end = &sent_;
+    if (sent_start_known_) in.sent_start = &sent_start_;
+  }
+  return in;
 }
 
 Eigen::MatrixXd& Exchange::sent() {
@@ -83,34 +90,30 @@ void Exchange::initialize() {
 
 // The values carried between windows, one function for writing and reading: combined, sent,
 // previous (the sender's mesh), d_n and d_{n+1} (the receiver's). A writer whose d_n equals
-// d_{n+1} writes d_{n+1} twice; a reader gets them as two arrays.
-template <class Archive, class Self>
-void Exchange::serialize(Archive& ar, Self& x) {
-  ar.io_section("exchange " + x.label());
-  if constexpr (!Archive::reading) {
-    for (const Eigen::MatrixXd* m :
-         {&x.combined(), &x.sent_, &x.previous_, x.start_is_end_ ? &x.end_ : &x.start_, &x.end_})
+// d_{n+1} writes d_{n+1} twice (and whose combined is sent's storage, sent's values); a reader
+// gets them as five arrays.
+void Exchange::serialize(StateArchive& ar) {
+  ar.section("exchange " + label());
+  if (!ar.reading()) {
+    const Eigen::MatrixXd& start = start_is_end_ ? end_ : start_;
+    for (const Eigen::MatrixXd* m : {&combined(), &std::as_const(sent_), &std::as_const(previous_),
+                                     &start, &std::as_const(end_)})
       ar.io(*m);
-  } else {
-    for (Eigen::MatrixXd* m : {&x.combined_, &x.sent_, &x.previous_, &x.start_, &x.end_})
-      ar.io(*m);
-    x.combined_is_sent_ = false;
-    x.start_is_end_ = false;
-    const Eigen::Index sender = x.from_points_;
-    const Eigen::Index receiver = x.target_mesh_->size();
-    for (const Eigen::MatrixXd* m : {&x.combined_, &x.sent_, &x.previous_})
-      if (m->rows() != sender || m->cols() != x.spec_.components)
-        ar.fail(fmt::format("{} x {} values of {} (the sender's mesh)", sender,
-                            x.spec_.components, x.label()));
-    for (const Eigen::MatrixXd* m : {&x.start_, &x.end_})
-      if (m->rows() != receiver || m->cols() != x.spec_.components)
-        ar.fail(fmt::format("{} x {} values of {} (the receiver's mesh)", receiver,
-                            x.spec_.components, x.label()));
+    return;
   }
+  for (Eigen::MatrixXd* m : {&combined_, &sent_, &previous_, &start_, &end_}) ar.io(*m);
+  combined_is_sent_ = false;
+  start_is_end_ = false;
+  sent_start_known_ = false;  // d_n's values before the mapping are not in the file
+  const Eigen::Index receiver = target_mesh_->size();
+  for (const Eigen::MatrixXd* m : {&combined_, &sent_, &previous_})
+    if (m->rows() != from_points_ || m->cols() != spec_.components)
+      ar.fail(fmt::format("{} x {} values of {} (the sender's mesh)", from_points_,
+                          spec_.components, label()));
+  for (const Eigen::MatrixXd* m : {&start_, &end_})
+    if (m->rows() != receiver || m->cols() != spec_.components)
+      ar.fail(fmt::format("{} x {} values of {} (the receiver's mesh)", receiver,
+                          spec_.components, label()));
 }
-
-void Exchange::write_state(BinaryWriter& out) const { serialize(out, *this); }
-
-void Exchange::read_state(BinaryReader& in) { serialize(in, *this); }
 
 }  // namespace partita::coupling

@@ -35,7 +35,8 @@ enum class Command : std::uint32_t {
   stable_time_step,
   finalize,
   abort,
-  meshes,  // handshake: the meshes a server asked for
+  meshes,   // handshake: the meshes a server asked for
+  mapping,  // before the first window: an exchange the server maps on its side
 };
 
 // A message under construction: a BinaryWriter over a string stream.
@@ -190,13 +191,15 @@ RemoteParticipant::RemoteParticipant(std::string name, Channel& channel, Ready r
     : Participant(std::move(name)),
       channel_(channel),
       meshes_(std::move(ready.meshes)),
-      supports_restart_(ready.supports_restart) {}
+      supports_restart_(ready.supports_restart),
+      maps_inputs_(ready.maps_inputs) {}
 
 std::string RemoteParticipant::read_reply(std::string_view what) const {
   Stopwatch wait;
   std::string bytes = channel_.receive(what);
   wait_seconds_ += wait.seconds();
   ++messages_;
+  bytes_received_ += static_cast<double>(bytes.size());
   // [u32 status] [results | error text] [f64 seconds] [i32 signal]: the results are returned
   // in the same string (no copy), the rest read in place
   constexpr std::size_t head = sizeof(std::uint32_t), tail = sizeof(double) + sizeof(std::int32_t);
@@ -222,6 +225,7 @@ std::string RemoteParticipant::read_reply(std::string_view what) const {
 
 std::string RemoteParticipant::call(std::string request, std::string_view what) const {
   Stopwatch send;
+  bytes_sent_ += static_cast<double>(request.size());
   channel_.send(std::move(request));
   wait_seconds_ += send.seconds();
   std::string reply = read_reply(what);
@@ -249,8 +253,12 @@ void RemoteParticipant::run_window(const TimeWindow& window, std::span<const Win
     m.out.write(*in.data);
     m.out.write(static_cast<std::uint8_t>(in.sees == ReaderSees::linear));
     m.out.write(static_cast<std::uint8_t>(in.start_is_end));
-    if (!in.start_is_end && in.sees == ReaderSees::linear) m.out.write(*in.start);
-    m.out.write(*in.end);
+    // [u8 which travel as the sender's values, the server maps them: 1 end, 2 start]
+    const bool start = !in.start_is_end && in.sees == ReaderSees::linear;
+    const std::uint8_t unmapped = (in.sent_end ? 1 : 0) | (start && in.sent_start ? 2 : 0);
+    m.out.write(unmapped);
+    if (start) m.out.write(unmapped & 2 ? *in.sent_start : *in.start);
+    m.out.write(unmapped & 1 ? *in.sent_end : *in.end);
   }
   write_outputs(m.out, outputs);
   // What the run asks after a window, answered with the window's reply (one message each way
@@ -260,7 +268,9 @@ void RemoteParticipant::run_window(const TimeWindow& window, std::span<const Win
   write_strings(m.out, cache_.work_meshes);
   cache_.valid = false;
   Stopwatch send;
-  channel_.send(m.str());
+  std::string bytes = m.str();
+  bytes_sent_ += static_cast<double>(bytes.size());
+  channel_.send(std::move(bytes));
   wait_seconds_ += send.seconds();
   pending_.assign(outputs.begin(), outputs.end());  // (no allocation after the first window)
   pending_window_ = true;
@@ -288,8 +298,21 @@ void RemoteParticipant::finish_window() {
 std::string RemoteParticipant::transport_summary() const {
   // the remote solver's own time is in seconds(); the rest of the waits is the messages' way
   // there and back (and the remote side's decoding and encoding)
-  return fmt::format("{} replies from {}, {:.3f} s waiting for them (its solver {:.3f} s of it)",
-                     messages_, channel_.peer(), wait_seconds_, seconds());
+  return fmt::format(
+      "{} replies from {}, {:.3f} s waiting for them (its solver {:.3f} s of it); {:.1f} kB sent "
+      "to it, {:.1f} kB received",
+      messages_, channel_.peer(), wait_seconds_, seconds(), bytes_sent_ / 1e3,
+      bytes_received_ / 1e3);
+}
+
+void RemoteParticipant::prepare_mapping(std::size_t exchange, const std::string& mesh,
+                                        const std::string& data, const InterfaceMesh& sender) {
+  Message m(Command::mapping);
+  m.out.write(static_cast<std::uint64_t>(exchange));
+  m.out.write(mesh);
+  m.out.write(data);
+  write_mesh(m.out, sender);
+  call(m.str(), "the set-up of the mapping of '" + data + "' to its mesh '" + mesh + "'");
 }
 
 int RemoteParticipant::substeps(double window_size) const {
@@ -459,6 +482,7 @@ Ready complete_handshake(Channel& server,
   for (std::uint64_t i = 0; i < n; ++i) ready.meshes.push_back(read_mesh(r.in));
   ready.supports_restart = r.in.get<std::uint8_t>() != 0;
   ready.stable_time_step = r.in.get<double>();
+  ready.maps_inputs = r.in.get<std::uint8_t>() != 0;
   return ready;
 }
 
@@ -515,7 +539,7 @@ std::vector<std::pair<std::string, Mesh>> ParticipantServer::hello(const Hello& 
   return got;
 }
 
-int ParticipantServer::serve(LocalParticipant& p) {
+int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping) {
   {
     Message m;
     m.out.write(std::string());
@@ -523,6 +547,7 @@ int ParticipantServer::serve(LocalParticipant& p) {
     for (const auto& mesh : p.meshes()) write_mesh(m.out, mesh);
     m.out.write(static_cast<std::uint8_t>(p.supports_restart()));
     m.out.write(p.stable_time_step());
+    m.out.write(static_cast<std::uint8_t>(static_cast<bool>(mapping)));
     controller_.send(m.str());
   }
   // What run_window() hands the participant, kept between windows (no allocation after the
@@ -530,6 +555,28 @@ int ParticipantServer::serve(LocalParticipant& p) {
   std::vector<std::string> names;  // mesh, data per input
   std::vector<Eigen::MatrixXd> starts, ends;
   std::vector<WindowInput> inputs;
+  // The exchanges this process maps (map_on: receiver), by mesh and data; the sender's values
+  // as they arrive.
+  struct Mapped {
+    std::string mesh, data;
+    ServerMapping mapping;
+  };
+  std::vector<Mapped> mapped;
+  Eigen::MatrixXd unmapped_values;
+  const auto map_into = [&](const std::string& mesh, const std::string& data,
+                            Eigen::MatrixXd& out) {
+    const auto at = std::find_if(mapped.begin(), mapped.end(), [&](const Mapped& x) {
+      return x.mesh == mesh && x.data == data;
+    });
+    if (at == mapped.end())
+      throw Error(fmt::format("the controller sent '{}' on '{}' to be mapped here, but set up no "
+                              "mapping for it",
+                              data, mesh));
+    Stopwatch clock;
+    at->mapping.mapper->map(unmapped_values, out);  // d = M s, as the controller's transmit()
+    if (at->mapping.scale != 1.0) out *= at->mapping.scale;
+    mapping_seconds_ += clock.seconds();
+  };
   OutputSlots slots;
   double reported_seconds = 0.0;
   int stopped_by = 0;
@@ -562,9 +609,21 @@ int ParticipantServer::serve(LocalParticipant& p) {
             names[2 * i + 1] = r.in.get_string();
             inputs[i].sees = r.in.get<std::uint8_t>() ? ReaderSees::linear : ReaderSees::constant;
             inputs[i].start_is_end = r.in.get<std::uint8_t>() != 0;
-            if (!inputs[i].start_is_end && inputs[i].sees == ReaderSees::linear)
-              r.in.read(starts[i]);
-            r.in.read(ends[i]);
+            const auto unmapped = r.in.get<std::uint8_t>();
+            if (!inputs[i].start_is_end && inputs[i].sees == ReaderSees::linear) {
+              if (unmapped & 2) {
+                r.in.read(unmapped_values);
+                map_into(names[2 * i], names[2 * i + 1], starts[i]);
+              } else {
+                r.in.read(starts[i]);
+              }
+            }
+            if (unmapped & 1) {
+              r.in.read(unmapped_values);
+              map_into(names[2 * i], names[2 * i + 1], ends[i]);
+            } else {
+              r.in.read(ends[i]);
+            }
           }
           slots.read(r.in);
           for (std::uint64_t i = 0; i < ni; ++i) {
@@ -586,6 +645,23 @@ int ParticipantServer::serve(LocalParticipant& p) {
             reply.out.write(static_cast<std::uint8_t>(w.has_value()));
             if (w) reply.out.write(*w);
           }
+          break;
+        }
+        case Command::mapping: {
+          const auto exchange = static_cast<std::size_t>(r.in.get<std::uint64_t>());
+          Mapped m;
+          m.mesh = r.in.get_string();
+          m.data = r.in.get_string();
+          const InterfaceMesh sender = read_mesh(r.in);
+          const InterfaceMesh* receiver = p.find_mesh(m.mesh);
+          if (!receiver || !mapping)
+            throw Error(fmt::format("the controller asked for a mapping to the mesh '{}', which "
+                                    "this process cannot set up",
+                                    m.mesh));
+          Stopwatch clock;
+          m.mapping = mapping(exchange, sender, *receiver);
+          mapping_seconds_ += clock.seconds();
+          mapped.push_back(std::move(m));
           break;
         }
         case Command::save_checkpoint:

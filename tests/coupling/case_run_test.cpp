@@ -170,12 +170,36 @@ TEST_CASE("CaseRun: bad coupling settings are clear errors at the key",
     CHECK_THAT(error_of("sub", text),
                Catch::Contains("coupling.substeps.two") && Catch::Contains(">= 1"));
   }
+  SECTION("map_on names the sides it allows") {
+    std::string text = implicit_case();
+    text.replace(text.find("{data: y1"), 9, "{map_on: middle, data: y1");
+    CHECK_THAT(error_of("map_on", text), Catch::Contains("coupling.exchanges[0].map_on") &&
+                                             Catch::Contains("receiver") &&
+                                             Catch::Contains("sender"));
+  }
   SECTION("convergence keys on an explicit scheme") {
     std::string text = implicit_case();
     text.replace(text.find("implicit-serial"), 15, "explicit-serial");
     CHECK_THAT(error_of("expl", text),
                Catch::Contains("coupling.convergence") && Catch::Contains("implicit-serial"));
   }
+}
+
+TEST_CASE("CaseRun: map_on sender and receiver give the same bytes in one process",
+          "[coupling][case][map_on]") {
+  // In one process the core maps every exchange, with the same mapper on the same values,
+  // whichever side is named: coupling.csv and the monitors are the same bytes.
+  const Registries r = test::test_registries();
+  std::string sender = implicit_case();
+  for (const char* data : {"{data: y1", "{data: y2"})
+    sender.replace(sender.find(data), 9, std::string("{map_on: sender, ") + (data + 1));
+  REQUIRE(sender.find("map_on: sender, data: y2") != std::string::npos);
+  const fs::path a = scratch("map_on_receiver"), b = scratch("map_on_sender");
+  CaseRun(write_case("map_receiver", implicit_case()), r, run_options(a, false)).run();
+  CaseRun(write_case("map_sender", sender), r, run_options(b, false)).run();
+  CHECK(read_text(a / "coupling.csv").size() > 100);
+  CHECK(read_text(a / "coupling.csv") == read_text(b / "coupling.csv"));
+  CHECK(read_text(a / "state.csv") == read_text(b / "state.csv"));
 }
 
 TEST_CASE("CaseRun: substeps auto follow the solver's stable time step", "[coupling][case]") {

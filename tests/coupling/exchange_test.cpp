@@ -1,7 +1,9 @@
 // A participant's side of a window (LocalParticipant over an Exchange's values): the substep
 // average and the time interpolation give, bit for bit, the numbers of their plain formulas (each operation is IEEE-rounded, so any correct evaluation of the same
 // operations in the same order must agree to the last bit, whatever vector width it uses); and a
-// run stops on non-finite values of an audited exchange (whose check reads the audit's totals).
+// run stops on non-finite values of an audited exchange (whose check reads the audit's totals);
+// an exchange mapped in the receiver's process names the sender's values whose mapping the
+// receiver holds.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -15,6 +17,8 @@
 #include "ode_participant.hpp"
 #include "partita/coupling/case_run.hpp"
 #include "partita/coupling/exchange.hpp"
+#include "partita/coupling/mapping/nearest_neighbor_mapper.hpp"
+#include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"
 
 using namespace partita;
@@ -148,6 +152,71 @@ TEST_CASE(
       CHECK(same_bits(solver.reads[static_cast<std::size_t>(k - 1)], expected));
     }
     CHECK(same_bits(solver.reads.back(), d1));
+  }
+}
+
+TEST_CASE(
+    "Exchange mapped on the receiver's side: a second copy of the mapper maps the values that "
+    "travel to the receiver's d_n and d_n+1 bit for bit",
+    "[coupling][exchange][map_on]") {
+  // the sender's mesh (1539 points) is larger than the receiver's (700)
+  auto a = std::make_unique<LocalParticipant>(
+      "a", std::make_unique<ArraySolver>(1539, DataKind::intensive));
+  auto b = std::make_unique<LocalParticipant>(
+      "b", std::make_unique<ArraySolver>(700, DataKind::intensive));
+  const Mesh& from = a->find_mesh("points")->mesh;
+  const Mesh& to = b->find_mesh("points")->mesh;
+  auto mapper = std::make_unique<NearestNeighborMapper>(Constraint::consistent);
+  mapper->compute(from, to);
+  NearestNeighborMapper theirs(Constraint::consistent);  // the receiver's process's own copy
+  theirs.compute(from, to);
+  Exchange e{"f", {a.get(), "points"}, {b.get(), "points"}, DataSpec{"f", 3, "N"},
+             std::move(mapper)};
+  CHECK(e.map_on() == MapOn::receiver);  // the default
+  e.set_mapped_by_receiver(true);
+  std::mt19937 g(11);
+  const auto mapped = [&](const Eigen::MatrixXd& sent) {
+    Eigen::MatrixXd d;
+    theirs.map(sent, d);
+    return d;
+  };
+
+  *e.window_output().combined = values(1539, g);
+  e.initialize();
+  WindowInput in = e.window_input();
+  REQUIRE(in.sent_end != nullptr);
+  CHECK(in.sent_end->rows() == 1539);  // the sender's values travel
+  CHECK(in.sent_start == nullptr);     // d_n = d_n+1: only the end is read
+  CHECK(same_bits(mapped(*in.sent_end), *in.end));
+
+  for (int window = 0; window < 3; ++window) {  // accepted windows: d_n is the last accepted
+    e.accept_window();
+    e.sent() = values(1539, g);
+    e.transmit();
+    in = e.window_input();
+    REQUIRE(in.sent_start != nullptr);
+    CHECK_FALSE(in.start_is_end);
+    CHECK(same_bits(mapped(*in.sent_start), *in.start));
+    CHECK(same_bits(mapped(*in.sent_end), *in.end));
+    e.sent() = values(1539, g);  // an implicit scheme's next iterate in the same window
+    e.transmit();
+    in = e.window_input();
+    CHECK(same_bits(mapped(*in.sent_start), *in.start));
+    CHECK(same_bits(mapped(*in.sent_end), *in.end));
+  }
+
+  SECTION("after a restart file d_n travels mapped (its sender's values are not in the file)") {
+    std::stringstream file;
+    BinaryWriter w(file);
+    StateArchive out(w);
+    e.serialize(out);
+    BinaryReader r(file, "restart");
+    StateArchive back(r);
+    e.serialize(back);
+    in = e.window_input();
+    CHECK(in.sent_start == nullptr);
+    REQUIRE(in.sent_end != nullptr);
+    CHECK(same_bits(mapped(*in.sent_end), *in.end));
   }
 }
 

@@ -1,4 +1,5 @@
-// BinaryWriter's recording and replay (a participant in another process writes its restart data
+// StateArchive (one serialise function writes and reads a state: the bytes of the plain writer
+// calls, every field back, a mismatch named); BinaryWriter's recording and replay (a participant in another process writes its restart data
 // into memory; the run's file must get the bytes and checksum table it would get in process),
 // and BinaryReader::raw_until (the controller hands such a participant its part of the file).
 #include <catch2/catch.hpp>
@@ -6,6 +7,8 @@
 #include <sstream>
 
 #include "partita/interface/binary_io.hpp"
+#include "partita/interface/error.hpp"
+#include "partita/interface/state_archive.hpp"
 
 namespace {
 
@@ -73,4 +76,93 @@ TEST_CASE("binary io: raw_until takes one part of a verified file and reads on a
   // and the run's reader goes on at the next part
   in.expect_section("end");
   CHECK(in.get<std::int64_t>() == 7);
+}
+
+namespace {
+
+// A state with one field of each kind a restart file holds, serialised by one function.
+struct Thing {
+  double x = 0.0;
+  bool flag = false;
+  long count = 0;
+  std::string name;
+  std::vector<int> list;
+  Eigen::MatrixXd m;
+  void serialize(partita::StateArchive& ar) {
+    ar.section("thing");
+    ar.io(x);
+    ar.io(flag);
+    ar.io(count);
+    ar.io(name);
+    ar.io(list);
+    ar.io(m);
+    if (ar.reading() && m.rows() != count) ar.fail("as many rows as the count");
+  }
+};
+
+}  // namespace
+
+TEST_CASE("state archive: one serialise function writes the plain writer's bytes and reads "
+          "every field back",
+          "[interface][binary_io]") {
+  Thing a;
+  a.x = -2.5;
+  a.flag = true;
+  a.count = 2;
+  a.name = "iqn-ils";
+  a.list = {3, 1, 4};
+  a.m.setConstant(2, 3, 0.125);
+  std::ostringstream archived, plain;
+  {
+    partita::BinaryWriter w(archived);
+    partita::StateArchive ar(w);
+    a.serialize(ar);
+  }
+  {  // the same fields by the writer's own calls (a bool as one byte)
+    partita::BinaryWriter w(plain);
+    w.section("thing");
+    w.write(a.x);
+    w.write(std::uint8_t{1});
+    w.write(a.count);
+    w.write(a.name);
+    w.write(a.list);
+    w.write(a.m);
+  }
+  CHECK(archived.str() == plain.str());
+
+  std::istringstream in(archived.str());
+  partita::BinaryReader r(in, "thing.bin");
+  partita::StateArchive ar(r);
+  Thing b;
+  b.serialize(ar);
+  CHECK(b.x == a.x);
+  CHECK(b.flag);
+  CHECK(b.count == a.count);
+  CHECK(b.name == a.name);
+  CHECK(b.list == a.list);
+  CHECK(b.m == a.m);
+
+  SECTION("a value that does not fit is named with the source") {
+    a.count = 5;  // but two rows
+    std::ostringstream bad;
+    partita::BinaryWriter w(bad);
+    partita::StateArchive wa(w);
+    a.serialize(wa);
+    std::istringstream bin(bad.str());
+    partita::BinaryReader br(bin, "bad.bin");
+    partita::StateArchive ra(br);
+    Thing c;
+    CHECK_THROWS_WITH(c.serialize(ra), Catch::Contains("bad.bin") &&
+                                           Catch::Contains("as many rows as the count"));
+  }
+  SECTION("another section is named") {
+    std::ostringstream other;
+    partita::BinaryWriter w(other);
+    w.section("other");
+    std::istringstream bin(other.str());
+    partita::BinaryReader br(bin, "other.bin");
+    partita::StateArchive ra(br);
+    Thing c;
+    CHECK_THROWS_WITH(c.serialize(ra), Catch::Contains("the section 'thing', found 'other'"));
+  }
 }

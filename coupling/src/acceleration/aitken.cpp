@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "partita/interface/binary_io.hpp"
+#include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -54,18 +54,11 @@ std::unique_ptr<Acceleration> Aitken::create(const config::Node& node) {
   return std::make_unique<Aitken>(node.real("initial_relaxation"));
 }
 
-void Aitken::write_state(BinaryWriter& out) const {
-  out.section("aitken");
-  out.write(omega_);
-  out.write(static_cast<std::uint8_t>(first_iteration_));
-  out.write(previous_residual_);
-}
-
-void Aitken::read_state(BinaryReader& in) {
-  in.expect_section("aitken");
-  in.read(omega_);
-  first_iteration_ = in.get<std::uint8_t>() != 0;
-  in.read(previous_residual_);
+void Aitken::serialize(StateArchive& ar) {
+  ar.section("aitken");
+  ar.io(omega_);
+  ar.io(first_iteration_);
+  ar.io(previous_residual_);
 }
 
 }  // namespace partita::coupling

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "partita/interface/binary_io.hpp"
+#include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -209,35 +209,22 @@ std::unique_ptr<Acceleration> IqnIls::create(const config::Node& node) {
   return std::make_unique<IqnIls>(o);
 }
 
-void IqnIls::write_state(BinaryWriter& out) const {
-  out.section("iqn-ils");
-  out.write(v_);
-  out.write(w_);
-  out.write(std::vector<int>(window_columns_.begin(), window_columns_.end()));
-  out.write(previous_residual_);
-  out.write(previous_x_tilde_);
-  out.write(static_cast<std::uint8_t>(first_iteration_));
-  qr_.write_state(out);
-  out.write(qr_weights_);
-  out.write(filtered_);
-  out.write(rebuilds_);
-}
-
-void IqnIls::read_state(BinaryReader& in) {
-  in.expect_section("iqn-ils");
-  in.read(v_);
-  in.read(w_);
-  std::vector<int> counts;
-  in.read(counts);
-  window_columns_.assign(counts.begin(), counts.end());
-  in.read(previous_residual_);
-  in.read(previous_x_tilde_);
-  first_iteration_ = in.get<std::uint8_t>() != 0;
-  qr_.read_state(in);
-  in.read(qr_weights_);
-  in.read(filtered_);
-  in.read(rebuilds_);
-  if (v_.cols() != w_.cols() || v_.rows() != w_.rows()) in.fail("V and W of equal shape");
+void IqnIls::serialize(StateArchive& ar) {
+  ar.section("iqn-ils");
+  ar.io(v_);
+  ar.io(w_);
+  std::vector<int> counts(window_columns_.begin(), window_columns_.end());  // (a deque)
+  ar.io(counts);
+  if (ar.reading()) window_columns_.assign(counts.begin(), counts.end());
+  ar.io(previous_residual_);
+  ar.io(previous_x_tilde_);
+  ar.io(first_iteration_);
+  qr_.serialize(ar);
+  ar.io(qr_weights_);
+  ar.io(filtered_);
+  ar.io(rebuilds_);
+  if (ar.reading() && (v_.cols() != w_.cols() || v_.rows() != w_.rows()))
+    ar.fail("V and W of equal shape");
 }
 
 }  // namespace partita::coupling

@@ -6,7 +6,7 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
-#include "partita/interface/binary_io.hpp"
+#include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"
 
 namespace partita::coupling {
@@ -223,36 +223,20 @@ std::unique_ptr<Acceleration> IqnImvj::create(const config::Node& node) {
   return std::make_unique<IqnImvj>(o);
 }
 
-void IqnImvj::write_state(BinaryWriter& out) const {
-  out.section("iqn-imvj");
-  out.write(v_);
-  out.write(w_);
-  qr_.write_state(out);
-  out.write(qr_weights_);
-  out.write(previous_residual_);
-  out.write(previous_x_tilde_);
-  out.write(static_cast<std::uint8_t>(first_iteration_));
-  out.write(a_);
-  out.write(b_);
-  out.write(windows_since_restart_);
-  out.write(restarts_);
-  out.write(filtered_);
-}
-
-void IqnImvj::read_state(BinaryReader& in) {
-  in.expect_section("iqn-imvj");
-  in.read(v_);
-  in.read(w_);
-  qr_.read_state(in);
-  in.read(qr_weights_);
-  in.read(previous_residual_);
-  in.read(previous_x_tilde_);
-  first_iteration_ = in.get<std::uint8_t>() != 0;
-  in.read(a_);
-  in.read(b_);
-  in.read(windows_since_restart_);
-  in.read(restarts_);
-  in.read(filtered_);
+void IqnImvj::serialize(StateArchive& ar) {
+  ar.section("iqn-imvj");
+  ar.io(v_);
+  ar.io(w_);
+  qr_.serialize(ar);
+  ar.io(qr_weights_);
+  ar.io(previous_residual_);
+  ar.io(previous_x_tilde_);
+  ar.io(first_iteration_);
+  ar.io(a_);
+  ar.io(b_);
+  ar.io(windows_since_restart_);
+  ar.io(restarts_);
+  ar.io(filtered_);
 }
 
 }  // namespace partita::coupling

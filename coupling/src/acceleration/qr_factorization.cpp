@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "partita/interface/binary_io.hpp"
+#include "partita/interface/state_archive.hpp"
 
 namespace partita::coupling {
 
@@ -102,16 +102,11 @@ Eigen::VectorXd QrFactorization::solve(const Eigen::VectorXd& b) const {
   return r_.triangularView<Eigen::Upper>().solve(qtb);
 }
 
-void QrFactorization::write_state(BinaryWriter& out) const {
-  out.write(q_);
-  out.write(r_);
-}
-
-void QrFactorization::read_state(BinaryReader& in) {
-  in.read(q_);
-  in.read(r_);
-  if (q_.cols() != r_.cols() || r_.rows() != r_.cols())
-    in.fail("a QR factorisation of matching size");
+void QrFactorization::serialize(StateArchive& ar) {
+  ar.io(q_);
+  ar.io(r_);
+  if (ar.reading() && (q_.cols() != r_.cols() || r_.rows() != r_.cols()))
+    ar.fail("a QR factorisation of matching size");
 }
 
 }  // namespace partita::coupling

@@ -4,7 +4,7 @@
 
 #include "participant_threads.hpp"
 #include "partita/coupling/stopwatch.hpp"
-#include "partita/interface/binary_io.hpp"
+#include "partita/interface/state_archive.hpp"
 
 namespace partita::coupling {
 
@@ -117,14 +117,9 @@ void CouplingScheme::send_outputs(Participant& p) {
   }
 }
 
-void CouplingScheme::write_state(BinaryWriter& out) const {
-  out.section("scheme " + name());
-  for (const Exchange* e : exchanges_) e->write_state(out);
-}
-
-void CouplingScheme::read_state(BinaryReader& in) {
-  in.expect_section("scheme " + name());
-  for (Exchange* e : exchanges_) e->read_state(in);
+void CouplingScheme::serialize(StateArchive& ar) {
+  ar.section("scheme " + name());
+  for (Exchange* e : exchanges_) e->serialize(ar);
 }
 
 }  // namespace partita::coupling

@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "partita/coupling/registries.hpp"
-#include "partita/interface/binary_io.hpp"
+#include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
@@ -176,18 +176,14 @@ WindowReport ImplicitScheme::run_window(const TimeWindow& window) {
   }
 }
 
-void ImplicitScheme::write_state(BinaryWriter& out) const {
-  CouplingScheme::write_state(out);
-  out.write(std::string(acceleration_ ? acceleration_->name() : "none"));
-  if (acceleration_) acceleration_->write_state(out);
-}
-
-void ImplicitScheme::read_state(BinaryReader& in) {
-  CouplingScheme::read_state(in);
-  const std::string stored = in.get_string();
+// The exchanges, the acceleration's name (a reader checks it is its own), its history.
+void ImplicitScheme::serialize(StateArchive& ar) {
+  CouplingScheme::serialize(ar);
   const std::string mine = acceleration_ ? acceleration_->name() : "none";
-  if (stored != mine) in.fail("the acceleration '" + mine + "', found '" + stored + "'");
-  if (acceleration_) acceleration_->read_state(in);
+  std::string stored = mine;
+  ar.io(stored);
+  if (stored != mine) ar.fail("the acceleration '" + mine + "', found '" + stored + "'");
+  if (acceleration_) acceleration_->serialize(ar);
 }
 
 namespace {

@@ -63,7 +63,8 @@
 
 namespace partita::coupling {
 
-class Channel;  // remote_participant.hpp
+class Channel;         // remote_participant.hpp
+struct ServerMapping;  // remote_participant.hpp
 
 struct RunOptions {
   std::filesystem::path output_dir;  ///< empty: out/<case name>/ relative to the current directory
@@ -185,10 +186,9 @@ class CaseRun {
     double max_energy_balance_error = 0.0;
     std::string energy_csv;
     std::vector<std::pair<std::string, std::vector<std::pair<double, std::string>>>> pvds;
-    template <class Archive>
-    void serialize_case(Archive& ar);  // name, identity, window: checked before the rest
-    template <class Archive>
-    void serialize_state(Archive& ar);
+    // Written and read by the same functions (StateArchive: state_archive.hpp).
+    void serialize_case(StateArchive& ar);  // name, identity, window: checked before the rest
+    void serialize_state(StateArchive& ar);
   };
   SavedRun saved_run(const Progress& progress) const;
   void build_participants(const config::Node& root);
@@ -198,6 +198,13 @@ class CaseRun {
     return options_.distributed.participant.empty() || options_.distributed.participant == participant;
   }
   void build_exchanges(const config::Node& coupling);
+  // The mapper of the exchange `item` (sender field `ws`), computed from `from` to `to`; the
+  // controller's for every exchange, a server's for the exchanges it maps (map_on: receiver).
+  std::unique_ptr<Mapper> exchange_mapper(const config::Node& item, const DataSpec& ws,
+                                          const Mesh& from, const Mesh& to,
+                                          const std::string& label) const;
+  ServerMapping server_mapping(std::size_t exchange, const InterfaceMesh& from,
+                               const InterfaceMesh& to) const;
   void build_monitors(const config::Node& root);
   void build_energy_balance(const config::Node& root);
   // participant.quantity named by a node, checked against what the participant reports
@@ -250,6 +257,7 @@ class CaseRun {
   vtk::Options vtk_options_;                                // output.vtk
   std::vector<std::unique_ptr<Participant>> participants_;  // in scheme order
   LocalParticipant* served_ = nullptr;  // the participant a server process runs
+  config::Node served_coupling_;        // a server's: the case's coupling section (its mappers)
   std::vector<std::unique_ptr<Exchange>> exchanges_;
   std::unique_ptr<CouplingScheme> scheme_;
   std::vector<Monitor> monitors_;

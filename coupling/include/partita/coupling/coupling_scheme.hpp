@@ -66,10 +66,10 @@ class CouplingScheme {
   /// Columns (name, unit) of the per-window residuals in coupling.csv.
   virtual std::vector<std::pair<std::string, std::string>> residual_columns() const { return {}; }
 
-  /// Restart files, between windows: every exchange's values, then what the scheme itself
-  /// carries (an implicit scheme: its acceleration's history).
-  virtual void write_state(BinaryWriter& out) const;
-  virtual void read_state(BinaryReader& in);
+  /// Restart files, between windows, written and read by this one function: every exchange's
+  /// values, then what the scheme itself carries (an implicit scheme: its acceleration's
+  /// history).
+  virtual void serialize(StateArchive& ar);
 
   const std::vector<Participant*>& participants() const { return participants_; }
   const std::vector<Exchange*>& exchanges() const { return exchanges_; }

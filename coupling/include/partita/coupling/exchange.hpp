@@ -15,6 +15,14 @@
 // Call order per window: window_output() handed to the writer's run_window(); [remember_previous()
 // per iteration]; set sent(); transmit(); window_input() handed to the reader's run_window();
 // accept_window() once the window is accepted.
+//
+// Where the mapping runs (map_on, the case key): in one process the core maps every exchange
+// (the same numbers either way). With participants in processes of their own the core (in the
+// controller's process) still maps every exchange, since the checks, the audits, the interface
+// output and the restart files read both sides; what changes is what travels to a receiver in
+// another process: with map_on: receiver (the default) the sender's values, which the receiver's
+// process maps with its own copy of the mapper (set_mapped_by_receiver()); with map_on: sender
+// the mapped values. What a participant in another process writes travels as written.
 
 #include <memory>
 #include <string>
@@ -26,11 +34,13 @@
 #include "partita/interface/solver.hpp"
 
 namespace partita {
-class BinaryWriter;
-class BinaryReader;
+class StateArchive;
 }  // namespace partita
 
 namespace partita::coupling {
+
+/// Which participant's process maps an exchange (the case key map_on; see the file comment).
+enum class MapOn { receiver, sender };
 
 class Exchange {
  public:
@@ -53,6 +63,13 @@ class Exchange {
   const DataSpec& spec() const { return spec_; }
   ReaderSees reader_sees() const { return reader_sees_; }
   WriterCombines writer_combines() const { return writer_combines_; }
+  MapOn map_on() const { return map_on_; }
+  void set_map_on(MapOn side) { map_on_ = side; }
+  /// The receiver's process maps what it reads (it runs in another process and map_on is
+  /// receiver): window_input() then also names the sender's values of d_n and d_{n+1}, and
+  /// accept_window() keeps a copy of the sender's values of d_n.
+  void set_mapped_by_receiver(bool on) { mapped_by_receiver_ = on; }
+  bool mapped_by_receiver() const { return mapped_by_receiver_; }
   const Mapper* mapper() const { return mapper_.get(); }
   /// The sender's and the receiver's interface meshes (fixed for the run, see Solver::meshes()).
   const Mesh& source_mesh() const { return *source_mesh_; }
@@ -84,24 +101,22 @@ class Exchange {
   const Eigen::MatrixXd& received() const { return end_; }
   /// d_n = d_{n+1}: the window is accepted (no copy: start_ is taken from end_ by the next
   /// transmit(), which swaps the two before mapping into end_).
-  void accept_window() { start_is_end_ = true; }
+  void accept_window() {
+    start_is_end_ = true;
+    if (mapped_by_receiver_) {  // d_n's values before the mapping, for the receiver's process
+      sent_start_ = sent_;
+      sent_start_known_ = true;
+    }
+  }
 
   /// Initial data, once the writer's initial_values() filled window_output()'s combined:
   /// sent = previous = combined, transmitted, start = end.
   void initialize();
 
-  /// Restart files: the values carried between windows (sent, combined, previous, start, end).
-  void write_state(BinaryWriter& out) const;
-  /// Throws partita::Error if the stored values do not fit this exchange's meshes.
-  void read_state(BinaryReader& in);
-
- private:
-  /// write_state and read_state through one function (Archive: BinaryWriter with a const
-  /// Exchange, or BinaryReader).
-  template <class Archive, class Self>
-  static void serialize(Archive& ar, Self& x);
-
- public:
+  /// Restart files, written and read by this one function: the values carried between
+  /// windows (combined, sent, previous, start, end). Reading throws partita::Error if the
+  /// stored values do not fit this exchange's meshes.
+  void serialize(StateArchive& ar);
 
   /// FOR TESTING AUDITS ONLY: transmit() multiplies what arrives by `factor` (a deliberately
   /// broken exchange, the case key `scale`; 1: the plain mapping, the default).
@@ -118,6 +133,10 @@ class Exchange {
   std::unique_ptr<Mapper> mapper_;
   ReaderSees reader_sees_;
   WriterCombines writer_combines_;
+  MapOn map_on_ = MapOn::receiver;
+  bool mapped_by_receiver_ = false;
+  Eigen::MatrixXd sent_start_;     // mapped_by_receiver_: sent when d_n was accepted
+  bool sent_start_known_ = false;  // (not after a restart file: then d_n travels mapped)
   Eigen::Index from_points_ = 0;
   const Mesh* source_mesh_ = nullptr;
   const Mesh* target_mesh_ = nullptr;

@@ -51,8 +51,7 @@ class ImplicitScheme : public CouplingScheme {
   bool parallel() const override { return !options_.serial; }
   std::vector<std::pair<std::string, std::string>> residual_columns() const override;
   const Acceleration* acceleration() const { return acceleration_.get(); }
-  void write_state(BinaryWriter& out) const override;
-  void read_state(BinaryReader& in) override;
+  void serialize(StateArchive& ar) override;
   const std::vector<Exchange*>& accelerated() const { return accelerated_; }
 
   static std::unique_ptr<CouplingScheme> create_serial(const SchemeContext& context);

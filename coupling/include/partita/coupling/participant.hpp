@@ -55,6 +55,12 @@ struct WindowInput {
   const Eigen::MatrixXd* start = nullptr;  ///< d_n (not used when start_is_end)
   const Eigen::MatrixXd* end = nullptr;    ///< d_{n+1}, the newest value
   bool start_is_end = true;                ///< no new value this window: d_{n+1} = d_n
+  /// Where the receiver's own process maps (map_on: receiver, the receiver in another process):
+  /// the sender's values whose mapping d_n and d_{n+1} are (start and end above hold the mapped
+  /// values as well; a port in another process sends these, the smaller message where the
+  /// sender's mesh is the smaller). nullptr: not known (then the mapped value travels).
+  const Eigen::MatrixXd* sent_start = nullptr;
+  const Eigen::MatrixXd* sent_end = nullptr;
 };
 
 /// One field a participant sends: its window value goes to *combined (whose storage may be

@@ -17,22 +17,29 @@
 //
 // Window exchange: one request and one reply per participant per window (per iteration of an
 // implicit scheme): the inputs at the window's ends go out, the outputs combined over the
-// substeps come back. run_window() only sends; finish_window() waits for the reply, so a
+// substeps come back. An input whose exchange maps on the receiver (map_on: receiver, the
+// default) travels as the sender's values and the server maps it with its own copy of the
+// mapper (set up once by prepare_mapping(): the controller hands over the sender's mesh, the
+// server builds the mapper from the case's exchange); the controller maps it too, for its checks,
+// audits and restart files, so both hold the same bits. run_window() only sends; finish_window() waits for the reply, so a
 // parallel scheme lets every remote participant work while the controller's own one does.
 //
 // Start-up (handshake), before the first window, each server sends
 //   hello: [partita version] [case hash] [participant] [meshes] [mesh requests]
 // and the controller answers with the meshes it asked for (another participant's surface),
-// after which the server sends its final meshes, stable step and restart support. A mismatch
+// after which the server sends its final meshes, stable step, restart support and whether it can
+// map what it reads. A mismatch
 // (version, case, participant) is an error on both sides naming both.
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "partita/coupling/mapping/mapper.hpp"
 #include "partita/coupling/participant.hpp"
 #include "partita/interface/config.hpp"
 
@@ -79,6 +86,8 @@ struct Ready {
   std::vector<InterfaceMesh> meshes;
   bool supports_restart = false;
   double stable_time_step = 0.0;
+  bool maps_inputs = false;  // it can map what it reads (partita's own processes; not an
+                             // external program through the participant API)
   std::string error;
 };
 
@@ -86,6 +95,13 @@ struct Ready {
 class RemoteParticipant final : public Participant {
  public:
   RemoteParticipant(std::string name, Channel& channel, Ready ready);
+
+  /// Before the first window: the server maps the case's exchange number `exchange` (into its
+  /// mesh `mesh`, field `data`) on its side; `sender` is the sender's mesh, handed over.
+  void prepare_mapping(std::size_t exchange, const std::string& mesh, const std::string& data,
+                       const InterfaceMesh& sender);
+  /// Whether its process can map what it reads (else the controller maps it).
+  bool maps_inputs() const { return maps_inputs_; }
 
   const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
   void initial_values(std::span<WindowOutput> outputs) override;
@@ -118,6 +134,7 @@ class RemoteParticipant final : public Participant {
   Channel& channel_;
   std::vector<InterfaceMesh> meshes_;
   bool supports_restart_ = false;
+  bool maps_inputs_ = false;
   // A window sent, its reply not yet read: where its outputs go (a copy: the caller's array
   // may be reused for another participant meanwhile, as a parallel scheme does).
   std::vector<WindowOutput> pending_;
@@ -138,8 +155,21 @@ class RemoteParticipant final : public Participant {
   mutable Cache cache_;
   mutable double wait_seconds_ = 0.0;  // in the channel: sending, and waiting for replies
   mutable long messages_ = 0;
+  mutable double bytes_sent_ = 0.0, bytes_received_ = 0.0;
   mutable double extra_seconds_ = 0.0;
 };
+
+/// A server's mapping of an exchange it maps on its side: the mapper computed from the sender's
+/// mesh to its own, and the exchange's scale (1 but where a test breaks it on purpose).
+struct ServerMapping {
+  std::unique_ptr<Mapper> mapper;
+  double scale = 1.0;
+};
+/// Builds a server's mapping from the case: the exchange's number in coupling.exchanges, the
+/// sender's mesh (from the controller) and the receiver's (the server's own).
+using MappingFactory = std::function<ServerMapping(std::size_t exchange,
+                                                   const InterfaceMesh& sender,
+                                                   const InterfaceMesh& receiver)>;
 
 /// The remote side: the start-up handshake and the loop that answers the controller's requests
 /// with a LocalParticipant, until the run ends (finalize: returns normally) or the controller
@@ -155,11 +185,15 @@ class ParticipantServer {
   void fail_setup(const std::string& error) noexcept;
   /// Send the final meshes, then answer requests until the run ends; returns the signal that
   /// stopped the run (0: none; the process exits with 128 + it, as the controller does).
-  int serve(LocalParticipant& p);
+  /// `mapping` builds the mappers of the exchanges this process maps (map_on: receiver).
+  int serve(LocalParticipant& p, const MappingFactory& mapping = {});
+  /// Time spent mapping what this process read [s].
+  double mapping_seconds() const { return mapping_seconds_; }
 
  private:
   Channel& controller_;
   const std::atomic<int>* stop_signal_;
+  double mapping_seconds_ = 0.0;
 };
 
 /// The controller's side of one server's handshake: its hello (checked against this process's

@@ -19,6 +19,9 @@
 // A reader calls verify_checksums() before it uses anything: every section's bytes are checked
 // against the table (one pass over the file), so a flipped bit anywhere is an error naming the
 // section, never a resumed run with a moved particle. Reads then stop at the table.
+//
+// A state that is written and read back (a part of a restart file) does both through one
+// function over a StateArchive (state_archive.hpp), which writes or reads each field as named.
 
 #include <cstdint>
 #include <cstring>
@@ -82,13 +85,6 @@ class BinaryWriter {
   /// Write a recording as its writer wrote it: the header's bytes, then per section
   /// section(name) and its bytes.
   void replay(const Recording& r);
-
-  /// One serialise function for writing and reading (`template <class Archive> void
-  /// serialize(Archive& ar)` with ar.io(x) and ar.io_section(name)): here io() writes.
-  static constexpr bool reading = false;
-  template <class T>
-  void io(const T& v) { write(v); }
-  void io_section(const std::string& name) { section(name); }
 
   bool good() const { return static_cast<bool>(out_); }
 
@@ -163,12 +159,6 @@ class BinaryReader {
                                  : std::string("other data")));
   }
   std::string bytes() { return get_string(); }
-
-  /// The reading side of a serialise function (see BinaryWriter::io): io() reads.
-  static constexpr bool reading = true;
-  template <class T>
-  void io(T& v) { read(v); }
-  void io_section(const std::string& name) { expect_section(name); }
 
   /// The bytes from here up to the next section (in the verified checksum table) whose name
   /// `stop` accepts, or up to the table; the position moves past them. Only after

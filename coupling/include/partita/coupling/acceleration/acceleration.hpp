@@ -20,8 +20,7 @@ namespace partita::config {
 class Spec;
 }
 namespace partita {
-class BinaryWriter;
-class BinaryReader;
+class StateArchive;
 }  // namespace partita
 
 namespace partita::coupling {
@@ -40,10 +39,10 @@ class Acceleration {
                                 const Eigen::VectorXd& weights) = 0;
   /// Registered name, for messages and the summary.
   virtual std::string name() const = 0;
-  /// Restart files: everything carried from window to window (between windows only), so that a
-  /// resumed run iterates bit for bit as one that never stopped. Stateless: nothing.
-  virtual void write_state(BinaryWriter& out) const {}
-  virtual void read_state(BinaryReader& in) {}
+  /// Restart files, written and read by this one function: everything carried from window to
+  /// window (between windows only), so that a resumed run iterates bit for bit as one that
+  /// never stopped. Stateless: nothing.
+  virtual void serialize(StateArchive& /*ar*/) {}
 };
 
 }  // namespace partita::coupling

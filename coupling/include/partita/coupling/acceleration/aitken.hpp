@@ -20,8 +20,7 @@ class Aitken : public Acceleration {
   void window_converged(const Eigen::VectorXd&, const Eigen::VectorXd&,
                         const Eigen::VectorXd&) override;
   std::string name() const override { return "aitken"; }
-  void write_state(BinaryWriter& out) const override;
-  void read_state(BinaryReader& in) override;
+  void serialize(StateArchive& ar) override;
   /// The relaxation factor of the last accelerate().
   double omega() const { return omega_; }
 

@@ -54,8 +54,7 @@ class IqnIls : public Acceleration {
   void window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
                         const Eigen::VectorXd& weights) override;
   std::string name() const override { return "iqn-ils"; }
-  void write_state(BinaryWriter& out) const override;
-  void read_state(BinaryReader& in) override;
+  void serialize(StateArchive& ar) override;
 
   /// Columns in V and W now.
   Eigen::Index columns() const { return v_.cols(); }

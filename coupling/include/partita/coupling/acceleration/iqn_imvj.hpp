@@ -60,8 +60,7 @@ class IqnImvj : public Acceleration {
   void window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
                         const Eigen::VectorXd& weights) override;
   std::string name() const override { return "iqn-imvj"; }
-  void write_state(BinaryWriter& out) const override;
-  void read_state(BinaryReader& in) override;
+  void serialize(StateArchive& ar) override;
 
   /// Columns of this window in V and W.
   Eigen::Index columns() const { return v_.cols(); }

@@ -19,8 +19,7 @@
 #include <Eigen/Core>
 
 namespace partita {
-class BinaryWriter;
-class BinaryReader;
+class StateArchive;
 }  // namespace partita
 
 namespace partita::coupling {
@@ -55,8 +54,8 @@ class QrFactorization {
   const Eigen::MatrixXd& q() const { return q_; }
   const Eigen::MatrixXd& r() const { return r_; }
   /// Restart files: Q and R as they are.
-  void write_state(BinaryWriter& out) const;
-  void read_state(BinaryReader& in);
+  /// Restart files: Q and R, written and read by this one function.
+  void serialize(StateArchive& ar);
 
  private:
   Eigen::MatrixXd q_;  // rows x cols
