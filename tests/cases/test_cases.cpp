@@ -5,7 +5,8 @@
 // takes the largest |value| of a column over every row instead (e.g. the energy balance error of
 // energy.csv at every output time). A script check's `args` are passed after the run's output
 // folder; `{out:NAME}` stands for the output folder of the earlier run NAME of the same file (a
-// comparison of two runs, e.g. a collision against the driven run of the same structure).
+// comparison of two runs, e.g. a collision against the driven run of the same structure). A
+// run's `threads` (default 1) is its --threads.
 
 #include <catch2/catch.hpp>
 
@@ -105,15 +106,15 @@ void compare(const YAML::Node& check, double value, const std::string& what,
   if (check["at_least"]) CHECK(value >= check["at_least"].as<double>());
 }
 
-}  // namespace
-
-TEST_CASE("cases: shortened runs meet their reference values", "[cases][slow]") {
+// The runs of every case folder `pick` accepts (two test cases, so that ctest -j runs the long
+// double hull beside the others).
+void run_case_checks(bool (*pick)(const std::string& folder)) {
   const fs::path root = fs::path(PARTITA_SOURCE_DIR) / "cases";
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   int runs = 0;
   for (const auto& dir : fs::directory_iterator(root)) {
     const fs::path checks = dir.path() / "checks.yaml";
-    if (!fs::exists(checks)) continue;
+    if (!fs::exists(checks) || !pick(dir.path().filename().string())) continue;
     const YAML::Node doc = YAML::LoadFile(checks.string());
     // a script's `args` may name an earlier run's output folder as {out:NAME}: that folder is
     // kept until the end of the folder's runs
@@ -139,8 +140,8 @@ TEST_CASE("cases: shortened runs meet their reference values", "[cases][slow]") 
         std::string cmd =
             quote(PARTITA_EXECUTABLE) + " run " +
             quote((dir.path() / run["case"].as<std::string>()).string()) + " --output " +
-            quote(out.string()) +
-            " --threads 1 --log-level warn";
+            quote(out.string()) + " --threads " +
+            std::to_string(run["threads"] ? run["threads"].as<int>() : 1) + " --log-level warn";
         // one run, also of a sweep case, unless the entry says `sweep: true` (its checks compare
         // the variants)
         if (!(run["sweep"] && run["sweep"].as<bool>())) cmd += " --no-sweep";
@@ -214,4 +215,17 @@ TEST_CASE("cases: shortened runs meet their reference values", "[cases][slow]") 
     }
   }
   CHECK(runs >= 0);
+}
+
+bool is_double_hull(const std::string& folder) { return folder == "double_hull_impact"; }
+bool is_not_double_hull(const std::string& folder) { return !is_double_hull(folder); }
+
+}  // namespace
+
+TEST_CASE("cases: shortened runs meet their reference values", "[cases][slow]") {
+  run_case_checks(is_not_double_hull);
+}
+
+TEST_CASE("cases: the double hull's coarse runs meet their reference values", "[cases][slow]") {
+  run_case_checks(is_double_hull);
 }
