@@ -31,15 +31,21 @@ mkdir -p "$(dirname "$exclude")"
 grep -qx '/.dev/' "$exclude" 2>/dev/null || echo '/.dev/' >> "$exclude"
 stage=$(mktemp -d)
 trap 'rm -rf "$stage"' EXIT
-mkdir -p "$stage/bin" "$stage/lib" "$stage/data"
+mkdir -p "$stage/bin" "$stage/lib" "$stage/data" "$stage/share/partita"
 for b in "${bins[@]}"; do strip -o "$stage/bin/$(basename "$b")" "$b"; done
-# every library the binaries load, but the C library and the loader (the device's own are newer)
-ldd "${bins[@]}" | awk '$3 ~ /^\// {print $3}' | sort -u |
-  grep -v -E '/(libc|libm|libdl|libpthread|librt|ld-linux[^/]*)\.so' |
-  while read -r lib; do cp -L "$lib" "$stage/lib/"; done
+# the app's plot scripts where an installed partita finds them (bin/../share/partita)
+cp app/plot_monitors.py app/plot_sweep.py "$stage/share/partita/"
+# the libraries that ELF files $@ load, but the C library and the loader (the device's own are
+# newer), into $stage/lib
+copy_libraries() {
+  ldd "$@" | awk '$3 ~ /^\// {print $3}' | sort -u |
+    grep -v -E '/(libc|libm|libdl|libpthread|librt|ld-linux[^/]*)\.so' |
+    while read -r lib; do cp -L "$lib" "$stage/lib/"; done
+}
+copy_libraries "${bins[@]}"
 ((only)) || cp "$data"/bed_large.data "$data"/bed_small.data "$stage/data/"
 mkdir -p .dev
-tar -C "$stage" -czf .dev/bundle.tar.gz bin lib data
+tar -C "$stage" -czf .dev/bundle.tar.gz bin lib data share
 echo "pack.sh: .dev/bundle.tar.gz $(du -h .dev/bundle.tar.gz | cut -f1) (binaries of $(git rev-parse --short HEAD))"
 if ((only)); then
   echo "device call: run(command='bash bench/device/parallel_threads.sh', carry=['.dev'], timeout_s=300)"
