@@ -9,12 +9,9 @@
 # process time (wall, user, sys) to $OUT/parallel_threads.log.
 set -uo pipefail
 runs=${RUNS:-5}
-out=${OUT:-.}
-log=$out/parallel_threads.log
-: > "$log"
-say() { echo "$*" | tee -a "$log"; }
 source "$(dirname "$0")/bundle.sh"
-unpack_bundle || { say "no .dev/bundle.tar.gz"; exit 1; }
+open_log parallel_threads.log
+unpack_bundle || exit 1
 export PARTITA_LOG_LEVEL=info
 say "$(nproc) processors; $(grep -m1 'model name' /proc/cpuinfo); $(uptime)"
 common=(--set time.end=0.01 --set output.every=1 --set coupling.on_energy_created=warn

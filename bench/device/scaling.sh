@@ -9,15 +9,11 @@
 #   5. the 10^6-granule scale case on 2, 8 and 16 threads (time per participant, memory).
 # Everything goes to $OUT/scaling.log (or ./scaling.log without $OUT).
 set -uo pipefail
-out=${OUT:-.}
-log=$out/scaling.log
-: > "$log"
-say() { echo "$*" | tee -a "$log"; }
+source "$(dirname "$0")/bundle.sh"
+open_log scaling.log
 step() { say ""; say "== $* ($(date -u +%T))"; }
 run() { say "\$ $*"; "$@" 2>&1 | tee -a "$log"; say "(rc ${PIPESTATUS[0]})"; }
-
-source "$(dirname "$0")/bundle.sh"
-unpack_bundle || { say "no .dev/bundle.tar.gz: run bench/device/pack.sh here first"; exit 1; }
+unpack_bundle || exit 1
 export PARTITA_LOG_LEVEL=warn
 # the tests find their files and the app through the paths compiled in
 provide_build_paths | tee -a "$log"
