@@ -9,15 +9,10 @@
 # process time (wall, user, sys) to $OUT/parallel_threads.log.
 set -uo pipefail
 runs=${RUNS:-5}
-out=${OUT:-.}
-log=$out/parallel_threads.log
-: > "$log"
-say() { echo "$*" | tee -a "$log"; }
-dev=/tmp/partita-dev
-rm -rf "$dev" && mkdir -p "$dev"
-tar -C "$dev" -xzf .dev/bundle.tar.gz || { say "no .dev/bundle.tar.gz"; exit 1; }
-export LD_LIBRARY_PATH=$dev/lib PARTITA_LOG_LEVEL=info
-unset OMP_WAIT_POLICY OMP_NUM_THREADS
+source "$(dirname "$0")/bundle.sh"
+open_log parallel_threads.log
+unpack_bundle || exit 1
+export PARTITA_LOG_LEVEL=info
 say "$(nproc) processors; $(grep -m1 'model name' /proc/cpuinfo); $(uptime)"
 common=(--set time.end=0.01 --set output.every=1 --set coupling.on_energy_created=warn
         --set participants.granules.time_step_fraction=0.12)

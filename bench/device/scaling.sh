@@ -9,22 +9,14 @@
 #   5. the 10^6-granule scale case on 2, 8 and 16 threads (time per participant, memory).
 # Everything goes to $OUT/scaling.log (or ./scaling.log without $OUT).
 set -uo pipefail
-out=${OUT:-.}
-log=$out/scaling.log
-: > "$log"
-say() { echo "$*" | tee -a "$log"; }
+source "$(dirname "$0")/bundle.sh"
+open_log scaling.log
 step() { say ""; say "== $* ($(date -u +%T))"; }
 run() { say "\$ $*"; "$@" 2>&1 | tee -a "$log"; say "(rc ${PIPESTATUS[0]})"; }
-
-dev=/tmp/partita-dev
-rm -rf "$dev" && mkdir -p "$dev"
-tar -C "$dev" -xzf .dev/bundle.tar.gz || { say "no .dev/bundle.tar.gz: run bench/device/pack.sh here first"; exit 1; }
-export LD_LIBRARY_PATH=$dev/lib
+unpack_bundle || exit 1
 export PARTITA_LOG_LEVEL=warn
-unset OMP_WAIT_POLICY OMP_NUM_THREADS
-# the tests find their files through the source path compiled in (PARTITA_SOURCE_DIR)
-src=$(strings "$dev/bin/partita_tests" | grep -m1 -oE '^/[^ ]*/main$' || true)
-[[ -n $src && ! -e $src ]] && mkdir -p "$(dirname "$src")" && ln -s "$PWD" "$src"
+# the tests find their files and the app through the paths compiled in
+provide_build_paths | tee -a "$log"
 
 step machine
 run nproc
