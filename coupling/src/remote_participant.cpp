@@ -271,6 +271,8 @@ void RemoteParticipant::run_window(const TimeWindow& window, std::span<const Win
   std::string bytes = m.str();
   bytes_sent_ += static_cast<double>(bytes.size());
   channel_.send(std::move(bytes));
+  // the peer waits for it: let it start while this process runs its own participants
+  channel_.deliver("the window's inputs to be taken");
   wait_seconds_ += send.seconds();
   pending_.assign(outputs.begin(), outputs.end());  // (no allocation after the first window)
   pending_window_ = true;

@@ -88,6 +88,20 @@ std::string MpiChannel::receive(std::string_view what) {
   return bytes;
 }
 
+void MpiChannel::deliver(std::string_view what) {
+  using clock = std::chrono::steady_clock;
+  const auto start = clock::now();
+  for (progress(); !pending_.empty(); progress()) {
+    const double waited = std::chrono::duration<double>(clock::now() - start).count();
+    if (waited > deadline_)
+      throw PeerTimeout(fmt::format(
+          "{} took nothing for {:.0f} s while waiting for {} (--peer-timeout {:g}): that process "
+          "is stuck or gone",
+          name_, waited, what, deadline_));
+    std::this_thread::yield();
+  }
+}
+
 void MpiChannel::drain(double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (!pending_.empty() && std::chrono::steady_clock::now() < until) {

@@ -59,6 +59,12 @@ class Channel {
   virtual std::string peer() const = 0;
   /// The longest wait for one message [s].
   virtual double deadline() const = 0;
+  /// Return once the peer has the messages sent so far (at most deadline() seconds). Where a
+  /// transport moves a large message only while the sender calls into it (MPI's rendezvous
+  /// without a progress thread), a sender that goes off to work would hold the peer up until its
+  /// next call: a parallel scheme hands a remote participant its window this way before running
+  /// its own. Default: nothing to do (send() delivers).
+  virtual void deliver(std::string_view /*what*/) {}
 };
 
 /// The hash every process of a distributed run compares at start-up: FNV-1a of the case as loaded

@@ -50,6 +50,9 @@ class MpiChannel final : public coupling::Channel {
   std::string receive(std::string_view what) override;
   std::string peer() const override { return name_; }
   double deadline() const override { return deadline_; }
+  /// Completes the sends under way (OpenMPI moves a message above the eager limit, 4 KB over
+  /// shared memory, only while the sender calls MPI); throws PeerTimeout after deadline().
+  void deliver(std::string_view what) override;
   /// Complete the sends still under way, waiting at most `seconds`.
   void drain(double seconds);
 
