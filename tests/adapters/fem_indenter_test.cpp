@@ -80,6 +80,39 @@ TEST_CASE("fem indenter: a free sphere dropped on a free block, through the YAML
   CHECK(d(0, 2) == Approx(monitor(*s, "ball.z") - 0.15001));
 }
 
+TEST_CASE("fem indenter: a free body takes the forces on its mesh, a driven one refuses them",
+          "[adapters][fem][contact]") {
+  // far from the block: only the handed-over forces act. 3 N up in all, spread over the
+  // vertices, on 2 kg moving down at 2 m/s: v = -2 + 1.5 t, and its work is the kinetic energy's change
+  auto s = make_fem(with(
+      "{name: ball, shape: sphere, radius: 0.05, position: [0.05, 0.05, 0.5], face: zmax, "
+      "motion: {mass: 2, velocity: [0, 0, -2]}}"));
+  const InterfaceMesh* ball = nullptr;
+  for (const auto& m : s->meshes())
+    if (m.mesh.name() == "ball") ball = &m;
+  REQUIRE(ball != nullptr);
+  REQUIRE(ball->reads.size() == 1);
+  CHECK(ball->reads[0].name == "force");
+  Eigen::MatrixXd f = Eigen::MatrixXd::Zero(ball->mesh.size(), 3);
+  f.col(2).setConstant(3.0 / static_cast<double>(ball->mesh.size()));
+  s->read("ball", "force", f);
+  const double dt = s->stable_time_step();
+  const int n = 200;
+  for (int k = 0; k < n; ++k) s->advance(dt);
+  const double t = n * dt, v = -2.0 + 1.5 * t;
+  CHECK(monitor(*s, "ball.vz") == Approx(v).epsilon(1e-9));
+  CHECK(monitor(*s, "ball.external_force_z") == Approx(3.0).epsilon(1e-12));
+  CHECK(monitor(*s, "ball.external_work") == Approx(0.5 * 2.0 * (v * v - 4.0)).epsilon(1e-8));
+  CHECK_THROWS_WITH(s->read("ball", "displacement", f), Catch::Contains("reads only 'force' on indenter mesh 'ball'"));
+
+  auto driven = make_fem(with(
+      "{name: punch, shape: sphere, radius: 0.05, position: [0.05, 0.05, 0.5], face: zmax, "
+      "motion: {velocity: [0, 0, -1]}}"));
+  for (const auto& m : driven->meshes())
+    if (m.mesh.name() == "punch") CHECK(m.reads.empty());
+  CHECK_THROWS_WITH(driven->read("punch", "force", f), Catch::Contains("only when the indenter is free (motion.mass)"));
+}
+
 TEST_CASE("fem indenter: bad input names the key and what is allowed", "[adapters][fem][contact]") {
   auto error_of = [](const std::string& yaml) -> std::string {
     try {

@@ -817,6 +817,15 @@ void FemAdapter::apply_nodal_forces() {
 }
 
 void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
+  for (const auto& ind : indenters_) {
+    if (!ind.has_surface || ind.name != mesh) continue;
+    if (data != "force" || !ind.contact->indenter().is_free())
+      throw Error("fem '" + name_ + "' reads only 'force' on indenter mesh '" + ind.name +
+                  "', and only when the indenter is free (motion.mass)");
+    // the resultant of the forces on the surface's vertices moves the rigid body
+    ind.contact->set_external_force(values.colwise().sum().transpose());
+    return;
+  }
   Part part = Part::nodes;
   Interface& i = interfaces_[find_interface(mesh, &part)];
   if (part == Part::quadrature && data == "traction") {
@@ -900,6 +909,10 @@ void FemAdapter::advance(double dt) {
 }
 
 std::optional<double> FemAdapter::interface_work(std::string_view mesh) const {
+  for (const auto& ind : indenters_)  // a free indenter: the work of the forces it read on it
+    if (ind.has_surface && ind.name == mesh)
+      return ind.contact->indenter().is_free() ? std::optional<double>(ind.contact->indenter().external_work())
+                                               : std::nullopt;
   Part part = Part::nodes;
   return interfaces_[find_interface(mesh, &part)].audit.work;
 }

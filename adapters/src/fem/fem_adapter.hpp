@@ -111,7 +111,7 @@ class FemAdapter : public Solver {
   struct Indenter {
     std::string name;
     Eigen::Vector3d reference;  // its `position`: the monitors' N.x, N.y, N.z at rest
-    const fem::IndenterContact* contact = nullptr;
+    fem::IndenterContact* contact = nullptr;
     bool has_surface = false;  // offers the mesh <name> (writes "displacement")
   };
   std::vector<Indenter> indenters_;

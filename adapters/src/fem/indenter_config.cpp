@@ -39,8 +39,9 @@ std::shared_ptr<Spec> indenter_spec() {
   motion->any("table",
               "driven: the velocity over time, [[t, vx, vy, vz], ...] (linear between rows, held "
               "before the first and after the last; integrated exactly)");
-  motion->real("mass", "free: the indenter's mass (moves under the contact force and gravity; "
-                       "analysis.integrator: central-difference)")
+  motion->real("mass", "free: the indenter's mass (moves under the contact force, gravity and the "
+                       "resultant of the forces an exchange gives its mesh <name> (data force: "
+                       "granules it pushes); analysis.integrator: central-difference)")
       .unit("kg")
       .positive();
   motion->reals("gravity", "free: gravitational acceleration on the indenter").unit("m/s^2").size(3).def(std::vector<double>{0.0, 0.0, 0.0});
@@ -49,7 +50,8 @@ std::shared_ptr<Spec> indenter_spec() {
       "indenter",
       "a rigid body that translates and touches the nodes of an FE face (penalty contact)");
   s->string("name", "monitors <name>.x, .vx, .force_x, .penetration, .work, .kinetic_energy, .contact_energy, "
-                    ".friction_work ...; the moving mesh <name> (sphere, capsule, surface)")
+                    ".friction_work ... (free: .external_force_x, .external_work); the moving mesh "
+                    "<name> (sphere, capsule, surface): writes displacement, reads force when free")
       .required();
   s->choice("shape",
             "sphere (radius), capsule (radius, length, axis: a cylinder with hemispherical ends, "
@@ -223,6 +225,10 @@ IndenterBuild build_indenter(const Node& n, const fem::Model& model,
     b.has_surface = true;
     b.surface.mesh = Mesh(b.name, p, t);
     b.surface.writes.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});
+    // a free body also takes forces on its surface (their resultant moves it: granules it has
+    // broken in among); a driven one follows its table whatever pushes it
+    if (b.contact->indenter().is_free())
+      b.surface.reads.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
   }
   return b;
 }
@@ -246,6 +252,11 @@ void add_indenter_monitors(const std::string& name, const Eigen::Vector3d& refer
     out.push_back({name + ".force_" + kAxes[k], "N", contact.contact_force()[k]});
   out.push_back({name + ".penetration", "m", body.penetration()});
   out.push_back({name + ".work", "J", body.work()});
+  if (body.is_free()) {  // the forces handed over by the coupling on its surface
+    for (int k = 0; k < 3; ++k)
+      out.push_back({name + ".external_force_" + kAxes[k], "N", body.external_force()[k]});
+    out.push_back({name + ".external_work", "J", body.external_work()});
+  }
   out.push_back({name + ".kinetic_energy", "J", body.kinetic_energy()});  // 0 when driven
   out.push_back({name + ".contact_energy", "J", contact.stored_energy()});
   out.push_back({name + ".friction_work", "J", contact.dissipated_work()});

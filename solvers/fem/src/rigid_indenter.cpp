@@ -37,7 +37,7 @@ void RigidIndenter::move_to(double t) {
     return;
   }
   // V_1/2 = V + dt/2 A;  d_1 = d + dt V_1/2  (V_1 follows from the force at d_1 in commit())
-  const Vec3 v_half = committed_.v + 0.5 * dt * (committed_.f / mass_ + gravity_);
+  const Vec3 v_half = committed_.v + 0.5 * dt * ((committed_.f + external_) / mass_ + gravity_);
   trial_.d = committed_.d + dt * v_half;
   trial_.v = v_half;
 }
@@ -49,12 +49,18 @@ void RigidIndenter::set_contact_force(const Vec3& force) {
   if (trial_.t == committed_.t && trial_.d == committed_.d) committed_.f = force;
 }
 
+void RigidIndenter::set_external_force(const Vec3& force) {
+  if (!force.allFinite()) throw Error("rigid indenter: the external force must be finite");
+  external_ = force;
+}
+
 void RigidIndenter::commit() {
   const double dt = trial_.t - committed_.t;
   if (!table_ && dt != 0.0) {
     // A_1 = F_1 / m + g;  V_1 = V_1/2 + dt/2 A_1
-    trial_.v += 0.5 * dt * (trial_.f / mass_ + gravity_);
+    trial_.v += 0.5 * dt * ((trial_.f + external_) / mass_ + gravity_);
   }
+  trial_.external_work = committed_.external_work + external_.dot(trial_.d - committed_.d);
   // W += -1/2 (F_n + F_n+1) . (d_n+1 - d_n)
   trial_.work = committed_.work - 0.5 * (committed_.f + trial_.f).dot(trial_.d - committed_.d);
   if (!committed_.touched && trial_.f.squaredNorm() > 0.0) {
@@ -75,9 +81,10 @@ void RigidIndenter::write_state(std::span<double> out) const {
   const Configuration& c = committed_;
   double* p = out.data();
   *p++ = c.t;
-  for (const Vec3* v : {&c.d, &c.v, &c.f, &c.d_first, &c.e_first})
+  for (const Vec3* v : {&c.d, &c.v, &c.f, &c.d_first, &c.e_first, &external_})
     for (int k = 0; k < 3; ++k) *p++ = (*v)[k];
   *p++ = c.work;
+  *p++ = c.external_work;
   *p++ = c.touched ? 1.0 : 0.0;
   (void)p;
 }
@@ -89,9 +96,10 @@ void RigidIndenter::read_state(std::span<const double> in) {
   Configuration& c = committed_;
   const double* p = in.data();
   c.t = *p++;
-  for (Vec3* v : {&c.d, &c.v, &c.f, &c.d_first, &c.e_first})
+  for (Vec3* v : {&c.d, &c.v, &c.f, &c.d_first, &c.e_first, &external_})
     for (int k = 0; k < 3; ++k) (*v)[k] = *p++;
   c.work = *p++;
+  c.external_work = *p++;
   c.touched = *p++ != 0.0;
   trial_ = committed_;
 }

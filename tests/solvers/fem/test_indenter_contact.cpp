@@ -470,3 +470,34 @@ TEST_CASE("indenter contact: detached nodes take no contact force", "[fem][conta
       CHECK(f.segment<3>(at) == f_all.segment<3>(at));
   }
 }
+
+TEST_CASE("free indenter: an external force decelerates it as F/m, its work is the change of kinetic energy",
+          "[fem][contact]") {
+  // no contact: a constant force F on a body of mass m moving at v0; velocity Verlet integrates a
+  // constant acceleration exactly: d(t) = v0 t + F t^2 / (2 m), and F . d = m/2 (v^2 - v0^2)
+  const double m = 2.0, v0 = -2.0, f = 3.0, dt = 1e-3;
+  RigidIndenter body(std::make_shared<SphereShape>(Vec3(0, 0, 10), 0.5), m, Vec3(0, 0, v0), Vec3::Zero());
+  body.set_external_force(Vec3(0, 0, f));
+  const int n = 500;
+  for (int k = 1; k <= n; ++k) {
+    body.move_to(k * dt);
+    body.set_contact_force(Vec3::Zero());
+    body.commit();
+  }
+  const double t = n * dt;
+  CHECK(body.displacement().z() == Approx(v0 * t + f * t * t / (2 * m)).epsilon(1e-12));
+  CHECK(body.velocity().z() == Approx(v0 + f / m * t).epsilon(1e-12));
+  CHECK(body.external_work() == Approx(0.5 * m * (std::pow(v0 + f / m * t, 2) - v0 * v0)).epsilon(1e-10));
+  CHECK(body.work() == 0.0);
+  CHECK_THROWS_WITH(body.set_external_force(Vec3(0, 0, std::nan(""))), Catch::Contains("finite"));
+  // the state round trip keeps the force and its work (a resumed run goes on the same)
+  std::vector<double> state(RigidIndenter::kStateSize);
+  body.write_state(state);
+  RigidIndenter copy(std::make_shared<SphereShape>(Vec3(0, 0, 10), 0.5), m, Vec3::Zero(), Vec3::Zero());
+  copy.read_state(state);
+  CHECK(copy.external_force() == body.external_force());
+  CHECK(copy.external_work() == body.external_work());
+  copy.move_to(t + dt);
+  body.move_to(t + dt);
+  CHECK(copy.trial_displacement() == body.trial_displacement());
+}

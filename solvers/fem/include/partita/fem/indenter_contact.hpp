@@ -82,6 +82,8 @@ class IndenterContact final : public OperatorContribution {
   }
 
   const RigidIndenter& indenter() const { return indenter_; }
+  // A force on the body from outside this model (RigidIndenter::set_external_force).
+  void set_external_force(const Vec3& force) { indenter_.set_external_force(force); }
   // Force of the last add() on the indenter [N] (after commit(): the committed one).
   const Vec3& contact_force() const { return force_on_body_; }
   std::size_t active_nodes() const { return active_; }

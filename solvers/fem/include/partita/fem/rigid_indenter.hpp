@@ -23,6 +23,12 @@ namespace partita::fem {
 // after each evaluation at the trial configuration; commit() when the step is accepted.
 // The work the body does on the structure, sum -1/2 (F_n + F_n+1) . (d_n+1 - d_n) with F the
 // force on the body, is committed with it; so are the first contact and the penetration.
+//
+// An external force (set_external_force: e.g. the granules' push on a bow that has broken into a
+// filled cell, handed over by the coupling once a window) acts on a free body beside the contact
+// force, A = (F + F_ext) / m + g, held until it is set again; its work on the body,
+// sum F_ext . (d_n+1 - d_n) (exact for a force held over the step), is committed too. A driven
+// body's motion ignores it (its work is still booked: what the prescribed motion did against it).
 class RigidIndenter {
  public:
   RigidIndenter(std::shared_ptr<const RigidShape> shape, VelocityTable velocity);
@@ -36,6 +42,8 @@ class RigidIndenter {
 
   void move_to(double t);
   void set_contact_force(const Vec3& force);
+  // From the next move_to on (throws Error unless finite).
+  void set_external_force(const Vec3& force);
   void commit();
 
   // trial configuration (of the last move_to)
@@ -47,13 +55,15 @@ class RigidIndenter {
   const Vec3& velocity() const { return committed_.v; }
   const Vec3& contact_force() const { return committed_.f; }  // on the body [N]
   double work() const { return committed_.work; }  // done on the structure [J]
+  const Vec3& external_force() const { return external_; }  // on the body [N]
+  double external_work() const { return committed_.external_work; }  // done on the body [J]
   double kinetic_energy() const { return is_free() ? 0.5 * mass_ * committed_.v.squaredNorm() : 0.0; }
   // Displacement along the path since the first contact: (d - d_c) . e, d_c the displacement at
   // the first committed step with a contact force, e the direction of motion then (0 before).
   double penetration() const;
 
   // The committed state, flattened (restart), and its restoration (the trial becomes it).
-  static constexpr std::size_t kStateSize = 19;
+  static constexpr std::size_t kStateSize = 23;
   void write_state(std::span<double> out) const;
   void read_state(std::span<const double> in);
 
@@ -62,6 +72,7 @@ class RigidIndenter {
     double t = 0.0;
     Vec3 d = Vec3::Zero(), v = Vec3::Zero(), f = Vec3::Zero();
     double work = 0.0;
+    double external_work = 0.0;
     bool touched = false;  // a contact force has acted
     Vec3 d_first = Vec3::Zero(), e_first = Vec3::Zero();
   };
@@ -69,6 +80,7 @@ class RigidIndenter {
   std::optional<VelocityTable> table_;
   double mass_ = 0.0;
   Vec3 gravity_ = Vec3::Zero();
+  Vec3 external_ = Vec3::Zero();
   Configuration committed_, trial_;
 };
 
