@@ -33,7 +33,8 @@ class ExternalParticipant::Bridge {
   std::string program_failed_;     // the program left early (set by the destructor)
   bool write_checkpoint_ = false, read_checkpoint_ = false;
   double step_ = 0.0, time_ = 0.0, checkpoint_time_ = 0.0;
-  std::map<std::pair<std::string, std::string>, Eigen::MatrixXd> inputs_, outputs_;
+  std::map<std::pair<std::string, std::string>, Eigen::MatrixXd> outputs_;
+  coupling::LocalParticipant* local_ = nullptr;  // its window and inputs during the program's turn
   std::map<std::string, MonitorValue> monitors_;
 
   // --- set before the thread starts ---
@@ -90,10 +91,9 @@ class ProgramSolver final : public Solver {
  public:
   explicit ProgramSolver(Bridge& b) : b_(b) {}
   const std::vector<InterfaceMesh>& meshes() const override { return b_.meshes_; }
-  void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) override {
-    std::lock_guard lock(b_.mutex_);
-    b_.inputs_[{std::string(mesh), std::string(data)}] = values;
-  }
+  // The program reads the window's inputs itself, at the times it asks for
+  // (ExternalParticipant::read(), through the participant's current_inputs()).
+  void read(std::string_view, std::string_view, const Eigen::MatrixXd&) override {}
   void write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) override {
     std::lock_guard lock(b_.mutex_);
     auto it = b_.outputs_.find({std::string(mesh), std::string(data)});
@@ -141,6 +141,17 @@ void serve(Bridge& b) {
     server.hello(h);  // an external program asks for no meshes
     coupling::LocalParticipant local(b.participant_, std::make_unique<ProgramSolver>(b),
                                      b.substeps_);
+    struct Current {  // the program reads the window's inputs through it
+      Bridge& b;
+      Current(Bridge& bridge, coupling::LocalParticipant& p) : b(bridge) {
+        std::lock_guard lock(b.mutex_);
+        b.local_ = &p;
+      }
+      ~Current() {
+        std::lock_guard lock(b.mutex_);
+        b.local_ = nullptr;
+      }
+    } current(b, local);
     server.serve(local);
     b.end("");
   } catch (const std::exception& e) {
@@ -286,15 +297,35 @@ bool ExternalParticipant::requires_reading_checkpoint() {
 
 void ExternalParticipant::read(std::string_view mesh, std::string_view data,
                                Eigen::MatrixXd& values) const {
+  read(mesh, data, time_step_size(), values);
+}
+
+void ExternalParticipant::read(std::string_view mesh, std::string_view data,
+                               double relative_read_time, Eigen::MatrixXd& values) const {
   Bridge& b = *bridge_;
   b.check_names(mesh, data, true);
   std::lock_guard lock(b.mutex_);
-  if (b.turn_ != Bridge::Turn::program) throw UsageError("read() outside a step");
-  const auto it = b.inputs_.find({std::string(mesh), std::string(data)});
-  if (it == b.inputs_.end())
+  if (b.turn_ != Bridge::Turn::program || !b.local_ || !b.local_->current_window())
+    throw UsageError("read() outside a step (after initialize(), before advance())");
+  if (!(relative_read_time >= 0.0 && relative_read_time <= b.step_))
+    throw UsageError(fmt::format(
+        "read('{}', '{}', {:.17g}): the relative read time is measured from the start of the "
+        "current step (time() = {:.17g} s) and must lie in [0, time_step_size()] = [0, {:.17g}] s",
+        mesh, data, relative_read_time, b.time_, b.step_));
+  const coupling::WindowInput* in = nullptr;
+  for (const coupling::WindowInput& i : b.local_->current_inputs())
+    if (*i.mesh == mesh && *i.data == data) in = &i;
+  if (!in)
     throw UsageError(fmt::format("no exchange of the case sends '{}' to {}.{}", data,
                                  b.participant_, mesh));
-  values = it->second;
+  // The step is substep k + 1 of the window's m (k done): its times [0, dt] are the window's
+  // fractions [k/m, (k+1)/m], exactly so at both ends (at dt the fraction a partita
+  // participant reads at: the same bits), read as the case's reader_sees gives it.
+  const coupling::TimeWindow& w = *b.local_->current_window();
+  const double fraction =
+      (static_cast<double>(w.substep()) + relative_read_time / b.step_) / w.substeps();
+  const Eigen::MatrixXd& seen = coupling::input_at(*in, fraction, values);
+  if (&seen != &values) values = seen;
 }
 
 void ExternalParticipant::write(std::string_view mesh, std::string_view data,

@@ -9,6 +9,7 @@
 //     if (p.requires_writing_checkpoint()) { save my state }
 //     const double dt = p.time_step_size();
 //     p.read("nodes", "pressure", pressure);                         // at the end of the step
+//     p.read("nodes", "pressure", 0.5 * dt, mid);                    // or at any time of it
 //     my_solver.step(dt, pressure); p.write("nodes", "cross_section_area", area);
 //     p.advance(dt);
 //     if (p.requires_reading_checkpoint()) { restore my state }      // the window is repeated
@@ -22,9 +23,12 @@
 // In the case the participant is `solid: {solver: external}` (any further keys are the program's
 // own); its substeps come from `coupling.substeps` (a number, or auto from
 // set_stable_time_step()). The program takes the steps the API gives (time_step_size(): the
-// window's substeps, as a partita participant takes them) and reads each input at the step's end
-// with the case's reader_sees (linear: interpolated between the window's ends); what it writes
-// is combined over the window's steps with the case's writer_combines. Inside, the API runs the
+// window's substeps, as a partita participant takes them) and reads each input at the time of the
+// step it asks for (relative to the step's start, as preCICE v3's relativeReadTime; the step's
+// end by default) with the case's reader_sees (linear: interpolated between the window's ends by
+// the same function, coupling::input_at(), as partita's own participants; constant: the window
+// end's value); what it writes is combined over the window's steps with the case's
+// writer_combines. Inside, the API runs the
 // same participant code as partita's own processes (a LocalParticipant over a Solver that hands
 // each step to the program), so a program that computes what an in-tree solver computes gives
 // the in-process run's results bit for bit, iteration counts of implicit schemes included.
@@ -91,8 +95,15 @@ class ExternalParticipant {
   bool requires_writing_checkpoint();
   /// True after advance() when the window is repeated: restore the state saved.
   bool requires_reading_checkpoint();
-  /// An input at the end of the current step (N x components).
+  /// An input at the end of the current step (N x components): read(mesh, data,
+  /// time_step_size(), values).
   void read(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) const;
+  /// An input at `relative_read_time` [s] after the start of the current step (as preCICE v3's
+  /// relativeReadTime: 0 the step's start, time_step_size() its end), as the case's reader_sees
+  /// gives it: `linear` interpolates between the window's ends, `constant` gives the window
+  /// end's value. Throws UsageError for a time outside [0, time_step_size()].
+  void read(std::string_view mesh, std::string_view data, double relative_read_time,
+            Eigen::MatrixXd& values) const;
   /// An output at the end of the current step (N x components).
   void write(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values);
   /// A scalar for the case's monitors (participant.<name>), reported after each window.
