@@ -7,6 +7,7 @@
 #include "partita/mpi/external_participant.hpp"
 
 #include <condition_variable>
+#include <functional>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -16,6 +17,7 @@
 
 #include "partita/coupling/participant.hpp"
 #include "partita/coupling/remote_participant.hpp"
+#include "partita/interface/binary_io.hpp"
 #include "partita/interface/config.hpp"
 #include "partita/mpi/mpi_channel.hpp"
 
@@ -36,6 +38,10 @@ class ExternalParticipant::Bridge {
   std::map<std::pair<std::string, std::string>, Eigen::MatrixXd> outputs_;
   coupling::LocalParticipant* local_ = nullptr;  // its window and inputs during the program's turn
   std::map<std::string, MonitorValue> monitors_;
+  std::function<std::vector<char>()> restart_writer_;  // the program's state for restart files
+  int stop_signal_ = 0;            // the signal that stopped the run early (0: none)
+  bool resuming_ = false;          // a restart file gave this participant's part
+  std::vector<char> restart_state_;
 
   // --- set before the thread starts ---
   std::string participant_;
@@ -118,6 +124,26 @@ class ProgramSolver final : public Solver {
     b_.write_checkpoint_ = false;
     b_.time_ = b_.checkpoint_time_;
   }
+  // Restart files: the time of the program's steps and the bytes of its restart writer (called
+  // here, on the API's thread, while the program waits in advance() or initialize()).
+  bool supports_restart() const override { return static_cast<bool>(b_.restart_writer_); }
+  void write_restart(BinaryWriter& out) const override {
+    const std::vector<char> state = b_.restart_writer_();
+    std::lock_guard lock(b_.mutex_);
+    out.section("external program");
+    out.write(b_.time_);
+    out.write(state);
+  }
+  void read_restart(BinaryReader& in) override {
+    in.expect_section("external program");
+    const auto t = in.get<double>();
+    std::vector<char> state;
+    in.read(state);
+    std::lock_guard lock(b_.mutex_);
+    b_.time_ = t;
+    b_.restart_state_ = std::move(state);
+    b_.resuming_ = true;
+  }
   std::vector<MonitorValue> monitors() const override {
     std::lock_guard lock(b_.mutex_);
     std::vector<MonitorValue> v;
@@ -152,7 +178,11 @@ void serve(Bridge& b) {
         b.local_ = nullptr;
       }
     } current(b, local);
-    server.serve(local);
+    const int signal = server.serve(local);
+    {
+      std::lock_guard lock(b.mutex_);
+      b.stop_signal_ = signal;
+    }
     b.end("");
   } catch (const std::exception& e) {
     b.end(e.what());
@@ -194,6 +224,24 @@ ExternalParticipant::~ExternalParticipant() {
 void ExternalParticipant::add_mesh(InterfaceMesh mesh) {
   if (bridge_->initialized_) throw UsageError("add_mesh() after initialize()");
   bridge_->meshes_.push_back(std::move(mesh));
+}
+
+void ExternalParticipant::set_restart_writer(std::function<std::vector<char>()> state) {
+  if (bridge_->initialized_) throw UsageError("set_restart_writer() after initialize()");
+  if (!state) throw UsageError("set_restart_writer() needs a function that gives the state");
+  bridge_->restart_writer_ = std::move(state);
+}
+
+bool ExternalParticipant::is_resuming() const {
+  if (!bridge_->initialized_) throw UsageError("is_resuming() before initialize()");
+  std::lock_guard lock(bridge_->mutex_);
+  return bridge_->resuming_;
+}
+
+const std::vector<char>& ExternalParticipant::restart_state() const {
+  if (!is_resuming())
+    throw UsageError("restart_state() of a run that does not resume (ask is_resuming() first)");
+  return bridge_->restart_state_;
 }
 
 void ExternalParticipant::set_stable_time_step(double dt) {
@@ -273,6 +321,11 @@ void ExternalParticipant::initialize() {
 bool ExternalParticipant::is_coupling_ongoing() const {
   std::lock_guard lock(bridge_->mutex_);
   return !bridge_->ended_;
+}
+
+int ExternalParticipant::stopped_by_signal() const {
+  std::lock_guard lock(bridge_->mutex_);
+  return bridge_->stop_signal_;
 }
 
 double ExternalParticipant::time_step_size() const {

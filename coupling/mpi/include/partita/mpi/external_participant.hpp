@@ -4,7 +4,9 @@
 //
 //   partita::mpi::ExternalParticipant p("solid", "tube.yaml");      // the case's participant
 //   p.add_mesh({partita::Mesh("nodes", points), {{"pressure", 1, "Pa"}}, {{"cross_section_area", 1, "m^2"}}});
+//   p.set_restart_writer([&] { return my_state_as_bytes(); });       // optional: restart files
 //   p.initialize();                                                    // the handshake
+//   if (p.is_resuming()) restore_my_state(p.restart_state());         // partita run --resume
 //   while (p.is_coupling_ongoing()) {
 //     if (p.requires_writing_checkpoint()) { save my state }
 //     const double dt = p.time_step_size();
@@ -38,6 +40,7 @@
 // MPI with it unless the program did, and finalises what it initialised).
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -82,11 +85,27 @@ class ExternalParticipant {
   void add_mesh(InterfaceMesh mesh);
   /// The largest step the program can take (substeps: auto); default: no limit.
   void set_stable_time_step(double dt);
+  /// Restart files: `state` gives the program's state as bytes. Called each time the run writes
+  /// a restart file (output.restart, the run's end, SIGINT/SIGTERM to partita), between windows,
+  /// on a thread of the API's while the program waits in advance() (never while the program's
+  /// own code runs). Without it the run writes no restart files (and refuses output.restart).
+  void set_restart_writer(std::function<std::vector<char>()> state);
+
+  // After initialize():
+  /// Whether the run resumes from a restart file (partita run ... --resume DIR): then time() is
+  /// the restart point's and restart_state() the bytes `state` gave there; restore them before
+  /// the first step.
+  bool is_resuming() const;
+  const std::vector<char>& restart_state() const;
 
   /// Join the run (the handshake); throws RunStopped where the controller refuses it.
   void initialize();
-  /// False once the run has ended (after the last window).
+  /// False once the run has ended (after the last window, or early: stopped_by_signal()).
   bool is_coupling_ongoing() const;
+  /// Once the run has ended: the signal (SIGINT, SIGTERM to a process of the run) that stopped it
+  /// after a window, with a restart file where the program has a restart writer; 0 when it ran to
+  /// its end. (partita's processes then exit with 128 + it.)
+  int stopped_by_signal() const;
   /// The step to take now [s] (advance() must be given it).
   double time_step_size() const;
   /// The time at the start of the step [s].
