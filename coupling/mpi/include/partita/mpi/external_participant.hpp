@@ -30,10 +30,17 @@
 // end by default) with the case's reader_sees (linear: interpolated between the window's ends by
 // the same function, coupling::input_at(), as partita's own participants; constant: the window
 // end's value); what it writes is combined over the window's steps with the case's
-// writer_combines. Inside, the API runs the
-// same participant code as partita's own processes (a LocalParticipant over a Solver that hands
-// each step to the program), so a program that computes what an in-tree solver computes gives
-// the in-process run's results bit for bit, iteration counts of implicit schemes included.
+// writer_combines. Inside, the API runs the same participant code as partita's own processes (a
+// LocalParticipant over a Solver that hands each step to the program), so a program that
+// computes what an in-tree solver computes gives the in-process run's results bit for bit,
+// iteration counts of implicit schemes included.
+//
+// Restart: with a restart writer the participant's part of each restart file is the time of its
+// steps and the writer's bytes; a run resumed on partita's side (partita run ... --resume DIR,
+// the program started as for a new run) gives them back through is_resuming() and
+// restart_state(). A SIGINT/SIGTERM to a process of the run ends the loop after the window
+// (stopped_by_signal()). `partita check CASE` checks the case but the program's own meshes,
+// fields and quantities, which the handshake checks when it joins.
 //
 // The messages to the controller go from a thread of the API's while the program waits in
 // initialize(), advance() or finalize() (MPI_THREAD_SERIALIZED is enough; the API initialises
