@@ -264,6 +264,11 @@ int main(int argc, char** argv) {
       options.check_only = true;
       partita::coupling::CaseRun c(case_file, registries, options);
       std::cout << "partita check: " << case_file << " is valid\n";
+      for (const auto& name : c.external_participants())
+        std::cout << "partita check: participant '" << name
+                  << "' is an external program (solver: external): its meshes, fields and "
+                     "quantities are checked when it joins the run (the handshake); the rest of "
+                     "the case against the exchanges that name it\n";
       return 0;
     }
     if (!participant.empty()) {

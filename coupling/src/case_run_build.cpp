@@ -16,6 +16,7 @@
 #include "partita/coupling/remote_participant.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/coupling/sweep.hpp"
+#include "external_stand_in.hpp"
 #include "plain_name.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -61,6 +62,13 @@ Participant* CaseRun::participant(const std::string& name) const {
   for (const auto& p : participants_)
     if (p->name() == name) return p.get();
   return nullptr;
+}
+
+std::vector<std::string> CaseRun::external_participants() const {
+  std::vector<std::string> names;
+  for (const auto& p : participants_)
+    if (dynamic_cast<const ExternalStandIn*>(p.get())) names.push_back(p->name());
+  return names;
 }
 
 CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOptions options)
@@ -223,6 +231,51 @@ void CaseRun::check_sweep_values(const fs::path& case_file, const Sweep& sweep) 
     }
 }
 
+// (partita check) The meshes an external program must have for the case's exchanges that name
+// it: each with the fields it reads and writes there (as the other end declares them) and the
+// other end's points, so that the exchanges, their mappers and the scheme build as in a run.
+// What the program really declares is checked when it joins (the handshake).
+static std::vector<InterfaceMesh> stand_in_meshes(
+    const config::Node& coupling, const std::string& name,
+    const std::function<const std::vector<InterfaceMesh>*(const std::string&)>& built_meshes) {
+  std::vector<InterfaceMesh> meshes;
+  if (!coupling.has("exchanges") || !coupling["exchanges"].is_sequence()) return meshes;
+  for (const config::Node& item : coupling["exchanges"].items()) {
+    if (!item.is_map() || !item.has("data") || !item.has("from") || !item.has("to")) continue;
+    const auto [from_p, from_m] = split_dot(item["from"], "a mesh");
+    const auto [to_p, to_m] = split_dot(item["to"], "a mesh");
+    const bool reads = to_p == name;
+    if (!reads && from_p != name) continue;
+    const std::string mesh = reads ? to_m : from_m, data = item.string("data");
+    // the other end, where it is built: its mesh's points and its declaration of the field
+    const InterfaceMesh* other = nullptr;
+    if (const auto* m = built_meshes(reads ? from_p : to_p))
+      for (const auto& im : *m)
+        if (im.mesh.name() == (reads ? from_m : to_m)) other = &im;
+    auto at = std::find_if(meshes.begin(), meshes.end(),
+                           [&](const InterfaceMesh& m) { return m.mesh.name() == mesh; });
+    if (at == meshes.end()) {
+      InterfaceMesh m;
+      if (other) {
+        m.mesh = Mesh(mesh, other->mesh.points(), other->mesh.triangles());
+        if (other->mesh.has_weights()) m.mesh.set_weights(other->mesh.weights());
+      } else {
+        m.mesh = Mesh(mesh, Mesh::Points::Zero(1, 3));
+      }
+      meshes.push_back(std::move(m));
+      at = std::prev(meshes.end());
+    }
+    DataSpec spec{data, 1, "", DataKind::intensive};
+    if (other)
+      for (const auto& d : reads ? other->writes : other->reads)
+        if (d.name == data) spec = d;
+    auto& fields = reads ? at->reads : at->writes;
+    if (std::none_of(fields.begin(), fields.end(), [&](const DataSpec& d) { return d.name == data; }))
+      fields.push_back(spec);
+  }
+  return meshes;
+}
+
 void CaseRun::build_participants(const config::Node& root) {
   const config::Node ps = root["participants"];
   if (!ps.is_map() || ps.size() == 0)
@@ -317,6 +370,7 @@ void CaseRun::build_participants(const config::Node& root) {
       pn.fail("participant '" + name + "' needs 'solver: <name>'; known solvers: " +
               join_names(registries_.solvers.names()) + ", or external");
     if (pn.string("solver") == "external") {  // a program of its own (partita::mpi::ExternalParticipant)
+      if (options_.check_only) continue;  // checked with a stand-in (below), and when it joins
       if (runs_here(name))
         pn["solver"].fail(
             "participant '" + name + "' is an external program (solver: external), which joins a "
@@ -414,6 +468,17 @@ void CaseRun::build_participants(const config::Node& root) {
 
   for (const std::string& name : order) {
     const config::Node pn = ps[name];
+    if (options_.check_only && pn.string("solver") == "external") {
+      participants_.push_back(std::make_unique<ExternalStandIn>(
+          name, stand_in_meshes(coupling, name,
+                                [&](const std::string& pname) -> const std::vector<InterfaceMesh>* {
+                                  if (const Participant* p = participant(pname)) return &p->meshes();
+                                  for (const auto& x : built)  // (those after it in the order)
+                                    if (x.name == pname && x.solver) return &x.solver->meshes();
+                                  return nullptr;
+                                })));
+      continue;
+    }
     auto b = std::find_if(built.begin(), built.end(), [&](const Built& x) { return x.name == name; });
     Substeps s = substeps.count(name) ? substeps[name] : Substeps{};
     if (!coupled) s.automatic = true;  // alone: as many steps per window as its stability needs
@@ -601,6 +666,8 @@ Participant* CaseRun::named_participant(const config::Node& n, const std::string
 CaseRun::NamedQuantity CaseRun::resolve_quantity(const config::Node& q) const {
   const auto [pname, quantity] = split_dot(q, "a quantity");
   Participant* p = named_participant(q, pname);
+  if (dynamic_cast<const ExternalStandIn*>(p))  // (partita check) known when the program joins
+    return {p, quantity, {}};
   std::vector<std::string> known;
   std::string unit;
   for (const auto& v : p->monitors()) {
@@ -631,7 +698,7 @@ void CaseRun::build_energy_balance(const config::Node& root) {
     for (const config::Node& q : string_items(en[key])) {
       const NamedQuantity nq = resolve_quantity(q);
       const std::string full = nq.participant->name() + "." + nq.quantity;
-      if (nq.unit != "J")
+      if (nq.unit != "J" && !dynamic_cast<const ExternalStandIn*>(nq.participant))
         q.fail("'" + full + "' is in " + (nq.unit.empty() ? "no unit" : nq.unit) +
                ": an energy term must be an energy or a work in J");
       if (!seen.insert(full).second)

@@ -15,6 +15,15 @@ const InterfaceMesh* Participant::find_mesh(std::string_view mesh) const {
   return nullptr;
 }
 
+const Eigen::MatrixXd& input_at(const WindowInput& in, double fraction, Eigen::MatrixXd& scratch) {
+  if (in.sees == ReaderSees::constant || fraction >= 1.0 || in.start_is_end) return *in.end;
+  // d_n + s (d_{n+1} - d_n), s the fraction of the window (k/m at the end of substep k)
+  scratch.resize(in.end->rows(), in.end->cols());  // (keeps its storage: same shape)
+  elementwise::interpolate(scratch.data(), in.start->data(), in.end->data(), in.end->size(),
+                           fraction);
+  return scratch;
+}
+
 LocalParticipant::LocalParticipant(std::string name, std::unique_ptr<Solver> solver,
                                    Substeps substeps)
     : Participant(std::move(name)), solver_(std::move(solver)), substeps_(substeps) {
@@ -90,22 +99,22 @@ void LocalParticipant::run_window(const TimeWindow& window, std::span<const Wind
     read_values_.resize(inputs.size());
   }
   for (Collect& c : collect_) c.count = 0;
+  struct Current {  // what current_window() and current_inputs() give while the window runs
+    LocalParticipant& p;
+    Current(LocalParticipant& q, const TimeWindow& w, std::span<const WindowInput> in) : p(q) {
+      p.current_window_ = &w;
+      p.current_inputs_ = in;
+    }
+    ~Current() {
+      p.current_window_ = nullptr;
+      p.current_inputs_ = {};
+    }
+  } current(*this, w, inputs);
   // for k = 0..m-1: read d(t_{n,k+1}); advance(t_{n,k+1} - t_{n,k}); write f_{n,k+1}
   while (!w.end_reached()) {
     const double fraction = w.fraction_at(w.substep() + 1);
-    for (std::size_t i = 0; i < inputs.size(); ++i) {  // the time interpolation
-      const WindowInput& in = inputs[i];
-      if (in.sees == ReaderSees::constant || fraction >= 1.0 || in.start_is_end) {
-        read_values_[i] = in.end;
-        continue;
-      }
-      // d_{n,k} = d_n + (k/m) (d_{n+1} - d_n)
-      Eigen::MatrixXd& scratch = read_scratch_[i];
-      scratch.resize(in.end->rows(), in.end->cols());  // (keeps its storage: same shape)
-      elementwise::interpolate(scratch.data(), in.start->data(), in.end->data(), in.end->size(),
-                               fraction);
-      read_values_[i] = &scratch;
-    }
+    for (std::size_t i = 0; i < inputs.size(); ++i)  // the time interpolation
+      read_values_[i] = &input_at(inputs[i], fraction, read_scratch_[i]);
     {
       // The solver's own work, read + advance + write, timed as one: one clock pair per
       // substep rather than one per call (a clock read costs 20-50 ns; 6 substeps a window).

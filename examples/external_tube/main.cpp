@@ -4,9 +4,13 @@
 // at the N + 1 nodes x_i = i L / N, coupled to partita's tube1d-fluid through
 // partita::mpi::ExternalParticipant. Usage (see README.md):
 //   mpirun -n 1 partita run tube_external.yaml --participant fluid : -n 1 ./tube_solid tube_external.yaml
+// (with the same --set KEY=VALUE options on both sides, if any). Its state in restart files is
+// the wall's area; partita run ... --resume DIR on partita's side resumes it.
 #include <cmath>
+#include <cstring>
 #include <iostream>
 #include <numbers>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -30,13 +34,17 @@ struct Wall {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: tube_solid CASE.yaml (under mpirun, beside partita)\n";
+  partita::mpi::ExternalOptions options;  // the --set options of partita's side, the same
+  for (int i = 2; i + 1 < argc && std::strcmp(argv[i], "--set") == 0; i += 2)
+    options.overrides.push_back(argv[i + 1]);
+  if (argc < 2 || argc != 2 + 2 * static_cast<int>(options.overrides.size())) {
+    std::cerr << "usage: tube_solid CASE.yaml [--set KEY=VALUE ...] (under mpirun, beside partita, "
+                 "with its --set options)\n";
     return 2;
   }
   try {
     const Wall wall;
-    partita::mpi::ExternalParticipant solid("solid", argv[1]);
+    partita::mpi::ExternalParticipant solid("solid", argv[1], options);
     // The coupling mesh: the nodes, reading the pressure and writing the area.
     partita::Mesh::Points x = partita::Mesh::Points::Zero(wall.cells + 1, 3);
     for (int i = 0; i <= wall.cells; ++i) x(i, 0) = wall.length / wall.cells * i;
@@ -48,7 +56,23 @@ int main(int argc, char** argv) {
     for (int i = 0; i <= wall.cells; ++i) area(i, 0) = wall.area_of(pressure(i, 0));
     solid.write("nodes", "cross_section_area", area);  // the initial value
     solid.set_monitor("mid_area", "m^2", area(area.rows() / 2, 0));
+    // restart files: the area as bytes (written while this thread waits in advance())
+    solid.set_restart_writer([&area] {
+      std::vector<char> bytes(sizeof(double) * area.size());
+      std::memcpy(bytes.data(), area.data(), bytes.size());
+      return bytes;
+    });
     solid.initialize();
+    if (solid.is_resuming()) {
+      const std::vector<char>& bytes = solid.restart_state();
+      if (bytes.size() != sizeof(double) * area.size()) {
+        std::cerr << "tube_solid: the restart point holds " << bytes.size() << " bytes, not the "
+                  << sizeof(double) * area.size() << " of this wall's area\n";
+        return 1;
+      }
+      std::memcpy(area.data(), bytes.data(), bytes.size());
+      std::cout << "tube_solid: resumed at t = " << solid.time() << " s\n";
+    }
 
     while (solid.is_coupling_ongoing()) {
       if (solid.requires_writing_checkpoint()) saved_area = area;
@@ -61,6 +85,11 @@ int main(int argc, char** argv) {
       if (solid.requires_reading_checkpoint()) area = saved_area;
     }
     solid.finalize();
+    if (const int signal = solid.stopped_by_signal()) {  // a restart file was written
+      std::cout << "tube_solid: stopped by signal " << signal
+                << " (resume with partita run ... --resume DIR)\n";
+      return 128 + signal;
+    }
     std::cout << "tube_solid: finished\n";
     return 0;
   } catch (const partita::mpi::RunStopped& e) {

@@ -12,6 +12,10 @@
 #   changed-case                     the second process reads another time.end: refused at start-up,
 #                                    naming the mismatch, before any window
 #   sigkill                          the second process killed (SIGKILL) mid-run: mpirun ends within 10 s
+#   external-read PLUGIN PROBE SEES an external program (read_probe.cpp) reads the plugin solver
+#                                    ramp's field, linear in time, at 0, dt/3, dt/2 and dt of each
+#                                    step with reader_sees SEES: the analytic value (within 1e-12),
+#                                    times outside the step refused
 #   signal                           SIGINT to the second process: every process ends after the window
 #                                    with status 130 and a restart file; resumed, the run gives the
 #                                    bytes of an uninterrupted one
@@ -156,6 +160,17 @@ case "$SCENARIO" in
                    -n 1 "$P" run "$case_file" --resume two --threads 1 --participant granules "${sets[@]}" \
                    > resume.log 2>&1 || { cat resume.log; fail "the resumed run"; }
     same_files one two
+    ;;
+  external-read)
+    plugin=$1 probe=$2 sees=$3
+    set_sees=(--set "coupling.exchanges[0].reader_sees=$sees")
+    "${MPIRUN[@]}" -n 1 "$P" run "$HERE/external_read.yaml" -o two --threads 1 --plugin "$plugin" \
+                   --participant ramp "${set_sees[@]}" : \
+                   -n 1 "$probe" "$HERE/external_read.yaml" "$sees" "${set_sees[@]}" > two.log 2>&1
+    status=$?
+    cat two.log
+    [ "$status" -eq 0 ] || fail "the run with the external program failed (status $status)"
+    grep -q "^read_probe: passed" two.log || fail "the program's reads are not the analytic values"
     ;;
   *)
     fail "unknown scenario $SCENARIO"

@@ -7,6 +7,7 @@
 #include "partita/mpi/external_participant.hpp"
 
 #include <condition_variable>
+#include <functional>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -16,6 +17,7 @@
 
 #include "partita/coupling/participant.hpp"
 #include "partita/coupling/remote_participant.hpp"
+#include "partita/interface/binary_io.hpp"
 #include "partita/interface/config.hpp"
 #include "partita/mpi/mpi_channel.hpp"
 
@@ -33,8 +35,13 @@ class ExternalParticipant::Bridge {
   std::string program_failed_;     // the program left early (set by the destructor)
   bool write_checkpoint_ = false, read_checkpoint_ = false;
   double step_ = 0.0, time_ = 0.0, checkpoint_time_ = 0.0;
-  std::map<std::pair<std::string, std::string>, Eigen::MatrixXd> inputs_, outputs_;
+  std::map<std::pair<std::string, std::string>, Eigen::MatrixXd> outputs_;
+  coupling::LocalParticipant* local_ = nullptr;  // its window and inputs during the program's turn
   std::map<std::string, MonitorValue> monitors_;
+  std::function<std::vector<char>()> restart_writer_;  // the program's state for restart files
+  int stop_signal_ = 0;            // the signal that stopped the run early (0: none)
+  bool resuming_ = false;          // a restart file gave this participant's part
+  std::vector<char> restart_state_;
 
   // --- set before the thread starts ---
   std::string participant_;
@@ -90,10 +97,9 @@ class ProgramSolver final : public Solver {
  public:
   explicit ProgramSolver(Bridge& b) : b_(b) {}
   const std::vector<InterfaceMesh>& meshes() const override { return b_.meshes_; }
-  void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) override {
-    std::lock_guard lock(b_.mutex_);
-    b_.inputs_[{std::string(mesh), std::string(data)}] = values;
-  }
+  // The program reads the window's inputs itself, at the times it asks for
+  // (ExternalParticipant::read(), through the participant's current_inputs()).
+  void read(std::string_view, std::string_view, const Eigen::MatrixXd&) override {}
   void write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) override {
     std::lock_guard lock(b_.mutex_);
     auto it = b_.outputs_.find({std::string(mesh), std::string(data)});
@@ -118,6 +124,26 @@ class ProgramSolver final : public Solver {
     b_.write_checkpoint_ = false;
     b_.time_ = b_.checkpoint_time_;
   }
+  // Restart files: the time of the program's steps and the bytes of its restart writer (called
+  // here, on the API's thread, while the program waits in advance() or initialize()).
+  bool supports_restart() const override { return static_cast<bool>(b_.restart_writer_); }
+  void write_restart(BinaryWriter& out) const override {
+    const std::vector<char> state = b_.restart_writer_();
+    std::lock_guard lock(b_.mutex_);
+    out.section("external program");
+    out.write(b_.time_);
+    out.write(state);
+  }
+  void read_restart(BinaryReader& in) override {
+    in.expect_section("external program");
+    const auto t = in.get<double>();
+    std::vector<char> state;
+    in.read(state);
+    std::lock_guard lock(b_.mutex_);
+    b_.time_ = t;
+    b_.restart_state_ = std::move(state);
+    b_.resuming_ = true;
+  }
   std::vector<MonitorValue> monitors() const override {
     std::lock_guard lock(b_.mutex_);
     std::vector<MonitorValue> v;
@@ -141,7 +167,22 @@ void serve(Bridge& b) {
     server.hello(h);  // an external program asks for no meshes
     coupling::LocalParticipant local(b.participant_, std::make_unique<ProgramSolver>(b),
                                      b.substeps_);
-    server.serve(local);
+    struct Current {  // the program reads the window's inputs through it
+      Bridge& b;
+      Current(Bridge& bridge, coupling::LocalParticipant& p) : b(bridge) {
+        std::lock_guard lock(b.mutex_);
+        b.local_ = &p;
+      }
+      ~Current() {
+        std::lock_guard lock(b.mutex_);
+        b.local_ = nullptr;
+      }
+    } current(b, local);
+    const int signal = server.serve(local);
+    {
+      std::lock_guard lock(b.mutex_);
+      b.stop_signal_ = signal;
+    }
     b.end("");
   } catch (const std::exception& e) {
     b.end(e.what());
@@ -183,6 +224,24 @@ ExternalParticipant::~ExternalParticipant() {
 void ExternalParticipant::add_mesh(InterfaceMesh mesh) {
   if (bridge_->initialized_) throw UsageError("add_mesh() after initialize()");
   bridge_->meshes_.push_back(std::move(mesh));
+}
+
+void ExternalParticipant::set_restart_writer(std::function<std::vector<char>()> state) {
+  if (bridge_->initialized_) throw UsageError("set_restart_writer() after initialize()");
+  if (!state) throw UsageError("set_restart_writer() needs a function that gives the state");
+  bridge_->restart_writer_ = std::move(state);
+}
+
+bool ExternalParticipant::is_resuming() const {
+  if (!bridge_->initialized_) throw UsageError("is_resuming() before initialize()");
+  std::lock_guard lock(bridge_->mutex_);
+  return bridge_->resuming_;
+}
+
+const std::vector<char>& ExternalParticipant::restart_state() const {
+  if (!is_resuming())
+    throw UsageError("restart_state() of a run that does not resume (ask is_resuming() first)");
+  return bridge_->restart_state_;
 }
 
 void ExternalParticipant::set_stable_time_step(double dt) {
@@ -264,6 +323,11 @@ bool ExternalParticipant::is_coupling_ongoing() const {
   return !bridge_->ended_;
 }
 
+int ExternalParticipant::stopped_by_signal() const {
+  std::lock_guard lock(bridge_->mutex_);
+  return bridge_->stop_signal_;
+}
+
 double ExternalParticipant::time_step_size() const {
   std::lock_guard lock(bridge_->mutex_);
   return bridge_->step_;
@@ -286,15 +350,35 @@ bool ExternalParticipant::requires_reading_checkpoint() {
 
 void ExternalParticipant::read(std::string_view mesh, std::string_view data,
                                Eigen::MatrixXd& values) const {
+  read(mesh, data, time_step_size(), values);
+}
+
+void ExternalParticipant::read(std::string_view mesh, std::string_view data,
+                               double relative_read_time, Eigen::MatrixXd& values) const {
   Bridge& b = *bridge_;
   b.check_names(mesh, data, true);
   std::lock_guard lock(b.mutex_);
-  if (b.turn_ != Bridge::Turn::program) throw UsageError("read() outside a step");
-  const auto it = b.inputs_.find({std::string(mesh), std::string(data)});
-  if (it == b.inputs_.end())
+  if (b.turn_ != Bridge::Turn::program || !b.local_ || !b.local_->current_window())
+    throw UsageError("read() outside a step (after initialize(), before advance())");
+  if (!(relative_read_time >= 0.0 && relative_read_time <= b.step_))
+    throw UsageError(fmt::format(
+        "read('{}', '{}', {:.17g}): the relative read time is measured from the start of the "
+        "current step (time() = {:.17g} s) and must lie in [0, time_step_size()] = [0, {:.17g}] s",
+        mesh, data, relative_read_time, b.time_, b.step_));
+  const coupling::WindowInput* in = nullptr;
+  for (const coupling::WindowInput& i : b.local_->current_inputs())
+    if (*i.mesh == mesh && *i.data == data) in = &i;
+  if (!in)
     throw UsageError(fmt::format("no exchange of the case sends '{}' to {}.{}", data,
                                  b.participant_, mesh));
-  values = it->second;
+  // The step is substep k + 1 of the window's m (k done): its times [0, dt] are the window's
+  // fractions [k/m, (k+1)/m], exactly so at both ends (at dt the fraction a partita
+  // participant reads at: the same bits), read as the case's reader_sees gives it.
+  const coupling::TimeWindow& w = *b.local_->current_window();
+  const double fraction =
+      (static_cast<double>(w.substep()) + relative_read_time / b.step_) / w.substeps();
+  const Eigen::MatrixXd& seen = coupling::input_at(*in, fraction, values);
+  if (&seen != &values) values = seen;
 }
 
 void ExternalParticipant::write(std::string_view mesh, std::string_view data,

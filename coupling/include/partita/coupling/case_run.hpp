@@ -149,6 +149,9 @@ class CaseRun {
   const CouplingScheme& scheme() const { return *scheme_; }
   /// Participant by name (nullptr if none).
   Participant* participant(const std::string& name) const;
+  /// (check only) The external programs (solver: external): the check built the rest of the
+  /// case without them; their meshes, fields and quantities are checked when they join a run.
+  std::vector<std::string> external_participants() const;
 
  private:
   struct Monitor {

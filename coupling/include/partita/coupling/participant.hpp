@@ -75,6 +75,12 @@ struct WindowOutput {
   Eigen::MatrixXd* combined = nullptr;
 };
 
+/// What the reader of `in` sees at `fraction` of the window (0: its start, 1: its end): the one
+/// time interpolation of what a participant reads. d_{n+1} (`constant`, no new value this window,
+/// fraction >= 1), else d_n + fraction (d_{n+1} - d_n) computed into `scratch` (`linear`).
+/// Returns *in.end or scratch.
+const Eigen::MatrixXd& input_at(const WindowInput& in, double fraction, Eigen::MatrixXd& scratch);
+
 class Participant {
  public:
   explicit Participant(std::string name) : name_(std::move(name)) {}
@@ -144,6 +150,11 @@ class LocalParticipant final : public Participant {
   Solver& solver() { return *solver_; }
   const Solver& solver() const { return *solver_; }
   const Substeps& substep_setting() const { return substeps_; }
+  /// While run_window() runs (a solver's advance() may ask): the window with its substep count
+  /// and the substeps done before the current one, and the window's inputs. nullptr and empty
+  /// outside run_window(). (The external-code API reads at any time of a step through these.)
+  const TimeWindow* current_window() const { return current_window_; }
+  std::span<const WindowInput> current_inputs() const { return current_inputs_; }
 
   const std::vector<InterfaceMesh>& meshes() const override { return solver_->meshes(); }
   void initial_values(std::span<WindowOutput> outputs) override;
@@ -183,6 +194,8 @@ class LocalParticipant final : public Participant {
   std::vector<Collect> collect_;
   std::vector<Eigen::MatrixXd> read_scratch_;         // per input: the interpolated values
   std::vector<const Eigen::MatrixXd*> read_values_;   // per input: what the solver reads
+  const TimeWindow* current_window_ = nullptr;
+  std::span<const WindowInput> current_inputs_;
 };
 
 }  // namespace partita::coupling
