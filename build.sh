@@ -3,7 +3,8 @@
 #
 #   ./build.sh run [CASE.yaml] [partita run options]   install what is missing, build, run a case
 #                                                      (default: the seed-000 steel plate case)
-#   ./build.sh test [--sanitize]                       install what is missing, build, run ctest
+#   ./build.sh test [--sanitize]                       install what is missing, build, run ctest,
+#                                                      print the build's, the tests' and the total time
 #                                                      (--sanitize: a clang build with ASan, UBSan
 #                                                       and libFuzzer instrumentation in build-asan/,
 #                                                       the suite without the tests tagged [slow])
@@ -91,13 +92,21 @@ case "$cmd" in
     # and a spinning barrier on an oversubscribed core costs a whole scheduler slice. (Not for
     # `run`: a run alone on the machine is faster with the default, spinning, policy.)
     export OMP_WAIT_POLICY=${OMP_WAIT_POLICY:-PASSIVE}
+    start=$(date +%s)
+    dir=build
     if [ "${1:-}" = "--sanitize" ]; then
+      dir=build-asan
       configure_sanitized -O1
-      ctest --test-dir build-asan --output-on-failure -j "$JOBS"
     else
       configure_and_build build -DCMAKE_BUILD_TYPE=Release
-      ctest --test-dir build --output-on-failure -j "$JOBS"
     fi
+    built=$(date +%s)
+    status=0
+    ctest --test-dir "$dir" --output-on-failure -j "$JOBS" || status=$?
+    end=$(date +%s)
+    echo "build.sh test: build $(( built - start )) s, tests $(( end - built )) s," \
+         "total $(( end - start )) s (ctest exit status $status)"
+    exit $status
     ;;
   fuzz)
     seconds=${1:-60}

@@ -1,5 +1,5 @@
 // partita: the command line. A thin main over the libraries:
-//   partita run CASE.yaml [--output DIR] [--threads N] [--log-level L] [--resume DIR]
+//   partita run CASE.yaml [--output DIR] [--threads N] [--log-level L] [--resume DIR] [--no-plots]
 //   mpirun -n 1 partita run CASE --participant A : -n 1 partita run CASE --participant B
 //   partita check CASE.yaml
 //   partita list
@@ -103,6 +103,26 @@ void plot_csv_files(const std::filesystem::path& dir) {
     partita::log::get("app")->info("plots: {}/*.png", dir.string());
 }
 
+// Whether a run draws the PNG plots of its CSV files: not with --no-plots, nor with
+// PARTITA_NO_PLOTS=1 in the environment (the test suite sets it: its tests read the CSV files,
+// not the pictures, and the plots cost 2-4 s of python per short run). An unknown value warns
+// and draws them, as PARTITA_LOG_LEVEL does.
+bool plots_wanted(bool no_plots_option) {
+  if (no_plots_option) return false;
+  const char* env = std::getenv("PARTITA_NO_PLOTS");
+  if (env == nullptr || *env == '\0') return true;
+  const std::string v = env;
+  for (const char* off : {"1", "true", "yes", "on"})
+    if (v == off) return false;
+  for (const char* on : {"0", "false", "no", "off"})
+    if (v == on) return true;
+  partita::log::get("app")->warn(
+      "PARTITA_NO_PLOTS='{}' is not a switch (allowed: 1, true, yes, on: no plots; 0, false, no, "
+      "off or empty: plots); drawing the plots",
+      v);
+  return true;
+}
+
 // The case's post-processing scripts (output.scripts), with the output folder as argument.
 void run_scripts(const std::vector<std::filesystem::path>& scripts,
                  const std::filesystem::path& dir) {
@@ -128,6 +148,10 @@ int list(const Registries& r) {
 int docs(const Registries& r, const std::string& name) {
   if (name.empty() || name == "case") {
     std::cout << partita::coupling::case_spec(r)->docs() << "\n"
+              << "After a run, partita run draws a PNG plot of each CSV file of the output "
+                 "folder (python3 with matplotlib); partita run --no-plots, or the environment "
+                 "variable PARTITA_NO_PLOTS=1, leaves them out (the CSV files and output.scripts "
+                 "are not affected).\n"
               << "Each registered name has its own page: partita docs NAME (see partita list).\n";
     return 0;
   }
@@ -185,10 +209,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> overrides;
   std::string resume_dir;
   bool no_sweep = false;
+  bool no_plots = false;
   int jobs = 1;
   run->add_flag("--no-sweep", no_sweep,
                 "Run the case as written, ignoring its sweep section (each variant of a sweep "
                 "runs so)");
+  run->add_flag("--no-plots", no_plots,
+                "Do not draw the PNG plots of the CSV files after the run (nor a sweep's "
+                "sweep.png); the environment variable PARTITA_NO_PLOTS=1 does the same. The "
+                "case's output.scripts still run");
   run->add_option("-j,--jobs", jobs, "Variants of a sweep run at once (default 1)")
       ->check(CLI::PositiveNumber);
   run->add_option("--resume", resume_dir,
@@ -271,6 +300,13 @@ int main(int argc, char** argv) {
                      "the case against the exchanges that name it\n";
       return 0;
     }
+    const bool plots = plots_wanted(no_plots);
+    auto finish = [&](const std::filesystem::path& dir) {
+      if (plots)
+        plot_csv_files(dir);
+      else
+        partita::log::get("app")->debug("plots: not drawn (--no-plots or PARTITA_NO_PLOTS)");
+    };
     if (!participant.empty()) {
       if (!no_sweep && resume_dir.empty() && partita::app::has_sweep(case_file, overrides))
         throw partita::Error(
@@ -285,7 +321,7 @@ int main(int argc, char** argv) {
       d.stop_signal = &g_stop_signal;
       d.install_stop_handlers = install_stop_handlers;
       d.on_finished = [&](const partita::coupling::CaseRun& c) {
-        plot_csv_files(c.output_dir());
+        finish(c.output_dir());
         run_scripts(c.scripts(), c.output_dir());
         std::cout << "partita run: finished; output in " << c.output_dir().string() << "/\n";
       };
@@ -303,6 +339,7 @@ int main(int argc, char** argv) {
       so.output_dir = output_dir;
       so.overrides = overrides;
       so.jobs = jobs;
+      so.plots = plots;
       so.threads = options.threads;
       so.log_level = log_level;
       so.stop_signal = &g_stop_signal;
@@ -312,7 +349,7 @@ int main(int argc, char** argv) {
     partita::coupling::CaseRun c(case_file, registries, options);
     install_stop_handlers();
     c.run();
-    plot_csv_files(c.output_dir());
+    finish(c.output_dir());
     if (const int signal = c.summary().stopped_by_signal; signal != 0) {
       std::cout << "partita run: stopped by signal " << signal << " after window "
                 << c.summary().windows << "; output in " << c.output_dir().string() << "/";
@@ -326,8 +363,8 @@ int main(int argc, char** argv) {
     }
     run_scripts(c.scripts(), c.output_dir());
     std::cout << "partita run: finished; output in " << c.output_dir().string()
-              << "/ (CSV time series and their "
-              << "PNG plots; VTK series for ParaView in vtk/*.pvd)\n";
+              << "/ (CSV time series" << (plots ? " and their PNG plots" : "")
+              << "; VTK series for ParaView in vtk/*.pvd)\n";
     return 0;
   } catch (const partita::Error& e) {
     std::cerr << "partita: error: " << e.what() << "\n";

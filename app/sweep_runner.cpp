@@ -92,6 +92,7 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
       args.push_back("--plugin");
       args.push_back(p);
     }
+    if (!options.plots) args.push_back("--no-plots");
     std::error_code ec;
     fs::remove(vdir / "log.txt", ec);
     const pid_t pid = spawn(args, vdir / "log.txt");
@@ -135,7 +136,8 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
   sweep.write_summary(dir, status);
   logger->info("sweep summary: {}", (dir / "sweep.csv").string());
 
-  if (!sweep.plot_monitor().empty()) {
+  const bool plot = options.plots && !sweep.plot_monitor().empty();
+  if (plot) {
     fs::path script = PARTITA_SWEEP_PLOT_SCRIPT;
     if (!fs::exists(script))
       script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_sweep.py";
@@ -166,7 +168,7 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
     return 1;
   }
   std::cout << "partita run: sweep finished; " << variants.size() << " variants in " << dir.string()
-            << "/ (summary sweep.csv" << (sweep.plot_monitor().empty() ? "" : ", plot sweep.png")
+            << "/ (summary sweep.csv" << (plot ? ", plot sweep.png" : "")
             << ")\n";
   return 0;
 }

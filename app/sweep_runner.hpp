@@ -1,7 +1,8 @@
 #pragma once
 // `partita run CASE` for a case with a `sweep` section: every variant in its own process (this
 // executable with --no-sweep and the variant's --set values), at most `jobs` at once, the
-// progress of the whole sweep on stderr, then DIR/sweep.csv and DIR/sweep.png.
+// progress of the whole sweep on stderr, then DIR/sweep.csv and DIR/sweep.png (not with
+// --no-plots, which the variants get too).
 
 #include <atomic>
 #include <filesystem>
@@ -19,6 +20,7 @@ struct SweepOptions {
   int jobs = 1;
   int threads = 1;  ///< threads of the whole sweep (shared by the jobs)
   std::string log_level = "info";
+  bool plots = true;  ///< the variants' PNG plots and sweep.png (false: --no-plots)
   std::vector<std::string> plugins;  ///< the --plugin libraries (every variant gets them)
   const std::atomic<int>* stop_signal = nullptr;
 };

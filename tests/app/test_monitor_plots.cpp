@@ -1,6 +1,7 @@
 // Monitor PNGs (app/plot_monitors.py): one panel per unit, so a count, a mass, forces and an
 // energy never share one y axis (issue 26). The script's own listing of its panels is checked,
-// then the PNG is drawn where matplotlib is installed (build.sh installs it).
+// then the PNG is drawn where matplotlib is installed (build.sh installs it). The runs of the
+// test suite draw none (PARTITA_NO_PLOTS=1, tests/main.cpp): the switch is checked here.
 
 #include <catch2/catch.hpp>
 
@@ -42,5 +43,41 @@ TEST_CASE("monitor plots: one panel per unit", "[app][plots]") {
     CHECK(drawn.status == 0);
     CHECK(fs::file_size(dir / "mixed.png") > 1000);
   }
+  fs::remove_all(dir);
+}
+
+// `partita run --no-plots` and PARTITA_NO_PLOTS: the run's CSV files without their PNGs; an
+// unknown value of the variable warns, names what is allowed, and draws them.
+TEST_CASE("monitor plots: --no-plots and PARTITA_NO_PLOTS leave the PNGs out", "[app][plots]") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("partita_no_plots_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const std::string run = quote(PARTITA_EXECUTABLE) + " run " +
+                          quote(PARTITA_SOURCE_DIR "/tests/inputs/sweep/tube_sweep.yaml") +
+                          " --no-sweep --threads 1 --set time.end=0.03 --output ";
+  auto files = [](const fs::path& d, const std::string& ext) {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(d)) n += e.path().extension() == ext;
+    return n;
+  };
+  for (const std::string how : {"PARTITA_NO_PLOTS=0 ", "PARTITA_NO_PLOTS=1 "}) {
+    const std::string option = how == "PARTITA_NO_PLOTS=0 " ? " --no-plots" : "";
+    const auto r = partita::test::run_command(how + run + quote((dir / "off").string()) + option);
+    INFO(how << option << "\n" << r.output);
+    REQUIRE(r.status == 0);
+    CHECK(files(dir / "off", ".csv") >= 2);  // coupling.csv and the monitor tube.csv
+    CHECK(files(dir / "off", ".png") == 0);
+    CHECK(r.output.find("PNG") == std::string::npos);
+    fs::remove_all(dir / "off");
+  }
+  const auto r = partita::test::run_command("PARTITA_NO_PLOTS=maybe " + run +
+                                            quote((dir / "on").string()));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("PARTITA_NO_PLOTS='maybe' is not a switch (allowed: 1,") !=
+        std::string::npos);
+  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  if (partita::test::run_command(python + " -c 'import matplotlib'").status == 0)
+    CHECK(files(dir / "on", ".png") == files(dir / "on", ".csv"));
   fs::remove_all(dir);
 }

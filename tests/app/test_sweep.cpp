@@ -28,9 +28,16 @@ fs::path scratch(const std::string& name) { return partita::test::scratch_dir("s
 
 std::string read_all(const fs::path& p) { return partita::test::read_file(p); }
 
-partita::test::CommandResult run(const std::string& args) {
-  return partita::test::run_command(quote(PARTITA_EXECUTABLE) + " run " + quote(kCase.string()) +
-                                    " " + args);
+partita::test::CommandResult run(const std::string& args, const std::string& env = "") {
+  return partita::test::run_command(env + quote(PARTITA_EXECUTABLE) + " run " +
+                                    quote(kCase.string()) + " " + args);
+}
+
+std::set<std::string> pngs_under(const fs::path& dir) {
+  std::set<std::string> found;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.path().extension() == ".png") found.insert(fs::relative(e.path(), dir).string());
+  return found;
 }
 
 std::vector<std::string> csv_lines(const fs::path& p) {
@@ -45,7 +52,8 @@ std::vector<std::string> csv_lines(const fs::path& p) {
 TEST_CASE("sweep: variants differ only in the swept value, the summary has one row each",
           "[app][sweep][slow]") {
   const fs::path dir = scratch("plain");
-  const auto r = run("--jobs 2 --output " + quote(dir.string()));
+  // with the plots (the test suite turns them off): sweep.png and each variant's own
+  const auto r = run("--jobs 2 --output " + quote(dir.string()), "PARTITA_NO_PLOTS=0 ");
   INFO(r.output);
   REQUIRE(r.status == 0);
   const auto rows = csv_lines(dir / "sweep.csv");
@@ -79,13 +87,19 @@ TEST_CASE("sweep: variants differ only in the swept value, the summary has one r
   CHECK(peak[0] < peak[1]);
   CHECK(peak[1] < peak[2]);
   CHECK(fs::exists(dir / "sweep.png"));
+  for (const std::string a : {"1.0", "3.0", "5.0"})
+    CHECK(fs::exists(dir / ("amplitude=" + a) / "tube.png"));
   fs::remove_all(dir);
 }
 
 TEST_CASE("sweep: two jobs at once write the same files as one", "[app][sweep][slow]") {
   const fs::path one = scratch("jobs1"), two = scratch("jobs2");
   REQUIRE(run("--jobs 1 --output " + quote(one.string())).status == 0);
-  REQUIRE(run("--jobs 2 --output " + quote(two.string())).status == 0);
+  // --no-plots reaches every variant: no PNG anywhere (the environment variable alone in `one`)
+  REQUIRE(run("--jobs 2 --no-plots --output " + quote(two.string()), "PARTITA_NO_PLOTS=0 ")
+              .status == 0);
+  CHECK(pngs_under(one).empty());
+  CHECK(pngs_under(two).empty());
   CHECK(read_all(one / "sweep.csv") == read_all(two / "sweep.csv"));
   for (const std::string a : {"1.0", "3.0", "5.0"})
     for (const std::string f : {"tube.csv", "coupling.csv"}) {
