@@ -101,14 +101,17 @@ void register_all(coupling::Registries& r) {
        {"external_work", "J", "work of the applied and coupled loads"},
        {"damping_work", "J", "work dissipated by Rayleigh damping"},
        {"energy_balance", "J",
-        "external work - (strain + kinetic + plastic + damping + eroded): zero for an exact "
-        "balance"},
+        "external work - (strain + kinetic + plastic + damping + eroded + enhanced strain): "
+        "zero for an exact balance"},
        {"newton_iterations", "",
         "Newton iterations of the last step (nonlinear materials; 0 on the linear path)"},
        {"failed_elements", "", "elements whose mean equivalent plastic strain reached eps_f"},
        {"first_failure_time", "s", "when the first element failed (-1 until then)"},
        {"eroded_energy", "J",
         "strain energy, plastic work and kinetic energy that left with eroded elements"},
+       {"enhanced_strain_work", "J",
+        "dissipated by the reduced Hex8's once-a-step update of its enhanced thickness strain "
+        "(0 without hex8: reduced)"},
        {"max_equivalent_plastic_strain", "", "largest over the quadrature points"},
        {"<point>.equivalent_plastic_strain", "",
         "a point (points:), nonlinear material: the mean of its element's points"},

@@ -760,6 +760,8 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       // an eroded element's nodes leave the surface the indenter touches
       b.contact->set_detached(
           [s = solver_.get()](std::size_t node) { return s->node_detached(node); });
+      b.contact->set_eroded(
+          [s = solver_.get()](std::size_t element) { return s->element_eroded(element); });
       solver_->add_contribution(std::move(b.contact));
     }
     if (!transient_) solver_->solve_static();

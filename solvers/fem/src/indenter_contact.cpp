@@ -51,7 +51,8 @@ IndenterContact::IndenterContact(std::string name, const Model& model, const std
   } catch (const Error& e) {
     throw Error("contact '" + name_ + "': " + e.what());
   }
-  std::vector<double> k(mesh_.num_nodes(), 0.0);
+  face_ = face;
+  face_owner_ = owners;
   for (std::size_t f = 0; f < elements.size(); ++f) {
     const auto& s = elements[f];
     const Element& el = mesh_.element(owners[f]);
@@ -60,14 +61,30 @@ IndenterContact::IndenterContact(std::string name, const Model& model, const std
     // k_n += factor E (A_f / n_f) / h_f
     const double modulus = model.material(el.region).youngs_modulus;
     const auto nf = static_cast<double>(node_count(s.type));
-    for (auto n : s.node_span()) k[n] += options_.penalty_factor * modulus * (area / nf) / h;
+    face_stiffness_.push_back(options_.penalty_factor * modulus * (area / nf) / h);
   }
-  for (auto n : nodes_) k_normal_.push_back(k[n]);
+  node_slot_.assign(mesh_.num_nodes(), 0);
+  for (std::size_t j = 0; j < nodes_.size(); ++j) node_slot_[nodes_[j]] = j;
+  sum_penalty_stiffness();
+  gap_committed_.assign(nodes_.size(), 1.0);  // apart: the first add() at rest sets them
+  gap_trial_ = gap_committed_;
+  force_committed_.assign(nodes_.size(), Vec3::Zero());
+  force_trial_ = force_committed_;
   if (options_.friction > 0.0) {
     ft_committed_.assign(nodes_.size(), Vec3::Zero());
     ft_trial_ = ft_committed_;
     u_committed_ = ft_committed_;
     u_trial_ = ft_committed_;
+  }
+}
+
+void IndenterContact::sum_penalty_stiffness() {
+  // in the face elements' order, as the first sum: the same bits while nothing is eroded
+  k_normal_.assign(nodes_.size(), 0.0);
+  const auto& elements = mesh_.face(face_);
+  for (std::size_t f = 0; f < elements.size(); ++f) {
+    if (eroded_ && eroded_(face_owner_[f])) continue;
+    for (auto n : elements[f].node_span()) k_normal_[node_slot_[n]] += face_stiffness_[f];
   }
 }
 
@@ -82,6 +99,8 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
                           const BlockAssembler& assembler) {
   const Vec3 d = indenter_.trial_displacement();
   const Vec3 dd = d - indenter_.displacement();
+  const bool at_committed = indenter_.trial_time() == indenter_.time() && d == indenter_.displacement();
+  if (at_committed && eroded_) sum_penalty_stiffness();
   const RigidShape& shape = indenter_.shape();
   const bool friction = options_.friction > 0.0;
   energy_ = 0.0;
@@ -89,6 +108,7 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
   active_ = 0;
   double round_off2 = 0.0;
   Vec3 on_body = Vec3::Zero();
+  double work = 0.0;
   ElementMatrix ke(3, 3);
   for (std::size_t j = 0; j < nodes_.size(); ++j) {
     const std::size_t node = nodes_[j];
@@ -96,8 +116,18 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
     const Vec3 ui = u.segment<3>(at);
     if (friction) u_trial_[j] = ui;
     const ShapeDistance s = shape.distance(mesh_.node(node) + ui - d);
+    gap_trial_[j] = s.gap;
+    const Vec3& force_before = force_committed_[j];
+    const bool touched_before = force_before.squaredNorm() > 0.0;
     if (!(s.gap < 0.0) || (detached_ && detached_(node))) {  // apart, or eroded away
       if (friction) ft_trial_[j].setZero();
+      force_trial_[j].setZero();
+      // released during the step: the force acted over the part g < 0, down from p_0
+      if (touched_before) {
+        const double g0 = gap_committed_[j];
+        const double inside = s.gap > 0.0 && g0 < 0.0 ? g0 / (g0 - s.gap) : 1.0;
+        work += 0.5 * inside * force_before.dot(dd);
+      }
       continue;
     }
     ++active_;
@@ -132,6 +162,15 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
     }
     f.segment<3>(at) -= force;
     on_body -= force;
+    force_trial_[j] = force;
+    if (touched_before) {
+      work += 0.5 * (force_before + force).dot(dd);  // in contact at both ends: the trapezoid
+    } else {
+      // touched during the step: the force acted over the part g < 0, up to p_1
+      const double g0 = gap_committed_[j];
+      const double inside = g0 > 0.0 ? s.gap / (s.gap - g0) : 1.0;
+      work += 0.5 * inside * force.dot(dd);
+    }
     const double scale = kn * (mesh_.node(node).norm() + ui.norm() + d.norm() + std::abs(s.gap)) +
                          force.norm();
     round_off2 += scale * scale;
@@ -140,10 +179,21 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
   force_on_body_ = on_body;
   round_off_ = std::numeric_limits<double>::epsilon() * std::sqrt(round_off2);
   indenter_.set_contact_force(on_body);
+  work_trial_ = work;
+  if (at_committed) {
+    // at the committed configuration (a run's start, a restored state, a refresh after an
+    // erosion): its gaps and forces are the step's start
+    gap_committed_ = gap_trial_;
+    force_committed_ = force_trial_;
+    work_trial_ = 0.0;
+  }
 }
 
 void IndenterContact::commit() {
-  indenter_.commit();
+  indenter_.commit(work_trial_);
+  work_trial_ = 0.0;
+  gap_committed_ = gap_trial_;
+  force_committed_ = force_trial_;
   if (options_.friction > 0.0) {
     ft_committed_ = ft_trial_;
     u_committed_ = u_trial_;

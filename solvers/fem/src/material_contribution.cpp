@@ -200,7 +200,8 @@ MaterialContribution::MaterialContribution(const Model& model)
   for (const auto& e : mesh_.elements()) {
     eas_offset_.push_back(alpha_end);
     if (eas_hex8_ && e.type == ElementType::Hex8) alpha_end += 9;
-    if (reduced_hex8_ && e.type == ElementType::Hex8) alpha_end += 1;  // its enhanced beta
+    // its enhanced beta and the h of the last evaluation (enhanced_strain_work)
+    if (reduced_hex8_ && e.type == ElementType::Hex8) alpha_end += 2;
   }
   // rupture: each element's failure time (-1: intact), then the eroded energy
   element_failure_strain_.assign(mesh_.num_elements(), std::numeric_limits<double>::infinity());
@@ -221,6 +222,10 @@ MaterialContribution::MaterialContribution(const Model& model)
     failure_offset_ = alpha_end;
   }
   if (failure_offset_ != kNoFailure) alpha_end += mesh_.num_elements() + 1;
+  if (reduced_hex8_) {
+    enhanced_work_offset_ = alpha_end++;
+    enhanced_work_trial_.assign(mesh_.num_elements(), 0.0);
+  }
   committed_.assign(alpha_end, 0.0);
   if (failure_offset_ != kNoFailure) {
     std::fill_n(committed_.begin() + static_cast<std::ptrdiff_t>(failure_offset_),
@@ -384,6 +389,7 @@ void MaterialContribution::evaluate_element(std::size_t e, const Eigen::VectorXd
   fe.setZero(3 * nn);
   fabs.setZero(nn);
   if (ke != nullptr) ke->setZero(3 * nn, 3 * nn);
+  if (!enhanced_work_trial_.empty()) enhanced_work_trial_[e] = 0.0;
   if (failure_offset_ != kNoFailure && eroded(e)) return;  // an eroded element: nothing
   if (eas_hex8_ && el.type == ElementType::Hex8) {
     evaluate_eas(e, ue, fe, ke, energy, fabs);
@@ -699,6 +705,11 @@ void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacement
 }
 
 void MaterialContribution::commit() {
+  if (enhanced_work_offset_ != kNoFailure) {
+    double w = committed_[enhanced_work_offset_];
+    for (double we : enhanced_work_trial_) w += we;
+    trial_[enhanced_work_offset_] = w;
+  }
   // Explicit steps commit every step, ~1 kB of history per element: the copy shared by the
   // threads (issue 27's benchmark; a plain copy, the same bits).
   constexpr std::size_t kBlock = 1 << 15;
@@ -951,6 +962,11 @@ void MaterialContribution::evaluate_reduced(std::size_t e, const ElementDisplace
     eqps_[qi] = law.equivalent_plastic_strain(std::span<const double>(trial_).subspan(s0, ns));
   }
   trial_[a0] = beta - h * k_beta_inverse;
+  // the enhanced strain's work since the last evaluation: -1/2 (h_k + h_k+1)(beta_k - beta_k-1),
+  // beta_k - beta_k-1 = -h_k / K_bb (enhanced_strain_work())
+  const double h_before = committed_[a0 + 1];
+  trial_[a0 + 1] = h;
+  enhanced_work_trial_[e] = 0.5 * (h_before + h) * h_before * k_beta_inverse;
   // hourglass: q_alpha = U^T gamma_alpha, f_a += gamma_alpha,a K_alpha q_alpha
   const Vec3 q1 = un.transpose() * gamma1, q4 = un.transpose() * gamma4;
   const Vec3 p1 = k1 * q1, p4 = k4 * q4;

@@ -55,14 +55,18 @@ void RigidIndenter::set_external_force(const Vec3& force) {
 }
 
 void RigidIndenter::commit() {
+  // W += -1/2 (F_n + F_n+1) . (d_n+1 - d_n)
+  commit(-0.5 * (committed_.f + trial_.f).dot(trial_.d - committed_.d));
+}
+
+void RigidIndenter::commit(double work_increment) {
   const double dt = trial_.t - committed_.t;
   if (!table_ && dt != 0.0) {
     // A_1 = F_1 / m + g;  V_1 = V_1/2 + dt/2 A_1
     trial_.v += 0.5 * dt * ((trial_.f + external_) / mass_ + gravity_);
   }
   trial_.external_work = committed_.external_work + external_.dot(trial_.d - committed_.d);
-  // W += -1/2 (F_n + F_n+1) . (d_n+1 - d_n)
-  trial_.work = committed_.work - 0.5 * (committed_.f + trial_.f).dot(trial_.d - committed_.d);
+  trial_.work = committed_.work + work_increment;
   if (!committed_.touched && trial_.f.squaredNorm() > 0.0) {
     trial_.touched = true;
     trial_.d_first = committed_.d;

@@ -781,10 +781,14 @@ double StructuralSolver::plastic_work() const {
   return operator_->plastic_work();
 }
 
+double StructuralSolver::enhanced_strain_work() const {
+  return nonlinear_ != nullptr ? nonlinear_->material().enhanced_strain_work() : 0.0;
+}
+
 double StructuralSolver::energy_balance() const {
-  // W_ext - (W_strain + E_kin + W_plastic + W_damping + W_eroded)
-  return external_work() -
-         (strain_energy() + kinetic_energy() + plastic_work() + damping_work() + eroded_energy());
+  // W_ext - (W_strain + E_kin + W_plastic + W_damping + W_eroded + W_beta)
+  return external_work() - (strain_energy() + kinetic_energy() + plastic_work() + damping_work() +
+                            eroded_energy() + enhanced_strain_work());
 }
 
 int StructuralSolver::newton_iterations() const {

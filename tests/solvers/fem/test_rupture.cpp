@@ -8,7 +8,11 @@
 #include "partita/fem/box_mesher.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/failure_criterion.hpp"
+#include "partita/fem/finite_strain_j2_law.hpp"
+#include "partita/fem/indenter_contact.hpp"
 #include "partita/fem/j2_plasticity_law.hpp"
+#include "partita/fem/sphere_shape.hpp"
+#include "partita/fem/velocity_table.hpp"
 #include "partita/fem/structural_solver.hpp"
 
 using namespace partita::fem;
@@ -242,4 +246,67 @@ TEST_CASE("rupture: the nodes of an eroded end element leave the structure",
   }
   CHECK(detached == 4);
   CHECK(kept == 12);
+}
+
+// The energy books through a rupture and the ringing after it (issue 29): a clamped steel plate
+// 100 x 100 x 4 mm of 10 x 10 reduced Hex8 (finite-strain J2, eps_f = 0.2, erosion), struck at
+// its centre by a rigid sphere (R = 15 mm) driven at 20 m/s: it tears, 16 elements erode, the
+// sphere passes through and the petals ring. No other input, so the sphere's work must equal
+//   E_kin + E_strain (with the springs) + W_plastic + W_eroded + W_beta,
+// W_beta the energy the reduced Hex8's once-a-step update of its enhanced thickness strain
+// dissipates (MaterialContribution::enhanced_strain_work()). Measured (2026-11-28): within
+// 0.33 % of the work at every step once it passes 100 J (7 % of its final 1360 J; 0.14 % at the
+// end), and the balance moves by 0.14 J over the 0.94 ms of ringing while W_beta grows by 2.8 J
+// (the drift that was not booked before); without summing the penalty stiffness over the intact
+// face elements the hole's edge nodes (a quarter of their mass left, all of their stiffness)
+// chattered on the sphere and created 70 J (-5.8 %). What is left is the central difference's: its kinetic energy jumps
+// when an element's force and mass leave between two steps, and at each touch and release of a
+// moving node (IndenterContact); both are of the first order in dt, hence the bound of 0.5 %.
+TEST_CASE("rupture: a plate torn by a sphere closes its energy books through erosion and ringing",
+          "[fem][rupture][explicit][books]") {
+  const double side = 0.1, thickness = 0.004, radius = 0.015, speed = 20.0;
+  Model m(make_box_mesh({Vec3::Zero(), Vec3(side, side, thickness), {10, 10, 1}, ElementType::Hex8}));
+  m.set_material_law(std::make_shared<FiniteStrainJ2Law>(kE, kNu, kRho, HardeningCurve::linear(kSy, 1e9)));
+  m.set_hex8_formulation(Hex8Formulation::Reduced);
+  m.set_failure_criterion(FailureCriterion::constant(0.2, true));
+  for (const char* edge : {"xmin", "xmax", "ymin", "ymax"}) m.fix(edge);
+  SolverOptions o;
+  o.mass = MassType::Lumped;
+  o.integrator = Integrator::CentralDifference;
+  StructuralSolver s(std::move(m), o);
+  auto sphere = std::make_shared<SphereShape>(Vec3(side / 2, side / 2, thickness + radius + 1e-4), radius);
+  auto contact = std::make_unique<IndenterContact>(
+      "sphere", s.model(), "zmax", RigidIndenter(sphere, VelocityTable({{0.0, Vec3(0, 0, -speed)}})));
+  IndenterContact& c = *contact;
+  c.set_detached([&s](std::size_t node) { return s.node_detached(node); });
+  c.set_eroded([&s](std::size_t element) { return s.element_eroded(element); });
+  s.add_contribution(std::move(contact));
+  const double dt = 0.9 * s.stable_time_step();
+  auto balance = [&] { return c.indenter().work() + s.energy_balance(); };
+  // the ringing: from the last step with a contact force or a new failure on
+  double worst = 0.0, ringing_start = 0.0, balance_start = 0.0, beta_start = 0.0;
+  std::size_t failed = 0;
+  while (s.time() < 0.0024) {
+    s.step(dt);
+    if (c.active_nodes() > 0 || s.failed_elements() != failed) {
+      failed = s.failed_elements();
+      ringing_start = s.time();
+      balance_start = balance();
+      beta_start = s.enhanced_strain_work();
+    }
+    if (c.indenter().work() > 100.0) worst = std::max(worst, std::abs(balance()) / c.indenter().work());
+  }
+  const double drift = balance() - balance_start, beta = s.enhanced_strain_work() - beta_start;
+  INFO("failed " << s.failed_elements() << ", work " << c.indenter().work() << " J, ringing from "
+                 << ringing_start << " s: the balance moves by " << drift
+                 << " J, the enhanced strain dissipates " << beta << " J");
+  CHECK(s.failed_elements() >= 8);
+  CHECK(s.eroded_energy() > 0.1 * c.indenter().work());
+  CHECK(ringing_start < 0.0018);  // the sphere has passed through: 0.6 ms of ringing or more
+  CHECK(worst < 0.005);
+  CHECK(beta > 0.0);
+  CHECK(std::abs(drift) < 0.1 * beta);
+  WARN("torn plate: |balance| / work <= " << worst << " once the work passes 100 J; ringing from "
+       << ringing_start << " s: balance moves " << drift << " J, enhanced strain work " << beta
+       << " J (total " << s.enhanced_strain_work() << " J of " << c.indenter().work() << " J)");
 }

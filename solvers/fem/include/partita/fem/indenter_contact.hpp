@@ -41,6 +41,20 @@ struct IndenterContactOptions {
 // P(f_t,c) the committed force turned into the current tangent plane (its length kept); a node
 // that separates forgets its f_t. Stored energy adds |f_t|^2 / (2 k_t).
 //
+// The body's work on the structure (RigidIndenter::work()), node by node over a step: the
+// integral of the node's contact force along the body's path, the gap taken as linear in time
+// between its values at the step's ends (g_0, g_1), as it is for a plane and straight paths:
+//   in contact at both ends:  1/2 (p_0 + p_1) . dd         (the trapezoid: exact for k_n g)
+//   touching during the step (g_0 >= 0 > g_1):  1/2 (-g_1 / (g_0 - g_1)) p_1 . dd
+//   leaving during the step (g_0 < 0 <= g_1):   1/2 ( g_0 / (g_0 - g_1)) p_0 . dd
+// (the force is zero over the part of the step before the touch, after the release). The
+// trapezoid over a whole step in which a node first touches booked 1/2 k_n |g_1| |dd|, up to
+// (|g_1| + g_0) / |g_1| times the spring energy 1/2 k_n g_1^2 that the penalty springs hold then.
+// What the central difference gives the nodes at a touch or a release differs from the exact
+// work of the force on their own path (the force acts from a step's end on); that is the
+// integrator's, not the books': a node at rest when it is touched gains nothing over the step,
+// and the bow's work is then exactly the springs' energy.
+//
 // Tangent (static and Newmark, driven indenters): k_n n n^T per node in contact, plus k_t
 // (I - n n^T) in stick and mu |p| k_t / |f_t,trial| (I - n n^T - t t^T) in slip (the friction
 // force's dependence on the normal force and the normal's turning, and the curvature term
@@ -80,6 +94,12 @@ class IndenterContact final : public OperatorContribution {
   void set_detached(std::function<bool(std::size_t node)> detached) {
     detached_ = std::move(detached);
   }
+  /// Eroded volume elements (the solver's element_eroded()): at each evaluation at the committed
+  /// configuration (a refresh after an erosion, a restored state) k_n is summed again over the
+  /// face elements whose volume element is intact, so that a node on the edge of a hole keeps
+  /// the stiffness of the elements it still has, in proportion to its mass (its k_n / m_i, and
+  /// with it the stable step, stays that of the intact surface); default: none.
+  void set_eroded(std::function<bool(std::size_t element)> eroded) { eroded_ = std::move(eroded); }
 
   const RigidIndenter& indenter() const { return indenter_; }
   // A force on the body from outside this model (RigidIndenter::set_external_force).
@@ -100,13 +120,24 @@ class IndenterContact final : public OperatorContribution {
   // friction history per face node (friction > 0): committed and trial tangential force, the
   // committed displacement and that of the last add()
   std::vector<Vec3> ft_committed_, ft_trial_, u_committed_, u_trial_;
+  // per face node, the gap and the contact force on the node (zero apart) at the committed
+  // configuration and at the last add() (the body's work over a step)
+  std::vector<double> gap_committed_, gap_trial_;
+  std::vector<Vec3> force_committed_, force_trial_;
+  double work_trial_ = 0.0;  // the body's work over the step to the last add()'s configuration
   double friction_work_ = 0.0, friction_work_trial_ = 0.0;
   double energy_ = 0.0, round_off_ = 0.0;
   Vec3 force_on_body_ = Vec3::Zero();
   std::size_t active_ = 0;
   mutable std::vector<double> state_;
   double step_start_ = 0.0;  // committed time at the last set_time(t, 0)
-  std::function<bool(std::size_t)> detached_;
+  std::function<bool(std::size_t)> detached_, eroded_;
+  // per face element: the volume element it bounds and its factor E A_f / (n_f h_f)
+  std::vector<std::size_t> face_owner_;
+  std::vector<double> face_stiffness_;
+  std::vector<std::size_t> node_slot_;  // mesh node -> its index in nodes_ (face nodes only)
+  std::string face_;
+  void sum_penalty_stiffness();  // k_normal_ from the face elements (the intact ones)
 };
 
 }  // namespace partita::fem

@@ -115,6 +115,18 @@ class MaterialContribution final : public OperatorContribution {
   // committed plastic work of element e [J]
   double element_plastic_work(std::size_t e) const;
 
+  // The reduced Hex8's enhanced thickness strain beta, updated once per explicit step
+  // (beta_k+1 = beta_k - h_k+1 / K_bb, h = d W / d beta at (u_k+1, beta_k)): between two
+  // evaluations the laws see F change by beta's increment too, whose work the nodal forces do
+  // not do. Over the step from F_k = F(u_k, beta_k-1) to F_k+1 = F(u_k+1, beta_k) the laws receive
+  // the nodal forces' trapezoidal work plus 1/2 (h_k + h_k+1)(beta_k - beta_k-1) =
+  // -1/2 (h_k + h_k+1) h_k / K_bb: the lagged update relaxes the mode and dissipates
+  //   W_beta = sum_steps 1/2 (h_k + h_k+1) h_k / K_bb  (about h^2 / K_bb a step, >= 0)
+  // (committed, in the state: h_k per element and the sum) [J]; 0 without reduced Hex8.
+  double enhanced_strain_work() const {
+    return enhanced_work_offset_ == kNoFailure ? 0.0 : committed_[enhanced_work_offset_];
+  }
+
  private:
   using ElementDisplacements = Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxElementNodes, 3>;
   // One element's fe and, when ke != nullptr, ke (zeroed by the caller); adds its strain energy
@@ -187,6 +199,10 @@ class MaterialContribution final : public OperatorContribution {
   std::vector<double> element_failure_strain_;   // per element: eps_f (inf: none)
   std::vector<char> element_erodes_;             // per element: its region erodes
   std::vector<double> element_energy_;           // per element: int W dV at the last add()
+  // reduced Hex8: per element the enhanced strain's work of the last add() (enhanced_strain_work),
+  // summed at commit into the state's slot enhanced_work_offset_ (kNoFailure: none)
+  std::vector<double> enhanced_work_trial_;
+  std::size_t enhanced_work_offset_ = kNoFailure;
   MatrixX6 cauchy_;
   Eigen::VectorXd eqps_;
   PhaseSeconds phase_seconds_;

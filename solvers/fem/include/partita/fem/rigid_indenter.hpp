@@ -20,9 +20,10 @@ namespace partita::fem {
 //
 // Call order (IndenterContact does it): move_to(t) places the trial configuration at t from
 // the committed one (any number of times: Newton iterations, cut-backs); set_contact_force(F)
-// after each evaluation at the trial configuration; commit() when the step is accepted.
-// The work the body does on the structure, sum -1/2 (F_n + F_n+1) . (d_n+1 - d_n) with F the
-// force on the body, is committed with it; so are the first contact and the penetration.
+// after each evaluation at the trial configuration; commit(work) when the step is accepted,
+// with the work the body did on the structure over the step (IndenterContact integrates it node
+// by node; without it, the trapezoid -1/2 (F_n + F_n+1) . (d_n+1 - d_n), F the force on the
+// body); the first contact and the penetration are committed with it.
 //
 // An external force (set_external_force: e.g. the granules' push on a bow that has broken into a
 // filled cell, handed over by the coupling once a window) acts on a free body beside the contact
@@ -45,6 +46,7 @@ class RigidIndenter {
   // From the next move_to on (throws Error unless finite).
   void set_external_force(const Vec3& force);
   void commit();
+  void commit(double work_increment);
 
   // trial configuration (of the last move_to)
   const Vec3& trial_displacement() const { return trial_.d; }

@@ -136,8 +136,12 @@ class StructuralSolver final : private StructuralSystem {
   double external_work() const {
     return kin_.external_work;
   }  // sum 1/2 (F_n + F_n+1).(u_n+1 - u_n)
-  // external work - (strain + kinetic + plastic + damping + eroded) [J]: zero for an exact
-  // energy balance (prescribed displacements do work through the reactions, not counted here).
+  // The reduced Hex8's lagged enhanced-strain update: the energy it dissipates [J]
+  // (MaterialContribution::enhanced_strain_work(); 0 without reduced Hex8)
+  double enhanced_strain_work() const;
+  // external work - (strain + kinetic + plastic + damping + eroded + enhanced strain) [J]: zero
+  // for an exact energy balance (prescribed displacements do work through the reactions, not
+  // counted here).
   double energy_balance() const;
   double max_displacement() const;    // max over nodes of |u|
   Vec3 total_coupling_force() const;  // sum of the coupling loads [N]
