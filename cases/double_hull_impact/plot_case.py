@@ -449,10 +449,10 @@ def plot_force(runs, outdir, plt):
     save(fig, outdir, "force_penetration.png")
 
 
-NICE = {"hull.strain_energy": "hull elastic (strain)", "hull.kinetic_energy": "hull kinetic",
-        "hull.bow.contact_energy": "bow contact", "granules.kinetic_energy": "granules kinetic",
+NICE = {"hull.strain_energy": "hull elastic (strain, bow contact springs)", "hull.kinetic_energy": "hull kinetic",
+        "hull.enhanced_strain_work": "hull enhanced strain (reduced Hex8)", "hull.bow.kinetic_energy": "bow kinetic", "granules.kinetic_energy": "granules kinetic",
         "granules.elastic_energy": "granules contact (elastic)", "hull.eroded_energy": "eroded elements",
-        "hull.bow.friction_work": "bow friction", "granules.friction_work": "granules friction",
+        "granules.friction_work": "granules friction",
         "granules.damping_work": "granules damping", "granules.stiffening_work": "granules stiffening",
         "granules.breakage_energy": "granules breakage"}
 

@@ -500,6 +500,7 @@ TEST_CASE("free indenter: an external force decelerates it as F/m, its work is t
   copy.move_to(t + dt);
   body.move_to(t + dt);
   CHECK(copy.trial_displacement() == body.trial_displacement());
+}
 
 // The books of a driven body's work, node by node (issue 29). A free elastic column of 4 Hex8 at
 // rest (linear path: K u, whose trapezoidal work is exact; lumped mass m_i), struck by a rigid plane
