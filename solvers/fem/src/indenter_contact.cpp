@@ -125,7 +125,7 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
       // released during the step: the force acted over the part g < 0, down from p_0
       if (touched_before) {
         const double g0 = gap_committed_[j];
-        const double inside = s.gap > 0.0 && g0 < 0.0 ? g0 / (g0 - s.gap) : 1.0;
+        const double inside = options_.path_work && s.gap > 0.0 && g0 < 0.0 ? g0 / (g0 - s.gap) : 1.0;
         work += 0.5 * inside * force_before.dot(dd);
       }
       continue;
@@ -168,7 +168,7 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
     } else {
       // touched during the step: the force acted over the part g < 0, up to p_1
       const double g0 = gap_committed_[j];
-      const double inside = g0 > 0.0 ? s.gap / (s.gap - g0) : 1.0;
+      const double inside = options_.path_work && g0 > 0.0 ? s.gap / (s.gap - g0) : 1.0;
       work += 0.5 * inside * force.dot(dd);
     }
     const double scale = kn * (mesh_.node(node).norm() + ui.norm() + d.norm() + std::abs(s.gap)) +

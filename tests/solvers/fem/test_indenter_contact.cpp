@@ -529,7 +529,8 @@ TEST_CASE("driven plane on a free block: its work closes the energy books at eve
   const double dt_elements = s.stable_time_step();
   const double z0 = height + 3.37 * v * dt_elements;  // the plane's start: it touches within a step
   auto plane = std::make_shared<PlaneShape>(Vec3(0, 0, z0), Vec3(0, 0, -1));
-  IndenterContact& c = add_contact(s, "zmax", RigidIndenter(plane, VelocityTable({{0.0, Vec3(0, 0, -v)}})));
+  IndenterContact& c = add_contact(s, "zmax", RigidIndenter(plane, VelocityTable({{0.0, Vec3(0, 0, -v)}})),
+                                   {1.0, 0.0, 1.0, /*path_work=*/true});
   const double dt = 0.9 * s.stable_time_step();
   // lumped mass: each cube gives each of its nodes rho a^3 / 8
   Eigen::VectorXd nodal_mass = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(s.mesh().num_nodes()));

@@ -15,6 +15,14 @@ struct IndenterContactOptions {
   double penalty_factor = 1.0;
   double friction = 0.0;            // Coulomb coefficient mu (0: frictionless)
   double tangential_factor = 1.0;   // k_t = tangential_factor * k_n (elastic slip of the stick)
+  // How the body's work is booked over a step in which a node touches or leaves: false (default)
+  // the trapezoid 1/2 (p_0 + p_1) . dd, the work the central difference's own energy follows
+  // (Verlet: its kinetic energy is the forces' trapezoidal work plus dt^2/8 sum |F|^2/m, which
+  // does not accumulate); true: only over the part of the step with g < 0 (the gap linear over
+  // the step), exact for the springs (a touch from rest books 1/2 k g^2), which leaves in the
+  // books the energy the central difference gives a node it releases while moving (about
+  // 1/2 (1 - s) p . du): a chattering contact then shows a few per cent for a while.
+  bool path_work = false;
 };
 
 // Node-to-rigid-surface penalty contact of a RigidIndenter with the nodes of a named face: one
