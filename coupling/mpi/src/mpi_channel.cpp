@@ -58,29 +58,40 @@ void MpiChannel::send(std::string bytes) {
             &p.request);
 }
 
-std::string MpiChannel::receive(std::string_view what) {
+// Polls `done` (which also moves this side's sends on) until it holds: yielding for the first
+// 10 ms (the other side's window is often shorter), then napping up to 1 ms; PeerTimeout after the
+// deadline, naming the peer and what was awaited.
+template <class Done>
+void MpiChannel::wait_for(Done done, std::string_view what, const char* stalled) {
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
   auto nap = std::chrono::microseconds(0);
-  MPI_Status status;
-  for (;;) {
-    int flag = 0;
-    MPI_Iprobe(rank_, kTag, comm_, &flag, &status);
-    if (flag) break;
-    progress();
+  while (!done()) {
     const double waited = std::chrono::duration<double>(clock::now() - start).count();
     if (waited > deadline_)
       throw PeerTimeout(fmt::format(
-          "no message from {} for {:.0f} s while waiting for {} (--peer-timeout {:g}): that "
-          "process is stuck or gone",
-          name_, waited, what, deadline_));
-    if (waited < 1e-2) {  // the first 10 ms: yield only (a window of the other side is often shorter)
+          "{} {} for {:.0f} s while waiting for {} (--peer-timeout {:g}): that process is stuck "
+          "or gone",
+          name_, stalled, waited, what, deadline_));
+    if (waited < 1e-2) {
       std::this_thread::yield();
     } else {
       nap = std::min(std::chrono::microseconds(1000), nap + std::chrono::microseconds(20));
       std::this_thread::sleep_for(nap);
     }
   }
+}
+
+std::string MpiChannel::receive(std::string_view what) {
+  MPI_Status status;
+  wait_for(
+      [&] {
+        int flag = 0;
+        MPI_Iprobe(rank_, kTag, comm_, &flag, &status);
+        if (!flag) progress();
+        return flag != 0;
+      },
+      what, "sent nothing");
   int count = 0;
   MPI_Get_count(&status, MPI_BYTE, &count);
   std::string bytes(static_cast<std::size_t>(count), '\0');
@@ -89,17 +100,12 @@ std::string MpiChannel::receive(std::string_view what) {
 }
 
 void MpiChannel::deliver(std::string_view what) {
-  using clock = std::chrono::steady_clock;
-  const auto start = clock::now();
-  for (progress(); !pending_.empty(); progress()) {
-    const double waited = std::chrono::duration<double>(clock::now() - start).count();
-    if (waited > deadline_)
-      throw PeerTimeout(fmt::format(
-          "{} took nothing for {:.0f} s while waiting for {} (--peer-timeout {:g}): that process "
-          "is stuck or gone",
-          name_, waited, what, deadline_));
-    std::this_thread::yield();
-  }
+  wait_for(
+      [&] {
+        progress();
+        return pending_.empty();
+      },
+      what, "took nothing");
 }
 
 void MpiChannel::drain(double seconds) {

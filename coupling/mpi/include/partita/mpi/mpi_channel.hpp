@@ -62,6 +62,8 @@ class MpiChannel final : public coupling::Channel {
     MPI_Request request;
   };
   void progress();
+  template <class Done>
+  void wait_for(Done done, std::string_view what, const char* stalled);
   MPI_Comm comm_;
   int rank_;
   std::string name_;
