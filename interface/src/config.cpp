@@ -221,6 +221,10 @@ void check_value(const Node& c, const Param& p) {
     case Type::reals:
     case Type::integers:
     case Type::strings: {
+      if (p.type() == Type::strings && c.is_scalar() && p.length() <= 1) {  // one string: [it]
+        check_choice(c, p, c.as_string());
+        break;
+      }
       if (!c.is_sequence())
         c.fail(std::string("expected a ") + type_name(p.type()) + " such as [1, 2, 3], found " +
                c.describe());

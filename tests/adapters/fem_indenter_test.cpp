@@ -131,6 +131,16 @@ TEST_CASE("fem indenter: bad input names the key and what is allowed", "[adapter
   CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1], face: top, "
                            "motion: {velocity: [0, 0, -1]}}")),
              Catch::Contains("unknown face 'top'") && Catch::Contains("zmax"));
+  // a list of faces: each must exist, none twice; a valid list builds
+  CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1], face: [zmax, top], "
+                           "motion: {velocity: [0, 0, -1]}}")),
+             Catch::Contains("unknown face 'top'") && Catch::Contains("zmax"));
+  CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1], face: [zmax, xmax, zmax], "
+                           "motion: {velocity: [0, 0, -1]}}")),
+             Catch::Contains("'zmax' is named twice"));
+  CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1], face: [zmax, xmax], "
+                           "motion: {velocity: [0, 0, -1]}}")),
+             Catch::Equals("no error"));
   CHECK_THAT(error_of(with("{name: a, shape: capsule, radius: 1, position: [0, 0, 1], face: zmax, "
                            "motion: {velocity: [0, 0, -1]}}")),
              Catch::Contains("capsule needs 'length'"));

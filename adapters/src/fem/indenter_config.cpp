@@ -77,7 +77,10 @@ std::shared_ptr<Spec> indenter_spec() {
           "are missed; default: the contact face's mean element size)")
       .unit("m")
       .positive();
-  s->string("face", "the FE face whose nodes it touches").required();
+  s->strings("face",
+             "the FE face whose nodes it touches, or a list of faces (their union: e.g. [outer, "
+             "cell_1_1], the struck face and the cavity behind it, for a body that breaks through)")
+      .required();
   s->section("penalty", "penalty stiffness", penalty);
   s->real("friction", "Coulomb friction coefficient (0: frictionless)").non_negative().def(0.0);
   s->section("motion", "how it moves", motion).required();
@@ -96,16 +99,18 @@ void forbid_keys(const Node& n, const std::string& shape, std::initializer_list<
     if (n.has(k)) n[k].fail(fmt::format("'{}' does not apply to shape {}", k, shape));
 }
 
-double mean_face_size(const fem::Mesh& mesh, const std::string& face) {
-  const auto& elements = mesh.face(face);
+double mean_face_size(const fem::Mesh& mesh, const std::vector<std::string>& faces) {
   double sum = 0.0;
-  for (const auto& e : elements) {
-    const auto corners = static_cast<std::size_t>(fem::corner_count(e.type));
-    for (std::size_t k = 0; k < corners; ++k)
-      sum += (mesh.node(e.nodes[k]) - mesh.node(e.nodes[(k + 1) % corners])).norm() /
-             static_cast<double>(corners);
-  }
-  return elements.empty() ? 1.0 : sum / static_cast<double>(elements.size());
+  std::size_t count = 0;
+  for (const std::string& face : faces)
+    for (const auto& e : mesh.face(face)) {
+      const auto corners = static_cast<std::size_t>(fem::corner_count(e.type));
+      for (std::size_t k = 0; k < corners; ++k)
+        sum += (mesh.node(e.nodes[k]) - mesh.node(e.nodes[(k + 1) % corners])).norm() /
+               static_cast<double>(corners);
+      ++count;
+    }
+  return count == 0 ? 1.0 : sum / static_cast<double>(count);
 }
 
 fem::VelocityTable velocity_table(const Node& table) {
@@ -131,11 +136,17 @@ IndenterBuild build_indenter(const Node& n, const fem::Model& model,
   IndenterBuild b;
   b.name = n.string("name");
   const std::string shape = n.string("shape");
-  const std::string face = n.string("face");
+  const std::vector<std::string> face = n.strings("face");
   const auto faces = model.mesh().face_names();
-  if (std::find(faces.begin(), faces.end(), face) == faces.end())
-    n["face"].fail("unknown face '" + face + "'; the mesh has: " + join_names(faces) +
-                   did_you_mean(face, faces));
+  if (face.empty()) n["face"].fail("no face given; the mesh has: " + join_names(faces));
+  for (std::size_t i = 0; i < face.size(); ++i) {
+    if (std::find(faces.begin(), faces.end(), face[i]) == faces.end())
+      n["face"].fail("unknown face '" + face[i] + "'; the mesh has: " + join_names(faces) +
+                     did_you_mean(face[i], faces));
+    if (std::find(face.begin(), face.begin() + static_cast<std::ptrdiff_t>(i), face[i]) !=
+        face.begin() + static_cast<std::ptrdiff_t>(i))
+      n["face"].fail("the face '" + face[i] + "' is named twice");
+  }
   if (shape != "surface" && !n.has("position")) n.fail("shape " + shape + " needs 'position'");
   b.reference = n.has("position") ? n.vec3("position") : Eigen::Vector3d::Zero();
   std::shared_ptr<const fem::RigidShape> geometry;

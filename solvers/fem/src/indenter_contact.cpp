@@ -36,6 +36,12 @@ double element_volume(const Mesh& mesh, const Element& e) {
 
 IndenterContact::IndenterContact(std::string name, const Model& model, const std::string& face,
                                  RigidIndenter indenter, IndenterContactOptions options)
+    : IndenterContact(std::move(name), model, std::vector<std::string>{face}, std::move(indenter),
+                      options) {}
+
+IndenterContact::IndenterContact(std::string name, const Model& model,
+                                 const std::vector<std::string>& faces, RigidIndenter indenter,
+                                 IndenterContactOptions options)
     : name_(std::move(name)), mesh_(model.mesh()), indenter_(std::move(indenter)), options_(options) {
   if (!(options_.penalty_factor > 0.0) || !std::isfinite(options_.penalty_factor))
     throw Error("contact '" + name_ + "': the penalty factor must be > 0");
@@ -43,27 +49,39 @@ IndenterContact::IndenterContact(std::string name, const Model& model, const std
     throw Error("contact '" + name_ + "': the friction coefficient must be >= 0");
   if (!(options_.tangential_factor > 0.0))
     throw Error("contact '" + name_ + "': the tangential penalty factor must be > 0");
-  const auto& elements = mesh_.face(face);  // throws, listing the faces, if unknown
-  nodes_ = mesh_.face_nodes(face);
-  std::vector<std::size_t> owners;  // the volume element each face element bounds
-  try {
-    owners = mesh_.face_owners(face);
-  } catch (const Error& e) {
-    throw Error("contact '" + name_ + "': " + e.what());
-  }
-  face_ = face;
-  face_owner_ = owners;
-  for (std::size_t f = 0; f < elements.size(); ++f) {
-    const auto& s = elements[f];
-    const Element& el = mesh_.element(owners[f]);
-    const double area = corner_area(mesh_, s);
-    const double h = element_volume(mesh_, el) / area;
-    // k_n += factor E (A_f / n_f) / h_f
-    const double modulus = model.material(el.region).youngs_modulus;
-    const auto nf = static_cast<double>(node_count(s.type));
-    face_stiffness_.push_back(options_.penalty_factor * modulus * (area / nf) / h);
-  }
+  if (faces.empty()) throw Error("contact '" + name_ + "': no face given");
   node_slot_.assign(mesh_.num_nodes(), 0);
+  std::vector<char> taken(mesh_.num_nodes(), 0);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const std::string& face = faces[i];
+    if (std::find(faces.begin(), faces.begin() + static_cast<std::ptrdiff_t>(i), face) !=
+        faces.begin() + static_cast<std::ptrdiff_t>(i))
+      throw Error("contact '" + name_ + "': the face '" + face + "' is named twice");
+    const auto& elements = mesh_.face(face);  // throws, listing the faces, if unknown
+    std::vector<std::size_t> owners;           // the volume element each face element bounds
+    try {
+      owners = mesh_.face_owners(face);
+    } catch (const Error& e) {
+      throw Error("contact '" + name_ + "': " + e.what());
+    }
+    for (const std::size_t n : mesh_.face_nodes(face))  // the union, in the faces' order
+      if (!taken[n]) {
+        taken[n] = 1;
+        nodes_.push_back(n);
+      }
+    for (std::size_t f = 0; f < elements.size(); ++f) {
+      const auto& s = elements[f];
+      const Element& el = mesh_.element(owners[f]);
+      const double area = corner_area(mesh_, s);
+      const double h = element_volume(mesh_, el) / area;
+      // k_n += factor E (A_f / n_f) / h_f
+      const double modulus = model.material(el.region).youngs_modulus;
+      const auto nf = static_cast<double>(node_count(s.type));
+      face_stiffness_.push_back(options_.penalty_factor * modulus * (area / nf) / h);
+      face_elements_.push_back(s);
+      face_owner_.push_back(owners[f]);
+    }
+  }
   for (std::size_t j = 0; j < nodes_.size(); ++j) node_slot_[nodes_[j]] = j;
   sum_penalty_stiffness();
   gap_committed_.assign(nodes_.size(), 1.0);  // apart: the first add() at rest sets them
@@ -81,10 +99,9 @@ IndenterContact::IndenterContact(std::string name, const Model& model, const std
 void IndenterContact::sum_penalty_stiffness() {
   // in the face elements' order, as the first sum: the same bits while nothing is eroded
   k_normal_.assign(nodes_.size(), 0.0);
-  const auto& elements = mesh_.face(face_);
-  for (std::size_t f = 0; f < elements.size(); ++f) {
+  for (std::size_t f = 0; f < face_elements_.size(); ++f) {
     if (eroded_ && eroded_(face_owner_[f])) continue;
-    for (auto n : elements[f].node_span()) k_normal_[node_slot_[n]] += face_stiffness_[f];
+    for (auto n : face_elements_[f].node_span()) k_normal_[node_slot_[n]] += face_stiffness_[f];
   }
 }
 

@@ -607,3 +607,52 @@ TEST_CASE("driven plane on a free block: its work closes the energy books at eve
     vz += nodal_mass[i / 3] * s.velocity()[i] / nodal_mass.sum();
   CHECK(vz < -v);
 }
+
+TEST_CASE("indenter contact on two faces: the union's force is the sum of the faces' contacts",
+          "[fem][contact]") {
+  // A sphere (R = 10 mm) pressed into the edge where the block's top (zmax) and side (xmax)
+  // meet: it reaches nodes of the top alone, of the side alone, and of both (the edge). The
+  // penalty force -k_n g n is linear in k_n, and the union's k_n of a node is the sum of its
+  // faces' elements' stiffness: frictionless, the union's nodal forces are the sum of the two
+  // single-face contacts' at every node, and its active nodes their union.
+  const Model model = small_block();
+  const BlockAssembler assembler(model.mesh());
+  const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
+  const auto sphere = [] {
+    return RigidIndenter(std::make_shared<SphereShape>(Vec3(0.024, 0.01, 0.014), 0.010),
+                         VelocityTable({{0.0, Vec3::Zero()}}));
+  };
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+  const auto forces = [&](IndenterContact& c, std::size_t& active) {
+    c.set_time(1.0, 1.0);
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+    c.add(u, f, nullptr, assembler);
+    active = c.active_nodes();
+    return f;
+  };
+  IndenterContact top("top", model, "zmax", sphere()), side("side", model, "xmax", sphere());
+  IndenterContact both("both", model, std::vector<std::string>{"zmax", "xmax"}, sphere());
+  std::size_t a_top = 0, a_side = 0, a_both = 0;
+  const Eigen::VectorXd f_top = forces(top, a_top), f_side = forces(side, a_side);
+  const Eigen::VectorXd f_both = forces(both, a_both);
+  // nodes in contact: the edge's (y = 5, 10, 15 mm) on both faces, one more on each face alone
+  std::size_t shared = 0;
+  for (std::size_t node = 0; node < model.mesh().num_nodes(); ++node) {
+    const auto at = 3 * static_cast<Eigen::Index>(node);
+    if (f_top.segment<3>(at).norm() > 0.0 && f_side.segment<3>(at).norm() > 0.0) ++shared;
+  }
+  REQUIRE(shared >= 1);
+  REQUIRE(a_top > shared);
+  REQUIRE(a_side > shared);
+  CHECK(a_both == a_top + a_side - shared);
+  const double scale = f_both.cwiseAbs().maxCoeff();
+  REQUIRE(scale > 0.0);
+  CHECK((f_both - (f_top + f_side)).cwiseAbs().maxCoeff() <= 1e-12 * scale);
+  CHECK((both.contact_force() - (top.contact_force() + side.contact_force())).norm() <=
+        1e-12 * both.contact_force().norm());
+  // a face named twice, an unknown one
+  CHECK_THROWS_WITH(IndenterContact("t", model, std::vector<std::string>{"zmax", "zmax"}, sphere()),
+                    Catch::Contains("'zmax' is named twice"));
+  CHECK_THROWS_WITH(IndenterContact("t", model, std::vector<std::string>{"zmax", "top"}, sphere()),
+                    Catch::Contains("top"));
+}

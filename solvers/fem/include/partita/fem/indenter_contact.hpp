@@ -25,8 +25,10 @@ struct IndenterContactOptions {
   bool path_work = false;
 };
 
-// Node-to-rigid-surface penalty contact of a RigidIndenter with the nodes of a named face: one
-// contribution to the FE operator (OperatorContribution), beside the material's.
+// Node-to-rigid-surface penalty contact of a RigidIndenter with the nodes of one or more named
+// faces (their union: a node on two of them is one contact node, with the stiffness of the face
+// elements around it on both): one contribution to the FE operator (OperatorContribution),
+// beside the material's.
 //
 // Normal: for a face node at x = X + u and the indenter displaced by d, g = g_shape(x - d) (the
 // shape's signed distance, < 0 inside) and n its outward normal; where g < 0
@@ -80,6 +82,9 @@ class IndenterContact final : public OperatorContribution {
   // Throws Error for an unknown face (listing the known ones), a bad option or a face element
   // that bounds no volume element.
   IndenterContact(std::string name, const Model& model, const std::string& face,
+                  RigidIndenter indenter, IndenterContactOptions options = {});
+  // The union of several faces (at least one; each named once).
+  IndenterContact(std::string name, const Model& model, const std::vector<std::string>& faces,
                   RigidIndenter indenter, IndenterContactOptions options = {});
 
   std::string_view name() const override { return name_; }
@@ -140,11 +145,12 @@ class IndenterContact final : public OperatorContribution {
   mutable std::vector<double> state_;
   double step_start_ = 0.0;  // committed time at the last set_time(t, 0)
   std::function<bool(std::size_t)> detached_, eroded_;
-  // per face element: the volume element it bounds and its factor E A_f / (n_f h_f)
+  // per face element (the faces' elements one face after the other): the element, the volume
+  // element it bounds and its factor E A_f / (n_f h_f)
+  std::vector<SurfaceElement> face_elements_;
   std::vector<std::size_t> face_owner_;
   std::vector<double> face_stiffness_;
   std::vector<std::size_t> node_slot_;  // mesh node -> its index in nodes_ (face nodes only)
-  std::string face_;
   void sum_penalty_stiffness();  // k_normal_ from the face elements (the intact ones)
 };
 
