@@ -56,7 +56,7 @@ import numpy as np
 
 G = 9.81
 SECTION_Y = 0.181                 # the bow's axis (x = y = 0.181)
-BOW_RADIUS, BOW_LENGTH = 0.030, 0.030
+BOW_RADIUS, BOW_LENGTH = 0.030, 0.030   # the capsule's radius; its cylinder's length unless vtk/hull_bow says
 CELLS = [f"c{i}{j}" for j in range(3) for i in range(3)]
 
 
@@ -638,7 +638,7 @@ def plot_sections(run, outdir, plt, prefix):
         if run.has("hull.bow.z"):
             zc = float(run.at("hull.bow.z", t))
             ang = np.linspace(0, np.pi, 60)
-            half = BOW_LENGTH / 2
+            half = bow_length(run.folder) / 2
             xs = np.concatenate([SECTION_Y + BOW_RADIUS * np.cos(ang), SECTION_Y - BOW_RADIUS * np.cos(ang)])
             zs = np.concatenate([zc + half + BOW_RADIUS * np.sin(ang), zc - half - BOW_RADIUS * np.sin(ang)])
             xs, zs = np.append(xs, xs[0]), np.append(zs, zs[0])
@@ -653,6 +653,16 @@ def plot_sections(run, outdir, plt, prefix):
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("z [mm]")
         save(fig, outdir, f"{prefix}_{n}.png")
+
+
+def bow_length(folder):
+    """The capsule's cylinder length from the bow's surface mesh (vtk/hull_bow_000000.vtp: its
+    extent along z less the two hemispheres), BOW_LENGTH when the file is missing."""
+    path = os.path.join(folder, "vtk", "hull_bow_000000.vtp")
+    if not os.path.exists(path):
+        return BOW_LENGTH
+    pts, _, _ = read_vtk(path)
+    return max(0.0, float(pts[:, 2].max() - pts[:, 2].min()) - 2 * BOW_RADIUS)
 
 
 def save(fig, outdir, name):
