@@ -59,6 +59,48 @@ std::vector<fs::path> write_every_format(Solver& s, const fs::path& dir,
 
 }  // namespace
 
+TEST_CASE("fem adapter: the .vtu's contact_force is the indenters' force on each node",
+          "[adapters][fem][output][contact]") {
+  // a driven sphere pressed 0.2 mm into a clamped block's top, one static step: the nodes of
+  // the top face under it carry the contact force, every other node none, and their sum is
+  // minus the force on the sphere (action and reaction)
+  const fs::path dir = scratch("fem_contact");
+  auto s = test::make_solver(
+      "fem",
+      "solver: fem\n"
+      "mesh: {box: {origin: [0, 0, 0], size: [0.02, 0.02, 0.01], cells: [4, 4, 2]}}\n"
+      "material: {youngs_modulus: 70 GPa, poisson_ratio: 0.3, density: 2700}\n"
+      "constraints: [{set: zmin, fix: [x, y, z]}]\n"
+      "indenters: [{name: ball, shape: sphere, radius: 0.008, position: [0.01, 0.01, 0.018], face: zmax,\n"
+      "             motion: {velocity: [0, 0, -0.0002]}}]\n"
+      "analysis: {type: static}\n",
+      PARTITA_SOURCE_DIR, dir);
+  s->advance(1.0);  // the sphere 0.2 mm into the top
+  double force_z = 0.0;
+  for (const auto& m : s->monitors())
+    if (m.name == "ball.force_z") force_z = m.value;
+  REQUIRE(force_z > 0.0);  // pushed back up
+  const auto dirs = write_every_format(*s, dir);
+  const auto c = read_vtk(dirs[0] / s->output_files()[0].second);
+  REQUIRE(c.ok);
+  REQUIRE(c.point.count("contact_force") == 1);
+  const auto& f = c.point.at("contact_force").values;
+  double sum[3] = {0, 0, 0};
+  int touched = 0;
+  for (std::size_t i = 0; i < c.points; ++i) {
+    for (int k = 0; k < 3; ++k) sum[k] += f[3 * i + k];
+    if (f[3 * i + 2] != 0.0) {
+      ++touched;
+      CHECK(c.xyz[3 * i + 2] == Approx(0.01));  // on the top face
+      CHECK(f[3 * i + 2] < 0.0);                // pushed down
+    }
+  }
+  CHECK(touched >= 1);
+  CHECK(sum[2] == Approx(-force_z).epsilon(1e-9));
+  CHECK(std::abs(sum[0]) <= 1e-9 * force_z);
+  CHECK(std::abs(sum[1]) <= 1e-9 * force_z);
+}
+
 TEST_CASE("fem adapter: the .vtu of every element type, in every format",
           "[adapters][fem][output]") {
   const fs::path dir = scratch("fem");

@@ -1006,7 +1006,9 @@ void FemAdapter::read_restart(BinaryReader& in) {
 
 void FemAdapter::write_output(const OutputFrame& frame) {
   const std::string file = fmt::format("{}_fem_{:06d}.vtu", frame.prefix, frame.index);
-  write_fem_vtu(*solver_, frame.vtk_directory / file, frame.vtk);
+  std::vector<const fem::IndenterContact*> contacts;
+  for (const auto& ind : indenters_) contacts.push_back(ind.contact);
+  write_fem_vtu(*solver_, frame.vtk_directory / file, frame.vtk, contacts);
   files_ = {{"fem", file}};
   for (const auto& ind : indenters_) {  // the indenters' surfaces where they are
     if (!ind.has_surface) continue;

@@ -19,7 +19,8 @@ std::uint8_t vtk_cell_type(fem::ElementType type) {
 }
 
 void write_fem_vtu(const fem::StructuralSolver& solver, const std::filesystem::path& path,
-                   const vtk::Options& options) {
+                   const vtk::Options& options,
+                   std::span<const fem::IndenterContact* const> contacts) {
   static_assert(sizeof(fem::Vec3) == 3 * sizeof(double), "node arrays are xyz xyz ...");
   const fem::Mesh& mesh = solver.mesh();
   const std::size_t n = mesh.num_nodes(), ne = mesh.num_elements();
@@ -51,6 +52,14 @@ void write_fem_vtu(const fem::StructuralSolver& solver, const std::filesystem::p
   piece.point_active = {
       {"Vectors", "displacement"}, {"Tensors", "stress"}, {"Scalars", "von_mises"}};
   piece.cell_data = {DataArray::view("region", region.data(), ne)};
+  std::vector<fem::Vec3> contact_force;
+  if (!contacts.empty()) {
+    contact_force.assign(n, fem::Vec3::Zero());
+    for (const fem::IndenterContact* c : contacts)
+      for (std::size_t j = 0; j < c->nodes().size(); ++j)
+        contact_force[c->nodes()[j]] += c->node_forces()[j];
+    piece.point_data.push_back(DataArray::view("contact_force", contact_force.front().data(), n, 3));
+  }
   // equivalent plastic strain: per cell (the mean of its points) and per point (the mean of
   // the cells that share it); `failed` (1: failed, 2: eroded) with a failure criterion
   Eigen::VectorXd eqps_nodes;

@@ -121,6 +121,8 @@ class IndenterContact final : public OperatorContribution {
   const Vec3& contact_force() const { return force_on_body_; }
   std::size_t active_nodes() const { return active_; }
   const std::vector<std::size_t>& nodes() const { return nodes_; }
+  // The contact force on each of nodes() [N] at the committed configuration (zero apart).
+  const std::vector<Vec3>& node_forces() const { return force_committed_; }
   const std::vector<double>& penalty_stiffness() const { return k_normal_; }
 
  private:
