@@ -187,11 +187,14 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     if (extensive || weighted) audited_.push_back(e.get());
   }
   // Energy audit: pairs of participants with exchanges both ways whose solvers report the work
-  // done on them through the meshes they read on.
+  // done on them through the meshes they read on; not through a prescribed mesh (a driven body's
+  // surface: the work it does is the reader's input).
   for (const auto& e : exchanges_) {
     Participant* reader = &e->to();
     Participant* writer = &e->from();
     if (reader == writer || !reader->interface_work(e->to_mesh())) continue;
+    if (const InterfaceMesh* from = writer->find_mesh(e->from_mesh()); from && from->prescribed)
+      continue;
     auto it = std::find_if(energy_pairs_.begin(), energy_pairs_.end(), [&](const EnergyPair& p) {
       return (p.a == reader && p.b == writer) || (p.a == writer && p.b == reader);
     });

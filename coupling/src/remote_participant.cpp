@@ -63,6 +63,7 @@ void write_mesh(BinaryWriter& out, const InterfaceMesh& m) {
                        m.mesh.triangles().data() + m.mesh.triangles().size());
   out.write(tri);
   out.write(m.mesh.weights());
+  out.write(static_cast<std::uint8_t>(m.prescribed));
   for (const auto* specs : {&m.reads, &m.writes}) {
     out.write(static_cast<std::uint64_t>(specs->size()));
     for (const DataSpec& d : *specs) {
@@ -88,6 +89,7 @@ InterfaceMesh read_mesh(BinaryReader& in) {
   Eigen::VectorXd weights;
   in.read(weights);
   if (weights.size() > 0) m.mesh.set_weights(weights);
+  m.prescribed = in.get<std::uint8_t>() != 0;
   for (auto* specs : {&m.reads, &m.writes}) {
     const auto n = in.get<std::uint64_t>();
     for (std::uint64_t i = 0; i < n; ++i) {

@@ -181,6 +181,36 @@ TEST_CASE("energy balance: a coupled oscillator closes within 2 %, a scaled exch
     CHECK(std::find(t.header.begin(), t.header.end(), "input coupling created [J]") !=
           t.header.end());
   }
+  SECTION("work through a prescribed mesh (a driven body's) is an input, not the coupling's") {
+    // The mass participant also drives a point at 0.1 m/s (its mesh 'driver', prescribed), which
+    // the spring participant reads on its mesh 'probe' (a spring k_p = 1000 N/m to the ground,
+    // pushing nothing back: as a driven bow's surface handed to the granules). The work on the
+    // probe, 1/2 k_p x^2, did not pass between the two: what the coupling created is the plain
+    // run's. Not marked prescribed, the audit counts it: created = plain + the probe's work.
+    const auto with_driver = [](const char* prescribed) {
+      std::string text = oscillator_case();
+      const std::string mass = "damping: 0.5, force: 2.0, v0: 1.0}";
+      text.replace(text.find(mass), mass.size(),
+                   std::string("damping: 0.5, force: 2.0, v0: 1.0, driver_speed: 0.1, "
+                               "driver_prescribed: ") + prescribed + "}");
+      const std::string spring = "spring: {solver: test-spring, stiffness: 100}";
+      text.replace(text.find(spring), spring.size(),
+                   "spring: {solver: test-spring, stiffness: 100, probe_stiffness: 1000}");
+      const std::string last_exchange = "to: mass.point}\n";
+      text.insert(text.find(last_exchange) + last_exchange.size(),
+                  "    - {data: displacement, from: mass.driver, to: spring.probe}\n");
+      return text;
+    };
+    const Table plain = run_case("plain-again", oscillator_case());
+    const Table driven = run_case("driven", with_driver("true"));
+    CHECK(driven.column("coupling created [J]") == plain.column("coupling created [J]"));
+    CHECK(driven.column("energy balance error [-]") == plain.column("energy balance error [-]"));
+    const Table counted = run_case("driven-unmarked", with_driver("false"));
+    // at t = 0.5 s the probe is at 0.05 m: 1/2 1000 0.05^2 = 1.25 J (the trapezoid is exact)
+    const double probe_work = 0.5 * 1000.0 * 0.05 * 0.05;
+    CHECK(counted.column("coupling created [J]").back() - plain.column("coupling created [J]").back() ==
+          Approx(probe_work).epsilon(1e-6));
+  }
   SECTION("forces scaled by 0.9: the balance fails, and the coupling column holds the loss") {
     // The mass feels 0.9 of the spring's pull, the spring stores 1/2 k x^2: the system gains
     // 0.1 * 1/2 k x^2, up to about 0.1 * 1/2 (k / (k + 0.9 k)) * 0.5 J / 0.5 J = 5 % of the scale.

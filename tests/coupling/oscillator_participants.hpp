@@ -22,23 +22,33 @@
 
 namespace partita::coupling::test {
 
+// With driver_speed s != 0 it also has a mesh "driver" whose displacement is s t, prescribed
+// (InterfaceMesh::prescribed as driver_prescribed says): a driven body beside the mass.
 class MassParticipant : public Solver {
  public:
-  MassParticipant(double m, double k, double c, double f, double x0, double v0)
-      : m_(m), k_(k), c_(c), f_(f), x_(x0), v_(v0) {
+  MassParticipant(double m, double k, double c, double f, double x0, double v0,
+                  double driver_speed = 0.0, bool driver_prescribed = true)
+      : m_(m), k_(k), c_(c), f_(f), x_(x0), v_(v0), driver_speed_(driver_speed) {
     InterfaceMesh im;
     im.mesh = Mesh("point", Mesh::Points::Zero(1, 3));
     im.writes.push_back(DataSpec{"displacement", 1, "m", DataKind::intensive});
     im.reads.push_back(DataSpec{"force", 1, "N", DataKind::extensive});
     meshes_.push_back(std::move(im));
+    if (driver_speed != 0.0) {
+      InterfaceMesh driver;
+      driver.mesh = Mesh("driver", Mesh::Points::Zero(1, 3));
+      driver.writes.push_back(DataSpec{"displacement", 1, "m", DataKind::intensive});
+      driver.prescribed = driver_prescribed;
+      meshes_.push_back(std::move(driver));
+    }
   }
   const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
   void read(std::string_view, std::string_view, const Eigen::MatrixXd& v) override {
     u_ = v(0, 0);
   }
-  void write(std::string_view, std::string_view, Eigen::MatrixXd& v) override {
+  void write(std::string_view mesh, std::string_view, Eigen::MatrixXd& v) override {
     v.resize(1, 1);
-    v(0, 0) = x_;
+    v(0, 0) = mesh == "driver" ? driver_speed_ * t_ : x_;
   }
   double stable_time_step() const override { return INFINITY; }
   void advance(double dt) override {
@@ -90,23 +100,32 @@ class MassParticipant : public Solver {
     Sums s;
   };
   std::vector<InterfaceMesh> meshes_;
-  double m_, k_, c_, f_, x_, v_, u_ = 0.0, t_ = 0.0;
+  double m_, k_, c_, f_, x_, v_, driver_speed_, u_ = 0.0, t_ = 0.0;
   Sums s_;
   Saved saved_;
 };
 
+// With probe_stiffness k_p > 0 it has a second mesh "probe" that only reads a displacement: a
+// spring k_p to the ground driven by it, which pushes nothing back (a driven body's surface);
+// its interface_work is the driving motion's work on it, 1/2 k_p x_p^2.
 class SpringParticipant : public Solver {
  public:
-  explicit SpringParticipant(double k) : k_(k) {
+  explicit SpringParticipant(double k, double k_probe = 0.0) : k_(k), kp_(k_probe) {
     InterfaceMesh im;
     im.mesh = Mesh("point", Mesh::Points::Zero(1, 3));
     im.writes.push_back(DataSpec{"force", 1, "N", DataKind::extensive});
     im.reads.push_back(DataSpec{"displacement", 1, "m", DataKind::intensive});
     meshes_.push_back(std::move(im));
+    if (kp_ > 0.0) {
+      InterfaceMesh probe;
+      probe.mesh = Mesh("probe", Mesh::Points::Zero(1, 3));
+      probe.reads.push_back(DataSpec{"displacement", 1, "m", DataKind::intensive});
+      meshes_.push_back(std::move(probe));
+    }
   }
   const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
-  void read(std::string_view, std::string_view, const Eigen::MatrixXd& v) override {
-    next_ = v(0, 0);
+  void read(std::string_view mesh, std::string_view, const Eigen::MatrixXd& v) override {
+    (mesh == "probe" ? probe_next_ : next_) = v(0, 0);
   }
   void write(std::string_view, std::string_view, Eigen::MatrixXd& v) override {
     v.resize(1, 1);
@@ -118,6 +137,8 @@ class SpringParticipant : public Solver {
   void advance(double dt) override {
     work_ += 0.5 * k_ * (x_ + next_) * (next_ - x_);
     x_ = next_;
+    probe_work_ += 0.5 * kp_ * (probe_ + probe_next_) * (probe_next_ - probe_);
+    probe_ = probe_next_;
     t_ += dt;
   }
   double time() const override { return t_; }
@@ -132,6 +153,7 @@ class SpringParticipant : public Solver {
     return {{"elastic_energy", "J", 0.5 * k_ * x_ * x_}};
   }
   std::optional<double> interface_work(std::string_view mesh) const override {
+    if (mesh == "probe" && kp_ > 0.0) return probe_work_;
     if (mesh != "point") return std::nullopt;
     return work_;
   }
@@ -145,7 +167,8 @@ class SpringParticipant : public Solver {
 
  private:
   std::vector<InterfaceMesh> meshes_;
-  double k_, x_ = 0.0, next_ = 0.0, t_ = 0.0, work_ = 0.0;
+  double k_, kp_, x_ = 0.0, next_ = 0.0, t_ = 0.0, work_ = 0.0;
+  double probe_ = 0.0, probe_next_ = 0.0, probe_work_ = 0.0;  // not saved: the audit's test only
   std::vector<double> saved_ = {0, 0, 0, 0};
 };
 
@@ -158,20 +181,26 @@ inline void add_oscillator_solvers(Registries& r) {
   mass->real("force", "constant applied force").def(0.0);
   mass->real("x0", "initial displacement").def(0.0);
   mass->real("v0", "initial velocity").def(0.0);
+  mass->real("driver_speed", "speed of the mesh driver (0: no such mesh)").def(0.0);
+  mass->boolean("driver_prescribed", "the mesh driver is marked prescribed").def(true);
   r.solvers.add(
       "test-mass", "a damped mass on a spring",
       [](const SolverContext& c) -> std::unique_ptr<Solver> {
         return std::make_unique<MassParticipant>(c.config.real("mass"), c.config.real("stiffness"),
                                                  c.config.real("damping"), c.config.real("force"),
-                                                 c.config.real("x0"), c.config.real("v0"));
+                                                 c.config.real("x0"), c.config.real("v0"),
+                                                 c.config.real("driver_speed"),
+                                                 c.config.boolean("driver_prescribed"));
       },
       mass);
   auto spring = std::make_shared<config::Spec>("test-spring", "a massless spring");
   spring->real("stiffness", "stiffness").positive().def(100.0);
+  spring->real("probe_stiffness", "a second, driven spring on the mesh probe (0: none)").min(0.0).def(0.0);
   r.solvers.add(
       "test-spring", "a massless spring",
       [](const SolverContext& c) -> std::unique_ptr<Solver> {
-        return std::make_unique<SpringParticipant>(c.config.real("stiffness"));
+        return std::make_unique<SpringParticipant>(c.config.real("stiffness"),
+                                                   c.config.real("probe_stiffness"));
       },
       spring);
 }

@@ -240,6 +240,8 @@ IndenterBuild build_indenter(const Node& n, const fem::Model& model,
     // broken in among); a driven one follows its table whatever pushes it
     if (b.contact->indenter().is_free())
       b.surface.reads.push_back(DataSpec{"force", 3, "N", DataKind::extensive});
+    else
+      b.surface.prescribed = true;  // the work it does on a reader is that reader's input
   }
   return b;
 }

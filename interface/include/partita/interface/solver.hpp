@@ -67,6 +67,11 @@ struct InterfaceMesh {
   Mesh mesh;
   std::vector<DataSpec> reads;   ///< fields the solver accepts through read()
   std::vector<DataSpec> writes;  ///< fields the solver provides through write()
+  /// Its motion is prescribed (a driven rigid body's surface): it takes no load back, and the
+  /// work done through it on a participant that reads its motion is that participant's input
+  /// (the case lists it in energy.inputs), not energy passed between the two: the coupling's
+  /// energy audit of the pair leaves such exchanges out.
+  bool prescribed = false;
 };
 
 /// A surface a solver takes from another participant at set-up (e.g. an FE face as a DEM wall):
