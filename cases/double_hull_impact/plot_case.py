@@ -19,7 +19,7 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
   max_abs_energy_error[_empty]   largest |energy balance error| of energy.csv over the rows whose
                           indenter work exceeds 1 % of its final value
   quasi_static_ke_ratio[_empty]  max of (hull + granules kinetic energy) / (hull strain energy +
-                          plastic work) over the rows after first contact whose internal energy
+                          plastic work + eroded elements' energy) over the rows after first contact whose internal energy
                           exceeds 5 % of its final value (before that the ratio is 0/0 noise)
   filled_over_empty_min   min of filled / empty force at equal penetration, from 60 % of the
                           smaller final penetration of the two runs on (needs EMPTY_DIR)
@@ -33,11 +33,14 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
   inner_yield_penetration_{filled,empty}_m, energy_to_inner_yield_{filled,empty}_J   the same at the
                           first row with hull.inner_plate.plastic_work > 0
   broken_granules         granules.breakage.events at the last row
-  footprint_area_90       [m^2] the smallest area of the inner plate's cavity faces (the cells' faces
-                          facing -z above mid-depth) carrying 90 % of the granules' upward force on
-                          them, at the last output frame (from the DEM's mesh files vtk/granules_cXX
-                          or the interface files vtk/granules_interface_cXX); footprint_fraction_90:
-                          that area over the cavity faces' total
+  footprint_area_90[_empty] [m^2] the smallest area of the inner plate's cavity faces (the cells' faces
+                          facing -z above mid-depth) carrying 90 % of the upward force on them, at
+                          the last output frame: the granules' (the DEM's mesh files vtk/granules_cXX
+                          or the interface files vtk/granules_interface_cXX) and the bow's own
+                          contact (the hull's point array contact_force, where the files have it);
+                          footprint_fraction_90: that area over the cavity faces' total;
+                          inner_plate_granule_force[_empty]_N, inner_plate_bow_force[_empty]_N: the
+                          upward forces of each on the inner plate
   collision_initial_kinetic_energy_J, collision_max_penetration_m, collision_absorbed_J (the
                           bow's kinetic energy lost by its deepest row), collision_final_kinetic_energy_J
                           for a run whose bow is free (hull.bow.kinetic_energy > 0 at the start);
@@ -268,7 +271,10 @@ def internal_energy(run):
         plastic = sum(run.at(f"hull.{p}.plastic_work") for p in ("outer_plate", "inner_plate", "webs"))
     if strain is None or plastic is None:
         return None
-    return strain + plastic
+    # the failed elements' energy (elastic and plastic when they were eroded) stays absorbed:
+    # without it the internal energy would fall at each erosion
+    eroded = run.at("hull.eroded_energy") if run.has("hull.eroded_energy") else 0.0
+    return strain + plastic + eroded
 
 
 def ke_ratio(run, suffix):
@@ -368,11 +374,10 @@ def filled_over_empty(filled, empty):
     key("filled_over_empty_from_m", float(start))
 
 
-def footprint(run):
-    """The smallest area of the inner plate's cavity faces carrying 90 % of the granules' upward
-    force on them, at the last output frame."""
-    faces = []   # (area, upward force) of each face
-    source = None
+def granule_items(run):
+    """(area, upward force) of the inner plate's cavity faces from the granules' mesh or interface
+    files at the last output frame, and the files' name; ([], None) without them."""
+    faces = []
     for c in CELLS:
         for name in (f"granules_{c}", f"granules_interface_{c}"):
             frames = pvd_frames(run.folder, name)
@@ -405,22 +410,68 @@ def footprint(run):
                     faces.append((area_n[v], force[v, 2]))
             source = name.rsplit("_", 1)[0]
             break
+    return faces, (source if faces else None)
+
+
+def bow_items(run):
+    """(area, upward force) of the inner plate's cavity-facing nodes from the bow's own contact
+    forces (the hull's point array contact_force, at the last output frame): each node stands for
+    a quarter of the reference areas of the inner plate's element faces it is a corner of. None
+    when the files have no contact_force (runs before 2026-11-28)."""
+    frames = pvd_frames(run.folder, "hull_fem")
+    if not frames:
+        return None
+    pts, cells, data = read_vtk(frames[-1][1])
+    if "contact_force" not in data or "region" not in data or "displacement" not in data:
+        return None
+    ref = pts - data["displacement"]
+    region = data["region"].reshape(-1)
+    area = np.zeros(len(pts))
+    for cl, r in zip(cells, region):
+        if int(r) != 1 or len(cl) != 8:   # the inner plate's hexahedra
+            continue
+        cl = np.asarray(cl)
+        z = ref[cl, 2]
+        low = cl[np.argsort(z)[:4]]        # the cavity-facing (lower) face
+        p = ref[low]
+        c = p.mean(axis=0)
+        ang = np.arctan2(p[:, 1] - c[1], p[:, 0] - c[0])
+        q = p[np.argsort(ang)]
+        a = 0.5 * np.linalg.norm(np.cross(q[2] - q[0], q[3] - q[1]))
+        area[low] += a / 4
+    fz = data["contact_force"][:, 2]
+    return [(area[v], fz[v]) for v in np.nonzero(area > 0)[0]]
+
+
+def footprint(run, suffix=""):
+    """The smallest area of the inner plate's cavity faces carrying 90 % of the upward force on
+    them (the granules' and the bow's own contact), at the last output frame."""
+    faces, source = granule_items(run)
+    cavity_area = sum(x for x, _ in faces)
+    bow = bow_items(run)
+    bow_up = float(np.clip([f for _, f in bow], 0, None).sum()) if bow else 0.0
+    if bow is not None:
+        key("inner_plate_bow_force" + suffix + "_N", bow_up)
+    if bow_up > 0:
+        faces = faces + bow
     if not faces:
         note(f"{run.label}: no granules' mesh or interface files (vtk/granules_cXX.pvd or "
-             "vtk/granules_interface_cXX.pvd) with forces (footprint_area_90 skipped)")
+             "vtk/granules_interface_cXX.pvd) with forces and no bow contact on the inner plate "
+             "(footprint_area_90 skipped)")
         return
     a, f = np.array(faces).T
     up = np.clip(f, 0, None)
     if up.sum() <= 0:
-        note(f"{run.label}: no upward granule force on the inner plate (footprint_area_90 skipped)")
+        note(f"{run.label}: no upward force on the inner plate (footprint_area_90 skipped)")
         return
     order = np.argsort(-up / a)
     carried = np.cumsum(up[order])
     n = int(np.searchsorted(carried, 0.9 * carried[-1])) + 1
-    key("footprint_area_90", float(a[order][:n].sum()))
-    key("footprint_fraction_90", float(a[order][:n].sum() / a.sum()))
-    key("inner_plate_granule_force_N", float(up.sum()))
-    note(f"footprint from {source}_cXX (last frame)")
+    key("footprint_area_90" + suffix, float(a[order][:n].sum()))
+    if source:
+        key("footprint_fraction_90" + suffix, float(a[order][:n].sum() / cavity_area))
+        key("inner_plate_granule_force" + suffix + "_N", float(up.sum() - bow_up))
+    note(f"{run.label}: footprint from " + " and ".join(x for x in (source and f"{source}_cXX", bow_up > 0 and "the bow's contact_force") if x) + " (last frame)")
 
 
 # ---------------------------------------------------------------------------------------- plots
@@ -729,6 +780,8 @@ def main():
     else:
         note("filled: no column granules.breakage.events (broken_granules skipped)")
     guarded("footprint_area_90", footprint, filled)
+    if empty:
+        guarded("footprint_area_90_empty", footprint, empty, "_empty")
 
     import matplotlib
     matplotlib.use("Agg")
