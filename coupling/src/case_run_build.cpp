@@ -431,6 +431,16 @@ void CaseRun::build_participants(const config::Node& root) {
     const std::string pname = source.substr(0, dot);
     const std::string mname = dot == std::string::npos ? "" : source.substr(dot + 1);
     const std::vector<InterfaceMesh>* from = offered(pname);
+    if (options_.check_only && dot != std::string::npos && !from && ps.has(pname) &&
+        ps[pname].is_map() &&
+        ps[pname].has("solver") && ps[pname].string("solver") == "external")
+      fail(fmt::format(
+          "'{}' is a mesh of participant '{}', an external program (solver: external): its "
+          "meshes are known only when it joins the run, and the handshake checks this one then; "
+          "partita check cannot build participant '{}', which takes it as a surface (check the "
+          "case by running it with the program: mpirun -n 1 partita run CASE --participant {} "
+          ": -n 1 ./program CASE)",
+          source, pname, receiver, receiver));
     if (dot == std::string::npos || !from)
       fail("'" + source + "' names no participant's mesh (participant.mesh); participants: " +
            join_names(names) + did_you_mean(pname, names));
