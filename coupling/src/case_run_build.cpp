@@ -510,6 +510,9 @@ void CaseRun::build_participants(const config::Node& root) {
     else
       participants_.push_back(std::make_unique<RemoteParticipant>(name, *dist.servers[remote].second,
                                                                   std::move(ready[remote])));
+    if (b == built.end() && pn.string("solver") == "external")  // named in messages
+      external_programs_[name] = fmt::format("'{}' of {}", hellos[remote].program,
+                                             dist.servers[remote].second->peer());
     if (coupled && participants_.back()->meshes().empty())
       pn.fail("solver '" + pn.string("solver") + "' of participant '" + name +
               "' exposes no coupling mesh");
@@ -527,6 +530,7 @@ void CaseRun::serve_handshake(std::unique_ptr<Solver>& solver,
   Hello h;
   h.case_hash = case_hash_;
   h.participant = name;
+  h.program = "partita";
   h.meshes = solver->meshes();
   const std::vector<MeshRequest> requests = solver->mesh_requests();
   for (const MeshRequest& r : requests) h.mesh_requests.emplace_back(r.name, r.source);

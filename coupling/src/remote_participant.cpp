@@ -441,6 +441,7 @@ Hello receive_hello(Channel& server, const std::string& participant, std::uint64
   h.version = r.get_string();
   h.case_hash = r.get<std::uint64_t>();
   h.participant = r.get_string();
+  h.program = r.get_string();
   std::string mismatch;
   if (h.version != std::string(version()))
     mismatch = fmt::format("it runs partita {}, this process {}", h.version, std::string(version()));
@@ -523,6 +524,7 @@ std::vector<std::pair<std::string, Mesh>> ParticipantServer::hello(const Hello& 
     out.write(std::string(version()));
     out.write(h.case_hash);
     out.write(h.participant);
+    out.write(h.program);
     out.write(static_cast<std::uint64_t>(h.meshes.size()));
     for (const auto& mesh : h.meshes) write_mesh(out, mesh);
     out.write(static_cast<std::uint64_t>(h.mesh_requests.size()));

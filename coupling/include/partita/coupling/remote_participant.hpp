@@ -26,7 +26,7 @@
 // parallel scheme lets every remote participant work while the controller's own one does.
 //
 // Start-up (handshake), before the first window, each server sends
-//   hello: [partita version] [case hash] [participant] [meshes] [mesh requests]
+//   hello: [partita version] [case hash] [participant] [program] [meshes] [mesh requests]
 // and the controller answers with the meshes it asked for (another participant's surface),
 // after which the server sends its final meshes, stable step, restart support and whether it can
 // map what it reads. A mismatch
@@ -94,6 +94,7 @@ struct Hello {
   std::string version;
   std::uint64_t case_hash = 0;
   std::string participant;
+  std::string program;  // its executable's name ("partita", or an external program's), for messages
   std::vector<InterfaceMesh> meshes;
   std::vector<std::pair<std::string, std::string>> mesh_requests;  // (name, participant.mesh)
   std::string error;  // set when its set-up failed (then nothing else is)
