@@ -40,6 +40,13 @@ enum class Command : std::uint32_t {
   mapping,  // before the first window: an exchange the server maps on its side
 };
 
+// Whether two matrices hold the same values to the bit (-0 and 0 differ, a NaN equals its copy).
+bool same_bits(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         (a.size() == 0 ||
+          std::memcmp(a.data(), b.data(), static_cast<std::size_t>(a.size()) * sizeof(double)) == 0);
+}
+
 // Starts a message in `buffer` (cleared: its capacity is kept) with its command.
 MessageWriter start(std::string& buffer, Command c) {
   buffer.clear();
@@ -239,17 +246,43 @@ void RemoteParticipant::run_window(const TimeWindow& window, std::span<const Win
   out.write(window.size());
   out.write(static_cast<std::int64_t>(window.index()));
   out.write(static_cast<std::uint64_t>(inputs.size()));
-  for (const WindowInput& in : inputs) {
+  if (held_.size() != inputs.size()) held_.assign(inputs.size(), Held{});
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const WindowInput& in = inputs[i];
+    Held& held = held_[i];
+    if (held.mesh != in.mesh || held.data != in.data) {  // another input: nothing held
+      held = Held{};
+      held.mesh = in.mesh;
+      held.data = in.data;
+    }
     out.write(*in.mesh);
     out.write(*in.data);
     out.write(static_cast<std::uint8_t>(in.sees == ReaderSees::linear));
     out.write(static_cast<std::uint8_t>(in.start_is_end));
-    // [u8 which travel as the sender's values, the server maps them: 1 end, 2 start]
+    // [u8 flags] which travel as the sender's values, the server maps them: 1 end, 2 start;
+    // the start does not travel: 4 it is the last request's end, 8 its start
     const bool start = !in.start_is_end && in.sees == ReaderSees::linear;
-    const std::uint8_t unmapped = (in.sent_end ? 1 : 0) | (start && in.sent_start ? 2 : 0);
-    out.write(unmapped);
-    if (start) out.write(unmapped & 2 ? *in.sent_start : *in.start);
-    out.write(unmapped & 1 ? *in.sent_end : *in.end);
+    const bool start_unmapped = start && in.sent_start;
+    const Eigen::MatrixXd& start_values = start_unmapped ? *in.sent_start : *in.start;
+    std::uint8_t flags = (in.sent_end ? 1 : 0) | (start_unmapped ? 2 : 0);
+    if (start && held.end_valid && held.end_unmapped == start_unmapped &&
+        same_bits(held.end, start_values))
+      flags |= 4;  // the next window: d_n = the last d_{n+1}
+    else if (start && held.start_valid && held.start_unmapped == start_unmapped &&
+             same_bits(held.start, start_values))
+      flags |= 8;  // the next iteration: the same d_n
+    out.write(flags);
+    if (start && !(flags & 12)) out.write(start_values);
+    const Eigen::MatrixXd& end_values = flags & 1 ? *in.sent_end : *in.end;
+    out.write(end_values);
+    // what the server holds now (as it will do: a start taken from the last end swaps the two)
+    if (flags & 4) held.start.swap(held.end);
+    else if (start && !(flags & 8)) held.start = start_values;  // (no allocation: same shape)
+    held.start_valid = start;
+    held.start_unmapped = start_unmapped;
+    held.end = end_values;
+    held.end_valid = true;
+    held.end_unmapped = flags & 1;
   }
   write_outputs(out, outputs);
   // What the run asks after a window, answered with the window's reply (one message each way
@@ -618,6 +651,7 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
           const auto index = r.get<std::int64_t>();
           // an input: two names' counts, three flags and a matrix's shape at least
           const std::size_t ni = r.count(5 * sizeof(std::uint64_t), "a list of inputs");
+          const std::size_t held = ni == starts.size() ? ni : 0;  // the last request's values
           names.resize(2 * ni);
           starts.resize(ni);
           ends.resize(ni);
@@ -628,7 +662,12 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
             inputs[i].sees = r.get<std::uint8_t>() ? ReaderSees::linear : ReaderSees::constant;
             inputs[i].start_is_end = r.get<std::uint8_t>() != 0;
             const auto unmapped = r.get<std::uint8_t>();
-            if (!inputs[i].start_is_end && inputs[i].sees == ReaderSees::linear) {
+            if ((unmapped & 12) && i >= held) r.fail("values of the last request");
+            if (unmapped & 4) {
+              starts[i].swap(ends[i]);  // d_n: the last request's d_{n+1}
+            } else if (unmapped & 8) {
+              // d_n: the last request's
+            } else if (!inputs[i].start_is_end && inputs[i].sees == ReaderSees::linear) {
               if (unmapped & 2) {
                 r.read(unmapped_values);
                 map_into(names[2 * i], names[2 * i + 1], starts[i]);

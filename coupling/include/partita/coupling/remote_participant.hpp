@@ -18,7 +18,8 @@
 //
 // Window exchange: one request and one reply per participant per window (per iteration of an
 // implicit scheme): the inputs at the window's ends go out, the outputs combined over the
-// substeps come back. An input whose exchange maps on the receiver (map_on: receiver, the
+// substeps come back. A start that equals, to the bit, what the server already holds (the last
+// request's end: the next window; its start: the next iteration) travels as a flag only. An input whose exchange maps on the receiver (map_on: receiver, the
 // default) travels as the sender's values and the server maps it with its own copy of the
 // mapper (set up once by prepare_mapping(): the controller hands over the sender's mesh, the
 // server builds the mapper from the case's exchange); the controller maps it too, for its checks,
@@ -162,6 +163,17 @@ class RemoteParticipant final : public Participant {
   // may be reused for another participant meanwhile, as a parallel scheme does).
   std::vector<WindowOutput> pending_;
   bool pending_window_ = false;
+  // Per input of the last window's request: the values the server holds (as they travelled:
+  // the sender's or mapped), so that a start equal to the last end (the next window of an
+  // explicit scheme) or to the last start (the next iteration of an implicit one) does not
+  // travel again (compared to the bit).
+  struct Held {
+    const std::string* mesh = nullptr;
+    const std::string* data = nullptr;
+    bool start_valid = false, start_unmapped = false, end_valid = false, end_unmapped = false;
+    Eigen::MatrixXd start, end;
+  };
+  std::vector<Held> held_;
   mutable int stop_request_ = 0;
   // The answers to the run's questions after a window, sent with the window's reply (valid until
   // the remote state changes: the next window, a restored checkpoint, a restart read).
