@@ -434,6 +434,16 @@ void CaseRun::build_participants(const config::Node& root) {
     const std::string pname = source.substr(0, dot);
     const std::string mname = dot == std::string::npos ? "" : source.substr(dot + 1);
     const std::vector<InterfaceMesh>* from = offered(pname);
+    if (options_.check_only && dot != std::string::npos && !from && ps.has(pname) &&
+        ps[pname].is_map() &&
+        ps[pname].has("solver") && ps[pname].string("solver") == "external")
+      fail(fmt::format(
+          "'{}' is a mesh of participant '{}', an external program (solver: external): its "
+          "meshes are known only when it joins the run, and the handshake checks this one then; "
+          "partita check cannot build participant '{}', which takes it as a surface (check the "
+          "case by running it with the program: mpirun -n 1 partita run CASE --participant {} "
+          ": -n 1 ./program CASE)",
+          source, pname, receiver, receiver));
     if (dot == std::string::npos || !from)
       fail("'" + source + "' names no participant's mesh (participant.mesh); participants: " +
            join_names(names) + did_you_mean(pname, names));
@@ -503,6 +513,9 @@ void CaseRun::build_participants(const config::Node& root) {
     else
       participants_.push_back(std::make_unique<RemoteParticipant>(name, *dist.servers[remote].second,
                                                                   std::move(ready[remote])));
+    if (b == built.end() && pn.string("solver") == "external")  // named in messages
+      external_programs_[name] = fmt::format("'{}' of {}", hellos[remote].program,
+                                             dist.servers[remote].second->peer());
     if (coupled && participants_.back()->meshes().empty())
       pn.fail("solver '" + pn.string("solver") + "' of participant '" + name +
               "' exposes no coupling mesh");
@@ -520,6 +533,7 @@ void CaseRun::serve_handshake(std::unique_ptr<Solver>& solver,
   Hello h;
   h.case_hash = case_hash_;
   h.participant = name;
+  h.program = "partita";
   h.meshes = solver->meshes();
   const std::vector<MeshRequest> requests = solver->mesh_requests();
   for (const MeshRequest& r : requests) h.mesh_requests.emplace_back(r.name, r.source);

@@ -96,10 +96,22 @@ void totals(const Eigen::MatrixXd& v, const Mesh& mesh, bool extensive, bool mag
 }  // namespace
 
 std::string CaseRun::restart_blocker() const {
-  for (const auto& p : participants_)
-    if (!p->supports_restart())
-      return "participant '" + p->name() + "' has a solver that cannot write restart files";
-  return {};
+  std::string why;  // every participant that cannot, each with its fix
+  for (const auto& p : participants_) {
+    if (p->supports_restart()) continue;
+    if (!why.empty()) why += "; ";
+    if (const auto e = external_programs_.find(p->name()); e != external_programs_.end())
+      why += fmt::format(
+          "the external program {} did not call set_restart_writer() before initialize(), so it "
+          "has no part to write in a restart file or to read back: in the program, call "
+          "ExternalParticipant::set_restart_writer(f) before initialize() (f gives the program's "
+          "state as bytes; a resumed run gives them back through restart_state()), or run "
+          "without restart files",
+          e->second);
+    else
+      why += "participant '" + p->name() + "' has a solver that cannot write restart files";
+  }
+  return why;
 }
 
 fs::path CaseRun::newest_restart_file() const {

@@ -5,10 +5,11 @@
 
 #include <algorithm>
 #include <cstring>
-#include <sstream>
+#include <sstream>  // restart data only (a solver writes it to a BinaryWriter)
 
 #include <fmt/format.h>
 
+#include "message_codec.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
@@ -39,24 +40,22 @@ enum class Command : std::uint32_t {
   mapping,  // before the first window: an exchange the server maps on its side
 };
 
-// A message under construction: a BinaryWriter over a string stream.
-struct Message {
-  std::ostringstream stream;
-  BinaryWriter out{stream};
-  explicit Message(Command c) { out.write(static_cast<std::uint32_t>(c)); }
-  Message() = default;
-  std::string str() { return std::move(stream).str(); }  // the bytes, moved out (once)
-};
+// Whether two matrices hold the same values to the bit (-0 and 0 differ, a NaN equals its copy).
+bool same_bits(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         (a.size() == 0 ||
+          std::memcmp(a.data(), b.data(), static_cast<std::size_t>(a.size()) * sizeof(double)) == 0);
+}
 
-// A message received: a BinaryReader over its bytes.
-struct Received {
-  std::istringstream stream;
-  BinaryReader in;
-  Received(std::string bytes, const std::string& source)
-      : stream(std::move(bytes)), in(stream, source) {}
-};
+// Starts a message in `buffer` (cleared: its capacity is kept) with its command.
+MessageWriter start(std::string& buffer, Command c) {
+  buffer.clear();
+  MessageWriter out(buffer);
+  out.write(static_cast<std::uint32_t>(c));
+  return out;
+}
 
-void write_mesh(BinaryWriter& out, const InterfaceMesh& m) {
+void write_mesh(MessageWriter& out, const InterfaceMesh& m) {
   out.write(m.mesh.name());
   out.write(Eigen::MatrixXd(m.mesh.points()));
   std::vector<int> tri(m.mesh.triangles().data(),
@@ -75,7 +74,7 @@ void write_mesh(BinaryWriter& out, const InterfaceMesh& m) {
   }
 }
 
-InterfaceMesh read_mesh(BinaryReader& in) {
+InterfaceMesh read_mesh(MessageReader& in) {
   InterfaceMesh m;
   const std::string name = in.get_string();
   Eigen::MatrixXd points;
@@ -104,7 +103,7 @@ InterfaceMesh read_mesh(BinaryReader& in) {
   return m;
 }
 
-void write_monitors(BinaryWriter& out, const std::vector<MonitorValue>& v) {
+void write_monitors(MessageWriter& out, const std::vector<MonitorValue>& v) {
   out.write(static_cast<std::uint64_t>(v.size()));
   for (const auto& m : v) {
     out.write(m.name);
@@ -113,23 +112,24 @@ void write_monitors(BinaryWriter& out, const std::vector<MonitorValue>& v) {
   }
 }
 
-std::vector<MonitorValue> read_monitors(BinaryReader& in) {
-  std::vector<MonitorValue> v(in.get<std::uint64_t>());
+// Into `v`, reusing its storage (no allocation for the same names as the last time).
+void read_monitors(MessageReader& in, std::vector<MonitorValue>& v) {
+  // an item: two counts and a value
+  v.resize(in.count(3 * sizeof(std::uint64_t), "a list of monitor values"));
   for (auto& m : v) {
-    m.name = in.get_string();
-    m.unit = in.get_string();
-    m.value = in.get<double>();
+    in.read(m.name);
+    in.read(m.unit);
+    in.read(m.value);
   }
-  return v;
 }
 
-void write_strings(BinaryWriter& out, const std::vector<std::string>& v) {
+void write_strings(MessageWriter& out, const std::vector<std::string>& v) {
   out.write(static_cast<std::uint64_t>(v.size()));
   for (const auto& s : v) out.write(s);
 }
 
 // What a participant writes (its outputs' names, shapes and combination), in requests.
-void write_outputs(BinaryWriter& out, std::span<const WindowOutput> outputs) {
+void write_outputs(MessageWriter& out, std::span<const WindowOutput> outputs) {
   out.write(static_cast<std::uint64_t>(outputs.size()));
   for (const WindowOutput& o : outputs) {
     out.write(*o.mesh);
@@ -147,19 +147,19 @@ struct OutputSlots {
   std::vector<std::string> names;  // mesh, data, label per output
   std::vector<Eigen::MatrixXd> combined;
   std::vector<WindowOutput> outputs;
-  void read(BinaryReader& in) {
-    const auto n = static_cast<std::size_t>(in.get<std::uint64_t>());
+  void read(MessageReader& in) {
+    const std::size_t n = in.count(3 * sizeof(std::uint64_t), "a list of outputs");
     names.resize(3 * n);
     combined.resize(n);
     outputs.assign(n, {});
     for (std::size_t i = 0; i < n; ++i) {
       WindowOutput& o = outputs[i];
-      names[3 * i] = in.get_string();
-      names[3 * i + 1] = in.get_string();
+      in.read(names[3 * i]);
+      in.read(names[3 * i + 1]);
       o.combines = in.get<std::uint8_t>() ? WriterCombines::average : WriterCombines::last;
       o.points = in.get<std::int64_t>();
       o.components = in.get<std::int32_t>();
-      names[3 * i + 2] = in.get_string();
+      in.read(names[3 * i + 2]);
     }
     for (std::size_t i = 0; i < n; ++i) {  // (names is sized: the pointers stay valid)
       outputs[i].mesh = &names[3 * i];
@@ -170,10 +170,10 @@ struct OutputSlots {
   }
 };
 
-std::vector<std::string> read_strings(BinaryReader& in) {
-  std::vector<std::string> v(in.get<std::uint64_t>());
-  for (auto& s : v) s = in.get_string();
-  return v;
+// Into `v`, reusing its storage.
+void read_strings(MessageReader& in, std::vector<std::string>& v) {
+  v.resize(in.count(sizeof(std::uint64_t), "a list of texts"));
+  for (auto& s : v) in.read(s);
 }
 
 }  // namespace
@@ -192,87 +192,110 @@ std::uint64_t case_hash(const config::Node& loaded) {
 RemoteParticipant::RemoteParticipant(std::string name, Channel& channel, Ready ready)
     : Participant(std::move(name)),
       channel_(channel),
+      peer_(channel.peer()),
       meshes_(std::move(ready.meshes)),
       supports_restart_(ready.supports_restart),
       maps_inputs_(ready.maps_inputs) {}
 
-std::string RemoteParticipant::read_reply(std::string_view what) const {
+std::string_view RemoteParticipant::read_reply(std::string_view what) const {
   Stopwatch wait;
-  std::string bytes = channel_.receive(what);
+  channel_.receive(reply_, what);
   wait_seconds_ += wait.seconds();
   ++messages_;
-  bytes_received_ += static_cast<double>(bytes.size());
-  // [u32 status] [results | error text] [f64 seconds] [i32 signal]: the results are returned
-  // in the same string (no copy), the rest read in place
+  bytes_received_ += static_cast<double>(reply_.size());
+  // [u32 status] [results | error text] [f64 seconds] [i32 signal]: the results are read in
+  // place, the rest too
   constexpr std::size_t head = sizeof(std::uint32_t), tail = sizeof(double) + sizeof(std::int32_t);
-  if (bytes.size() < head) throw Error(channel_.peer() + " sent a damaged reply");
+  if (reply_.size() < head) throw Error(peer_ + " sent a damaged reply");
   std::uint32_t status = 0;
-  std::memcpy(&status, bytes.data(), head);
+  std::memcpy(&status, reply_.data(), head);
   if (status != 0) {
-    Received r(std::move(bytes), channel_.peer());
-    r.in.get<std::uint32_t>();
-    throw Error(fmt::format("{} failed: {}", channel_.peer(), r.in.get_string()));
+    MessageReader r(std::string_view(reply_).substr(head), peer_);
+    throw Error(fmt::format("{} failed: {}", peer_, r.view_string()));
   }
-  if (bytes.size() < head + tail) throw Error(channel_.peer() + " sent a damaged reply");
+  if (reply_.size() < head + tail) throw Error(peer_ + " sent a damaged reply");
   double seconds = 0.0;
   std::int32_t signal = 0;
-  std::memcpy(&seconds, bytes.data() + bytes.size() - tail, sizeof(double));
-  std::memcpy(&signal, bytes.data() + bytes.size() - sizeof(std::int32_t), sizeof(std::int32_t));
+  std::memcpy(&seconds, reply_.data() + reply_.size() - tail, sizeof(double));
+  std::memcpy(&signal, reply_.data() + reply_.size() - sizeof(std::int32_t), sizeof(std::int32_t));
   extra_seconds_ += seconds;
   if (signal != 0) stop_request_ = signal;
-  bytes.resize(bytes.size() - tail);
-  bytes.erase(0, head);
-  return bytes;
+  return std::string_view(reply_).substr(head, reply_.size() - head - tail);
 }
 
-std::string RemoteParticipant::call(std::string request, std::string_view what) const {
+std::string_view RemoteParticipant::call(std::string_view what) const {
   Stopwatch send;
-  bytes_sent_ += static_cast<double>(request.size());
-  channel_.send(std::move(request));
+  bytes_sent_ += static_cast<double>(request_.size());
+  channel_.send(request_);
   wait_seconds_ += send.seconds();
-  std::string reply = read_reply(what);
+  const std::string_view reply = read_reply(what);
   const_cast<RemoteParticipant*>(this)->add_seconds(extra_seconds_);
   extra_seconds_ = 0.0;
   return reply;
 }
 
 void RemoteParticipant::initial_values(std::span<WindowOutput> outputs) {
-  Message m(Command::initial_values);
-  write_outputs(m.out, outputs);
-  Received r(call(m.str(), "its initial values"), channel_.peer());
-  for (WindowOutput& o : outputs) r.in.read(*o.combined);
+  MessageWriter out = start(request_, Command::initial_values);
+  write_outputs(out, outputs);
+  MessageReader r(call("its initial values"), peer_);
+  for (WindowOutput& o : outputs) r.read(*o.combined);
 }
 
 void RemoteParticipant::run_window(const TimeWindow& window, std::span<const WindowInput> inputs,
                                    std::span<WindowOutput> outputs) {
   if (pending_window_) finish_window();
-  Message m(Command::run_window);
-  m.out.write(window.size());
-  m.out.write(static_cast<std::int64_t>(window.index()));
-  m.out.write(static_cast<std::uint64_t>(inputs.size()));
-  for (const WindowInput& in : inputs) {
-    m.out.write(*in.mesh);
-    m.out.write(*in.data);
-    m.out.write(static_cast<std::uint8_t>(in.sees == ReaderSees::linear));
-    m.out.write(static_cast<std::uint8_t>(in.start_is_end));
-    // [u8 which travel as the sender's values, the server maps them: 1 end, 2 start]
+  MessageWriter out = start(request_, Command::run_window);
+  out.write(window.size());
+  out.write(static_cast<std::int64_t>(window.index()));
+  out.write(static_cast<std::uint64_t>(inputs.size()));
+  if (held_.size() != inputs.size()) held_.assign(inputs.size(), Held{});
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const WindowInput& in = inputs[i];
+    Held& held = held_[i];
+    if (held.mesh != in.mesh || held.data != in.data) {  // another input: nothing held
+      held = Held{};
+      held.mesh = in.mesh;
+      held.data = in.data;
+    }
+    out.write(*in.mesh);
+    out.write(*in.data);
+    out.write(static_cast<std::uint8_t>(in.sees == ReaderSees::linear));
+    out.write(static_cast<std::uint8_t>(in.start_is_end));
+    // [u8 flags] which travel as the sender's values, the server maps them: 1 end, 2 start;
+    // the start does not travel: 4 it is the last request's end, 8 its start
     const bool start = !in.start_is_end && in.sees == ReaderSees::linear;
-    const std::uint8_t unmapped = (in.sent_end ? 1 : 0) | (start && in.sent_start ? 2 : 0);
-    m.out.write(unmapped);
-    if (start) m.out.write(unmapped & 2 ? *in.sent_start : *in.start);
-    m.out.write(unmapped & 1 ? *in.sent_end : *in.end);
+    const bool start_unmapped = start && in.sent_start;
+    const Eigen::MatrixXd& start_values = start_unmapped ? *in.sent_start : *in.start;
+    std::uint8_t flags = (in.sent_end ? 1 : 0) | (start_unmapped ? 2 : 0);
+    if (start && held.end_valid && held.end_unmapped == start_unmapped &&
+        same_bits(held.end, start_values))
+      flags |= 4;  // the next window: d_n = the last d_{n+1}
+    else if (start && held.start_valid && held.start_unmapped == start_unmapped &&
+             same_bits(held.start, start_values))
+      flags |= 8;  // the next iteration: the same d_n
+    out.write(flags);
+    if (start && !(flags & 12)) out.write(start_values);
+    const Eigen::MatrixXd& end_values = flags & 1 ? *in.sent_end : *in.end;
+    out.write(end_values);
+    // what the server holds now (as it will do: a start taken from the last end swaps the two)
+    if (flags & 4) held.start.swap(held.end);
+    else if (start && !(flags & 8)) held.start = start_values;  // (no allocation: same shape)
+    held.start_valid = start;
+    held.start_unmapped = start_unmapped;
+    held.end = end_values;
+    held.end_valid = true;
+    held.end_unmapped = flags & 1;
   }
-  write_outputs(m.out, outputs);
+  write_outputs(out, outputs);
   // What the run asks after a window, answered with the window's reply (one message each way
   // per window): the monitors, the state check and the interface work it asked for before.
-  write_strings(m.out, cache_.monitor_names);
-  m.out.write(static_cast<std::uint8_t>(cache_.want_state));
-  write_strings(m.out, cache_.work_meshes);
+  write_strings(out, cache_.monitor_names);
+  out.write(static_cast<std::uint8_t>(cache_.want_state));
+  write_strings(out, cache_.work_meshes);
   cache_.valid = false;
   Stopwatch send;
-  std::string bytes = m.str();
-  bytes_sent_ += static_cast<double>(bytes.size());
-  channel_.send(std::move(bytes));
+  bytes_sent_ += static_cast<double>(request_.size());
+  channel_.send(request_);
   // the peer waits for it: let it start while this process runs its own participants
   channel_.deliver("the window's inputs to be taken");
   wait_seconds_ += send.seconds();
@@ -283,16 +306,16 @@ void RemoteParticipant::run_window(const TimeWindow& window, std::span<const Win
 void RemoteParticipant::finish_window() {
   if (!pending_window_) return;
   pending_window_ = false;
-  Received r(read_reply("the end of its window"), channel_.peer());
+  MessageReader r(read_reply("the end of its window"), peer_);
   add_seconds(extra_seconds_);
   extra_seconds_ = 0.0;
-  for (WindowOutput& o : pending_) r.in.read(*o.combined);
-  cache_.monitors = read_monitors(r.in);
-  if (cache_.want_state) cache_.state = r.in.get_string();
+  for (WindowOutput& o : pending_) r.read(*o.combined);
+  read_monitors(r, cache_.monitors);
+  if (cache_.want_state) r.read(cache_.state);
   cache_.work.clear();
   for (std::size_t i = 0; i < cache_.work_meshes.size(); ++i) {
-    if (r.in.get<std::uint8_t>() != 0)
-      cache_.work.emplace_back(r.in.get<double>());
+    if (r.get<std::uint8_t>() != 0)
+      cache_.work.emplace_back(r.get<double>());
     else
       cache_.work.emplace_back(std::nullopt);
   }
@@ -305,62 +328,69 @@ std::string RemoteParticipant::transport_summary() const {
   return fmt::format(
       "{} replies from {}, {:.3f} s waiting for them (its solver {:.3f} s of it); {:.1f} kB sent "
       "to it, {:.1f} kB received",
-      messages_, channel_.peer(), wait_seconds_, seconds(), bytes_sent_ / 1e3,
-      bytes_received_ / 1e3);
+      messages_, peer_, wait_seconds_, seconds(), bytes_sent_ / 1e3, bytes_received_ / 1e3);
 }
 
 void RemoteParticipant::prepare_mapping(std::size_t exchange, const std::string& mesh,
                                         const std::string& data, const InterfaceMesh& sender) {
-  Message m(Command::mapping);
-  m.out.write(static_cast<std::uint64_t>(exchange));
-  m.out.write(mesh);
-  m.out.write(data);
-  write_mesh(m.out, sender);
-  call(m.str(), "the set-up of the mapping of '" + data + "' to its mesh '" + mesh + "'");
+  MessageWriter out = start(request_, Command::mapping);
+  out.write(static_cast<std::uint64_t>(exchange));
+  out.write(mesh);
+  out.write(data);
+  write_mesh(out, sender);
+  call("the set-up of the mapping of '" + data + "' to its mesh '" + mesh + "'");
 }
 
 int RemoteParticipant::substeps(double window_size) const {
-  Message m(Command::substeps);
-  m.out.write(window_size);
-  Received r(call(m.str(), "its substeps"), channel_.peer());
-  return r.in.get<std::int32_t>();
+  MessageWriter out = start(request_, Command::substeps);
+  out.write(window_size);
+  MessageReader r(call("its substeps"), peer_);
+  return r.get<std::int32_t>();
 }
 
 double RemoteParticipant::stable_time_step() const {
-  Received r(call(Message(Command::stable_time_step).str(), "its stable time step"),
-             channel_.peer());
-  return r.in.get<double>();
+  start(request_, Command::stable_time_step);
+  MessageReader r(call("its stable time step"), peer_);
+  return r.get<double>();
 }
 
 void RemoteParticipant::save_checkpoint() {
-  call(Message(Command::save_checkpoint).str(), "its checkpoint");
+  start(request_, Command::save_checkpoint);
+  call("its checkpoint");
 }
 
 void RemoteParticipant::restore_checkpoint() {
   cache_.valid = false;
-  call(Message(Command::restore_checkpoint).str(), "the restoring of its checkpoint");
+  start(request_, Command::restore_checkpoint);
+  call("the restoring of its checkpoint");
 }
 
 std::vector<MonitorValue> RemoteParticipant::monitors() const {
-  Received r(call(Message(Command::monitors).str(), "its monitors"), channel_.peer());
-  return read_monitors(r.in);
+  start(request_, Command::monitors);
+  MessageReader r(call("its monitors"), peer_);
+  std::vector<MonitorValue> v;
+  read_monitors(r, v);
+  return v;
 }
 
 std::vector<MonitorValue> RemoteParticipant::monitor_values(
     const std::vector<std::string>& names) const {
   if (cache_.valid && names == cache_.monitor_names) return cache_.monitors;
   cache_.monitor_names = names;  // asked with every window from now on
-  Message m(Command::monitor_values);
-  write_strings(m.out, names);
-  Received r(call(m.str(), "its monitor values"), channel_.peer());
-  return read_monitors(r.in);
+  MessageWriter out = start(request_, Command::monitor_values);
+  write_strings(out, names);
+  MessageReader r(call("its monitor values"), peer_);
+  std::vector<MonitorValue> v;
+  read_monitors(r, v);
+  return v;
 }
 
 std::string RemoteParticipant::check_state() const {
   if (cache_.valid && cache_.want_state) return cache_.state;
   cache_.want_state = true;
-  Received r(call(Message(Command::check_state).str(), "its state check"), channel_.peer());
-  return r.in.get_string();
+  start(request_, Command::check_state);
+  MessageReader r(call("its state check"), peer_);
+  return r.get_string();
 }
 
 std::optional<double> RemoteParticipant::interface_work(std::string_view mesh) const {
@@ -371,43 +401,46 @@ std::optional<double> RemoteParticipant::interface_work(std::string_view mesh) c
     cache_.work_meshes.emplace_back(mesh);
     cache_.valid = false;  // the cached answers no longer line up with the meshes
   }
-  Message m(Command::interface_work);
-  m.out.write(std::string(mesh));
-  Received r(call(m.str(), "its interface work"), channel_.peer());
-  if (r.in.get<std::uint8_t>() == 0) return std::nullopt;
-  return r.in.get<double>();
+  MessageWriter out = start(request_, Command::interface_work);
+  out.write(mesh);
+  MessageReader r(call("its interface work"), peer_);
+  if (r.get<std::uint8_t>() == 0) return std::nullopt;
+  return r.get<double>();
 }
 
 void RemoteParticipant::write_output(const OutputFrame& frame) {
-  Message m(Command::write_output);
-  m.out.write(frame.vtk_directory.string());
-  m.out.write(frame.prefix);
-  m.out.write(static_cast<std::int32_t>(frame.index));
-  m.out.write(frame.time);
-  m.out.write(static_cast<std::int32_t>(frame.vtk.format));
-  m.out.write(static_cast<std::int32_t>(frame.vtk.zlib_level));
-  m.out.write(static_cast<std::uint64_t>(frame.vtk.block_size));
-  m.out.write(static_cast<std::int32_t>(frame.vtk.precision));
-  call(m.str(), "its output");
+  MessageWriter out = start(request_, Command::write_output);
+  out.write(frame.vtk_directory.string());
+  out.write(frame.prefix);
+  out.write(static_cast<std::int32_t>(frame.index));
+  out.write(frame.time);
+  out.write(static_cast<std::int32_t>(frame.vtk.format));
+  out.write(static_cast<std::int32_t>(frame.vtk.zlib_level));
+  out.write(static_cast<std::uint64_t>(frame.vtk.block_size));
+  out.write(static_cast<std::int32_t>(frame.vtk.precision));
+  call("its output");
 }
 
 std::vector<std::pair<std::string, std::string>> RemoteParticipant::output_files() const {
-  Received r(call(Message(Command::output_files).str(), "its output files"), channel_.peer());
-  const auto a = read_strings(r.in);
-  const auto b = read_strings(r.in);
+  start(request_, Command::output_files);
+  MessageReader r(call("its output files"), peer_);
+  std::vector<std::string> a, b;
+  read_strings(r, a);
+  read_strings(r, b);
   std::vector<std::pair<std::string, std::string>> files;
   for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) files.emplace_back(a[i], b[i]);
   return files;
 }
 
 void RemoteParticipant::write_restart(BinaryWriter& out) const {
-  Received r(call(Message(Command::write_restart).str(), "its restart data"), channel_.peer());
+  start(request_, Command::write_restart);
+  MessageReader r(call("its restart data"), peer_);
   BinaryWriter::Recording rec;
-  rec.header = r.in.get_string();
-  const auto n = r.in.get<std::uint64_t>();
+  rec.header = r.get_string();
+  const auto n = r.count(2 * sizeof(std::uint64_t), "a list of restart sections");
   for (std::uint64_t i = 0; i < n; ++i) {
-    std::string name = r.in.get_string();
-    rec.sections.emplace_back(std::move(name), r.in.get_string());
+    std::string name = r.get_string();
+    rec.sections.emplace_back(std::move(name), r.get_string());
   }
   out.replay(rec);
 }
@@ -418,30 +451,32 @@ void RemoteParticipant::read_restart(BinaryReader& in) {
     return section.rfind("participant ", 0) == 0 || section == "end";
   });
   cache_.valid = false;
-  Message m(Command::read_restart);
-  m.out.write(in.source());
-  m.out.write(part);
-  call(m.str(), "the reading of its restart data");
+  MessageWriter out = start(request_, Command::read_restart);
+  out.write(in.source());
+  out.write(part);
+  call("the reading of its restart data");
 }
 
 void RemoteParticipant::finalize() {
-  Message m(Command::finalize);
-  m.out.write(static_cast<std::int32_t>(stop_request_));
-  call(m.str(), "its finalize");
+  MessageWriter out = start(request_, Command::finalize);
+  out.write(static_cast<std::int32_t>(stop_request_));
+  call("its finalize");
 }
 
 // ---------------------------------------------------------------------------------------------
 // The handshake
 
 Hello receive_hello(Channel& server, const std::string& participant, std::uint64_t case_hash) {
-  Received r(server.receive("its start-up message (hello)"), server.peer());
+  const std::string peer = server.peer(), bytes = server.receive("its start-up message (hello)");
+  MessageReader r(bytes, peer);
   Hello h;
-  h.error = r.in.get_string();
+  h.error = r.get_string();
   if (!h.error.empty())
-    throw Error(fmt::format("{} failed at set-up: {}", server.peer(), h.error));
-  h.version = r.in.get_string();
-  h.case_hash = r.in.get<std::uint64_t>();
-  h.participant = r.in.get_string();
+    throw Error(fmt::format("{} failed at set-up: {}", peer, h.error));
+  h.version = r.get_string();
+  h.case_hash = r.get<std::uint64_t>();
+  h.participant = r.get_string();
+  h.program = r.get_string();
   std::string mismatch;
   if (h.version != std::string(version()))
     mismatch = fmt::format("it runs partita {}, this process {}", h.version, std::string(version()));
@@ -453,48 +488,50 @@ Hello receive_hello(Channel& server, const std::string& participant, std::uint64
         "must read the same case file with the same --set options",
         h.case_hash, case_hash);
   if (!mismatch.empty()) {
-    const std::string why = fmt::format("{} does not match the controller: {}", server.peer(),
-                                        mismatch);
+    const std::string why = fmt::format("{} does not match the controller: {}", peer, mismatch);
     abort_server(server, why);
     throw Error(why);
   }
-  const auto n = r.in.get<std::uint64_t>();
-  for (std::uint64_t i = 0; i < n; ++i) h.meshes.push_back(read_mesh(r.in));
-  const auto q = r.in.get<std::uint64_t>();
+  const auto n = r.get<std::uint64_t>();
+  for (std::uint64_t i = 0; i < n; ++i) h.meshes.push_back(read_mesh(r));
+  const auto q = r.get<std::uint64_t>();
   for (std::uint64_t i = 0; i < q; ++i) {
-    std::string name = r.in.get_string();
-    h.mesh_requests.emplace_back(std::move(name), r.in.get_string());
+    std::string name = r.get_string();
+    h.mesh_requests.emplace_back(std::move(name), r.get_string());
   }
   return h;
 }
 
 Ready complete_handshake(Channel& server,
                          const std::vector<std::pair<std::string, Mesh>>& meshes) {
-  Message m(Command::meshes);
-  m.out.write(static_cast<std::uint64_t>(meshes.size()));
+  std::string bytes;
+  MessageWriter out = start(bytes, Command::meshes);
+  out.write(static_cast<std::uint64_t>(meshes.size()));
   for (const auto& [name, mesh] : meshes) {
-    m.out.write(name);
-    write_mesh(m.out, InterfaceMesh{mesh, {}, {}});
+    out.write(name);
+    write_mesh(out, InterfaceMesh{mesh, {}, {}});
   }
-  server.send(m.str());
-  Received r(server.receive("its meshes after the handshake"), server.peer());
+  server.send(bytes);
+  const std::string peer = server.peer();
+  server.receive(bytes, "its meshes after the handshake");
+  MessageReader r(bytes, peer);
   Ready ready;
-  ready.error = r.in.get_string();
+  ready.error = r.get_string();
   if (!ready.error.empty())
-    throw Error(fmt::format("{} failed at set-up: {}", server.peer(), ready.error));
-  const auto n = r.in.get<std::uint64_t>();
-  for (std::uint64_t i = 0; i < n; ++i) ready.meshes.push_back(read_mesh(r.in));
-  ready.supports_restart = r.in.get<std::uint8_t>() != 0;
-  ready.stable_time_step = r.in.get<double>();
-  ready.maps_inputs = r.in.get<std::uint8_t>() != 0;
+    throw Error(fmt::format("{} failed at set-up: {}", peer, ready.error));
+  const auto n = r.get<std::uint64_t>();
+  for (std::uint64_t i = 0; i < n; ++i) ready.meshes.push_back(read_mesh(r));
+  ready.supports_restart = r.get<std::uint8_t>() != 0;
+  ready.stable_time_step = r.get<double>();
+  ready.maps_inputs = r.get<std::uint8_t>() != 0;
   return ready;
 }
 
 void abort_server(Channel& server, const std::string& why) noexcept {
   try {
-    Message m(Command::abort);
-    m.out.write(why);
-    server.send(m.str());
+    std::string bytes;
+    start(bytes, Command::abort).write(why);
+    server.send(bytes);
   } catch (...) {
   }
 }
@@ -507,58 +544,67 @@ ParticipantServer::ParticipantServer(Channel& controller, const std::atomic<int>
 
 void ParticipantServer::fail_setup(const std::string& error) noexcept {
   try {
-    Message m;
-    m.out.write(error.empty() ? std::string("(no message)") : error);
-    controller_.send(m.str());
+    std::string bytes;
+    MessageWriter(bytes).write(error.empty() ? std::string("(no message)") : error);
+    controller_.send(bytes);
   } catch (...) {
   }
 }
 
 std::vector<std::pair<std::string, Mesh>> ParticipantServer::hello(const Hello& h) {
+  std::string bytes;
   {
-    Message m;
-    m.out.write(std::string());  // no error
-    m.out.write(std::string(version()));
-    m.out.write(h.case_hash);
-    m.out.write(h.participant);
-    m.out.write(static_cast<std::uint64_t>(h.meshes.size()));
-    for (const auto& mesh : h.meshes) write_mesh(m.out, mesh);
-    m.out.write(static_cast<std::uint64_t>(h.mesh_requests.size()));
+    MessageWriter out(bytes);
+    out.write(std::string());  // no error
+    out.write(std::string(version()));
+    out.write(h.case_hash);
+    out.write(h.participant);
+    out.write(h.program);
+    out.write(static_cast<std::uint64_t>(h.meshes.size()));
+    for (const auto& mesh : h.meshes) write_mesh(out, mesh);
+    out.write(static_cast<std::uint64_t>(h.mesh_requests.size()));
     for (const auto& [name, source] : h.mesh_requests) {
-      m.out.write(name);
-      m.out.write(source);
+      out.write(name);
+      out.write(source);
     }
-    controller_.send(m.str());
+    controller_.send(bytes);
   }
-  Received r(controller_.receive("the meshes of the handshake"), controller_.peer());
-  const auto c = static_cast<Command>(r.in.get<std::uint32_t>());
-  if (c == Command::abort) throw StoppedByController("stopping: " + r.in.get_string());
+  const std::string peer = controller_.peer();
+  controller_.receive(bytes, "the meshes of the handshake");
+  MessageReader r(bytes, peer);
+  const auto c = static_cast<Command>(r.get<std::uint32_t>());
+  if (c == Command::abort) throw StoppedByController("stopping: " + r.get_string());
   if (c != Command::meshes) throw Error("the controller sent a damaged handshake");
   std::vector<std::pair<std::string, Mesh>> got;
-  const auto n = r.in.get<std::uint64_t>();
+  const auto n = r.get<std::uint64_t>();
   for (std::uint64_t i = 0; i < n; ++i) {
-    std::string name = r.in.get_string();
-    got.emplace_back(std::move(name), read_mesh(r.in).mesh);
+    std::string name = r.get_string();
+    got.emplace_back(std::move(name), read_mesh(r).mesh);
   }
   return got;
 }
 
 int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping) {
+  const std::string peer = controller_.peer();
+  // The messages' buffers, kept for the whole run (they grow to the largest message; no
+  // allocation after that).
+  std::string request, reply;
   {
-    Message m;
-    m.out.write(std::string());
-    m.out.write(static_cast<std::uint64_t>(p.meshes().size()));
-    for (const auto& mesh : p.meshes()) write_mesh(m.out, mesh);
-    m.out.write(static_cast<std::uint8_t>(p.supports_restart()));
-    m.out.write(p.stable_time_step());
-    m.out.write(static_cast<std::uint8_t>(static_cast<bool>(mapping)));
-    controller_.send(m.str());
+    MessageWriter out(reply);
+    out.write(std::string());
+    out.write(static_cast<std::uint64_t>(p.meshes().size()));
+    for (const auto& mesh : p.meshes()) write_mesh(out, mesh);
+    out.write(static_cast<std::uint8_t>(p.supports_restart()));
+    out.write(p.stable_time_step());
+    out.write(static_cast<std::uint8_t>(static_cast<bool>(mapping)));
+    controller_.send(reply);
   }
   // What run_window() hands the participant, kept between windows (no allocation after the
-  // first window but the messages themselves).
+  // first window).
   std::vector<std::string> names;  // mesh, data per input
   std::vector<Eigen::MatrixXd> starts, ends;
   std::vector<WindowInput> inputs;
+  std::vector<std::string> monitor_names, work_meshes;
   // The exchanges this process maps (map_on: receiver), by mesh and data; the sender's values
   // as they arrive.
   struct Mapped {
@@ -585,78 +631,89 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
   double reported_seconds = 0.0;
   int stopped_by = 0;
   for (;;) {
-    Received r(controller_.receive("its next request"), controller_.peer());
-    const auto command = static_cast<Command>(r.in.get<std::uint32_t>());
+    controller_.receive(request, "its next request");
+    MessageReader r(request, peer);
+    const auto command = static_cast<Command>(r.get<std::uint32_t>());
     if (command == Command::abort)
-      throw StoppedByController("stopping: " + r.in.get_string());
-    Message reply;
-    reply.out.write(std::uint32_t{0});
+      throw StoppedByController("stopping: " + r.get_string());
+    reply.clear();
+    MessageWriter out(reply);
+    out.write(std::uint32_t{0});
     bool done = false;
     try {
       switch (command) {
         case Command::initial_values: {
-          slots.read(r.in);
+          slots.read(r);
           p.initial_values(slots.outputs);
-          for (const auto& c : slots.combined) reply.out.write(c);
+          for (const auto& c : slots.combined) out.write(c);
           break;
         }
         case Command::run_window: {
-          const double size = r.in.get<double>();
-          const auto index = r.in.get<std::int64_t>();
-          const auto ni = r.in.get<std::uint64_t>();
+          const double size = r.get<double>();
+          const auto index = r.get<std::int64_t>();
+          // an input: two names' counts, three flags and a matrix's shape at least
+          const std::size_t ni = r.count(5 * sizeof(std::uint64_t), "a list of inputs");
+          const std::size_t held = ni == starts.size() ? ni : 0;  // the last request's values
           names.resize(2 * ni);
           starts.resize(ni);
           ends.resize(ni);
           inputs.assign(ni, {});
-          for (std::uint64_t i = 0; i < ni; ++i) {
-            names[2 * i] = r.in.get_string();
-            names[2 * i + 1] = r.in.get_string();
-            inputs[i].sees = r.in.get<std::uint8_t>() ? ReaderSees::linear : ReaderSees::constant;
-            inputs[i].start_is_end = r.in.get<std::uint8_t>() != 0;
-            const auto unmapped = r.in.get<std::uint8_t>();
-            if (!inputs[i].start_is_end && inputs[i].sees == ReaderSees::linear) {
+          for (std::size_t i = 0; i < ni; ++i) {
+            r.read(names[2 * i]);
+            r.read(names[2 * i + 1]);
+            inputs[i].sees = r.get<std::uint8_t>() ? ReaderSees::linear : ReaderSees::constant;
+            inputs[i].start_is_end = r.get<std::uint8_t>() != 0;
+            const auto unmapped = r.get<std::uint8_t>();
+            if ((unmapped & 12) && i >= held) r.fail("values of the last request");
+            if (unmapped & 4) {
+              starts[i].swap(ends[i]);  // d_n: the last request's d_{n+1}
+            } else if (unmapped & 8) {
+              // d_n: the last request's
+            } else if (!inputs[i].start_is_end && inputs[i].sees == ReaderSees::linear) {
               if (unmapped & 2) {
-                r.in.read(unmapped_values);
+                r.read(unmapped_values);
                 map_into(names[2 * i], names[2 * i + 1], starts[i]);
               } else {
-                r.in.read(starts[i]);
+                r.read(starts[i]);
               }
             }
             if (unmapped & 1) {
-              r.in.read(unmapped_values);
+              r.read(unmapped_values);
               map_into(names[2 * i], names[2 * i + 1], ends[i]);
             } else {
-              r.in.read(ends[i]);
+              r.read(ends[i]);
             }
           }
-          slots.read(r.in);
-          for (std::uint64_t i = 0; i < ni; ++i) {
+          slots.read(r);
+          for (std::size_t i = 0; i < ni; ++i) {
             inputs[i].mesh = &names[2 * i];
             inputs[i].data = &names[2 * i + 1];
             inputs[i].start = &starts[i];
             inputs[i].end = &ends[i];
           }
-          const auto monitor_names = read_strings(r.in);
-          const bool want_state = r.in.get<std::uint8_t>() != 0;
-          const auto work_meshes = read_strings(r.in);
+          read_strings(r, monitor_names);
+          const bool want_state = r.get<std::uint8_t>() != 0;
+          read_strings(r, work_meshes);
           p.run_window(TimeWindow(size, index, 1), inputs, slots.outputs);
-          for (const auto& c : slots.combined) reply.out.write(c);
-          write_monitors(reply.out, monitor_names.empty() ? std::vector<MonitorValue>{}
-                                                          : p.monitor_values(monitor_names));
-          if (want_state) reply.out.write(p.check_state());
+          for (const auto& c : slots.combined) out.write(c);
+          if (monitor_names.empty())
+            out.write(std::uint64_t{0});  // no monitor values
+          else
+            write_monitors(out, p.monitor_values(monitor_names));
+          if (want_state) out.write(p.check_state());
           for (const auto& mesh : work_meshes) {
             const auto w = p.interface_work(mesh);
-            reply.out.write(static_cast<std::uint8_t>(w.has_value()));
-            if (w) reply.out.write(*w);
+            out.write(static_cast<std::uint8_t>(w.has_value()));
+            if (w) out.write(*w);
           }
           break;
         }
         case Command::mapping: {
-          const auto exchange = static_cast<std::size_t>(r.in.get<std::uint64_t>());
+          const auto exchange = static_cast<std::size_t>(r.get<std::uint64_t>());
           Mapped m;
-          m.mesh = r.in.get_string();
-          m.data = r.in.get_string();
-          const InterfaceMesh sender = read_mesh(r.in);
+          m.mesh = r.get_string();
+          m.data = r.get_string();
+          const InterfaceMesh sender = read_mesh(r);
           const InterfaceMesh* receiver = p.find_mesh(m.mesh);
           if (!receiver || !mapping)
             throw Error(fmt::format("the controller asked for a mapping to the mesh '{}', which "
@@ -675,32 +732,33 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
           p.restore_checkpoint();
           break;
         case Command::monitors:
-          write_monitors(reply.out, p.monitors());
+          write_monitors(out, p.monitors());
           break;
         case Command::monitor_values: {
-          const auto names_asked = read_strings(r.in);
-          write_monitors(reply.out, p.monitor_values(names_asked));
+          std::vector<std::string> names_asked;
+          read_strings(r, names_asked);
+          write_monitors(out, p.monitor_values(names_asked));
           break;
         }
         case Command::check_state:
-          reply.out.write(p.check_state());
+          out.write(p.check_state());
           break;
         case Command::interface_work: {
-          const auto w = p.interface_work(r.in.get_string());
-          reply.out.write(static_cast<std::uint8_t>(w.has_value()));
-          if (w) reply.out.write(*w);
+          const auto w = p.interface_work(r.view_string());
+          out.write(static_cast<std::uint8_t>(w.has_value()));
+          if (w) out.write(*w);
           break;
         }
         case Command::write_output: {
           OutputFrame f;
-          f.vtk_directory = r.in.get_string();
-          f.prefix = r.in.get_string();
-          f.index = r.in.get<std::int32_t>();
-          f.time = r.in.get<double>();
-          f.vtk.format = static_cast<vtk::Format>(r.in.get<std::int32_t>());
-          f.vtk.zlib_level = r.in.get<std::int32_t>();
-          f.vtk.block_size = r.in.get<std::uint64_t>();
-          f.vtk.precision = static_cast<vtk::Precision>(r.in.get<std::int32_t>());
+          f.vtk_directory = r.get_string();
+          f.prefix = r.get_string();
+          f.index = r.get<std::int32_t>();
+          f.time = r.get<double>();
+          f.vtk.format = static_cast<vtk::Format>(r.get<std::int32_t>());
+          f.vtk.zlib_level = r.get<std::int32_t>();
+          f.vtk.block_size = r.get<std::uint64_t>();
+          f.vtk.precision = static_cast<vtk::Precision>(r.get<std::int32_t>());
           p.write_output(f);  // output time on the controller, not the solver's (as in process)
           break;
         }
@@ -710,8 +768,8 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
             a.push_back(series);
             b.push_back(file);
           }
-          write_strings(reply.out, a);
-          write_strings(reply.out, b);
+          write_strings(out, a);
+          write_strings(out, b);
           break;
         }
         case Command::write_restart: {
@@ -719,29 +777,29 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
           BinaryWriter w(bytes);
           p.write_restart(w);
           const BinaryWriter::Recording rec = w.recording(bytes.str());
-          reply.out.write(rec.header);
-          reply.out.write(static_cast<std::uint64_t>(rec.sections.size()));
+          out.write(rec.header);
+          out.write(static_cast<std::uint64_t>(rec.sections.size()));
           for (const auto& [name, b] : rec.sections) {
-            reply.out.write(name);
-            reply.out.write(b);
+            out.write(name);
+            out.write(b);
           }
           break;
         }
         case Command::read_restart: {
-          const std::string source = r.in.get_string() + " (participant " + p.name() + ")";
-          std::istringstream part(r.in.get_string());
+          const std::string source = r.get_string() + " (participant " + p.name() + ")";
+          std::istringstream part(r.get_string());
           BinaryReader in(part, source);
           p.read_restart(in);
           break;
         }
         case Command::substeps:
-          reply.out.write(static_cast<std::int32_t>(p.substeps(r.in.get<double>())));
+          out.write(static_cast<std::int32_t>(p.substeps(r.get<double>())));
           break;
         case Command::stable_time_step:
-          reply.out.write(p.stable_time_step());
+          out.write(p.stable_time_step());
           break;
         case Command::finalize:
-          stopped_by = r.in.get<std::int32_t>();
+          stopped_by = r.get<std::int32_t>();
           p.finalize();
           done = true;
           break;
@@ -750,26 +808,26 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
                                   static_cast<std::uint32_t>(command)));
       }
     } catch (const std::exception& e) {
-      Message failed;
-      failed.out.write(std::uint32_t{1});
-      failed.out.write(std::string(e.what()));
-      failed.out.write(0.0);
-      failed.out.write(std::int32_t{0});
-      controller_.send(failed.str());
+      reply.clear();
+      MessageWriter failed(reply);
+      failed.write(std::uint32_t{1});
+      failed.write(std::string(e.what()));
+      failed.write(0.0);
+      failed.write(std::int32_t{0});
+      controller_.send(reply);
       // the controller stops the run and answers with abort (or goes away): wait for it, so
       // this process exits with the run's error, not a timeout
       try {
-        Received last(controller_.receive("the controller's answer to this error"),
-                      controller_.peer());
+        controller_.receive(request, "the controller's answer to this error");
       } catch (...) {
       }
       throw;
     }
     const double seconds = p.seconds() - reported_seconds;
     reported_seconds = p.seconds();
-    reply.out.write(seconds);
-    reply.out.write(static_cast<std::int32_t>(stop_signal_ ? stop_signal_->load() : 0));
-    controller_.send(reply.str());
+    out.write(seconds);
+    out.write(static_cast<std::int32_t>(stop_signal_ ? stop_signal_->load() : 0));
+    controller_.send(reply);
     if (done) return stopped_by;
   }
 }

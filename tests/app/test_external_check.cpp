@@ -57,3 +57,23 @@ TEST_CASE("external: partita check of a case with an external program checks the
   CHECK(run.output.find("is an external program (solver: external), which joins a run over MPI") !=
         std::string::npos);
 }
+
+TEST_CASE("external: partita check of a surface taken from an external program says why it "
+          "cannot be checked",
+          "[app][external]") {
+  // the granules take the plate's bottom face as a wall; with the plate an external program, its
+  // meshes are known only when it joins: not "names no participant's mesh"
+  const std::string confined = quote(
+      (fs::path(PARTITA_SOURCE_DIR) / "cases/confined_compression/confined_compression.yaml")
+          .string());
+  const auto r = run_partita("check " + confined + " --set participants.plate.solver=external");
+  INFO(r.output);
+  CHECK(r.status == 1);
+  CHECK_FALSE(r.signalled);
+  CHECK(r.output.find("names no participant's mesh") == std::string::npos);
+  CHECK(r.output.find("participants.granules.meshes[0].from") != std::string::npos);  // the key
+  CHECK(r.output.find("'plate.bottom' is a mesh of participant 'plate', an external program") !=
+        std::string::npos);
+  CHECK(r.output.find("the handshake checks this one") != std::string::npos);
+  CHECK(r.output.find("cannot build participant 'granules'") != std::string::npos);
+}

@@ -16,6 +16,9 @@
 #                                    ramp's field, linear in time, at 0, dt/3, dt/2 and dt of each
 #                                    step with reader_sees SEES: the analytic value (within 1e-12),
 #                                    times outside the step refused
+#   external-no-restart PLUGIN PROBE the same program (which gives no restart writer) in a case with
+#                                    output.restart: refused before the first window, naming the
+#                                    program and set_restart_writer() before initialize()
 #   signal                           SIGINT to the second process: every process ends after the window
 #                                    with status 130 and a restart file; resumed, the run gives the
 #                                    bytes of an uninterrupted one
@@ -171,6 +174,20 @@ case "$SCENARIO" in
     cat two.log
     [ "$status" -eq 0 ] || fail "the run with the external program failed (status $status)"
     grep -q "^read_probe: passed" two.log || fail "the program's reads are not the analytic values"
+    ;;
+  external-no-restart)
+    plugin=$1 probe=$2
+    restart=(--set output.restart.every_windows=2)
+    "${MPIRUN[@]}" -n 1 "$P" run "$HERE/external_read.yaml" -o two --threads 1 --plugin "$plugin" \
+                   --participant ramp "${restart[@]}" : \
+                   -n 1 "$probe" "$HERE/external_read.yaml" linear "${restart[@]}" > two.log 2>&1
+    status=$?
+    cat two.log
+    [ "$status" -ne 0 ] || fail "a case with output.restart ran with a program without restart writer"
+    grep -qF "the external program '$(basename "$probe")' of participant 'probe' (rank 1) did not call set_restart_writer() before initialize()" two.log ||
+      fail "the refusal does not name the program and set_restart_writer() before initialize()"
+    grep -q "remove output.restart" two.log || fail "the refusal does not say what to do"
+    [ ! -e two/restart ] || fail "restart files were written"
     ;;
   *)
     fail "unknown scenario $SCENARIO"

@@ -156,6 +156,13 @@ class ProgramSolver final : public Solver {
   Bridge& b_;
 };
 
+// This program's file name, for the controller's messages ("the program" where unknown).
+std::string program_name() {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec || exe.filename().empty() ? std::string("the program") : exe.filename().string();
+}
+
 // The API's thread: the handshake, then the requests until the run ends.
 void serve(Bridge& b) {
   try {
@@ -163,6 +170,7 @@ void serve(Bridge& b) {
     coupling::Hello h;
     h.case_hash = b.case_hash_;
     h.participant = b.participant_;
+    h.program = program_name();
     h.meshes = b.meshes_;
     server.hello(h);  // an external program asks for no meshes
     coupling::LocalParticipant local(b.participant_, std::make_unique<ProgramSolver>(b),

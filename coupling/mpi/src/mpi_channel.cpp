@@ -47,15 +47,22 @@ MpiChannel::MpiChannel(MPI_Comm comm, int rank, std::string name, double deadlin
 
 MpiChannel::~MpiChannel() { drain(2.0); }
 
-void MpiChannel::send(std::string bytes) {
+void MpiChannel::send(std::string& bytes) {
   if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     throw Error(fmt::format("a message of {} bytes to {} is above MPI's 2 GiB per message",
                             bytes.size(), name_));
   progress();
-  pending_.push_back({std::move(bytes), MPI_REQUEST_NULL});
-  Pending& p = pending_.back();
-  MPI_Isend(p.bytes.data(), static_cast<int>(p.bytes.size()), MPI_BYTE, rank_, kTag, comm_,
-            &p.request);
+  std::unique_ptr<Pending> p;
+  if (spare_.empty()) {
+    p = std::make_unique<Pending>();
+  } else {
+    p = std::move(spare_.back());
+    spare_.pop_back();
+  }
+  p->bytes.swap(bytes);  // the caller gets the spare buffer (empty, its capacity kept)
+  MPI_Isend(p->bytes.data(), static_cast<int>(p->bytes.size()), MPI_BYTE, rank_, kTag, comm_,
+            &p->request);
+  pending_.push_back(std::move(p));
 }
 
 // Polls `done` (which also moves this side's sends on) until it holds: yielding for the first
@@ -82,7 +89,7 @@ void MpiChannel::wait_for(Done done, std::string_view what, const char* stalled)
   }
 }
 
-std::string MpiChannel::receive(std::string_view what) {
+void MpiChannel::receive(std::string& bytes, std::string_view what) {
   MPI_Status status;
   wait_for(
       [&] {
@@ -94,9 +101,9 @@ std::string MpiChannel::receive(std::string_view what) {
       what, "sent nothing");
   int count = 0;
   MPI_Get_count(&status, MPI_BYTE, &count);
-  std::string bytes(static_cast<std::size_t>(count), '\0');
+  // (a buffer of the same size as the last message is not touched: no allocation, no filling)
+  if (bytes.size() != static_cast<std::size_t>(count)) bytes.resize(static_cast<std::size_t>(count));
   MPI_Recv(bytes.data(), count, MPI_BYTE, rank_, kTag, comm_, MPI_STATUS_IGNORE);
-  return bytes;
 }
 
 void MpiChannel::deliver(std::string_view what) {
@@ -117,12 +124,17 @@ void MpiChannel::drain(double seconds) {
 }
 
 void MpiChannel::progress() {
-  while (!pending_.empty()) {
-    int done = 0;
-    MPI_Test(&pending_.front().request, &done, MPI_STATUS_IGNORE);
-    if (!done) return;
-    pending_.pop_front();
+  std::size_t done = 0;
+  while (done < pending_.size()) {
+    int flag = 0;
+    MPI_Test(&pending_[done]->request, &flag, MPI_STATUS_IGNORE);
+    if (!flag) break;
+    pending_[done]->bytes.clear();
+    ++done;
   }
+  if (done == 0) return;
+  for (std::size_t i = 0; i < done; ++i) spare_.push_back(std::move(pending_[i]));
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(done));
 }
 
 }  // namespace partita::mpi

@@ -272,6 +272,8 @@ class CaseRun {
   // restart files
   std::uint64_t identity_ = 0;  // hash of the case's participants and coupling sections
   std::uint64_t case_hash_ = 0;  // hash of the whole case (canonical YAML)
+  // The external programs in the run (solver: external), by participant: "'program' of <peer>".
+  std::map<std::string, std::string> external_programs_;
   std::int64_t restart_every_windows_ = 0;
   double restart_every_seconds_ = 0.0;
   int restart_keep_ = 2;

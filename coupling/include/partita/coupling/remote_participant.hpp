@@ -9,7 +9,8 @@
 // in several: the remote side runs the same LocalParticipant on the same inputs.
 //
 // The transport is a Channel (a link to one peer: send bytes, receive bytes with a deadline);
-// app/ implements it over MPI. Messages are BinaryWriter streams:
+// coupling/mpi/ implements it over MPI. Messages are written and read in place in buffers kept
+// for the run (coupling/src/message_codec.hpp; BinaryWriter's layout without its checksums):
 //
 //   request   [u32 command] [arguments]
 //   reply     [u32 status: 0 ok, 1 failed] [ok: results | failed: the error text]
@@ -17,7 +18,8 @@
 //
 // Window exchange: one request and one reply per participant per window (per iteration of an
 // implicit scheme): the inputs at the window's ends go out, the outputs combined over the
-// substeps come back. An input whose exchange maps on the receiver (map_on: receiver, the
+// substeps come back. A start that equals, to the bit, what the server already holds (the last
+// request's end: the next window; its start: the next iteration) travels as a flag only. An input whose exchange maps on the receiver (map_on: receiver, the
 // default) travels as the sender's values and the server maps it with its own copy of the
 // mapper (set up once by prepare_mapping(): the controller hands over the sender's mesh, the
 // server builds the mapper from the case's exchange); the controller maps it too, for its checks,
@@ -25,7 +27,7 @@
 // parallel scheme lets every remote participant work while the controller's own one does.
 //
 // Start-up (handshake), before the first window, each server sends
-//   hello: [partita version] [case hash] [participant] [meshes] [mesh requests]
+//   hello: [partita version] [case hash] [participant] [program] [meshes] [mesh requests]
 // and the controller answers with the meshes it asked for (another participant's surface),
 // after which the server sends its final meshes, stable step, restart support and whether it can
 // map what it reads. A mismatch
@@ -45,15 +47,26 @@
 
 namespace partita::coupling {
 
-/// A message link to one peer process.
+/// A message link to one peer process. A sender keeps one buffer per link and direction: send()
+/// takes the message's bytes and hands back a buffer to write the next one into, receive() fills
+/// the caller's buffer; once the buffers have grown to the largest message, a window's exchange
+/// allocates nothing.
 class Channel {
  public:
   virtual ~Channel() = default;
-  /// Queue `bytes` for the peer (returns before the peer has received them).
-  virtual void send(std::string bytes) = 0;
-  /// The peer's next message; waits at most deadline() seconds, then throws partita::Error
-  /// naming the peer and `what` was awaited.
-  virtual std::string receive(std::string_view what) = 0;
+  /// Queue the message in `bytes` for the peer (returns before the peer has received it). Takes
+  /// the bytes and leaves in `bytes` an empty buffer for the next message (one whose send has
+  /// completed, its capacity kept, where the transport recycles them).
+  virtual void send(std::string& bytes) = 0;
+  /// The peer's next message, into `bytes` (its storage reused); waits at most deadline()
+  /// seconds, then throws partita::Error naming the peer and `what` was awaited.
+  virtual void receive(std::string& bytes, std::string_view what) = 0;
+  /// The same, into a new string (start-up and failure paths).
+  std::string receive(std::string_view what) {
+    std::string bytes;
+    receive(bytes, what);
+    return bytes;
+  }
   /// The peer, for messages: the participant it runs and where ("participant 'granules'
   /// (rank 1)"); errors read "<peer> failed: ...".
   virtual std::string peer() const = 0;
@@ -82,6 +95,7 @@ struct Hello {
   std::string version;
   std::uint64_t case_hash = 0;
   std::string participant;
+  std::string program;  // its executable's name ("partita", or an external program's), for messages
   std::vector<InterfaceMesh> meshes;
   std::vector<std::pair<std::string, std::string>> mesh_requests;  // (name, participant.mesh)
   std::string error;  // set when its set-up failed (then nothing else is)
@@ -134,10 +148,14 @@ class RemoteParticipant final : public Participant {
   std::string transport_summary() const override;
 
  private:
-  // One request, its reply (throws the server's error, naming the participant).
-  std::string call(std::string request, std::string_view what) const;
-  std::string read_reply(std::string_view what) const;
+  // The request in request_ sent, its reply read: the results' bytes, in reply_ (throws the
+  // server's error, naming the participant).
+  std::string_view call(std::string_view what) const;
+  std::string_view read_reply(std::string_view what) const;
   Channel& channel_;
+  std::string peer_;  // channel_.peer(), for messages
+  // The messages' buffers, kept between windows (cleared, not freed).
+  mutable std::string request_, reply_;
   std::vector<InterfaceMesh> meshes_;
   bool supports_restart_ = false;
   bool maps_inputs_ = false;
@@ -145,7 +163,17 @@ class RemoteParticipant final : public Participant {
   // may be reused for another participant meanwhile, as a parallel scheme does).
   std::vector<WindowOutput> pending_;
   bool pending_window_ = false;
-  std::string scratch_;
+  // Per input of the last window's request: the values the server holds (as they travelled:
+  // the sender's or mapped), so that a start equal to the last end (the next window of an
+  // explicit scheme) or to the last start (the next iteration of an implicit one) does not
+  // travel again (compared to the bit).
+  struct Held {
+    const std::string* mesh = nullptr;
+    const std::string* data = nullptr;
+    bool start_valid = false, start_unmapped = false, end_valid = false, end_unmapped = false;
+    Eigen::MatrixXd start, end;
+  };
+  std::vector<Held> held_;
   mutable int stop_request_ = 0;
   // The answers to the run's questions after a window, sent with the window's reply (valid until
   // the remote state changes: the next window, a restored checkpoint, a restart read).

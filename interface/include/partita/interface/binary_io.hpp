@@ -38,6 +38,22 @@
 
 namespace partita {
 
+/// Why a matrix announced as `rows` x `cols` doubles cannot be read into a `Derived` when at
+/// most `max_values` values can follow (a negative or too large size, another shape than a
+/// fixed one); empty when it can. For the readers of this layout (BinaryReader, the messages
+/// between processes).
+template <class Derived>
+std::string matrix_shape_problem(std::int64_t rows, std::int64_t cols, std::uint64_t max_values) {
+  static_assert(std::is_same_v<typename Derived::Scalar, double>, "doubles only");
+  if (rows < 0 || cols < 0 ||
+      (rows > 0 && static_cast<std::uint64_t>(cols) > max_values / static_cast<std::uint64_t>(rows)))
+    return "a matrix of " + std::to_string(rows) + " x " + std::to_string(cols) + " values";
+  if ((Derived::RowsAtCompileTime != Eigen::Dynamic && rows != Derived::RowsAtCompileTime) ||
+      (Derived::ColsAtCompileTime != Eigen::Dynamic && cols != Derived::ColsAtCompileTime))
+    return "a matrix of another shape than " + std::to_string(rows) + " x " + std::to_string(cols);
+  return {};
+}
+
 class BinaryWriter {
  public:
   explicit BinaryWriter(std::ostream& out) : out_(out) {}
@@ -137,14 +153,11 @@ class BinaryReader {
   }
   template <class Derived>
   void read(Eigen::PlainObjectBase<Derived>& m) {
-    static_assert(std::is_same_v<typename Derived::Scalar, double>, "doubles only");
     const auto rows = get<std::int64_t>();
     const auto cols = get<std::int64_t>();
-    if (rows < 0 || cols < 0 || (rows > 0 && cols > (INT64_MAX / 8) / rows))
-      fail("a matrix of " + std::to_string(rows) + " x " + std::to_string(cols) + " values");
-    if ((Derived::RowsAtCompileTime != Eigen::Dynamic && rows != Derived::RowsAtCompileTime) ||
-        (Derived::ColsAtCompileTime != Eigen::Dynamic && cols != Derived::ColsAtCompileTime))
-      fail("a matrix of another shape than " + std::to_string(rows) + " x " + std::to_string(cols));
+    if (const std::string why = matrix_shape_problem<Derived>(rows, cols, INT64_MAX / 8);
+        !why.empty())
+      fail(why);
     check_remaining(static_cast<std::uint64_t>(rows * cols) * sizeof(double), "a matrix");
     m.resize(rows, cols);
     raw(m.data(), static_cast<std::size_t>(rows * cols) * sizeof(double), "a matrix");

@@ -8,7 +8,7 @@
 // process, and splits the communicator by participant. The process of rank 0 is the controller;
 // it has a channel to each other process, every other process one to rank 0.
 
-#include <deque>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -39,15 +39,18 @@ struct Membership {
 /// the run has one process only.
 Membership join(MPI_Comm comm, const std::string& participant);
 
-/// One peer: non-blocking sends (each message's buffer lives until its send completes), receives
-/// that poll with a deadline (MPI_Iprobe; yielding for the first 10 ms, then sleeping in growing steps of up
-/// to 1 ms, so a waiting process leaves its core to a working one).
+/// One peer: non-blocking sends (each message's buffer lives until its send completes, then is
+/// handed back to a later send() for the next message: no allocation once the buffers have
+/// grown), receives that poll with a deadline (MPI_Iprobe; yielding for the first 10 ms, then
+/// sleeping in growing steps of up to 1 ms, so a waiting process leaves its core to a working
+/// one) and receive into the caller's buffer (MPI_Get_count, then MPI_Recv into it).
 class MpiChannel final : public coupling::Channel {
  public:
   MpiChannel(MPI_Comm comm, int rank, std::string name, double deadline);
   ~MpiChannel() override;
-  void send(std::string bytes) override;
-  std::string receive(std::string_view what) override;
+  void send(std::string& bytes) override;
+  void receive(std::string& bytes, std::string_view what) override;
+  using coupling::Channel::receive;
   std::string peer() const override { return name_; }
   double deadline() const override { return deadline_; }
   /// Completes the sends under way (OpenMPI moves a message above the eager limit, 4 KB over
@@ -59,7 +62,7 @@ class MpiChannel final : public coupling::Channel {
  private:
   struct Pending {
     std::string bytes;
-    MPI_Request request;
+    MPI_Request request = MPI_REQUEST_NULL;
   };
   void progress();
   template <class Done>
@@ -68,7 +71,9 @@ class MpiChannel final : public coupling::Channel {
   int rank_;
   std::string name_;
   double deadline_;
-  std::deque<Pending> pending_;  // a deque: a push never moves the buffers under way
+  // Sends under way, oldest first, and finished ones whose buffers wait for reuse. Each on the
+  // heap: its bytes never move while MPI reads them (a short string's bytes live in the object).
+  std::vector<std::unique_ptr<Pending>> pending_, spare_;
 };
 
 }  // namespace partita::mpi
