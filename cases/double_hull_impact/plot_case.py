@@ -32,6 +32,8 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
   energy_to_rupture_{filled,empty}_J     indenter work (hull.bow.work + granules.bow.work) up to it
   inner_yield_penetration_{filled,empty}_m, energy_to_inner_yield_{filled,empty}_J   the same at the
                           first row with hull.inner_plate.plastic_work > 0
+  energy_final_{filled,empty}_J   indenter work at the last row
+  inner_deflection_final_{filled,empty}_m   hull.inner_centre.displacement_z at the last row
   broken_granules         granules.breakage.events at the last row
   footprint_area_90[_empty] [m^2] the smallest area of the inner plate's cavity faces (the cells' faces
                           facing -z above mid-depth) carrying 90 % of the upward force on them, at
@@ -319,6 +321,10 @@ def milestones(run, suffix):
             key("inner_yield_penetration" + suffix + "_m", float(run.pen[hit[0]]))
             if w is not None:
                 key("energy_to_inner_yield" + suffix + "_J", float(w[hit[0]]))
+    if w is not None:
+        key("energy_final" + suffix + "_J", float(w[-1]))
+    if run.has("hull.inner_centre.displacement_z"):
+        key("inner_deflection_final" + suffix + "_m", float(run.at("hull.inner_centre.displacement_z")[-1]))
 
 
 def collision(run, driven):
