@@ -42,6 +42,9 @@ TEST_CASE("dem adapter: breakage keys are validated", "[adapters][dem][breakage]
   CHECK_THROWS_WITH(test::make_dem(dem_yaml(ok + ", pattern: apolonian-14}\n"), out),
                     Catch::Contains("apollonian-14"));
   CHECK_THROWS_WITH(test::make_dem(dem_yaml(ok + ", mass: kept}\n"), out), Catch::Contains("restored"));
+  CHECK_NOTHROW(test::make_dem(dem_yaml(ok + ", below_limit: powder}\n"), out));
+  CHECK_THROWS_WITH(test::make_dem(dem_yaml(ok + ", below_limit: dust}\n"), out),
+                    Catch::Contains("below_limit") && Catch::Contains("powder"));
   // d_min above every particle: accepted (a warning says nothing can break)
   std::string big = ok + "}\n";
   big.replace(big.find("comminution_limit: 1 mm"), 23, "comminution_limit: 5 mm");

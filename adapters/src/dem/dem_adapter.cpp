@@ -179,10 +179,18 @@ std::shared_ptr<Spec> make_spec() {
                "none (every particle at sigma_lim,0 (d/d0)^(-3/m))",
                {"weibull", "none"})
       .def("weibull");
-  breakage->real("comminution_limit", "d_min: particles with a smaller diameter never break")
+  breakage->real("comminution_limit", "d_min: particles with a smaller diameter do not fragment")
       .unit("m")
       .positive()
       .required();
+  breakage
+      ->choice("below_limit",
+               "what a particle smaller than comminution_limit does when a contact reaches its "
+               "strength: unbreakable (nothing: it never breaks) or powder (it is crushed to "
+               "powder: removed, its mass and kinetic and contact energy counted in "
+               "breakage.powder_mass and breakage.powder_energy; powder carries no load)",
+               {"unbreakable", "powder"})
+      .def("unbreakable");
   breakage
       ->choice("pattern",
                "fragments inscribed in the broken particle: equal-4 (tetrahedron, 36 % of the "
@@ -658,6 +666,7 @@ void DemAdapter::add_breakage(const config::Node& b) {
   p.weibull_modulus = b.real("weibull_modulus");
   p.scatter = b.string("scatter") == "weibull";
   p.comminution_limit = b.real("comminution_limit");
+  p.powder = b.string("below_limit") == "powder";
   p.pattern = dem::FragmentPattern::named(b.string("pattern")).kind();
   p.restore_mass = b.string("mass") == "restored";
   p.seed = static_cast<std::uint64_t>(b.integer("seed"));
@@ -1062,6 +1071,9 @@ std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::stri
     v.push_back({"breakage.mass_lost", "kg", c.mass_lost});
     v.push_back({"breakage.mass_restored", "kg", c.mass_restored});
     v.push_back({"breakage.energy_released", "J", c.energy_released});
+    v.push_back({"breakage.powder_events", "", static_cast<double>(c.powder_events)});
+    v.push_back({"breakage.powder_mass", "kg", c.powder_mass});
+    v.push_back({"breakage.powder_energy", "J", c.powder_energy});
     if (wanted("stable_time_step")) v.push_back({"stable_time_step", "s", stable_time_step()});
   }
   if (names.empty()) return v;

@@ -27,7 +27,8 @@
 // <wall>.force_x|y|z [N] (a box wall: all its faces), <wall>.<face>.force_x|y|z [N] (each closed
 // face of a box wall, faces xmin..zmax), particles, contacts_per_particle; with `breakage`:
 // breakage.events, .fragments, .fragment_mass [kg], .mass_lost [kg], .mass_restored [kg],
-// .energy_released [J], stable_time_step [s] (it falls as fragments appear; `auto` substeps follow
+// .energy_released [J], .powder_events, .powder_mass [kg], .powder_energy [J],
+// stable_time_step [s] (it falls as fragments appear; `auto` substeps follow
 // it), and the grading (cumulative mass passing per size) appended to
 // <output>/<participant>_grading.csv at each output time. With output: {particles_file: end |
 // every-output} the particles are written as a LAMMPS data file that particles: {file: ...} reads

@@ -44,6 +44,7 @@ Breakage::Breakage(const BreakageParameters& p) : parameters_(p), pattern_(p.pat
   check_positive(p.comminution_limit, "the comminution limit d_min [m]", msg);
   if (!msg.str().empty()) throw Error(msg.str());
   broken_.reserve(64);
+  powder_.reserve(64);
 }
 
 void Breakage::attach(System& system) {
@@ -60,7 +61,7 @@ void Breakage::set_limit(System& system, std::size_t i, double strength) const {
   ParticleStore& store = system.store_unsynced();
   const double pi3 = std::numbers::pi * std::numbers::pi * std::numbers::pi;
   store.array<double>(h_limit_)[i] =
-      2.0 * store.core().radius[i] >= parameters_.comminution_limit
+      parameters_.powder || 2.0 * store.core().radius[i] >= parameters_.comminution_limit
           ? 9.0 / 16.0 * pi3 * strength * strength * strength
           : std::numeric_limits<double>::infinity();
 }
@@ -94,17 +95,20 @@ void Breakage::end_of_step(System& system, double /*dt*/) {
   const std::size_t n = p.size();
   if (load.size() != n) return;  // no force pass since the set changed
   if (!system.contact_load_reached()) return;  // (every load below its limit)
-  // break when F (E'/r')^2 >= (9/16) pi^3 sigma^3 (eq. 2, see the class comment), d >= d_min
+  // break when F (E'/r')^2 >= (9/16) pi^3 sigma^3 (eq. 2, see the class comment): into
+  // fragments for d >= d_min, to powder below it (the limit is infinite there without powder)
   const std::vector<double>& limit = store.array<double>(h_limit_);
   broken_.clear();
+  powder_.clear();
   for (std::size_t i = 0; i < n; ++i) {
     if (strength[i] < 0.0) {
       strength[i] = draw_strength(p.id[i], 2.0 * p.radius[i]);
       set_limit(system, i, strength[i]);
     }
-    if (load[i] >= limit[i]) broken_.push_back(i);
+    if (load[i] >= limit[i])
+      (2.0 * p.radius[i] >= parameters_.comminution_limit ? broken_ : powder_).push_back(i);
   }
-  if (!broken_.empty()) break_particles(system, broken_);
+  if (!broken_.empty() || !powder_.empty()) crush(system, broken_, powder_);
 }
 
 double Breakage::contact_energy(const System& system, std::size_t i) const {
@@ -140,8 +144,13 @@ double Breakage::contact_energy(const System& system, std::size_t i) const {
 }
 
 void Breakage::break_particles(System& system, const std::vector<std::size_t>& indices) {
-  if (indices.empty()) return;
-  const std::vector<std::size_t> parents = indices;  // (indices may be broken_)
+  crush(system, indices, {});
+}
+
+void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
+                     const std::vector<std::size_t>& powder) {
+  if (fragment.empty() && powder.empty()) return;
+  const std::vector<std::size_t> parents = fragment;  // (fragment may be broken_)
   const Particles& p = system.particles();
   const std::size_t n = p.size();
   struct Fragment {
@@ -204,6 +213,17 @@ void Breakage::break_particles(System& system, const std::vector<std::size_t>& i
       released += 0.5 * missing * v.squaredNorm() + 0.5 * i_missing * w.squaredNorm();
     }
     ++counters_.events;
+  }
+  for (std::size_t i : powder) {  // removed whole: their motion and contacts leave with them
+    if (i >= n || remove[i])
+      throw Error("crush: bad or repeated index " + std::to_string(i));
+    remove[i] = 1;
+    const double e = contact_energy(system, i) + 0.5 * p.mass[i] * p.velocity[i].squaredNorm() +
+                     0.5 * p.inertia[i] * p.angular_velocity[i].squaredNorm();
+    ++counters_.powder_events;
+    counters_.powder_mass += p.mass[i];
+    counters_.powder_energy += e;
+    released += e;
   }
   system.remove_particles(remove);
   std::vector<std::size_t> added;

@@ -122,6 +122,84 @@ TEST_CASE("dem: below the comminution limit a granule never breaks", "[dem][brea
   CHECK(t.sys.particle_count() == 1);
 }
 
+TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh turns to powder at the "
+          "force of eq. 2", "[dem][breakage][energy]") {
+  // The case of a fragment caught between a rigid bow (a moving mesh) and a plate (the floor):
+  // unbreakable, it is squeezed until the mesh passes it; with powder on it leaves the system
+  // when its contacts reach its strength (the same criterion as above the limit), its mass and
+  // its energy counted, and the energy balance closes across the removal.
+  BreakageParameters b = parameters(3.0);
+  const double d = 2.0e-3, speed = 0.005;
+  b.comminution_limit = 2.5e-3;
+  b.powder = true;
+  System sys;
+  const int g = sys.add_material({E, NU, RHO});
+  const int s = sys.add_material({E_P, NU_P, 7850.0});
+  sys.add_interaction(g, g, {0.3, 0.5, 0.0});
+  sys.add_interaction(g, s, {0.3, 0.5, 0.0});
+  sys.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
+  sys.add_plane({0, 0, 0}, {0, 0, 1}, s);
+  Eigen::MatrixX3d x(4, 3);  // a square of side 4 d at the granule's top
+  x << -2 * d, -2 * d, d, 2 * d, -2 * d, d, 2 * d, 2 * d, d, -2 * d, 2 * d, d;
+  TriangleMesh::Triangles t(2, 3);
+  t << 0, 1, 2, 0, 2, 3;
+  const int mesh = sys.add_mesh(x, t, s);
+  sys.add_hook(std::make_unique<Breakage>(b));
+  sys.set_energy_tracking(true);
+  const double mass = test::sphere_mass(0.5 * d, RHO);
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  const Eigen::MatrixX3d x0 = x;
+  double f = 0.0;
+  long steps = 0;
+  for (; steps < 2'000'000 && breakage_of(sys).counters().powder_events == 0; ++steps) {
+    x.col(2) = x0.col(2).array() - speed * dt * static_cast<double>(steps + 1);
+    sys.set_vertex_positions(mesh, x);
+    sys.step(dt);
+    f = sys.mesh_force(mesh).norm();
+  }
+  const BreakageCounters& c = breakage_of(sys).counters();
+  // the energy of the two Hertz contacts (floor and mesh, same materials) carrying F:
+  // 2 x 2/5 F delta, delta = (3 F / (4 E' sqrt(r)))^(2/3)
+  const double e_eff = 1.0 / ((1.0 - NU * NU) / E + (1.0 - NU_P * NU_P) / E_P);
+  const double delta = std::pow(3.0 * f / (4.0 * e_eff * std::sqrt(0.5 * d)), 2.0 / 3.0);
+  const double stored = 2.0 * 0.4 * f * delta;
+  const System::Energies& e = sys.energies();
+  INFO("powder after " << steps << " steps at F = " << f << " N; eq. 2: " << eq2_force(d, b)
+                       << " N; powder energy " << c.powder_energy << " J, 2 x 2/5 F delta "
+                       << stored << " J, breakage " << e.breakage << " J, mesh work "
+                       << e.mesh_work[0] << " J, balance error " << sys.energy_balance_error());
+  REQUIRE(c.powder_events == 1);
+  CHECK(f == Approx(eq2_force(d, b)).epsilon(0.01));
+  CHECK(sys.particle_count() == 0);
+  CHECK(c.events == 0);
+  CHECK(c.fragments == 0);
+  CHECK(c.powder_mass == Approx(mass).epsilon(1e-12));
+  CHECK(c.powder_energy == Approx(stored).epsilon(0.02));
+  CHECK(c.energy_released == c.powder_energy);
+  // the system's own books: the mechanical energy that left with the particle
+  CHECK(e.breakage == Approx(c.powder_energy).epsilon(0.02));
+  CHECK(std::abs(sys.energy_balance_error()) < 2e-3);
+  // the same squeeze without powder: the granule stays and the mesh presses it beyond eq. 2
+  b.powder = false;
+  System keep;
+  keep.add_material({E, NU, RHO});
+  keep.add_material({E_P, NU_P, 7850.0});
+  keep.add_interaction(g, g, {0.3, 0.5, 0.0});
+  keep.add_interaction(g, s, {0.3, 0.5, 0.0});
+  keep.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
+  keep.add_plane({0, 0, 0}, {0, 0, 1}, s);
+  const int m2 = keep.add_mesh(x0, t, s);
+  keep.add_hook(std::make_unique<Breakage>(b));
+  for (long k = 0; k < 2 * steps; ++k) {
+    x.col(2) = x0.col(2).array() - speed * dt * static_cast<double>(k + 1);
+    keep.set_vertex_positions(m2, x);
+    keep.step(dt);
+  }
+  CHECK(keep.particle_count() == 1);
+  CHECK(keep.mesh_force(m2).norm() > 2.0 * eq2_force(d, b));
+  CHECK(breakage_of(keep).counters().powder_events == 0);
+}
+
 TEST_CASE("dem: breakage conserves momentum and does not create kinetic energy",
           "[dem][breakage]") {
   for (const std::string& pattern : FragmentPattern::names())

@@ -18,7 +18,11 @@
 // which it breaks is kept beside it ("breakage_load_limit"): the force pass compares each load
 // with it as the load is completed (System::contact_load_reached()), so a step in which nothing
 // breaks costs no pass over the particles here (issue 13: at most 5 % on a large bed).
-// Particles with d < d_min (comminution limit) never break; fragments are breakable.
+// Particles with d < d_min (comminution limit) do not fragment; fragments are breakable. With
+// BreakageParameters::powder a particle below d_min whose load reaches its strength (the same
+// criterion) is crushed to powder: removed at the end of the step, its mass, kinetic energy and
+// contact energy counted (the System books the change of mechanical energy as breakage energy,
+// as for fragments). Without it such a particle never breaks.
 //
 // Fragments (FragmentPattern, in a random orientation drawn from (seed, id)): radius R rho_k at
 // x + R Q c_k, material of the parent, velocity v + omega x (R Q c_k) and spin omega (the parent's
@@ -71,8 +75,12 @@ class Breakage final : public StepHook {
   /// The force at which a particle of strength sigma breaks in a contact of E', r' (eq. 2) [N].
   static double critical_force(double strength, double e_eff, double r_eff);
   /// Replaces the particles of the given indices (ascending, each < particle_count()) by their
-  /// fragments now, whatever their load (also used by end_of_step()).
+  /// fragments now, whatever their load and size.
   void break_particles(System& system, const std::vector<std::size_t>& indices);
+  /// Breaks `fragment` (as break_particles()) and removes `powder` as powder (counted), in one
+  /// change of the particle set; both ascending, disjoint, each < particle_count().
+  void crush(System& system, const std::vector<std::size_t>& fragment,
+             const std::vector<std::size_t>& powder);
 
  private:
   // elastic (normal Hertz) energy of particle i's contacts at the current positions
@@ -88,6 +96,7 @@ class Breakage final : public StepHook {
   int h_strength_ = -1;
   int h_limit_ = -1;
   std::vector<std::size_t> broken_;  // scratch (reserved: no allocation while nothing breaks)
+  std::vector<std::size_t> powder_;  // (the same, for the particles crushed to powder)
 };
 
 }  // namespace partita::dem

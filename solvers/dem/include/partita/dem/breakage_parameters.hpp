@@ -15,7 +15,13 @@ struct BreakageParameters {
   /// whose characteristic value (37 % survive it) is sigma_lim,0 (d/d0)^(-3/m); false: every
   /// particle has exactly that value.
   bool scatter = true;
-  double comminution_limit = 0.0;  ///< d_min [m] > 0: particles with d < d_min never break
+  double comminution_limit = 0.0;  ///< d_min [m] > 0: particles with d < d_min do not fragment
+  /// What a particle with d < d_min does when a contact reaches its strength (eq. 2 with the
+  /// size effect, as above it): false: nothing (it never breaks); true: it is crushed to powder,
+  /// i.e. removed from the system, its mass and its kinetic and contact energy counted
+  /// (BreakageCounters::powder_*). Powder carries no load: use it where the fines are few or
+  /// where an unbreakable sphere would be squeezed through a gap narrower than itself.
+  bool powder = false;
   FragmentPattern::Kind pattern = FragmentPattern::Kind::apollonian_14;
   /// false: the mass the inscribed fragments cannot hold is lost (counted); true: it is restored
   /// (fragments carry the parent's mass and moment of inertia about its centre; counted).

@@ -33,7 +33,8 @@ class SystemState {
   // 2: mesh contact histories as rows of the particles near a mesh (MeshContacts), after the
   // particle store, which no longer has the four mesh arrays of version 1
   // 3: the cumulative energies (System::energies()) after the hooks' state
-  static constexpr std::uint32_t format_version = 3;
+  // 4: the breakage counters' powder fields
+  static constexpr std::uint32_t format_version = 4;
 
   double time() const { return time_; }
   long step_count() const { return steps_; }
