@@ -32,6 +32,11 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
   energy_to_rupture_{filled,empty}_J     indenter work (hull.bow.work + granules.bow.work) up to it
   inner_yield_penetration_{filled,empty}_m, energy_to_inner_yield_{filled,empty}_J   the same at the
                           first row with hull.inner_plate.plastic_work > 0
+  inner_rupture_penetration_{filled,empty}_m, energy_to_inner_rupture_{filled,empty}_J   the same at
+                          the inner plate's first failed element: the first row whose
+                          hull.failed_elements rises while hull.inner_plate.plastic_work falls (an
+                          eroded element's plastic work leaves its part's sum)
+  powder_events, powder_mass_kg   granules.breakage.powder_* at the last row (below_limit: powder)
   energy_final_{filled,empty}_J   indenter work at the last row
   inner_deflection_final_{filled,empty}_m   hull.inner_centre.displacement_z at the last row
   broken_granules         granules.breakage.events at the last row
@@ -321,6 +326,23 @@ def milestones(run, suffix):
             key("inner_yield_penetration" + suffix + "_m", float(run.pen[hit[0]]))
             if w is not None:
                 key("energy_to_inner_yield" + suffix + "_J", float(w[hit[0]]))
+    if pw is not None and run.has("hull.failed_elements"):
+        # an eroded element's plastic work leaves its part's sum, which otherwise never falls:
+        # the first row whose failed count rises while the inner plate's plastic work falls
+        failed = run.at("hull.failed_elements")
+        hit = np.nonzero((np.diff(failed) > 0) & (np.diff(pw) < 0))[0]
+        if not len(hit):
+            note(f"{run.label}: no element of the inner plate has failed")
+        else:
+            k = hit[0] + 1
+            key("inner_rupture_time" + suffix + "_s", float(run.t[k]))
+            key("inner_rupture_penetration" + suffix + "_m", float(run.pen[k]))
+            if w is not None:
+                key("energy_to_inner_rupture" + suffix + "_J", float(w[k]))
+    if run.has("granules.breakage.powder_events"):
+        key("powder_events", float(run.at("granules.breakage.powder_events")[-1]))
+    if run.has("granules.breakage.powder_mass"):
+        key("powder_mass_kg", float(run.at("granules.breakage.powder_mass")[-1]))
     if w is not None:
         key("energy_final" + suffix + "_J", float(w[-1]))
     if run.has("hull.inner_centre.displacement_z"):

@@ -39,6 +39,16 @@ const Breakage& breakage_of(const System& sys) {
   return static_cast<const Breakage&>(sys.hook(0));
 }
 
+// A granule (material 0) of diameter d resting on a floor z = 0 of platen steel (material 1).
+void granule_on_floor(System& sys, double d) {
+  const int g = sys.add_material({E, NU, RHO});
+  const int s = sys.add_material({E_P, NU_P, 7850.0});
+  sys.add_interaction(g, g, {0.3, 0.5, 0.0});
+  sys.add_interaction(g, s, {0.3, 0.5, 0.0});
+  sys.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
+  sys.add_plane({0, 0, 0}, {0, 0, 1}, s);
+}
+
 // A granule of diameter d resting on a floor z = 0, a top platen touching it and moving down at
 // speed u; no gravity.
 struct Platens {
@@ -46,13 +56,8 @@ struct Platens {
   int top = -1;
   double u = 0.0;
   Platens(double d, const BreakageParameters& b, double speed) : u(speed) {
-    const int g = sys.add_material({E, NU, RHO});
-    const int s = sys.add_material({E_P, NU_P, 7850.0});
-    sys.add_interaction(g, g, {0.3, 0.5, 0.0});
-    sys.add_interaction(g, s, {0.3, 0.5, 0.0});
-    sys.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
-    sys.add_plane({0, 0, 0}, {0, 0, 1}, s);
-    top = sys.add_plane({0, 0, d}, {0, 0, -1}, s, {0, 0, -speed});
+    granule_on_floor(sys, d);
+    top = sys.add_plane({0, 0, d}, {0, 0, -1}, 1, {0, 0, -speed});
     sys.add_hook(std::make_unique<Breakage>(b));
   }
 };
@@ -133,12 +138,8 @@ TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh turns t
   b.comminution_limit = 2.5e-3;
   b.powder = true;
   System sys;
-  const int g = sys.add_material({E, NU, RHO});
-  const int s = sys.add_material({E_P, NU_P, 7850.0});
-  sys.add_interaction(g, g, {0.3, 0.5, 0.0});
-  sys.add_interaction(g, s, {0.3, 0.5, 0.0});
-  sys.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
-  sys.add_plane({0, 0, 0}, {0, 0, 1}, s);
+  granule_on_floor(sys, d);
+  const int s = 1;  // the platens' steel
   Eigen::MatrixX3d x(4, 3);  // a square of side 4 d at the granule's top
   x << -2 * d, -2 * d, d, 2 * d, -2 * d, d, 2 * d, 2 * d, d, -2 * d, 2 * d, d;
   TriangleMesh::Triangles t(2, 3);
@@ -182,12 +183,7 @@ TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh turns t
   // the same squeeze without powder: the granule stays and the mesh presses it beyond eq. 2
   b.powder = false;
   System keep;
-  keep.add_material({E, NU, RHO});
-  keep.add_material({E_P, NU_P, 7850.0});
-  keep.add_interaction(g, g, {0.3, 0.5, 0.0});
-  keep.add_interaction(g, s, {0.3, 0.5, 0.0});
-  keep.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
-  keep.add_plane({0, 0, 0}, {0, 0, 1}, s);
+  granule_on_floor(keep, d);
   const int m2 = keep.add_mesh(x0, t, s);
   keep.add_hook(std::make_unique<Breakage>(b));
   for (long k = 0; k < 2 * steps; ++k) {
@@ -409,13 +405,8 @@ TEST_CASE("dem: a breakage model added after the first steps takes over at once"
   Platens with(d, b, 0.005);  // hook from the start
   // the same set-up without the hook
   System plain;
-  const int g = plain.add_material({E, NU, RHO});
-  const int s = plain.add_material({E_P, NU_P, 7850.0});
-  plain.add_interaction(g, g, {0.3, 0.5, 0.0});
-  plain.add_interaction(g, s, {0.3, 0.5, 0.0});
-  plain.add_particle({0, 0, 0.5 * d}, 0.5 * d, g);
-  plain.add_plane({0, 0, 0}, {0, 0, 1}, s);
-  const int top = plain.add_plane({0, 0, d}, {0, 0, -1}, s, {0, 0, -0.005});
+  granule_on_floor(plain, d);
+  const int top = plain.add_plane({0, 0, d}, {0, 0, -1}, 1, {0, 0, -0.005});
   const double dt = 0.2 * plain.rayleigh_time_step();
   plain.run(50, dt);
   with.sys.run(50, dt);
