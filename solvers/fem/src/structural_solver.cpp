@@ -224,12 +224,20 @@ void StructuralSolver::assemble_mass() {
   } else {
     Eigen::VectorXd diag = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(ndof_));
     Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m;
+    // each element's nodal masses kept for region_energies() (a monitor every window)
+    element_lumped_start_.resize(mesh().num_elements() + 1);
+    element_lumped_start_[0] = 0;
+    for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei)
+      element_lumped_start_[ei + 1] =
+          element_lumped_start_[ei] + static_cast<std::size_t>(node_count(mesh().elements()[ei].type));
+    element_lumped_.assign(element_lumped_start_.back(), 0.0);
     for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei) {
       const Element& e = mesh().elements()[ei];
       if (element_eroded(ei)) continue;  // erosion: the element's mass has left
       integrator_.lumped_mass(e.type, element_coordinates(mesh(), e), element_density(ei), m);
       for (int a = 0; a < node_count(e.type); ++a) {
         diag.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a])).array() += m[a];
+        element_lumped_[element_lumped_start_[ei] + static_cast<std::size_t>(a)] = m[a];
       }
     }
     m_.resize(diag.size(), diag.size());

@@ -137,7 +137,6 @@ RegionEnergies StructuralSolver::region_energies() const {
   out.strain_energy.assign(regions, 0.0);
   out.kinetic_energy.assign(regions, 0.0);
   ElementMatrix m_e, k_e;
-  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxElementNodes, 1> m_lumped;
   ElementVector v_e, u_e;
   for (std::size_t e = 0; e < mesh().num_elements(); ++e) {
     const Element& el = mesh().elements()[e];
@@ -149,23 +148,23 @@ RegionEnergies StructuralSolver::region_energies() const {
       v_e.segment<3>(3 * a) = kin_.v.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a]));
       u_e.segment<3>(3 * a) = kin_.u.segment<3>(3 * static_cast<Eigen::Index>(el.nodes[a]));
     }
-    const ElementCoordinates x = element_coordinates(mesh(), el);
     if (nonlinear_ != nullptr) {
       out.strain_energy[r] += nonlinear_->material().element_strain_energy()[e];
       if (!element_eroded(e)) out.plastic_work[r] += nonlinear_->material().element_plastic_work(e);
     } else {
       // 1/2 u_e^T K_e u_e
-      integrator_.stiffness(el.type, x, model_.material(el.region).elasticity_matrix(), k_e);
+      integrator_.stiffness(el.type, element_coordinates(mesh(), el), model_.material(el.region).elasticity_matrix(), k_e);
       out.strain_energy[r] += 0.5 * u_e.dot(k_e * u_e);
     }
     if (!mass_ready_ || element_eroded(e)) continue;
     // 1/2 v_e^T M_e v_e (its share of the assembled mass)
     if (options_.mass == MassType::Lumped) {
-      integrator_.lumped_mass(el.type, x, element_density(e), m_lumped);
+      // the nodal masses assemble_mass() built (the same numbers, not recomputed each window)
+      const double* m_lumped = element_lumped_.data() + element_lumped_start_[e];
       for (int a = 0; a < nn; ++a)
         out.kinetic_energy[r] += 0.5 * m_lumped[a] * v_e.segment<3>(3 * a).squaredNorm();
     } else {
-      integrator_.consistent_mass(el.type, x, element_density(e), m_e);
+      integrator_.consistent_mass(el.type, element_coordinates(mesh(), el), element_density(e), m_e);
       out.kinetic_energy[r] += 0.5 * v_e.dot(m_e * v_e);
     }
   }

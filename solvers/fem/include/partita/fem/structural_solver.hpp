@@ -268,6 +268,10 @@ class StructuralSolver final : private StructuralSystem {
   mutable std::vector<double> element_omega2_;  // element_frequencies_squared()
   std::vector<double> mass_scale_;              // per element s_e (empty: no mass scaling)
   std::vector<double> element_mass_;            // per element rho V (with mass scaling)
+  // lumped mass: each element's nodal masses as assembled (element e's from
+  // element_lumped_[element_lumped_start_[e]]; an eroded element's are stale and not read)
+  std::vector<double> element_lumped_;
+  std::vector<std::size_t> element_lumped_start_;
   mutable Eigen::VectorXd prescribed_work_;  // apply_prescribed()'s buffer
 
   // loads
