@@ -3,11 +3,12 @@
 coarse.yaml), filled with granules and, optionally, against the empty hull (empty.yaml,
 coarse_empty.yaml).
 
-Usage: plot_case.py FILLED_DIR [EMPTY_DIR] [--out DIR] [--driven DIR]
+Usage: plot_case.py FILLED_DIR [EMPTY_DIR] [--out DIR] [--driven DIR] [--rate OTHER_DIR]
   FILLED_DIR, EMPTY_DIR: the runs' output folders (bow.csv, parts.csv, granules.csv, energy.csv,
   vtk/); PNGs go to DIR (default FILLED_DIR). --driven DIR: for a collision run (a free bow,
   collision.yaml), the driven run of the same hull it is compared with (the collision_* keys). The case test calls it as `plot_case.py OUT` with the
-  filled run alone (checks.yaml: {script: plot_case.py, key: ...}).
+  filled run alone (checks.yaml: {script: plot_case.py, key: ...}). --rate OTHER_DIR: the same
+  case with the bow at another speed (the quasi-static check: the rate_* keys, rate_force.png).
 
 Writes force_penetration.png, energy.png, inner_deflection.png, section_<k>.png (k = 1, 2, 3: the
 output frames nearest 1/3, 2/3 and all of the final penetration, cut at y = 0.181 m through the
@@ -55,6 +56,12 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
                           which the driven run's indenter work reached collision_absorbed_J) and
                           collision_over_driven_penetration (their ratio: 1 when the striker meets the
                           same force-penetration curve, the energy method of collision analysis)
+  rate_force_ratio_<p>mm   with --rate: OTHER's force over FILLED's at penetration p (every 5 mm of
+                          the common range, and at 25/50/100 % of FILLED's final penetration as
+                          rate_force_ratio_{25,50,100}), each a +-1.5 mm mean; rate_work_ratio_<pct>:
+                          the same for the indenter's work at 25/50/100 %; rate_max_force_dev
+                          (rate_max_force_dev_at_m): the largest |ratio - 1| where FILLED's force
+                          is above 10 % of its largest +-1.5 mm mean
 A missing file or column skips its item with a note on stderr (plot_case: ...), never a traceback."""
 import csv
 import os
@@ -379,6 +386,60 @@ def collision(run, driven):
     reached = float(np.interp(absorbed, w, driven.pen))
     key("driven_penetration_at_absorbed_m", reached)
     key("collision_over_driven_penetration", float(pen[deepest]) / reached)
+
+
+def rate_compare(run, other, outdir, plt):
+    """The same case at another bow speed: force and work ratios at equal penetration."""
+    for r in (run, other):
+        if len(r.t) <= r.contact + 10:
+            note(f"{r.label}: no contact yet (rate keys skipped)")
+            return
+    half = 0.0015
+    p1, f1 = run.smoothed_force(2 * half)
+    p2, f2 = other.smoothed_force(2 * half)
+    top = min(p1[-1], p2[-1]) - half
+    p2u, k2 = np.unique(p2, return_index=True)
+
+    def ratio(p):
+        a = float(np.interp(p, p1, f1))
+        b = float(np.interp(p, p2u, f2[k2]))
+        return b / a if a != 0 else float("nan")
+    for mm in range(5, int(1e3 * top) + 1, 5):
+        key(f"rate_force_ratio_{mm}mm", ratio(1e-3 * mm), "{:.4f}")
+    final = run.pen[-1]
+    w1, w2 = run.work(), other.work()
+    for pct in (25, 50, 100):
+        p = pct / 100 * final
+        if p <= top:
+            key(f"rate_force_ratio_{pct}", ratio(p), "{:.4f}")
+        if w1 is not None and w2 is not None and p <= min(run.pen[-1], other.pen[-1]):
+            a = float(np.interp(p, run.pen, np.maximum.accumulate(w1)))
+            b = float(np.interp(p, other.pen, np.maximum.accumulate(w2)))
+            key(f"rate_work_ratio_{pct}", b / a if a else float("nan"), "{:.5f}")
+    sel = (p1 >= run.pen[run.contact] + half) & (p1 <= top) & (f1 > 0.1 * np.max(f1))
+    if sel.any():
+        r = np.interp(p1[sel], p2u, f2[k2]) / f1[sel]
+        i = int(np.argmax(np.abs(r - 1)))
+        key("rate_max_force_dev", float(abs(r[i] - 1)), "{:.4f}")
+        key("rate_max_force_dev_at_m", float(p1[sel][i]))
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
+    for r, (p, f), c in ((run, (p1, f1), "C0"), (other, (p2, f2), "C1")):
+        ax.plot(1e3 * p, 1e-3 * f, color=c, lw=1.4, label=f"{os.path.basename(os.path.normpath(r.folder))} (+-1.5 mm mean)")
+    pp = p1[(p1 <= top)]
+    rr = np.interp(pp, p2u, f2[k2]) / np.where(np.interp(pp, p1, f1) != 0, np.interp(pp, p1, f1), np.nan)
+    bx.plot(1e3 * pp, rr, color="k", lw=1)
+    bx.axhspan(0.97, 1.03, color="C2", alpha=0.2, label="+-3 %")
+    ax.set_ylabel("indenter force [kN]")
+    ax.set_yscale("symlog", linthresh=0.1)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("the same case at two bow speeds")
+    bx.set_ylim(0.8, 1.2)
+    bx.set_xlabel("penetration [mm]")
+    bx.set_ylabel("force ratio")
+    bx.grid(alpha=0.3)
+    bx.legend(fontsize=8)
+    save(fig, outdir, "rate_force.png")
 
 
 def filled_over_empty(filled, empty):
@@ -761,7 +822,7 @@ def guarded(what, f, *args):
 
 
 def main():
-    args, outdir, driven_dir = [], None, None
+    args, outdir, driven_dir, rate_dir = [], None, None, None
     argv = sys.argv[1:]
     while argv:
         a = argv.pop(0)
@@ -769,6 +830,8 @@ def main():
             outdir = argv.pop(0)
         elif a == "--driven" and argv:
             driven_dir = argv.pop(0)
+        elif a == "--rate" and argv:
+            rate_dir = argv.pop(0)
         elif a in ("-h", "--help") or a.startswith("--"):
             sys.exit(__doc__)
         else:
@@ -814,6 +877,12 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    if rate_dir:
+        try:
+            other = Run(rate_dir, "other speed")
+        except (RuntimeError, OSError) as e:
+            sys.exit(f"plot_case: --rate: {e}")
+        guarded("rate keys", rate_compare, filled, other, outdir, plt)
     guarded("force_penetration.png", plot_force, runs, outdir, plt)
     guarded("energy.png", plot_energy, runs, outdir, plt)
     guarded("inner_deflection.png", plot_deflection, runs, outdir, plt)
