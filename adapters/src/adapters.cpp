@@ -45,6 +45,12 @@ void register_all(coupling::Registries& r) {
         "magnitudes); KE with velocity Verlet's half-step term"},
        {"particles", "", "number of particles"},
        {"mass", "kg", "total mass of the particles"},
+       {"momentum_x", "kg m/s",
+        "linear momentum sum m v of the particles, x (its change over an interval is gravity's "
+        "and the walls' and meshes' impulse on the particles: the weight check of a bed that is "
+        "not at rest)"},
+       {"momentum_y", "kg m/s", "... y"},
+       {"momentum_z", "kg m/s", "... z"},
        {"breakage.events", "", "particles broken so far (with breakage on)"},
        {"breakage.fragments", "", "fragments created so far"},
        {"breakage.fragment_mass", "kg", "mass of the fragments created so far"},

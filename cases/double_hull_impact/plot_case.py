@@ -16,7 +16,10 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
   weight_balance          -(sum of granules.cXX.force_z) / (granules.mass g), averaged over the rows
                           before the bow touches (penetration 0) after the first 2 ms (1: the
                           granules' weight rests on the hull); weight_balance_last: the same over
-                          the last 20 % of those rows (the settled state)
+                          the last 20 % of those rows (the settled state); weight_balance_impulse
+                          (with the monitor granules.momentum_z): over the same rows, (the cells'
+                          and the bow's impulse on the granules - the change of their momentum) /
+                          the impulse of m g (1 also while the bed rings: Newton's second law)
   max_abs_energy_error[_empty]   largest |energy balance error| of energy.csv over the rows whose
                           indenter work exceeds 1 % of its final value
   quasi_static_ke_ratio[_empty]  max of (hull + granules kinetic energy) / (hull strain energy +
@@ -261,6 +264,21 @@ def weight_balance(run):
     key("weight_balance", float(np.mean(-fz[rows]) / np.mean(weight)))
     last = rows[len(rows) - max(1, len(rows) // 5):]
     key("weight_balance_last", float(np.mean(-fz[last]) / np.mean(run.at("granules.mass")[last] * G)))
+    # the impulse balance over the same rows (a bed that rings is not at rest, so the cells' force
+    # is its weight plus the rate of its momentum): (integral of the hull's and the bow's force on
+    # the granules - the change of their momentum) / integral of m g
+    if not run.has("granules.momentum_z"):
+        note(f"{run.label}: no column granules.momentum_z (weight_balance_impulse skipped)")
+        return
+    if len(rows) < 2:
+        return
+    on_bed = fz[rows]
+    if run.has("granules.bow.force_z"):
+        on_bed = on_bed + run.at("granules.bow.force_z")[rows]
+    t = run.t[rows]
+    trap = lambda y: float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+    p = run.at("granules.momentum_z")[rows]
+    key("weight_balance_impulse", (trap(-on_bed) - float(p[-1] - p[0])) / trap(weight))
 
 
 def energy_error(run, suffix):

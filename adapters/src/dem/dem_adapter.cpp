@@ -998,6 +998,12 @@ std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::stri
     for (const double m : system_.particles().mass) mass += m;
     v.push_back({"mass", "kg", mass});
   }
+  if (wanted("momentum_x") || wanted("momentum_y") || wanted("momentum_z")) {
+    const Eigen::Vector3d m = system_.linear_momentum();
+    v.push_back({"momentum_x", "kg m/s", m.x()});
+    v.push_back({"momentum_y", "kg m/s", m.y()});
+    v.push_back({"momentum_z", "kg m/s", m.z()});
+  }
   if (wanted("contacts_per_particle"))
     v.push_back({"contacts_per_particle", "", system_.mean_contacts_per_particle()});
   // the DEM's energy accounting (dem::System::energies(), cumulative since the first step; with

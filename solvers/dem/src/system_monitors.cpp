@@ -51,6 +51,18 @@ double System::kinetic_energy() const {
   });
 }
 
+Eigen::Vector3d System::linear_momentum() const {
+  const Particles& p = store_.core();
+  const auto n = static_cast<std::ptrdiff_t>(p.size());
+  const PackedParticle* q = verlet_.ahead();
+  Eigen::Vector3d out;
+  for (int k = 0; k < 3; ++k)
+    out[k] = q != nullptr
+                 ? ordered_sum(n, [&](std::ptrdiff_t i) { return p.mass[i] * q[i].v[k]; })
+                 : ordered_sum(n, [&](std::ptrdiff_t i) { return p.mass[i] * p.velocity[i][k]; });
+  return out;
+}
+
 double System::half_step_term(double dt) const {
   const Particles& p = store_.core();
   const auto n = static_cast<std::ptrdiff_t>(p.size());

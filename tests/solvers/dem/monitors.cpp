@@ -1,4 +1,4 @@
-// The monitors over every particle (kinetic energy, potential energy, contact count) and the state
+// The monitors over every particle (kinetic energy, potential energy, momentum, contact count) and the state
 // check (first_particle_astray) on beds large enough for their parallel passes: independent sums,
 // the same bits on any number of threads, and the same values read from the packed state while
 // stepping as from the store after a sync.
@@ -36,7 +36,7 @@ TEST_CASE("dem: monitors over a large bed: exact sums, any thread count, packed 
   const int n = 28;  // 21,952 particles: more than parallel_pass_min, so the passes run in parallel
   const double r = 1e-3;
   REQUIRE(n * n * n > parallel_pass_min);
-  double ke[3] = {}, pe[3] = {};
+  double ke[3] = {}, pe[3] = {}, pz[3] = {};
   std::size_t contacts[3] = {};
   for (int threads : {1, 2, 3}) {
     set_num_threads(threads);
@@ -46,11 +46,13 @@ TEST_CASE("dem: monitors over a large bed: exact sums, any thread count, packed 
     sys.run(3, dt);  // the packed state is ahead of the store's copies
     const double ke_packed = sys.kinetic_energy();
     const double pe_packed = sys.potential_energy();
+    const double pz_packed = sys.linear_momentum().z();
 
     // independently: long double sums over the synced store
     const Particles& p = sys.particles();
-    long double ke_ref = 0.0L, pe_ref = 0.0L;
+    long double ke_ref = 0.0L, pe_ref = 0.0L, pz_ref = 0.0L;
     for (std::size_t i = 0; i < p.size(); ++i) {
+      pz_ref += static_cast<long double>(p.mass[i]) * p.velocity[i].z();
       ke_ref += 0.5L * p.mass[i] * p.velocity[i].squaredNorm() +
                 0.5L * p.inertia[i] * p.angular_velocity[i].squaredNorm();
       pe_ref -= static_cast<long double>(p.mass[i]) * (-9.81 * p.position[i].z());
@@ -58,10 +60,13 @@ TEST_CASE("dem: monitors over a large bed: exact sums, any thread count, packed 
     INFO(threads << " threads");
     CHECK(ke_packed == Approx(static_cast<double>(ke_ref)).epsilon(1e-12));
     CHECK(pe_packed == Approx(static_cast<double>(pe_ref)).epsilon(1e-12));
+    CHECK(pz_packed == Approx(static_cast<double>(pz_ref)).epsilon(1e-12));
+    CHECK(sys.linear_momentum().z() == pz_packed);
     CHECK(sys.kinetic_energy() == ke_packed);  // read from the store now: the same bits
     CHECK(sys.potential_energy() == pe_packed);
     ke[threads - 1] = ke_packed;
     pe[threads - 1] = pe_packed;
+    pz[threads - 1] = pz_packed;
     contacts[threads - 1] = sys.contact_count();
   }
   set_num_threads(before);
@@ -69,6 +74,8 @@ TEST_CASE("dem: monitors over a large bed: exact sums, any thread count, packed 
   CHECK(ke[0] == ke[2]);
   CHECK(pe[0] == pe[1]);
   CHECK(pe[0] == pe[2]);
+  CHECK(pz[0] == pz[1]);
+  CHECK(pz[0] == pz[2]);
   CHECK(contacts[0] == 0);  // spacing 2.5 r: no sphere touches another
   CHECK(contacts[1] == 0);
   CHECK(contacts[2] == 0);

@@ -85,6 +85,51 @@ TEST_CASE("dem: a settled column puts its whole weight on the floor", "[dem][phy
   CHECK(mean == Approx(weight).epsilon(0.005));
 }
 
+TEST_CASE("dem: impulse balance of a falling column: walls' impulse = weight's + momentum's change",
+          "[dem][physics]") {
+  // Newton's second law for the whole bed (the pair forces cancel): d/dt sum m v = M g + the
+  // walls' forces on the particles. While the column falls and hits the floor, the
+  // floor force is far from the weight at any moment, but over any interval
+  // integral(-W_z) dt - M g t = P_z(t) - P_z(0) (W: the particles' force on the walls, the
+  // integral by the trapezoidal rule over the steps, as the velocity update takes it).
+  System sys;
+  const int grain = sys.add_material({1.0e7, 0.3, 2500.0});
+  const int smooth = sys.add_material({1.0e7, 0.3, 2500.0});
+  sys.add_interaction(grain, grain, {0.5, 0.3, 0.0});
+  sys.add_interaction(grain, smooth, {0.0, 0.3, 0.0});
+  sys.set_gravity({0, 0, -9.81});
+  const Packing pk = test::two_size_packing(
+      Eigen::Vector3d(0, 0, 2e-3), Eigen::Vector3d(4e-3, 4e-3, 14e-3), 1.2e-3, 1.0e-3, 0.6, 11);
+  sys.add_particles(pk.positions, pk.radii, grain);
+  const int floor = sys.add_plane({0, 0, 0}, {0, 0, 1}, grain);
+  const int sides = sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(4e-3, 4e-3, 1.0), smooth,
+                                0b001111);
+  double weight = 0.0;
+  for (double m : sys.particles().mass) weight += 9.81 * m;
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  auto wall_force_on_bed = [&] { return -(sys.wall_force(floor).z() + sys.wall_force(sides).z()); };
+  sys.step(dt);
+  const double p0 = sys.linear_momentum().z();
+  double f0 = wall_force_on_bed(), impulse = 0.0, floor_mean = 0.0;
+  const long steps = static_cast<long>(0.024 / dt);  // 24 ms: the fall of 2 mm (20 ms), the impact
+  for (long s = 0; s < steps; ++s) {
+    sys.step(dt);
+    const double f1 = wall_force_on_bed();
+    impulse += 0.5 * dt * (f0 + f1);
+    floor_mean += -sys.wall_force(floor).z() / static_cast<double>(steps);
+    f0 = f1;
+  }
+  const double t = static_cast<double>(steps) * dt;
+  const double dp = sys.linear_momentum().z() - p0;
+  INFO(sys.particle_count() << " spheres, " << steps << " steps: weight " << weight
+                            << " N, mean floor force " << floor_mean << " N, momentum change "
+                            << dp << " kg m/s, walls' impulse - weight's " << impulse - weight * t);
+  // not at rest: the mean floor force over the interval is not the weight
+  CHECK(std::abs(floor_mean / weight - 1.0) > 0.05);
+  // the impulse balance closes to a small fraction of the weight's impulse
+  CHECK(dp == Approx(impulse - weight * t).margin(1e-3 * weight * t));
+}
+
 TEST_CASE("dem: wide size distribution: a large sphere rests on a bed of small ones",
           "[dem][physics]") {
   // Radius ratio 10: cells are sized by the largest sphere; every contact must still be found.

@@ -229,6 +229,9 @@ class System {
   const MeshContacts& mesh_contacts() const { return mesh_contacts_; }
   /// Kinetic energy, translational + rotational [J].
   double kinetic_energy() const;
+  /// Linear momentum sum m v [kg m/s] (its rate is gravity's m g plus the walls' and meshes'
+  /// forces on the particles: the impulse balance of a bed that is not at rest).
+  Eigen::Vector3d linear_momentum() const;
   /// Elastic energy stored in all contacts (Hertz 8/15 E* sqrt(R*) delta^(5/2) + tangential
   /// springs) at the current positions [J]: the contacts of the last force pass with their
   /// tangential springs. Before the first step the contacts of the moment, particle pairs, planes
