@@ -25,6 +25,30 @@ Eigen::Vector3d random_velocity(std::uint64_t& s, double a) {
   return v;
 }
 
+// A column of about 100 spheres (radii 0.5 and 0.6 mm) generated in [0, 4 mm]^2 x [z0, z0 + 12 mm]
+// over a floor at z = 0 (id floor), between four frictionless side walls (id sides: they carry no
+// vertical load), friction 0.5 between spheres and with the floor, restitution 0.3, gravity.
+struct Column {
+  System sys;
+  int floor = -1, sides = -1;
+  double weight = 0.0;  // sum m g [N]
+  explicit Column(double z0) {
+    const int grain = sys.add_material({1.0e7, 0.3, 2500.0});
+    const int smooth = sys.add_material({1.0e7, 0.3, 2500.0});
+    sys.add_interaction(grain, grain, {0.5, 0.3, 0.0});
+    sys.add_interaction(grain, smooth, {0.0, 0.3, 0.0});
+    sys.set_gravity({0, 0, -9.81});
+    const Packing pk = test::two_size_packing(Eigen::Vector3d(0, 0, z0),
+                                              Eigen::Vector3d(4e-3, 4e-3, z0 + 12e-3), 1.2e-3,
+                                              1.0e-3, 0.6, 11);
+    sys.add_particles(pk.positions, pk.radii, grain);
+    floor = sys.add_plane({0, 0, 0}, {0, 0, 1}, grain);
+    sides = sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(4e-3, 4e-3, 1.0), smooth,
+                        0b001111);  // four sides
+    for (double m : sys.particles().mass) weight += 9.81 * m;
+  }
+};
+
 }  // namespace
 
 TEST_CASE("dem: energy is conserved without damping or friction", "[dem][physics]") {
@@ -58,20 +82,10 @@ TEST_CASE("dem: energy is conserved without damping or friction", "[dem][physics
 TEST_CASE("dem: a settled column puts its whole weight on the floor", "[dem][physics]") {
   // Frictionless side walls (they carry no vertical load), friction between spheres and with
   // the floor, restitution 0.3: at rest the floor force equals the total weight.
-  System sys;
-  const int grain = sys.add_material({1.0e7, 0.3, 2500.0});
-  const int smooth = sys.add_material({1.0e7, 0.3, 2500.0});
-  sys.add_interaction(grain, grain, {0.5, 0.3, 0.0});
-  sys.add_interaction(grain, smooth, {0.0, 0.3, 0.0});
-  sys.set_gravity({0, 0, -9.81});
-  const Packing pk = test::two_size_packing(
-      Eigen::Vector3d::Zero(), Eigen::Vector3d(4e-3, 4e-3, 12e-3), 1.2e-3, 1.0e-3, 0.6, 11);
-  sys.add_particles(pk.positions, pk.radii, grain);
-  const int floor = sys.add_plane({0, 0, 0}, {0, 0, 1}, grain);
-  sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(4e-3, 4e-3, 1.0), smooth,
-              0b001111);  // four sides
-  double weight = 0.0;
-  for (double m : sys.particles().mass) weight += 9.81 * m;
+  Column c(0.0);
+  System& sys = c.sys;
+  const int floor = c.floor;
+  const double weight = c.weight;
   const double dt = 0.2 * sys.rayleigh_time_step();
   sys.run(static_cast<long>(0.2 / dt), dt);  // 0.2 s
   double mean = 0.0;
@@ -92,20 +106,10 @@ TEST_CASE("dem: impulse balance of a falling column: walls' impulse = weight's +
   // floor force is far from the weight at any moment, but over any interval
   // integral(-W_z) dt - M g t = P_z(t) - P_z(0) (W: the particles' force on the walls, the
   // integral by the trapezoidal rule over the steps, as the velocity update takes it).
-  System sys;
-  const int grain = sys.add_material({1.0e7, 0.3, 2500.0});
-  const int smooth = sys.add_material({1.0e7, 0.3, 2500.0});
-  sys.add_interaction(grain, grain, {0.5, 0.3, 0.0});
-  sys.add_interaction(grain, smooth, {0.0, 0.3, 0.0});
-  sys.set_gravity({0, 0, -9.81});
-  const Packing pk = test::two_size_packing(
-      Eigen::Vector3d(0, 0, 2e-3), Eigen::Vector3d(4e-3, 4e-3, 14e-3), 1.2e-3, 1.0e-3, 0.6, 11);
-  sys.add_particles(pk.positions, pk.radii, grain);
-  const int floor = sys.add_plane({0, 0, 0}, {0, 0, 1}, grain);
-  const int sides = sys.add_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(4e-3, 4e-3, 1.0), smooth,
-                                0b001111);
-  double weight = 0.0;
-  for (double m : sys.particles().mass) weight += 9.81 * m;
+  Column c(2e-3);  // 2 mm above the floor
+  System& sys = c.sys;
+  const int floor = c.floor, sides = c.sides;
+  const double weight = c.weight;
   const double dt = 0.2 * sys.rayleigh_time_step();
   auto wall_force_on_bed = [&] { return -(sys.wall_force(floor).z() + sys.wall_force(sides).z()); };
   sys.step(dt);
