@@ -19,8 +19,8 @@
 // interface_work(M): the work the motion of M did on the particles (energy audit); none on
 // M_centres (what it reads moves nothing).
 // Monitors: kinetic_energy [J], momentum_x|y|z [kg m/s] (sum m v: with the meshes' and walls'
-// forces and gravity, the impulse balance of a bed that is not at rest), the energy accounting (dem::System::energies(), cumulative
-// since the first step) friction_work, damping_work, breakage_energy, stiffening_work,
+// forces and gravity, the impulse balance of a bed that is not at rest), the energy accounting
+// (dem::System::energies(), cumulative since the first step) friction_work, damping_work, breakage_energy, stiffening_work,
 // gravity_work, wall_work (all walls and meshes), M.work and <wall>.work [J], elastic_energy [J]
 // and energy_balance_error [-] (each a pass over the particles: computed when asked for),
 // M.force_x|y|z [N] (force of the particles on mesh M),

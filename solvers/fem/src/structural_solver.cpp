@@ -228,8 +228,8 @@ void StructuralSolver::assemble_mass() {
     element_lumped_start_.resize(mesh().num_elements() + 1);
     element_lumped_start_[0] = 0;
     for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei)
-      element_lumped_start_[ei + 1] =
-          element_lumped_start_[ei] + static_cast<std::size_t>(node_count(mesh().elements()[ei].type));
+      element_lumped_start_[ei + 1] = element_lumped_start_[ei] +
+                                      static_cast<std::size_t>(node_count(mesh().elements()[ei].type));
     element_lumped_.assign(element_lumped_start_.back(), 0.0);
     for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei) {
       const Element& e = mesh().elements()[ei];

@@ -153,7 +153,8 @@ RegionEnergies StructuralSolver::region_energies() const {
       if (!element_eroded(e)) out.plastic_work[r] += nonlinear_->material().element_plastic_work(e);
     } else {
       // 1/2 u_e^T K_e u_e
-      integrator_.stiffness(el.type, element_coordinates(mesh(), el), model_.material(el.region).elasticity_matrix(), k_e);
+      integrator_.stiffness(el.type, element_coordinates(mesh(), el),
+                            model_.material(el.region).elasticity_matrix(), k_e);
       out.strain_energy[r] += 0.5 * u_e.dot(k_e * u_e);
     }
     if (!mass_ready_ || element_eroded(e)) continue;
@@ -164,7 +165,8 @@ RegionEnergies StructuralSolver::region_energies() const {
       for (int a = 0; a < nn; ++a)
         out.kinetic_energy[r] += 0.5 * m_lumped[a] * v_e.segment<3>(3 * a).squaredNorm();
     } else {
-      integrator_.consistent_mass(el.type, element_coordinates(mesh(), el), element_density(e), m_e);
+      integrator_.consistent_mass(el.type, element_coordinates(mesh(), el), element_density(e),
+                                  m_e);
       out.kinetic_energy[r] += 0.5 * v_e.dot(m_e * v_e);
     }
   }
