@@ -3,12 +3,13 @@
 coarse.yaml), filled with granules and, optionally, against the empty hull (empty.yaml,
 coarse_empty.yaml).
 
-Usage: plot_case.py FILLED_DIR [EMPTY_DIR] [--out DIR] [--driven DIR] [--rate OTHER_DIR]
+Usage: plot_case.py FILLED_DIR [EMPTY_DIR] [--out DIR] [--driven DIR] [--rate OTHER_DIR ...]
   FILLED_DIR, EMPTY_DIR: the runs' output folders (bow.csv, parts.csv, granules.csv, energy.csv,
   vtk/); PNGs go to DIR (default FILLED_DIR). --driven DIR: for a collision run (a free bow,
   collision.yaml), the driven run of the same hull it is compared with (the collision_* keys). The case test calls it as `plot_case.py OUT` with the
   filled run alone (checks.yaml: {script: plot_case.py, key: ...}). --rate OTHER_DIR: the same
-  case with the bow at another speed (the quasi-static check: the rate_* keys, rate_force.png).
+  case with the bow at another speed (the quasi-static check: the rate_* keys, rate_force.png);
+  repeated, each further run at yet another speed (keys rate2_*, rate3_*, ..., one figure).
 
 Writes force_penetration.png, energy.png, inner_deflection.png, section_<k>.png (k = 1, 2, 3: the
 output frames nearest 1/3, 2/3 and all of the final penetration, cut at y = 0.181 m through the
@@ -64,7 +65,8 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
                           rate_force_ratio_{25,50,100}), each a +-1.5 mm mean; rate_work_ratio_<pct>:
                           the same for the indenter's work at 25/50/100 %; rate_max_force_dev
                           (rate_max_force_dev_at_m): the largest |ratio - 1| where FILLED's force
-                          is above 10 % of its largest +-1.5 mm mean
+                          is above 10 % of its largest +-1.5 mm mean; a second (third, ...) --rate:
+                          the same keys as rate2_* (rate3_*, ...)
 A missing file or column skips its item with a note on stderr (plot_case: ...), never a traceback."""
 import csv
 import os
@@ -406,57 +408,67 @@ def collision(run, driven):
     key("collision_over_driven_penetration", float(pen[deepest]) / reached)
 
 
-def rate_compare(run, other, outdir, plt):
-    """The same case at another bow speed: force and work ratios at equal penetration."""
-    for r in (run, other):
+def rate_compare(run, others, outdir, plt):
+    """The same case at other bow speeds: force and work ratios at equal penetration (keys
+    rate_* for the first OTHER, rate<k>_* for the k-th, k >= 2), one figure with them all."""
+    for r in [run] + others:
         if len(r.t) <= r.contact + 10:
             note(f"{r.label}: no contact yet (rate keys skipped)")
             return
     half = 0.0015
     p1, f1 = run.smoothed_force(2 * half)
-    p2, f2 = other.smoothed_force(2 * half)
-    top = min(p1[-1], p2[-1]) - half
-    p2u, k2 = np.unique(p2, return_index=True)
+    curves = []
+    for k, other in enumerate(others):
+        prefix = "rate" if k == 0 else f"rate{k + 1}"
+        p2, f2 = other.smoothed_force(2 * half)
+        top = min(p1[-1], p2[-1]) - half
+        p2u, k2 = np.unique(p2, return_index=True)
+        curves.append((other, p2, f2, p2u, k2, top))
 
-    def ratio(p):
-        a = float(np.interp(p, p1, f1))
-        b = float(np.interp(p, p2u, f2[k2]))
-        return b / a if a != 0 else float("nan")
-    for mm in range(5, int(1e3 * top) + 1, 5):
-        key(f"rate_force_ratio_{mm}mm", ratio(1e-3 * mm), "{:.4f}")
-    final = run.pen[-1]
-    w1, w2 = run.work(), other.work()
-    for pct in (25, 50, 100):
-        p = pct / 100 * final
-        if p <= top:
-            key(f"rate_force_ratio_{pct}", ratio(p), "{:.4f}")
-        if w1 is not None and w2 is not None and p <= min(run.pen[-1], other.pen[-1]):
-            a = float(np.interp(p, run.pen, np.maximum.accumulate(w1)))
-            b = float(np.interp(p, other.pen, np.maximum.accumulate(w2)))
-            key(f"rate_work_ratio_{pct}", b / a if a else float("nan"), "{:.5f}")
-    sel = (p1 >= run.pen[run.contact] + half) & (p1 <= top) & (f1 > 0.1 * np.max(f1))
-    if sel.any():
-        r = np.interp(p1[sel], p2u, f2[k2]) / f1[sel]
-        i = int(np.argmax(np.abs(r - 1)))
-        key("rate_max_force_dev", float(abs(r[i] - 1)), "{:.4f}")
-        key("rate_max_force_dev_at_m", float(p1[sel][i]))
+        def ratio(p):
+            a = float(np.interp(p, p1, f1))
+            b = float(np.interp(p, p2u, f2[k2]))
+            return b / a if a != 0 else float("nan")
+        for mm in range(5, int(1e3 * top) + 1, 5):
+            key(f"{prefix}_force_ratio_{mm}mm", ratio(1e-3 * mm), "{:.4f}")
+        final = run.pen[-1]
+        w1, w2 = run.work(), other.work()
+        for pct in (25, 50, 100):
+            p = pct / 100 * final
+            if p <= top:
+                key(f"{prefix}_force_ratio_{pct}", ratio(p), "{:.4f}")
+            if w1 is not None and w2 is not None and p <= min(run.pen[-1], other.pen[-1]):
+                a = float(np.interp(p, run.pen, np.maximum.accumulate(w1)))
+                b = float(np.interp(p, other.pen, np.maximum.accumulate(w2)))
+                key(f"{prefix}_work_ratio_{pct}", b / a if a else float("nan"), "{:.5f}")
+        sel = (p1 >= run.pen[run.contact] + half) & (p1 <= top) & (f1 > 0.1 * np.max(f1))
+        if sel.any():
+            r = np.interp(p1[sel], p2u, f2[k2]) / f1[sel]
+            i = int(np.argmax(np.abs(r - 1)))
+            key(f"{prefix}_max_force_dev", float(abs(r[i] - 1)), "{:.4f}")
+            key(f"{prefix}_max_force_dev_at_m", float(p1[sel][i]))
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(7, 6), sharex=True, gridspec_kw={"height_ratios": [2, 1]})
-    for r, (p, f), c in ((run, (p1, f1), "C0"), (other, (p2, f2), "C1")):
-        ax.plot(1e3 * p, 1e-3 * f, color=c, lw=1.4, label=f"{os.path.basename(os.path.normpath(r.folder))} (+-1.5 mm mean)")
-    pp = p1[(p1 <= top)]
-    rr = np.interp(pp, p2u, f2[k2]) / np.where(np.interp(pp, p1, f1) != 0, np.interp(pp, p1, f1), np.nan)
-    bx.plot(1e3 * pp, rr, color="k", lw=1)
+    label = lambda r: f"{os.path.basename(os.path.normpath(r.folder))} (+-1.5 mm mean)"
+    ax.plot(1e3 * p1, 1e-3 * f1, color="C0", lw=1.4, label=label(run))
+    for k, (other, p2, f2, p2u, k2, top) in enumerate(curves):
+        c = f"C{k + 1}"
+        ax.plot(1e3 * p2, 1e-3 * f2, color=c, lw=1.4, label=label(other))
+        pp = p1[(p1 <= top)]
+        a = np.interp(pp, p1, f1)
+        rr = np.interp(pp, p2u, f2[k2]) / np.where(a != 0, a, np.nan)
+        bx.plot(1e3 * pp, rr, color=c, lw=1,
+                label=f"{os.path.basename(os.path.normpath(other.folder))} / {os.path.basename(os.path.normpath(run.folder))}")
     bx.axhspan(0.97, 1.03, color="C2", alpha=0.2, label="+-3 %")
     ax.set_ylabel("indenter force [kN]")
     ax.set_yscale("symlog", linthresh=0.1)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    ax.set_title("the same case at two bow speeds")
-    bx.set_ylim(0.8, 1.2)
+    ax.set_title("the same case at several bow speeds" if len(others) > 1 else "the same case at two bow speeds")
+    bx.set_ylim(0.6 if len(others) > 1 else 0.8, 1.4 if len(others) > 1 else 1.2)
     bx.set_xlabel("penetration [mm]")
     bx.set_ylabel("force ratio")
     bx.grid(alpha=0.3)
-    bx.legend(fontsize=8)
+    bx.legend(fontsize=7)
     save(fig, outdir, "rate_force.png")
 
 
@@ -840,7 +852,7 @@ def guarded(what, f, *args):
 
 
 def main():
-    args, outdir, driven_dir, rate_dir = [], None, None, None
+    args, outdir, driven_dir, rate_dirs = [], None, None, []
     argv = sys.argv[1:]
     while argv:
         a = argv.pop(0)
@@ -849,7 +861,7 @@ def main():
         elif a == "--driven" and argv:
             driven_dir = argv.pop(0)
         elif a == "--rate" and argv:
-            rate_dir = argv.pop(0)
+            rate_dirs.append(argv.pop(0))
         elif a in ("-h", "--help") or a.startswith("--"):
             sys.exit(__doc__)
         else:
@@ -895,12 +907,14 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    if rate_dir:
-        try:
-            other = Run(rate_dir, "other speed")
-        except (RuntimeError, OSError) as e:
-            sys.exit(f"plot_case: --rate: {e}")
-        guarded("rate keys", rate_compare, filled, other, outdir, plt)
+    if rate_dirs:
+        others = []
+        for d in rate_dirs:
+            try:
+                others.append(Run(d, f"other speed ({d})"))
+            except (RuntimeError, OSError) as e:
+                sys.exit(f"plot_case: --rate: {e}")
+        guarded("rate keys", rate_compare, filled, others, outdir, plt)
     guarded("force_penetration.png", plot_force, runs, outdir, plt)
     guarded("energy.png", plot_energy, runs, outdir, plt)
     guarded("inner_deflection.png", plot_deflection, runs, outdir, plt)
