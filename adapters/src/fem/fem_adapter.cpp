@@ -802,20 +802,28 @@ std::size_t FemAdapter::find_interface(std::string_view mesh, Part* part) const 
   throw Error("fem '" + name_ + "' has no mesh '" + std::string(mesh) + "'");
 }
 
+// The interfaces' nodal forces go to the solver as one set (StructuralSolver::set_nodal_forces
+// re-sums every coupling load over the whole force vector). read() only stores an interface's
+// forces and marks them pending: with N interfaces and a read per interface per substep, applying
+// at every read cost N^2 sums a substep (9 interfaces: 63 a window of 7 substeps, 7 % of the coarse
+// double hull's run). They are applied once, before the step (and before anything that stores the
+// solver's loads); the sum and its order are the same, so the results are bit for bit unchanged.
 void FemAdapter::apply_nodal_forces() {
-  std::vector<std::size_t> nodes;
+  if (!forces_pending_) return;
+  forces_pending_ = false;
   std::size_t n = 0;
   for (const auto& i : interfaces_)
     if (i.has_forces) n += i.nodes.size();
-  fem::MatrixX3 f(static_cast<Eigen::Index>(n), 3);
+  force_nodes_.clear();  // (work arrays: no allocation once they have grown)
+  force_rows_.resize(static_cast<Eigen::Index>(n), 3);
   Eigen::Index row = 0;
   for (const auto& i : interfaces_) {
     if (!i.has_forces) continue;
-    nodes.insert(nodes.end(), i.nodes.begin(), i.nodes.end());
-    f.middleRows(row, i.nodal_forces.rows()) = i.nodal_forces;
+    force_nodes_.insert(force_nodes_.end(), i.nodes.begin(), i.nodes.end());
+    force_rows_.middleRows(row, i.nodal_forces.rows()) = i.nodal_forces;
     row += i.nodal_forces.rows();
   }
-  solver_->set_nodal_forces(nodes, f);
+  solver_->set_nodal_forces(force_nodes_, force_rows_);
 }
 
 void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
@@ -835,9 +843,15 @@ void FemAdapter::read(std::string_view mesh, std::string_view data, const Eigen:
     i.has_tractions = true;
     solver_->set_face_tractions_at_quadrature_points(i.face, i.tractions);
   } else if (part == Part::nodes && data == "force") {
+    if (values.rows() != static_cast<Eigen::Index>(i.nodes.size()) || values.cols() != 3)
+      throw Error("fem '" + name_ + "': 'force' on mesh '" + i.name + "' needs " +
+                  std::to_string(i.nodes.size()) + " rows of 3, got " +
+                  std::to_string(values.rows()) + " x " + std::to_string(values.cols()));
+    if (!values.allFinite())
+      throw Error("fem '" + name_ + "': non-finite 'force' on mesh '" + i.name + "'");
     i.nodal_forces = values;
     i.has_forces = true;
-    apply_nodal_forces();
+    forces_pending_ = true;  // applied before the step (apply_nodal_forces)
   } else {
     throw Error("fem '" + name_ + "' reads 'force' on mesh '" + i.name + "' and 'traction' on '" +
                 i.name + "_quadrature', not '" + std::string(data) + "' on '" + std::string(mesh) +
@@ -874,6 +888,7 @@ void FemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
 }
 
 void FemAdapter::advance(double dt) {
+  apply_nodal_forces();
   u_before_ = solver_->displacement();  // (no allocation after the first step: same size)
   try {
     if (transient_)
@@ -926,6 +941,7 @@ double FemAdapter::stable_time_step() const {
 }
 
 void FemAdapter::save_checkpoint() {
+  apply_nodal_forces();  // the state holds the loads read so far
   checkpoint_ = solver_->save_state();
   for (auto& i : interfaces_) i.audit_checkpoint = i.audit;
   has_checkpoint_ = true;
@@ -935,6 +951,7 @@ void FemAdapter::restore_checkpoint() {
   if (!has_checkpoint_)
     throw Error("fem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   solver_->restore_state(checkpoint_);
+  forces_pending_ = false;  // the checkpoint's loads hold until the next read
   failure_log_.restored(*solver_);
   for (auto& i : interfaces_) i.audit = i.audit_checkpoint;
 }
@@ -1001,6 +1018,7 @@ void FemAdapter::read_restart(BinaryReader& in) {
     in.read(i.audit.tractions);
   }
   solver_->restore_state(s);
+  forces_pending_ = false;
   failure_log_.restored(*solver_);
 }
 

@@ -84,6 +84,7 @@ class FemAdapter : public Solver {
   /// Index into interfaces_ of the coupling mesh `mesh` (and which of its meshes); throws if
   /// unknown.
   std::size_t find_interface(std::string_view mesh, Part* part) const;
+  /// Hands the interfaces' nodal forces to the solver if a read changed them since (see the .cpp).
   void apply_nodal_forces();
 
   std::string name_;
@@ -93,6 +94,9 @@ class FemAdapter : public Solver {
   fem::SolverState checkpoint_;
   bool has_checkpoint_ = false;
   std::vector<Interface> interfaces_;
+  bool forces_pending_ = false;          // a "force" read not yet handed to the solver
+  std::vector<std::size_t> force_nodes_;  // work arrays of apply_nodal_forces
+  fem::MatrixX3 force_rows_;
   Eigen::VectorXd u_before_, du_;  // displacement before a step and its increment (work arrays)
   std::vector<InterfaceMesh> meshes_;
   std::vector<std::pair<std::string, std::string>> files_;
