@@ -28,6 +28,13 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
                           exceeds 5 % of its final value (before that the ratio is 0/0 noise)
   filled_over_empty_min   min of filled / empty force at equal penetration, from 60 % of the
                           smaller final penetration of the two runs on (needs EMPTY_DIR)
+  granule_contact_penetration_m  the filled run's penetration at the granules' first force on the bow
+  filled_minus_empty_work_min_J  min of the bow's work filled - empty at equal penetration, from
+                          that first contact to the smaller final penetration (needs EMPTY_DIR)
+  filled_force_where_empty_free_min_N, empty_free_from_m  min of the filled bow's force (smoothed
+                          over 4 % of the travel) where the empty bow's smoothed force is zero after
+                          its first contact (it has passed the outer plate's petals: the bed alone
+                          resists), and where that begins
   final_penetration_{filled,empty}_m
   force_{25,50,100}_{filled,empty}_N   the indenter's resisting force (-(hull.bow.force_z +
                           granules.bow.force_z)) at 25/50/100 % of the final penetration, averaged
@@ -493,6 +500,50 @@ def filled_over_empty(filled, empty):
     key("filled_over_empty_from_m", float(start))
 
 
+def filled_against_empty(filled, empty):
+    """Filled > empty beyond the bow's first contact with the granules: the work at equal
+    penetration (the force itself crosses where the two hulls tear a fraction of a millimetre
+    apart), and the force where the empty bow touches nothing (the bed alone resists)."""
+    if not filled.has("granules.bow.force_z"):
+        note("filled: no column granules.bow.force_z (filled_minus_empty keys skipped)")
+        return
+    touched = np.nonzero(filled.at("granules.bow.force_z") != 0)[0]
+    if not len(touched):
+        note("filled: the granules never touch the bow (filled_minus_empty keys skipped)")
+        return
+    p_c = float(filled.pen[touched[0]])
+    key("granule_contact_penetration_m", p_c)
+    wf, we = filled.work(), empty.work()
+    if wf is None or we is None:
+        note("a run has no bow work column (filled_minus_empty_work_min_J skipped)")
+        return
+    end = min(filled.pen[-1], empty.pen[-1])
+    sel = (filled.pen >= p_c) & (filled.pen <= end)
+    if not sel.any():
+        note("no common penetration beyond the granules' first contact (filled_minus_empty skipped)")
+        return
+    pe_u, k = np.unique(empty.pen, return_index=True)
+    key("filled_minus_empty_work_min_J", float(np.min(wf[sel] - np.interp(filled.pen[sel], pe_u, we[k]))))
+    # where the empty bow touches nothing after its first contact (the outer plate's petals have let
+    # it go): its force is zero, the filled bow's is the bed's (smoothed over 4 % of the travel)
+    window = 0.04 * end
+    pf, ff = filled.smoothed_force(window)
+    pe_s, fe = empty.smoothed_force(window)
+    free = fe == 0
+    if not free.any():
+        note("the empty bow touches the hull all the way (filled_force_where_empty_free_min_N skipped)")
+        return
+    p_free = pe_s[free]
+    lo, hi = float(p_free.min()), float(p_free.max())
+    inside = (pf >= lo) & (pf <= hi)
+    inside &= np.interp(pf, pe_s, free.astype(float)) == 1.0
+    if not inside.any():
+        note("no filled row where the empty bow is free (filled_force_where_empty_free_min_N skipped)")
+        return
+    key("filled_force_where_empty_free_min_N", float(np.min(ff[inside])))
+    key("empty_free_from_m", lo)
+
+
 def granule_items(run):
     """(area, upward force) of the inner plate's cavity faces from the granules' mesh or interface
     files at the last output frame, and the files' name; ([], None) without them."""
@@ -895,6 +946,7 @@ def main():
         guarded(f"forces and milestones ({run.label})", milestones, run, "_" + run.label)
     if empty:
         guarded("filled_over_empty_min", filled_over_empty, filled, empty)
+        guarded("filled_minus_empty keys", filled_against_empty, filled, empty)
     guarded("collision keys", collision, filled, driven)
     if filled.has("granules.breakage.events"):
         key("broken_granules", float(filled.at("granules.breakage.events")[-1]), "{:.0f}")
