@@ -475,7 +475,7 @@ def rate_compare(run, others, outdir, plt):
     bx.set_xlabel("penetration [mm]")
     bx.set_ylabel("force ratio")
     bx.grid(alpha=0.3)
-    bx.legend(fontsize=7)
+    bx.legend(fontsize=7, loc="upper left")  # (the curves part past 45 mm, on the right)
     save(fig, outdir, "rate_force.png")
 
 
