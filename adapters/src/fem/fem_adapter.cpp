@@ -943,7 +943,13 @@ double FemAdapter::stable_time_step() const {
 void FemAdapter::save_checkpoint() {
   apply_nodal_forces();  // the state holds the loads read so far
   checkpoint_ = solver_->save_state();
-  for (auto& i : interfaces_) i.audit_checkpoint = i.audit;
+  for (auto& i : interfaces_) {
+    i.audit_checkpoint = i.audit;
+    i.nodal_forces_checkpoint = i.nodal_forces;
+    i.tractions_checkpoint = i.tractions;
+    i.has_forces_checkpoint = i.has_forces;
+    i.has_tractions_checkpoint = i.has_tractions;
+  }
   has_checkpoint_ = true;
 }
 
@@ -953,7 +959,13 @@ void FemAdapter::restore_checkpoint() {
   solver_->restore_state(checkpoint_);
   forces_pending_ = false;  // the checkpoint's loads hold until the next read
   failure_log_.restored(*solver_);
-  for (auto& i : interfaces_) i.audit = i.audit_checkpoint;
+  for (auto& i : interfaces_) {  // and the values read then: the loads the restored solver holds
+    i.audit = i.audit_checkpoint;
+    i.nodal_forces = i.nodal_forces_checkpoint;
+    i.tractions = i.tractions_checkpoint;
+    i.has_forces = i.has_forces_checkpoint;
+    i.has_tractions = i.has_tractions_checkpoint;
+  }
 }
 
 std::string FemAdapter::check_state() const {

@@ -79,6 +79,11 @@ class FemAdapter : public Solver {
       Eigen::MatrixX3d forces;     // nodal forces of the last step (empty: none)
       Eigen::MatrixX3d tractions;  // tractions of the last step (empty: none)
     } audit, audit_checkpoint;
+    // What was read when the checkpoint was saved: a restore brings back the solver's loads and
+    // these with them (the audit and the force monitors read them until the next read).
+    Eigen::MatrixX3d nodal_forces_checkpoint, tractions_checkpoint;
+    bool has_forces_checkpoint = false;
+    bool has_tractions_checkpoint = false;
   };
   enum class Part { nodes, quadrature, centres };  // the meshes N, N_quadrature, N_centres
   /// Index into interfaces_ of the coupling mesh `mesh` (and which of its meshes); throws if
