@@ -1,9 +1,13 @@
-# partita_add_module(<name> [SOURCES_GLOB <pattern>] [PUBLIC <deps...>] [PRIVATE <deps...>])
+# partita_add_module(<name> [SOURCES_GLOB <pattern>] [PUBLIC <deps...>] [PRIVATE <deps...>]
+#                    [PCH <headers...>])
 # One library target per module: partita_<name> with the alias partita::<name>, headers in the
 # module's include/, sources found by the glob (default src/*.cpp), C++20, the project warnings
 # linked PRIVATE (build interface only), installed and exported for find_package(partita).
+# PCH: headers most of the module's sources include (the standard library, Eigen, the module's
+# own base headers), precompiled once for the module (PARTITA_PCH, on by default; a source with
+# compile options of its own must set SKIP_PRECOMPILE_HEADERS). It changes no generated code.
 function(partita_add_module name)
-  cmake_parse_arguments(M "" "SOURCES_GLOB" "PUBLIC;PRIVATE" ${ARGN})
+  cmake_parse_arguments(M "" "SOURCES_GLOB" "PUBLIC;PRIVATE;PCH" ${ARGN})
   if(NOT M_SOURCES_GLOB)
     set(M_SOURCES_GLOB src/*.cpp)
   endif()
@@ -21,6 +25,9 @@ function(partita_add_module name)
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_compile_features(${target} PUBLIC cxx_std_20)
   target_link_libraries(${target} PUBLIC ${M_PUBLIC} PRIVATE ${M_PRIVATE} $<BUILD_INTERFACE:partita::warnings>)
+  if(PARTITA_PCH AND M_PCH)
+    target_precompile_headers(${target} PRIVATE ${M_PCH})
+  endif()
   install(TARGETS ${target} EXPORT partitaTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

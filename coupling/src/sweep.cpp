@@ -89,7 +89,7 @@ void check_key_path(const config::Node& root, const config::Node& where, const s
         where.fail("the swept key '" + path + "': '" + done + "' has no element [" +
                    std::to_string(index) + "]");
       n = n[index];
-      done += "[" + std::to_string(index) + "]";
+      done += fmt::format("[{}]", index);
       i = close + 1;
     }
     if (i < path.size() && path[i] == '.') ++i;
@@ -283,20 +283,21 @@ void Sweep::write_summary(const fs::path& dir, const std::vector<std::string>& s
     return q + "\"";
   };
   std::string text = "variant";
-  for (const auto& p : parameters_) text += "," + csv_text(p.label);
+  for (const auto& p : parameters_) (text += ',') += csv_text(p.label);
   text += ",status";
-  for (const auto& r : results_) text += "," + csv_text(r.name);
+  for (const auto& r : results_) (text += ',') += csv_text(r.name);
   text += "\n";
   for (std::size_t k = 0; k < variants_.size(); ++k) {
     const Variant& v = variants_[k];
     text += csv_text(v.folder);
-    for (const auto& value : v.values) text += "," + csv_text(value);
+    for (const auto& value : v.values) (text += ',') += csv_text(value);
     const std::string st = k < status.size() ? status[k] : std::string("not run");
-    text += "," + csv_text(st);
+    (text += ',') += csv_text(st);
     for (const auto& r : results_) {
       const double x =
           st == "ok" ? evaluate(r, dir / v.folder) : std::numeric_limits<double>::quiet_NaN();
-      text += "," + (std::isnan(x) ? std::string() : fmt::format("{:.10g}", x));
+      text += ',';
+      if (!std::isnan(x)) text += fmt::format("{:.10g}", x);
     }
     text += "\n";
   }

@@ -28,6 +28,7 @@
 #include <istream>
 #include <ostream>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -166,10 +167,21 @@ class BinaryReader {
   void expect_section(const std::string& name) {
     std::string s;
     read(s);
-    if (s != "§" + name)
-      fail("the section '" + name + "', found " +
-           (s.rfind("§", 0) == 0 ? "'" + s.substr(std::string("§").size()) + "'"
-                                 : std::string("other data")));
+    // (built with +=: GCC 12 warns falsely on "literal" + std::string, bug 105651)
+    const std::string_view mark = "§";
+    const bool marked = s.rfind(mark, 0) == 0;
+    if (marked && std::string_view(s).substr(mark.size()) == name) return;
+    std::string what = "the section '";
+    what += name;
+    what += "', found ";
+    if (marked) {
+      what += '\'';
+      what.append(s, mark.size());
+      what += '\'';
+    } else {
+      what += "other data";
+    }
+    fail(what);
   }
   std::string bytes() { return get_string(); }
 
