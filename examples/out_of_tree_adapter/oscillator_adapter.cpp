@@ -7,8 +7,9 @@
 
 using namespace partita;
 
-OscillatorAdapter::OscillatorAdapter(double mass, double stiffness, State initial)
-    : m_(mass), k_(stiffness), s_(initial), checkpoint_(initial) {
+OscillatorAdapter::OscillatorAdapter(double mass, double stiffness, State initial, double gravity,
+                                     double damping)
+    : m_(mass), k_(stiffness), g_(gravity), c_(damping), s_(initial), checkpoint_(initial) {
   InterfaceMesh m;
   m.mesh = Mesh("mass", Mesh::Points::Zero(1, 3));
   m.writes.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});
@@ -22,13 +23,20 @@ std::shared_ptr<const config::Spec> OscillatorAdapter::spec() {
   s->real("stiffness", "the spring stiffness k").unit("N/m").positive().required();
   s->real("displacement", "initial displacement z_0").unit("m").def(0.0);
   s->real("velocity", "initial velocity v_0").unit("m/s").def(0.0);
+  s->real("gravity", "gravitational acceleration g along z (the weight m g; e.g. -9.81)")
+      .unit("m/s^2")
+      .def(0.0);
+  s->real("damping", "dashpot coefficient c between the mass and the fixed support (force -c v)")
+      .unit("N s/m")
+      .non_negative()
+      .def(0.0);
   return s;
 }
 
 std::vector<QuantityDoc> OscillatorAdapter::quantities() {
   return {{"z", "m", "displacement of the mass"},
           {"v", "m/s", "velocity of the mass"},
-          {"energy", "J", "kinetic plus spring energy"}};
+          {"energy", "J", "kinetic plus spring energy (plus the weight's potential energy -m g z)"}};
 }
 
 void OscillatorAdapter::register_in(Registry<SolverFactory>& solvers) {
@@ -39,7 +47,7 @@ std::unique_ptr<Solver> OscillatorAdapter::create(const SolverContext& context) 
   const config::Node& c = context.config;
   return std::make_unique<OscillatorAdapter>(
       c.real("mass"), c.real("stiffness"),
-      State{c.real("displacement"), c.real("velocity"), 0.0});
+      State{c.real("displacement"), c.real("velocity"), 0.0}, c.real("gravity"), c.real("damping"));
 }
 
 void OscillatorAdapter::read(std::string_view mesh, std::string_view data,
@@ -58,14 +66,28 @@ void OscillatorAdapter::write(std::string_view mesh, std::string_view data,
   values(0, 2) = s_.z;
 }
 
-// Exact for a force constant over the step: about z_eq = F/k the motion is harmonic,
-//   z(t + dt) = z_eq + (z - z_eq) cos(w dt) + v/w sin(w dt),  w = sqrt(k/m).
+// Exact for a force constant over the step (the force read plus the weight m g): about
+// z_eq = (F + m g)/k the motion y = z - z_eq is that of a free damped oscillator,
+//   m y'' + c y' + k y = 0,  w0 = sqrt(k/m),  h = c/(2m):
+//   y(t + dt) = e^(-h dt) (y C + (v + h y) S),  v(t + dt) = e^(-h dt) (v C - (w0^2 y + h v) S)
+// with C = cos(wd dt), S = sin(wd dt)/wd, wd = sqrt(w0^2 - h^2) (underdamped; undamped: h = 0),
+// C = cosh(q dt), S = sinh(q dt)/q, q = sqrt(h^2 - w0^2) (overdamped), C = 1, S = dt (critical).
 void OscillatorAdapter::advance(double dt) {
-  const double w = std::sqrt(k_ / m_), z_eq = force_ / k_;
-  const double c = std::cos(w * dt), s = std::sin(w * dt);
-  const double z = z_eq + (s_.z - z_eq) * c + s_.v / w * s;
-  s_.v = -(s_.z - z_eq) * w * s + s_.v * c;
-  s_.z = z;
+  const double w0 = std::sqrt(k_ / m_), z_eq = (force_ + m_ * g_) / k_;
+  const double h = c_ / (2.0 * m_), d = w0 * w0 - h * h;
+  double C = 1.0, S = dt;
+  if (d > 0.0) {
+    const double wd = std::sqrt(d);
+    C = std::cos(wd * dt);
+    S = std::sin(wd * dt) / wd;
+  } else if (d < 0.0) {
+    const double q = std::sqrt(-d);
+    C = std::cosh(q * dt);
+    S = std::sinh(q * dt) / q;
+  }
+  const double decay = std::exp(-h * dt), y = s_.z - z_eq;
+  s_.z = z_eq + decay * (y * C + (s_.v + h * y) * S);
+  s_.v = decay * (s_.v * C - (w0 * w0 * y + h * s_.v) * S);
   s_.t += dt;
 }
 
@@ -88,5 +110,5 @@ void OscillatorAdapter::read_restart(BinaryReader& in) {
 std::vector<MonitorValue> OscillatorAdapter::monitors() const {
   return {{"z", "m", s_.z},
           {"v", "m/s", s_.v},
-          {"energy", "J", 0.5 * m_ * s_.v * s_.v + 0.5 * k_ * s_.z * s_.z}};
+          {"energy", "J", 0.5 * m_ * s_.v * s_.v + 0.5 * k_ * s_.z * s_.z - m_ * g_ * s_.z}};
 }

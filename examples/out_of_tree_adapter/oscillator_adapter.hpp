@@ -1,6 +1,8 @@
 #pragma once
 // A mass on a spring along z (one degree of freedom), as a partita solver: the smallest complete
-// adapter. It exposes one mesh, "mass" (one point), writes its displacement and reads a force.
+// adapter. It exposes one mesh, "mass" (one point), writes its displacement and reads a force
+// (the force the other participant exerts on it: its motion is the other side's boundary motion,
+// the other side's reaction its load). Optionally under gravity along z and with a dashpot.
 
 #include <memory>
 
@@ -13,7 +15,8 @@ class OscillatorAdapter final : public partita::Solver {
   struct State {
     double z = 0.0, v = 0.0, t = 0.0;
   };
-  OscillatorAdapter(double mass, double stiffness, State initial);
+  OscillatorAdapter(double mass, double stiffness, State initial, double gravity = 0.0,
+                    double damping = 0.0);
   static std::unique_ptr<partita::Solver> create(const partita::SolverContext& context);
   static std::shared_ptr<const partita::config::Spec> spec();
   static std::vector<partita::QuantityDoc> quantities();
@@ -34,7 +37,7 @@ class OscillatorAdapter final : public partita::Solver {
   std::vector<partita::MonitorValue> monitors() const override;
 
  private:
-  double m_, k_, force_ = 0.0;
+  double m_, k_, g_, c_, force_ = 0.0;
   State s_, checkpoint_;
   std::vector<partita::InterfaceMesh> meshes_;
 };
