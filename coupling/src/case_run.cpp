@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <set>
 
@@ -84,6 +85,23 @@ void CaseRun::open_csv_files() {
   if (energy_) energy_csv_ = CsvSeries(output_dir_ / "energy.csv", "time", "s", energy_->columns());
 }
 
+// The monitors' plots against another quantity (monitors[].plots), one line each: x, then its
+// y, as the CSV's column names without their units. plot_monitors.py reads DIR/<name>.plots
+// beside DIR/<name>.csv; a monitor without plots has no such file.
+void CaseRun::write_plot_requests() const {
+  for (const auto& m : monitors_) {
+    const fs::path file = output_dir_ / (m.name + ".plots");
+    if (m.plots.empty()) {
+      std::error_code ec;
+      fs::remove(file, ec);  // an earlier run's
+      continue;
+    }
+    std::ofstream out(file);
+    for (const auto& xy : m.plots) out << join_names(xy, ",") << "\n";
+    if (!out) throw Error("cannot write " + file.string());
+  }
+}
+
 void CaseRun::flush_csv_files() {
   Stopwatch clock;
   coupling_csv_.flush();
@@ -140,6 +158,7 @@ void CaseRun::run() {
     fs::create_directories(output_dir_ / "vtk");
     summary_.resumed_from = progress_.windows_done;
   }
+  write_plot_requests();
 
   logger->info(
       "case '{}': {} windows of {:.6g} s to t = {:.6g} s, scheme {}, participants {}; output in "
@@ -256,12 +275,30 @@ void CaseRun::run() {
       summary_.imbalance_warnings
           ? fmt::format("; {} windows with an exchange off balance", summary_.imbalance_warnings)
           : std::string());
-  if (energy_)
-    logger->info("energy balance: largest |error| {:.3g}{}", summary_.max_energy_balance_error,
-                 summary_.energy_balance_warnings
-                     ? fmt::format(", {} windows beyond energy.tolerance {:.3g}",
-                                   summary_.energy_balance_warnings, energy_->settings().tolerance)
-                     : std::string());
+  if (energy_) {
+    // The windows the tolerance reads: those whose energy reached energy.floor.
+    const double floor = energy_->settings().floor;
+    const std::string below =
+        summary_.energy_balance_uncounted
+            ? fmt::format("; {} windows whose energy stayed below energy.floor {:.3g} J not "
+                          "counted",
+                          summary_.energy_balance_uncounted, floor)
+            : std::string();
+    if (summary_.max_energy_balance_window < 0)
+      logger->info("energy balance: no window's energy reached energy.floor {:.3g} J, nothing "
+                   "to read",
+                   floor);
+    else
+      logger->info("energy balance: largest |error| {:.3g} at t = {:.6g} s (window {}){}{}",
+                   summary_.max_energy_balance_error, summary_.max_energy_balance_time,
+                   summary_.max_energy_balance_window,
+                   summary_.energy_balance_warnings
+                       ? fmt::format("; {} windows beyond energy.tolerance {:.3g}",
+                                     summary_.energy_balance_warnings,
+                                     energy_->settings().tolerance)
+                       : std::string(),
+                   below);
+  }
 }
 
 }  // namespace partita::coupling

@@ -748,9 +748,36 @@ void CaseRun::build_monitors(const config::Node& root) {
           "a monitor name becomes DIR/<name>.csv: it must be non-empty, without '/', and not "
           "'coupling'");
     if (!files.insert(mon.name).second) m["name"].fail("two monitors are named '" + mon.name + "'");
+    std::vector<std::string> columns;
     for (const config::Node& q : string_items(m["quantities"])) {
       const NamedQuantity nq = resolve_quantity(q);
       mon.quantities.emplace_back(nq.participant, nq.quantity);
+      columns.push_back(nq.participant->name() + "." + nq.quantity);
+    }
+    if (m.has("plots")) {
+      // Each plot draws columns of this monitor's CSV: x and y must be among its quantities.
+      const auto column = [&](const config::Node& q) {
+        const std::string name = q.as_string();
+        if (std::find(columns.begin(), columns.end(), name) == columns.end())
+          q.fail("'" + name + "' is not one of the quantities of monitor '" + mon.name +
+                 "' (a plot draws its columns): " + join_names(columns) +
+                 did_you_mean(name, columns) + "; add it to the monitor's quantities");
+        return name;
+      };
+      std::set<std::string> xs;
+      for (const config::Node& plot : m["plots"].items()) {
+        std::vector<std::string> xy = {column(plot["x"])};
+        if (!xs.insert(xy.front()).second)
+          plot["x"].fail("two plots of monitor '" + mon.name + "' have x '" + xy.front() +
+                         "' (both would be " + mon.name + "_vs_" + xy.front() +
+                         ".png): put their y in one list");
+        for (const config::Node& y : string_items(plot["y"])) {
+          xy.push_back(column(y));
+          if (xy.back() == xy.front())
+            y.fail("'" + xy.front() + "' is the plot's x: a y must be another quantity");
+        }
+        mon.plots.push_back(std::move(xy));
+      }
     }
     monitors_.push_back(std::move(mon));
   }

@@ -183,8 +183,15 @@ class CaseRun::EnergyBalanceObserver : public WindowObserver {
     Stopwatch csv_clock;
     run_.energy_csv_.record(w.time, row_);
     run_.summary_.output_seconds += csv_clock.seconds();
-    run_.summary_.max_energy_balance_error =
-        std::max(run_.summary_.max_energy_balance_error, std::abs(b.error));
+    RunSummary& sum = run_.summary_;
+    if (!balance.counts(b)) {
+      ++sum.energy_balance_uncounted;  // below energy.floor: not read, as by the tolerance
+    } else if (sum.max_energy_balance_window < 0 ||
+               std::abs(b.error) > sum.max_energy_balance_error) {
+      sum.max_energy_balance_error = std::abs(b.error);
+      sum.max_energy_balance_time = w.time;
+      sum.max_energy_balance_window = w.window;
+    }
     if (!balance.exceeded(b)) return;
     const std::string what = fmt::format(
         "window {} (t = {:.6g} s): the energy balance is off by {:.3g} (energy.tolerance "

@@ -21,8 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kMagic = "partita restart file";
-constexpr std::uint32_t kVersion = 4;  // 2: the energy audit; 3: section checksums; 4: the
-                                       // energy balance
+constexpr std::uint32_t kVersion = 5;  // 2: the energy audit; 3: section checksums; 4: the
+                                       // energy balance; 5: when its largest error occurred
 constexpr std::uint32_t kByteOrder = 0x01020304u;
 
 // DIR/restart/w000000001234.bin -> 1234; -1 for other names.
@@ -158,6 +158,9 @@ void CaseRun::SavedRun::serialize_state(StateArchive& ar) {
   ar.io(energy_initial);
   ar.io(energy_balance_warnings);
   ar.io(max_energy_balance_error);
+  ar.io(max_energy_balance_time);
+  ar.io(max_energy_balance_window);
+  ar.io(energy_balance_uncounted);
   ar.io(energy_csv);
   ar.section("csv");
   ar.io(coupling_csv);
@@ -220,6 +223,9 @@ CaseRun::SavedRun CaseRun::saved_run(const Progress& progress) const {
   }
   r.energy_balance_warnings = summary_.energy_balance_warnings;
   r.max_energy_balance_error = summary_.max_energy_balance_error;
+  r.max_energy_balance_time = summary_.max_energy_balance_time;
+  r.max_energy_balance_window = summary_.max_energy_balance_window;
+  r.energy_balance_uncounted = summary_.energy_balance_uncounted;
   for (const auto& [series, pvd] : pvds_) r.pvds.emplace_back(series, pvd.entries());
   return r;
 }
@@ -366,6 +372,9 @@ void CaseRun::read_restart_file(const fs::path& path, Progress& progress) {
     monitors_[i].csv.restore_text(std::move(read.monitors[i].second));
   summary_.energy_balance_warnings = static_cast<long>(read.energy_balance_warnings);
   summary_.max_energy_balance_error = read.max_energy_balance_error;
+  summary_.max_energy_balance_time = read.max_energy_balance_time;
+  summary_.max_energy_balance_window = read.max_energy_balance_window;
+  summary_.energy_balance_uncounted = static_cast<long>(read.energy_balance_uncounted);
   if (energy_ && !read.energy_csv.empty()) {
     energy_->restore(read.energy_started != 0, read.energy_initial);
     energy_csv_.restore_text(std::move(read.energy_csv));

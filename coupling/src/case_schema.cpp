@@ -135,6 +135,18 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
       std::make_shared<Spec>("monitor", "a CSV time series DIR/<name>.csv of solver quantities");
   monitor->string("name", "file name without .csv").required();
   monitor->strings("quantities", "participant.quantity of each column").required();
+  auto monitor_plot = std::make_shared<Spec>(
+      "monitor plot",
+      "quantities of the monitor drawn against another of its quantities instead of time "
+      "(e.g. {x: hull.bow.penetration, y: [hull.bow.force_z]}): DIR/<name>_vs_<x>.png");
+  monitor_plot->string("x", "the quantity along the x axis, one of the monitor's quantities")
+      .required();
+  monitor_plot->strings("y", "the quantities drawn over it, of the monitor's quantities")
+      .required();
+  monitor->list("plots",
+                "plots of the monitor's quantities against one of them, beside its plot over "
+                "time; each {x, y}",
+                monitor_plot);
 
   auto energy = std::make_shared<Spec>(
       "energy",
@@ -165,7 +177,9 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
   energy
       ->real("floor",
              "smallest scale of the error (keeps round-off at rest from reading as an error); "
-             "default none")
+             "a window whose energy (sum |inputs| or sum |stored| + sum |dissipated|) stays "
+             "below it is written to energy.csv but not held to the tolerance nor counted in the "
+             "run's largest error; default none")
       .unit("J")
       .positive();
 

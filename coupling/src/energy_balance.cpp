@@ -58,7 +58,8 @@ EnergyBalance::Row EnergyBalance::evaluate(const std::vector<double>& values,
   Row r;
   r.inputs = inputs;
   r.stored_dissipated = held;
-  r.scale = std::max({input_scale, held_scale, settings_.floor});
+  r.measured = std::max(input_scale, held_scale);
+  r.scale = std::max(r.measured, settings_.floor);
   r.error = r.scale > 0.0 ? (held - inputs - initial_) / r.scale : 0.0;
   row.assign(values.begin(), values.end());
   if (settings_.coupling_column) row.push_back(coupling_created);

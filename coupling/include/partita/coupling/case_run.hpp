@@ -115,7 +115,13 @@ struct RunSummary {
   long imbalance_warnings = 0;         ///< windows where an exchange's balance exceeded the limit
   long energy_warnings = 0;            ///< windows where the coupling created too much energy
   long energy_balance_warnings = 0;    ///< windows with |energy balance error| over its bound
-  double max_energy_balance_error = 0.0;  ///< largest |energy balance error| (energy section)
+  /// The largest |energy balance error| of the windows whose energy reached energy.floor (the
+  /// rule of energy.tolerance: EnergyBalance::counts), and when it occurred (-1: no window
+  /// counted yet).
+  double max_energy_balance_error = 0.0;
+  double max_energy_balance_time = -1.0;
+  std::int64_t max_energy_balance_window = -1;
+  long energy_balance_uncounted = 0;  ///< windows below energy.floor (not counted)
   double mean_iterations() const {
     return windows > 0 ? static_cast<double>(iterations) / windows : 0.0;
   }
@@ -157,6 +163,7 @@ class CaseRun {
   struct Monitor {
     std::string name;
     std::vector<std::pair<Participant*, std::string>> quantities;
+    std::vector<std::vector<std::string>> plots;  // monitor.plots: x, then its y
     CsvSeries csv;
   };
   // What run() carries from window to window besides the solvers (restart files keep it).
@@ -187,6 +194,8 @@ class CaseRun {
     double energy_initial = 0.0;      // ("" without an energy section)
     std::int64_t energy_balance_warnings = 0;
     double max_energy_balance_error = 0.0;
+    double max_energy_balance_time = -1.0;
+    std::int64_t max_energy_balance_window = -1, energy_balance_uncounted = 0;
     std::string energy_csv;
     std::vector<std::pair<std::string, std::vector<std::pair<double, std::string>>>> pvds;
     // Written and read by the same functions (StateArchive: state_archive.hpp).
@@ -220,6 +229,7 @@ class CaseRun {
   Participant* named_participant(const config::Node& n, const std::string& name) const;
   void check_sweep_values(const std::filesystem::path& case_file, const class Sweep& sweep) const;
   void write_output(int frame, double time);
+  void write_plot_requests() const;  // DIR/<monitor>.plots, for the plot script
   void open_csv_files();   // coupling.csv, the monitors' and energy.csv (their headers)
   void flush_csv_files();
 

@@ -11,6 +11,10 @@
 //   initial = stored + dissipated - inputs at t = 0,
 //   scale = max(sum |inputs|, sum |stored| + sum |dissipated|, floor)   (0 / 0 = 0).
 //
+// A window whose energy stays below the floor (both sums of magnitudes under it: the system at
+// rest, a first touch's few mJ) is written to energy.csv with its error over the floor, but it
+// is not held to the tolerance nor counted in the run's largest error (counts()).
+//
 // The coupling's own term is the net energy the interfaces created (the energy audit's sum of
 // the work done on both sides of each pair, Solver::interface_work): a lossless coupling
 // creates none. By default it is reported (column `coupling created [J]`) and not counted, so
@@ -34,12 +38,13 @@ class EnergyBalance {
   struct Settings {
     double tolerance = 0.0;       ///< |error| above it warns once (or stops); 0: no bound
     bool stop = false;            ///< beyond the tolerance: stop the run
-    double floor = 0.0;           ///< smallest scale [J]
+    double floor = 0.0;           ///< smallest scale [J]; a window below it is not counted
     bool coupling_column = false; ///< the case has interface pairs (a `coupling created` column)
     bool count_coupling = false;  ///< the coupling's created energy is an input term
   };
   struct Row {
     double inputs = 0.0, stored_dissipated = 0.0, scale = 0.0, error = 0.0;
+    double measured = 0.0;  ///< max(sum |inputs|, sum |stored| + sum |dissipated|): the floor aside
   };
 
   EnergyBalance() = default;
@@ -54,9 +59,12 @@ class EnergyBalance {
   /// initial value) fixes the initial energy. `row` receives the CSV values after time.
   Row evaluate(const std::vector<double>& values, double coupling_created,
                std::vector<double>& row);
-  /// |error| beyond the tolerance (a bound was given).
+  /// The window's energy reached the floor: its error counts (the tolerance, the run's largest
+  /// error). Without a floor every window counts.
+  bool counts(const Row& r) const { return !(r.measured < settings_.floor); }
+  /// A counted window's |error| beyond the tolerance (a bound was given).
   bool exceeded(const Row& r) const {
-    return settings_.tolerance > 0.0 && !(abs_value(r.error) <= settings_.tolerance);
+    return settings_.tolerance > 0.0 && counts(r) && !(abs_value(r.error) <= settings_.tolerance);
   }
   /// "stored 1.2 J + dissipated ... " for a diagnosis.
   std::string describe(const Row& r) const;
