@@ -1,14 +1,19 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Overlay one monitor column of every variant of a partita sweep in one PNG.
 
 Usage: plot_sweep.py [--x XCOLUMN] [--x-scale F] [--y-scale F] OUT.png COLUMN LABEL FILE.csv [...]
 COLUMN is the column's name without its unit ("granules.plate.force_z"); each FILE.csv is the
 variant's monitor CSV (first column: time). Variants whose file or column is missing are left
-out. The PNG is written under a temporary name and renamed.
+out. Each variant has its own colour and line style, the legend beside its panel; more than
+MAX_SERIES variants are drawn in several panels of MAX_SERIES, stacked on the same axes' ranges.
+The PNG is written under a temporary name and renamed.
 """
 import csv
 import os
 import sys
+
+MAX_SERIES = 6
+STYLES = ["-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (8, 2))]
 
 
 def main(argv):
@@ -27,8 +32,7 @@ def main(argv):
             y_scale = float(value)
         argv = argv[:1] + argv[3:]
     out, column = argv[1], argv[2]
-    fig, ax = plt.subplots(figsize=(7, 4.2), dpi=120)
-    xlabel, ylabel, drawn = "time [s]", column, 0
+    xlabel, ylabel, curves = "time [s]", column, []
     pairs = argv[3:]
     for label, path in zip(pairs[0::2], pairs[1::2]):
         if not os.path.exists(path):
@@ -49,17 +53,22 @@ def main(argv):
         if y_scale != 1.0:
             ylabel += " x %g" % y_scale
         data = [r for r in rows[1:] if len(r) == len(header)]
-        ax.plot([x_scale * float(r[xc]) for r in data], [y_scale * float(r[c]) for r in data],
-                lw=1.3, label=label)
-        drawn += 1
-    if drawn == 0:
+        curves.append((label, [x_scale * float(r[xc]) for r in data],
+                       [y_scale * float(r[c]) for r in data]))
+    if not curves:
         return 1
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title("sweep: " + column)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
+    chunks = [curves[k:k + MAX_SERIES] for k in range(0, len(curves), MAX_SERIES)]
+    fig, axes = plt.subplots(len(chunks), 1, sharex=True, sharey=True, squeeze=False,
+                             figsize=(9, 1.2 + 3.2 * len(chunks)), dpi=120,
+                             constrained_layout=True)
+    for ax, chunk in zip(axes[:, 0], chunks):
+        for k, (label, xs, ys) in enumerate(chunk):
+            ax.plot(xs, ys, color="C%d" % k, ls=STYLES[k % len(STYLES)], lw=1.3, label=label)
+        ax.set_ylabel(ylabel)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    axes[-1, 0].set_xlabel(xlabel)
+    axes[0, 0].set_title("sweep: " + column)
     tmp = out + ".part.png"
     fig.savefig(tmp)
     os.replace(tmp, out)

@@ -9,8 +9,10 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -43,6 +45,67 @@ TEST_CASE("monitor plots: one panel per unit", "[app][plots]") {
     CHECK(drawn.status == 0);
     CHECK(fs::file_size(dir / "mixed.png") > 1000);
   }
+  fs::remove_all(dir);
+}
+
+// Quantities of unrelated size get panels of their own, even of one unit or none: a count never
+// shares an axis with a ratio, nor a column with one more than 100 times smaller; a panel holds
+// at most 6 lines; a time of -1 ("not yet") is not drawn; a case of one participant has nothing
+// coupled to plot.
+TEST_CASE("monitor plots: unrelated sizes apart, few lines a panel, placeholders masked",
+          "[app][plots]") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("partita_plots_sizes_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  const std::string script = (fs::path(PARTITA_SOURCE_DIR) / "app" / "plot_monitors.py").string();
+  const auto panels = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    const auto r = partita::test::run_command(python + " " + quote(script) + " --list-panels " +
+                                              quote(dir / name));
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    return r.output;
+  };
+  // coupling.csv: iterations (a count) beside an imbalance of 4e-8, over time, not the window
+  CHECK(panels("coupling.csv",
+               "window,time [s],iterations,imbalance force a->b\n"
+               "0,0,0,0\n1,0.1,3,4e-8\n2,0.2,5,3e-8\n") ==
+        "[]: iterations\n[]: imbalance force a->b\n");
+  // one participant: iterations of 1 and nothing else
+  CHECK(panels("single.csv", "window,time [s],iterations\n0,0,1\n1,0.1,1\n2,0.2,1\n") ==
+        "(no plot: nothing coupled)\n");
+  // a particle count beside contacts per particle; failed elements beside a plastic strain; a
+  // first failure time of -1 until it happens
+  CHECK(panels("bed.csv",
+               "time [s],g.particles,g.contacts_per_particle,h.failed_elements,"
+               "h.max_equivalent_plastic_strain,h.first_failure_time [s]\n"
+               "0,1612,0,0,0,-1\n1e-3,1612,4.2,0,0.1,-1\n2e-3,1610,4.1,3,0.31,1.5e-3\n") ==
+        "[]: g.particles\n"
+        "[]: g.contacts_per_particle, h.max_equivalent_plastic_strain\n"
+        "[]: h.failed_elements\n"
+        "[s]: h.first_failure_time [s] (-1 not drawn)\n");
+  // (the two counts are 500 times apart; the two ratios 14 times)
+  // 8 energies of one size: no panel holds more than 6 lines, and every one is drawn once
+  std::string header = "time [s]", row0 = "0", row1 = "1";
+  for (int k = 0; k < 8; ++k) {
+    header += ",p.e" + std::to_string(k) + " [J]";
+    row0 += ",0";
+    row1 += "," + std::to_string(10 + k);
+  }
+  const std::string listed = panels("energy.csv", header + "\n" + row0 + "\n" + row1 + "\n");
+  std::istringstream lines(listed);
+  std::string line;
+  int drawn = 0, panel_count = 0;
+  while (std::getline(lines, line)) {
+    const int n = static_cast<int>(std::count(line.begin(), line.end(), ',')) + 1;
+    CHECK(n <= 6);
+    drawn += n;
+    ++panel_count;
+  }
+  CHECK(drawn == 8);
+  CHECK(panel_count == 2);
   fs::remove_all(dir);
 }
 
