@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The rebound of cases/bouncing_sphere: reads DIR/sphere.csv (the sphere's centre height z and
 vertical velocity every window) and prints key=value lines:
   drop_height_m     bottom of the sphere above the plane at the start (z0 - R)

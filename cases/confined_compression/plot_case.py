@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Figures and checks of the confined compression sweep (seed 001, Figs. 1 and 2).
 
 Usage: plot_case.py OUTPUT_DIR
@@ -23,7 +23,26 @@ import glob
 import os
 import sys
 
-import matplotlib
+# The python partita's own plots use (app/process.cpp); the modules' Debian packages.
+PARTITA_PYTHON = "/usr/bin/python3"
+DEBIAN_PACKAGE = {"numpy": "python3-numpy", "matplotlib": "python3-matplotlib", "vtk": "python3-vtk9"}
+
+
+def require(*modules):
+    """Stop with one line when a module this script needs is missing: which one, its Debian
+    package, the python that lacks it and the one partita's own plots use."""
+    import importlib
+    for m in modules:
+        try:
+            importlib.import_module(m)
+        except ImportError:
+            sys.exit(f"{os.path.basename(sys.argv[0])}: the python module {m} is missing in "
+                     f"{sys.executable} (Debian package {DEBIAN_PACKAGE.get(m, m)}); run it with "
+                     f"{PARTITA_PYTHON}, the python partita's own plots use, or install it there")
+
+
+require("matplotlib", "vtk")
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Strike a settled bed off level: remove every granule whose top (z + r) is above a height
 (LAMMPS data as partita writes it). The step between fill.yaml (the bed settled under gravity,
 standing above the cavities' top) and the relaxation under the inner plate (fill.yaml again,

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The cavities of the double-hull section as one ASCII STL (floor and four side walls of each
 cell, normals into the cell, walls 30 mm taller than the cavity): the fill's container."""
 import sys

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Force balance of the granules in the loaded hollow box (hollow_box.yaml), from OUT/wall.csv:
 the forces the FE box received on its six inner faces, averaged over the last 20 % of the rows.
 At (quasi-static) rest the granules are in equilibrium: the box's inner faces carry their weight

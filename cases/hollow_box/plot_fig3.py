@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Seed 001, Fig. 3: the granules confined in the hollow box, initial (left) and final (right)
 configuration. The granules are drawn as spheres to scale (front half, y < 15 mm, so that the
 inside shows); the box as the wire frame of its outer and inner (cavity) edges. Final: each
@@ -7,6 +7,7 @@ granule coloured by how far it moved under the load [um].
 Usage: plot_fig3.py INITIAL.data FINAL.data [PNG]
        (e.g. cases/hollow_box/settled.data out/hollow-box/E=2GPa/granules.data fig3.png)
 Reads particle files (LAMMPS data, as partita writes them: id type diameter density x y z)."""
+import os
 import sys
 
 OUTER = ((0.0, 0.0, 0.0), (0.040, 0.030, 0.030))
@@ -37,9 +38,28 @@ def box_edges(ax, lo, hi, **style):
             ax.plot(*[[1e3 * a[k], 1e3 * b[k]] for k in range(3)], **style)
 
 
+# The python partita's own plots use (app/process.cpp); the modules' Debian packages.
+PARTITA_PYTHON = "/usr/bin/python3"
+DEBIAN_PACKAGE = {"numpy": "python3-numpy", "matplotlib": "python3-matplotlib", "vtk": "python3-vtk9"}
+
+
+def require(*modules):
+    """Stop with one line when a module this script needs is missing: which one, its Debian
+    package, the python that lacks it and the one partita's own plots use."""
+    import importlib
+    for m in modules:
+        try:
+            importlib.import_module(m)
+        except ImportError:
+            sys.exit(f"{os.path.basename(sys.argv[0])}: the python module {m} is missing in "
+                     f"{sys.executable} (Debian package {DEBIAN_PACKAGE.get(m, m)}); run it with "
+                     f"{PARTITA_PYTHON}, the python partita's own plots use, or install it there")
+
+
 def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
+    require("matplotlib", "numpy")
     first, last = read(sys.argv[1]), read(sys.argv[2])
     png = sys.argv[3] if len(sys.argv) > 3 else "fig3.png"
     import matplotlib

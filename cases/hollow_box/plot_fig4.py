@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Seed 001, Fig. 4: the displacement of the opposite wall along its centre line, divided by the
 box length L, over the position along the line: one curve per particle Young's modulus (the
 variants of the hollow_box.yaml sweep) and the empty box (empty_box.yaml) as the reference.
@@ -46,7 +46,26 @@ def modulus(folder):
     return float(m.group(1)) * scale[m.group(2)] if m else float("nan")
 
 
+# The python partita's own plots use (app/process.cpp); the modules' Debian packages.
+PARTITA_PYTHON = "/usr/bin/python3"
+DEBIAN_PACKAGE = {"numpy": "python3-numpy", "matplotlib": "python3-matplotlib", "vtk": "python3-vtk9"}
+
+
+def require(*modules):
+    """Stop with one line when a module this script needs is missing: which one, its Debian
+    package, the python that lacks it and the one partita's own plots use."""
+    import importlib
+    for m in modules:
+        try:
+            importlib.import_module(m)
+        except ImportError:
+            sys.exit(f"{os.path.basename(sys.argv[0])}: the python module {m} is missing in "
+                     f"{sys.executable} (Debian package {DEBIAN_PACKAGE.get(m, m)}); run it with "
+                     f"{PARTITA_PYTHON}, the python partita's own plots use, or install it there")
+
+
 def main():
+    require("matplotlib")
     sweep = sys.argv[1] if len(sys.argv) > 1 else "out/hollow-box"
     empty = sys.argv[2] if len(sys.argv) > 2 else "out/hollow-box-empty"
     png = sys.argv[3] if len(sys.argv) > 3 else os.path.join(sweep, "fig4.png")

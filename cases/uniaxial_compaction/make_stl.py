@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Write plate_bottom.stl: the lower face of the 20 x 20 mm plate at z = 20 mm as a binary STL,
 16 x 16 cells split into 512 triangles with normals facing down (towards the granules).
 The FE side meshes the same face with 20 x 20 quadrilaterals: the two meshes do not match,

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The deformed plate seen from both sides (the analogue of seed 000, Fig. 3): the lower face of
 the FE plate and the STL plate of the DEM at the last output frame, deflection in colour, and a
 section through the middle with both. Also prints how far the STL vertices lie from the FE
@@ -28,7 +28,26 @@ def last(pattern):
     return files[-1]
 
 
+# The python partita's own plots use (app/process.cpp); the modules' Debian packages.
+PARTITA_PYTHON = "/usr/bin/python3"
+DEBIAN_PACKAGE = {"numpy": "python3-numpy", "matplotlib": "python3-matplotlib", "vtk": "python3-vtk9"}
+
+
+def require(*modules):
+    """Stop with one line when a module this script needs is missing: which one, its Debian
+    package, the python that lacks it and the one partita's own plots use."""
+    import importlib
+    for m in modules:
+        try:
+            importlib.import_module(m)
+        except ImportError:
+            sys.exit(f"{os.path.basename(sys.argv[0])}: the python module {m} is missing in "
+                     f"{sys.executable} (Debian package {DEBIAN_PACKAGE.get(m, m)}); run it with "
+                     f"{PARTITA_PYTHON}, the python partita's own plots use, or install it there")
+
+
 def main(argv):
+    require("vtk")
     out = argv[1]
     fe, dem, mesh = (argv[2:5] + ["plate", "granules", "plate"][len(argv[2:5]):])[:3]
     fa = arrays(last(os.path.join(out, "vtk", f"{fe}_fem_*.vtu")))
@@ -71,7 +90,9 @@ def main(argv):
     try:
         import matplotlib
     except ImportError:
-        print("plot_plate: python3-matplotlib is not installed; no picture", file=sys.stderr)
+        print(f"plot_plate: no python module matplotlib in {sys.executable} (Debian package "
+              f"python3-matplotlib; {PARTITA_PYTHON} is the python partita's own plots use): no "
+              "picture", file=sys.stderr)
         return 0
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
