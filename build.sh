@@ -23,8 +23,16 @@ cd "$(dirname "$0")"
 
 # libsuitesparse-dev: CHOLMOD, the FEM's supernodal sparse Cholesky (optional: without it the
 # build falls back to Eigen's solver). libopenblas0-serial: the BLAS CHOLMOD's supernodes run on
-# (Debian's reference BLAS makes the factorisation about 4x slower); single-threaded, so the
-# results do not depend on the thread count and restarts stay bit-identical.
+# (Debian's reference BLAS makes the factorisation about 4x slower). Which BLAS answers is not
+# left to Debian's libblas.so.3 alternative: other packages can pull in the threaded OpenBLAS
+# (libopenblas0-pthread outranks the serial one), whose sums follow the cores, so a plate
+# factorised in a process of its own would give other bits than in a shared one. The build
+# (solvers/fem/CMakeLists.txt, PARTITA_BLAS_DIR) gives the executables the serial OpenBLAS's
+# folder as their run path, so this one package answers whatever the alternatives select (they
+# stay as the machine's owner set them), and every run sets whatever BLAS is loaded to one thread
+# per call through the BLAS's own API (fem::use_serial_blas; `--log-level debug` names the
+# library and its threads). The results then depend neither on the thread count nor on which
+# BLAS packages are installed, and restarts stay bit-identical.
 PACKAGES=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
           catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib
           python3-vtk9 libsuitesparse-dev libopenblas0-serial zlib1g-dev

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <mutex>
 
+#include "partita/fem/blas_runtime.hpp"
 #include "partita/fem/error.hpp"
 #include "supernodal_factorize.hpp"
 #include "supernodal_kernels.hpp"
@@ -161,6 +162,8 @@ std::mutex& cholmod_mutex() {
 class Cholmod final : public SparseFactorisation::Impl {
  public:
   Cholmod(FillOrdering ordering, bool indefinite_ok) : indefinite_ok_(indefinite_ok) {
+    // one thread per BLAS call whatever BLAS is loaded: the factor must not depend on the cores
+    use_serial_blas();
     cholmod_start(&c_);
     c_.print = 0;  // no output: failures are reported through factorize()'s result
     c_.supernodal = CHOLMOD_SUPERNODAL;
