@@ -362,9 +362,15 @@ int main(int argc, char** argv) {
       return 128 + signal;
     }
     run_scripts(c.scripts(), c.output_dir());
+    // name only what is there: a case may write no VTK (no output.vtk, or no participant with
+    // a mesh to show)
+    bool vtk = false;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(c.output_dir() / "vtk", ec))
+      if (entry.path().extension() == ".pvd") vtk = true;
     std::cout << "partita run: finished; output in " << c.output_dir().string()
               << "/ (CSV time series" << (plots ? " and their PNG plots" : "")
-              << "; VTK series for ParaView in vtk/*.pvd)\n";
+              << (vtk ? "; VTK series for ParaView in vtk/*.pvd" : "") << ")\n";
     return 0;
   } catch (const partita::Error& e) {
     std::cerr << "partita: error: " << e.what() << "\n";

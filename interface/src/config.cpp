@@ -1,9 +1,12 @@
 #include "partita/interface/config.hpp"
 
+#include "partita/interface/log.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <unordered_set>
@@ -88,6 +91,10 @@ Param& Param::max(double v, bool exclusive) {
 Param& Param::range(double lo, double hi, bool open) {
   min(lo, open);
   return max(hi, open);
+}
+Param& Param::typical(double lo, double hi, std::string what) {
+  typical_ = Typical{lo, hi, std::move(what)};
+  return *this;
 }
 Param& Param::choices(std::vector<std::string> names) {
   choices_ = std::move(names);
@@ -193,6 +200,48 @@ void check_bounds(const Node& c, const Param& p, double v) {
            (p.unit_name().empty() ? "" : " (" + p.unit_name() + ")"));
 }
 
+// A value outside the declared typical range: one warning per place in a file (a case is
+// validated more than once: by check, by the run, by each sweep variant).
+void check_typical(const Node& c, const Param& p, double v) {
+  const auto& t = p.typical_range();
+  if (!t || (v >= t->lo && v <= t->hi) || v == 0.0) return;
+  const SourceLocation where = c.location();
+  {
+    static std::mutex m;
+    static std::set<std::string> warned;
+    const std::lock_guard<std::mutex> lock(m);
+    if (!warned.insert(where.str() + " " + c.path()).second) return;
+  }
+  const std::string text = c.is_scalar() ? c.yaml().Scalar() : num(v);
+  const bool bare = is_number_text(text);
+  const std::string& unit = p.unit_name();
+  // what was probably meant: the number as written with a prefix that brings it inside
+  std::vector<std::string> meant;
+  if (bare) {
+    for (const char* prefix : {"G", "M", "k", "m", "u", "n"}) {
+      const auto si = parse_quantity(text + " " + prefix + unit, unit);
+      if (si && *si >= t->lo && *si <= t->hi && meant.size() < 2) meant.push_back(text + " " + prefix + unit);
+    }
+    for (const auto& [equivalent, factor] : std::vector<std::pair<std::string, double>>{
+             {"g/cm^3", 1e3}}) {
+      if (unit == "kg/m^3" && v * factor >= t->lo && v * factor <= t->hi && meant.size() < 2)
+        meant.push_back(text + " " + equivalent);
+    }
+  }
+  std::string message = num(v) + " " + unit + " as read" +
+                        (bare ? " (a number without a unit is in " + unit + ")" : "") +
+                        " is outside the " + t->what + " (" + num(t->lo) + " to " + num(t->hi) +
+                        " " + unit + ")";
+  if (!meant.empty()) {
+    message += "; did you mean " + meant[0] + (meant.size() > 1 ? " or " + meant[1] : "") +
+               "? Write the unit after the number: " + p.key() + ": " + meant[0];
+  } else {
+    message += "; check the value and its unit";
+  }
+  std::string key = c.path();
+  log::get("interface")->warn("{}: key '{}': {}", where.str(), key, message);
+}
+
 void check_choice(const Node& c, const Param& p, const std::string& v) {
   if (p.allowed().empty()) return;
   for (const auto& a : p.allowed())
@@ -203,9 +252,12 @@ void check_choice(const Node& c, const Param& p, const std::string& v) {
 
 void check_value(const Node& c, const Param& p) {
   switch (p.type()) {
-    case Type::real:
-      check_bounds(c, p, c.as_real(p.unit_name()));
+    case Type::real: {
+      const double v = c.as_real(p.unit_name());
+      check_bounds(c, p, v);
+      check_typical(c, p, v);
       break;
+    }
     case Type::integer:
       check_bounds(c, p, static_cast<double>(c.as_integer()));
       break;
@@ -232,9 +284,11 @@ void check_value(const Node& c, const Param& p) {
         c.fail("expected " + std::to_string(p.length()) + " values, found " +
                std::to_string(c.size()));
       for (const Node& e : c.items()) {
-        if (p.type() == Type::reals)
-          check_bounds(e, p, e.as_real(p.unit_name()));
-        else if (p.type() == Type::integers)
+        if (p.type() == Type::reals) {
+          const double v = e.as_real(p.unit_name());
+          check_bounds(e, p, v);
+          check_typical(e, p, v);
+        } else if (p.type() == Type::integers)
           check_bounds(e, p, static_cast<double>(e.as_integer()));
         else
           check_choice(e, p, e.as_string());
@@ -318,6 +372,11 @@ std::string Spec::docs(int indent) const {
     s += ")";
     if (!p.allowed().empty()) s += " one of: " + join_names(p.allowed()) + ";";
     if (!p.bounds_text().empty()) s += " " + p.bounds_text() + ";";
+    if (const auto& t = p.typical_range())
+      s += " typically " + num(t->lo) + " to " + num(t->hi) + " " + p.unit_name() + " (" +
+           t->what + ", a warning outside);";
+    if (const std::string eq = equivalent_units(p.unit_name()); !eq.empty())
+      s += " also in " + eq + ";";
     s += " " + p.doc() + "\n";
     if (p.sub_spec()) s += p.sub_spec()->docs(indent + 4);
   }
@@ -328,6 +387,33 @@ std::string Spec::docs(int indent) const {
 
 // ---------------------------------------------------------------------------------------------
 // Quantities with units
+
+namespace {
+// Units a structures or process engineer writes for a declared SI unit, with their factor to it
+// (besides the SI prefixes, which parse_quantity() handles for every unit).
+const std::vector<std::pair<std::string, double>>& equivalents(std::string_view unit) {
+  static const std::vector<std::pair<std::string, double>> none;
+  static const std::vector<std::pair<std::string, double>> pressure = {
+      {"N/mm^2", 1e6}, {"N/m^2", 1.0},   {"kN/m^2", 1e3}, {"kN/mm^2", 1e9},
+      {"MN/m^2", 1e6}, {"N/cm^2", 1e4}, {"bar", 1e5},    {"mbar", 1e2}};
+  static const std::vector<std::pair<std::string, double>> density = {
+      {"g/cm^3", 1e3}, {"kg/dm^3", 1e3}, {"t/m^3", 1e3}, {"t/mm^3", 1e12}, {"kg/mm^3", 1e9},
+      {"g/m^3", 1e-3}};
+  static const std::vector<std::pair<std::string, double>> speed = {
+      {"km/h", 1.0 / 3.6}, {"m/ms", 1e3}, {"mm/ms", 1.0}};
+  static const std::vector<std::pair<std::string, double>> energy = {
+      {"N m", 1.0}, {"Nm", 1.0}, {"N mm", 1e-3}, {"Nmm", 1e-3}, {"kN m", 1e3}};
+  static const std::vector<std::pair<std::string, double>> frequency = {{"1/s", 1.0}};
+  static const std::vector<std::pair<std::string, double>> rate = {{"Hz", 1.0}};
+  if (unit == "Pa") return pressure;
+  if (unit == "kg/m^3") return density;
+  if (unit == "m/s") return speed;
+  if (unit == "J") return energy;
+  if (unit == "Hz") return frequency;
+  if (unit == "1/s") return rate;
+  return none;
+}
+}  // namespace
 
 std::optional<double> parse_quantity(std::string_view text, std::string_view unit,
                                      std::string* why) {
@@ -354,8 +440,45 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
     if (why) *why = "not a finite number";
     return std::nullopt;
   }
-  const std::string_view token =
-      trim(std::string_view(r.ptr, static_cast<std::size_t>(end - r.ptr)));
+  const std::string_view rest(r.ptr, static_cast<std::size_t>(end - r.ptr));
+  // Digit groups ("210,000", "210 000", "0,3"): a comma is a thousands separator to some readers
+  // and a decimal one to others, so neither is guessed.
+  const bool comma_group = rest.size() >= 2 && rest[0] == ',' && std::isdigit(static_cast<unsigned char>(rest[1]));
+  const std::string_view after_space = trim(rest);
+  const bool space_group = !comma_group && rest.size() > after_space.size() && !after_space.empty() &&
+                           std::isdigit(static_cast<unsigned char>(after_space[0]));
+  if (comma_group || space_group) {
+    if (why) {
+      std::string digits(text.substr(0, static_cast<std::size_t>(r.ptr - text.data())));
+      std::string tail;
+      std::size_t i = 0;
+      const std::string_view r2 = comma_group ? rest : after_space;
+      std::string groups;
+      for (; i < r2.size() && (std::isdigit(static_cast<unsigned char>(r2[i])) || r2[i] == ',' ||
+                               r2[i] == ' ');
+           ++i)
+        if (r2[i] != ',' && r2[i] != ' ') groups += r2[i];
+      tail = std::string(trim(r2.substr(i)));
+      const std::string u = tail.empty() ? std::string() : " " + tail;
+      *why = "'" + std::string(text) + "' has digit groups separated by " +
+             (comma_group ? "a comma" : "a space") +
+             ", which partita reads neither as a thousands nor as a decimal separator; write " +
+             digits + groups + u + (comma_group ? " if the comma groups thousands, or " + digits +
+                                                      "." + groups + u + " if it is a decimal comma"
+                                                : "") +
+             " (a point is the decimal separator; 2.1e5 is 210000)";
+    }
+    return std::nullopt;
+  }
+  std::string normalised(trim(rest));
+  // superscripts and a power written without a caret (N/mm², N/mm2) as in the declared units
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"\xC2\xB2", "^2"}, {"\xC2\xB3", "^3"}})
+    for (auto pos = normalised.find(from); pos != std::string::npos; pos = normalised.find(from))
+      normalised.replace(pos, from.size(), to);
+  if (normalised.size() >= 2 && (normalised.back() == '2' || normalised.back() == '3') &&
+      std::isalpha(static_cast<unsigned char>(normalised[normalised.size() - 2])))
+    normalised.insert(normalised.size() - 1, "^");
+  const std::string_view token = normalised;
   if (token.empty()) return value;
   if (unit.empty()) {
     if (why) *why = "'" + std::string(token) + "' follows the number, but this value takes no unit";
@@ -392,10 +515,21 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
     if (token == p + base) return converted(value * std::pow(f, power) * base_factor);
   }
   if (base_factor != 1.0 && token == base) return converted(value * base_factor);
-  if (why)
+  for (const auto& [name, factor] : equivalents(unit))
+    if (token == name) return converted(value * factor);
+  if (why) {
+    const std::string eq = equivalent_units(unit);
     *why = "unit '" + std::string(token) + "' is not allowed here; the unit is " +
-           std::string(unit) + " (SI prefixes G, M, k, m, u, n may precede it)";
+           std::string(unit) + " (SI prefixes G, M, k, m, u, n may precede it" +
+           (eq.empty() ? std::string() : "; also " + eq) + ")";
+  }
   return std::nullopt;
+}
+
+std::string equivalent_units(std::string_view unit) {
+  std::string s;
+  for (const auto& [name, factor] : equivalents(unit)) s += (s.empty() ? "" : ", ") + name;
+  return s;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -506,6 +640,56 @@ class DocumentCheck {
   std::unordered_set<std::size_t> checked_;  // positions of the quoted scalars scanned
 };
 
+// The innermost '{' or '[' still open at byte `stop` of a YAML text (quoted strings and
+// comments skipped): where a missing '}' or ']' belongs. yaml-cpp reports a flow collection
+// that is never closed where it gave up looking, often a line or more later.
+std::optional<std::pair<SourceLocation, char>> unclosed_bracket(const std::string& text,
+                                                                std::size_t stop,
+                                                                const std::string& name) {
+  struct Open {
+    char c;
+    int line, column;
+  };
+  std::vector<Open> open;
+  int line = 1, column = 0;
+  char quote = 0;
+  bool comment = false;
+  char previous = '\n';
+  for (std::size_t i = 0; i < text.size() && i < stop; ++i) {
+    const char c = text[i];
+    ++column;
+    if (c == '\n') {
+      ++line;
+      column = 0;
+      comment = false;
+      previous = c;
+      continue;
+    }
+    if (comment) continue;
+    if (quote) {
+      if (quote == '"' && c == '\\') {
+        ++i;
+        ++column;
+      } else if (c == quote) {
+        quote = 0;
+      }
+    } else if (c == '#' && (previous == ' ' || previous == '\t' || previous == '\n')) {
+      comment = true;
+    } else if (c == '"' || c == '\'') {
+      if (previous == ' ' || previous == '\t' || previous == '\n' || previous == '{' ||
+          previous == '[' || previous == ',' || previous == ':')
+        quote = c;
+    } else if (c == '{' || c == '[') {
+      open.push_back({c, line, column});
+    } else if ((c == '}' || c == ']') && !open.empty()) {
+      open.pop_back();
+    }
+    previous = c;
+  }
+  if (open.empty()) return std::nullopt;
+  return std::pair{SourceLocation{name, open.back().line, open.back().column}, open.back().c};
+}
+
 }  // namespace
 
 Node Node::load_string(const std::string& text, const std::string& name) {
@@ -517,6 +701,18 @@ Node Node::load_string(const std::string& text, const std::string& name) {
     n.fallback_ = SourceLocation{name, 1, 1};
     return n;
   } catch (const YAML::Exception& e) {
+    if (e.msg.find("flow") != std::string::npos) {
+      const std::size_t stop =
+          e.mark.pos >= 0 ? static_cast<std::size_t>(e.mark.pos) + 1 : text.size();
+      if (const auto at = unclosed_bracket(text, stop, name)) {
+        const bool map = at->second == '{';
+        throw Error(at->first, "",
+                    std::string("YAML syntax error: the '") + (map ? "{" : "[") +
+                        "' opened here is never closed; add the '" + (map ? "}" : "]") +
+                        "' where the " + (map ? "map" : "list") + " ends (the parser gave up at line " +
+                        std::to_string(e.mark.line + 1) + ": " + e.msg + ")");
+      }
+    }
     throw Error(SourceLocation{name, e.mark.line + 1, e.mark.column + 1}, "",
                 "YAML syntax error: " + e.msg + " (check indentation, colons and brackets)");
   }

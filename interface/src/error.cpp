@@ -60,7 +60,18 @@ std::string nearest_name(std::string_view name, const std::vector<std::string>& 
     }
   }
   const std::size_t limit = std::max<std::size_t>(2, std::max(name.size(), best.size()) / 3);
-  if (best.empty() || best_d > limit) return "";
+  if (!best.empty() && best_d <= limit) return best;
+  // A name written short or long, a whole word of it kept: 'poisson' for 'poisson_ratio',
+  // 'youngs' for 'youngs_modulus', 'friction_coefficient' for 'friction'. The shortest such.
+  if (name.size() < 3) return "";
+  auto word_prefix = [](std::string_view longer, std::string_view shorter) {
+    return longer.size() > shorter.size() && longer.substr(0, shorter.size()) == shorter &&
+           (longer[shorter.size()] == '_' || longer[shorter.size()] == '-');
+  };
+  best.clear();
+  for (const auto& k : known)
+    if ((word_prefix(k, name) || word_prefix(name, k)) && (best.empty() || k.size() < best.size()))
+      best = k;
   return best;
 }
 

@@ -33,11 +33,16 @@ std::shared_ptr<const Spec> material_spec() {
   static const std::shared_ptr<const Spec> spec = [] {
     auto m = std::make_shared<Spec>("material",
                                     "bulk properties of a DEM material (particles, walls, meshes)");
-    m->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
+    m->real("youngs_modulus", "Young's modulus E")
+        .unit("Pa")
+        .positive()
+        .typical(config::kSolidModulusLow, config::kSolidModulusHigh, config::kSolidModulusWhat)
+        .required();
     m->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
     m->real("density", "mass density rho (used for particles)")
         .unit("kg/m^3")
         .positive()
+        .typical(config::kSolidDensityLow, config::kSolidDensityHigh, config::kSolidDensityWhat)
         .def(2500.0);
     return m;
   }();
@@ -380,6 +385,29 @@ DemAdapter::DemAdapter(const SolverContext& context)
         for (const Node& b : g["boxes"].items()) regions.push_back(b);
       dem::PackingSpec ps;
       ps.diameters = g.reals("diameters");
+      // A diameter must fit the smallest box it fills and be resolved by the positions' round-off
+      // there (1e-12 of the box): a length written without its unit is in metres.
+      for (std::size_t i = 0; i < ps.diameters.size(); ++i) {
+        const Node d = g["diameters"][i];
+        const bool bare = d.is_scalar() && config::parse_quantity(d.yaml().Scalar(), "");
+        for (const Node& b : regions) {
+          const Eigen::Vector3d size = b.vec3("size");
+          if (ps.diameters[i] > size.minCoeff())
+            d.fail(fmt::format(
+                "diameter {:.6g} m{} is larger than the box it fills ({:.4g} x {:.4g} x {:.4g} "
+                "m, line {}){}",
+                ps.diameters[i], bare ? " as read (a number without a unit is in m)" : "",
+                size.x(), size.y(), size.z(), b.location().line,
+                bare ? fmt::format("; did you mean {} mm? Write the unit: {} mm",
+                                   d.yaml().Scalar(), d.yaml().Scalar())
+                     : std::string()));
+          if (ps.diameters[i] < 1e-12 * size.maxCoeff())
+            d.fail(fmt::format(
+                "diameter {:.6g} m is below the round-off of positions in a box of {:.4g} m "
+                "(1e-12 of it): contacts cannot be resolved; check the value and its unit",
+                ps.diameters[i], size.maxCoeff()));
+        }
+      }
       ps.fractions =
           g.has("fractions") ? g.reals("fractions") : std::vector<double>(ps.diameters.size(), 1.0);
       if (ps.fractions.size() != ps.diameters.size())

@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "partita/fem/blas_runtime.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/face_area.hpp"
 #include "partita/fem/state_io.hpp"
@@ -25,6 +26,11 @@ namespace {
 
 using config::Node;
 using config::Spec;
+
+// Yield stresses of structural materials: soft polymers (about 1 MPa) to maraging and
+// high-strength steels (2-3 GPa); outside, a warning (a unit left out, most likely).
+constexpr double kYieldLow = 1e5, kYieldHigh = 1e10;
+constexpr const char* kYieldWhat = "yield stresses of solids (polymer foams to hardened steel)";
 
 const std::vector<std::string> kComponents = {"x", "y", "z"};
 
@@ -92,6 +98,7 @@ std::shared_ptr<Spec> make_spec() {
   hardening_point->real("yield_stress", "uniaxial yield stress there")
       .unit("Pa")
       .positive()
+      .typical(kYieldLow, kYieldHigh, kYieldWhat)
       .required();
   auto material = std::make_shared<Spec>(
       "material", "isotropic material: linear elastic, compressible Neo-Hooke or J2 plasticity");
@@ -105,12 +112,21 @@ std::shared_ptr<Spec> make_spec() {
                {"linear-elastic", "neo-hooke", "neo-hooke-decoupled", "j2-plasticity",
                 "j2-plasticity-finite-strain"})
       .def("linear-elastic");
-  material->real("youngs_modulus", "Young's modulus E").unit("Pa").positive().required();
-  material->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
-  material->real("density", "mass density rho").unit("kg/m^3").positive().required();
-  material->real("yield_stress", "j2-plasticity: initial uniaxial yield stress")
+  material->real("youngs_modulus", "Young's modulus E")
       .unit("Pa")
-      .positive();
+      .positive()
+      .typical(config::kSolidModulusLow, config::kSolidModulusHigh, config::kSolidModulusWhat)
+      .required();
+  material->real("poisson_ratio", "Poisson's ratio nu").range(-1.0, 0.5, true).required();
+  material->real("density", "mass density rho")
+      .unit("kg/m^3")
+      .positive()
+      .typical(config::kSolidDensityLow, config::kSolidDensityHigh, config::kSolidDensityWhat)
+      .required();
+  material->real("yield_stress", "j2-plasticity: initial uniaxial yield stress (below E)")
+      .unit("Pa")
+      .positive()
+      .typical(kYieldLow, kYieldHigh, kYieldWhat);
   material
       ->real("hardening_modulus", "j2-plasticity: linear isotropic hardening d sigma_y / d eps_p")
       .unit("Pa")
@@ -384,13 +400,29 @@ std::shared_ptr<const fem::MaterialLaw> build_law(const Node& mat) {
       return std::make_shared<fem::J2PlasticityLaw>(e, nu, rho, std::move(curve));
     return std::make_shared<fem::FiniteStrainJ2Law>(e, nu, rho, std::move(curve));
   };
+  // A yield stress at or above Young's modulus is a yield strain of 1 or more: a unit left out
+  // (a bare number is in Pa), not a material.
+  const auto check_yield = [&](const Node& at, double sigma_y) {
+    if (sigma_y < e) return;
+    std::string hint;
+    if (mat["youngs_modulus"].is_scalar() &&
+        config::parse_quantity(mat["youngs_modulus"].yaml().Scalar(), "").has_value())
+      hint = "; a number without a unit is in Pa: write the unit, e.g. youngs_modulus: " +
+             mat["youngs_modulus"].yaml().Scalar() + " GPa";
+    at.fail(fmt::format(
+        "yield stress {:.6g} Pa is not below Young's modulus {:.6g} Pa (youngs_modulus at line "
+        "{}): a yield strain sigma_y / E = {:.3g}, where solids yield at 1e-4 to 1e-1{}",
+        sigma_y, e, mat["youngs_modulus"].location().line, sigma_y / e, hint));
+  };
   if (mat.has("hardening_table")) {
     if (mat.has("yield_stress"))
       mat["yield_stress"].fail(
           "give either yield_stress (and hardening_modulus) or hardening_table");
     std::vector<std::pair<double, double>> points;
-    for (const Node& p : mat["hardening_table"].items())
+    for (const Node& p : mat["hardening_table"].items()) {
       points.emplace_back(p.real("plastic_strain"), p.real("yield_stress"));
+      check_yield(p["yield_stress"], points.back().second);
+    }
     try {
       return make(fem::HardeningCurve::tabulated(points));
     } catch (const fem::Error& error) {
@@ -401,6 +433,7 @@ std::shared_ptr<const fem::MaterialLaw> build_law(const Node& mat) {
     mat.fail(model +
              " needs 'yield_stress' (and optionally 'hardening_modulus') or "
              "'hardening_table'");
+  check_yield(mat["yield_stress"], mat.real("yield_stress"));
   return make(fem::HardeningCurve::linear(mat.real("yield_stress"), mat.real("hardening_modulus")));
 }
 
@@ -638,6 +671,12 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
         !(model.is_linear() && options.integrator == fem::Integrator::CentralDifference))
       options.nonlinear_path = true;
     solver_ = std::make_unique<fem::StructuralSolver>(std::move(model), options);
+    if (fem::resolve(options.linear_solver) == fem::LinearSolver::Cholmod) {
+      const fem::BlasInfo blas = fem::use_serial_blas();
+      log::get("adapters")->debug("fem '{}': BLAS {} ({}, {}), {} thread(s) per call", name_,
+                                  blas.name, blas.library.empty() ? "not loaded" : blas.library,
+                                  blas.threading, blas.threads);
+    }
     // Newton iterations, load steps and cut-backs of the nonlinear path, at debug level (a
     // line per Newton iteration: microseconds beside the factorisation of the tangent)
     solver_->set_progress_callback(

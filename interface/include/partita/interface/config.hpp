@@ -16,8 +16,10 @@
 //   double rho = m.real("density");           // the default if absent
 //
 // Reals may carry a unit after the number ("10 kPa", "2 mm") when the parameter declares a unit:
-// the unit must be the declared one with an SI prefix (G, M, k, c (for m only), m, u, n), and it is
-// converted explicitly to SI.
+// the unit must be the declared one with an SI prefix (G, M, k, c (for m only), m, u, n), or one
+// of the usual equivalents (N/mm^2 for Pa, g/cm^3 and t/mm^3 for kg/m^3, km/h for m/s, ...), and
+// it is converted explicitly to SI. A number with digit groups ("210,000") is refused with the
+// ways to write it.
 
 #include <deque>
 #include <filesystem>
@@ -74,6 +76,12 @@ class Param {
   Param& non_negative() { return min(0.0, false); }
   /// min < value < max (open = true) or min <= value <= max.
   Param& range(double lo, double hi, bool open = false);
+  /// The values a physical input takes in practice, in SI (for Young's modulus: soft rubber to
+  /// diamond). A value outside is accepted with a warning that names the key, the value as read
+  /// in SI and, where a unit prefix brings it inside, what was probably meant ("210 GPa"): a
+  /// number without a unit is in SI, and a modulus written in GPa without its unit is 1e9 too
+  /// small. `what` names the range in the message ("Young's moduli of solids").
+  Param& typical(double lo, double hi, std::string what);
   Param& choices(std::vector<std::string> names);
   Param& size(int n);  ///< exact length of a reals/integers/strings sequence
   Param& spec(std::shared_ptr<const Spec> s);  ///< for section and list
@@ -88,6 +96,11 @@ class Param {
   const std::string& unit_name() const { return unit_; }
   const std::optional<std::pair<double, bool>>& min_bound() const { return min_; }
   const std::optional<std::pair<double, bool>>& max_bound() const { return max_; }
+  struct Typical {
+    double lo, hi;
+    std::string what;
+  };
+  const std::optional<Typical>& typical_range() const { return typical_; }
   const std::vector<std::string>& allowed() const { return choices_; }
   int length() const { return size_; }
   const std::shared_ptr<const Spec>& sub_spec() const { return spec_; }
@@ -103,6 +116,7 @@ class Param {
   std::optional<YAML::Node> default_;
   std::string unit_;
   std::optional<std::pair<double, bool>> min_, max_;  // value, exclusive
+  std::optional<Typical> typical_;
   std::vector<std::string> choices_;
   int size_ = -1;
   std::shared_ptr<const Spec> spec_;
@@ -173,6 +187,18 @@ class Spec {
   std::deque<Param> params_;  // deque: references returned by add() stay valid
   std::vector<std::pair<std::vector<std::string>, bool>> one_of_;
 };
+
+/// Typical ranges (SI) of the bulk properties of solids, for Param::typical(): Young's modulus
+/// from soft rubbers and gels (0.1 MPa) to diamond (1.2 TPa), density from polymer foams
+/// (10 kg/m^3) to osmium (22,600 kg/m^3).
+inline constexpr double kSolidModulusLow = 1e5, kSolidModulusHigh = 1.2e12;
+inline constexpr const char* kSolidModulusWhat = "Young's moduli of solids (soft rubber to diamond)";
+inline constexpr double kSolidDensityLow = 10.0, kSolidDensityHigh = 2.3e4;
+inline constexpr const char* kSolidDensityWhat = "densities of solids (polymer foams to osmium)";
+
+/// The units accepted for a parameter declared in `unit`, besides the SI prefixes: "N/mm^2, ..."
+/// ("" when none).
+std::string equivalent_units(std::string_view unit);
 
 /// Convert "10 kPa" / "2 mm" / "3.5" to SI for a parameter whose unit is `unit`.
 /// Returns nullopt when the text is not a number followed by an allowed unit; `why` says what.
