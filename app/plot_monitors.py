@@ -154,18 +154,20 @@ def panels(header, cols=None, x=0):
         kinds = {}
         for i in idx:
             kinds.setdefault(dimensionless(u) and is_count(cols[i]), []).append(i)
-        clusters = []
-        for members in kinds.values():
+        clusters, values = [], []  # values: the clusters that are not counts
+        for count, members in kinds.items():
             left = sorted((i for i in members if mags[i] > 0), key=lambda i: -mags[i])
             while left:
                 head = mags[left[0]]
                 c = [i for i in left if mags[i] >= head / SPAN]
                 clusters.append(c)
+                if not count:
+                    values.append(c)
                 left = [i for i in left if i not in c]
         zeros = [i for i in idx if mags[i] == 0]
-        if zeros:  # all zero (or not yet drawn): beside the largest, or alone
-            if clusters:
-                clusters[0] += zeros
+        if zeros:  # all zero (or not yet drawn): beside the largest values, never a count
+            if values:
+                values[0] += zeros
             else:
                 clusters.append(zeros)
         for c in sorted((sorted(c) for c in clusters), key=lambda c: c[0]):

@@ -1,5 +1,5 @@
-#!/usr/bin/env python3
-"""Issue 29's figures and headline numbers of a double-hull impact run (double_hull_impact.yaml,
+#!/usr/bin/python3
+"""The figures and headline numbers of a double-hull impact run (double_hull_impact.yaml,
 coarse.yaml), filled with granules and, optionally, against the empty hull (empty.yaml,
 coarse_empty.yaml).
 
@@ -79,9 +79,29 @@ import csv
 import os
 import re
 import sys
+import textwrap
 import xml.etree.ElementTree as ET
 
-import numpy as np
+# The python partita's own plots use (app/process.cpp); the modules' Debian packages.
+PARTITA_PYTHON = "/usr/bin/python3"
+DEBIAN_PACKAGE = {"numpy": "python3-numpy", "matplotlib": "python3-matplotlib", "vtk": "python3-vtk9"}
+
+
+def require(*modules):
+    """Stop with one line when a module this script needs is missing: which one, its Debian
+    package, the python that lacks it and the one partita's own plots use."""
+    import importlib
+    for m in modules:
+        try:
+            importlib.import_module(m)
+        except ImportError:
+            sys.exit(f"{os.path.basename(sys.argv[0])}: the python module {m} is missing in "
+                     f"{sys.executable} (Debian package {DEBIAN_PACKAGE.get(m, m)}); run it with "
+                     f"{PARTITA_PYTHON}, the python partita's own plots use, or install it there")
+
+
+require("numpy", "matplotlib")
+import numpy as np  # noqa: E402
 
 G = 9.81
 SECTION_Y = 0.181                 # the bow's axis (x = y = 0.181)
@@ -703,6 +723,21 @@ def energy_terms(run):
 
 
 COLOURS = {}
+BANDS = 6   # stacked bands a reader tells apart: the largest terms, the rest summed in one
+
+
+def bands(terms):
+    """The largest BANDS - 1 terms (by their final value) in their order, and the others summed
+    as one band named after them."""
+    big = sorted(range(len(terms)), key=lambda k: -abs(float(terms[k][1][-1])))
+    keep = sorted(big[:BANDS - 1]) if len(terms) > BANDS else list(range(len(terms)))
+    out = [terms[k] for k in keep]
+    rest = [terms[k] for k in range(len(terms)) if k not in keep]
+    if rest:
+        names = ", ".join(l for l, _ in rest)
+        out.append((f"{len(rest)} smaller terms:\n" + "\n".join(textwrap.wrap(names, 50)),
+                    sum(v for _, v in rest)))
+    return out
 
 
 def color_of(label, cmap):
@@ -715,13 +750,13 @@ def plot_energy(runs, outdir, plt):
     if not runs:
         note("no energy.csv with rows after contact (energy.png skipped)")
         return
-    fig, axes = plt.subplots(1, len(runs), figsize=(7.5 * len(runs), 5.2), squeeze=False)
+    fig, axes = plt.subplots(1, len(runs), figsize=(7.5 * len(runs), 7.4), squeeze=False)
     cmap = plt.get_cmap("tab20")
     for ax, run in zip(axes[0], runs):
         s = slice(run.contact, None)
         p = 1e3 * run.pen[s]
         terms = [(l, v[s]) for l, v in energy_terms(run)]
-        shown = [(l, v) for l, v in terms if np.max(np.abs(v)) > 1e-4 * max(1e-12, max(np.max(np.abs(u)) for _, u in terms))]
+        shown = bands(terms)
         ax.stackplot(p, *[v for _, v in shown], labels=[l for l, _ in shown],
                      colors=[color_of(l, cmap) for l, _ in shown], alpha=0.85)
         ax.plot(p, sum(v for _, v in terms), "k-", lw=1.5, label="sum of the terms")
@@ -735,7 +770,7 @@ def plot_energy(runs, outdir, plt):
         ax.set_ylabel("energy [J]")
         ax.set_title(f"{run.label}: energy absorbed (cumulative from t = 0)")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper left")
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)  # below
         if run.has("energy balance error"):
             ax2 = ax.twinx()
             err = 100 * run.at("energy balance error")[s]
