@@ -18,7 +18,8 @@ one time axis, so that a reader tells every line apart:
 A time column (unit s) holds -1 while its event has not happened (a first failure): those rows
 are not drawn. Columns whose name contains "applied", "reference" or "static" (expected values)
 are drawn thicker. coupling.csv with nothing but iterations of 1 (one participant: nothing
-coupled) gets no plot.
+coupled) gets no plot. A grading table (time_s, diameter_m, passing) is drawn as the grading
+curves of at most MAX_SERIES of its times.
 
 NAME.plots beside NAME.csv (written by the run for the monitor's `plots` key), one line
 "x,y1,y2,..." of column names without units each, adds NAME_vs_<x>.png: the y columns over x.
@@ -35,6 +36,7 @@ MAX_PANELS = 6
 SPAN = 100.0
 STYLES = ["-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (8, 2))]
 PLACEHOLDER = -1.0
+GRADING = ["time_s", "diameter_m", "passing"]  # a DEM grading table (granules_grading.csv)
 
 
 def unit_of(name):
@@ -196,6 +198,30 @@ def draw(plt, panel_list, header, cols, x, masked, title):
     return fig
 
 
+def grading(plt, cols, name):
+    """A DEM grading table (time, diameter, mass passing; rows by time): the curves of at most
+    MAX_SERIES output times, the first and the last among them, over the diameter."""
+    times = sorted(set(cols[0]))
+    if len(times) > MAX_SERIES:
+        times = [times[round(k * (len(times) - 1) / (MAX_SERIES - 1))] for k in range(MAX_SERIES)]
+    fig, ax = plt.subplots(figsize=(9, 4.2), dpi=120, constrained_layout=True)
+    for k, t in enumerate(times):
+        rows = sorted((d, p) for tt, d, p in zip(*cols) if tt == t)
+        ax.step([1e3 * d for d, _ in rows], [p for _, p in rows], where="post",
+                color="C%d" % k, ls=STYLES[k % len(STYLES)], lw=1.3, label="t = %.4g s" % t)
+    ax.set_xscale("log")
+    from matplotlib.ticker import FormatStrFormatter
+    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(FormatStrFormatter("%g"))
+    ax.tick_params(axis="x", which="minor", labelsize=7)
+    ax.set_xlabel("diameter [mm]")
+    ax.set_ylabel("mass passing [-]")
+    ax.set_title(name)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    return fig
+
+
 def save(plt, fig, out):
     tmp = out + ".part.png"
     fig.savefig(tmp)
@@ -215,6 +241,8 @@ def plot(path):
         return []  # nothing worth a plot
     base = os.path.splitext(path)[0]
     name = os.path.basename(base)
+    if header == GRADING:
+        return [save(plt, grading(plt, cols, name), base + ".png")]
     x = x_of(header)
     masked = mask_placeholders(header, cols, x)
     found = panels(header, cols, x)
@@ -265,6 +293,10 @@ def main(argv):
                 continue
             if cols and nothing_coupled(header, cols):
                 print("(no plot: nothing coupled)")
+                continue
+            if header == GRADING:
+                print("(grading curves of %d of %d times)" % (
+                    min(MAX_SERIES, len(set(cols[0]))), len(set(cols[0]))))
                 continue
             x = x_of(header)
             masked = mask_placeholders(header, cols, x) if cols and cols[0] else set()
