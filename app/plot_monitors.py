@@ -307,9 +307,9 @@ def main(argv):
     try:
         import matplotlib  # noqa: F401
     except ImportError:
-        print("plot_monitors: no module matplotlib for %s (Debian: apt install python3-matplotlib); "
-              "no plots" % sys.executable, file=sys.stderr)
-        return 0
+        print("plot_monitors: the python module matplotlib is missing in %s (Debian package "
+              "python3-matplotlib): no plots" % sys.executable, file=sys.stderr)
+        return 1
     for p in argv[1:]:
         for out in plot(p):
             print(out)
