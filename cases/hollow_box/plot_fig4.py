@@ -93,7 +93,7 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(8.6, 4.4))
     for label, z, ux, before in curves:
         style = dict(color="black", linestyle="--") if label == "empty box" else {}
         line, = ax.plot([1e3 * x for x in z], [u / L for u in ux], marker=".", label=label, **style)
@@ -106,9 +106,9 @@ def main():
     ax.set_title("Hollow box, 500 kPa on one end: load transfer by the granules")
     ax.ticklabel_format(axis="y", style="sci", scilimits=(0, 0))
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=9, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # beside
     fig.tight_layout()
-    fig.savefig(png, dpi=130)
+    fig.savefig(png, dpi=130, bbox_inches="tight")
     print(f"wrote {png}")
 
 
