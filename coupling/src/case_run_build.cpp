@@ -590,9 +590,21 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
       if (d.name == data) rs = &d;
     if (!rs) {
       const auto r = names_of(to.mesh->reads);
+      bool writes_it = false;
+      for (const auto& d : to.mesh->writes) writes_it = writes_it || d.name == data;
+      // Two participants that both prescribe the same field on one interface: each computes it,
+      // neither takes it (both move the interface, or both push on it).
+      const std::string pairing =
+          writes_it ? "; '" + to.p->name() + "' writes '" + data +
+                          "' on that mesh itself, and two participants cannot both prescribe "
+                          "one field on an interface: one side moves it (writes displacement), "
+                          "the other pushes on it (writes force or traction), see "
+                          "docs/writing_an_adapter.md, 'Which written and read fields pair'"
+                    : std::string();
       item["data"].fail("participant '" + to.p->name() + "' does not read '" + data +
                         "' on mesh '" + to.mesh->mesh.name() + "'; it reads: " +
-                        (r.empty() ? "nothing" : join_names(r)) + did_you_mean(data, r));
+                        (r.empty() ? "nothing" : join_names(r)) + did_you_mean(data, r) +
+                        pairing);
     }
     if (ws->components != rs->components)
       item["data"].fail("'" + data + "' has " + std::to_string(ws->components) +
