@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 #include <unistd.h>
 
@@ -138,7 +139,7 @@ TEST_CASE("fem indenter: bad input names the key and what is allowed", "[adapter
   CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1], face: [zmax, xmax, zmax], "
                            "motion: {velocity: [0, 0, -1]}}")),
              Catch::Contains("'zmax' is named twice"));
-  CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1], face: [zmax, xmax], "
+  CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1.1], face: [zmax, xmax], "
                            "motion: {velocity: [0, 0, -1]}}")),
              Catch::Equals("no error"));
   CHECK_THAT(error_of(with("{name: a, shape: capsule, radius: 1, position: [0, 0, 1], face: zmax, "
@@ -159,6 +160,61 @@ constraints: [{set: zmin, fix: [x, y, z]}]
   CHECK_THAT(error_of(with("{name: a, shape: sphere, radius: 1, position: [0, 0, 1], face: zmax, "
                            "motion: {}}")),
              Catch::Contains("velocity"));
+}
+
+TEST_CASE("fem indenter: one that starts inside the structure is refused at set-up, how deep and where",
+          "[adapters][fem][contact]") {
+  auto error_of = [](const std::string& yaml) -> std::string {
+    try {
+      make_fem(yaml);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  const auto depth_in = [](const std::string& what) {
+    std::smatch m;
+    REQUIRE(std::regex_search(what, m, std::regex("lies ([0-9.eE+-]+) m deep")));
+    return std::stod(m[1].str());
+  };
+  // A sphere of 10 mm meant to rest on the block's top (z = 0.1 m) with its centre 10 mm above
+  // it, its radius written without the unit: 10 m. The face node nearest the centre,
+  // (0.05, 0.05, 0.1), lies 0.01 m from it: 10 - 0.01 = 9.99 m inside.
+  {
+    const std::string what = error_of(
+        with("{name: ball, shape: sphere, radius: 10, position: [0.05, 0.05, 0.11], face: zmax, "
+             "motion: {velocity: [0, 0, -1]}}"));
+    INFO(what);
+    CHECK_THAT(what, Catch::Contains("indenter 'ball' starts inside the structure") &&
+                         Catch::Contains("face 'zmax' at (0.05, 0.05, 0.1) m") &&
+                         Catch::Contains("radius 10 m") && Catch::Contains("radius: 10 mm"));
+    CHECK(depth_in(what) == Approx(9.99).epsilon(1e-3));
+  }
+  // A capsule along x of radius 0.03 m whose axis runs 0.02 m above the top face, over the whole
+  // block: the top nodes on y = 0.05, right under the axis, are 0.03 - 0.02 = 0.01 m inside.
+  {
+    const std::string what = error_of(
+        with("{name: bow, shape: capsule, radius: 0.03, length: 0.2, axis: [1, 0, 0], "
+             "position: [0.05, 0.05, 0.12], face: zmax, motion: {velocity: [0, 0, -1]}}"));
+    INFO(what);
+    CHECK_THAT(what, Catch::Contains("indenter 'bow' starts inside") &&
+                         Catch::Contains("capsule (radius 0.03 m, length 0.2 m"));
+    CHECK(depth_in(what) == Approx(0.01).epsilon(1e-3));
+  }
+  // Just touching: the same sphere with its 0.05 m radius on the top face is accepted, and so is
+  // a plane on it, pointing down at the block
+  CHECK_THAT(error_of(with("{name: ball, shape: sphere, radius: 0.05, position: [0.05, 0.05, 0.15], "
+                           "face: zmax, motion: {velocity: [0, 0, -1]}}")),
+             Catch::Equals("no error"));
+  CHECK_THAT(error_of(with("{name: lid, shape: plane, position: [0, 0, 0.1], normal: [0, 0, -1], "
+                           "face: zmax, motion: {velocity: [0, 0, -1]}}")),
+             Catch::Equals("no error"));
+  // a plane 1 mm below the top face: 0.001 m deep
+  const std::string what = error_of(with("{name: lid, shape: plane, position: [0, 0, 0.099], "
+                                         "normal: [0, 0, -1], face: zmax, motion: {velocity: [0, 0, -1]}}"));
+  INFO(what);
+  CHECK_THAT(what, Catch::Contains("half-space") && Catch::Contains("normal points out of the rigid body"));
+  CHECK(depth_in(what) == Approx(0.001).epsilon(1e-6));
 }
 
 // A closed STL box as a flat punch (shape: surface) pressed by delta into a column on rollers

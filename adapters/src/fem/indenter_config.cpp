@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "partita/fem/capsule_shape.hpp"
 #include "partita/fem/error.hpp"
@@ -129,6 +130,60 @@ fem::VelocityTable velocity_table(const Node& table) {
   }
 }
 
+std::string vec(const fem::Vec3& v) { return fmt::format("({:.4g}, {:.4g}, {:.4g})", v.x(), v.y(), v.z()); }
+
+// A rigid body placed inside the structure is refused at set-up: its first evaluation would put
+// k_n times the overlap on the nodes inside (the usual cause: a length without its unit, read in
+// metres). Allowed: touching, i.e. a node inside by at most round-off of the face's size.
+void refuse_start_inside(const Node& n, const std::string& name, const std::string& shape,
+                         const std::vector<std::string>& faces, const fem::Model& model,
+                         const fem::IndenterContact& contact) {
+  const fem::IndenterContact::DeepestNode deepest = contact.deepest_node();
+  const double element = mean_face_size(model.mesh(), faces);
+  if (!(deepest.depth > 1e-6 * element)) return;
+  std::string face = faces.front();
+  for (const std::string& f : faces) {
+    const auto nodes = model.mesh().face_nodes(f);
+    if (std::find(nodes.begin(), nodes.end(), deepest.node) != nodes.end()) {
+      face = f;
+      break;
+    }
+  }
+  std::string body, hint;
+  const auto length = [](double v) { return fmt::format("{:.4g} m", v); };
+  if (shape == "sphere" || shape == "capsule") {
+    body = shape == "sphere"
+               ? fmt::format("its sphere (radius {}, centre {} m)", length(n.real("radius")),
+                             vec(n.vec3("position")))
+               : fmt::format("its capsule (radius {}, length {}, centre {} m)",
+                             length(n.real("radius")), length(n.real("length")),
+                             vec(n.vec3("position")));
+    hint = "lengths are in metres unless a unit is written (radius: 10 mm)";
+  } else if (shape == "plane") {
+    body = fmt::format("its half-space (boundary through {} m, normal {} out of the body)",
+                       vec(n.vec3("position")), vec(n.vec3("normal")));
+    hint = "position is a point of the plane in metres unless a unit is written, and normal "
+           "points out of the rigid body, towards the structure";
+  } else {
+    const fem::SurfaceTriangulation tri = contact.indenter().shape().triangulate();
+    fem::Vec3 lo = fem::Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const fem::Vec3& v : tri.vertices) {
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    body = fmt::format("its STL surface (from {} to {} m with scale {:.4g})", vec(lo), vec(hi),
+                       n.real("scale"));
+    hint = "STL coordinates are taken in metres times 'scale' (scale: 0.001 for a file in mm), "
+           "and 'position' translates them";
+  }
+  n.fail(fmt::format(
+      "indenter '{}' starts inside the structure: node {} of face '{}' at {} m lies {:.4g} m "
+      "deep inside {} (the face's elements are about {:.3g} m); a rigid indenter must start "
+      "outside, touching at most. Check its size and position: {}",
+      name, deepest.node, face, vec(model.mesh().node(deepest.node)), deepest.depth, body,
+      element, hint));
+}
+
 }  // namespace
 
 IndenterBuild build_indenter(const Node& n, const fem::Model& model,
@@ -226,6 +281,7 @@ IndenterBuild build_indenter(const Node& n, const fem::Model& model,
   } catch (const fem::Error& e) {
     n.fail(e.what());
   }
+  refuse_start_inside(n, b.name, shape, face, model, *b.contact);
   const fem::SurfaceTriangulation tri = b.contact->indenter().shape().triangulate();
   if (!tri.triangles.empty()) {
     Mesh::Points p(static_cast<Eigen::Index>(tri.vertices.size()), 3);

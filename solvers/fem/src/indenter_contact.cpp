@@ -206,6 +206,16 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
   }
 }
 
+IndenterContact::DeepestNode IndenterContact::deepest_node() const {
+  DeepestNode deepest;
+  const Vec3& d = indenter_.displacement();
+  for (const std::size_t node : nodes_) {
+    const double depth = -indenter_.shape().distance(mesh_.node(node) - d).gap;
+    if (depth > deepest.depth) deepest = {node, depth};
+  }
+  return deepest;
+}
+
 void IndenterContact::commit() {
   indenter_.commit(work_trial_);
   work_trial_ = 0.0;

@@ -120,6 +120,7 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
   // secant stiffness of the converged increments, d lambda / |du|: the first one and the
   // last one (their ratio tells a limit load from a numerical difficulty)
   double stiffness_first = -1.0, stiffness_last = -1.0;
+  double carried = 0.0;  // the last load factor reached with kRunawayStiffness of the first's
   Eigen::VectorXd f_lambda, u_trial, x;
   while (lambda < 1.0) {
     double next = lambda + increment;
@@ -145,6 +146,27 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
       if (du > 0.0) {
         stiffness_last = (next - lambda) / du;
         if (stiffness_first < 0.0) stiffness_first = stiffness_last;
+      }
+      const double ratio = stiffness_first > 0.0 ? stiffness_last / stiffness_first : 1.0;
+      if (ratio >= kRunawayStiffness) carried = next;
+      if (model_size_ > 0.0 && ratio < kRunawayStiffness) {
+        double moved = 0.0;  // the largest nodal displacement
+        for (Eigen::Index i = 0; i + 2 < u_trial.size(); i += 3)
+          moved = std::max(moved, u_trial.segment<3>(i).norm());
+        if (moved > model_size_) {
+          std::ostringstream msg;
+          msg << "limit load: the displacement runs away; the largest load factor carried is "
+              << carried << " (0: the state at the start of the step, 1: the loads at t = " << t1
+              << "). Newton accepted load factor " << next << " with a node moved " << moved
+              << " m, more than the model's size (" << model_size_
+              << " m), in an increment whose secant stiffness was " << 100.0 * ratio
+              << " % of the first's. The loads exceed what the structure can carry (a "
+                 "collapse, e.g. a plastic mechanism): keep them below about "
+              << carried
+              << " times the applied ones, prescribe a displacement instead, or give the "
+                 "material the hardening it has";
+          throw Error(msg.str());
+        }
       }
       kin.external_work += 0.5 * (kin.f + f_lambda).dot(u_trial - kin.u);
       kin.u = u_trial;

@@ -43,6 +43,15 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
               options_.factor_threading),
       newmark_(options_.newmark_beta, options_.newmark_gamma, options_.newton,
                options_.linear_solver, options_.fill_ordering, options_.factor_threading) {
+  {
+    // the static runaway test (a limit load where Newton keeps converging): the model's size
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t n = 0; n < model_.mesh().num_nodes(); ++n) {
+      lo = lo.cwiseMin(model_.mesh().node(n));
+      hi = hi.cwiseMax(model_.mesh().node(n));
+    }
+    if (model_.mesh().num_nodes() > 0) static_.set_model_size((hi - lo).norm());
+  }
   if (!(options_.newmark_beta > 0.0) || !(options_.newmark_gamma > 0.0)) {
     throw Error("Newmark parameters must be > 0 (beta = 1/4, gamma = 1/2 is the default)");
   }

@@ -138,7 +138,8 @@ inline double tip_deflection(const StructuralSolver& s) {
   return -w / static_cast<double>(nodes.size());
 }
 
-// step_static(1.0) of a load beyond a limit load: the largest load factor reached, read from the
+// step_static(1.0) of a load beyond a limit load: the largest load factor reached (or carried,
+// where the displacement ran away under converged increments), read from the
 // limit-load message; nullopt when it converged or failed otherwise. `what` gets the message.
 inline std::optional<double> limit_load_factor(StructuralSolver& s, std::string& what) {
   what.clear();
@@ -149,7 +150,7 @@ inline std::optional<double> limit_load_factor(StructuralSolver& s, std::string&
   }
   std::smatch m;
   if (what.find("limit load") == std::string::npos ||
-      !std::regex_search(what, m, std::regex("largest load factor reached is ([0-9.eE+-]+)")))
+      !std::regex_search(what, m, std::regex("largest load factor (?:reached|carried) is ([0-9.eE+-]+)")))
     return std::nullopt;
   return std::stod(m[1].str());
 }

@@ -1,5 +1,6 @@
 #pragma once
 #include <functional>
+#include <limits>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -115,6 +116,16 @@ class IndenterContact final : public OperatorContribution {
   void set_eroded(std::function<bool(std::size_t element)> eroded) { eroded_ = std::move(eroded); }
 
   const RigidIndenter& indenter() const { return indenter_; }
+  // The face node deepest inside the indenter with the structure undeformed (its reference
+  // coordinates) and the indenter at its committed position: depth = -g of that node, > 0 where
+  // it lies inside the body, <= 0 (minus the smallest gap) where none does. A set-up check: a
+  // body that starts inside the structure (a length in the wrong unit, a position off by a
+  // face) puts penalty forces of k_n times the overlap on the nodes at the first evaluation.
+  struct DeepestNode {
+    std::size_t node = 0;  // mesh node index (meaningless when the faces have no node)
+    double depth = -std::numeric_limits<double>::infinity();
+  };
+  DeepestNode deepest_node() const;
   // A force on the body from outside this model (RigidIndenter::set_external_force).
   void set_external_force(const Vec3& force) { indenter_.set_external_force(force); }
   // Force of the last add() on the indenter [N] (after commit(): the committed one).

@@ -19,6 +19,14 @@ namespace partita::fem {
 // a singular tangent, a stagnating or growing residual: the message gives the largest load
 // factor reached), or the load step, lambda, the residual, the tolerance and what the Newton
 // failure was (a stall at round-off, divergence, an inverted element ...).
+//
+// A limit load is also told where Newton keeps converging: a structure past its collapse load
+// whose model keeps a trace of stiffness (an element's residual constraint, the supports'
+// triaxiality) lets the load factor creep on while the displacement runs away. When an increment
+// is accepted with a node moved more than the model's size (set_model_size: the diagonal of
+// its bounding box) and a secant stiffness d lambda / |du| below kRunawayStiffness of the first
+// increment's, it throws Error with "limit load" and the largest load factor carried: the last
+// one reached by an increment that kept at least that fraction of the first's stiffness.
 class StaticIntegrator {
  public:
   explicit StaticIntegrator(NewtonOptions options = {},
@@ -28,6 +36,12 @@ class StaticIntegrator {
       : newton_(options, linear_solver, ordering, factor_threading) {}
   // Velocity and acceleration are set to zero; kin.time = t1.
   void solve(StructuralSystem& system, Kinematics& kin, double t1);
+  // The runaway test above (0: off, the default).
+  void set_model_size(double size) { model_size_ = size; }
+  // The fraction of the first increment's secant stiffness below which an increment counts as
+  // a runaway: 1 %, the stiffness of a perfectly plastic hinge or a hardening of E/100 and less
+  // (a beam's section keeps about H/E of its bending stiffness once fully plastic).
+  static constexpr double kRunawayStiffness = 0.01;
   // Reports of the Newton solves of the last solve() (converged increments and failures).
   const std::vector<NewtonReport>& reports() const { return reports_; }
   // Newton iterations and cut-backs as text (see ProgressCallback).
@@ -41,6 +55,7 @@ class StaticIntegrator {
                               double t1, double stiffness_first, double stiffness_last) const;
   NewtonSolver newton_;
   ProgressCallback progress_;
+  double model_size_ = 0.0;
   std::vector<NewtonReport> reports_;
 };
 
