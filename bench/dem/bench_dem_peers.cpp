@@ -8,8 +8,8 @@
 //                        [--quick] [--vtk DIR] [--no-peer] [--shuffle] [--sort N] [--breakage]
 //                        [--energy]  (the energy accounting on: System::set_energy_tracking)
 // --scaling: the large bed (unless --case names another) on 1, 2, 4, ... threads up to the
-// machine's processors (and that number), then the speed-up over 1 thread of each (issue 16's
-// aim: 12x at 16 threads; 9.7x measured when it was filed); particles renumbered in cell order
+// machine's processors (and that number), then the speed-up over 1 thread of each (the
+// aim: 12x at 16 threads); particles renumbered in cell order
 // every 10 list builds as in a partita run, unless --sort says otherwise. --profile (with or
 // without --scaling) adds, after each plain line, where a step's wall time went thread by thread
 // (System::step_profile(): the fork, each phase's busy time, mean and slowest thread, the waits at

@@ -2,8 +2,8 @@
 // (4.0, 3.125, 2.5 mm, equal numbers) at porosity 0.5 in a cube, as the cases use it.
 // Prints per size: granules, seconds, relaxation sweeps, the realised porosity and largest
 // overlap, the growth exponent of the time between successive sizes (t ~ N^a), and the ratio
-// of the 10^6 time to the aim of issue 16 (15 s on 2 cores) and to the time measured when the
-// issue was filed (31 s on 16 cores). Wall-clock on a possibly shared machine: read with care.
+// of the 10^6 time to the aim (15 s on 2 cores) and to an older generator's time (31 s on 16
+// cores). Wall-clock on a possibly shared machine: read with care.
 //
 // usage: bench_packing [--sizes 1e4,1e5,1e6] [--porosity P] [--seed S]
 

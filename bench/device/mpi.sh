@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs on the lent device machine (repository root, carry ['.dev']): what the MPI exchange costs
-# on a quiet machine (issue 28: under 5 % of the steel case's wall time) and what explicit-parallel
+# on a quiet machine (aim: under 5 % of the steel case's wall time) and what explicit-parallel
 # in two processes gains. The bundle: bench/device/pack.sh here, from a build with MPI (it then
 # carries OpenMPI: the device has none). bench_mpi (bench/mpi/) on the steel compaction case,
 # 1000 windows, RUNS runs each (default 5), one process per participant:

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs on the lent device machine (repository root, carry ['.dev']): the speed-up of a parallel
-# scheme's participants on threads in one process (issue 28), on a quiet machine, restricted to 2
+# scheme's participants on threads in one process, on a quiet machine, restricted to 2
 # of its cores (taskset) and on 4. The bundle: bench/device/pack.sh --threads-only here.
 # The steel compaction case, 1000 windows, the granules about as costly as the plate; per core set
 # and --threads: explicit-serial, explicit-parallel one after the other (concurrent: false) and

@@ -3,7 +3,7 @@
 # bench/device/pack.sh made here (carry ['.dev']). One call, about 5 minutes:
 #   1. the machine (processors, caches, the C library);
 #   2. the threaded-solver and thread-count tests on all cores (the same bits on any count);
-#   3. the DEM's thread scaling 1-16 of the large peer bed, twice (issue 16: aim 12x at 16), the
+#   3. the DEM's thread scaling 1-16 of the large peer bed, twice (aim 12x at 16), the
 #      second time with each step's time thread by thread (--profile);
 #   4. the 263k-dof plate's factorisation and transient step at 1, 2, 4, 8 and 16 threads;
 #   5. the 10^6-granule scale case on 2, 8 and 16 threads (time per participant, memory).

@@ -20,12 +20,12 @@
 //              --lines: minutes a step at the default size; try 80x80)
 //   fj2-plain  finite-strain J2, plain Hex8
 //   j2-reduced  small-strain J2, reduced Hex8 (Hex8Formulation::Reduced: one point in the plane,
-//              6 through the thickness, hourglass stabilisation; issue 27's explicit plate element)
+//              6 through the thickness, hourglass stabilisation; the explicit plate element)
 //   fj2-reduced finite-strain J2, reduced Hex8
 // Printed per line: element-steps per second (elements x steps / wall seconds of the timed
 // steps), points per element, law evaluations per element-step (EAS: points x local passes),
-// the share of plastic points at the end, the ratio to the aim (1e6 element-steps/s on 2 cores,
-// issue 27) and to the linear-elastic explicit step. Then, on one thread, where a step's time
+// the share of plastic points at the end, the ratio to the aim (1e6 element-steps/s on 2 cores)
+// and to the linear-elastic explicit step. Then, on one thread, where a step's time
 // goes: the material law, the element kinematics (F, the element force, the EAS condensation),
 // the assembly (the element forces into the global force), the contact (0: no indenter in the
 // model) and the rest (integrator update, commit of the histories). The shares come from the
@@ -71,7 +71,7 @@ namespace {
 
 constexpr double kE = 210e9, kNu = 0.3, kRho = 7850.0, kSy = 250e6, kH = kE / 100.0;
 constexpr double kCell = 0.05, kThick = 0.01;
-constexpr double kAim = 1e6;  // element-steps per second on 2 cores (issue 27)
+constexpr double kAim = 1e6;  // element-steps per second on 2 cores (the aim)
 
 double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();

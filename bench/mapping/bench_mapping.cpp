@@ -5,7 +5,7 @@
 // shared machine), and the fitted growth exponent (log-log slope) of compute and map: about 1
 // (n log n) is the goal; 2 would mean an all-pairs loop somewhere.
 //
-// Then area-balanced (issue 16) between 10^4 and 10^6 interface cells: STL-like triangle centres
+// Then area-balanced between 10^4 and 10^6 interface cells: STL-like triangle centres
 // (weights: areas) to the 2 x 2 Gauss points of a non-matching quad grid (weights: h^2/4), as on
 // the seed's traction route. Prints set-up time per 10^5 cells (goal: under 1 s), the entries,
 // and the balance errors: max_q |sum_i W_qi - 1| (rows), max_i |sum_q w_q W_qi - c_i| / c_i

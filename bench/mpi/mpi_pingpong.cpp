@@ -1,4 +1,4 @@
-// mpi_pingpong: MPI's own floor under partita's exchange (issue 28). Two ranks pass a request of
+// mpi_pingpong: MPI's own floor under partita's exchange. Two ranks pass a request of
 // A bytes and a reply of B bytes back and forth, polling as partita's MpiChannel does (MPI_Isend
 // completed with MPI_Test, MPI_Iprobe then MPI_Recv, sched_yield between polls), optionally with
 // W microseconds of work on each side between the messages (the data then goes cold in cache, as

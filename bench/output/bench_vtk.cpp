@@ -1,6 +1,6 @@
 // bench_vtk: one frame of N DEM particles (default 10^6) with the arrays the DEM adapter writes
 // (points, vertex cells, radius, id, velocity, angular_velocity, force), written
-//   - the old way: main's ASCII writer before issue 16 (System::write_particles_vtp: the arrays
+//   - the old way: the DEM solver's former ASCII writer (System::write_particles_vtp: the arrays
 //     copied into per-array vectors, 12 significant digits through an ostream; kept here as the
 //     reference, since the solver no longer writes files),
 //   - by the DEM adapter's writer (adapters::write_particles_vtp, interface/vtk_xml) in each format
@@ -64,8 +64,8 @@ Frame make_frame(std::size_t n, bool at_rest) {
   return f;
 }
 
-// ---- the old writer (solvers/dem/src/vtk_writer.cpp and System::write_particles_vtp on main
-// before issue 16), the reference of the ratios --------------------------------------------------
+// ---- the old writer (solvers/dem/src/vtk_writer.cpp and System::write_particles_vtp, since
+// removed), the reference of the ratios --------------------------------------------------
 struct OldArray {
   std::string name;
   int components = 1;

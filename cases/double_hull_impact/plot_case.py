@@ -607,7 +607,7 @@ def bow_items(run):
     """(area, upward force) of the inner plate's cavity-facing nodes from the bow's own contact
     forces (the hull's point array contact_force, at the last output frame): each node stands for
     a quarter of the reference areas of the inner plate's element faces it is a corner of. None
-    when the files have no contact_force (runs before 2026-11-28)."""
+    when the files have no contact_force (runs written without that array)."""
     frames = pvd_frames(run.folder, "hull_fem")
     if not frames:
         return None

@@ -1,4 +1,4 @@
-// Issue 26 (DEM participant): one sphere on a plane runs with the defaults, per-face box wall
+// The DEM participant's inputs: one sphere on a plane runs with the defaults, per-face box wall
 // forces and particle monitors, absurd particle positions in a particle file or a restart file.
 #include <catch2/catch.hpp>
 

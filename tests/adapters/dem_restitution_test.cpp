@@ -1,4 +1,4 @@
-// Issue 13: the DEM participant's default time step (time_step_fraction 0.2 of the Rayleigh
+// The DEM participant's default time step (time_step_fraction 0.2 of the Rayleigh
 // step) realises the declared restitution to 1 % for 0.1 <= e <= 1, between two spheres and on a
 // wall, impacts from 0.01 to 10 m/s.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// The FE adapter's coupled nodal forces (issue 29's nine cell interfaces): a "force" read on an
+// The FE adapter's coupled nodal forces (as the double hull's nine cell interfaces): a "force" read on an
 // interface is stored and handed to the solver with every other interface's forces once, before
 // the step. The contract: the step sees the last values read on each interface, whatever the
 // order and number of reads, every interface's at once (superposition); a read of the wrong size or

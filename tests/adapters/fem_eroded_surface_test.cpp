@@ -1,4 +1,4 @@
-// Eroded elements leave the DEM's contact surfaces (issues 27 and 29): the FE participant writes
+// Eroded elements leave the DEM's contact surfaces: the FE participant writes
 // "attached" per triangle of an interface (its mesh N_centres), 0 once the element under the
 // triangle is eroded; a DEM that took the interface as a wall reads it on its M_centres and
 // drops those triangles, so a granule resting on the FE face falls through where the hull has

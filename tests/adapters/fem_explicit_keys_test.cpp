@@ -1,4 +1,4 @@
-// The FEM participant's central-difference keys of issue 27's explicit work: mass scaling
+// The FEM participant's central-difference keys: mass scaling
 // (analysis.mass_scaling_time_step: the added mass as monitors, the step offered raised) and the
 // reduced Hex8 (mesh.hex8: reduced), and the errors where they do not apply.
 #include <catch2/catch.hpp>

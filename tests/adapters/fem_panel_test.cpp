@@ -1,4 +1,4 @@
-// The FEM participant's mesh.panel key (issue 29): a cellular panel from YAML, its parts as
+// The FEM participant's mesh.panel key: a cellular panel from YAML, its parts as
 // energy regions, its cells' faces as coupling interfaces, and bad values refused at their key.
 #include <catch2/catch.hpp>
 

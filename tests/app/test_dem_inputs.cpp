@@ -1,4 +1,4 @@
-// Issue 26 (DEM inputs through the executable): an STL whose orientation contradicts itself is
+// DEM inputs through the executable: an STL whose orientation contradicts itself is
 // accepted with a warning naming the triangles; the set-up log counts meshes handed over.
 #include <catch2/catch.hpp>
 

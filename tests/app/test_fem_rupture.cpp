@@ -1,4 +1,4 @@
-// The FE adapter's rupture and energies-by-part keys (issue 27) from YAML
+// The FE adapter's rupture and energies-by-part keys from YAML
 // (tests/inputs/fem/strip_rupture.yaml): the first failure time against the closed form, the
 // log line naming the failed element's part, the per-part energies adding up to the totals,
 // and erosion keeping the energy balance.

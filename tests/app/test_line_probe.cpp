@@ -51,7 +51,7 @@ TEST_CASE("line probe: the exact linear field of a patch test, to 1e-12", "[app]
   fs::remove_all(dir);
 }
 
-// A total-force face load and point monitors (issue 26) on the same patch-test field: F = 100 kN
+// A total-force face load and point monitors on the same patch-test field: F = 100 kN
 // over the 0.01 m^2 face is sigma = 10 MPa; the points' displacements are u = sigma/E (x, -nu y,
 // -nu z) at the corner and at a point inside an element, to 1e-12; the static reaction is -F.
 TEST_CASE("point monitors and a total-force load: the exact patch-test field", "[app][probe]") {

@@ -1,5 +1,5 @@
 // Monitor PNGs (app/plot_monitors.py): one panel per unit, so a count, a mass, forces and an
-// energy never share one y axis (issue 26). The script's own listing of its panels is checked,
+// energy never share one y axis. The script's own listing of its panels is checked,
 // then the PNG is drawn where matplotlib is installed (build.sh installs it). The runs of the
 // test suite draw none (PARTITA_NO_PLOTS=1, tests/main.cpp): the switch is checked here.
 

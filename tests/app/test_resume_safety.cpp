@@ -1,4 +1,4 @@
-// A refused resume changes nothing, and a damaged restart file is always refused (issue 26):
+// A refused resume changes nothing, and a damaged restart file is always refused:
 //  - `partita run CASE --resume DIR` with a restart file that is empty, from another case, from
 //    the same case with other participants (another particle count), of a run that has ended,
 //    truncated, or with one byte flipped in any of its sections exits 1 with a message, and every

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Participants as processes over MPI (issue 28), run by ctest (tests/CMakeLists.txt):
+# Participants as processes over MPI, run by ctest (tests/CMakeLists.txt):
 #   distributed.sh PARTITA SCENARIO [ARGS...]
 # Scenarios:
 #   identical CASE A B [--set ...]   the case in one process, then A and B in two processes: every

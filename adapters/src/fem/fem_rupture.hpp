@@ -1,5 +1,5 @@
 #pragma once
-// The FEM adapter's rupture and energies-by-part keys and monitors (issue 27):
+// The FEM adapter's rupture and energies-by-part keys and monitors:
 //   material.failure   {criterion: constant | gl, strain, thickness, uniform_strain,
 //                       necking_strain, erosion}: fem::FailureCriterion
 //   mesh.box.regions   [{name, from, to}]: element regions of a box mesh (elements whose centre

@@ -101,7 +101,7 @@ void WallContacts::resize(ParticleStore& store, std::size_t n) {
 
 // Each plane's total over the blocks in block order, then each wall's over its planes in plane
 // order: a fixed order whatever the number of threads. The planes' sums are independent chains
-// (one chain per wall, as before 2026-11-27, took 2-3 us a step for the 313 blocks of the
+// (one chain per wall would take 2-3 us a step for the 313 blocks of the
 // 20,001-particle peer bed, serial between the parallel force passes).
 void WallContacts::reduce(std::size_t n) {
   const std::size_t np = planes_.size();

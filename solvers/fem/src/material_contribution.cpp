@@ -313,7 +313,7 @@ void MaterialContribution::require_not_inverted(std::size_t e, double det_f) con
   throw InvertedElementError(msg.str());
 }
 
-// ---- explicit steps: the force alone (issue 27, bench/fem/bench_fem_explicit) ----
+// ---- explicit steps: the force alone (timed by bench/fem/bench_fem_explicit) ----
 // All elements in one parallel loop, each into its own slice of flat buffers (no allocation:
 // the element vectors live on the stack), then the nodes in parallel, each node's sum over its
 // elements in element order: f_int, the round-off bounds and the energy have the bits of the
@@ -409,8 +409,8 @@ void MaterialContribution::evaluate_plain(std::size_t e, const ElementDisplaceme
   const int nn = node_count(el.type);
   const MaterialLaw& law = *element_law_[e];
   MaterialResponse resp;
-  // N: the node count as a compile-time size (Hex8: fixed-size products, issue 27's explicit
-  // benchmark) or Eigen::Dynamic (the other elements)
+  // N: the node count as a compile-time size (Hex8: fixed-size products, for the explicit
+  // benchmark's speed) or Eigen::Dynamic (the other elements)
   auto points = [&]<int N>(std::integral_constant<int, N>) {
     constexpr int kMax = N == Eigen::Dynamic ? kMaxElementNodes : N;
     using Gradients = Eigen::Matrix<double, N, 3, Eigen::RowMajor, kMax, 3>;
@@ -581,7 +581,7 @@ void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacement
   // energy, the stresses, the trial histories, the round-off bounds; sets the stress scale
   // sum |P| |G| w of h and the round-off bound of h, sum dP |g_J| w (as the nodes' fabs).
   double scale = 0.0, h_round_off = 0.0;
-  // ---- explicit steps (no element tangent wanted; issue 27, bench/fem/bench_fem_explicit) ----
+  // ---- explicit steps (no element tangent wanted; bench/fem/bench_fem_explicit) ----
   // Only K_aa of kx is assembled (the 3 enhanced "nodes", the same entries, the same bits: the
   // local Newton is unchanged) and each point's tangent A is kept; the condensation's
   // K_ua d_alpha = sum_q w G_u^T A_q (G_a d_alpha) is then one product per point (below)
@@ -711,7 +711,7 @@ void MaterialContribution::commit() {
     trial_[enhanced_work_offset_] = w;
   }
   // Explicit steps commit every step, ~1 kB of history per element: the copy shared by the
-  // threads (issue 27's benchmark; a plain copy, the same bits).
+  // threads (bench/fem/bench_fem_explicit; a plain copy, the same bits).
   constexpr std::size_t kBlock = 1 << 15;
   const std::size_t n = trial_.size();
   committed_.resize(n);

@@ -1,4 +1,4 @@
-// StructuralSolver: rupture (failure criterion, erosion) and energies by region (issue 27).
+// StructuralSolver: rupture (failure criterion, erosion) and energies by region.
 #include <algorithm>
 #include <limits>
 

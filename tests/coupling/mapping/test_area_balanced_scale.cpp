@@ -1,4 +1,4 @@
-// area-balanced at the sizes of issue 16 (10^5 interface cells): the operator is built exactly,
+// area-balanced at large sizes (10^5 interface cells): the operator is built exactly,
 // not iterated, so its two properties hold to round-off at any size. Independent reasons:
 //   rows sum to 1 and W >= 0          (the contract: constants reproduced, convex weights);
 //   sum_q w_q W_qi = A_i sum(w)/sum(A) (the integral preserved per source point; the reference

@@ -1,4 +1,4 @@
-// Issue 26 (DEM): absurd extents, a single particle's self-interaction, the faces of a box wall.
+// DEM inputs: absurd extents, a single particle's self-interaction, the faces of a box wall.
 #include <catch2/catch.hpp>
 
 #include "dem_test_helpers.hpp"

@@ -126,7 +126,7 @@ double max_overlap_grid(const Packing& p, double box) {
 
 }  // namespace
 
-// Issue 16: the generator at 10^5 granules (the case of a million is timed by bench_packing).
+// The generator at 10^5 granules (the case of a million is timed by bench_packing).
 TEST_CASE("dem: packing generator at 10^5 granules: porosity, overlap bound, uniform density",
           "[dem][generator]") {
   const double box = 0.1567;  // 10^5 seed-000 granules at porosity 0.5

@@ -1,5 +1,5 @@
-// The time step chosen from the restitution realises it to 1 % (issue 13: at 0.2 of the Rayleigh
-// step the calibrated e = 0.1 came out several per cent low), impacts from 0.01 to 10 m/s.
+// The time step chosen from the restitution realises it to 1 % (a fixed 0.2 of the Rayleigh
+// step would make the calibrated e = 0.1 several per cent low), impacts from 0.01 to 10 m/s.
 
 #include "dem_test_helpers.hpp"
 

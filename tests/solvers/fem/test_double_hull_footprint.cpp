@@ -1,4 +1,4 @@
-// Issue 29's check of the empty double hull (cases/double_hull_impact): before the first contact
+// A check of the empty double hull (cases/double_hull_impact): before the first contact
 // spreads, the force of the rigid capsule indenter at small penetration against the same hull
 // loaded by a prescribed displacement of the indenter's footprint (within 10 %), and that force
 // against plate theory (bounded between a plate's plastic collapse load under a

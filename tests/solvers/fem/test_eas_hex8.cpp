@@ -1,4 +1,4 @@
-// The EAS Hex8 of the nonlinear path (issue 27: thin plates that bend and yield): enhanced
+// The EAS Hex8 of the nonlinear path (for thin plates that bend and yield): enhanced
 // assumed strain after Simo & Armero (1992) / Simo, Armero & Taylor (1993), 9 modes with
 // Taylor's constant-Jacobian scaling, 6 Gauss points through a thin element's thickness.
 #include <catch2/catch.hpp>

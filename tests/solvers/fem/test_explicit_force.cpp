@@ -1,4 +1,4 @@
-// The explicit steps' path of the material's force (issue 27's speed work): without a tangent
+// The explicit steps' path of the material's force: without a tangent
 // MaterialContribution::add() evaluates all elements in one parallel loop and sums node by node,
 // and the laws skip their tangent (MaterialLaw::evaluate_stress). Both must give the force,
 // energy and stresses of the tangent path: bit for bit where the same operations run (plain

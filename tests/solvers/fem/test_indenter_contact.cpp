@@ -1,4 +1,4 @@
-// Rigid indenters in contact with FE surfaces (issue 27): the shapes' signed distances, the
+// Rigid indenters in contact with FE surfaces: the shapes' signed distances, the
 // driven motion's exact integral, Hertz's sphere on an elastic block, a flat punch's reaction, a
 // free mass dropped on a free block (momentum and energy), friction's dissipation and restart.
 #include <catch2/catch.hpp>
@@ -502,7 +502,7 @@ TEST_CASE("free indenter: an external force decelerates it as F/m, its work is t
   CHECK(copy.trial_displacement() == body.trial_displacement());
 }
 
-// The books of a driven body's work, node by node (issue 29). A free elastic column of 4 Hex8 at
+// The books of a driven body's work, node by node. A free elastic column of 4 Hex8 at
 // rest (linear path: K u, whose trapezoidal work is exact; lumped mass m_i), struck by a rigid plane
 // driven down at constant speed V: no other force. Velocity Verlet's identity gives the kinetic
 // energy as the trapezoidal work of the forces plus dt^2/8 sum |F_i|^2 / m_i, so with the body's

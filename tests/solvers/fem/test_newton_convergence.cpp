@@ -1,4 +1,4 @@
-// Newton convergence on a stiff steel cantilever (issue 27): a test invariant to the size of the
+// Newton convergence on a stiff steel cantilever: a test invariant to the size of the
 // load and to the number of load steps, with a floor at the round-off of the internal force;
 // failure messages that say what happened (a limit load, an inverted element).
 //

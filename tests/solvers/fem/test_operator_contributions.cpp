@@ -1,4 +1,4 @@
-// The FE operator of the nonlinear path as a sum of contributions (issue 27): a contribution
+// The FE operator of the nonlinear path as a sum of contributions: a contribution
 // beside the material's (here a spring bed, written in the test as a user would) joins the
 // static, Newmark and central-difference analyses without a change to them.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// The reduced Hex8 (Hex8Formulation::Reduced, issue 27's explicit plate element): one point in
+// The reduced Hex8 (Hex8Formulation::Reduced, the explicit plate element): one point in
 // the plane, a line of points through the thickness, hourglass stabilisation, one enhanced
 // thickness strain updated once per step. Central difference only.
 #include <catch2/catch.hpp>

@@ -1,4 +1,4 @@
-// Energies by part (issue 27): plastic work, strain energy and kinetic energy per element region,
+// Energies by part: plastic work, strain energy and kinetic energy per element region,
 // summing to the model's totals, against a closed-form two-material case.
 #include <catch2/catch.hpp>
 #include <cmath>

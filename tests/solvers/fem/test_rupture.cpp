@@ -1,4 +1,4 @@
-// Rupture (issue 27): a failure strain per material, constant or Germanischer Lloyd's
+// Rupture: a failure strain per material, constant or Germanischer Lloyd's
 // element-size-dependent eps_f = eps_g + eps_e t / l_e, the first failed element reported, and
 // element erosion in explicit analyses with its energy kept in the balance.
 #include <catch2/catch.hpp>
@@ -248,16 +248,16 @@ TEST_CASE("rupture: the nodes of an eroded end element leave the structure",
   CHECK(kept == 12);
 }
 
-// The energy books through a rupture and the ringing after it (issue 29): a clamped steel plate
+// The energy books through a rupture and the ringing after it: a clamped steel plate
 // 100 x 100 x 4 mm of 10 x 10 reduced Hex8 (finite-strain J2, eps_f = 0.2, erosion), struck at
 // its centre by a rigid sphere (R = 15 mm) driven at 20 m/s: it tears, 16 elements erode, the
 // sphere passes through and the petals ring. No other input, so the sphere's work must equal
 //   E_kin + E_strain (with the springs) + W_plastic + W_eroded + W_beta,
 // W_beta the energy the reduced Hex8's once-a-step update of its enhanced thickness strain
-// dissipates (MaterialContribution::enhanced_strain_work()). Measured (2026-11-28): within
+// dissipates (MaterialContribution::enhanced_strain_work()). Measured: within
 // 0.33 % of the work at every step once it passes 100 J (7 % of its final 1360 J; 0.14 % at the
 // end), and the balance moves by 0.14 J over the 0.94 ms of ringing while W_beta grows by 2.8 J
-// (the drift that was not booked before); without summing the penalty stiffness over the intact
+// (a drift unless W_beta is booked); without summing the penalty stiffness over the intact
 // face elements the hole's edge nodes (a quarter of their mass left, all of their stiffness)
 // chattered on the sphere and created 70 J (-5.8 %). What is left is the central difference's: its kinetic energy jumps
 // when an element's force and mass leave between two steps, and at each touch and release of a

@@ -4,7 +4,7 @@
 // factor does not depend on the number of threads, bit for bit, in every repeat; a matrix that is
 // not positive definite is refused (or, where allowed, handed to the L D L^T fallback); a new
 // pattern is analysed again; the automatic choice takes it only for large factors; and the
-// plate's static and Newmark results agree with Eigen's solver to 1e-10 (issue 16).
+// plate's static and Newmark results agree with Eigen's solver to 1e-10.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <vector>
@@ -172,7 +172,7 @@ TEST_CASE("threaded factorisation: automatic only for large factors, and the pla
 
   // the seed plate, 40 x 40 x 4 Hex8 (25k dofs, a factor of ~7e6 entries: the threaded
   // factorisation by default): static (corner reaction p A = 4 N) and 10 Newmark steps against
-  // Eigen's L D L^T, within the issue's 1e-10
+  // Eigen's L D L^T, within 1e-10
   const double l = 0.02;
   const Model model = seed_plate(40, 4);
   SolverOptions threaded, eigen;

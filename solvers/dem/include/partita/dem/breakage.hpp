@@ -17,7 +17,7 @@
 // "breakage_strength", so it follows the particle and is saved and restored with it. The load at
 // which it breaks is kept beside it ("breakage_load_limit"): the force pass compares each load
 // with it as the load is completed (System::contact_load_reached()), so a step in which nothing
-// breaks costs no pass over the particles here (issue 13: at most 5 % on a large bed).
+// breaks costs no pass over the particles here (the aim: at most 5 % on a large bed).
 // Particles with d < d_min (comminution limit) do not fragment; fragments are breakable. With
 // BreakageParameters::powder a particle below d_min whose load reaches its strength (the same
 // criterion) is crushed to powder: removed at the end of the step, its mass, kinetic energy and
