@@ -1,7 +1,7 @@
 # partita_add_module(<name> [SOURCES_GLOB <pattern>] [PUBLIC <deps...>] [PRIVATE <deps...>]
 #                    [PCH <headers...>])
 # One library target per module: partita_<name> with the alias partita::<name>, headers in the
-# module's include/, sources found by the glob (default src/*.cpp), C++20, the project warnings
+# module's include/, sources found by the glob in src/ and its subfolders (default src/*.cpp), C++20, the project warnings
 # linked PRIVATE (build interface only), installed and exported for find_package(partita).
 # PCH: headers most of the module's sources include (the standard library, Eigen, the module's
 # own base headers), precompiled once for the module (PARTITA_PCH, on by default; a source with
