@@ -37,10 +37,10 @@ TimeWindow TimeWindow::next(int substeps) const {
 }
 
 namespace {
-// ceil(x) where x within 1e-9 relative of an integer counts as that integer.
+// ceil(x) where x within TimeWindow::tolerance (relative) of an integer counts as that integer.
 double tolerant_ceil(double x) {
   const double r = std::round(x);
-  if (std::abs(x - r) <= 1e-9 * std::max(1.0, std::abs(x))) return r;
+  if (std::abs(x - r) <= TimeWindow::tolerance * std::max(1.0, std::abs(x))) return r;
   return std::ceil(x);
 }
 }  // namespace

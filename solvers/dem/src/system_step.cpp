@@ -40,7 +40,11 @@ void System::step(double dt) {
     msg << "step: the time step must be > 0 s, got " << dt;
     throw Error(msg.str());
   }
-  if (dt > rayleigh_dt_ * (1.0 + 1e-12)) {
+  // A step may exceed the Rayleigh step by the coupling's window tolerance (1e-9 relative,
+  // partita::coupling::TimeWindow::tolerance, which the DEM cannot name): a window split into
+  // substeps of at most the Rayleigh step gives substeps up to that much longer.
+  constexpr double kStepTolerance = 1e-9;
+  if (dt > rayleigh_dt_ * (1.0 + kStepTolerance)) {
     std::ostringstream msg;
     msg.precision(6);
     msg << "step: time step " << dt << " s is above the Rayleigh time step " << rayleigh_dt_

@@ -51,8 +51,15 @@ class TimeWindow {
   /// The same window with another substep count (progress reset).
   TimeWindow with_substeps(int substeps) const { return TimeWindow(size_, index_, substeps); }
 
+  /// The one tolerance of window-time arithmetic, relative: a ratio of times within it of a whole
+  /// number counts as that number, and a time within it (times the window) of a target has
+  /// reached it. Far above the round-off of a time built from 2^53 windows or fewer (a few ulps
+  /// per operation), far below any step a solver takes (a substep is at least 1e-6 of a window
+  /// in practice).
+  static constexpr double tolerance = 1e-9;
+
   /// Number of windows of `size` needed to reach `end`: ceil(end / size), where a ratio within
-  /// 1e-9 (relative) of a whole number counts as that number (0.3 / 0.1 gives 3, not 4).
+  /// `tolerance` (relative) of a whole number counts as that number (0.3 / 0.1 gives 3, not 4).
   /// Throws partita::Error for a count above max_windows (2^53: window times are exact products).
   static std::int64_t count_to(double end, double size);
   static constexpr double max_windows = 9007199254740992.0;  // 2^53
@@ -65,8 +72,10 @@ class TimeWindow {
     return substeps_for(step, max_step) > 1;
   }
   /// Whether time t has reached `target` on a clock of windows of `size`: t >= target less
-  /// 1e-9 of a window (a time that is a sum or a product of windows rounds either way).
-  static bool reached(double t, double target, double size) { return t >= target - 1e-9 * size; }
+  /// `tolerance` of a window (a time that is a sum or a product of windows rounds either way).
+  static bool reached(double t, double target, double size) {
+    return t >= target - tolerance * size;
+  }
 
  private:
   double size_;
