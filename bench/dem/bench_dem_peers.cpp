@@ -155,7 +155,7 @@ void print_scaling(const std::string& bed, const std::vector<std::pair<int, doub
   std::printf("\n");
   for (const auto& [t, r] : rates)
     if (t == 16)
-      std::printf("# issue 16's aim at 16 threads: 12x (9.7x when it was filed); here %.2fx\n",
+      std::printf("# the aim at 16 threads: 12x (the first threaded DEM: 9.7x); here %.2fx\n",
                   r / one);
   std::fflush(stdout);
 }

@@ -75,8 +75,8 @@ int main(int argc, char** argv) {
                 p.max_overlap / 1.25e-3, expo);
     std::fflush(stdout);
     if (n >= 0.99e6 && n <= 1.01e6)
-      std::printf("  10^6 granules: %.2f s = %.2fx the aim (15 s on 2 cores), %.2fx the time when "
-                  "issue 16 was filed (31 s on 16 cores)\n", t, t / 15.0, t / 31.0);
+      std::printf("  10^6 granules: %.2f s = %.2fx the aim (15 s on 2 cores), %.2fx the first "
+                  "generator's time (31 s on 16 cores)\n", t, t / 15.0, t / 31.0);
     prev_n = n;
     prev_t = t;
   }

@@ -491,7 +491,7 @@ int main(int argc, char** argv) {
   }
   std::printf(
       "\n  (cpu): the main thread's CPU over wall seconds (below 1 on 1 thread: other processes); "
-      "per cpu-s: element-steps per CPU second (1 thread: the calling thread's CPU, the rate on an idle core; more threads: all threads' CPU, with OMP_WAIT_POLICY=PASSIVE so that waiting threads do not count: near the 1-thread figure when the split adds no work); vs aim: element-steps/s over 1e6 (issue 27: 10^6 on 2 cores); vs linear: over the "
+      "per cpu-s: element-steps per CPU second (1 thread: the calling thread's CPU, the rate on an idle core; more threads: all threads' CPU, with OMP_WAIT_POLICY=PASSIVE so that waiting threads do not count: near the 1-thread figure when the split adds no work); vs aim: element-steps/s over 1e6 (the aim: 10^6 on 2 cores); vs linear: over the "
       "linear-elastic explicit step (the linear path, K u) on as many threads; contact: no "
       "indenter in the model\n");
   return 0;
