@@ -120,7 +120,14 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
   // secant stiffness of the converged increments, d lambda / |du|: the first one and the
   // last one (their ratio tells a limit load from a numerical difficulty)
   double stiffness_first = -1.0, stiffness_last = -1.0;
-  double carried = 0.0;  // the last load factor reached with kRunawayStiffness of the first's
+  // The runaway test's stiffness, |dF| / |du| of an increment with dF the change of the loads
+  // on the free dofs, against that of the first increment of the first solve under loads (the
+  // structure at rest: a load ramped over many solves is measured against it too); none where
+  // the loads do not change (a prescribed displacement drives it: nothing can run away).
+  Eigen::VectorXd load_change;
+  dofs.gather_free(f1 - f0, load_change);
+  const double load_norm = load_change.norm();
+  double carried = 0.0;  // the last load factor reached with kRunawayStiffness of the reference
   Eigen::VectorXd f_lambda, u_trial, x;
   while (lambda < 1.0) {
     double next = lambda + increment;
@@ -147,7 +154,12 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
         stiffness_last = (next - lambda) / du;
         if (stiffness_first < 0.0) stiffness_first = stiffness_last;
       }
-      const double ratio = stiffness_first > 0.0 ? stiffness_last / stiffness_first : 1.0;
+      double ratio = 1.0;
+      if (du > 0.0 && load_norm > 0.0) {
+        const double stiffness = (next - lambda) * load_norm / du;
+        if (!(reference_stiffness_ > 0.0)) reference_stiffness_ = stiffness;
+        ratio = stiffness / reference_stiffness_;
+      }
       if (ratio >= kRunawayStiffness) carried = next;
       if (model_size_ > 0.0 && ratio < kRunawayStiffness) {
         double moved = 0.0;  // the largest nodal displacement
@@ -160,11 +172,13 @@ void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t
               << "). Newton accepted load factor " << next << " with a node moved " << moved
               << " m, more than the model's size (" << model_size_
               << " m), in an increment whose secant stiffness was " << 100.0 * ratio
-              << " % of the first's. The loads exceed what the structure can carry (a "
-                 "collapse, e.g. a plastic mechanism): keep them below about "
-              << carried
-              << " times the applied ones, prescribe a displacement instead, or give the "
-                 "material the hardening it has";
+              << " % of the structure's at rest. The loads exceed what the structure can carry (a "
+                 "collapse, e.g. a plastic mechanism): ";
+          if (carried > 0.0)
+            msg << "keep them below about " << carried << " times the applied ones";
+          else
+            msg << "keep them at those the step started from";
+          msg << ", prescribe a displacement instead, or give the material the hardening it has";
           throw Error(msg.str());
         }
       }

@@ -24,9 +24,10 @@ namespace partita::fem {
 // whose model keeps a trace of stiffness (an element's residual constraint, the supports'
 // triaxiality) lets the load factor creep on while the displacement runs away. When an increment
 // is accepted with a node moved more than the model's size (set_model_size: the diagonal of
-// its bounding box) and a secant stiffness d lambda / |du| below kRunawayStiffness of the first
-// increment's, it throws Error with "limit load" and the largest load factor carried: the last
-// one reached by an increment that kept at least that fraction of the first's stiffness.
+// its bounding box) and a secant stiffness |dF| / |du| (dF the increment's change of the loads)
+// below kRunawayStiffness of the first loaded increment's (of the first solve: the structure at
+// rest), it throws Error with "limit load" and the largest load factor carried: the last one
+// reached by an increment that kept at least that fraction of the stiffness at rest.
 class StaticIntegrator {
  public:
   explicit StaticIntegrator(NewtonOptions options = {},
@@ -56,6 +57,7 @@ class StaticIntegrator {
   NewtonSolver newton_;
   ProgressCallback progress_;
   double model_size_ = 0.0;
+  double reference_stiffness_ = 0.0;  // of the runaway test: the first loaded increment's
   std::vector<NewtonReport> reports_;
 };
 
