@@ -1,4 +1,4 @@
-// Rigid indenters of the FEM participant through its YAML (issue 27): the keys build the
+// Rigid indenters of the FEM participant through its YAML: the keys build the
 // contact, the monitors report it, the energy balance includes the indenter's work, the surface
 // is offered as a moving mesh, and bad input is refused with the key named.
 #include <catch2/catch.hpp>
