@@ -1,7 +1,7 @@
 // A DEM run writes its final state as a particle file (output: {particles_file: end}) that
 // another case reads (particles: {file: ...}): the restarted run's particles, written again
 // before its first step, are the same file apart from the title line. The writer prints every
-// number in its shortest exact form (tests/solvers/dem/lammps_data_io.cpp), so equal text means
+// number in its shortest exact form (tests/solvers/dem/test_lammps_data_io.cpp), so equal text means
 // the same positions, velocities, diameters and densities bit for bit.
 
 #include <catch2/catch.hpp>

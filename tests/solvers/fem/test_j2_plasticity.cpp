@@ -230,5 +230,5 @@ TEST_CASE("j2 output: the element equivalent plastic strain of a uniaxial test",
   REQUIRE(s.element_equivalent_plastic_strain().size() == 1);
   CHECK(s.element_equivalent_plastic_strain()[0] == Approx(ref.alpha).epsilon(1e-9));
   // (the FEM adapter writes it as the cell array equivalent_plastic_strain of the .vtu:
-  // tests/adapters/output_test.cpp)
+  // tests/adapters/test_output.cpp)
 }

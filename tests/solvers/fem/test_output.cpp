@@ -1,4 +1,4 @@
-// Scalar monitors (the VTK files are the FEM adapter's: tests/adapters/output_test.cpp).
+// Scalar monitors (the VTK files are the FEM adapter's: tests/adapters/test_output.cpp).
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
@@ -10,7 +10,7 @@ using namespace partita::fem;
 
 TEST_CASE("fem monitors for every element type", "[fem][output]") {
   // (the .vtu file of each element type is tested through the FEM adapter, which writes it:
-  // tests/adapters/output_test.cpp)
+  // tests/adapters/test_output.cpp)
   for (const ElementType type :
        {ElementType::Hex8, ElementType::Hex20, ElementType::Tet4, ElementType::Tet10}) {
     Model model(make_box_mesh({Vec3::Zero(), Vec3(1, 0.2, 0.2), {4, 1, 1}, type}));

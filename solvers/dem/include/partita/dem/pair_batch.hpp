@@ -12,7 +12,7 @@
 //
 // The lanes do the operations of the scalar kernel (PairContacts::force() with hertz_mindlin())
 // in the same order, so every result has the same bits whatever the kernel set
-// (tests/solvers/dem/pair_batch.cpp checks it on random contacts of every branch): pairs
+// (tests/solvers/dem/test_pair_batch.cpp checks it on random contacts of every branch): pairs
 // evaluated by the scalar kernel (across threads' parts) and by these sum alike, and results do
 // not depend on the thread count or on the machine's instruction sets. Built with
 // -ffp-contract=off (no fused multiply-add) like the scalar kernel.

@@ -28,7 +28,7 @@ class RestitutionCalibration {
   /// sqrt(E/rho)). The damping force uses the half-step velocity, an error of first order in
   /// dt that grows with the damping: measured at 0.2 of the Rayleigh step over 0.01..10 m/s,
   /// e = 0.1 is realised 2.2 % low and e = 0.3..0.7 up to 2.5 % off
-  /// (tests/solvers/dem/time_step_fraction.cpp). Piecewise constant in e (0 < e <= 1): 0.02 below
+  /// (tests/solvers/dem/test_time_step_fraction.cpp). Piecewise constant in e (0 < e <= 1): 0.02 below
   /// e = 0.15, 0.05 below 0.2, 0.1 below 0.9, else 0.2. A second-order damping velocity does not
   /// help: at 10 m/s a contact of these spheres lasts 3.4 steps of 0.2 dt_R, and damping on the
   /// end-of-step velocity (v_{n+1/2} + dt/2 F/m*, solved per contact in closed form) realised

@@ -53,7 +53,7 @@ TEST_CASE("every registered adapter honours the Solver contract", "[adapters][co
     DYNAMIC_SECTION("solver " << entry.name) {
       const auto it = samples().find(entry.name);
       INFO("add a sample configuration for '" << entry.name
-                                              << "' to tests/adapters/conformance_test.cpp");
+                                              << "' to tests/adapters/test_conformance.cpp");
       REQUIRE(it != samples().end());
       // the contract itself: partita::check_solver_contract (installed with the package, so
       // that an adapter written out of tree runs the same checks)
