@@ -1,11 +1,14 @@
 #!/usr/bin/python3
 """Overlay one monitor column of every variant of a partita sweep in one PNG.
 
-Usage: plot_sweep.py [--x XCOLUMN] [--x-scale F] [--y-scale F] OUT.png COLUMN LABEL FILE.csv [...]
+Usage: plot_sweep.py [--x XCOLUMN] [--x-scale F] [--y-scale F] [--list-panels] OUT.png COLUMN LABEL FILE.csv [...]
+--list-panels prints the variants of each panel, one line a panel, and draws nothing.
 COLUMN is the column's name without its unit ("granules.plate.force_z"); each FILE.csv is the
 variant's monitor CSV (first column: time). Variants whose file or column is missing are left
-out. Each variant has its own colour and line style, the legend beside its panel; more than
-MAX_SERIES variants are drawn in several panels of MAX_SERIES, stacked on the same axes' ranges.
+out. Each variant has its own colour and line style, the legend beside its panel. Variants are
+grouped into panels by size (their largest |value|): a variant more than SPREAD times the smallest
+of its panel starts a new panel, each with its own y range, so a 0.1 N curve is not flattened
+under a 45 N one; a panel holds at most MAX_SERIES variants.
 The PNG is written under a temporary name and renamed.
 """
 import csv
@@ -13,14 +16,13 @@ import os
 import sys
 
 MAX_SERIES = 6
+SPREAD = 100.0
 STYLES = ["-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (8, 2))]
 
 
 def main(argv):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    list_panels = "--list-panels" in argv
+    argv = [a for a in argv if a != "--list-panels"]
     x_column, x_scale, y_scale = "", 1.0, 1.0
     while len(argv) > 1 and argv[1].startswith("--"):
         key, value = argv[1], argv[2]
@@ -57,8 +59,29 @@ def main(argv):
                        [y_scale * float(r[c]) for r in data]))
     if not curves:
         return 1
-    chunks = [curves[k:k + MAX_SERIES] for k in range(0, len(curves), MAX_SERIES)]
-    fig, axes = plt.subplots(len(chunks), 1, sharex=True, sharey=True, squeeze=False,
+    def size(curve):
+        return max((abs(y) for y in curve[2]), default=0.0)
+
+    # panels by size (the variants' own order kept inside a panel), at most MAX_SERIES each
+    chunks = []
+    for curve in sorted(curves, key=size):
+        last = chunks[-1] if chunks else None
+        if (last is None or len(last) >= MAX_SERIES
+                or size(curve) > SPREAD * max(size(last[0]), 1e-300)):
+            chunks.append([curve])
+        else:
+            last.append(curve)
+    order = {id(c): k for k, c in enumerate(curves)}
+    chunks = [sorted(chunk, key=lambda c: order[id(c)]) for chunk in chunks]
+    chunks.sort(key=lambda chunk: min(order[id(c)] for c in chunk))
+    if list_panels:
+        for chunk in chunks:
+            print(", ".join(c[0] for c in chunk))
+        return 0
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(len(chunks), 1, sharex=True, sharey=False, squeeze=False,
                              figsize=(9, 1.2 + 3.2 * len(chunks)), dpi=120,
                              constrained_layout=True)
     for ax, chunk in zip(axes[:, 0], chunks):

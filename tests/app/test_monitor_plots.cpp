@@ -14,6 +14,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace fs = std::filesystem;
 using partita::test::quote;
@@ -142,5 +144,36 @@ TEST_CASE("monitor plots: --no-plots and PARTITA_NO_PLOTS leave the PNGs out", "
   const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
   if (partita::test::run_command(python + " -c 'import matplotlib'").status == 0)
     CHECK(files(dir / "on", ".png") == files(dir / "on", ".csv"));
+  fs::remove_all(dir);
+}
+
+// A sweep's variants of one quantity can span orders of magnitude (a far wall's force from 0.1 N
+// for soft granules to 45 N for stiff ones): a variant more than 100 times the smallest of its
+// panel starts a panel of its own (its own y range), at most 6 variants a panel, the panels in
+// the order of their first variant.
+TEST_CASE("sweep plot: variants of unrelated size on panels of their own", "[app][plots]") {
+  const fs::path dir =
+      fs::temp_directory_path() / ("partita_sweep_plots_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  const std::string script = (fs::path(PARTITA_SOURCE_DIR) / "app" / "plot_sweep.py").string();
+  std::string args;
+  const std::vector<std::pair<std::string, double>> peaks = {
+      {"2MPa", 0.1}, {"20MPa", 0.12}, {"200MPa", 1.0}, {"2GPa", 3.0}, {"20GPa", 44.0}, {"200GPa", 45.0}};
+  for (const auto& [label, peak] : peaks) {
+    const fs::path csv = dir / (label + ".csv");
+    std::ofstream(csv) << "time [s],far.force_z [N]\n0,0\n0.1," << peak / 2 << "\n0.2," << -peak
+                       << "\n";
+    args += " " + label + " " + quote(csv);
+  }
+  const auto listed = partita::test::run_command(python + " " + quote(script) +
+                                                 " --list-panels " + quote(dir / "sweep.png") +
+                                                 " far.force_z" + args);
+  INFO(listed.output);
+  REQUIRE(listed.status == 0);
+  // 0.1 N opens the first panel, which takes up to 100 x 0.1 = 10 N; 44 N opens the second
+  CHECK(listed.output == "2MPa, 20MPa, 200MPa, 2GPa\n20GPa, 200GPa\n");
+  CHECK_FALSE(fs::exists(dir / "sweep.png"));  // listing draws nothing
   fs::remove_all(dir);
 }
