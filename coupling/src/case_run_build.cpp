@@ -625,12 +625,6 @@ void CaseRun::build_exchanges(const config::Node& coupling) {
     exchanges_.push_back(std::make_unique<Exchange>(
         data, Exchange::End{from.p, from.mesh->mesh.name()},
         Exchange::End{to.p, to.mesh->mesh.name()}, *ws, std::move(mapper), rsee, wc));
-    if (const double scale = item.real("scale"); scale != 1.0) {
-      exchanges_.back()->set_scale(scale);
-      log::get("coupling")
-          ->warn("{}: exchange {} multiplies what arrives by {} (scale: for testing audits only)",
-                 item["scale"].location().str(), exchanges_.back()->label(), scale);
-    }
     Exchange& e = *exchanges_.back();
     e.set_map_on(item.string("map_on") == "sender" ? MapOn::sender : MapOn::receiver);
     // A receiver in another process maps what it reads on its side (it is sent the sender's
@@ -680,7 +674,6 @@ ServerMapping CaseRun::server_mapping(std::size_t exchange, const InterfaceMesh&
   m.mapper = exchange_mapper(item, *ws, from.mesh, to.mesh,
                              fmt::format("'{}' {} -> {}.{} (on the receiver's side)", data,
                                          item.string("from"), served_->name(), to.mesh.name()));
-  m.scale = item.real("scale");
   return m;
 }
 

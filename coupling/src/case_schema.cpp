@@ -66,12 +66,6 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
                "either way (and in one process, where it changes nothing)",
                {"receiver", "sender"})
       .def("receiver");
-  exchange
-      ->real("scale",
-             "FOR TESTING AUDITS ONLY: multiply what arrives by this factor (a deliberately "
-             "broken exchange: the balance and energy audits must then report it)")
-      .positive()
-      .def(1.0);
 
   auto coupling = std::make_shared<Spec>("coupling", "how the participants advance together");
   coupling->string("scheme", "coupling scheme; known: " + join_names(registries.schemes.names()))

@@ -624,7 +624,6 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
                               data, mesh));
     Stopwatch clock;
     at->mapping.mapper->map(unmapped_values, out);  // d = M s, as the controller's transmit()
-    if (at->mapping.scale != 1.0) out *= at->mapping.scale;
     mapping_seconds_ += clock.seconds();
   };
   OutputSlots slots;

@@ -14,6 +14,7 @@
 #include "ode_participant.hpp"
 #include "oscillator_participants.hpp"
 #include "partita/coupling/case_run.hpp"
+#include "partita/coupling/mapping/nearest_neighbor_mapper.hpp"
 #include "partita/interface/error.hpp"
 
 using namespace partita;
@@ -67,8 +68,41 @@ class BooksParticipant : public Solver {
   double p_, d_, until_, eps_, end_, t_ = 0.0, saved_ = 0.0;
 };
 
+// A deliberately broken exchange, registered by this test only: the nearest-neighbour mapping
+// times `factor`, so what arrives is not what was sent and the audits must say so.
+class ScaledMapper final : public Mapper {
+ public:
+  ScaledMapper(std::unique_ptr<Mapper> inner, double factor)
+      : inner_(std::move(inner)), factor_(factor) {}
+  void compute(const Mesh& from, const Mesh& to) override {
+    inner_->compute(from, to);
+    set_meshes(from, to);
+  }
+  void map(const Eigen::MatrixXd& in, Eigen::MatrixXd& out) const override {
+    inner_->map(in, out);
+    out *= factor_;
+  }
+  Constraint constraint() const override { return inner_->constraint(); }
+  std::string name() const override { return "test-scaled"; }
+
+ private:
+  std::unique_ptr<Mapper> inner_;
+  double factor_;
+};
+
 Registries registries() {
   Registries r = test::test_registries();
+  auto scaled = std::make_shared<config::Spec>("test-scaled", "nearest-neighbor times a factor");
+  scaled->string("type", "test-scaled").required();
+  scaled->real("factor", "what arrives over what the nearest-neighbor mapping gives").def(0.9);
+  r.mappers.add(
+      "test-scaled", "nearest-neighbor times a factor (a broken exchange, for this test)",
+      [scaled](const MapperContext& c) -> std::unique_ptr<Mapper> {
+        return std::make_unique<ScaledMapper>(
+            std::make_unique<NearestNeighborMapper>(c.constraint),
+            c.config.validated(scaled).real("factor"));
+      },
+      scaled);
   test::add_oscillator_solvers(r);
   auto spec = std::make_shared<config::Spec>("test-books", "given energy books");
   spec->real("power", "input power").def(1.0);
@@ -254,18 +288,18 @@ TEST_CASE("energy balance: a coupled oscillator closes within 2 %, a scaled exch
   SECTION("forces scaled by 0.9: the balance fails, and the coupling column holds the loss") {
     // The mass feels 0.9 of the spring's pull, the spring stores 1/2 k x^2: the system gains
     // 0.1 * 1/2 k x^2, up to about 0.1 * 1/2 (k / (k + 0.9 k)) * 0.5 J / 0.5 J = 5 % of the scale.
-    const Table t = run_case("scaled", oscillator_case(", scale: 0.9"));
+    const Table t = run_case("scaled", oscillator_case(", mapper: {type: test-scaled, factor: 0.9}"));
     const double worst = max_abs(t.column("energy balance error [-]"));
     INFO("largest |error| " << worst);
     CHECK(worst > 0.02);
     CHECK(worst < 0.08);
     // what the error shows is what the coupling created (reported, not counted)
-    const Table c = run_case("scaled-counted", oscillator_case(", scale: 0.9", "  coupling: counted\n"));
+    const Table c = run_case("scaled-counted", oscillator_case(", mapper: {type: test-scaled, factor: 0.9}", "  coupling: counted\n"));
     CHECK(max_abs(c.column("energy balance error [-]")) <= 1e-10);
   }
   SECTION("with a tolerance and on_exceeded: stop the scaled run stops with a diagnosis") {
     try {
-      run_case("stop", oscillator_case(", scale: 0.9", "  tolerance: 0.02\n  on_exceeded: stop\n"));
+      run_case("stop", oscillator_case(", mapper: {type: test-scaled, factor: 0.9}", "  tolerance: 0.02\n  on_exceeded: stop\n"));
       FAIL("the run did not stop");
     } catch (const Error& e) {
       const std::string what = e.what();

@@ -5,8 +5,7 @@
 //   sender:   its window value (averaged or last over its substeps: the participant's side,
 //             participant.hpp) arrives in combined(); an implicit scheme may replace it by an
 //             accelerated value — sent();
-//   mapping:  received = M sent (the mapper; identity when none) — transmit(); times a
-//             factor where a test breaks the exchange on purpose (set_scale());
+//   mapping:  received = M sent (the mapper; identity when none) — transmit();
 //   receiver: gets the window's start value d_n and the newest value d_{n+1} on its own mesh
 //             (window_input()) and sees them in time as it subcycles (its side again). Where no
 //             new value came yet (first participant of a serial scheme, parallel explicit
@@ -118,11 +117,6 @@ class Exchange {
   /// stored values do not fit this exchange's meshes.
   void serialize(StateArchive& ar);
 
-  /// FOR TESTING AUDITS ONLY: transmit() multiplies what arrives by `factor` (a deliberately
-  /// broken exchange, the case key `scale`; 1: the plain mapping, the default).
-  void set_scale(double factor) { scale_ = factor; }
-  double scale() const { return scale_; }
-
   /// Wall time spent mapping [s].
   double mapping_seconds() const { return mapping_seconds_; }
 
@@ -147,7 +141,6 @@ class Exchange {
   Eigen::MatrixXd start_, end_;
   bool start_is_end_ = false;  // d_n = d_{n+1}: start_'s own values are stale
   double mapping_seconds_ = 0.0;
-  double scale_ = 1.0;
 };
 
 }  // namespace partita::coupling

@@ -194,10 +194,9 @@ class RemoteParticipant final : public Participant {
 };
 
 /// A server's mapping of an exchange it maps on its side: the mapper computed from the sender's
-/// mesh to its own, and the exchange's scale (1 but where a test breaks it on purpose).
+/// mesh to its own.
 struct ServerMapping {
   std::unique_ptr<Mapper> mapper;
-  double scale = 1.0;
 };
 /// Builds a server's mapping from the case: the exchange's number in coupling.exchanges, the
 /// sender's mesh (from the controller) and the receiver's (the server's own).
