@@ -10,6 +10,9 @@ Reads particle files (LAMMPS data, as partita writes them: id type diameter dens
 import os
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from python_modules import require  # noqa: E402  (cases/python_modules.py: the missing-module check)
+
 OUTER = ((0.0, 0.0, 0.0), (0.040, 0.030, 0.030))
 INNER = ((0.001, 0.001, 0.001), (0.039, 0.029, 0.029))
 
@@ -36,24 +39,6 @@ def box_edges(ax, lo, hi, **style):
     for a, b in itertools.combinations(itertools.product(*zip(lo, hi)), 2):
         if sum(x != y for x, y in zip(a, b)) == 1:
             ax.plot(*[[1e3 * a[k], 1e3 * b[k]] for k in range(3)], **style)
-
-
-# The python partita's own plots use (app/process.cpp); the modules' Debian packages.
-PARTITA_PYTHON = "/usr/bin/python3"
-DEBIAN_PACKAGE = {"numpy": "python3-numpy", "matplotlib": "python3-matplotlib", "vtk": "python3-vtk9"}
-
-
-def require(*modules):
-    """Stop with one line when a module this script needs is missing: which one, its Debian
-    package, the python that lacks it and the one partita's own plots use."""
-    import importlib
-    for m in modules:
-        try:
-            importlib.import_module(m)
-        except ImportError:
-            sys.exit(f"{os.path.basename(sys.argv[0])}: the python module {m} is missing in "
-                     f"{sys.executable} (Debian package {DEBIAN_PACKAGE.get(m, m)}); run it with "
-                     f"{PARTITA_PYTHON}, the python partita's own plots use, or install it there")
 
 
 def main():

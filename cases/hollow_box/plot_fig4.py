@@ -16,6 +16,9 @@ import os
 import re
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from python_modules import require  # noqa: E402  (cases/python_modules.py: the missing-module check)
+
 L = 0.040              # box length along x [m]
 LOAD = 500e3 * 0.030 * 0.030  # pressure x area of the outer end face [N]
 BEFORE_LOAD_FRAME = 1  # probe frame at t = 10 ms, the start of the ramp (output every 10 ms)
@@ -44,24 +47,6 @@ def modulus(folder):
     m = re.match(r"E=([0-9.eE+-]+)\s*([kMG]?)Pa", os.path.basename(folder))
     scale = {"": 1.0, "k": 1e3, "M": 1e6, "G": 1e9}
     return float(m.group(1)) * scale[m.group(2)] if m else float("nan")
-
-
-# The python partita's own plots use (app/process.cpp); the modules' Debian packages.
-PARTITA_PYTHON = "/usr/bin/python3"
-DEBIAN_PACKAGE = {"numpy": "python3-numpy", "matplotlib": "python3-matplotlib", "vtk": "python3-vtk9"}
-
-
-def require(*modules):
-    """Stop with one line when a module this script needs is missing: which one, its Debian
-    package, the python that lacks it and the one partita's own plots use."""
-    import importlib
-    for m in modules:
-        try:
-            importlib.import_module(m)
-        except ImportError:
-            sys.exit(f"{os.path.basename(sys.argv[0])}: the python module {m} is missing in "
-                     f"{sys.executable} (Debian package {DEBIAN_PACKAGE.get(m, m)}); run it with "
-                     f"{PARTITA_PYTHON}, the python partita's own plots use, or install it there")
 
 
 def main():

@@ -13,6 +13,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from python_modules import require  # noqa: E402  (cases/python_modules.py: the missing-module check)
 from vtk_file import arrays  # noqa: E402  (cases/vtk_file.py: VTK's reader, any encoding)
 
 
@@ -26,24 +27,6 @@ def last(pattern):
     if not files:
         sys.exit(f"plot_plate: no file matches {pattern}")
     return files[-1]
-
-
-# The python partita's own plots use (app/process.cpp); the modules' Debian packages.
-PARTITA_PYTHON = "/usr/bin/python3"
-DEBIAN_PACKAGE = {"numpy": "python3-numpy", "matplotlib": "python3-matplotlib", "vtk": "python3-vtk9"}
-
-
-def require(*modules):
-    """Stop with one line when a module this script needs is missing: which one, its Debian
-    package, the python that lacks it and the one partita's own plots use."""
-    import importlib
-    for m in modules:
-        try:
-            importlib.import_module(m)
-        except ImportError:
-            sys.exit(f"{os.path.basename(sys.argv[0])}: the python module {m} is missing in "
-                     f"{sys.executable} (Debian package {DEBIAN_PACKAGE.get(m, m)}); run it with "
-                     f"{PARTITA_PYTHON}, the python partita's own plots use, or install it there")
 
 
 def main(argv):
