@@ -797,16 +797,8 @@ void DemAdapter::advance(double dt) {
                 " s: " + e.what());
   }
   // the work the meshes' motion did on the particles over this step (no allocation: same sizes)
-  for (auto& cm : meshes_dem_) {
-    const Eigen::MatrixX3d& f = system_.vertex_forces(cm.id);
-    CouplingMesh::Work& a = cm.audit;
-    double w = 0.0;
-    for (Eigen::Index v = 0; v < f.rows(); ++v)
-      w += (a.force.row(v) + f.row(v)).dot(cm.positions.row(v) - a.position.row(v));
-    a.work -= 0.5 * w;  // f_v is the particles' force on the mesh: the mesh's on them is -f_v
-    a.position = cm.positions;
-    a.force = f;
-  }
+  // (no allocation: same sizes)
+  for (auto& cm : meshes_dem_) cm.audit.motion_step(cm.positions, system_.vertex_forces(cm.id));
 }
 
 std::optional<double> DemAdapter::interface_work(std::string_view mesh) const {
@@ -815,12 +807,12 @@ std::optional<double> DemAdapter::interface_work(std::string_view mesh) const {
   // what M_centres reads ("attached") moves nothing: the motion's work is M's alone (counted
   // once when a case exchanges on both)
   if (centres) return std::nullopt;
-  return cm.audit.work;
+  return cm.audit.work();
 }
 
 void DemAdapter::save_checkpoint() {
   checkpoint_ = system_.save_state();
-  for (auto& cm : meshes_dem_) cm.audit_checkpoint = cm.audit;
+  for (auto& cm : meshes_dem_) cm.audit.save_checkpoint();
   has_checkpoint_ = true;
 }
 
@@ -828,7 +820,7 @@ void DemAdapter::restore_checkpoint() {
   if (!has_checkpoint_)
     throw Error("dem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   system_.restore_state(checkpoint_);
-  for (auto& cm : meshes_dem_) cm.audit = cm.audit_checkpoint;
+  for (auto& cm : meshes_dem_) cm.audit.restore_checkpoint();
   stable_for_count_ = kNoCount;
 }
 
@@ -887,11 +879,7 @@ void DemAdapter::write_restart(BinaryWriter& out) const {
                                // histories, walls, mesh vertices, hooks' counters and RNG state
   out.bytes(state.str());
   out.section("dem interface work");
-  for (const auto& cm : meshes_dem_) {
-    out.write(cm.audit.work);
-    out.write(Eigen::MatrixXd(cm.audit.position));
-    out.write(Eigen::MatrixXd(cm.audit.force));
-  }
+  for (const auto& cm : meshes_dem_) cm.audit.save(out);
 }
 
 void DemAdapter::read_restart(BinaryReader& in) {
@@ -908,16 +896,7 @@ void DemAdapter::read_restart(BinaryReader& in) {
   if (const std::string astray = particle_astray(true); !astray.empty())
     throw Error(in.source() + ": the DEM state of '" + name_ + "' cannot be resumed: " + astray);
   in.expect_section("dem interface work");
-  for (auto& cm : meshes_dem_) {
-    Eigen::MatrixXd x, f;
-    cm.audit.work = in.get<double>();
-    in.read(x);
-    in.read(f);
-    if (x.rows() != cm.reference.rows() || x.cols() != 3 || f.rows() != x.rows() || f.cols() != 3)
-      in.fail(std::to_string(cm.reference.rows()) + " vertices of mesh '" + cm.name + "'");
-    cm.audit.position = x;
-    cm.audit.force = f;
-  }
+  for (auto& cm : meshes_dem_) cm.audit.load(in, "vertices of mesh '" + cm.name + "'");
 }
 
 void DemAdapter::add_coupling_mesh(const std::string& name, const Mesh& mesh, int material) {
@@ -927,8 +906,7 @@ void DemAdapter::add_coupling_mesh(const std::string& name, const Mesh& mesh, in
   cm.positions = mesh.points();
   cm.areas = mesh.triangle_areas();
   cm.id = system_.add_mesh(mesh.points(), mesh.triangles(), material);
-  cm.audit.position = mesh.points();
-  cm.audit.force = system_.vertex_forces(cm.id);
+  cm.audit = InterfaceWork::motion(mesh.points(), system_.vertex_forces(cm.id));
   InterfaceMesh vertices;
   vertices.mesh = Mesh(name, mesh.points(), mesh.triangles());
   vertices.reads.push_back(DataSpec{"displacement", 3, "m", DataKind::intensive});

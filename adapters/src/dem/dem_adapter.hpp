@@ -45,6 +45,7 @@
 #include "partita/dem/breakage.hpp"
 #include "partita/dem/packing_generator.hpp"
 #include "partita/dem/system.hpp"
+#include "partita/interface/interface_work.hpp"
 #include "partita/interface/solver.hpp"
 #include "partita/interface/time_table.hpp"
 
@@ -86,14 +87,9 @@ class DemAdapter : public Solver {
     Eigen::VectorXd areas;       // triangle areas (reference) [m^2]
     Eigen::MatrixX3d positions;  // current vertex positions (work array)
     // The interface energy audit (Solver::interface_work): the work the moving mesh did on the
-    // particles since t = 0, -sum_v 1/2 (f_v,k + f_v,k+1) . (x_v,k+1 - x_v,k) over the steps,
-    // with f_v the contact forces on the vertices (barycentric: exact for the linear motion of
-    // each triangle), and the vertex positions and forces at the end of the last step.
-    struct Work {
-      double work = 0.0;          // [J]
-      Eigen::MatrixX3d position;  // x_v,k
-      Eigen::MatrixX3d force;     // f_v,k
-    } audit, audit_checkpoint;
+    // particles since t = 0, with f_v the contact forces on the vertices (barycentric: exact for
+    // the linear motion of each triangle).
+    InterfaceWork audit = InterfaceWork::motion({}, {});  // started by add_coupling_mesh
   };
   struct Wall {
     std::string name;

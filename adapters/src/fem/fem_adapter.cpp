@@ -941,27 +941,11 @@ void FemAdapter::advance(double dt) {
   failure_log_.after_step(*solver_, name_);
   // the work of each interface's loads over this step: 1/2 (f_k + f_k+1) . du
   du_ = solver_->displacement() - u_before_;
-  for (auto& i : interfaces_) {
-    Interface::Work& a = i.audit;
-    double w = 0.0;
-    if (i.has_tractions) {
-      w += solver_->face_traction_work(i.face, i.tractions, du_);
-      if (a.tractions.rows() == i.tractions.rows())
-        w += solver_->face_traction_work(i.face, a.tractions, du_);
-      a.tractions = i.tractions;
-    }
-    if (i.has_forces) {
-      const bool previous = a.forces.rows() == i.nodal_forces.rows();
-      for (std::size_t k = 0; k < i.nodes.size(); ++k) {
-        const auto r = static_cast<Eigen::Index>(k);
-        const auto d = du_.segment<3>(3 * static_cast<Eigen::Index>(i.nodes[k]));
-        w += i.nodal_forces.row(r).dot(d);
-        if (previous) w += a.forces.row(r).dot(d);
-      }
-      a.forces = i.nodal_forces;
-    }
-    a.work += 0.5 * w;
-  }
+  for (auto& i : interfaces_)
+    i.audit.load_step(
+        du_, i.has_tractions ? &i.tractions : nullptr,
+        [&](const Eigen::MatrixX3d& t) { return solver_->face_traction_work(i.face, t, du_); },
+        i.nodes, i.has_forces ? &i.nodal_forces : nullptr);
 }
 
 std::optional<double> FemAdapter::interface_work(std::string_view mesh) const {
@@ -970,7 +954,7 @@ std::optional<double> FemAdapter::interface_work(std::string_view mesh) const {
       return ind.contact->indenter().is_free() ? std::optional<double>(ind.contact->indenter().external_work())
                                                : std::nullopt;
   Part part = Part::nodes;
-  return interfaces_[find_interface(mesh, &part)].audit.work;
+  return interfaces_[find_interface(mesh, &part)].audit.work();
 }
 
 double FemAdapter::stable_time_step() const {
@@ -983,7 +967,7 @@ void FemAdapter::save_checkpoint() {
   apply_nodal_forces();  // the state holds the loads read so far
   checkpoint_ = solver_->save_state();
   for (auto& i : interfaces_) {
-    i.audit_checkpoint = i.audit;
+    i.audit.save_checkpoint();
     i.nodal_forces_checkpoint = i.nodal_forces;
     i.tractions_checkpoint = i.tractions;
     i.has_forces_checkpoint = i.has_forces;
@@ -999,7 +983,7 @@ void FemAdapter::restore_checkpoint() {
   forces_pending_ = false;  // the checkpoint's loads hold until the next read
   failure_log_.restored(*solver_);
   for (auto& i : interfaces_) {  // and the values read then: the loads the restored solver holds
-    i.audit = i.audit_checkpoint;
+    i.audit.restore_checkpoint();
     i.nodal_forces = i.nodal_forces_checkpoint;
     i.tractions = i.tractions_checkpoint;
     i.has_forces = i.has_forces_checkpoint;
@@ -1036,11 +1020,7 @@ void FemAdapter::write_restart(BinaryWriter& out) const {
     out.write(static_cast<std::uint8_t>(i.has_tractions));
   }
   out.section("fem interface work");
-  for (const auto& i : interfaces_) {
-    out.write(i.audit.work);
-    out.write(i.audit.forces);
-    out.write(i.audit.tractions);
-  }
+  for (const auto& i : interfaces_) i.audit.save(out);
 }
 
 void FemAdapter::read_restart(BinaryReader& in) {
@@ -1063,11 +1043,7 @@ void FemAdapter::read_restart(BinaryReader& in) {
     i.has_tractions = in.get<std::uint8_t>() != 0;
   }
   in.expect_section("fem interface work");
-  for (auto& i : interfaces_) {
-    i.audit.work = in.get<double>();
-    in.read(i.audit.forces);
-    in.read(i.audit.tractions);
-  }
+  for (auto& i : interfaces_) i.audit.load(in, "loads of interface '" + i.name + "'");
   solver_->restore_state(s);
   forces_pending_ = false;
   failure_log_.restored(*solver_);

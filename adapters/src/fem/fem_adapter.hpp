@@ -31,6 +31,7 @@
 #include "line_probe.hpp"
 #include "partita/fem/fem.hpp"
 #include "mesh_locator.hpp"
+#include "partita/interface/interface_work.hpp"
 #include "partita/interface/solver.hpp"
 
 namespace partita::adapters {
@@ -72,13 +73,8 @@ class FemAdapter : public Solver {
     bool has_forces = false;
     bool has_tractions = false;
     // The interface energy audit (Solver::interface_work): the work of the received loads on the
-    // displacements since t = 0, sum over steps of 1/2 (f_k + f_k+1) . (u_k+1 - u_k) (the
-    // trapezoidal rule of Newmark's energy balance), and the loads of the last step.
-    struct Work {
-      double work = 0.0;           // [J]
-      Eigen::MatrixX3d forces;     // nodal forces of the last step (empty: none)
-      Eigen::MatrixX3d tractions;  // tractions of the last step (empty: none)
-    } audit, audit_checkpoint;
+    // displacements since t = 0 (the trapezoidal rule of Newmark's energy balance).
+    InterfaceWork audit = InterfaceWork::loads();
     // What was read when the checkpoint was saved: a restore brings back the solver's loads and
     // these with them (the audit and the force monitors read them until the next read).
     Eigen::MatrixX3d nodal_forces_checkpoint, tractions_checkpoint;
