@@ -21,39 +21,14 @@ namespace partita::fem {
 // formulation is FBar; plain Hex8 locks in bending of thin parts and near-incompressible flow.
 // Regions without a law use a LinearElasticLaw of their Material.
 //
-// EAS Hex8 (Hex8Formulation::IncompatibleModes, the default: the nonlinear path's form of the
-// linear path's incompatible modes): enhanced assumed strain after Simo & Armero (IJNME 33,
-// 1992, 1413-1449) with the 9 modes of Simo, Armero & Taylor (CMAME 110, 1993, 359-386) and
-// Taylor, Beresford & Wilson's constant-Jacobian scaling (so that the patch test passes on
-// distorted elements):
-//   F = I + sum_a u_a (x) grad_X N_a + sum_J alpha_J (x) g_J,
-//   g_J(xi) = (j0 / j(xi)) xi_J (J0^-1)_J.   (J0 = dX/dxi, j0 = det J0 at the centre; row J)
-// The three g_J act as the gradients of three extra "nodes" whose 9 displacements alpha are
-// element unknowns: the element is the plain one of 11 nodes, its alpha found per element
-// (local Newton from the committed alpha, h(u, alpha) = int G^T P dV = 0) and condensed:
-//   f_e = f_u - K_ua K_aa^-1 h,   K_e = K_uu - K_ua K_aa^-1 K_au.
-// int g_J dV = 0 for any symmetric rule (the orthogonality that makes the patch test pass);
-// for small strains the element is Wilson's / Taylor's QM6 (Simo & Rifai 1990). No shear
-// locking in bending, no volumetric locking up to nu ~ 0.49. Rule: 2x2x2 Gauss; a thin element
-// (its thinnest direction less than half as thick as both others) gets 2x2 x 6 Gauss points
-// with 6 through the thickness, so that it yields from its surfaces inward (a fully plastic
-// section's moment integrated to +2 %, where 2 points overestimate it by 15 %).
-//
-// F-bar Hex8 (Hex8Formulation::FBar): at each point F_bar = (J_bar / J)^(1/3) F, J = det F,
-// J_bar = (1/V) int J dV the element's volume ratio (de Souza Neto, Peric, Dutko & Owen 1996,
-// Int. J. Solids Struct. 33, 3277-3296, use det F at the centre; the volume ratio makes a
-// homogeneous deformation exact on distorted elements too: the patch test). The isochoric part
-// of F_bar is that of F; its volume change is the element's mean: the volumetric energy sees
-// one dilatation per element (no volumetric locking). Internal force and tangent are the first
-// and second derivatives of Pi = int W(F_bar) dV (a variational form of F-bar), with
-//   d F_bar = s (d F + F (x) (d ln J_bar - d ln J) / 3),  s = (J_bar / J)^(1/3):
-//   f = int B_bar^T P_bar dV,  K = int B_bar^T A B_bar + s (e c^T + c e^T
-//        + (F : P_bar)(e e^T + (H_bar - H) / 3)) dV,
-// e = (d ln J_bar - d ln J) / 3, c = dF/du^T P_bar, H = d^2 ln J, H_bar = d^2 ln J_bar.
-// For a hyperelastic law K is the Hessian of Pi: symmetric, so the LDL^T Newton solver applies
-// unchanged, and the work of f_int is stored as int W(F_bar) dV (the energy balance closes).
-// de Souza Neto's own form, int sigma(F_bar) : grad_x(dv) dv, has an unsymmetric tangent and no
-// potential; it would need an LU factorisation and an energy monitor of its own.
+// Element formulations, one file each, beside what they share (material_contribution.cpp: set-up,
+// assembly, commit, rupture; material_contribution_kernels.hpp: the point-level pieces):
+//   material_contribution_full.cpp     full integration (every element but the Hex8 variants)
+//   material_contribution_eas.cpp      EAS Hex8 (Hex8Formulation::IncompatibleModes, the default)
+//   material_contribution_fbar.cpp     F-bar Hex8 (Hex8Formulation::FBar)
+//   material_contribution_reduced.cpp  reduced Hex8 with hourglass control (Hex8Formulation::Reduced,
+//                                      central difference only)
+// Each file opens with its formulation's equations and references.
 class MaterialContribution final : public OperatorContribution {
  public:
   explicit MaterialContribution(const Model& model);
