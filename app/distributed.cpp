@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "partita/coupling/remote_participant.hpp"
+#include "partita/run/remote_participant.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
@@ -66,7 +66,7 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
   MPI_Comm participant_comm = m.participant_comm;
 
   std::vector<std::unique_ptr<mpi::MpiChannel>> channels;
-  coupling::RunOptions& ro = o.run;
+  run::RunOptions& ro = o.run;
   ro.distributed.participant = o.participant;
   if (rank == 0) {
     for (int r = 1; r < m.size; ++r) {
@@ -83,7 +83,7 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
   int status = 0;
   bool built = false;
   try {
-    coupling::CaseRun c(o.case_file, registries, ro);
+    run::CaseRun c(o.case_file, registries, ro);
     built = true;
     if (o.install_stop_handlers) o.install_stop_handlers();
     c.run();
@@ -103,12 +103,12 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
                                  ? std::string(e.what())
                                  : "internal error: " + std::string(e.what());
     if (rank == 0) {
-      for (auto& ch : channels) coupling::abort_server(*ch, who + " stopped the run: " + what);
+      for (auto& ch : channels) run::abort_server(*ch, who + " stopped the run: " + what);
     } else if (!built && !stuck &&
-               dynamic_cast<const coupling::StoppedByController*>(&e) == nullptr) {
+               dynamic_cast<const run::StoppedByController*>(&e) == nullptr) {
       // the controller waits for this process's hello or final meshes: tell it, and wait for its
       // answer so that it can name this failure before every process ends
-      coupling::ParticipantServer(*channels.front()).fail_setup(what);
+      run::ParticipantServer(*channels.front()).fail_setup(what);
       try {
         channels.front()->receive("the controller's answer to this failure");
       } catch (...) {

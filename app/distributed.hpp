@@ -8,7 +8,7 @@
 // of the mpirun line) is the controller: it runs the coupling core (schemes, mapping,
 // accelerations, audits) and writes the run's common files (coupling.csv, the monitors'
 // CSV files and plots, restart files, the summary); every other process builds only its own
-// participant and answers the controller (coupling/remote_participant.hpp). Each process writes
+// participant and answers the controller (partita/run/remote_participant.hpp). Each process writes
 // its own participant's VTK files into the same output folder (a folder all processes see).
 //
 // Every wait for another process has a deadline (--peer-timeout, default 600 s): a peer that
@@ -21,20 +21,20 @@
 #include <functional>
 #include <string>
 
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/coupling/registries.hpp"
 
 namespace partita::app {
 
 struct DistributedOptions {
   std::filesystem::path case_file;
-  coupling::RunOptions run;  ///< as for a run in one process (distributed is set here)
+  run::RunOptions run;  ///< as for a run in one process (distributed is set here)
   std::string participant;   ///< the participant this process runs
   double peer_timeout = 600.0;  ///< [s] the longest wait for a message from another process
   std::atomic<int>* stop_signal = nullptr;
   std::function<void()> install_stop_handlers;
   /// Called on the controller after a run that finished (plots, scripts, the last line).
-  std::function<void(const coupling::CaseRun&)> on_finished;
+  std::function<void(const run::CaseRun&)> on_finished;
 };
 
 /// Whether this partita can run participants in separate processes (built with MPI).

@@ -33,7 +33,7 @@
 
 #include "partita/adapters/mesh_files.hpp"
 #include "partita/adapters/register_all.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/coupling/registries.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -147,7 +147,7 @@ int list(const Registries& r) {
 
 int docs(const Registries& r, const std::string& name) {
   if (name.empty() || name == "case") {
-    std::cout << partita::coupling::case_spec(r)->docs() << "\n"
+    std::cout << partita::run::case_spec(r)->docs() << "\n"
               << "After a run, partita run draws a PNG plot of each CSV file of the output "
                  "folder (python3 with matplotlib); partita run --no-plots, or the environment "
                  "variable PARTITA_NO_PLOTS=1, leaves them out (the CSV files and output.scripts "
@@ -271,7 +271,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("list")) return list(registries);
     if (app.got_subcommand("docs")) return docs(registries, doc_name);
 
-    partita::coupling::RunOptions options;
+    partita::run::RunOptions options;
     options.output_dir = output_dir;
     options.overrides = overrides;
     options.resume_dir = resume_dir;
@@ -291,7 +291,7 @@ int main(int argc, char** argv) {
     plugins.load_case(case_file, overrides);  // a case file from here on
     if (app.got_subcommand("check")) {
       options.check_only = true;
-      partita::coupling::CaseRun c(case_file, registries, options);
+      partita::run::CaseRun c(case_file, registries, options);
       std::cout << "partita check: " << case_file << " is valid\n";
       for (const auto& name : c.external_participants())
         std::cout << "partita check: participant '" << name
@@ -320,7 +320,7 @@ int main(int argc, char** argv) {
       d.peer_timeout = peer_timeout;
       d.stop_signal = &g_stop_signal;
       d.install_stop_handlers = install_stop_handlers;
-      d.on_finished = [&](const partita::coupling::CaseRun& c) {
+      d.on_finished = [&](const partita::run::CaseRun& c) {
         finish(c.output_dir());
         run_scripts(c.scripts(), c.output_dir());
         std::cout << "partita run: finished; output in " << c.output_dir().string() << "/\n";
@@ -346,7 +346,7 @@ int main(int argc, char** argv) {
       so.plugins = plugins.command_line();
       return partita::app::run_sweep(registries, so);
     }
-    partita::coupling::CaseRun c(case_file, registries, options);
+    partita::run::CaseRun c(case_file, registries, options);
     install_stop_handlers();
     c.run();
     finish(c.output_dir());

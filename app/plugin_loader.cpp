@@ -8,7 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/coupling/plugin.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -176,7 +176,7 @@ void Plugins::load_command_line(const std::vector<std::string>& libraries) {
 }
 
 void Plugins::load_case(const fs::path& case_file, const std::vector<std::string>& overrides) {
-  for (const auto& p : coupling::case_plugins(case_file, overrides))
+  for (const auto& p : run::case_plugins(case_file, overrides))
     load(p.library, p.where.location().str() + ": plugins");
 }
 

@@ -7,8 +7,8 @@
 
 #include <fmt/format.h>
 
-#include "partita/coupling/case_run.hpp"
-#include "partita/coupling/sweep.hpp"
+#include "partita/run/case_run.hpp"
+#include "partita/run/sweep.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/output.hpp"
@@ -41,16 +41,16 @@ std::string error_line(const fs::path& log, int status) {
 int run_sweep(const coupling::Registries& registries, const SweepOptions& options) {
   auto logger = log::get("app");
   const config::Node root = config::Node::load_file(options.case_file, options.overrides)
-                                .validated(coupling::case_spec(registries));
-  const coupling::Sweep sweep(root);
+                                .validated(run::case_spec(registries));
+  const run::Sweep sweep(root);
   {
     // What `partita check` does, before any folder is made: the case and every swept value,
     // each as its variants will run it (an error names the value's line in the case file).
-    coupling::RunOptions check;
+    run::RunOptions check;
     check.check_only = true;
     check.overrides = options.overrides;
     check.threads = options.threads;
-    const coupling::CaseRun checked(options.case_file, registries, check);
+    const run::CaseRun checked(options.case_file, registries, check);
   }
   const fs::path dir = options.output_dir.empty() ? fs::current_path() / "out" / root.string("case")
                                                   : options.output_dir;

@@ -1,4 +1,4 @@
-#include "elementwise.hpp"
+#include "partita/coupling/elementwise.hpp"
 
 #include <cmath>
 

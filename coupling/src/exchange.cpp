@@ -4,7 +4,7 @@
 
 #include <fmt/format.h>
 
-#include "elementwise.hpp"
+#include "partita/coupling/elementwise.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"

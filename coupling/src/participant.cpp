@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "elementwise.hpp"
+#include "partita/coupling/elementwise.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/coupling/time_window.hpp"
 #include "partita/interface/error.hpp"

@@ -3,7 +3,7 @@
 
 #include "oscillator_adapter.hpp"
 #include "partita/adapters/register_all.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/interface/conformance.hpp"
 
 int main(int argc, char** argv) try {
@@ -21,9 +21,9 @@ int main(int argc, char** argv) try {
     return failures.empty() ? 0 : 1;
   }
   if (command != "run" || argc < 3) return std::cerr << "usage: run CASE.yaml [DIR] | conformance\n", 2;
-  partita::coupling::RunOptions options;
+  partita::run::RunOptions options;
   if (argc > 3) options.output_dir = argv[3];
-  partita::coupling::CaseRun run(argv[2], registries, options);
+  partita::run::CaseRun run(argv[2], registries, options);
   run.run();
   return 0;
 } catch (const partita::Error& e) {

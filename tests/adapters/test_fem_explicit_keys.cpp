@@ -8,7 +8,7 @@
 #include <string>
 
 #include "partita/adapters/register_all.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/interface/error.hpp"
 
 using namespace partita;

@@ -10,7 +10,7 @@
 #include <unistd.h>
 
 #include "partita/adapters/register_all.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/interface/error.hpp"
 
 using namespace partita;

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "partita/adapters/register_all.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 
 using namespace partita;
 namespace fs = std::filesystem;
@@ -14,8 +14,8 @@ namespace fs = std::filesystem;
 namespace {
 
 // Options by name (robust to fields added later).
-coupling::RunOptions run_options(const std::filesystem::path& dir, bool check_only) {
-  coupling::RunOptions o;
+run::RunOptions run_options(const std::filesystem::path& dir, bool check_only) {
+  run::RunOptions o;
   o.output_dir = dir;
   o.check_only = check_only;
   return o;
@@ -93,9 +93,9 @@ TEST_CASE(
   const auto r = registries();
   const fs::path out =
       fs::temp_directory_path() / ("partita_tube_out_" + std::to_string(::getpid()));
-  coupling::CaseRun iqn(shortened("iqn-ils", "0.1"), r, run_options(out / "iqn", false));
+  run::CaseRun iqn(shortened("iqn-ils", "0.1"), r, run_options(out / "iqn", false));
   iqn.run();
-  coupling::CaseRun aitken(shortened("aitken", "0.1"), r, run_options(out / "aitken", false));
+  run::CaseRun aitken(shortened("aitken", "0.1"), r, run_options(out / "aitken", false));
   aitken.run();
   const auto& si = iqn.summary();
   const auto& sa = aitken.summary();
@@ -118,11 +118,11 @@ TEST_CASE("Elastic tube (t = 1): IQN-IMVJ converges in every window and carries 
   const fs::path out =
       fs::temp_directory_path() / ("partita_tube_imvj_" + std::to_string(::getpid()));
   const fs::path cases = fs::path(PARTITA_SOURCE_DIR) / "cases/elastic_tube_1d";
-  coupling::CaseRun imvj(cases / "iqn-imvj.yaml", r, run_options(out / "imvj", false));
+  run::CaseRun imvj(cases / "iqn-imvj.yaml", r, run_options(out / "imvj", false));
   imvj.run();
-  coupling::RunOptions o = run_options(out / "ils0", false);
+  run::RunOptions o = run_options(out / "ils0", false);
   o.overrides = {"coupling.acceleration.reused_windows=0"};
-  coupling::CaseRun ils0(cases / "iqn-ils.yaml", r, o);
+  run::CaseRun ils0(cases / "iqn-ils.yaml", r, o);
   ils0.run();
   const auto& sm = imvj.summary();
   const auto& s0 = ils0.summary();
@@ -138,7 +138,7 @@ TEST_CASE("Elastic tube (t = 1): IQN-IMVJ converges in every window and carries 
 TEST_CASE("Every elastic tube case file validates (check_only)", "[adapters][tube1d][case]") {
   const auto r = registries();
   for (const char* c : {"constant", "aitken", "iqn-ils", "iqn-imvj"}) {
-    coupling::CaseRun run(
+    run::CaseRun run(
         fs::path(PARTITA_SOURCE_DIR) / "cases/elastic_tube_1d" / (std::string(c) + ".yaml"), r,
         run_options("unused", true));
     CHECK(run.window_count() == 100);

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "partita/adapters/register_all.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/coupling/mapping/mapper.hpp"
 #include "partita/coupling/registries.hpp"
 #include "partita/interface/config.hpp"
@@ -48,7 +48,7 @@ void validate_named(const Registry& registry, const Node& n) {
 
 void validate_case(const std::string& text) {
   const Registries& reg = registries();
-  static const auto spec = partita::coupling::case_spec(reg);
+  static const auto spec = partita::run::case_spec(reg);
   const Node root = Node::load_string(text, "fuzz.yaml").validated(spec);
   (void)root["time"].real_opt("end");
   (void)root["time"].real("window");

@@ -16,7 +16,7 @@
 #include <fmt/format.h>
 
 #include "partita/coupling/participant.hpp"
-#include "partita/coupling/remote_participant.hpp"
+#include "partita/run/remote_participant.hpp"
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/config.hpp"
 #include "partita/mpi/mpi_channel.hpp"
@@ -166,8 +166,8 @@ std::string program_name() {
 // The API's thread: the handshake, then the requests until the run ends.
 void serve(Bridge& b) {
   try {
-    coupling::ParticipantServer server(*b.channel_);
-    coupling::Hello h;
+    run::ParticipantServer server(*b.channel_);
+    run::Hello h;
     h.case_hash = b.case_hash_;
     h.participant = b.participant_;
     h.program = program_name();
@@ -293,7 +293,7 @@ void ExternalParticipant::initialize() {
                        "--participant OTHER : -n 1 ./program CASE");
     // The case as every process reads it: its hash, and this participant's substeps.
     const config::Node loaded = config::Node::load_file(b.case_file_, b.options_.overrides);
-    b.case_hash_ = coupling::case_hash(loaded);
+    b.case_hash_ = run::case_hash(loaded);
     if (!loaded.has("participants") || !loaded["participants"].has(b.participant_))
       throw UsageError("the case " + b.case_file_.string() + " has no participant '" +
                        b.participant_ + "'");
@@ -311,10 +311,10 @@ void ExternalParticipant::initialize() {
     if (m.rank == 0) {
       for (int r = 1; r < m.size; ++r) {
         MpiChannel other(b.options_.comm, r, "rank " + std::to_string(r), b.options_.peer_timeout);
-        coupling::abort_server(other, why);
+        run::abort_server(other, why);
       }
     } else {
-      coupling::ParticipantServer(*b.channel_).fail_setup(e.what());
+      run::ParticipantServer(*b.channel_).fail_setup(e.what());
       try {
         b.channel_->receive("the controller's answer to this failure");
       } catch (...) {

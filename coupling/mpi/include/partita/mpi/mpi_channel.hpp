@@ -1,5 +1,5 @@
 #pragma once
-// The coupling core's Channel (coupling/remote_participant.hpp) over MPI, and how the processes
+// The run library's Channel (partita/run/remote_participant.hpp) over MPI, and how the processes
 // of a distributed run find each other.
 //
 // Every process of the run (partita run --participant, or an external program through
@@ -15,7 +15,7 @@
 
 #include <mpi.h>
 
-#include "partita/coupling/remote_participant.hpp"
+#include "partita/run/remote_participant.hpp"
 #include "partita/interface/error.hpp"
 
 namespace partita::mpi {
@@ -44,13 +44,13 @@ Membership join(MPI_Comm comm, const std::string& participant);
 /// grown), receives that poll with a deadline (MPI_Iprobe; yielding for the first 10 ms, then
 /// sleeping in growing steps of up to 1 ms, so a waiting process leaves its core to a working
 /// one) and receive into the caller's buffer (MPI_Get_count, then MPI_Recv into it).
-class MpiChannel final : public coupling::Channel {
+class MpiChannel final : public run::Channel {
  public:
   MpiChannel(MPI_Comm comm, int rank, std::string name, double deadline);
   ~MpiChannel() override;
   void send(std::string& bytes) override;
   void receive(std::string& bytes, std::string_view what) override;
-  using coupling::Channel::receive;
+  using run::Channel::receive;
   std::string peer() const override { return name_; }
   double deadline() const override { return deadline_; }
   /// Completes the sends under way (OpenMPI moves a message above the eager limit, 4 KB over

@@ -20,7 +20,7 @@
 #include "partita/interface/binary_io.hpp"  // matrix_shape_problem(): the same layout
 #include "partita/interface/error.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
 
 class MessageWriter {
  public:
@@ -138,4 +138,4 @@ class MessageReader {
   std::size_t at_ = 0;
 };
 
-}  // namespace partita::coupling
+}  // namespace partita::run

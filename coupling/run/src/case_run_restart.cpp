@@ -6,15 +6,17 @@
 
 #include <fmt/format.h>
 
-#include "elementwise.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "partita/coupling/elementwise.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/state_archive.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
+
+using namespace coupling;  // the core this library builds on
 
 namespace fs = std::filesystem;
 
@@ -467,4 +469,4 @@ double CaseRun::coupling_created() const {
   return created;
 }
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -1,5 +1,5 @@
 // The case file's schema: every key a case accepts, declared once (validation and `partita docs`).
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -10,12 +10,14 @@
 #include <fmt/format.h>
 
 #include "partita/coupling/explicit_scheme.hpp"
-#include "partita/coupling/sweep.hpp"
+#include "partita/run/sweep.hpp"
 #include "plain_name.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
+
+using namespace coupling;  // the core this library builds on
 
 // ---------------------------------------------------------------------------------------------
 // Schema
@@ -262,4 +264,4 @@ std::vector<CasePlugin> case_plugins(const std::filesystem::path& case_file,
   return plugins;
 }
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -2,9 +2,9 @@
 
 #include <catch2/catch.hpp>
 
-#include "partita/coupling/progress_line.hpp"
+#include "partita/run/progress_line.hpp"
 
-using partita::coupling::ProgressLine;
+using partita::run::ProgressLine;
 
 TEST_CASE("progress line: time left from the rate over the windows counted",
           "[coupling][progress]") {

@@ -11,14 +11,15 @@
 #include <fstream>
 #include <sstream>
 
-#include "ode_participant.hpp"
-#include "oscillator_participants.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "../ode_participant.hpp"
+#include "../oscillator_participants.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/coupling/mapping/nearest_neighbor_mapper.hpp"
 #include "partita/interface/error.hpp"
 
 using namespace partita;
 using namespace partita::coupling;
+using namespace partita::run;
 
 namespace {
 

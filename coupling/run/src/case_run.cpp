@@ -1,4 +1,4 @@
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -10,15 +10,17 @@
 #include <fmt/format.h>
 
 #include "partita/coupling/explicit_scheme.hpp"
-#include "partita/coupling/progress_line.hpp"
-#include "partita/coupling/remote_participant.hpp"
+#include "partita/run/progress_line.hpp"
+#include "partita/run/remote_participant.hpp"
 #include "partita/coupling/stopwatch.hpp"
-#include "partita/coupling/sweep.hpp"
+#include "partita/run/sweep.hpp"
 #include "plain_name.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
+
+using namespace coupling;  // the core this library builds on
 
 namespace fs = std::filesystem;
 
@@ -301,4 +303,4 @@ void CaseRun::run() {
   }
 }
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -25,7 +25,7 @@
 
 #include "partita/interface/config.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
 
 class Sweep {
  public:
@@ -82,4 +82,4 @@ class Sweep {
   double plot_x_scale_ = 1.0, plot_y_scale_ = 1.0;
 };
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -10,7 +10,7 @@
 //
 // The transport is a Channel (a link to one peer: send bytes, receive bytes with a deadline);
 // coupling/mpi/ implements it over MPI. Messages are written and read in place in buffers kept
-// for the run (coupling/src/message_codec.hpp; BinaryWriter's layout without its checksums):
+// for the run (coupling/run/src/message_codec.hpp; BinaryWriter's layout without its checksums):
 //
 //   request   [u32 command] [arguments]
 //   reply     [u32 status: 0 ok, 1 failed] [ok: results | failed: the error text]
@@ -45,7 +45,7 @@
 #include "partita/coupling/participant.hpp"
 #include "partita/interface/config.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
 
 /// A message link to one peer process. A sender keeps one buffer per link and direction: send()
 /// takes the message's bytes and hands back a buffer to write the next one into, receive() fills
@@ -112,7 +112,7 @@ struct Ready {
 };
 
 /// A participant in another process (see the file comment).
-class RemoteParticipant final : public Participant {
+class RemoteParticipant final : public coupling::Participant {
  public:
   RemoteParticipant(std::string name, Channel& channel, Ready ready);
 
@@ -124,9 +124,9 @@ class RemoteParticipant final : public Participant {
   bool maps_inputs() const { return maps_inputs_; }
 
   const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
-  void initial_values(std::span<WindowOutput> outputs) override;
-  void run_window(const TimeWindow& window, std::span<const WindowInput> inputs,
-                  std::span<WindowOutput> outputs) override;
+  void initial_values(std::span<coupling::WindowOutput> outputs) override;
+  void run_window(const coupling::TimeWindow& window, std::span<const coupling::WindowInput> inputs,
+                  std::span<coupling::WindowOutput> outputs) override;
   void finish_window() override;
   int substeps(double window_size) const override;
   double stable_time_step() const override;
@@ -161,7 +161,7 @@ class RemoteParticipant final : public Participant {
   bool maps_inputs_ = false;
   // A window sent, its reply not yet read: where its outputs go (a copy: the caller's array
   // may be reused for another participant meanwhile, as a parallel scheme does).
-  std::vector<WindowOutput> pending_;
+  std::vector<coupling::WindowOutput> pending_;
   bool pending_window_ = false;
   // Per input of the last window's request: the values the server holds (as they travelled:
   // the sender's or mapped), so that a start equal to the last end (the next window of an
@@ -196,7 +196,7 @@ class RemoteParticipant final : public Participant {
 /// A server's mapping of an exchange it maps on its side: the mapper computed from the sender's
 /// mesh to its own.
 struct ServerMapping {
-  std::unique_ptr<Mapper> mapper;
+  std::unique_ptr<coupling::Mapper> mapper;
 };
 /// Builds a server's mapping from the case: the exchange's number in coupling.exchanges, the
 /// sender's mesh (from the controller) and the receiver's (the server's own).
@@ -219,7 +219,7 @@ class ParticipantServer {
   /// Send the final meshes, then answer requests until the run ends; returns the signal that
   /// stopped the run (0: none; the process exits with 128 + it, as the controller does).
   /// `mapping` builds the mappers of the exchanges this process maps (map_on: receiver).
-  int serve(LocalParticipant& p, const MappingFactory& mapping = {});
+  int serve(coupling::LocalParticipant& p, const MappingFactory& mapping = {});
   /// Time spent mapping what this process read [s].
   double mapping_seconds() const { return mapping_seconds_; }
 
@@ -238,4 +238,4 @@ Ready complete_handshake(Channel& server, const std::vector<std::pair<std::strin
 /// `why` from hello() or serve(). Never throws.
 void abort_server(Channel& server, const std::string& why) noexcept;
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -1,4 +1,4 @@
-// The bytes of the messages between processes (coupling/src/message_codec.hpp): BinaryWriter's
+// The bytes of the messages between processes (coupling/run/src/message_codec.hpp): BinaryWriter's
 // layout, values back to the bit, buffers reused, damaged messages refused with the peer named.
 #include <catch2/catch.hpp>
 
@@ -10,12 +10,12 @@
 
 #include <Eigen/Core>
 
-#include "../../coupling/src/message_codec.hpp"  // the core's internal message codec
+#include "../../../coupling/run/src/message_codec.hpp"  // the run library's internal message codec
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
 
-using partita::coupling::MessageReader;
-using partita::coupling::MessageWriter;
+using partita::run::MessageReader;
+using partita::run::MessageWriter;
 
 namespace {
 

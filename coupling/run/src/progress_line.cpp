@@ -1,4 +1,4 @@
-#include "partita/coupling/progress_line.hpp"
+#include "partita/run/progress_line.hpp"
 
 #include <unistd.h>
 #include <cstdio>
@@ -7,7 +7,9 @@
 
 #include "partita/interface/log.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
+
+using namespace coupling;  // the core this library builds on
 
 ProgressLine::ProgressLine(std::int64_t windows)
     : windows_(windows), tty_(isatty(fileno(stderr)) != 0) {}
@@ -53,4 +55,4 @@ void ProgressLine::finish() {
   printed_ = false;
 }
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -6,12 +6,14 @@
 
 #include <fmt/format.h>
 
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
+
+using namespace coupling;  // the core this library builds on
 
 namespace {
 // The energy audit acts when the coupling has created more than the tolerated share of the work
@@ -351,4 +353,4 @@ std::vector<std::unique_ptr<WindowObserver>> CaseRun::window_observers() {
   return o;
 }
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -1,4 +1,4 @@
-#include "partita/coupling/sweep.hpp"
+#include "partita/run/sweep.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,9 @@
 #include "partita/interface/output.hpp"
 #include "plain_name.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
+
+using namespace coupling;  // the core this library builds on
 
 namespace fs = std::filesystem;
 
@@ -304,4 +306,4 @@ void Sweep::write_summary(const fs::path& dir, const std::vector<std::string>& s
   write_file_atomically(dir / "sweep.csv", text);
 }
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -61,7 +61,7 @@
 #include "partita/interface/config.hpp"
 #include "partita/interface/output.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
 
 class Channel;         // remote_participant.hpp
 struct ServerMapping;  // remote_participant.hpp
@@ -131,7 +131,7 @@ class CaseRun {
  public:
   /// Parse and validate the whole case and build everything; throws partita::Error
   /// (file:line:col, key path, what is expected, did you mean).
-  CaseRun(const std::filesystem::path& case_file, const Registries& registries, RunOptions options);
+  CaseRun(const std::filesystem::path& case_file, const coupling::Registries& registries, RunOptions options);
   ~CaseRun();
   CaseRun(const CaseRun&) = delete;
   CaseRun& operator=(const CaseRun&) = delete;
@@ -152,9 +152,9 @@ class CaseRun {
   const RunSummary& summary() const { return summary_; }
   double window_size() const { return window_size_; }
   std::int64_t window_count() const { return window_count_; }
-  const CouplingScheme& scheme() const { return *scheme_; }
+  const coupling::CouplingScheme& scheme() const { return *scheme_; }
   /// Participant by name (nullptr if none).
-  Participant* participant(const std::string& name) const;
+  coupling::Participant* participant(const std::string& name) const;
   /// (check only) The external programs (solver: external): the check built the rest of the
   /// case without them; their meshes, fields and quantities are checked when they join a run.
   std::vector<std::string> external_participants() const;
@@ -162,7 +162,7 @@ class CaseRun {
  private:
   struct Monitor {
     std::string name;
-    std::vector<std::pair<Participant*, std::string>> quantities;
+    std::vector<std::pair<coupling::Participant*, std::string>> quantities;
     std::vector<std::vector<std::string>> plots;  // monitor.plots: x, then its y
     CsvSeries csv;
   };
@@ -204,7 +204,7 @@ class CaseRun {
   };
   SavedRun saved_run(const Progress& progress) const;
   void build_participants(const config::Node& root);
-  void serve_handshake(std::unique_ptr<Solver>& solver, std::map<std::string, Substeps>& substeps,
+  void serve_handshake(std::unique_ptr<Solver>& solver, std::map<std::string, coupling::Substeps>& substeps,
                        bool coupled);
   bool runs_here(const std::string& participant) const {
     return options_.distributed.participant.empty() || options_.distributed.participant == participant;
@@ -212,7 +212,7 @@ class CaseRun {
   void build_exchanges(const config::Node& coupling);
   // The mapper of the exchange `item` (sender field `ws`), computed from `from` to `to`; the
   // controller's for every exchange, a server's for the exchanges it maps (map_on: receiver).
-  std::unique_ptr<Mapper> exchange_mapper(const config::Node& item, const DataSpec& ws,
+  std::unique_ptr<coupling::Mapper> exchange_mapper(const config::Node& item, const DataSpec& ws,
                                           const Mesh& from, const Mesh& to,
                                           const std::string& label) const;
   ServerMapping server_mapping(std::size_t exchange, const InterfaceMesh& from,
@@ -221,12 +221,12 @@ class CaseRun {
   void build_energy_balance(const config::Node& root);
   // participant.quantity named by a node, checked against what the participant reports
   struct NamedQuantity {
-    Participant* participant;
+    coupling::Participant* participant;
     std::string quantity, unit;
   };
   NamedQuantity resolve_quantity(const config::Node& q) const;
   // the participant of that name, or an error at n naming the participants
-  Participant* named_participant(const config::Node& n, const std::string& name) const;
+  coupling::Participant* named_participant(const config::Node& n, const std::string& name) const;
   void check_sweep_values(const std::filesystem::path& case_file, const class Sweep& sweep) const;
   void write_output(int frame, double time);
   void write_plot_requests() const;  // DIR/<monitor>.plots, for the plot script
@@ -245,7 +245,7 @@ class CaseRun {
   class StopRequestObserver;
   class RestartObserver;
   class FlushObserver;
-  std::vector<std::unique_ptr<WindowObserver>> window_observers();
+  std::vector<std::unique_ptr<coupling::WindowObserver>> window_observers();
 
   // Restart files and run-time checks (case_run_restart.cpp)
   void write_restart_file(const Progress& progress);
@@ -259,7 +259,7 @@ class CaseRun {
   const std::vector<double>& audit_balance();
   std::string restart_blocker() const;  // why restart files cannot be written ("": they can)
 
-  const Registries& registries_;
+  const coupling::Registries& registries_;
   RunOptions options_;
   std::string name_;
   std::filesystem::path case_dir_, output_dir_;
@@ -268,11 +268,11 @@ class CaseRun {
   std::int64_t window_count_ = 0;
   double output_every_ = 0.0;                               // 0: first and last frame only
   vtk::Options vtk_options_;                                // output.vtk
-  std::vector<std::unique_ptr<Participant>> participants_;  // in scheme order
-  LocalParticipant* served_ = nullptr;  // the participant a server process runs
+  std::vector<std::unique_ptr<coupling::Participant>> participants_;  // in scheme order
+  coupling::LocalParticipant* served_ = nullptr;  // the participant a server process runs
   config::Node served_coupling_;        // a server's: the case's coupling section (its mappers)
-  std::vector<std::unique_ptr<Exchange>> exchanges_;
-  std::unique_ptr<CouplingScheme> scheme_;
+  std::vector<std::unique_ptr<coupling::Exchange>> exchanges_;
+  std::unique_ptr<coupling::CouplingScheme> scheme_;
   std::vector<Monitor> monitors_;
   std::vector<std::pair<std::string, PvdSeries>> pvds_;  // series name -> .pvd
   PvdSeries& pvd(const std::string& series);
@@ -289,7 +289,7 @@ class CaseRun {
   int restart_keep_ = 2;
   bool restart_at_end_ = false;
   // the balance audit: exchanges audited and the relative imbalance that warns
-  std::vector<const Exchange*> audited_;
+  std::vector<const coupling::Exchange*> audited_;
   double balance_tolerance_ = 0.01;
   std::vector<double> imbalance_;  // audit_balance()'s result and scratch space, kept between
   Eigen::VectorXd audit_sent_, audit_received_;  // windows (no allocation per window)
@@ -300,8 +300,8 @@ class CaseRun {
   // the other's data on (where its solver reports Solver::interface_work)
   struct EnergyPair {
     std::string label;  // "a-b"
-    Participant* a = nullptr;
-    Participant* b = nullptr;
+    coupling::Participant* a = nullptr;
+    coupling::Participant* b = nullptr;
     std::vector<std::string> a_meshes, b_meshes;
     // since t = 0: the work on each side at the last accepted window and the work that passed
     // (sum over windows of |change on a| + |change on b|: the scale of the audit)
@@ -320,13 +320,13 @@ class CaseRun {
   bool energy_stop_ = true;
   // the energy balance of the whole system (the case's energy section; null without one), its
   // terms as (participant, quantity) in its order, DIR/energy.csv
-  std::unique_ptr<EnergyBalance> energy_;
-  std::vector<std::pair<Participant*, std::string>> energy_terms_;
+  std::unique_ptr<coupling::EnergyBalance> energy_;
+  std::vector<std::pair<coupling::Participant*, std::string>> energy_terms_;
   CsvSeries energy_csv_;
 };
 
 /// The case file's schema (for validation and `partita docs`).
-std::shared_ptr<const config::Spec> case_spec(const Registries& registries);
+std::shared_ptr<const config::Spec> case_spec(const coupling::Registries& registries);
 
 /// One library of the case's `plugins:` list: its path (relative ones taken from the case file's
 /// folder) and the node that names it (for messages).
@@ -341,4 +341,4 @@ struct CasePlugin {
 std::vector<CasePlugin> case_plugins(const std::filesystem::path& case_file,
                                      const std::vector<std::string>& overrides);
 
-}  // namespace partita::coupling
+}  // namespace partita::run

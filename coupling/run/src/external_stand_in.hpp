@@ -14,17 +14,17 @@
 #include "partita/coupling/participant.hpp"
 #include "partita/interface/error.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
 
-class ExternalStandIn final : public Participant {
+class ExternalStandIn final : public coupling::Participant {
  public:
   ExternalStandIn(std::string name, std::vector<InterfaceMesh> meshes)
-      : Participant(std::move(name)), meshes_(std::move(meshes)) {}
+      : coupling::Participant(std::move(name)), meshes_(std::move(meshes)) {}
 
   const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
-  void initial_values(std::span<WindowOutput>) override { not_run(); }
-  void run_window(const TimeWindow&, std::span<const WindowInput>,
-                  std::span<WindowOutput>) override {
+  void initial_values(std::span<coupling::WindowOutput>) override { not_run(); }
+  void run_window(const coupling::TimeWindow&, std::span<const coupling::WindowInput>,
+                  std::span<coupling::WindowOutput>) override {
     not_run();
   }
   int substeps(double) const override { return 1; }
@@ -52,4 +52,4 @@ class ExternalStandIn final : public Participant {
   std::vector<InterfaceMesh> meshes_;
 };
 
-}  // namespace partita::coupling
+}  // namespace partita::run

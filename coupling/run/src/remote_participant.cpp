@@ -1,7 +1,7 @@
 // A participant in another process: the controller's proxy (RemoteParticipant), the remote
 // side's request loop (ParticipantServer) and the start-up handshake. The message layouts are
 // in remote_participant.hpp; each is written and read by one function pair here.
-#include "partita/coupling/remote_participant.hpp"
+#include "partita/run/remote_participant.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -15,7 +15,9 @@
 #include "partita/interface/error.hpp"
 #include "partita/interface/version.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
+
+using namespace coupling;  // the core this library builds on
 
 namespace {
 
@@ -831,4 +833,4 @@ int ParticipantServer::serve(LocalParticipant& p, const MappingFactory& mapping)
   }
 }
 
-}  // namespace partita::coupling
+}  // namespace partita::run

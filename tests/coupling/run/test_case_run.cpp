@@ -5,12 +5,13 @@
 #include <fstream>
 #include <sstream>
 
-#include "ode_participant.hpp"
-#include "partita/coupling/case_run.hpp"
+#include "../ode_participant.hpp"
+#include "partita/run/case_run.hpp"
 #include "partita/interface/error.hpp"
 
 using namespace partita;
 using namespace partita::coupling;
+using namespace partita::run;
 
 namespace {
 

@@ -7,7 +7,7 @@
 
 #include "partita/interface/config.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
 
 /// Letters, digits, '-', '_', '.', '+', not empty and not starting with '.': no '/', '\', no
 /// spaces, quotes or '..', so the name stays inside the folder it is put in.
@@ -29,4 +29,4 @@ inline void check_plain_name(const config::Node& n, const std::string& name,
            name + "'");
 }
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -8,7 +8,7 @@
 
 #include "partita/coupling/stopwatch.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
 
 class ProgressLine {
  public:
@@ -25,11 +25,11 @@ class ProgressLine {
  private:
   std::int64_t windows_;
   bool tty_;
-  Stopwatch clock_;
+  coupling::Stopwatch clock_;
   double last_ = -1e300;
   std::int64_t first_done_ = -1;  // the window of the first update and its time
   double first_seconds_ = 0.0;
   bool printed_ = false;
 };
 
-}  // namespace partita::coupling
+}  // namespace partita::run

@@ -1,6 +1,6 @@
 // CaseRun, phase one: building a run from a validated case (participants, meshes handed over,
 // exchanges and their mappers, the scheme, monitors, the audits' pairs).
-#include "partita/coupling/case_run.hpp"
+#include "partita/run/case_run.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -12,16 +12,18 @@
 #include <fmt/format.h>
 
 #include "partita/coupling/explicit_scheme.hpp"
-#include "partita/coupling/progress_line.hpp"
-#include "partita/coupling/remote_participant.hpp"
+#include "partita/run/progress_line.hpp"
+#include "partita/run/remote_participant.hpp"
 #include "partita/coupling/stopwatch.hpp"
-#include "partita/coupling/sweep.hpp"
+#include "partita/run/sweep.hpp"
 #include "external_stand_in.hpp"
 #include "plain_name.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 
-namespace partita::coupling {
+namespace partita::run {
+
+using namespace coupling;  // the core this library builds on
 
 namespace fs = std::filesystem;
 
@@ -75,7 +77,7 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     : registries_(registries), options_(std::move(options)) {
   const config::Node loaded =
       config::Node::load_file(case_file, options_.overrides, options_.override_origins);
-  case_hash_ = coupling::case_hash(loaded);
+  case_hash_ = run::case_hash(loaded);
   const config::Node root = loaded.validated(case_spec(registries));
   name_ = root.string("case");
   check_plain_name(root["case"], name_, "the case name");
@@ -791,4 +793,4 @@ void CaseRun::build_monitors(const config::Node& root) {
 // ---------------------------------------------------------------------------------------------
 // Running
 
-}  // namespace partita::coupling
+}  // namespace partita::run
