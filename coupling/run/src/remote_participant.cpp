@@ -9,7 +9,6 @@
 
 #include <fmt/format.h>
 
-#include "message_codec.hpp"
 #include "partita/coupling/stopwatch.hpp"
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"

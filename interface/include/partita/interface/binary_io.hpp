@@ -1,7 +1,16 @@
 #pragma once
-// Binary state streams for restart files. Values are written in the machine's own byte order
-// (restart files are for continuing a run on the same kind of machine, as LAMMPS's binary
-// restart files are); the file's header records the order and a reader refuses another one.
+// The one byte layout of partita's binary data, restart files and the messages between processes
+// alike (LayoutWriter, LayoutReader): numbers in the machine's own byte order, a text or a list
+// of numbers as [u64 count] and its bytes, a dense matrix of doubles as [i64 rows] [i64 cols] and
+// its values column by column. Two kinds of stream share it:
+// - restart files (BinaryWriter, BinaryReader) over std::ostream / std::istream, with named
+//   sections and their checksums (below). Restart files are for continuing a run on the same
+//   kind of machine, as LAMMPS's binary restart files are; the file's header records the byte
+//   order and a reader refuses another one.
+// - messages between processes (MessageWriter, MessageReader) over a buffer kept for the run,
+//   without sections or checksums: a writer appends to the caller's buffer (cleared, not freed:
+//   no allocation once it has grown to the largest message), a reader reads the bytes received
+//   in place.
 //
 //   BinaryWriter w(stream);                BinaryReader r(stream, "out/run/restart/w000100.bin");
 //   w.section("exchange");                 r.expect_section("exchange");
@@ -55,17 +64,20 @@ std::string matrix_shape_problem(std::int64_t rows, std::int64_t cols, std::uint
   return {};
 }
 
-class BinaryWriter {
+/// The layout's writer: each value's bytes go to the stream type `Sink` (which defines
+/// put(const void*, std::size_t); CRTP, so a value costs one inlined copy).
+template <class Sink>
+class LayoutWriter {
  public:
-  explicit BinaryWriter(std::ostream& out) : out_(out) {}
-
   template <class T>
   requires std::is_arithmetic_v<T>
   void write(T v) { put(&v, sizeof(T)); }
-  void write(const std::string& s) {
+  void write(std::string_view s) {
     write(static_cast<std::uint64_t>(s.size()));
     put(s.data(), s.size());
   }
+  void write(const std::string& s) { write(std::string_view(s)); }
+  void write(const char* s) { write(std::string_view(s)); }
   template <class T>
   requires std::is_arithmetic_v<T>
   void write(const std::vector<T>& v) {
@@ -80,6 +92,81 @@ class BinaryWriter {
     write(static_cast<std::int64_t>(m.cols()));
     put(m.data(), static_cast<std::size_t>(m.size()) * sizeof(double));
   }
+
+ protected:
+  LayoutWriter() = default;
+  ~LayoutWriter() = default;
+
+ private:
+  void put(const void* p, std::size_t n) { static_cast<Sink&>(*this).put(p, n); }
+};
+
+/// The layout's reader over the stream type `Source`, which defines
+///   take(void* p, std::size_t n, const char* what)   n bytes into p, or fail
+///   count(std::size_t item, const char* what)        a [u64 count] of items of at least
+///                                                    `item` bytes that fit in what remains
+///   max_doubles()                                    the most doubles a matrix may announce
+///   fits(std::uint64_t bytes, const char* what)      fail unless that many bytes remain
+///   fail(const std::string& what)                    throw partita::Error naming the source
+/// Every read is checked: a damaged size never allocates, a short stream is an error.
+template <class Source>
+class LayoutReader {
+ public:
+  template <class T>
+  requires std::is_arithmetic_v<T>
+  void read(T& v) { source().take(&v, sizeof(T), "a number"); }
+  template <class T>
+  requires std::is_arithmetic_v<T> T get() {
+    T v{};
+    read(v);
+    return v;
+  }
+  /// Into `s`, whose storage is reused.
+  void read(std::string& s) {
+    const auto n = static_cast<std::size_t>(source().count(1, "a text"));
+    s.resize(n);
+    source().take(s.data(), n, "a text");
+  }
+  std::string get_string() {
+    std::string s;
+    read(s);
+    return s;
+  }
+  template <class T>
+  requires std::is_arithmetic_v<T>
+  void read(std::vector<T>& v) {
+    const auto n = static_cast<std::size_t>(source().count(sizeof(T), "a list"));
+    v.resize(n);
+    source().take(v.data(), n * sizeof(T), "a list");
+  }
+  /// Into `m`, resized only where its shape differs (no allocation for a matrix of the same
+  /// shape as the last one).
+  template <class Derived>
+  void read(Eigen::PlainObjectBase<Derived>& m) {
+    const auto rows = get<std::int64_t>();
+    const auto cols = get<std::int64_t>();
+    if (const std::string why = matrix_shape_problem<Derived>(rows, cols, source().max_doubles());
+        !why.empty())
+      source().fail(why);
+    const auto bytes = static_cast<std::size_t>(rows * cols) * sizeof(double);
+    source().fits(bytes, "a matrix");
+    if (m.rows() != rows || m.cols() != cols) m.resize(rows, cols);
+    source().take(m.data(), bytes, "a matrix");
+  }
+
+ protected:
+  LayoutReader() = default;
+  ~LayoutReader() = default;
+
+ private:
+  Source& source() { return static_cast<Source&>(*this); }
+};
+
+/// A restart stream: the layout, with named sections and their checksums (see above).
+class BinaryWriter : public LayoutWriter<BinaryWriter> {
+ public:
+  explicit BinaryWriter(std::ostream& out) : out_(out) {}
+
   /// A named marker; the reader checks it (catches a reader and writer out of step). It also
   /// starts a new checksummed section.
   void section(const std::string& name);
@@ -106,6 +193,7 @@ class BinaryWriter {
   bool good() const { return static_cast<bool>(out_); }
 
  private:
+  friend class LayoutWriter<BinaryWriter>;
   struct Section {
     std::string name;
     std::uint64_t offset = 0;
@@ -121,48 +209,12 @@ class BinaryWriter {
   bool finished_ = false;
 };
 
-class BinaryReader {
+/// A restart stream read back: the layout, its sections checked by name and checksum.
+class BinaryReader : public LayoutReader<BinaryReader> {
  public:
   /// `source` names the stream in messages (a file name).
   BinaryReader(std::istream& in, std::string source) : in_(in), source_(std::move(source)) {}
 
-  template <class T>
-  requires std::is_arithmetic_v<T>
-  void read(T& v) { raw(&v, sizeof(T), "a number"); }
-  template <class T>
-  requires std::is_arithmetic_v<T> T get() {
-    T v{};
-    read(v);
-    return v;
-  }
-  void read(std::string& s) {
-    const std::uint64_t n = count(1, "a text");
-    s.resize(n);
-    raw(s.data(), n, "a text");
-  }
-  std::string get_string() {
-    std::string s;
-    read(s);
-    return s;
-  }
-  template <class T>
-  requires std::is_arithmetic_v<T>
-  void read(std::vector<T>& v) {
-    const std::uint64_t n = count(sizeof(T), "a list");
-    v.resize(n);
-    raw(v.data(), n * sizeof(T), "a list");
-  }
-  template <class Derived>
-  void read(Eigen::PlainObjectBase<Derived>& m) {
-    const auto rows = get<std::int64_t>();
-    const auto cols = get<std::int64_t>();
-    if (const std::string why = matrix_shape_problem<Derived>(rows, cols, INT64_MAX / 8);
-        !why.empty())
-      fail(why);
-    check_remaining(static_cast<std::uint64_t>(rows * cols) * sizeof(double), "a matrix");
-    m.resize(rows, cols);
-    raw(m.data(), static_cast<std::size_t>(rows * cols) * sizeof(double), "a matrix");
-  }
   /// Check the next marker is `name` (written by BinaryWriter::section).
   void expect_section(const std::string& name) {
     std::string s;
@@ -216,7 +268,12 @@ class BinaryReader {
   }
 
  private:
+  friend class LayoutReader<BinaryReader>;
   long long position() const { return static_cast<long long>(in_.tellg()); }
+  // LayoutReader's hooks
+  void take(void* p, std::size_t n, const char* what) { raw(p, n, what); }
+  static std::uint64_t max_doubles() { return INT64_MAX / 8; }
+  void fits(std::uint64_t n, const char* what) { check_remaining(n, what); }
   void raw(void* p, std::size_t n, const char* what) {
     if (n == 0) return;
     if (limit_ >= 0) {  // verified: the data ends at the checksum table
@@ -258,6 +315,65 @@ class BinaryReader {
   std::string source_;
   std::streamoff limit_ = -1;  // where the data ends (the checksum table), once verified
   std::vector<std::pair<std::string, std::streamoff>> table_;  // sections' names and offsets
+};
+
+/// A message between processes: the layout appended to a buffer the caller keeps between
+/// messages (the caller clears it for a new message; its capacity is kept).
+class MessageWriter : public LayoutWriter<MessageWriter> {
+ public:
+  explicit MessageWriter(std::string& buffer) : buffer_(buffer) {}
+
+ private:
+  friend class LayoutWriter<MessageWriter>;
+  void put(const void* p, std::size_t n) { buffer_.append(static_cast<const char*>(p), n); }
+  std::string& buffer_;
+};
+
+/// A message received, read in place. Every read is checked against the message's length: a
+/// damaged or truncated message is a partita::Error naming the peer, never a read past the end.
+class MessageReader : public LayoutReader<MessageReader> {
+ public:
+  /// Reads `bytes` (which must outlive the reader); `source` names the sender in messages.
+  MessageReader(std::string_view bytes, const std::string& source)
+      : bytes_(bytes), source_(source) {}
+  MessageReader(std::string_view bytes, const std::string&& source) = delete;  // kept by reference
+
+  /// A text as a view into the message (valid while its bytes are).
+  std::string_view view_string() {
+    const std::size_t n = count(1, "a text");
+    const std::string_view s = bytes_.substr(at_, n);
+    at_ += n;
+    return s;
+  }
+  /// A [u64 count] of items of at least `item` bytes each, which must fit in what is left (a
+  /// damaged count never allocates).
+  std::size_t count(std::size_t item, const char* what) {
+    const auto n = get<std::uint64_t>();
+    if (n > remaining() / item)
+      fail(std::string(what) + " of " + std::to_string(n) + " items of " + std::to_string(item) +
+           " bytes or more (" + std::to_string(remaining()) + " bytes remain)");
+    return static_cast<std::size_t>(n);
+  }
+  std::size_t remaining() const { return bytes_.size() - at_; }
+  /// Throw "<source> sent a damaged message: expected <what> at byte <n> of <size>".
+  [[noreturn]] void fail(const std::string& what) const {
+    throw Error(source_ + " sent a damaged message: expected " + what + " at byte " +
+                std::to_string(at_) + " of " + std::to_string(bytes_.size()));
+  }
+
+ private:
+  friend class LayoutReader<MessageReader>;
+  // LayoutReader's hooks (count and fail above)
+  void take(void* p, std::size_t n, const char* what) {
+    if (n > remaining()) fail(std::string(what) + " of " + std::to_string(n) + " bytes");
+    if (n > 0) std::memcpy(p, bytes_.data() + at_, n);
+    at_ += n;
+  }
+  std::uint64_t max_doubles() const { return remaining() / sizeof(double); }
+  void fits(std::uint64_t, const char*) const {}  // max_doubles() held the matrix to what remains
+  std::string_view bytes_;
+  const std::string& source_;
+  std::size_t at_ = 0;
 };
 
 }  // namespace partita

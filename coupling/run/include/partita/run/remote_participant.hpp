@@ -10,7 +10,8 @@
 //
 // The transport is a Channel (a link to one peer: send bytes, receive bytes with a deadline);
 // coupling/mpi/ implements it over MPI. Messages are written and read in place in buffers kept
-// for the run (coupling/run/src/message_codec.hpp; BinaryWriter's layout without its checksums):
+// for the run (MessageWriter, MessageReader: binary_io.hpp, the layout of restart files without
+// their sections and checksums):
 //
 //   request   [u32 command] [arguments]
 //   reply     [u32 status: 0 ok, 1 failed] [ok: results | failed: the error text]

@@ -1,5 +1,6 @@
-// The bytes of the messages between processes (coupling/run/src/message_codec.hpp): BinaryWriter's
-// layout, values back to the bit, buffers reused, damaged messages refused with the peer named.
+// The bytes of the messages between processes (MessageWriter, MessageReader: binary_io.hpp):
+// BinaryWriter's layout, values back to the bit, buffers reused, damaged messages refused with
+// the peer named.
 #include <catch2/catch.hpp>
 
 #include <cstdint>
@@ -10,12 +11,11 @@
 
 #include <Eigen/Core>
 
-#include "../../../coupling/run/src/message_codec.hpp"  // the run library's internal message codec
 #include "partita/interface/binary_io.hpp"
 #include "partita/interface/error.hpp"
 
-using partita::run::MessageReader;
-using partita::run::MessageWriter;
+using partita::MessageReader;
+using partita::MessageWriter;
 
 namespace {
 
@@ -29,7 +29,7 @@ Eigen::MatrixXd sample_matrix(Eigen::Index rows, Eigen::Index cols) {
 }  // namespace
 
 TEST_CASE("MessageWriter: the bytes of BinaryWriter for the same values (no sections)",
-          "[coupling][remote]") {
+          "[interface][binary_io][remote]") {
   const Eigen::MatrixXd m = sample_matrix(5, 3);
   const std::vector<int> list{3, -1, 4};
   std::string buffer;
@@ -51,7 +51,7 @@ TEST_CASE("MessageWriter: the bytes of BinaryWriter for the same values (no sect
 }
 
 TEST_CASE("MessageReader: every value back to the bit, matrices into their storage",
-          "[coupling][remote]") {
+          "[interface][binary_io][remote]") {
   const std::string peer = "participant 'granules' (rank 1)";
   const Eigen::MatrixXd m = sample_matrix(441, 3);
   std::string buffer = "stale bytes of a longer earlier message, cleared by the caller";
@@ -77,7 +77,7 @@ TEST_CASE("MessageReader: every value back to the bit, matrices into their stora
 }
 
 TEST_CASE("MessageReader: a truncated or damaged message is an error naming the peer",
-          "[coupling][remote]") {
+          "[interface][binary_io][remote]") {
   const std::string peer = "participant 'fluid' (rank 1)";
   std::string buffer;
   MessageWriter out(buffer);
