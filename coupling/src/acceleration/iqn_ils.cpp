@@ -7,23 +7,16 @@
 
 namespace partita::coupling {
 
-IqnIls::IqnIls(Options options) : options_(options) {
-  if (!(options_.initial_relaxation > 0.0 && options_.initial_relaxation <= 1.0))
-    throw Error("IQN-ILS initial relaxation must satisfy 0 < omega <= 1, found " +
-                std::to_string(options_.initial_relaxation));
-  if (options_.max_columns < 1) throw Error("IQN-ILS needs max_columns >= 1");
-  if (options_.reused_windows < 0) throw Error("IQN-ILS needs reused_windows >= 0");
+IqnIls::IqnIls(Options options)
+    : QuasiNewtonAcceleration(
+          "IQN-ILS", {options.initial_relaxation, options.max_columns, options.filter,
+                      options.filter_limit}),
+      reused_windows_(options.reused_windows) {
+  if (reused_windows_ < 0) throw Error("IQN-ILS needs reused_windows >= 0");
   window_columns_.push_front(0);
 }
 
-void IqnIls::erase_column(Eigen::Index j) {
-  const Eigen::Index n = v_.cols();
-  if (j + 1 < n) {
-    v_.middleCols(j, n - j - 1) = v_.rightCols(n - j - 1).eval();
-    w_.middleCols(j, n - j - 1) = w_.rightCols(n - j - 1).eval();
-  }
-  v_.conservativeResize(Eigen::NoChange, n - 1);
-  w_.conservativeResize(Eigen::NoChange, n - 1);
+void IqnIls::column_erased(Eigen::Index j) {
   // Which window owned column j (windows hold consecutive columns, current window first)?
   Eigen::Index first = 0;
   for (auto& count : window_columns_) {
@@ -35,34 +28,15 @@ void IqnIls::erase_column(Eigen::Index j) {
   }
 }
 
-void IqnIls::remove_column(Eigen::Index j) {
-  erase_column(j);
-  if (qr_.cols() > j) qr_.delete_column(j);
-}
-
-void IqnIls::clear(Eigen::Index rows) {
-  v_.resize(rows, 0);
-  w_.resize(rows, 0);
+void IqnIls::start_over(Eigen::Index rows) {
+  QuasiNewtonAcceleration::start_over(rows);
   for (auto& c : window_columns_) c = 0;
-  qr_.reset(rows);
-  qr_weights_.resize(0);
 }
 
 void IqnIls::rebuild(const Eigen::VectorXd& weights) {
-  // QR of D V by appending the columns newest first (insert_column at the back: no rotations);
-  // with QR2 a column whose orthogonal part is below the limit is dropped on the way.
+  // with QR2 a column whose orthogonal part is below the limit is dropped on the way
   ++rebuilds_;
-  qr_.reset(v_.rows());
-  qr_weights_ = weights;
-  const double limit = options_.filter == Filter::qr2 ? options_.filter_limit : 0.0;
-  for (Eigen::Index j = 0; j < v_.cols();) {
-    if (qr_.append(weights.cwiseProduct(v_.col(j)), limit)) {
-      ++j;
-    } else {
-      erase_column(j);
-      ++filtered_;
-    }
-  }
+  factorise(weights, settings_.filter == Filter::qr2 ? settings_.filter_limit : 0.0);
 }
 
 void IqnIls::match_weights(const Eigen::VectorXd& weights) {
@@ -83,101 +57,25 @@ void IqnIls::match_weights(const Eigen::VectorXd& weights) {
   rebuild(weights);
 }
 
-void IqnIls::add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                         const Eigen::VectorXd& weights) {
-  const Eigen::VectorXd r = x_tilde - x;
-  if (!first_iteration_ && previous_residual_.size() == r.size()) {
-    // V = [r_k - r_{k-1}, ...], W = [H(x_k) - H(x_{k-1}), ...], newest first
-    const Eigen::Index n = v_.cols();
-    Eigen::MatrixXd v(r.size(), n + 1), w(r.size(), n + 1);
-    v.col(0) = r - previous_residual_;
-    w.col(0) = x_tilde - previous_x_tilde_;
-    if (n > 0) {
-      v.rightCols(n) = v_;
-      w.rightCols(n) = w_;
-    }
-    ++window_columns_.front();
-    if (qr_.insert_column(0, weights.cwiseProduct(v.col(0)))) {
-      v_.swap(v);
-      w_.swap(w);
-    } else {
-      // zero, or dependent on the columns in to rounding: not a usable secant
-      --window_columns_.front();
-      ++filtered_;
-    }
-    while (v_.cols() > options_.max_columns) remove_column(v_.cols() - 1);
-  }
-  previous_residual_ = r;
-  previous_x_tilde_ = x_tilde;
-}
-
-void IqnIls::apply_filter() {
-  // On the updated factorisation: removing column j updates R for the columns after it, so each
-  // test sees the columns that are still in (as a rebuild newest first would).
-  if (options_.filter == Filter::qr2) {
-    for (Eigen::Index j = 0; j < qr_.cols();) {
-      if (std::abs(qr_.diagonal(j)) < options_.filter_limit * qr_.column_norm(j)) {
-        remove_column(j);
-        ++filtered_;
-      } else {
-        ++j;
-      }
-    }
-  } else if (options_.filter == Filter::qr1) {
-    bool again = true;
-    while (again) {
-      again = false;
-      const double rn = qr_.r_norm();
-      for (Eigen::Index j = 0; j < qr_.cols(); ++j) {
-        if (std::abs(qr_.diagonal(j)) < options_.filter_limit * rn) {
-          remove_column(j);
-          ++filtered_;
-          again = true;
-          break;
-        }
-      }
-    }
-  }
-}
-
-void IqnIls::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                        const Eigen::VectorXd& weights, Eigen::VectorXd& next) {
-  if (v_.rows() != x.size()) clear(x.size());  // the data changed size: start over
-  match_weights(weights);
-  add_columns(x, x_tilde, weights);
-  first_iteration_ = false;
-  if (v_.cols() > 0) apply_filter();
-  if (v_.cols() == 0) {
-    // no model yet: x_{k+1} = x_k + ω_0 r_k
-    next = x + options_.initial_relaxation * (x_tilde - x);
-    return;
-  }
+void IqnIls::quasi_newton_step(const Eigen::VectorXd& /*x*/, const Eigen::VectorXd& x_tilde,
+                               const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
+                               Eigen::VectorXd& next) {
   // c = argmin |D (V c + r_k)|;  x_{k+1} = H(x_k) + W c
-  const Eigen::VectorXd c = qr_.solve(-weights.cwiseProduct(x_tilde - x));
+  const Eigen::VectorXd c = least_squares(r, weights);
   next = x_tilde + w_ * c;
 }
 
 void IqnIls::window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
                               const Eigen::VectorXd& weights) {
   // The converged iteration's differences belong to the model too (preCICE adds them here).
-  if (v_.rows() == x.size() || v_.cols() == 0) {
-    if (v_.rows() != x.size()) clear(x.size());
-    match_weights(weights);
-    add_columns(x, x_tilde, weights);
-  }
+  if (v_.rows() == x.size() || v_.cols() == 0) update_difference_matrices(x, x_tilde, weights);
   first_iteration_ = true;
   // Keep the columns of the current window and `reused_windows` before it (deleting the last
   // column of the factorisation needs no rotation).
   window_columns_.push_front(0);
-  while (static_cast<int>(window_columns_.size()) > options_.reused_windows + 1) {
-    const int count = window_columns_.back();
+  while (static_cast<int>(window_columns_.size()) > reused_windows_ + 1) {
+    for (int i = window_columns_.back(); i > 0; --i) remove_column(v_.cols() - 1);
     window_columns_.pop_back();
-    for (int i = 0; i < count; ++i) {
-      const Eigen::Index last = v_.cols() - 1;
-      v_.conservativeResize(Eigen::NoChange, last);
-      w_.conservativeResize(Eigen::NoChange, last);
-      if (qr_.cols() > last) qr_.delete_column(last);
-    }
   }
 }
 

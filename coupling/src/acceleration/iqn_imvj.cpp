@@ -11,91 +11,31 @@
 
 namespace partita::coupling {
 
-IqnImvj::IqnImvj(Options options) : options_(options) {
-  if (!(options_.initial_relaxation > 0.0 && options_.initial_relaxation <= 1.0))
-    throw Error("IQN-IMVJ initial relaxation must satisfy 0 < omega <= 1, found " +
-                std::to_string(options_.initial_relaxation));
-  if (options_.max_columns < 1) throw Error("IQN-IMVJ needs max_columns >= 1");
-  if (options_.chunk_size < 1) throw Error("IQN-IMVJ needs chunk_size >= 1");
-  if (!(options_.truncation >= 0.0 && options_.truncation < 1.0))
+IqnImvj::IqnImvj(Options options)
+    : QuasiNewtonAcceleration(
+          "IQN-IMVJ", {options.initial_relaxation, options.max_columns, options.filter,
+                       options.filter_limit}),
+      restart_(options.restart),
+      chunk_size_(options.chunk_size),
+      truncation_(options.truncation) {
+  if (chunk_size_ < 1) throw Error("IQN-IMVJ needs chunk_size >= 1");
+  if (!(truncation_ >= 0.0 && truncation_ < 1.0))
     throw Error("IQN-IMVJ truncation must satisfy 0 <= truncation < 1, found " +
-                std::to_string(options_.truncation));
+                std::to_string(truncation_));
 }
 
-void IqnImvj::reset(Eigen::Index rows) {
-  v_.resize(rows, 0);
-  w_.resize(rows, 0);
+void IqnImvj::start_over(Eigen::Index rows) {
+  QuasiNewtonAcceleration::start_over(rows);
   a_.resize(rows, 0);
   b_.resize(rows, 0);
-  qr_.reset(rows);
-  qr_weights_.resize(0);
   windows_since_restart_ = 0;
 }
 
-void IqnImvj::start_window_factorisation(const Eigen::VectorXd& weights) {
+void IqnImvj::match_weights(const Eigen::VectorXd& weights) {
   // The weights are fixed within a window; should they change, refactorise the (few) columns.
   if (qr_weights_.size() == weights.size() && qr_weights_ == weights && qr_.cols() == v_.cols())
     return;
-  qr_.reset(v_.rows());
-  qr_weights_ = weights;
-  for (Eigen::Index j = 0; j < v_.cols();) {
-    if (qr_.append(weights.cwiseProduct(v_.col(j)))) {
-      ++j;
-    } else {
-      const Eigen::Index n = v_.cols();
-      v_.middleCols(j, n - j - 1) = v_.rightCols(n - j - 1).eval();
-      w_.middleCols(j, n - j - 1) = w_.rightCols(n - j - 1).eval();
-      v_.conservativeResize(Eigen::NoChange, n - 1);
-      w_.conservativeResize(Eigen::NoChange, n - 1);
-      ++filtered_;
-    }
-  }
-}
-
-void IqnImvj::remove_column(Eigen::Index j) {
-  const Eigen::Index n = v_.cols();
-  if (j + 1 < n) {
-    v_.middleCols(j, n - j - 1) = v_.rightCols(n - j - 1).eval();
-    w_.middleCols(j, n - j - 1) = w_.rightCols(n - j - 1).eval();
-  }
-  v_.conservativeResize(Eigen::NoChange, n - 1);
-  w_.conservativeResize(Eigen::NoChange, n - 1);
-  qr_.delete_column(j);
-}
-
-void IqnImvj::add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                          const Eigen::VectorXd& weights) {
-  const Eigen::VectorXd r = x_tilde - x;
-  if (!first_iteration_ && previous_residual_.size() == r.size()) {
-    const Eigen::VectorXd dv = r - previous_residual_;
-    if (qr_.insert_column(0, weights.cwiseProduct(dv))) {
-      const Eigen::Index n = v_.cols();
-      Eigen::MatrixXd v(r.size(), n + 1), w(r.size(), n + 1);
-      v.col(0) = dv;
-      w.col(0) = x_tilde - previous_x_tilde_;
-      if (n > 0) {
-        v.rightCols(n) = v_;
-        w.rightCols(n) = w_;
-      }
-      v_.swap(v);
-      w_.swap(w);
-    } else {
-      ++filtered_;  // zero, or dependent on the columns in to rounding
-    }
-    while (v_.cols() > options_.max_columns) remove_column(v_.cols() - 1);
-    if (options_.filter == Filter::qr2) {
-      for (Eigen::Index j = 0; j < qr_.cols();) {
-        if (std::abs(qr_.diagonal(j)) < options_.filter_limit * qr_.column_norm(j)) {
-          remove_column(j);
-          ++filtered_;
-        } else {
-          ++j;
-        }
-      }
-    }
-  }
-  previous_residual_ = r;
-  previous_x_tilde_ = x_tilde;
+  factorise(weights, 0.0);
 }
 
 Eigen::VectorXd IqnImvj::apply_previous_jacobian(const Eigen::VectorXd& y) const {
@@ -103,23 +43,14 @@ Eigen::VectorXd IqnImvj::apply_previous_jacobian(const Eigen::VectorXd& y) const
   return a_ * (b_.transpose() * y);
 }
 
-void IqnImvj::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                         const Eigen::VectorXd& weights, Eigen::VectorXd& next) {
-  if (v_.rows() != x.size()) reset(x.size());  // the data changed size: start over
-  start_window_factorisation(weights);
-  add_columns(x, x_tilde, weights);
-  first_iteration_ = false;
-  const Eigen::VectorXd r = x_tilde - x;
-  if (v_.cols() == 0 && a_.cols() == 0) {
-    // no model yet: x_{k+1} = x_k + omega_0 r_k
-    next = x + options_.initial_relaxation * r;
-    return;
-  }
+void IqnImvj::quasi_newton_step(const Eigen::VectorXd& /*x*/, const Eigen::VectorXd& x_tilde,
+                                const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
+                                Eigen::VectorXd& next) {
   // x_{k+1} = H(x_k) + W c - J_prev (r_k + V c),  c = argmin |D (V c + r_k)|
   Eigen::VectorXd rest = r;
   next = x_tilde;
   if (v_.cols() > 0) {
-    const Eigen::VectorXd c = qr_.solve(-weights.cwiseProduct(r));
+    const Eigen::VectorXd c = least_squares(r, weights);
     next += w_ * c;
     rest += v_ * c;
   }
@@ -129,9 +60,8 @@ void IqnImvj::accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tild
 void IqnImvj::window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
                                const Eigen::VectorXd& weights) {
   // The converged iteration's differences belong to this window's secants too.
-  if (v_.rows() != x.size()) reset(x.size());
-  start_window_factorisation(weights);
-  add_columns(x, x_tilde, weights);
+  update_difference_matrices(x, x_tilde, weights);
+  apply_filter();
   first_iteration_ = true;
   const Eigen::Index m = v_.cols();
   if (m > 0) {
@@ -147,18 +77,16 @@ void IqnImvj::window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& 
     a_.rightCols(m) = w_tilde;
     b_.rightCols(m) = z_t;
   }
-  v_.resize(x.size(), 0);
-  w_.resize(x.size(), 0);
-  qr_.reset(x.size());
-  qr_weights_.resize(0);
-  if (++windows_since_restart_ >= options_.chunk_size) restart();
+  // this window's secants live on in J_prev only
+  QuasiNewtonAcceleration::start_over(x.size());
+  if (++windows_since_restart_ >= chunk_size_) restart();
 }
 
 void IqnImvj::restart() {
   windows_since_restart_ = 0;
   if (a_.cols() == 0) return;
   ++restarts_;
-  if (options_.restart == Restart::zero) {
+  if (restart_ == Restart::zero) {
     a_.resize(a_.rows(), 0);
     b_.resize(b_.rows(), 0);
     return;
@@ -173,7 +101,7 @@ void IqnImvj::restart() {
                                         Eigen::ComputeThinU | Eigen::ComputeThinV);
   const Eigen::VectorXd& s = svd.singularValues();
   Eigen::Index keep = 0;
-  while (keep < s.size() && s(keep) > options_.truncation * s(0) && s(keep) > 0.0) ++keep;
+  while (keep < s.size() && s(keep) > truncation_ * s(0) && s(keep) > 0.0) ++keep;
   const Eigen::MatrixXd q_a = qa.householderQ() * Eigen::MatrixXd::Identity(rows, k);
   const Eigen::MatrixXd q_b = qb.householderQ() * Eigen::MatrixXd::Identity(rows, k);
   a_ = q_a * (svd.matrixU().leftCols(keep) * s.head(keep).asDiagonal());

@@ -22,24 +22,24 @@
 // applied on the way) only when the weights D change other than by a common factor (several
 // accelerated fields whose norms change differently; a common factor s just scales R), when the
 // data change size, and on the first call. When there are no columns (first iteration of the
-// first window) the step is a constant
-// relaxation with `initial_relaxation`. On a linear map of dimension n the iteration converges
-// in at most n + 1 evaluations of H (it is then equivalent to GMRES).
+// first window) the step is a constant relaxation with `initial_relaxation`. On a linear map of
+// dimension n the iteration converges in at most n + 1 evaluations of H (it is then equivalent
+// to GMRES). V, W, their factorisation, the filters and the iteration step are those of
+// QuasiNewtonAcceleration (shared with IQN-IMVJ); this class adds the reuse of past windows'
+// columns, the rescaling of R and the least-squares step.
 
 #include <deque>
 #include <memory>
 
 #include <Eigen/Core>
 
-#include "partita/coupling/acceleration/acceleration.hpp"
-#include "partita/coupling/acceleration/qr_factorization.hpp"
+#include "partita/coupling/acceleration/quasi_newton.hpp"
 #include "partita/interface/config.hpp"
 
 namespace partita::coupling {
 
-class IqnIls : public Acceleration {
+class IqnIls : public QuasiNewtonAcceleration {
  public:
-  enum class Filter { none, qr1, qr2 };
   struct Options {
     double initial_relaxation = 0.1;
     int max_columns = 50;
@@ -49,46 +49,29 @@ class IqnIls : public Acceleration {
   };
 
   explicit IqnIls(Options options);
-  void accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                  const Eigen::VectorXd& weights, Eigen::VectorXd& next) override;
   void window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
                         const Eigen::VectorXd& weights) override;
   std::string name() const override { return "iqn-ils"; }
   void serialize(StateArchive& ar) override;
 
-  /// Columns in V and W now.
-  Eigen::Index columns() const { return v_.cols(); }
-  /// Columns removed by the filter so far.
-  long filtered_columns() const { return filtered_; }
   /// Times the QR decomposition was rebuilt from V (instead of updated).
   long qr_rebuilds() const { return rebuilds_; }
-  /// The factorisation of D V (D: the weights of the last call).
-  const QrFactorization& qr() const { return qr_; }
-  /// V and W, newest column first.
-  const Eigen::MatrixXd& v() const { return v_; }
-  const Eigen::MatrixXd& w() const { return w_; }
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Acceleration> create(const config::Node& node);
 
  private:
-  void add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                   const Eigen::VectorXd& weights);
-  void erase_column(Eigen::Index j);   // from V, W and the window counts
-  void remove_column(Eigen::Index j);  // ... and from the factorisation
-  void clear(Eigen::Index rows);
+  void start_over(Eigen::Index rows) override;
+  void match_weights(const Eigen::VectorXd& weights) override;
+  void quasi_newton_step(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                         const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
+                         Eigen::VectorXd& next) override;
+  void column_inserted() override { ++window_columns_.front(); }
+  void column_erased(Eigen::Index j) override;
   void rebuild(const Eigen::VectorXd& weights);
-  void match_weights(const Eigen::VectorXd& weights);
-  void apply_filter();
 
-  Options options_;
-  Eigen::MatrixXd v_, w_;           // columns newest first
+  int reused_windows_;
   std::deque<int> window_columns_;  // columns per window, current window first
-  Eigen::VectorXd previous_residual_, previous_x_tilde_;
-  bool first_iteration_ = true;
-  QrFactorization qr_;          // of D V, D = diag(qr_weights_)
-  Eigen::VectorXd qr_weights_;  // empty: no factorisation yet
-  long filtered_ = 0;
   long rebuilds_ = 0;
 };
 

@@ -13,7 +13,9 @@
 // window's J becomes J_prev of the next: the information of past windows lives in J_prev and
 // is not re-fitted as IQN-ILS's reused columns are. With J_prev = 0 the step is IQN-ILS's.
 // Evaluated as x_{k+1} = H(x_k) + W c - J_prev (r_k + V c), c = argmin |D (V c + r_k)|, from the
-// updated QR of D V (the QR2 filter of IQN-ILS drops nearly dependent columns).
+// updated QR of D V (the QR2 filter of IQN-ILS drops nearly dependent columns). V, W, their
+// factorisation, the filter and the iteration step are QuasiNewtonAcceleration's (shared with
+// IQN-ILS); this class adds J_prev, its update when a window converges, and the restarts.
 //
 // J_prev is never formed: J_prev = A B^T with A, B of rows x p; each window appends its m
 // columns (A <- [A, W - J_prev V], B <- [B, D Q R^{-T}] with D V = Q R), so p grows with the
@@ -34,20 +36,18 @@
 
 #include <Eigen/Core>
 
-#include "partita/coupling/acceleration/acceleration.hpp"
-#include "partita/coupling/acceleration/qr_factorization.hpp"
+#include "partita/coupling/acceleration/quasi_newton.hpp"
 #include "partita/interface/config.hpp"
 
 namespace partita::coupling {
 
-class IqnImvj : public Acceleration {
+class IqnImvj : public QuasiNewtonAcceleration {
  public:
   enum class Restart { svd, zero };
-  enum class Filter { none, qr2 };
   struct Options {
     double initial_relaxation = 0.1;
     int max_columns = 50;  ///< per window
-    Filter filter = Filter::qr2;
+    Filter filter = Filter::qr2;  ///< a case offers none and qr2
     double filter_limit = 1e-2;
     Restart restart = Restart::svd;
     int chunk_size = 8;        ///< windows between restarts
@@ -55,43 +55,35 @@ class IqnImvj : public Acceleration {
   };
 
   explicit IqnImvj(Options options);
-  void accelerate(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                  const Eigen::VectorXd& weights, Eigen::VectorXd& next) override;
   void window_converged(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
                         const Eigen::VectorXd& weights) override;
   std::string name() const override { return "iqn-imvj"; }
   void serialize(StateArchive& ar) override;
 
-  /// Columns of this window in V and W.
-  Eigen::Index columns() const { return v_.cols(); }
   /// The rank p of the stored J_prev = A B^T (columns of A and B).
   Eigen::Index jacobian_terms() const { return a_.cols(); }
   /// J_prev applied to y (for tests).
   Eigen::VectorXd apply_previous_jacobian(const Eigen::VectorXd& y) const;
   long restarts() const { return restarts_; }
-  long filtered_columns() const { return filtered_; }
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Acceleration> create(const config::Node& node);
 
  private:
-  void reset(Eigen::Index rows);
-  void start_window_factorisation(const Eigen::VectorXd& weights);
-  void add_columns(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
-                   const Eigen::VectorXd& weights);
-  void remove_column(Eigen::Index j);
+  void start_over(Eigen::Index rows) override;
+  void match_weights(const Eigen::VectorXd& weights) override;
+  bool has_model() const override { return v_.cols() > 0 || a_.cols() > 0; }
+  void quasi_newton_step(const Eigen::VectorXd& x, const Eigen::VectorXd& x_tilde,
+                         const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
+                         Eigen::VectorXd& next) override;
   void restart();
 
-  Options options_;
-  Eigen::MatrixXd v_, w_;  // this window's columns, newest first
-  QrFactorization qr_;     // of D V
-  Eigen::VectorXd qr_weights_;
-  Eigen::VectorXd previous_residual_, previous_x_tilde_;
-  bool first_iteration_ = true;
+  Restart restart_;
+  int chunk_size_;
+  double truncation_;
   Eigen::MatrixXd a_, b_;  // J_prev = A B^T
   int windows_since_restart_ = 0;
   long restarts_ = 0;
-  long filtered_ = 0;
 };
 
 }  // namespace partita::coupling
