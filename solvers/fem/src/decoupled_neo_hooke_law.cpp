@@ -46,4 +46,13 @@ void DecoupledNeoHookeLaw::evaluate(const Mat3& f, std::span<const double>, std:
                      0.25 * kappa_ * (j * j - 1.0 - 2.0 * std::log(j));
 }
 
+MaterialLawEntry decoupled_neo_hooke_law_entry() {
+  return {"neo-hooke-decoupled", "W = mu/2 (I1_bar - 3) + kappa/4 (J^2 - 1 - 2 ln J)",
+          isotropic_parameters(),
+          [](const MaterialParameters& p) -> std::shared_ptr<const MaterialLaw> {
+            return std::make_shared<DecoupledNeoHookeLaw>(
+                p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density"));
+          }};
+}
+
 }  // namespace partita::fem

@@ -233,4 +233,16 @@ void FiniteStrainJ2Law::evaluate(const Mat3& f, std::span<const double> committe
   }
 }
 
+MaterialLawEntry finite_strain_j2_law_entry() {
+  auto parameters = isotropic_parameters();
+  for (auto& h : hardening_parameters()) parameters.push_back(std::move(h));
+  return {"j2-plasticity-finite-strain", "multiplicative, logarithmic strains",
+          std::move(parameters),
+          [](const MaterialParameters& p) -> std::shared_ptr<const MaterialLaw> {
+            return std::make_shared<FiniteStrainJ2Law>(
+                p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density"),
+                hardening_curve_from("j2-plasticity-finite-strain", p));
+          }};
+}
+
 }  // namespace partita::fem

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "partita/fem/error.hpp"
 
@@ -104,6 +105,53 @@ double HardeningCurve::return_map_increment(double g, double trial_norm, double 
     }
     dg += res / (2.0 * g + 2.0 / 3.0 * slope(alpha));
   }
+}
+
+std::vector<MaterialParameter> hardening_parameters() {
+  // yield stresses of structural materials: soft polymers (about 1 MPa) to maraging and
+  // high-strength steels (2-3 GPa)
+  return {MaterialParameter::number("yield_stress", "Pa", "initial uniaxial yield stress (below E)")
+              .positive()
+              .typical(1e5, 1e10, "yield stresses of solids (polymer foams to hardened steel)"),
+          MaterialParameter::number("hardening_modulus", "Pa",
+                                    "linear isotropic hardening d sigma_y / d eps_p")
+              .non_negative()
+              .def(0.0),
+          MaterialParameter::table("hardening_table",
+                                   "tabulated hardening instead of yield_stress and "
+                                   "hardening_modulus (piecewise linear, flat beyond the last "
+                                   "point)",
+                                   {{"plastic_strain", ""}, {"yield_stress", "Pa"}})
+              .non_negative()};
+}
+
+HardeningCurve hardening_curve_from(std::string_view law, const MaterialParameters& p) {
+  const std::string name(law);
+  const double e = p.real("youngs_modulus");
+  const auto check_yield = [&](double sigma_y) {
+    if (sigma_y < e) return;
+    std::ostringstream msg;
+    msg << name << ": yield stress " << sigma_y << " Pa is not below Young's modulus " << e
+        << " Pa: a yield strain sigma_y / E = " << sigma_y / e
+        << ", where solids yield at 1e-4 to 1e-1 (a unit left out?)";
+    throw Error(msg.str());
+  };
+  if (p.tables().count("hardening_table") != 0) {
+    if (p.values().count("yield_stress") != 0)
+      throw Error(name + ": give either yield_stress (and hardening_modulus) or hardening_table");
+    std::vector<std::pair<double, double>> points;
+    for (const auto& row : p.table("hardening_table")) {
+      points.emplace_back(row.at(0), row.at(1));
+      check_yield(points.back().second);
+    }
+    return HardeningCurve::tabulated(std::move(points));
+  }
+  if (p.values().count("yield_stress") == 0)
+    throw Error(name +
+                " needs 'yield_stress' (and optionally 'hardening_modulus') or 'hardening_table'");
+  check_yield(p.real("yield_stress"));
+  const double h = p.values().count("hardening_modulus") != 0 ? p.real("hardening_modulus") : 0.0;
+  return HardeningCurve::linear(p.real("yield_stress"), h);
 }
 
 }  // namespace partita::fem

@@ -91,4 +91,15 @@ void J2PlasticityLaw::evaluate_with(const Mat3& f, std::span<const double> commi
   pack_symmetric(r.stress, trial.subspan(8, 6));
 }
 
+MaterialLawEntry j2_plasticity_law_entry() {
+  auto parameters = isotropic_parameters();
+  for (auto& h : hardening_parameters()) parameters.push_back(std::move(h));
+  return {"j2-plasticity", "small strain, isotropic hardening", std::move(parameters),
+          [](const MaterialParameters& p) -> std::shared_ptr<const MaterialLaw> {
+            return std::make_shared<J2PlasticityLaw>(
+                p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density"),
+                hardening_curve_from("j2-plasticity", p));
+          }};
+}
+
 }  // namespace partita::fem

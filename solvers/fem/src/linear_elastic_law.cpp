@@ -27,4 +27,12 @@ void LinearElasticLaw::evaluate(const Mat3& f, std::span<const double>, std::spa
   r.energy_density = 0.5 * (r.stress.array() * eps.array()).sum();
 }
 
+MaterialLawEntry linear_elastic_law_entry() {
+  return {"linear-elastic", "small strain, the fast linear path", isotropic_parameters(),
+          [](const MaterialParameters& p) -> std::shared_ptr<const MaterialLaw> {
+            return std::make_shared<LinearElasticLaw>(Material{
+                p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density")});
+          }};
+}
+
 }  // namespace partita::fem

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "partita/fem/error.hpp"
+#include "partita/fem/material_law_registry.hpp"
 
 namespace partita::fem {
 
@@ -64,6 +65,20 @@ Matrix9 isotropic_elasticity_tensor(double lambda, double mu) {
     }
   }
   return c;
+}
+
+std::vector<MaterialParameter> isotropic_parameters() {
+  return {MaterialParameter::number("youngs_modulus", "Pa", "Young's modulus E")
+              .positive()
+              .typical(1e5, 1.2e12, "Young's moduli of solids (soft rubber to diamond)")
+              .required(),
+          MaterialParameter::number("poisson_ratio", "", "Poisson's ratio nu")
+              .range(-1.0, 0.5, true)
+              .required(),
+          MaterialParameter::number("density", "kg/m^3", "mass density rho")
+              .positive()
+              .typical(10.0, 2.3e4, "densities of solids (polymer foams to osmium)")
+              .required()};
 }
 
 }  // namespace partita::fem

@@ -45,4 +45,14 @@ void NeoHookeLaw::evaluate(const Mat3& f, std::span<const double>, std::span<dou
   r.energy_density = 0.5 * mu * (f.squaredNorm() - 3.0) - mu * log_j + 0.5 * lambda * log_j * log_j;
 }
 
+MaterialLawEntry neo_hooke_law_entry() {
+  return {"neo-hooke",
+          "compressible, finite strain, W = mu/2 (tr C - 3) - mu ln J + lambda/2 ln^2 J",
+          isotropic_parameters(),
+          [](const MaterialParameters& p) -> std::shared_ptr<const MaterialLaw> {
+            return std::make_shared<NeoHookeLaw>(p.real("youngs_modulus"),
+                                                 p.real("poisson_ratio"), p.real("density"));
+          }};
+}
+
 }  // namespace partita::fem

@@ -1,5 +1,6 @@
 #pragma once
 #include "partita/fem/material_law.hpp"
+#include "partita/fem/material_law_registry.hpp"
 
 namespace partita::fem {
 
@@ -27,5 +28,8 @@ class DecoupledNeoHookeLaw final : public MaterialLaw {
  private:
   double mu_ = 0.0, kappa_ = 0.0, density_ = 0.0;
 };
+
+// Its registry entry: "neo-hooke-decoupled" from youngs_modulus, poisson_ratio, density.
+MaterialLawEntry decoupled_neo_hooke_law_entry();
 
 }  // namespace partita::fem

@@ -1,6 +1,7 @@
 #pragma once
 #include "partita/fem/hardening_curve.hpp"
 #include "partita/fem/material_law.hpp"
+#include "partita/fem/material_law_registry.hpp"
 
 namespace partita::fem {
 
@@ -66,5 +67,9 @@ class FiniteStrainJ2Law final : public MaterialLaw {
   double density_ = 0.0, bulk_ = 0.0, shear_ = 0.0;
   HardeningCurve hardening_;
 };
+
+// Its registry entry: "j2-plasticity-finite-strain" from youngs_modulus, poisson_ratio, density
+// and the hardening (hardening_parameters()).
+MaterialLawEntry finite_strain_j2_law_entry();
 
 }  // namespace partita::fem

@@ -1,6 +1,9 @@
 #pragma once
+#include <string_view>
 #include <utility>
 #include <vector>
+
+#include "partita/fem/material_law_registry.hpp"
 
 namespace partita::fem {
 
@@ -31,5 +34,13 @@ class HardeningCurve {
   double sigma0_ = 0.0, h_ = 0.0;
   std::vector<std::pair<double, double>> points_;
 };
+
+// The hardening parameters of the J2 laws' registry entries: yield_stress and hardening_modulus
+// (linear), or hardening_table (rows of plastic strain, yield stress: tabulated).
+std::vector<MaterialParameter> hardening_parameters();
+// The curve those parameters give (one of the two forms; Error naming `law` when both or
+// neither are given, or when a yield stress is not below youngs_modulus: a yield strain of 1 or
+// more is a unit left out, not a material).
+HardeningCurve hardening_curve_from(std::string_view law, const MaterialParameters& p);
 
 }  // namespace partita::fem

@@ -1,6 +1,7 @@
 #pragma once
 #include "partita/fem/hardening_curve.hpp"
 #include "partita/fem/material_law.hpp"
+#include "partita/fem/material_law_registry.hpp"
 
 namespace partita::fem {
 
@@ -49,5 +50,9 @@ class J2PlasticityLaw final : public MaterialLaw {
   double density_ = 0.0, bulk_ = 0.0, shear_ = 0.0;
   HardeningCurve hardening_;
 };
+
+// Its registry entry: "j2-plasticity" from youngs_modulus, poisson_ratio, density and the
+// hardening (hardening_parameters()).
+MaterialLawEntry j2_plasticity_law_entry();
 
 }  // namespace partita::fem

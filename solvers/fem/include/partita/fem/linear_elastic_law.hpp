@@ -1,6 +1,7 @@
 #pragma once
 #include "partita/fem/material.hpp"
 #include "partita/fem/material_law.hpp"
+#include "partita/fem/material_law_registry.hpp"
 
 namespace partita::fem {
 
@@ -25,5 +26,8 @@ class LinearElasticLaw final : public MaterialLaw {
   LameConstants lame_;
   Matrix9 c_;
 };
+
+// Its registry entry: "linear-elastic" from youngs_modulus, poisson_ratio, density.
+MaterialLawEntry linear_elastic_law_entry();
 
 }  // namespace partita::fem

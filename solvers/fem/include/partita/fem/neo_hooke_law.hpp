@@ -1,5 +1,6 @@
 #pragma once
 #include "partita/fem/material_law.hpp"
+#include "partita/fem/material_law_registry.hpp"
 
 namespace partita::fem {
 
@@ -29,5 +30,8 @@ class NeoHookeLaw final : public MaterialLaw {
   LameConstants lame_;
   double density_ = 0.0;
 };
+
+// Its registry entry: "neo-hooke" from youngs_modulus, poisson_ratio, density.
+MaterialLawEntry neo_hooke_law_entry();
 
 }  // namespace partita::fem
