@@ -438,4 +438,12 @@ bool SparseFactorisation::threaded_factorisation() const {
   return !empty_ && impl_->threaded_factorisation();
 }
 
+void factorize_or_throw(SparseFactorisation& f, const SparseMatrix& a, const char* what) {
+  if (!f.factorize(a)) {
+    throw Error(std::string(what) +
+                " is singular or indefinite: the Dirichlet conditions do not prevent rigid-body "
+                "motion (fix more components) or an element is inverted");
+  }
+}
+
 }  // namespace partita::fem

@@ -1,6 +1,7 @@
 #include "partita/fem/newmark_integrator.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -120,7 +121,98 @@ class NewmarkProblem final : public NonlinearProblem {
 NewmarkIntegrator::NewmarkIntegrator(double beta, double gamma, NewtonOptions options,
                                      LinearSolver linear_solver, FillOrdering ordering,
                                      FactorThreading factor_threading)
-    : beta_(beta), gamma_(gamma), newton_(options, linear_solver, ordering, factor_threading) {}
+    : beta_(beta),
+      gamma_(gamma),
+      newton_(options, linear_solver, ordering, factor_threading),
+      linear_solver_(linear_solver),
+      ordering_(ordering),
+      factor_threading_(factor_threading) {}
+
+// ---- constant tangent: K_eff factorised once per step size ----
+
+void NewmarkIntegrator::factorise(StructuralSystem& system, double dt) {
+  const SparseMatrix* k = system.internal_forces().constant_tangent();
+  if (k == nullptr) return;  // Newton: its own factorisations
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  if (k_ff_.rows() == 0 && system.dofs().free_dofs().size() > 0) {
+    system.dofs().split(*k, k_ff_, k_fc_);
+    system.dofs().split(system.mass(), m_ff_, m_fc_);
+  }
+  const double c0 = 1.0 / (beta_ * dt * dt), c1 = gamma_ / (beta_ * dt);
+  // K_eff = K + gamma/(beta dt) C + 1/(beta dt^2) M with C = alpha M + beta_R K
+  const double sk = 1.0 + c1 * system.stiffness_damping();
+  const double sm = c0 + c1 * system.mass_damping();
+  const SparseMatrix keff_ff = sk * k_ff_ + sm * m_ff_;
+  keff_fc_ = sk * k_fc_ + sm * m_fc_;
+  // symbolic analysis once (the pattern of K_eff does not depend on dt), numeric per dt
+  if (!factor_) {
+    factor_ = std::make_unique<SparseFactorisation>(linear_solver_, ordering_);
+    factor_->set_solve_threading(solve_threading_);
+    factor_->set_factor_threading(factor_threading_);
+    factor_->analyze(keff_ff);
+  }
+  factorize_or_throw(*factor_, keff_ff, "effective matrix K_eff");
+  factor_dt_ = dt;
+  if (timings_ != nullptr) {
+    timings_->factor_nonzeros = factor_->factor_nonzeros();
+    ++timings_->factorisations;
+    timings_->factorisation += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+}
+
+void NewmarkIntegrator::step_constant_tangent(StructuralSystem& system, Kinematics& kin,
+                                              const SparseMatrix& k, double dt) {
+  if (!(factor_dt_ > 0.0) || std::abs(dt - factor_dt_) > 1e-9 * factor_dt_) factorise(system, dt);
+  const double h = factor_dt_;  // the clock advances by dt
+  const double beta = beta_, gamma = gamma_;
+  const double alpha_r = system.mass_damping(), beta_r = system.stiffness_damping();
+  const double c0 = 1.0 / (beta * h * h), c1 = gamma / (beta * h), c2 = 1.0 / (beta * h);
+  const double c3 = 0.5 / beta - 1.0, c4 = gamma / beta - 1.0, c5 = h * (0.5 * gamma / beta - 1.0);
+  const double t1 = kin.time + dt;
+  const DofPartition& dofs = system.dofs();
+  const SparseMatrix& m = system.mass();
+
+  // work vectors are members: no allocation once sized
+  Work& w = work_;
+  system.external_force(t1, w.f1);
+  // K_eff u1 = F1 + M (c0 u + c2 v + c3 a) + C (c1 u + c4 v + c5 a)
+  w.pm = c0 * kin.u + c2 * kin.v + c3 * kin.a;
+  w.rhs = w.f1;
+  if (alpha_r != 0.0 || beta_r != 0.0) {
+    w.pc = c1 * kin.u + c4 * kin.v + c5 * kin.a;
+    w.pm += alpha_r * w.pc;
+    w.rhs.noalias() += m * w.pm;
+    if (beta_r != 0.0) {
+      w.pc *= beta_r;
+      w.rhs.noalias() += k * w.pc;
+    }
+  } else {
+    w.rhs.noalias() += m * w.pm;
+  }
+  system.prescribed_values(t1, w.uc);
+  w.rf.resize(static_cast<Eigen::Index>(dofs.free_dofs().size()));
+  for (std::size_t i = 0; i < dofs.free_dofs().size(); ++i)
+    w.rf[static_cast<Eigen::Index>(i)] = w.rhs[dofs.free_dofs()[i]];
+  if (w.uc.size() > 0 && w.uc.cwiseAbs().maxCoeff() > 0.0) w.rf.noalias() -= keff_fc_ * w.uc;
+  factor_->solve(w.rf, w.uf);
+
+  w.u1.resize(kin.u.size());
+  for (std::size_t i = 0; i < dofs.free_dofs().size(); ++i)
+    w.u1[dofs.free_dofs()[i]] = w.uf[static_cast<Eigen::Index>(i)];
+  for (std::size_t i = 0; i < dofs.constrained_dofs().size(); ++i)
+    w.u1[dofs.constrained_dofs()[i]] = w.uc[static_cast<Eigen::Index>(i)];
+  // a1 = c0 (u1 - u) - c2 v - c3 a;  v1 = v + h ((1 - gamma) a + gamma a1)
+  w.a1 = c0 * (w.u1 - kin.u) - c2 * kin.v - c3 * kin.a;
+  kin.v += h * ((1.0 - gamma) * kin.a + gamma * w.a1);
+  kin.external_work += 0.5 * (kin.f + w.f1).dot(w.u1 - kin.u);
+  kin.u.swap(w.u1);
+  kin.a.swap(w.a1);
+  kin.f.swap(w.f1);
+  kin.time = t1;
+}
+
+// ---- Newton ----
 
 bool NewmarkIntegrator::try_step(StructuralSystem& system, Kinematics& kin, double dt) {
   const double t1 = kin.time + dt;
@@ -185,6 +277,10 @@ void NewmarkIntegrator::step_with_cutback(StructuralSystem& system, Kinematics& 
 
 void NewmarkIntegrator::step(StructuralSystem& system, Kinematics& kin, double dt) {
   step_iterations_ = 0;
+  if (const SparseMatrix* k = system.internal_forces().constant_tangent()) {
+    step_constant_tangent(system, kin, *k, dt);
+    return;
+  }
   step_with_cutback(system, kin, dt, 0);
 }
 

@@ -43,6 +43,8 @@ StructuralSolver::StructuralSolver(Model model, SolverOptions options)
               options_.factor_threading),
       newmark_(options_.newmark_beta, options_.newmark_gamma, options_.newton,
                options_.linear_solver, options_.fill_ordering, options_.factor_threading) {
+  newmark_.set_solve_threading(options_.solve_threading);
+  newmark_.set_timings(&timings_);
   {
     // the static runaway test (a limit load where Newton keeps converging): the model's size
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -486,20 +488,11 @@ void StructuralSolver::prescribed_values(double t, Eigen::VectorXd& uc) const {
 
 // ---------------------------------------------------------------- analyses
 
-namespace {
-void factorise_or_throw(SparseFactorisation& f, const SparseMatrix& a, const char* what) {
-  if (!f.factorize(a)) {
-    throw Error(std::string(what) +
-                " is singular or indefinite: the Dirichlet conditions do not prevent rigid-body "
-                "motion (fix more components) or an element is inverted");
-  }
-}
-}  // namespace
 
 void StructuralSolver::solve_static() {
   const auto t0 = Clock::now();
   last_was_static_ = true;
-  if (nonlinear_ != nullptr) {
+  if (uses_newton()) {
     static_.solve(*this, kin_, kin_.time);
     refresh_internal_force();
     update_failures();
@@ -514,7 +507,7 @@ void StructuralSolver::solve_static() {
     static_factor_->set_solve_threading(options_.solve_threading);
     static_factor_->set_factor_threading(options_.factor_threading);
     static_factor_->analyze(k_ff_);
-    factorise_or_throw(*static_factor_, k_ff_, "static stiffness matrix K_ff");
+    factorize_or_throw(*static_factor_, k_ff_, "static stiffness matrix K_ff");
     timings_.factor_nonzeros = static_factor_->factor_nonzeros();
     ++timings_.factorisations;
     timings_.factorisation += seconds_since(t0);
@@ -555,7 +548,7 @@ void StructuralSolver::initialise_acceleration() {
   // M_ff a_f = F_f - (K u + C v)_f   (prescribed accelerations taken as zero)
   evaluate_external_force(kin_.time, kin_.f);
   Eigen::VectorXd r;
-  if (nonlinear_ == nullptr) {
+  if (!uses_newton()) {
     r = kin_.f - k_ * kin_.u;
   } else {
     refresh_internal_force();
@@ -587,104 +580,29 @@ void StructuralSolver::initialise_acceleration() {
   acceleration_valid_ = true;
 }
 
-void StructuralSolver::factorise_dynamic(double dt) {
-  const auto t0 = Clock::now();
-  const double beta = options_.newmark_beta, gamma = options_.newmark_gamma;
-  const double c0 = 1.0 / (beta * dt * dt), c1 = gamma / (beta * dt);
-  // K_eff = K + gamma/(beta dt) C + 1/(beta dt^2) M with C = alpha M + beta_R K
-  const double sk = 1.0 + c1 * options_.rayleigh_beta;
-  const double sm = c0 + c1 * options_.rayleigh_alpha;
-  const SparseMatrix keff_ff = sk * k_ff_ + sm * m_ff_;
-  keff_fc_ = sk * k_fc_ + sm * m_fc_;
-  // symbolic analysis once (the pattern of K_eff does not depend on dt), numeric per dt
-  if (!dynamic_factor_) {
-    dynamic_factor_ =
-        std::make_unique<Factorisation>(options_.linear_solver, options_.fill_ordering);
-    dynamic_factor_->set_solve_threading(options_.solve_threading);
-    dynamic_factor_->set_factor_threading(options_.factor_threading);
-    dynamic_factor_->analyze(keff_ff);
-  }
-  factorise_or_throw(*dynamic_factor_, keff_ff, "effective matrix K_eff");
-  timings_.factor_nonzeros = dynamic_factor_->factor_nonzeros();
-  factor_dt_ = dt;
-  ++timings_.factorisations;
-  timings_.factorisation += seconds_since(t0);
-}
-
 void StructuralSolver::step(double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt))
     throw Error("step(dt): dt must be > 0, got " + std::to_string(dt));
   assemble_mass();
   last_was_static_ = false;
-  if (options_.integrator == Integrator::CentralDifference || nonlinear_ != nullptr) {
-    const auto t0 = Clock::now();
-    if (options_.integrator == Integrator::CentralDifference) {
-      if (!acceleration_valid_) central_.initialise(*this, kin_);
-      acceleration_valid_ = true;
-      central_.step(*this, kin_, dt);
-    } else {
-      if (!acceleration_valid_) initialise_acceleration();
-      newmark_.step(*this, kin_, dt);
-      refresh_internal_force();
-    }
-    update_failures();
-    ++steps_;
-    ++timings_.solves;
-    timings_.solve += seconds_since(t0);
-    return;
-  }
-  if (!acceleration_valid_) initialise_acceleration();
-  // A coupling hands over substeps as differences of absolute times, equal only to the last few
-  // bits: a step within a relative 1e-9 of the factorised one reuses K_eff (and integrates with
-  // the factorised step size h; the clock advances by dt).
-  if (!(factor_dt_ > 0.0) || std::abs(dt - factor_dt_) > 1e-9 * factor_dt_) factorise_dynamic(dt);
-  const double h = factor_dt_;
   const auto t0 = Clock::now();
-  const double beta = options_.newmark_beta, gamma = options_.newmark_gamma;
-  const double c0 = 1.0 / (beta * h * h), c1 = gamma / (beta * h), c2 = 1.0 / (beta * h);
-  const double c3 = 0.5 / beta - 1.0, c4 = gamma / beta - 1.0, c5 = h * (0.5 * gamma / beta - 1.0);
-  const double t1 = kin_.time + dt;
-
-  // work vectors are members: no allocation once sized
-  Work& w = work_;
-  evaluate_external_force(t1, w.f1);
-  // K_eff u1 = F1 + M (c0 u + c2 v + c3 a) + C (c1 u + c4 v + c5 a)
-  w.pm = c0 * kin_.u + c2 * kin_.v + c3 * kin_.a;
-  w.rhs = w.f1;
-  if (options_.rayleigh_alpha != 0.0 || options_.rayleigh_beta != 0.0) {
-    w.pc = c1 * kin_.u + c4 * kin_.v + c5 * kin_.a;
-    w.pm += options_.rayleigh_alpha * w.pc;
-    w.rhs.noalias() += m_ * w.pm;
-    if (options_.rayleigh_beta != 0.0) {
-      w.pc *= options_.rayleigh_beta;
-      w.rhs.noalias() += k_ * w.pc;
-    }
+  const double factorisation_before = timings_.factorisation;
+  if (options_.integrator == Integrator::CentralDifference) {
+    if (!acceleration_valid_) central_.initialise(*this, kin_);
+    acceleration_valid_ = true;
+    central_.step(*this, kin_, dt);
   } else {
-    w.rhs.noalias() += m_ * w.pm;
+    // Newmark: K_eff factorised once per step size while the operator's tangent is constant
+    // (the linear path), Newton otherwise
+    if (!acceleration_valid_) initialise_acceleration();
+    newmark_.step(*this, kin_, dt);
+    if (uses_newton()) refresh_internal_force();
   }
-  prescribed_values(t1, w.uc);
-  w.rf.resize(static_cast<Eigen::Index>(dofs_.free_dofs().size()));
-  for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
-    w.rf[static_cast<Eigen::Index>(k)] = w.rhs[dofs_.free_dofs()[k]];
-  if (w.uc.size() > 0 && w.uc.cwiseAbs().maxCoeff() > 0.0) w.rf.noalias() -= keff_fc_ * w.uc;
-  dynamic_factor_->solve(w.rf, w.uf);
-
-  w.u1.resize(kin_.u.size());
-  for (std::size_t k = 0; k < dofs_.free_dofs().size(); ++k)
-    w.u1[dofs_.free_dofs()[k]] = w.uf[static_cast<Eigen::Index>(k)];
-  for (std::size_t k = 0; k < dofs_.constrained_dofs().size(); ++k)
-    w.u1[dofs_.constrained_dofs()[k]] = w.uc[static_cast<Eigen::Index>(k)];
-  // a1 = c0 (u1 - u) - c2 v - c3 a;  v1 = v + h ((1 - gamma) a + gamma a1)
-  w.a1 = c0 * (w.u1 - kin_.u) - c2 * kin_.v - c3 * kin_.a;
-  kin_.v += h * ((1.0 - gamma) * kin_.a + gamma * w.a1);
-  kin_.external_work += 0.5 * (kin_.f + w.f1).dot(w.u1 - kin_.u);
-  kin_.u.swap(w.u1);
-  kin_.a.swap(w.a1);
-  kin_.f.swap(w.f1);
-  kin_.time = t1;
+  update_failures();
   ++steps_;
   ++timings_.solves;
-  timings_.solve += seconds_since(t0);
+  // the step's factorisation (a new step size) is counted in timings_.factorisation
+  timings_.solve += seconds_since(t0) - (timings_.factorisation - factorisation_before);
 }
 
 // ---------------------------------------------------------------- results
@@ -700,7 +618,7 @@ Vec3 StructuralSolver::reaction(const std::string& node_set) const {
   const auto& nodes = mesh().node_set(node_set);
   // r = K u + C v + M a - F  (nonlinear or explicit: f_int(u) for K u)
   Eigen::VectorXd r =
-      (nonlinear_ != nullptr || options_.integrator == Integrator::CentralDifference)
+      (uses_newton() || options_.integrator == Integrator::CentralDifference)
           ? Eigen::VectorXd(kin_.f_int - kin_.f)
           : Eigen::VectorXd(k_ * kin_.u - kin_.f);
   if (mass_ready_) {
@@ -809,7 +727,7 @@ double StructuralSolver::energy_balance() const {
 }
 
 int StructuralSolver::newton_iterations() const {
-  if (nonlinear_ == nullptr) return 0;
+  if (!uses_newton()) return 0;
   if (last_was_static_) {
     int n = 0;
     for (const auto& r : static_.reports()) n += r.iterations;
@@ -1048,7 +966,7 @@ SolverState StructuralSolver::save_state() const {
   s.face_tractions = face_tractions_;
   s.nodal_force_nodes = nodal_force_nodes_;
   s.nodal_forces = nodal_forces_;
-  s.factor_dt = factor_dt_;
+  s.factor_dt = newmark_.factor_dt();
   return s;
 }
 
@@ -1076,9 +994,9 @@ void StructuralSolver::restore_state(const SolverState& s) {
   nodal_forces_ = s.nodal_forces;
   // A state from another process (a restart file) carries the step size the factorisation was
   // made for; the same h gives the same K_eff and the same steps, bit for bit.
-  if (s.factor_dt > 0.0 && s.factor_dt != factor_dt_) {
+  if (s.factor_dt > 0.0 && s.factor_dt != newmark_.factor_dt()) {
     assemble_mass();  // K_eff needs M (assembled lazily at the first step)
-    factorise_dynamic(s.factor_dt);
+    newmark_.factorise(*this, s.factor_dt);
   }
   if (nonlinear_ != nullptr && nonlinear_->material().erosion() && mass_ready_) {
     // the eroded elements of this state, not those of the last: the lumped mass again
@@ -1086,7 +1004,7 @@ void StructuralSolver::restore_state(const SolverState& s) {
     assemble_mass();
     central_.invalidate_mass();
   }
-  if (nonlinear_ != nullptr || options_.integrator == Integrator::CentralDifference) {
+  if (uses_newton() || options_.integrator == Integrator::CentralDifference) {
     refresh_internal_force();
   }
 }

@@ -19,6 +19,11 @@ class InternalForceOperator {
   // f_int(u); K_t(u) as well when k != nullptr (k keeps its sparsity pattern once set).
   virtual void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) = 0;
   virtual void commit() = 0;
+  // The flag of a constant tangent: K when f_int(u) = K u with K fixed (linear elasticity), so
+  // that an integrator factorises its matrix once per step size and solves each step with one
+  // right-hand side, as deal.II's and MFEM's steppers do; nullptr (the default) when the tangent
+  // changes with u (Newton). The matrix is referenced: it lives as long as the operator.
+  virtual const SparseMatrix* constant_tangent() const { return nullptr; }
   // The time of the next evaluations: `fraction` of the way from the committed time to t (see
   // OperatorContribution::set_time; integrators call it before evaluating a step). Only time-
   // dependent terms (a moving rigid indenter) use it.

@@ -10,6 +10,7 @@ class LinearElasticOperator final : public InternalForceOperator {
   explicit LinearElasticOperator(const SparseMatrix& k) : k_(k) {}
   void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) override;
   void commit() override {}
+  const SparseMatrix* constant_tangent() const override { return &k_; }
   // eps |(|K| |u|)| of the last evaluate(): the bound of the error of the sum K u.
   double round_off() const override;
   double strain_energy() const override { return energy_; }

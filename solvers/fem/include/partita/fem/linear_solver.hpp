@@ -100,4 +100,8 @@ class SparseFactorisation {
   bool empty_ = false;  // a 0 x 0 matrix
 };
 
+// f.factorize(a), or Error "<what> is singular or indefinite: ..." with what to fix (the
+// Dirichlet conditions leave a rigid-body motion free, or an element is inverted).
+void factorize_or_throw(SparseFactorisation& f, const SparseMatrix& a, const char* what);
+
 }  // namespace partita::fem

@@ -33,7 +33,8 @@ namespace partita::fem {
 // Two paths, chosen from the model:
 //   linear (every region linear elastic, Model::is_linear()): K is assembled once (Hex8 with
 //     incompatible modes) and factorised once per dt; static = one solve, Newmark = one
-//     right-hand side and one pair of triangular solves per step.
+//     right-hand side and one pair of triangular solves per step (NewmarkIntegrator on the
+//     operator's constant tangent).
 //   nonlinear (a region has a MaterialLaw: neo-hooke, j2-plasticity, ...): a NonlinearOperator
 //     (f_int and K_t element by element, quadrature-point history), a StaticIntegrator (Newton
 //     with load stepping and cut-back) and a NewmarkIntegrator (Newton per step, cut-back).
@@ -222,9 +223,16 @@ class StructuralSolver final : private StructuralSystem {
   const FaceOperator& face_operator(const std::string& face) const;
   void update_coupling_force();
   void evaluate_external_force(double t, Eigen::VectorXd& f) const;
-  void prescribed_values(double t, Eigen::VectorXd& uc) const;
+  void prescribed_values(double t, Eigen::VectorXd& uc) const override;
   void initialise_acceleration();
   void refresh_internal_force();
+  // Static and Newmark solve with Newton on the operator (the nonlinear path), not with the
+  // linear path's factorise-once K (or K_eff). The linear path with contributions (central
+  // difference only, linear_sum_) never gets here with another integrator.
+  bool uses_newton() const {
+    return nonlinear_ != nullptr ||
+           (linear_sum_ != nullptr && options_.integrator != Integrator::CentralDifference);
+  }
   // StructuralSystem (what the integrators see)
   const DofPartition& dofs() const override { return dofs_; }
   InternalForceOperator& internal_forces() override { return *operator_; }
@@ -237,7 +245,6 @@ class StructuralSolver final : private StructuralSystem {
   void add_damping_force(const Eigen::VectorXd& v, double sign, Eigen::VectorXd& r) const;
   void external_force(double t, Eigen::VectorXd& f) const override;
   void apply_prescribed(double t, Eigen::VectorXd& u) const override;
-  void factorise_dynamic(double dt);
   // the density element e's mass is built with: the model's times its mass-scaling factor
   double element_density(std::size_t e) const {
     return model_.density(mesh().elements()[e].region) * mass_scale_factor(e);
@@ -259,11 +266,10 @@ class StructuralSolver final : private StructuralSystem {
   std::vector<SpaceTimeFunction> constrained_value_;  // per constrained dof (empty: zero)
 
   // matrices (full and partitioned)
-  SparseMatrix k_, m_, k_ff_, k_fc_, m_ff_, m_fc_, keff_fc_;
+  SparseMatrix k_, m_, k_ff_, k_fc_, m_ff_, m_fc_;
   SparseMatrix k0_;  // nonlinear path with rayleigh_beta > 0: K0 of C = alpha M + beta K0
   bool mass_ready_ = false;
-  std::unique_ptr<Factorisation> static_factor_, dynamic_factor_;
-  double factor_dt_ = -1.0;
+  std::unique_ptr<Factorisation> static_factor_;  // the linear path's K_ff (Newmark's K_eff: newmark_)
   mutable double stable_step_ = -1.0;        // cached stable_time_step()
   mutable std::vector<double> element_omega2_;  // element_frequencies_squared()
   std::vector<double> mass_scale_;              // per element s_e (empty: no mass scaling)
@@ -293,10 +299,6 @@ class StructuralSolver final : private StructuralSystem {
   CentralDifferenceIntegrator central_;
   bool acceleration_valid_ = false;
   bool last_was_static_ = false;  // newton_iterations(): of solve_static() or of step()
-  struct Work {                   // vectors of a dynamic step, kept between steps
-    Eigen::VectorXd f1, pm, pc, rhs, uc, rf, uf, u1, a1;
-  };
-  Work work_;
 
   SolverTimings timings_;
   // node_detached(): each node's elements (built at the first call)

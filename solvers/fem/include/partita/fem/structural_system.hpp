@@ -26,6 +26,8 @@ class StructuralSystem {
   virtual void external_force(double t, Eigen::VectorXd& f) const = 0;
   // Writes g(t) into the constrained entries of u.
   virtual void apply_prescribed(double t, Eigen::VectorXd& u) const = 0;
+  // g(t) alone, one value per constrained dof (DofPartition::constrained_dofs() order).
+  virtual void prescribed_values(double t, Eigen::VectorXd& uc) const = 0;
 };
 
 // The evolving kinematic state an integrator advances, and its energy bookkeeping.
