@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "partita/adapters/material_law_plugins.hpp"
 #include "partita/run/case_run.hpp"
 #include "partita/coupling/plugin.hpp"
 #include "partita/interface/error.hpp"
@@ -143,7 +144,6 @@ void Plugins::load(const fs::path& library, const std::string& named_by) {
   } catch (const std::exception& e) {
     throw Error(who + ": registering its entries failed: " + e.what());
   }
-  std::vector<std::string> names;
   for_each_pair(added, registries_, [&](const auto& from, const auto& into) {
     for (const auto& e : from.entries()) {
       const std::string k = key(from, e.name);
@@ -152,6 +152,12 @@ void Plugins::load(const fs::path& library, const std::string& named_by) {
                     "; names must be unique (rename one of them)");
     }
   });
+  // material laws of the FE solver: an optional second entry point
+  // (partita/adapters/material_laws.hpp), added once the names above are known to be free
+  std::vector<std::string> names;
+  if (void* laws = dlsym(handle, PARTITA_PLUGIN_MATERIAL_LAWS_SYMBOL))
+    for (const auto& law : adapters::add_plugin_material_laws(laws, who))
+      names.push_back("material law '" + law + "'");
   for_each_pair(added, registries_, [&](const auto& from, auto& into) {
     for (const auto& e : from.entries()) {
       // the one-line doc says where the entry comes from (partita list, partita docs NAME)
