@@ -281,8 +281,6 @@ std::shared_ptr<Spec> make_spec() {
   return s;
 }
 
-const std::vector<std::string> kFaces = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
-
 Mesh rectangle(const Node& g, const std::string& name) {
   const Eigen::Vector3d o = g.vec3("origin");
   const auto size = g.reals("size");
@@ -983,116 +981,6 @@ std::string DemAdapter::particle_astray(bool restored) const {
       "diverging; if the particle may go that far, raise the participant's key lost_margin",
       p.id[i], x.x(), x.y(), x.z(), out, domain_lo_.x(), domain_lo_.y(), domain_lo_.z(),
       domain_hi_.x(), domain_hi_.y(), domain_hi_.z(), lost_margin_);
-}
-
-std::vector<MonitorValue> DemAdapter::monitors() const {
-  return monitor_values({});
-}
-
-// names empty: all quantities. Those that take a pass over every particle or pair (the kinetic
-// energy, the mass, the contacts, the stable step) are computed only when asked for: the core asks
-// each window for what the case records.
-std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::string>& names) const {
-  auto wanted = [&](const std::string& n) {
-    return names.empty() || std::find(names.begin(), names.end(), n) != names.end();
-  };
-  std::vector<MonitorValue> v;
-  if (wanted("kinetic_energy")) v.push_back({"kinetic_energy", "J", system_.kinetic_energy()});
-  v.push_back({"particles", "", static_cast<double>(system_.particle_count())});
-  if (wanted("mass")) {
-    double mass = 0.0;
-    for (const double m : system_.particles().mass) mass += m;
-    v.push_back({"mass", "kg", mass});
-  }
-  if (wanted("momentum_x") || wanted("momentum_y") || wanted("momentum_z")) {
-    const Eigen::Vector3d m = system_.linear_momentum();
-    v.push_back({"momentum_x", "kg m/s", m.x()});
-    v.push_back({"momentum_y", "kg m/s", m.y()});
-    v.push_back({"momentum_z", "kg m/s", m.z()});
-  }
-  if (wanted("contacts_per_particle"))
-    v.push_back({"contacts_per_particle", "", system_.mean_contacts_per_particle()});
-  // the DEM's energy accounting (dem::System::energies(), cumulative since the first step; with
-  // energy_accounting: true)
-  const dem::System::Energies& en = system_.energies();
-  const bool energies = system_.energy_tracking();
-  if (energies) {
-  v.push_back({"friction_work", "J", en.friction});
-  v.push_back({"damping_work", "J", en.damping});
-  v.push_back({"breakage_energy", "J", en.breakage});
-  v.push_back({"stiffening_work", "J", en.stiffening});
-  v.push_back({"gravity_work", "J", en.gravity});
-  double walls_work = 0.0;
-  for (const double w : en.wall_work) walls_work += w;
-  for (const double w : en.mesh_work) walls_work += w;
-  v.push_back({"wall_work", "J", walls_work});
-  if (wanted("elastic_energy")) v.push_back({"elastic_energy", "J", system_.elastic_energy()});
-  if (wanted("energy_balance_error"))
-    v.push_back({"energy_balance_error", "", system_.energy_balance_error()});
-  }
-  const char* xyz[] = {"x", "y", "z"};
-  for (const auto& m : meshes_dem_) {
-    const Eigen::Vector3d f = system_.mesh_force(m.id);
-    for (int k = 0; k < 3; ++k) v.push_back({m.name + ".force_" + xyz[k], "N", f(k)});
-    const auto id = static_cast<std::size_t>(m.id);
-    if (energies)
-      v.push_back({m.name + ".work", "J", id < en.mesh_work.size() ? en.mesh_work[id] : 0.0});
-  }
-  for (const auto& w : walls_) {
-    const Eigen::Vector3d f = system_.wall_force(w.id);
-    for (int k = 0; k < 3; ++k) v.push_back({w.name + ".force_" + xyz[k], "N", f(k)});
-    const auto id = static_cast<std::size_t>(w.id);
-    if (energies)
-      v.push_back({w.name + ".work", "J", id < en.wall_work.size() ? en.wall_work[id] : 0.0});
-    for (int face = 0; face < 6; ++face)  // a box wall's closed faces, each on its own
-      if (w.faces & (1u << face)) {
-        const Eigen::Vector3d ff =
-            system_.wall_face_force(w.id, face).value_or(Eigen::Vector3d(0.0, 0.0, 0.0));
-        for (int k = 0; k < 3; ++k)
-          v.push_back({w.name + "." + kFaces[static_cast<std::size_t>(face)] + ".force_" + xyz[k],
-                       "N", ff(k)});
-      }
-  }
-  if (!tracked_.empty()) {
-    const dem::Particles& p = system_.particles();
-    static constexpr const char* kState[] = {"x", "y", "z", "vx", "vy", "vz"};
-    for (std::size_t k = 0; k < tracked_.size(); ++k) {
-      const std::string prefix = "particle." + std::to_string(tracked_[k]) + ".";
-      bool asked = names.empty();
-      for (int c = 0; c < 6 && !asked; ++c) asked = wanted(prefix + kState[c]);
-      if (!asked) continue;
-      std::size_t& i = tracked_index_[k];
-      if (i >= p.size() || p.id[i] != tracked_[k])  // renumbered (or removed): find it again
-        i = static_cast<std::size_t>(std::find(p.id.begin(), p.id.end(), tracked_[k]) -
-                                     p.id.begin());
-      if (i < p.size())
-        for (int c = 0; c < 3; ++c) {
-          tracked_last_[k][static_cast<std::size_t>(c)] = p.position[i][c];
-          tracked_last_[k][static_cast<std::size_t>(c + 3)] = p.velocity[i][c];
-        }
-      for (int c = 0; c < 6; ++c)
-        v.push_back({prefix + kState[c], c < 3 ? "m" : "m/s",
-                     tracked_last_[k][static_cast<std::size_t>(c)]});
-    }
-  }
-  if (const dem::Breakage* b = breakage()) {
-    const dem::BreakageCounters& c = b->counters();
-    v.push_back({"breakage.events", "", static_cast<double>(c.events)});
-    v.push_back({"breakage.fragments", "", static_cast<double>(c.fragments)});
-    v.push_back({"breakage.fragment_mass", "kg", c.fragment_mass});
-    v.push_back({"breakage.mass_lost", "kg", c.mass_lost});
-    v.push_back({"breakage.mass_restored", "kg", c.mass_restored});
-    v.push_back({"breakage.energy_released", "J", c.energy_released});
-    v.push_back({"breakage.powder_events", "", static_cast<double>(c.powder_events)});
-    v.push_back({"breakage.powder_mass", "kg", c.powder_mass});
-    v.push_back({"breakage.powder_energy", "J", c.powder_energy});
-    if (wanted("stable_time_step")) v.push_back({"stable_time_step", "s", stable_time_step()});
-  }
-  if (names.empty()) return v;
-  std::vector<MonitorValue> out;
-  for (auto& m : v)
-    if (wanted(m.name)) out.push_back(m);
-  return out;
 }
 
 }  // namespace partita::adapters

@@ -40,12 +40,14 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "partita/dem/breakage.hpp"
 #include "partita/dem/packing_generator.hpp"
 #include "partita/dem/system.hpp"
 #include "partita/interface/interface_work.hpp"
+#include "partita/interface/monitor_table.hpp"
 #include "partita/interface/solver.hpp"
 #include "partita/interface/time_table.hpp"
 
@@ -78,6 +80,11 @@ class DemAdapter : public Solver {
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);
+  /// The monitor quantities: their docs (registration) and values (dem_monitors.cpp).
+  static const MonitorTable<DemAdapter>& monitor_table();
+  /// The faces of a box wall, bit k of Wall::faces: kFaces[k].
+  static constexpr std::array<std::string_view, 6> kFaces = {"xmin", "xmax", "ymin",
+                                                             "ymax", "zmin", "zmax"};
 
  private:
   struct CouplingMesh {

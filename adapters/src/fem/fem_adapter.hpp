@@ -32,6 +32,7 @@
 #include "partita/fem/fem.hpp"
 #include "mesh_locator.hpp"
 #include "partita/interface/interface_work.hpp"
+#include "partita/interface/monitor_table.hpp"
 #include "partita/interface/solver.hpp"
 
 namespace partita::adapters {
@@ -60,6 +61,8 @@ class FemAdapter : public Solver {
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);
+  /// The monitor quantities: their docs (registration) and values (fem_monitors.cpp).
+  static const MonitorTable<FemAdapter>& monitor_table();
 
  private:
   struct Interface {

@@ -93,37 +93,6 @@ void apply_box_regions(fem::Mesh& mesh, const Node& box) {
   }
 }
 
-void append_rupture_monitors(const fem::StructuralSolver& solver,
-                             const std::function<bool(const std::string&)>& wanted,
-                             std::vector<MonitorValue>& out) {
-  out.push_back({"failed_elements", "", static_cast<double>(solver.failed_elements())});
-  // -1 until an element fails (a monitor value must be finite: the core takes a non-finite one
-  // for a diverging run)
-  if (wanted("first_failure_time")) {
-    const auto first = solver.first_failure();
-    out.push_back({"first_failure_time", "s", first ? first->time : -1.0});
-  }
-  if (wanted("eroded_energy")) out.push_back({"eroded_energy", "J", solver.eroded_energy()});
-  // the reduced Hex8's enhanced-strain update: dissipated (0 without reduced Hex8)
-  if (wanted("enhanced_strain_work"))
-    out.push_back({"enhanced_strain_work", "J", solver.enhanced_strain_work()});
-  if (wanted("max_equivalent_plastic_strain"))
-    out.push_back({"max_equivalent_plastic_strain", "", solver.max_equivalent_plastic_strain()});
-  const auto& regions = solver.mesh().region_names();
-  if (regions.size() < 2) return;
-  bool any = false;
-  for (const auto& r : regions)
-    for (const char* q : {".plastic_work", ".strain_energy", ".kinetic_energy"})
-      any = any || wanted(r + q);
-  if (!any) return;
-  const fem::RegionEnergies e = solver.region_energies();  // one pass over the elements
-  for (std::size_t i = 0; i < regions.size(); ++i) {
-    out.push_back({regions[i] + ".plastic_work", "J", e.plastic_work[i]});
-    out.push_back({regions[i] + ".strain_energy", "J", e.strain_energy[i]});
-    out.push_back({regions[i] + ".kinetic_energy", "J", e.kinetic_energy[i]});
-  }
-}
-
 void FailureLog::after_step(const fem::StructuralSolver& solver, const std::string& participant) {
   const std::size_t n = solver.failed_elements();
   if (n == count_) return;

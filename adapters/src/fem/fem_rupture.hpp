@@ -4,9 +4,9 @@
 //                       necking_strain, erosion}: fem::FailureCriterion
 //   mesh.box.regions   [{name, from, to}]: element regions of a box mesh (elements whose centre
 //                       lies in the box [from, to]; the rest stay in "all")
-// Monitors: failed_elements, first_failure_time [s] (-1 until an element fails),
-// eroded_energy [J], max_equivalent_plastic_strain, and with two or more regions
-// <region>.plastic_work | strain_energy | kinetic_energy [J].
+// Their monitors (declared in fem_monitors.cpp): failed_elements, first_failure_time [s] (-1
+// until an element fails), eroded_energy [J], max_equivalent_plastic_strain, and with two or more
+// regions <region>.plastic_work | strain_energy | kinetic_energy [J].
 
 #include <functional>
 #include <memory>
@@ -28,9 +28,6 @@ fem::FailureCriterion build_failure_criterion(const config::Node& material);
 void check_failure_keys(const config::Node& material, bool explicit_dynamics);
 // mesh.box.regions onto a box mesh (a region that holds no element is an error at its key).
 void apply_box_regions(fem::Mesh& mesh, const config::Node& box);
-void append_rupture_monitors(const fem::StructuralSolver& solver,
-                             const std::function<bool(const std::string&)>& wanted,
-                             std::vector<MonitorValue>& out);
 
 // Logs the first failed element (part, element, centre, time) once, at info level, and the
 // count of failed elements at debug level when it grows.

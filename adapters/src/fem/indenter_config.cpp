@@ -310,26 +310,4 @@ void write_indenter_vtp(const std::filesystem::path& file, const InterfaceMesh& 
             options);
 }
 
-void add_indenter_monitors(const std::string& name, const Eigen::Vector3d& reference,
-                           const fem::IndenterContact& contact, std::vector<MonitorValue>& out) {
-  const fem::RigidIndenter& body = contact.indenter();
-  static const char* kAxes[3] = {"x", "y", "z"};
-  const Eigen::Vector3d x = reference + body.displacement();
-  for (int k = 0; k < 3; ++k) out.push_back({name + "." + kAxes[k], "m", x[k]});
-  for (int k = 0; k < 3; ++k) out.push_back({name + ".v" + kAxes[k], "m/s", body.velocity()[k]});
-  for (int k = 0; k < 3; ++k)
-    out.push_back({name + ".force_" + kAxes[k], "N", contact.contact_force()[k]});
-  out.push_back({name + ".penetration", "m", body.penetration()});
-  out.push_back({name + ".work", "J", body.work()});
-  if (body.is_free()) {  // the forces handed over by the coupling on its surface
-    for (int k = 0; k < 3; ++k)
-      out.push_back({name + ".external_force_" + kAxes[k], "N", body.external_force()[k]});
-    out.push_back({name + ".external_work", "J", body.external_work()});
-  }
-  out.push_back({name + ".kinetic_energy", "J", body.kinetic_energy()});  // 0 when driven
-  out.push_back({name + ".contact_energy", "J", contact.stored_energy()});
-  out.push_back({name + ".friction_work", "J", contact.dissipated_work()});
-  out.push_back({name + ".contact_nodes", "", static_cast<double>(contact.active_nodes())});
-}
-
 }  // namespace partita::adapters

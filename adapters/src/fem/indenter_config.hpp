@@ -10,9 +10,11 @@
 //     - {name: ball, shape: sphere, radius: 0.05, position: [..], face: zmax,
 //        motion: {mass: 2, velocity: [0, 0, -3], gravity: [0, 0, -9.81]}}   # free
 //
-// Monitors per indenter N: N.x|y|z (its reference point: `position` plus its displacement),
-// N.vx|vy|vz, N.force_x|y|z (the contact force on it), N.penetration, N.work (done on the
-// structure), N.contact_energy (penalty springs), N.friction_work (dissipated), N.contact_nodes.
+// Monitors per indenter N (declared in fem_monitors.cpp): N.x|y|z (its reference point:
+// `position` plus its displacement), N.vx|vy|vz, N.force_x|y|z (the contact force on it),
+// N.penetration, N.work (done on the structure), N.external_force_x|y|z and N.external_work (a
+// free indenter), N.kinetic_energy, N.contact_energy (penalty springs), N.friction_work
+// (dissipated), N.contact_nodes.
 
 #include <filesystem>
 #include <memory>
@@ -49,9 +51,5 @@ IndenterBuild build_indenter(const config::Node& node, const fem::Model& model,
 // series <participant>_<name>).
 void write_indenter_vtp(const std::filesystem::path& file, const InterfaceMesh& surface,
                         const fem::IndenterContact& contact, const vtk::Options& options);
-
-// The monitor quantities of one indenter (see the file comment).
-void add_indenter_monitors(const std::string& name, const Eigen::Vector3d& reference,
-                           const fem::IndenterContact& contact, std::vector<MonitorValue>& out);
 
 }  // namespace partita::adapters

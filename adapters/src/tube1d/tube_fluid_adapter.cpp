@@ -77,11 +77,21 @@ void TubeFluidAdapter::read_restart(BinaryReader& in) {
   flow_.set_state(s);
 }
 
-std::vector<MonitorValue> TubeFluidAdapter::monitors() const {
-  const auto& p = flow_.pressure();
-  return {{"inlet_pressure", "Pa", p(0)},
-          {"outlet_pressure", "Pa", p(p.size() - 1)},
-          {"inlet_velocity", "m/s", flow_.velocity()(0)}};
+const MonitorTable<TubeFluidAdapter>& TubeFluidAdapter::monitor_table() {
+  static const MonitorTable<TubeFluidAdapter> table = [] {
+    using A = TubeFluidAdapter;
+    MonitorTable<A> t;
+    t.scalar("inlet_pressure", "Pa", "pressure in the first cell",
+             [](const A& a) { return a.flow_.pressure()(0); });
+    t.scalar("outlet_pressure", "Pa", "pressure in the last cell", [](const A& a) {
+      const auto& p = a.flow_.pressure();
+      return p(p.size() - 1);
+    });
+    t.scalar("inlet_velocity", "m/s", "velocity in the first cell",
+             [](const A& a) { return a.flow_.velocity()(0); });
+    return t;
+  }();
+  return table;
 }
 
 std::shared_ptr<const config::Spec> TubeFluidAdapter::spec() {

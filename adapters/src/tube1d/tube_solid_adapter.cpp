@@ -66,9 +66,19 @@ void TubeSolidAdapter::read_restart(BinaryReader& in) {
   wall_.set_state(p, a, t);
 }
 
-std::vector<MonitorValue> TubeSolidAdapter::monitors() const {
-  const auto& a = wall_.area();
-  return {{"mid_area", "m^2", a(a.size() / 2)}, {"max_area", "m^2", a.maxCoeff()}};
+const MonitorTable<TubeSolidAdapter>& TubeSolidAdapter::monitor_table() {
+  static const MonitorTable<TubeSolidAdapter> table = [] {
+    using A = TubeSolidAdapter;
+    MonitorTable<A> t;
+    t.scalar("mid_area", "m^2", "cross-section area at the middle of the tube", [](const A& a) {
+      const auto& area = a.wall_.area();
+      return area(area.size() / 2);
+    });
+    t.scalar("max_area", "m^2", "largest cross-section area",
+             [](const A& a) { return a.wall_.area().maxCoeff(); });
+    return t;
+  }();
+  return table;
 }
 
 std::shared_ptr<const config::Spec> TubeSolidAdapter::spec() {

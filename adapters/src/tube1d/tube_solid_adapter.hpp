@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "partita/interface/monitor_table.hpp"
 #include "partita/interface/solver.hpp"
 #include "partita/tube1d/tube_wall.hpp"
 
@@ -27,10 +28,15 @@ class TubeSolidAdapter : public Solver {
   void write_restart(BinaryWriter& out) const override;
   void read_restart(BinaryReader& in) override;
   std::vector<std::pair<std::string, std::string>> output_files() const override { return files_; }
-  std::vector<MonitorValue> monitors() const override;
+  std::vector<MonitorValue> monitors() const override { return monitor_values({}); }
+  std::vector<MonitorValue> monitor_values(const std::vector<std::string>& names) const override {
+    return monitor_table().values(*this, names);
+  }
 
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);
+  /// The monitor quantities: their docs (registration) and values.
+  static const MonitorTable<TubeSolidAdapter>& monitor_table();
 
  private:
   tube1d::TubeWall wall_;
