@@ -78,6 +78,7 @@ class DemAdapter : public Solver {
   std::optional<double> interface_work(std::string_view mesh) const override;
   void finalize() override;
 
+  /// The participant's keys (dem_schema.cpp); the adapter is built from them (dem_build.cpp).
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);
   /// The monitor quantities: their docs (registration) and values (dem_monitors.cpp).
@@ -106,6 +107,8 @@ class DemAdapter : public Solver {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // times table(t)
     TimeTable table;
   };
+  /// One entry of `materials` (dem_schema.cpp).
+  static std::shared_ptr<const config::Spec> material_spec();
   /// Index into meshes_dem_ of the coupling mesh `mesh` (vertices or centres); throws if unknown.
   std::size_t find(std::string_view mesh, bool* centres) const;
   void add_breakage(const config::Node& breakage);
