@@ -59,8 +59,11 @@ class FemAdapter : public Solver {
   std::vector<MonitorValue> monitor_values(const std::vector<std::string>& names) const override;
   std::optional<double> interface_work(std::string_view mesh) const override;
 
+  /// The participant's keys (fem_schema.cpp); the adapter is built from them (fem_build.cpp).
   static std::shared_ptr<const config::Spec> spec();
   static std::unique_ptr<Solver> create(const SolverContext& context);
+  /// The names of the components, as constraints and loads spell them.
+  static inline const std::vector<std::string> kComponents = {"x", "y", "z"};
   /// The monitor quantities: their docs (registration) and values (fem_monitors.cpp).
   static const MonitorTable<FemAdapter>& monitor_table();
 
@@ -84,6 +87,8 @@ class FemAdapter : public Solver {
     bool has_forces_checkpoint = false;
     bool has_tractions_checkpoint = false;
   };
+  /// A solver error with the case file's keys named where the solver names a Newton option.
+  static std::string with_newton_keys(const std::string& what);
   enum class Part { nodes, quadrature, centres };  // the meshes N, N_quadrature, N_centres
   /// Index into interfaces_ of the coupling mesh `mesh` (and which of its meshes); throws if
   /// unknown.
