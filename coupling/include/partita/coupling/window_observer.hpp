@@ -3,9 +3,10 @@
 // finished window to each observer in the order it registered them; the initial state (after
 // the scheme's initialisation, before the first window) is handed over as window 0. An observer
 // may stop the run by throwing partita::Error (a diagnosis); the observers after it then do not
-// see that window. The case runner's observers (partita::run), in their order: the balance audit,
-// the health check, coupling.csv, the monitors, the energy balance, the energy audit, the VTK
-// output, the stop requests (signals), the restart files and the CSV flushes.
+// see that window. The case runner's services observe its windows this way (partita::run,
+// service.hpp), in their order: the balance audit, the divergence stop, coupling.csv, the
+// monitors, the energy balance, the energy audit, the VTK output, the stop requests (signals),
+// the restart files, the CSV flushes and the progress line.
 
 #include <cstdint>
 
