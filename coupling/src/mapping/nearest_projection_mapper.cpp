@@ -8,8 +8,8 @@
 
 #include <Eigen/Cholesky>
 
-#include "closest_point.hpp"
 #include "local_frame.hpp"
+#include "partita/geometry/closest_point.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "point_tree.hpp"
@@ -96,7 +96,8 @@ SparseMapper::Matrix NearestProjectionMapper::project(const Mesh& source,
       const Eigen::Index t = static_cast<Eigen::Index>(t32);
       if (!usable[static_cast<std::size_t>(t)]) continue;
       const Eigen::Vector3d a = x.row(tri(t, 0)), b = x.row(tri(t, 1)), c = x.row(tri(t, 2));
-      const Eigen::Vector3d l = closest_point_barycentric(p, a, b, c);
+      const geometry::TriangleClosestPoint q = geometry::closest_point_on_triangle(p, a, b, c);
+      const Eigen::Vector3d l(q.barycentric[0], q.barycentric[1], q.barycentric[2]);
       const double d2 = (l(0) * a + l(1) * b + l(2) * c - p).squaredNorm();
       if (d2 < best || (d2 == best && t < best_t)) {
         best = d2;

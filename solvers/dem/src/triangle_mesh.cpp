@@ -161,55 +161,9 @@ bool TriangleMesh::feature_is_local_closest(int t, const TriangleClosestPoint& c
 }
 
 TriangleClosestPoint TriangleMesh::closest_point(int t, const Eigen::Vector3d& p) const {
-  const Eigen::Vector3d& a = position_[triangles_[t][0]];
-  const Eigen::Vector3d& b = position_[triangles_[t][1]];
-  const Eigen::Vector3d& c = position_[triangles_[t][2]];
-  TriangleClosestPoint r;
-  // Voronoi regions of the vertices, edges and face, tested in turn.
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) {
-    r.point = a, r.barycentric = {1.0, 0.0, 0.0}, r.feature = r.vertex, r.local_index = 0;
-    return r;
-  }
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) {
-    r.point = b, r.barycentric = {0.0, 1.0, 0.0}, r.feature = r.vertex, r.local_index = 1;
-    return r;
-  }
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    const double v = d1 / (d1 - d3);
-    r.point = a + v * ab, r.barycentric = {1.0 - v, v, 0.0}, r.feature = r.edge;
-    r.local_index = 0;
-    return r;
-  }
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) {
-    r.point = c, r.barycentric = {0.0, 0.0, 1.0}, r.feature = r.vertex, r.local_index = 2;
-    return r;
-  }
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    const double w = d2 / (d2 - d6);
-    r.point = a + w * ac, r.barycentric = {1.0 - w, 0.0, w}, r.feature = r.edge;
-    r.local_index = 2;
-    return r;
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    r.point = b + w * (c - b), r.barycentric = {0.0, 1.0 - w, w}, r.feature = r.edge;
-    r.local_index = 1;
-    return r;
-  }
-  const double denom = 1.0 / (va + vb + vc);
-  const double v = vb * denom, w = vc * denom;
-  r.point = a + v * ab + w * ac, r.barycentric = {1.0 - v - w, v, w}, r.feature = r.face;
-  r.local_index = 0;
-  return r;
+  return geometry::closest_point_on_triangle(p, position_[triangles_[t][0]],
+                                             position_[triangles_[t][1]],
+                                             position_[triangles_[t][2]]);
 }
 
 void TriangleMesh::write_state(BinaryWriter& out) const {

@@ -8,35 +8,9 @@
 #include <utility>
 
 #include "partita/fem/error.hpp"
+#include "partita/geometry/closest_point.hpp"
 
 namespace partita::fem {
-namespace {
-
-// The closest point of triangle (a, b, c) to p, and the feature it lies on: 0-2 the vertices
-// a, b, c; 3-5 the edges ab, bc, ca; 6 the face (Ericson, Real-Time Collision Detection, 2005,
-// section 5.1.5).
-Vec3 closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, int& feature) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return feature = 0, a;
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return feature = 1, b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return feature = 3, Vec3(a + d1 / (d1 - d3) * ab);
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return feature = 2, c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return feature = 5, Vec3(a + d2 / (d2 - d6) * ac);
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
-    return feature = 4, Vec3(b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b));
-  const double denom = 1.0 / (va + vb + vc);
-  return feature = 6, Vec3(a + ab * (vb * denom) + ac * (vc * denom));
-}
-
-}  // namespace
 
 TriangulatedShape::TriangulatedShape(std::vector<Vec3> vertices,
                                      std::vector<std::array<int, 3>> triangles,
@@ -151,17 +125,18 @@ ShapeDistance TriangulatedShape::distance(const Vec3& x) const {
   for (std::size_t k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
     const int t = cells_[k];
     const auto& tri = triangles_[static_cast<std::size_t>(t)];
-    int feature = 6;
-    const Vec3 c = closest_on_triangle(x, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]], feature);
-    const double d2 = (x - c).squaredNorm();
+    const geometry::TriangleClosestPoint c =
+        geometry::closest_point_on_triangle(x, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]);
+    const double d2 = (x - c.point).squaredNorm();
     if (d2 < best) {
       best = d2;
-      closest = c;
+      closest = c.point;
       best_t = t;
       const auto tt = static_cast<std::size_t>(t);
-      pseudo = feature < 3   ? vertex_normal_[tri[feature]]
-               : feature < 6 ? edge_normal_[tt][feature - 3]
-                             : face_normal_[tt];
+      // the pseudo-normal of the feature: vertex k, edge k (ab, bc, ca) or the face
+      pseudo = c.feature == c.vertex ? vertex_normal_[tri[c.local_index]]
+               : c.feature == c.edge ? edge_normal_[tt][c.local_index]
+                                     : face_normal_[tt];
     }
   }
   const double d = std::sqrt(best);

@@ -12,16 +12,12 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "partita/geometry/closest_point.hpp"
+
 namespace partita::dem {
 
-/// Closest point of a triangle to a point, with the feature it lies on.
-struct TriangleClosestPoint {
-  enum Feature { face = 0, edge = 1, vertex = 2 };
-  Eigen::Vector3d point;
-  std::array<double, 3> barycentric;  ///< weights of the triangle's vertices 0, 1, 2
-  Feature feature = face;
-  int local_index = 0;  ///< edge 0 (v0v1), 1 (v1v2), 2 (v2v0) or vertex 0..2
-};
+/// Closest point of a triangle to a point, with the feature it lies on (partita::geometry).
+using TriangleClosestPoint = geometry::TriangleClosestPoint;
 
 class TriangleMesh {
  public:
