@@ -38,6 +38,7 @@
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/version.hpp"
+#include "after_run.hpp"
 #include "distributed.hpp"
 #include "plugin_loader.hpp"
 #include "process.hpp"
@@ -79,59 +80,6 @@ void for_each_registry(const Registries& r, F&& f) {
   f("schemes", r.schemes);
   f("accelerations", r.accelerations);
   f("convergence measures", r.convergence_measures);
-}
-
-// PNG plots of the run's CSV time series, drawn by the bundled matplotlib script. A missing
-// python3/matplotlib costs the plots only, never the run.
-void plot_csv_files(const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  std::vector<std::string> csvs;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.path().extension() == ".csv") csvs.push_back(e.path().string());
-  if (csvs.empty()) return;
-  std::sort(csvs.begin(), csvs.end());
-  fs::path script = PARTITA_PLOT_SCRIPT;
-  if (!fs::exists(script))
-    script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_monitors.py";
-  if (!fs::exists(script)) return;
-  std::vector<std::string> args = {partita::app::python_interpreter(), script.string()};
-  args.insert(args.end(), csvs.begin(), csvs.end());
-  if (partita::app::run_program(args) != 0)
-    partita::log::get("app")->warn(
-        "plotting the CSV files failed (is python3-matplotlib installed?)");
-  else
-    partita::log::get("app")->info("plots: {}/*.png", dir.string());
-}
-
-// Whether a run draws the PNG plots of its CSV files: not with --no-plots, nor with
-// PARTITA_NO_PLOTS=1 in the environment (the test suite sets it: its tests read the CSV files,
-// not the pictures, and the plots cost 2-4 s of python per short run). An unknown value warns
-// and draws them, as PARTITA_LOG_LEVEL does.
-bool plots_wanted(bool no_plots_option) {
-  if (no_plots_option) return false;
-  const char* env = std::getenv("PARTITA_NO_PLOTS");
-  if (env == nullptr || *env == '\0') return true;
-  const std::string v = env;
-  for (const char* off : {"1", "true", "yes", "on"})
-    if (v == off) return false;
-  for (const char* on : {"0", "false", "no", "off"})
-    if (v == on) return true;
-  partita::log::get("app")->warn(
-      "PARTITA_NO_PLOTS='{}' is not a switch (allowed: 1, true, yes, on: no plots; 0, false, no, "
-      "off or empty: plots); drawing the plots",
-      v);
-  return true;
-}
-
-// The case's post-processing scripts (output.scripts), with the output folder as argument.
-void run_scripts(const std::vector<std::filesystem::path>& scripts,
-                 const std::filesystem::path& dir) {
-  for (const auto& s : scripts) {
-    partita::log::get("app")->info("post-processing: {}", s.filename().string());
-    if (partita::app::run_program({partita::app::python_interpreter(), s.string(), dir.string()}) !=
-        0)
-      partita::log::get("app")->warn("post-processing script {} failed", s.string());
-  }
 }
 
 int list(const Registries& r) {
@@ -300,10 +248,10 @@ int main(int argc, char** argv) {
                      "the case against the exchanges that name it\n";
       return 0;
     }
-    const bool plots = plots_wanted(no_plots);
+    const bool plots = partita::app::plots_wanted(no_plots);
     auto finish = [&](const std::filesystem::path& dir) {
       if (plots)
-        plot_csv_files(dir);
+        partita::app::plot_csv_files(dir);
       else
         partita::log::get("app")->debug("plots: not drawn (--no-plots or PARTITA_NO_PLOTS)");
     };
@@ -322,7 +270,7 @@ int main(int argc, char** argv) {
       d.install_stop_handlers = install_stop_handlers;
       d.on_finished = [&](const partita::run::CaseRun& c) {
         finish(c.output_dir());
-        run_scripts(c.scripts(), c.output_dir());
+        partita::app::run_scripts(c.scripts(), c.output_dir());
         std::cout << "partita run: finished; output in " << c.output_dir().string() << "/\n";
       };
       return partita::app::run_distributed(registries, d);
@@ -361,7 +309,7 @@ int main(int argc, char** argv) {
       std::cout << "\n";
       return 128 + signal;
     }
-    run_scripts(c.scripts(), c.output_dir());
+    partita::app::run_scripts(c.scripts(), c.output_dir());
     // name only what is there: a case may write no VTK (no output.vtk, or no participant with
     // a mesh to show)
     bool vtk = false;

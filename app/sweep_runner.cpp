@@ -12,6 +12,7 @@
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/output.hpp"
+#include "after_run.hpp"
 #include "process.hpp"
 
 namespace partita::app {
@@ -62,7 +63,8 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
                root.string("case"), variants.size(), dir.string(), jobs, threads,
                threads == 1 ? "" : "s");
 
-  const std::string self = fs::canonical("/proc/self/exe").string();
+  const std::string self = options.executable.empty() ? fs::canonical("/proc/self/exe").string()
+                                                      : options.executable.string();
   std::vector<std::string> status(variants.size());
   std::map<pid_t, std::size_t> running;
   std::size_t next = 0, done = 0, failed = 0;
@@ -138,9 +140,7 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
 
   const bool plot = options.plots && !sweep.plot_monitor().empty();
   if (plot) {
-    fs::path script = PARTITA_SWEEP_PLOT_SCRIPT;
-    if (!fs::exists(script))
-      script = fs::canonical("/proc/self/exe").parent_path() / "../share/partita/plot_sweep.py";
+    const fs::path script = bundled_script("plot_sweep.py");
     std::vector<std::string> args = {python_interpreter(),
                                      script.string(),
                                      "--x",

@@ -23,6 +23,9 @@ struct SweepOptions {
   bool plots = true;  ///< the variants' PNG plots and sweep.png (false: --no-plots)
   std::vector<std::string> plugins;  ///< the --plugin libraries (every variant gets them)
   const std::atomic<int>* stop_signal = nullptr;
+  /// The `partita` executable that runs each variant (empty: this process's own executable,
+  /// /proc/self/exe; a front end in another program names it).
+  std::filesystem::path executable;
 };
 
 /// Whether the case file (with the overrides) declares a sweep.
