@@ -22,13 +22,50 @@ void CaseRun::run() {
   if (options_.check_only) return;
   if (serves()) return serve();
   Stopwatch wall;
+  const bool resumed = start();
+  try {
+    advance_windows(resumed);
+  } catch (...) {
+    for (const auto& s : services_) s->finish(/*failed=*/true);  // the complete rows stay
+    report();
+    throw;
+  }
+  finish(wall);
+}
+
+// The window loop: the scheme advances a window, the services observe it (the initial state of
+// a new run as window 0), until the case's end or a service asks to stop.
+void CaseRun::advance_windows(bool resumed) {
+  auto notify = [&](FinishedWindow& w) {
+    for (const auto& s : services_) s->observe(w);
+  };
+  if (!resumed) {
+    scheme_->initialize();
+    FinishedWindow initial;
+    notify(initial);
+  }
+  for (std::int64_t n = state_->windows_done; n < window_count_; ++n) {
+    const TimeWindow window(window_size_, n, 1);
+    const WindowReport r = scheme_->advance(window);
+    state_->finished(n + 1, r);
+    FinishedWindow w;
+    w.window = n + 1;
+    w.time = window.end();
+    w.report = &r;
+    w.last = n + 1 == window_count_;
+    notify(w);
+    if (w.signal != 0) return stopped_by(w);
+  }
+}
+
+// A new run prepares its folder; a resumed one changes nothing in its folder before the restart
+// file has been read and accepted (resume()). Returns whether the run resumes.
+bool CaseRun::start() {
   const bool resumed = !options_.resume_dir.empty();
   const fs::path resume_file = resumed ? newest_restart_file(output_dir_) : fs::path();
   if (resumed)
     if (const std::string why = restart_blocker(); !why.empty())
       throw Error("cannot resume from " + resume_file.string() + ": " + why);
-  // A resumed run changes nothing in its folder before the restart file has been read and
-  // accepted (resume()); a new run prepares the folder here.
   if (!resumed) prepare_folder();
   build_services();
   if (resumed) resume(resume_file);
@@ -47,46 +84,22 @@ void CaseRun::run() {
       resumed ? fmt::format("; resumed after window {} from {}", state_->windows_done,
                             resume_file.filename().string())
               : std::string());
+  return resumed;
+}
 
-  // The services observe each finished window, also the initial state (window 0).
-  auto notify = [&](FinishedWindow& w) {
-    for (const auto& s : services_) s->observe(w);
-  };
-  try {
-    if (!resumed) {
-      scheme_->initialize();
-      FinishedWindow initial;
-      notify(initial);
-    }
-    for (std::int64_t n = state_->windows_done; n < window_count_; ++n) {
-      const TimeWindow window(window_size_, n, 1);
-      const WindowReport r = scheme_->advance(window);
-      state_->windows_done = n + 1;
-      state_->iterations += r.iterations;
-      state_->max_window_iterations = std::max(state_->max_window_iterations, r.iterations);
-      if (!r.converged) ++state_->unconverged_windows;
-      FinishedWindow w;
-      w.window = n + 1;
-      w.time = window.end();
-      w.report = &r;
-      w.last = n + 1 == window_count_;
-      notify(w);
-      if (w.signal != 0) {
-        summary_.stopped_by_signal = w.signal;
-        report();
-        log::get("coupling")->warn(
-            "stopped by signal {} after window {} (t = {:.6g} s){}", w.signal, n + 1, w.time,
-            summary_.last_restart.empty()
-                ? std::string()
-                : "; continue with: partita run CASE --resume " + output_dir_.string());
-        break;
-      }
-    }
-  } catch (...) {
-    for (const auto& s : services_) s->finish(/*failed=*/true);  // the complete rows stay
-    report();
-    throw;
-  }
+void CaseRun::stopped_by(const FinishedWindow& w) {
+  summary_.stopped_by_signal = w.signal;
+  report();
+  log::get("coupling")->warn(
+      "stopped by signal {} after window {} (t = {:.6g} s){}", w.signal, w.window, w.time,
+      summary_.last_restart.empty()
+          ? std::string()
+          : "; continue with: partita run CASE --resume " + output_dir_.string());
+}
+
+// The end of a run (also one stopped by a signal): the services close their files, the
+// participants finalize, and the wall time is split into its parts.
+void CaseRun::finish(const Stopwatch& wall) {
   scheme_->stop_threads();  // the participants' threads (a concurrent parallel scheme)
   for (const auto& s : services_) s->finish(/*failed=*/false);
   for (auto& p : participants_) {

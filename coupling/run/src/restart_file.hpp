@@ -17,6 +17,7 @@
 // Format 5 (the files of earlier partita versions) kept the same values in fixed places rather
 // than in the services' sections; it is still read (restart_format5.cpp).
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -38,6 +39,13 @@ struct RunState {
   std::int64_t iterations = 0;           // total over the windows
   std::int64_t unconverged_windows = 0;  // accepted at max_iterations
   int max_window_iterations = 0;
+  /// Window n (counted from 1) finished with report r.
+  void finished(std::int64_t n, const coupling::WindowReport& r) {
+    windows_done = n;
+    iterations += r.iterations;
+    max_window_iterations = std::max(max_window_iterations, r.iterations);
+    if (!r.converged) ++unconverged_windows;
+  }
   /// The case (read first and checked: a file of another case is named as such).
   void serialize_case(StateArchive& ar);
   void serialize_windows_done(StateArchive& ar);

@@ -60,6 +60,11 @@
 #include "partita/interface/output.hpp"
 #include "partita/run/run_summary.hpp"
 
+namespace partita::coupling {
+struct FinishedWindow;  // window_observer.hpp
+class Stopwatch;        // stopwatch.hpp
+}  // namespace partita::coupling
+
 namespace partita::run {
 
 class Channel;         // remote_participant.hpp
@@ -163,6 +168,10 @@ class CaseRun {
   std::string restart_blocker() const;  // why restart files cannot be written ("": they can)
 
   // The run (case_run.cpp)
+  bool start();                              // folder, services, restart file; true: resumed
+  void advance_windows(bool resumed);        // the window loop
+  void stopped_by(const coupling::FinishedWindow& w);  // a service asked to stop after window w
+  void finish(const coupling::Stopwatch& wall);  // files closed, participants finalized, summary
   void serve();                       // a server process: answer the controller until the end
   void prepare_folder();              // a new run: the output folder, an earlier run's VTK files
   void build_services();              // from settings_, in the order they observe a window
