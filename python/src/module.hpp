@@ -1,0 +1,31 @@
+#pragma once
+// The `partita._partita` extension module (pybind11): the run library's front end for Python,
+// beside the `partita` executable. Two translation units (pybind11 compiles slowly): module.cpp
+// (the module, the version, errors, check) and run.cpp (run and sweep, on a worker thread while
+// the caller's thread keeps Python's signals and the progress callback).
+
+#include <string>
+#include <vector>
+
+#include <pybind11/pybind11.h>
+
+#include "partita/interface/error.hpp"
+
+#include "partita/coupling/registries.hpp"
+
+namespace partita::python {
+
+/// The registries of the stock `partita` executable: the core's and every in-tree adapter's.
+const coupling::Registries& registries();
+
+/// Where each "key=value" override comes from, for messages: "partita.run(set={'key': ...})".
+std::vector<SourceLocation> override_origins(const std::vector<std::string>& overrides,
+                                             const std::string& call);
+
+/// A case with a `plugins:` list is refused with a clear error (the module loads no plugins).
+void refuse_plugins(const std::string& case_file, const std::vector<std::string>& overrides);
+
+/// run.cpp: _partita.run and _partita.sweep.
+void bind_run(pybind11::module_& m);
+
+}  // namespace partita::python
