@@ -10,6 +10,7 @@
 #include "partita/fem/dof_partition.hpp"
 #include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
+#include "partita/fem/face_load_operator.hpp"
 #include "partita/fem/face_mesh.hpp"
 #include "partita/fem/failure_event.hpp"
 #include "partita/fem/face_quadrature_point.hpp"
@@ -208,22 +209,17 @@ class StructuralSolver final : private StructuralSystem {
 
  private:
   using Factorisation = SparseFactorisation;
-  // Face load operator: f[node] += coefficient * t_q for each (node, qp, coefficient).
-  struct FaceOperator {
-    std::vector<std::size_t> node;
-    std::vector<std::size_t> qp;
-    std::vector<double> coefficient;
-    std::size_t num_qp = 0;
-  };
 
+  // --- set-up and assembly (structural_solver_assembly.cpp) ---
   void setup_dofs();
   void assemble_stiffness();
-  void assemble_mass();
+  void assemble_mass();  // once, at the first transient use (again after erosion)
   void assemble_loads();
-  const FaceOperator& face_operator(const std::string& face) const;
+  // --- faces and loads (structural_solver_loads.cpp) ---
+  const FaceLoadOperator& face_operator(const std::string& face) const;
   void update_coupling_force();
   void evaluate_external_force(double t, Eigen::VectorXd& f) const;
-  void prescribed_values(double t, Eigen::VectorXd& uc) const override;
+  // --- analyses (structural_solver.cpp) ---
   void initialise_acceleration();
   void refresh_internal_force();
   // Static and Newmark solve with Newton on the operator (the nonlinear path), not with the
@@ -233,7 +229,9 @@ class StructuralSolver final : private StructuralSystem {
     return nonlinear_ != nullptr ||
            (linear_sum_ != nullptr && options_.integrator != Integrator::CentralDifference);
   }
-  // StructuralSystem (what the integrators see)
+  // r += sign C v with C = alpha M + beta K0 (M assembled).
+  void add_damping_force(const Eigen::VectorXd& v, double sign, Eigen::VectorXd& r) const;
+  // --- StructuralSystem: what the integrators see ---
   const DofPartition& dofs() const override { return dofs_; }
   InternalForceOperator& internal_forces() override { return *operator_; }
   const SparseMatrix& mass() override;
@@ -241,10 +239,10 @@ class StructuralSolver final : private StructuralSystem {
   double mass_damping() const override { return options_.rayleigh_alpha; }
   double stiffness_damping() const override { return options_.rayleigh_beta; }
   const SparseMatrix& damping_stiffness() override { return nonlinear_ != nullptr ? k0_ : k_; }
-  // r += sign C v with C = alpha M + beta K0 (M assembled).
-  void add_damping_force(const Eigen::VectorXd& v, double sign, Eigen::VectorXd& r) const;
   void external_force(double t, Eigen::VectorXd& f) const override;
   void apply_prescribed(double t, Eigen::VectorXd& u) const override;
+  void prescribed_values(double t, Eigen::VectorXd& uc) const override;
+  // --- mass scaling and the stable step (structural_solver_mass.cpp) ---
   // the density element e's mass is built with: the model's times its mass-scaling factor
   double element_density(std::size_t e) const {
     return model_.density(mesh().elements()[e].region) * mass_scale_factor(e);
@@ -253,8 +251,9 @@ class StructuralSolver final : private StructuralSystem {
   // has none), computed once (stable_time_step() and the mass scaling)
   const std::vector<double>& element_frequencies_squared() const;
   void setup_mass_scaling();
-  void validate_failure_setup() const;  // structural_solver_failure.cpp
-  void update_failures();               // after each step: see failed_elements()
+  // --- failure (structural_solver_failure.cpp) ---
+  void validate_failure_setup() const;
+  void update_failures();  // after each step: see failed_elements()
 
   Model model_;
   SolverOptions options_;
@@ -264,13 +263,16 @@ class StructuralSolver final : private StructuralSystem {
   // dof partition
   DofPartition dofs_;
   std::vector<SpaceTimeFunction> constrained_value_;  // per constrained dof (empty: zero)
+  mutable Eigen::VectorXd prescribed_work_;           // apply_prescribed()'s buffer
 
   // matrices (full and partitioned)
   SparseMatrix k_, m_, k_ff_, k_fc_, m_ff_, m_fc_;
   SparseMatrix k0_;  // nonlinear path with rayleigh_beta > 0: K0 of C = alpha M + beta K0
   bool mass_ready_ = false;
   std::unique_ptr<Factorisation> static_factor_;  // the linear path's K_ff (Newmark's K_eff: newmark_)
-  mutable double stable_step_ = -1.0;        // cached stable_time_step()
+
+  // mass scaling, lumping and the stable step
+  mutable double stable_step_ = -1.0;           // cached stable_time_step()
   mutable std::vector<double> element_omega2_;  // element_frequencies_squared()
   std::vector<double> mass_scale_;              // per element s_e (empty: no mass scaling)
   std::vector<double> element_mass_;            // per element rho V (with mass scaling)
@@ -278,17 +280,16 @@ class StructuralSolver final : private StructuralSystem {
   // element_lumped_[element_lumped_start_[e]]; an eroded element's are stale and not read)
   std::vector<double> element_lumped_;
   std::vector<std::size_t> element_lumped_start_;
-  mutable Eigen::VectorXd prescribed_work_;  // apply_prescribed()'s buffer
 
   // loads
   std::vector<Eigen::VectorXd> load_vectors_;  // per model load, at unit amplitude
-  mutable std::map<std::string, FaceOperator> face_operators_;
+  mutable std::map<std::string, FaceLoadOperator> face_operators_;
   std::map<std::string, MatrixX3> face_tractions_;
   std::vector<std::size_t> nodal_force_nodes_;
   MatrixX3 nodal_forces_;
   Eigen::VectorXd coupling_force_;
 
-  // state
+  // state, the operator and the integrators
   std::size_t steps_ = 0;
   Kinematics kin_;
   std::unique_ptr<InternalForceOperator> operator_;
