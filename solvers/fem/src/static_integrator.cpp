@@ -1,6 +1,7 @@
 #include "partita/fem/static_integrator.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -94,8 +95,53 @@ std::string StaticIntegrator::failure_message(const NewtonReport& rep, int step,
   return msg.str();
 }
 
+StaticIntegrator::~StaticIntegrator() = default;
+
+void StaticIntegrator::solve_constant_tangent(StructuralSystem& system, Kinematics& kin,
+                                              const SparseMatrix& k, double t1) {
+  const DofPartition& dofs = system.dofs();
+  if (factored_ != &k) {
+    // K_ff factorised once for this tangent (symbolic analysis and numeric factorisation)
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    dofs.split(k, k_ff_, k_fc_);
+    factor_ = std::make_unique<SparseFactorisation>(linear_solver_, ordering_);
+    factor_->set_solve_threading(solve_threading_);
+    factor_->set_factor_threading(factor_threading_);
+    factor_->analyze(k_ff_);
+    factorize_or_throw(*factor_, k_ff_, "static stiffness matrix K_ff");
+    factored_ = &k;
+    if (timings_ != nullptr) {
+      timings_->factor_nonzeros = factor_->factor_nonzeros();
+      ++timings_->factorisations;
+      timings_->factorisation += std::chrono::duration<double>(Clock::now() - t0).count();
+    }
+  }
+  system.external_force(t1, kin.f);
+  Eigen::VectorXd uc;
+  system.prescribed_values(t1, uc);
+  // K_ff u_f = F_f - K_fc u_c
+  Eigen::VectorXd rhs(static_cast<Eigen::Index>(dofs.free_dofs().size()));
+  for (std::size_t i = 0; i < dofs.free_dofs().size(); ++i)
+    rhs[static_cast<Eigen::Index>(i)] = kin.f[dofs.free_dofs()[i]];
+  if (uc.size() > 0 && uc.cwiseAbs().maxCoeff() > 0.0) rhs -= k_fc_ * uc;
+  Eigen::VectorXd uf;
+  factor_->solve(rhs, uf);
+  for (std::size_t i = 0; i < dofs.free_dofs().size(); ++i)
+    kin.u[dofs.free_dofs()[i]] = uf[static_cast<Eigen::Index>(i)];
+  for (std::size_t i = 0; i < dofs.constrained_dofs().size(); ++i)
+    kin.u[dofs.constrained_dofs()[i]] = uc[static_cast<Eigen::Index>(i)];
+  kin.time = t1;
+  kin.v.setZero();
+  kin.a.setZero();
+}
+
 void StaticIntegrator::solve(StructuralSystem& system, Kinematics& kin, double t1) {
   reports_.clear();
+  if (const SparseMatrix* k = system.internal_forces().constant_tangent()) {
+    solve_constant_tangent(system, kin, *k, t1);
+    return;
+  }
   const DofPartition& dofs = system.dofs();
   const Eigen::VectorXd u0 = kin.u;
   Eigen::VectorXd f1, u_target = kin.u;

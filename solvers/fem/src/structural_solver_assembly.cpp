@@ -79,7 +79,6 @@ void StructuralSolver::assemble_stiffness() {
     integrator_.stiffness(e.type, element_coordinates(mesh(), e),
                           d[static_cast<std::size_t>(e.region)], m);
   });
-  dofs_.split(k_, k_ff_, k_fc_);
   timings_.assembly += seconds_since(t0);
 }
 

@@ -1,13 +1,22 @@
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "partita/fem/linear_solver.hpp"
 #include "partita/fem/newton_solver.hpp"
+#include "partita/fem/solver_timings.hpp"
 #include "partita/fem/structural_system.hpp"
 
 namespace partita::fem {
 
-// Nonlinear static equilibrium f_int(u) = F on the free dofs, u_c prescribed, by load stepping:
+// Static equilibrium f_int(u) = F(t1) on the free dofs, u_c = g(t1) prescribed.
+//
+// Constant tangent (InternalForceOperator::constant_tangent(): f_int = K u, linear elasticity):
+// one linear system, K_ff u_f = F_f - K_fc u_c, with K_ff factorised at the first solve and kept
+// for the following ones (the tangent and the constrained dofs do not change).
+//
+// Otherwise nonlinear, by load stepping:
 // from the current state (F_0 = f_int(u_0) on the free dofs, the applied load on the
 // constrained ones; u_c,0) to the target (F(t1), g(t1)) along
 //   F(lambda) = F_0 + lambda (F(t1) - F_0),  u_c(lambda) = u_c,0 + lambda (g(t1) - u_c,0),
@@ -34,9 +43,17 @@ class StaticIntegrator {
                             LinearSolver linear_solver = LinearSolver::Automatic,
                             FillOrdering ordering = FillOrdering::Automatic,
                             FactorThreading factor_threading = FactorThreading::Automatic)
-      : newton_(options, linear_solver, ordering, factor_threading) {}
+      : newton_(options, linear_solver, ordering, factor_threading),
+        linear_solver_(linear_solver),
+        ordering_(ordering),
+        factor_threading_(factor_threading) {}
+  ~StaticIntegrator();
   // Velocity and acceleration are set to zero; kin.time = t1.
   void solve(StructuralSystem& system, Kinematics& kin, double t1);
+  // Constant tangent: the threading of the triangular solves of K_ff's factor, and where its
+  // factorisation is counted (optional); set before the first solve.
+  void set_solve_threading(SolveThreading threading) { solve_threading_ = threading; }
+  void set_timings(SolverTimings* timings) { timings_ = timings; }
   // The runaway test above (0: off, the default).
   void set_model_size(double size) { model_size_ = size; }
   // The fraction of the first increment's secant stiffness below which an increment counts as
@@ -52,6 +69,8 @@ class StaticIntegrator {
   }
 
  private:
+  void solve_constant_tangent(StructuralSystem& system, Kinematics& kin, const SparseMatrix& k,
+                              double t1);
   std::string failure_message(const NewtonReport& rep, int step, double lambda, double next,
                               double t1, double stiffness_first, double stiffness_last) const;
   NewtonSolver newton_;
@@ -59,6 +78,15 @@ class StaticIntegrator {
   double model_size_ = 0.0;
   double reference_stiffness_ = 0.0;  // of the runaway test: the first loaded increment's
   std::vector<NewtonReport> reports_;
+  // constant tangent: K_ff's factor (for the matrix factored_), and K's partitioned blocks
+  LinearSolver linear_solver_;
+  FillOrdering ordering_;
+  FactorThreading factor_threading_;
+  SolveThreading solve_threading_ = SolveThreading::Automatic;
+  SolverTimings* timings_ = nullptr;
+  std::unique_ptr<SparseFactorisation> factor_;
+  const SparseMatrix* factored_ = nullptr;
+  SparseMatrix k_ff_, k_fc_;
 };
 
 }  // namespace partita::fem

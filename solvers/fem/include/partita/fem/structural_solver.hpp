@@ -208,8 +208,6 @@ class StructuralSolver final : private StructuralSystem {
   }
 
  private:
-  using Factorisation = SparseFactorisation;
-
   // --- set-up and assembly (structural_solver_assembly.cpp) ---
   void setup_dofs();
   void assemble_stiffness();
@@ -266,10 +264,9 @@ class StructuralSolver final : private StructuralSystem {
   mutable Eigen::VectorXd prescribed_work_;           // apply_prescribed()'s buffer
 
   // matrices (full and partitioned)
-  SparseMatrix k_, m_, k_ff_, k_fc_, m_ff_, m_fc_;
+  SparseMatrix k_, m_, m_ff_, m_fc_;
   SparseMatrix k0_;  // nonlinear path with rayleigh_beta > 0: K0 of C = alpha M + beta K0
   bool mass_ready_ = false;
-  std::unique_ptr<Factorisation> static_factor_;  // the linear path's K_ff (Newmark's K_eff: newmark_)
 
   // mass scaling, lumping and the stable step
   mutable double stable_step_ = -1.0;           // cached stable_time_step()
