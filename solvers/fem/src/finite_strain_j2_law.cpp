@@ -242,7 +242,8 @@ MaterialLawEntry finite_strain_j2_law_entry() {
             return std::make_shared<FiniteStrainJ2Law>(
                 p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density"),
                 hardening_curve_from("j2-plasticity-finite-strain", p));
-          }};
+          },
+          [](const MaterialParameters& p) { return check_hardening("j2-plasticity-finite-strain", p); }};
 }
 
 }  // namespace partita::fem

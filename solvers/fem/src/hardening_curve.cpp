@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -110,46 +112,77 @@ double HardeningCurve::return_map_increment(double g, double trial_norm, double 
 std::vector<MaterialParameter> hardening_parameters() {
   // yield stresses of structural materials: soft polymers (about 1 MPa) to maraging and
   // high-strength steels (2-3 GPa)
-  return {MaterialParameter::number("yield_stress", "Pa", "initial uniaxial yield stress (below E)")
-              .positive()
-              .typical(1e5, 1e10, "yield stresses of solids (polymer foams to hardened steel)"),
+  const auto yield_stress = [](std::string doc) {
+    return MaterialParameter::number("yield_stress", "Pa", std::move(doc))
+        .positive()
+        .typical(1e5, 1e10, "yield stresses of solids (polymer foams to hardened steel)");
+  };
+  return {yield_stress("initial uniaxial yield stress (below E)"),
           MaterialParameter::number("hardening_modulus", "Pa",
                                     "linear isotropic hardening d sigma_y / d eps_p")
               .non_negative()
               .def(0.0),
-          MaterialParameter::table("hardening_table",
-                                   "tabulated hardening instead of yield_stress and "
-                                   "hardening_modulus (piecewise linear, flat beyond the last "
-                                   "point)",
-                                   {{"plastic_strain", ""}, {"yield_stress", "Pa"}})
-              .non_negative()};
+          MaterialParameter::table(
+              "hardening_table",
+              "tabulated hardening instead of yield_stress and hardening_modulus (piecewise "
+              "linear, flat beyond the last point)",
+              "hardening_point", "a point of the hardening curve",
+              {MaterialParameter::number("plastic_strain", "",
+                                         "equivalent plastic strain (first point: 0)")
+                   .non_negative(),
+               yield_stress("uniaxial yield stress there")})};
 }
 
-HardeningCurve hardening_curve_from(std::string_view law, const MaterialParameters& p) {
+std::optional<MaterialParameterIssue> check_hardening(std::string_view law,
+                                                      const MaterialParameters& p) {
   const std::string name(law);
   const double e = p.real("youngs_modulus");
-  const auto check_yield = [&](double sigma_y) {
-    if (sigma_y < e) return;
+  // A yield stress at or above Young's modulus is a yield strain of 1 or more: a unit left out
+  // (a bare number is in SI), not a material.
+  const auto above_modulus = [&](double sigma_y) {
     std::ostringstream msg;
     msg << name << ": yield stress " << sigma_y << " Pa is not below Young's modulus " << e
-        << " Pa: a yield strain sigma_y / E = " << sigma_y / e
+        << " Pa: a yield strain sigma_y / E = " << std::setprecision(3) << sigma_y / e
         << ", where solids yield at 1e-4 to 1e-1 (a unit left out?)";
-    throw Error(msg.str());
+    return msg.str();
   };
   if (p.tables().count("hardening_table") != 0) {
     if (p.values().count("yield_stress") != 0)
-      throw Error(name + ": give either yield_stress (and hardening_modulus) or hardening_table");
+      return MaterialParameterIssue{
+          "yield_stress", -1, "", {"hardening_table"},
+          name + ": give either yield_stress (and hardening_modulus) or hardening_table"};
     std::vector<std::pair<double, double>> points;
-    for (const auto& row : p.table("hardening_table")) {
-      points.emplace_back(row.at(0), row.at(1));
-      check_yield(points.back().second);
+    const auto& rows = p.table("hardening_table");
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      points.emplace_back(rows[i].at(0), rows[i].at(1));
+      if (points.back().second >= e)
+        return MaterialParameterIssue{"hardening_table", static_cast<int>(i), "yield_stress",
+                                      {"youngs_modulus"}, above_modulus(points.back().second)};
     }
-    return HardeningCurve::tabulated(std::move(points));
+    try {
+      HardeningCurve::tabulated(std::move(points));
+    } catch (const Error& error) {
+      return MaterialParameterIssue{"hardening_table", -1, "", {}, error.what()};
+    }
+    return std::nullopt;
   }
   if (p.values().count("yield_stress") == 0)
-    throw Error(name +
-                " needs 'yield_stress' (and optionally 'hardening_modulus') or 'hardening_table'");
-  check_yield(p.real("yield_stress"));
+    return MaterialParameterIssue{
+        "", -1, "", {},
+        name + " needs 'yield_stress' (and optionally 'hardening_modulus') or 'hardening_table'"};
+  if (p.real("yield_stress") >= e)
+    return MaterialParameterIssue{"yield_stress", -1, "", {"youngs_modulus"},
+                                  above_modulus(p.real("yield_stress"))};
+  return std::nullopt;
+}
+
+HardeningCurve hardening_curve_from(std::string_view law, const MaterialParameters& p) {
+  if (auto issue = check_hardening(law, p)) throw Error(issue->message);
+  if (p.tables().count("hardening_table") != 0) {
+    std::vector<std::pair<double, double>> points;
+    for (const auto& row : p.table("hardening_table")) points.emplace_back(row.at(0), row.at(1));
+    return HardeningCurve::tabulated(std::move(points));
+  }
   const double h = p.values().count("hardening_modulus") != 0 ? p.real("hardening_modulus") : 0.0;
   return HardeningCurve::linear(p.real("yield_stress"), h);
 }

@@ -99,7 +99,8 @@ MaterialLawEntry j2_plasticity_law_entry() {
             return std::make_shared<J2PlasticityLaw>(
                 p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density"),
                 hardening_curve_from("j2-plasticity", p));
-          }};
+          },
+          [](const MaterialParameters& p) { return check_hardening("j2-plasticity", p); }};
 }
 
 }  // namespace partita::fem

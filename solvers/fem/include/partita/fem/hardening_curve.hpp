@@ -1,4 +1,5 @@
 #pragma once
+#include <optional>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -38,9 +39,12 @@ class HardeningCurve {
 // The hardening parameters of the J2 laws' registry entries: yield_stress and hardening_modulus
 // (linear), or hardening_table (rows of plastic strain, yield stress: tabulated).
 std::vector<MaterialParameter> hardening_parameters();
-// The curve those parameters give (one of the two forms; Error naming `law` when both or
-// neither are given, or when a yield stress is not below youngs_modulus: a yield strain of 1 or
-// more is a unit left out, not a material).
+// The rules between them (the J2 entries' check): one of the two forms, not both; every yield
+// stress below youngs_modulus (a yield strain of 1 or more is a unit left out, not a material);
+// a table that HardeningCurve::tabulated accepts. The first broken, naming `law`, or nothing.
+std::optional<MaterialParameterIssue> check_hardening(std::string_view law,
+                                                      const MaterialParameters& p);
+// The curve those parameters give (Error with check_hardening's message when one is broken).
 HardeningCurve hardening_curve_from(std::string_view law, const MaterialParameters& p);
 
 }  // namespace partita::fem

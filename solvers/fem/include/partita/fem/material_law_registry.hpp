@@ -35,7 +35,7 @@ struct MaterialParameter {
   std::string name;  // snake_case, as a case file spells it ("youngs_modulus")
   std::string unit;  // SI ("Pa", "kg/m^3"); empty for a pure number
   std::string doc;   // what it is, one line
-  // allowed range of a number (of every cell of a table when `columns` is set)
+  // allowed range of a number (a table's cells: its columns' ranges)
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
   bool min_exclusive = false, max_exclusive = false;
@@ -44,8 +44,10 @@ struct MaterialParameter {
   // A typical range, for documentation and plausibility warnings (absent: none).
   std::optional<std::pair<double, double>> typical_range;
   std::string typical_what;  // what the typical range covers ("Young's moduli of solids")
-  // A table parameter: the columns' names and units (one pair per column).
-  std::vector<std::pair<std::string, std::string>> columns;
+  // A table parameter: its columns, each a number parameter (name, unit, doc, range, typical
+  // range; every cell of the column is required), and what one row is (for documentation).
+  std::vector<MaterialParameter> columns;
+  std::string row_name, row_doc;  // "hardening_point", "a point of the hardening curve"
 
   // A number: MaterialParameter::number("density", "kg/m^3", "mass density").positive().required()
   static MaterialParameter number(std::string name, std::string unit, std::string doc) {
@@ -55,10 +57,12 @@ struct MaterialParameter {
     p.doc = std::move(doc);
     return p;
   }
-  // A table of rows, one value per column (name, unit).
-  static MaterialParameter table(std::string name, std::string doc,
-                                 std::vector<std::pair<std::string, std::string>> columns) {
+  // A table of rows, one value per column; `row_name` and `row_doc` say what a row is.
+  static MaterialParameter table(std::string name, std::string doc, std::string row_name,
+                                 std::string row_doc, std::vector<MaterialParameter> columns) {
     MaterialParameter p = number(std::move(name), "", std::move(doc));
+    p.row_name = std::move(row_name);
+    p.row_doc = std::move(row_doc);
     p.columns = std::move(columns);
     return p;
   }
@@ -152,14 +156,35 @@ class MaterialParameters {
 using MaterialLawFactory =
     std::function<std::shared_ptr<const MaterialLaw>(const MaterialParameters&)>;
 
+// A rule between a law's parameters that the given values break, and where: the parameter it is
+// about (empty: the parameters as a whole, e.g. one of two forms missing), a table's row
+// (0-based; -1: the whole parameter) and column (empty: the whole row), and the other parameters
+// the rule reads, so that a program reading a case can point at the key and name the others'
+// lines. The message states the rule and the values, and names the law.
+struct MaterialParameterIssue {
+  std::string parameter;
+  int row = -1;
+  std::string column;
+  std::vector<std::string> related;
+  std::string message;
+};
+
+// The rules between parameters of one law (each value already in its range, defaults filled in):
+// the first one broken, or nothing.
+using MaterialLawCheck =
+    std::function<std::optional<MaterialParameterIssue>(const MaterialParameters&)>;
+
 // One law: what a case names it, what it is, its parameters and how to build it.
 struct MaterialLawEntry {
   std::string name;
   std::string doc;  // one line
   std::vector<MaterialParameter> parameters;
   // Called with every declared parameter checked (given ones in range, required ones present,
-  // defaults filled in); may throw Error for rules between parameters (yield below E ...).
+  // defaults filled in) and `check` passed; may throw Error for what it alone can tell.
   MaterialLawFactory factory;
+  // The rules between parameters (a yield stress below Young's modulus, one of two forms of the
+  // hardening); empty: none.
+  MaterialLawCheck check = {};
 
   const MaterialParameter* find(std::string_view parameter) const {
     for (const auto& p : parameters)
@@ -167,8 +192,9 @@ struct MaterialLawEntry {
     return nullptr;
   }
 
-  // The checks above, then the factory. Error("<law>: ...") states the rule and the value.
-  std::shared_ptr<const MaterialLaw> create(const MaterialParameters& given) const {
+  // The given values checked against the declarations (known names, ranges, required ones
+  // present) with the defaults filled in. Error("<law>: ...") states the rule and the value.
+  MaterialParameters completed(const MaterialParameters& given) const {
     MaterialParameters p = given;
     for (const auto& [key, v] : given.values()) {
       const MaterialParameter* d = find(key);
@@ -184,15 +210,17 @@ struct MaterialLawEntry {
       const MaterialParameter* d = find(key);
       if (d == nullptr || !d->is_table())
         throw Error(name + ": unknown table '" + key + "'; its parameters: " + names());
-      for (const auto& row : rows) {
+      for (std::size_t r = 0; r < rows.size(); ++r) {
+        const auto& row = rows[r];
         if (row.size() != d->columns.size())
           throw Error(name + ": each row of " + key + " has " + std::to_string(d->columns.size()) +
-                      " values, got one of " + std::to_string(row.size()));
-        for (double v : row)
-          if (!d->allows(v)) {
+                      " values (" + column_names(*d) + "), got one of " +
+                      std::to_string(row.size()));
+        for (std::size_t c = 0; c < row.size(); ++c)
+          if (!d->columns[c].allows(row[c])) {
             std::ostringstream s;
-            s << name << ": the values of " << key << " must be " << d->range_text() << ", got "
-              << v;
+            s << name << ": " << key << " row " << r << ": " << d->columns[c].name << " must be "
+              << d->columns[c].range_text() << ", got " << row[c];
             throw Error(s.str());
           }
       }
@@ -205,12 +233,30 @@ struct MaterialLawEntry {
         throw Error(name + ": parameter '" + d.name + "' (" + d.doc + ") is required");
       }
     }
+    return p;
+  }
+
+  // The first rule between the parameters that `complete` (completed()'s values) breaks.
+  std::optional<MaterialParameterIssue> issue(const MaterialParameters& complete) const {
+    if (!check) return std::nullopt;
+    return check(complete);
+  }
+
+  // completed(), issue() (an Error with its message), then the factory.
+  std::shared_ptr<const MaterialLaw> create(const MaterialParameters& given) const {
+    const MaterialParameters p = completed(given);
+    if (auto broken = issue(p)) throw Error(broken->message);
     return factory(p);
   }
 
   std::string names() const {
     std::string s;
     for (const auto& d : parameters) s += (s.empty() ? "" : ", ") + d.name;
+    return s;
+  }
+  static std::string column_names(const MaterialParameter& table) {
+    std::string s;
+    for (const auto& c : table.columns) s += (s.empty() ? "" : ", ") + c.name;
     return s;
   }
 };
