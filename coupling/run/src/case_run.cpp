@@ -54,6 +54,7 @@ void CaseRun::advance_windows(bool resumed) {
     w.report = &r;
     w.last = n + 1 == window_count_;
     notify(w);
+    if (options_.on_window) options_.on_window(w.window, window_count_, w.time, r.iterations);
     if (w.signal != 0) return stopped_by(w);
   }
 }

@@ -46,6 +46,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -88,6 +89,12 @@ struct RunOptions {
   /// Set (to the signal number) by a signal handler: the run finishes the current window,
   /// writes a restart file, flushes every CSV and returns (summary().stopped_by_signal).
   const std::atomic<int>* stop_signal = nullptr;
+  /// Called after each finished window, once the services have observed it, on the thread that
+  /// runs the run: the windows done (1-based), the run's windows, the window's end time and its
+  /// iterations. For a front end's progress display (the Python module's callback); it must not
+  /// throw and should return quickly.
+  std::function<void(std::int64_t done, std::int64_t windows, double time, int iterations)>
+      on_window;
   /// A run over several processes (remote_participant.hpp): `participant` is the one this
   /// process runs (empty: all of them, in this process). The controller (the process that runs
   /// the coupling core and writes the common files) has a channel to each other participant's
