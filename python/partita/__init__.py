@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import collections
 import itertools
+import json
 import os
 import sys
 from pathlib import Path
@@ -33,22 +34,27 @@ Progress = collections.namedtuple("Progress", ["window", "windows", "time", "ite
 PathLike = Union[str, os.PathLike]
 
 
-def _yaml(value: Any) -> str:
-    """A Python value as YAML flow text (what `partita run --set KEY=VALUE` takes)."""
+def _yaml(value: Any, nested: bool = False) -> str:
+    """A Python value as YAML flow text (what `partita run --set KEY=VALUE` takes). Strings go
+    as they are (YAML reads "20 kPa" and "0.5" as --set does), quoted inside a list or map where
+    they hold a character of YAML's flow syntax."""
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, (int, float)):
         return repr(value)
-    if isinstance(value, str):
-        return value
     if isinstance(value, os.PathLike):
-        return os.fspath(value)
+        value = os.fspath(value)
+    if isinstance(value, str):
+        if nested and (any(c in value for c in "[]{},#&*!|>'\"%@`") or ": " in value
+                       or value != value.strip() or value == ""):
+            return json.dumps(value)
+        return value
     if isinstance(value, Mapping):
-        return "{" + ", ".join(f"{k}: {_yaml(v)}" for k, v in value.items()) + "}"
+        return "{" + ", ".join(f"{_yaml(str(k), True)}: {_yaml(v, True)}" for k, v in value.items()) + "}"
     if hasattr(value, "tolist"):  # numpy arrays and scalars
-        return _yaml(value.tolist())
+        return _yaml(value.tolist(), nested)
     if isinstance(value, Iterable):
-        return "[" + ", ".join(_yaml(v) for v in value) + "]"
+        return "[" + ", ".join(_yaml(v, True) for v in value) + "]"
     raise Error(f"set: the value {value!r} has no YAML form (give a number, string, list or dict)")
 
 

@@ -148,6 +148,12 @@ py::dict run_case(const std::string& case_file, const std::string& output, int t
   options.resume_dir = resume;
   options.stop_signal = &stop;
   options.threads = thread_count(threads);
+  options.on_window = [&now](std::int64_t done, std::int64_t windows, double time, int iterations) {
+    now.windows = windows;
+    now.time = time;
+    now.iterations = iterations;
+    now.window = done;  // last: the waiting thread reads the others once it sees this change
+  };
   const bool plots = app::plots_wanted(no_plots);
   run::RunSummary summary;
   fs::path output_dir;
