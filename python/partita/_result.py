@@ -7,7 +7,7 @@ from __future__ import annotations
 import dataclasses
 import re
 from pathlib import Path
-from typing import Dict, Optional
+from typing import Dict, List, Optional
 
 import pandas as pd
 
@@ -87,6 +87,8 @@ class Result:
     - ``summary``: a Summary
     - ``vtk``: {series name: path of its .pvd}
     - ``plots``: {name: path of its .png}
+    - ``probes``: {probe name: [path of each frame's CSV, in time order]} (DIR/probes/; read one
+      with partita.read_csv)
     Each DataFrame keeps the units of its columns in ``df.attrs["units"]``.
     """
 
@@ -111,6 +113,9 @@ class Result:
         self.summary = summary if summary is not None else Summary._from_coupling(self.coupling)
         self.vtk: Dict[str, Path] = {p.stem: p for p in sorted((self.output_dir / "vtk").glob("*.pvd"))}
         self.plots: Dict[str, Path] = {p.stem: p for p in sorted(self.output_dir.glob("*.png"))}
+        self.probes: Dict[str, List[Path]] = {}
+        for p in sorted((self.output_dir / "probes").glob("*.csv")):
+            self.probes.setdefault(re.sub(r"_\d+$", "", p.stem), []).append(p)
 
     def __getitem__(self, monitor: str) -> pd.DataFrame:
         """result["reaction"]: the monitor's DataFrame (also "coupling" and "energy")."""

@@ -1,6 +1,6 @@
 import os
 from pathlib import Path
-from typing import Dict, Optional, Union
+from typing import Dict, List, Optional, Union
 
 import pandas as pd
 
@@ -34,5 +34,6 @@ class Result:
     summary: Summary
     vtk: Dict[str, Path]
     plots: Dict[str, Path]
+    probes: Dict[str, List[Path]]
     def __init__(self, output_dir: Union[str, os.PathLike[str]], summary: Optional[Summary] = ...) -> None: ...
     def __getitem__(self, monitor: str) -> pd.DataFrame: ...
