@@ -135,3 +135,18 @@ def test_progress_reaches_the_last_window(sphere_case, tmp_path):
     r = partita.run(sphere_case, output=tmp_path, set={"time.end": 0.02}, progress=seen.append)
     assert seen and seen[-1].window == seen[-1].windows == r.summary.windows
     assert [p.window for p in seen] == sorted(p.window for p in seen)
+
+
+def test_an_exception_of_the_progress_callback_stops_the_run_and_is_raised(sphere_case, tmp_path):
+    class Enough(Exception):
+        pass
+
+    def stop(p):
+        raise Enough("enough")
+
+    with pytest.raises(Enough) as e:
+        partita.run(sphere_case, output=tmp_path, set={"time.end": 0.05}, progress=stop, poll=0.001)
+    r = e.value.result
+    assert r.summary.stopped_by_signal == signal.SIGINT
+    assert r.summary.windows < round(0.05 / 1.0e-4)
+    assert len(r.coupling) == r.summary.windows
