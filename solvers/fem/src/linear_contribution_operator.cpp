@@ -1,5 +1,6 @@
 #include "partita/fem/linear_contribution_operator.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "partita/fem/error.hpp"
@@ -7,23 +8,69 @@
 namespace partita::fem {
 
 LinearContributionOperator::LinearContributionOperator(const SparseMatrix& k, const Mesh& mesh)
-    : linear_(k), assembler_(mesh) {}
+    : k_(k), mesh_(mesh), linear_(k), assembler_(std::make_unique<BlockAssembler>(mesh)) {}
+
+LinearContributionOperator::~LinearContributionOperator() = default;
 
 void LinearContributionOperator::add_contribution(std::unique_ptr<OperatorContribution> contribution) {
   if (!contribution) throw Error("linear operator: a null contribution was added");
+  auto groups = contribution->coupled_node_groups();
+  if (!groups.empty()) {
+    if (pattern_fixed_) {
+      throw Error("linear operator: contribution '" + std::string(contribution->name()) +
+                  "' couples nodes beyond the mesh's elements and was added after a tangent was "
+                  "assembled (add such contributions before the first implicit solve)");
+    }
+    // pattern: the mesh's node adjacency plus every contribution's coupled node groups
+    for (const auto& c : contributions_) {
+      auto g = c->coupled_node_groups();
+      groups.insert(groups.end(), std::make_move_iterator(g.begin()),
+                    std::make_move_iterator(g.end()));
+    }
+    assembler_ = std::make_unique<BlockAssembler>(mesh_, groups);
+  }
   contributions_.push_back(std::move(contribution));
+}
+
+void LinearContributionOperator::map_stiffness(const SparseMatrix& tangent) {
+  // K's pattern (the mesh's node adjacency) is contained in the tangent's, column by column,
+  // both with sorted row indices
+  if (!k_.isCompressed() || k_.rows() != tangent.rows() || k_.cols() != tangent.cols())
+    throw Error("linear operator: the stiffness matrix does not match the tangent's pattern");
+  slot_.resize(static_cast<std::size_t>(k_.nonZeros()));
+  for (Eigen::Index j = 0; j < k_.outerSize(); ++j) {
+    Eigen::Index p = tangent.outerIndexPtr()[j];
+    const Eigen::Index end = tangent.outerIndexPtr()[j + 1];
+    for (Eigen::Index i = k_.outerIndexPtr()[j]; i < k_.outerIndexPtr()[j + 1]; ++i) {
+      while (p < end && tangent.innerIndexPtr()[p] < k_.innerIndexPtr()[i]) ++p;
+      if (p == end || tangent.innerIndexPtr()[p] != k_.innerIndexPtr()[i])
+        throw Error("linear operator: an entry of K lies outside the tangent's pattern");
+      slot_[static_cast<std::size_t>(i)] = p;
+    }
+  }
 }
 
 void LinearContributionOperator::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int,
                                           SparseMatrix* k) {
   if (k != nullptr) {
-    throw Error(
-        "the linear path with contributions (a rigid indenter) runs central difference only; "
-        "static and Newmark analyses with contributions take the nonlinear path");
+    for (const auto& c : contributions_) {
+      if (!c->has_tangent()) {
+        throw Error("linear operator: contribution '" + std::string(c->name()) +
+                    "' has no tangent: it works in central-difference (explicit) analyses only");
+      }
+    }
+    if (k->nonZeros() == 0) *k = assembler_->make_matrix();
+    if (!pattern_fixed_) map_stiffness(*k);
+    pattern_fixed_ = true;
+    // K_t = K, then the contributions' K_c added below
+    std::fill(k->valuePtr(), k->valuePtr() + k->nonZeros(), 0.0);
+    const double* kv = k_.valuePtr();
+    double* tv = k->valuePtr();
+    for (std::size_t i = 0; i < slot_.size(); ++i) tv[slot_[i]] = kv[i];
   }
   // f = K u + sum_c f_c(u)
   linear_.evaluate(u, f_int, nullptr);
-  for (const auto& c : contributions_) c->add(u, f_int, nullptr, assembler_);
+  for (const auto& c : contributions_) c->add(u, f_int, k, *assembler_);
 }
 
 void LinearContributionOperator::commit() {

@@ -115,19 +115,15 @@ StructuralSolver::~StructuralSolver() = default;
 void StructuralSolver::add_contribution(std::unique_ptr<OperatorContribution> contribution) {
   if (nonlinear_ != nullptr) {
     nonlinear_->add_contribution(std::move(contribution));
-  } else if (options_.integrator == Integrator::CentralDifference) {
-    // the linear path's explicit steps: K u (one sparse product) plus the contributions
+  } else {
+    // the linear path: K u (one sparse product) plus the contributions; with them the tangent
+    // is no longer constant, so static and Newmark take Newton on the sum
     if (linear_sum_ == nullptr) {
       auto op = std::make_unique<LinearContributionOperator>(k_, mesh());
       linear_sum_ = op.get();
       operator_ = std::move(op);
     }
     linear_sum_->add_contribution(std::move(contribution));
-  } else {
-    throw Error(
-        "operator contributions on a linear-elastic model need central difference, or the "
-        "nonlinear path (SolverOptions::nonlinear_path, or a material law) for static and "
-        "Newmark analyses: the linear path factorises K once");
   }
   stable_step_ = -1.0;  // the contribution may lower it
   refresh_internal_force();

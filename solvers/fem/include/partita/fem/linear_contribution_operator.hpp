@@ -1,4 +1,5 @@
 #pragma once
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -10,18 +11,26 @@
 
 namespace partita::fem {
 
-// The linear path's explicit operator with contributions beside K u (a rigid indenter's contact):
-//   f_int(u) = K u + sum_c f_c(u),
+// The linear path's operator with contributions beside K u (a rigid indenter's contact):
+//   f_int(u) = K u + sum_c f_c(u),   K_t(u) = K + sum_c K_c(u),
 // K the assembled linear-elastic stiffness (referenced, as LinearElasticOperator does), so the
-// material part stays one sparse product per step. Central difference only: it offers no tangent
-// (the linear path's static and Newmark solves factorise K once; a model that needs contributions
-// there takes the nonlinear path, SolverOptions::nonlinear_path). Energies, round-off and the
-// committed state are the sums / concatenation of K u's and the contributions'.
+// material part stays one sparse product per evaluation. Its tangent is not constant (a contact
+// opens and closes), so it offers none (constant_tangent() is nullptr): static and Newmark
+// analyses take Newton on it, central difference needs f_int alone. The tangent's sparsity
+// pattern is the mesh's node adjacency plus the node groups the contributions declare
+// (OperatorContribution::coupled_node_groups()); K's values are copied into it at each tangent
+// evaluation. Energies, round-off and the committed state are the sums / concatenation of
+// K u's and the contributions'.
 class LinearContributionOperator final : public InternalForceOperator {
  public:
   LinearContributionOperator(const SparseMatrix& k, const Mesh& mesh);
+  ~LinearContributionOperator() override;
+  // One that couples nodes beyond the mesh's elements must come before the first tangent is
+  // assembled (the pattern is fixed then).
   void add_contribution(std::unique_ptr<OperatorContribution> contribution);
+  std::size_t num_contributions() const { return contributions_.size(); }
 
+  // f = K u + sum_c f_c(u); K_t as well when k != nullptr (every contribution must offer one).
   void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int, SparseMatrix* k) override;
   void commit() override;
   void set_time(double t, double fraction) override;
@@ -34,9 +43,15 @@ class LinearContributionOperator final : public InternalForceOperator {
   double max_frequency_squared(const Eigen::VectorXd& nodal_mass) const;
 
  private:
+  // K's entries in the tangent's pattern: K_t.valuePtr()[slot_[i]] += K.valuePtr()[i]
+  void map_stiffness(const SparseMatrix& tangent);
+  const SparseMatrix& k_;
+  const Mesh& mesh_;
   LinearElasticOperator linear_;
-  BlockAssembler assembler_;  // add()'s signature; no tangent is assembled
+  std::unique_ptr<BlockAssembler> assembler_;
   std::vector<std::unique_ptr<OperatorContribution>> contributions_;
+  std::vector<Eigen::Index> slot_;
+  bool pattern_fixed_ = false;  // a tangent has been assembled with assembler_'s pattern
   mutable std::vector<double> state_;
 };
 

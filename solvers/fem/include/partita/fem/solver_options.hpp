@@ -38,10 +38,10 @@ struct SolverOptions {
   // K_eff, and Newton's tangents.
   FactorThreading factor_threading = FactorThreading::Automatic;
   // The nonlinear path (NonlinearOperator: element by element, a sum of OperatorContributions)
-  // even for a linear-elastic model, so that contributions such as a rigid indenter's contact
-  // can be added (the linear path's K u has no slot for them). Regions without a law use the
-  // small-strain LinearElasticLaw (the same Hex8 modes, as EAS); explicit steps cost more than
-  // the linear path's sparse product.
+  // even for a linear-elastic model. Regions without a law use the small-strain
+  // LinearElasticLaw (the same Hex8 modes, as EAS); explicit steps cost more than the linear
+  // path's sparse product. Contributions (a rigid indenter's contact) do not need it: the
+  // linear path adds them to K u (LinearContributionOperator) for every integrator.
   bool nonlinear_path = false;
   // Mass scaling of central-difference analyses (0: off), as crash analysts use it for
   // quasi-static runs (LS-DYNA's DT2MS < 0, Abaqus/Explicit's fixed mass scaling to a target

@@ -31,16 +31,18 @@ namespace partita::fem {
 
 // Static and transient structural analysis of a Model.
 //
-// Two paths, chosen from the model:
-//   linear (every region linear elastic, Model::is_linear()): K is assembled once (Hex8 with
-//     incompatible modes) and factorised once per dt; static = one solve, Newmark = one
-//     right-hand side and one pair of triangular solves per step (NewmarkIntegrator on the
-//     operator's constant tangent).
-//   nonlinear (a region has a MaterialLaw: neo-hooke, j2-plasticity, ...): a NonlinearOperator
-//     (f_int and K_t element by element, quadrature-point history), a StaticIntegrator (Newton
-//     with load stepping and cut-back) and a NewmarkIntegrator (Newton per step, cut-back).
-//   SolverOptions::integrator = CentralDifference selects explicit dynamics on either path
-//     (lumped mass; stable_time_step() gives the largest stable step).
+// One operator (InternalForceOperator) and one integrator per analysis: StaticIntegrator,
+// NewmarkIntegrator, CentralDifferenceIntegrator (SolverOptions::integrator = CentralDifference:
+// explicit dynamics, lumped mass, stable_time_step() the largest stable step). Where the
+// operator's tangent is constant the implicit integrators factorise K_ff (static) or K_eff
+// (Newmark, once per step size) once and solve each step with one right-hand side; otherwise
+// they take Newton (load stepping and cut-back). The operator follows from the model:
+//   linear (every region linear elastic, Model::is_linear()): K assembled once (Hex8 with
+//     incompatible modes), f_int = K u (LinearElasticOperator: a constant tangent); with operator
+//     contributions (a contact) K u plus them (LinearContributionOperator: Newton).
+//   nonlinear (a region has a MaterialLaw: neo-hooke, j2-plasticity, ..., or
+//     SolverOptions::nonlinear_path): a NonlinearOperator (f_int and K_t element by element,
+//     quadrature-point history, plus the contributions).
 //
 // Dofs are node-major: dof 3 i + c is component c of node i. Dirichlet dofs are eliminated
 // (partitioned: free f / constrained c), so a factorisation depends on dt and on which dofs
@@ -190,14 +192,14 @@ class StructuralSolver final : private StructuralSystem {
   // Newton reports of the last nonlinear static solve / Newmark step.
   const std::vector<NewtonReport>& static_reports() const { return static_.reports(); }
   const NewtonReport& newmark_report() const { return newmark_.last_report(); }
-  // Newton iterations of the last step() or solve_static() of the nonlinear path (all load
-  // steps, cut-backs and failed tries); 0 on the linear path and for central difference.
+  // Newton iterations of the last step() or solve_static() (all load steps, cut-backs and
+  // failed tries); 0 where the operator's tangent is constant and for central difference.
   int newton_iterations() const;
   // Adds a contribution to the FE operator beside the material's (OperatorContribution: a
-  // contact, a spring bed ...), before the first step or solve. Nonlinear path: the static,
-  // Newmark and central-difference integrators see the sum. Linear path: central difference
-  // only (K u plus the contributions, LinearContributionOperator); static and Newmark there need
-  // SolverOptions::nonlinear_path.
+  // contact, a spring bed ...), before the first step or solve. The static, Newmark and
+  // central-difference integrators see the sum: on the nonlinear path NonlinearOperator's, on
+  // the linear path K u plus the contributions (LinearContributionOperator, still one sparse
+  // product for K u), whose tangent is not constant: static and Newmark take Newton on it.
   // The Rayleigh K0 stays the material's tangent at rest.
   void add_contribution(std::unique_ptr<OperatorContribution> contribution);
   // Newton iterations, load steps and cut-backs of the nonlinear path as lines of text (the
@@ -220,13 +222,10 @@ class StructuralSolver final : private StructuralSystem {
   // --- analyses (structural_solver.cpp) ---
   void initialise_acceleration();
   void refresh_internal_force();
-  // Static and Newmark solve with Newton on the operator (the nonlinear path), not with the
-  // linear path's factorise-once K (or K_eff). The linear path with contributions (central
-  // difference only, linear_sum_) never gets here with another integrator.
-  bool uses_newton() const {
-    return nonlinear_ != nullptr ||
-           (linear_sum_ != nullptr && options_.integrator != Integrator::CentralDifference);
-  }
+  // Static and Newmark solve with Newton on the operator (the nonlinear path, or the linear
+  // path with contributions), not with a factorise-once K_ff (or K_eff): the operator has no
+  // constant tangent. Its internal force f_int(u) is then kept in kin_.f_int.
+  bool uses_newton() const { return operator_->constant_tangent() == nullptr; }
   // r += sign C v with C = alpha M + beta K0 (M assembled).
   void add_damping_force(const Eigen::VectorXd& v, double sign, Eigen::VectorXd& r) const;
   // --- StructuralSystem: what the integrators see ---
