@@ -221,19 +221,6 @@ std::string unit_hint(const Node& at, const std::string& key, const MaterialPara
   row[issue.column].fail(message);
 }
 
-// The small-strain constants of the model's Material (the solver's stable step, nodal stresses
-// and contact stiffness read them): the case's youngs_modulus, poisson_ratio and density where
-// the law takes them, else those of the law's bulk modulus, dilatational wave speed and density
-// (lambda + 2 mu = rho c^2).
-fem::Material elastic_constants(const fem::MaterialParameters& p, const fem::MaterialLaw& law) {
-  if (p.has("youngs_modulus") && p.has("poisson_ratio") && p.has("density"))
-    return {p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density")};
-  const double rho = law.density(), k = law.bulk_modulus();
-  const double c = law.dilatational_wave_speed();
-  const double mu = 0.75 * (rho * c * c - k);
-  return {9.0 * k * mu / (3.0 * k + mu), (3.0 * k - 2.0 * mu) / (2.0 * (3.0 * k + mu)), rho};
-}
-
 }  // namespace
 
 std::shared_ptr<config::Spec> fem_material_spec() {
@@ -261,8 +248,9 @@ fem::Model build_fem_model(fem::Mesh mesh, const config::Node& mat) {
     mat.fail(error.what());
   }
   if (!law) mat.fail("material model " + entry.name + ": its factory made no law");
-  fem::Model model(std::move(mesh), elastic_constants(p, *law));
-  model.set_material_law(std::move(law));  // a linear-elastic law: its Material, the linear path
+  // the one material of the model: the law (a linear-elastic law keeps the linear path)
+  fem::Model model(std::move(mesh));
+  model.set_material_law(std::move(law));
   model.set_failure_criterion(build_failure_criterion(mat));
   return model;
 }

@@ -6,7 +6,7 @@
 
 namespace partita::fem {
 
-DecoupledNeoHookeLaw::DecoupledNeoHookeLaw(double e, double nu, double rho) : density_(rho) {
+DecoupledNeoHookeLaw::DecoupledNeoHookeLaw(double e, double nu, double rho) : elastic_{e, nu, rho}, density_(rho) {
   validate_isotropic_constants("neo-hooke-decoupled", e, nu, rho);
   mu_ = e / (2.0 * (1.0 + nu));
   kappa_ = e / (3.0 * (1.0 - 2.0 * nu));

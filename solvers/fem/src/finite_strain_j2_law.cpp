@@ -92,7 +92,7 @@ Mat3 trial_elastic_left_cauchy_green(const Mat3& f, std::span<const double> comm
 }  // namespace
 
 FiniteStrainJ2Law::FiniteStrainJ2Law(double e, double nu, double rho, HardeningCurve hardening)
-    : density_(rho), hardening_(std::move(hardening)) {
+    : elastic_{e, nu, rho}, density_(rho), hardening_(std::move(hardening)) {
   validate_isotropic_constants("j2-plasticity-finite-strain", e, nu, rho);
   const auto lame = lame_constants(e, nu);
   shear_ = lame.mu;

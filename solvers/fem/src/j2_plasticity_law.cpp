@@ -8,7 +8,7 @@
 namespace partita::fem {
 
 J2PlasticityLaw::J2PlasticityLaw(double e, double nu, double rho, HardeningCurve hardening)
-    : density_(rho), hardening_(std::move(hardening)) {
+    : elastic_{e, nu, rho}, density_(rho), hardening_(std::move(hardening)) {
   validate_isotropic_constants("j2-plasticity", e, nu, rho);
   const auto lame = lame_constants(e, nu);
   shear_ = lame.mu;

@@ -9,6 +9,14 @@
 
 namespace partita::fem {
 
+Material MaterialLaw::small_strain_material() const {
+  // K = lambda + 2/3 mu and rho c_d^2 = lambda + 2 mu give mu = 3/4 (rho c_d^2 - K); then
+  // E = 9 K mu / (3 K + mu), nu = (3 K - 2 mu) / (2 (3 K + mu))
+  const double rho = density(), k = bulk_modulus(), c = dilatational_wave_speed();
+  const double mu = 0.75 * (rho * c * c - k);
+  return {9.0 * k * mu / (3.0 * k + mu), (3.0 * k - 2.0 * mu) / (2.0 * (3.0 * k + mu)), rho};
+}
+
 void MaterialLaw::initialise_state(std::span<double> state) const {
   std::fill(state.begin(), state.end(), 0.0);
 }

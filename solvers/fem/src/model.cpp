@@ -9,10 +9,18 @@ namespace partita::fem {
 
 Model::Model(Mesh mesh, const Material& material) : mesh_(std::move(mesh)) {
   mesh_.validate();
-  material.validate();
-  materials_.assign(std::max<std::size_t>(1, mesh_.region_names().size()), material);
-  laws_.assign(materials_.size(), nullptr);
-  failure_.assign(materials_.size(), FailureCriterion{});
+  const std::size_t regions = std::max<std::size_t>(1, mesh_.region_names().size());
+  laws_.resize(regions);
+  linear_.resize(regions);
+  materials_.resize(regions);
+  set_material(material);
+  failure_.assign(regions, FailureCriterion{});
+}
+
+void Model::assign(std::size_t region, std::shared_ptr<const MaterialLaw> law) {
+  linear_.at(region) = dynamic_cast<const LinearElasticLaw*>(law.get()) != nullptr;
+  materials_.at(region) = law->small_strain_material();
+  laws_.at(region) = std::move(law);
 }
 
 void Model::set_failure_criterion(const FailureCriterion& criterion) {
@@ -24,43 +32,25 @@ void Model::set_failure_criterion(const std::string& region, const FailureCriter
 }
 
 void Model::set_material(const Material& material) {
-  material.validate();
-  std::fill(materials_.begin(), materials_.end(), material);
-  std::fill(laws_.begin(), laws_.end(), nullptr);
+  set_material_law(std::make_shared<LinearElasticLaw>(material));  // validates
 }
 
 void Model::set_material(const std::string& region, const Material& material) {
-  material.validate();
-  const auto r = static_cast<std::size_t>(mesh_.region(region));
-  materials_.at(r) = material;
-  laws_.at(r) = nullptr;
+  set_material_law(region, std::make_shared<LinearElasticLaw>(material));
 }
 
 void Model::set_material_law(std::shared_ptr<const MaterialLaw> law) {
   if (!law) throw Error("set_material_law: null law");
-  if (const auto* linear = dynamic_cast<const LinearElasticLaw*>(law.get())) {
-    set_material(linear->material());
-    return;
-  }
-  std::fill(laws_.begin(), laws_.end(), law);
+  for (std::size_t r = 0; r < laws_.size(); ++r) assign(r, law);
 }
 
 void Model::set_material_law(const std::string& region, std::shared_ptr<const MaterialLaw> law) {
   if (!law) throw Error("set_material_law('" + region + "'): null law");
-  if (const auto* linear = dynamic_cast<const LinearElasticLaw*>(law.get())) {
-    set_material(region, linear->material());
-    return;
-  }
-  laws_.at(static_cast<std::size_t>(mesh_.region(region))) = std::move(law);
+  assign(static_cast<std::size_t>(mesh_.region(region)), std::move(law));
 }
 
 bool Model::is_linear() const {
-  return std::all_of(laws_.begin(), laws_.end(), [](const auto& l) { return l == nullptr; });
-}
-
-double Model::density(int region) const {
-  const auto* law = material_law(region);
-  return law != nullptr ? law->density() : material(region).density;
+  return std::all_of(linear_.begin(), linear_.end(), [](char l) { return l != 0; });
 }
 
 void Model::check_component(int component) const {

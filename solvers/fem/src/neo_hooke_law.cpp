@@ -6,7 +6,7 @@
 
 namespace partita::fem {
 
-NeoHookeLaw::NeoHookeLaw(double e, double nu, double rho) : density_(rho) {
+NeoHookeLaw::NeoHookeLaw(double e, double nu, double rho) : elastic_{e, nu, rho}, density_(rho) {
   validate_isotropic_constants("neo-hooke", e, nu, rho);
   lame_ = lame_constants(e, nu);
 }

@@ -1,4 +1,5 @@
 #pragma once
+#include "partita/fem/material.hpp"
 #include "partita/fem/material_law.hpp"
 #include "partita/fem/material_law_registry.hpp"
 
@@ -19,6 +20,7 @@ class DecoupledNeoHookeLaw final : public MaterialLaw {
 
   std::string_view name() const override { return "neo-hooke-decoupled"; }
   double density() const override { return density_; }
+  Material small_strain_material() const override { return elastic_; }
   double dilatational_wave_speed() const override;
   double bulk_modulus() const override { return kappa_; }
   void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
@@ -26,6 +28,7 @@ class DecoupledNeoHookeLaw final : public MaterialLaw {
   double mu() const { return mu_; }
 
  private:
+  Material elastic_;  // E, nu, rho as given
   double mu_ = 0.0, kappa_ = 0.0, density_ = 0.0;
 };
 

@@ -1,5 +1,6 @@
 #pragma once
 #include "partita/fem/hardening_curve.hpp"
+#include "partita/fem/material.hpp"
 #include "partita/fem/material_law.hpp"
 #include "partita/fem/material_law_registry.hpp"
 
@@ -35,6 +36,7 @@ class FiniteStrainJ2Law final : public MaterialLaw {
 
   std::string_view name() const override { return "j2-plasticity-finite-strain"; }
   double density() const override { return density_; }
+  Material small_strain_material() const override { return elastic_; }
   double dilatational_wave_speed() const override;
   double bulk_modulus() const override { return bulk_; }
   int state_size() const override { return kStateSize; }
@@ -60,6 +62,7 @@ class FiniteStrainJ2Law final : public MaterialLaw {
   }
 
  private:
+  Material elastic_;  // E, nu, rho as given
   static constexpr int kStateSize = 14;
   // P and W at F from the committed history; writes the trial history.
   void stress(const Mat3& f, std::span<const double> committed, std::span<double> trial, Mat3& p,

@@ -1,5 +1,6 @@
 #pragma once
 #include "partita/fem/hardening_curve.hpp"
+#include "partita/fem/material.hpp"
 #include "partita/fem/material_law.hpp"
 #include "partita/fem/material_law_registry.hpp"
 
@@ -26,6 +27,7 @@ class J2PlasticityLaw final : public MaterialLaw {
   std::string_view name() const override { return "j2-plasticity"; }
   bool small_strain() const override { return true; }
   double density() const override { return density_; }
+  Material small_strain_material() const override { return elastic_; }
   double dilatational_wave_speed() const override;
   double bulk_modulus() const override { return bulk_; }
   int state_size() const override { return 14; }
@@ -45,6 +47,7 @@ class J2PlasticityLaw final : public MaterialLaw {
   const HardeningCurve& hardening() const { return hardening_; }
 
  private:
+  Material elastic_;  // E, nu, rho as given
   void evaluate_with(const Mat3& f, std::span<const double> committed, std::span<double> trial,
                      MaterialResponse& response, bool with_tangent) const;
   double density_ = 0.0, bulk_ = 0.0, shear_ = 0.0;

@@ -15,6 +15,7 @@ class LinearElasticLaw final : public MaterialLaw {
   std::string_view name() const override { return "linear-elastic"; }
   bool small_strain() const override { return true; }
   double density() const override { return material_.density; }
+  Material small_strain_material() const override { return material_; }
   double dilatational_wave_speed() const override;
   double bulk_modulus() const override;
   void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,

@@ -2,6 +2,7 @@
 #include <span>
 #include <string_view>
 
+#include "partita/fem/material.hpp"
 #include "partita/fem/material_response.hpp"
 #include "partita/fem/types.hpp"
 
@@ -29,6 +30,11 @@ class MaterialLaw {
   virtual double dilatational_wave_speed() const = 0;
   // Bulk modulus K = lambda + 2/3 mu at rest [Pa].
   virtual double bulk_modulus() const = 0;
+  // The isotropic small-strain constants at rest (Young's modulus, Poisson's ratio, density):
+  // what the solver reads whatever the law (the linear path's stiffness and stresses, the
+  // contact penalty). Default: from the bulk modulus and the dilatational wave speed
+  // (rho c_d^2 = K + 4/3 mu); a law made of E, nu and rho returns those.
+  virtual Material small_strain_material() const;
 
   // True for the small-strain laws (eps = sym(F - I)): their `stress` is the Cauchy stress
   // sigma itself, used as P by the operator; false for finite-strain laws, whose `stress` is P

@@ -22,23 +22,31 @@ class Model {
 
   const Mesh& mesh() const { return mesh_; }
 
-  // --- material ---
-  void set_material(const Material& material);  // every region
+  // --- material: one law per region ---
+  // A linear-elastic material for every region / one region: a LinearElasticLaw of it.
+  void set_material(const Material& material);
   void set_material(const std::string& region, const Material& material);
+  // A constitutive law (linear-elastic, neo-hooke, j2-plasticity, ...) for every region / one
+  // region.
+  void set_material_law(std::shared_ptr<const MaterialLaw> law);
+  void set_material_law(const std::string& region, std::shared_ptr<const MaterialLaw> law);
+  // The law of a region (a linear-elastic region's is its LinearElasticLaw).
+  const MaterialLaw& law(int region) const { return *laws_.at(static_cast<std::size_t>(region)); }
+  // The law of a region, or nullptr when the region is linear elastic (its material(region)
+  // is all the linear path needs).
+  const MaterialLaw* material_law(int region) const {
+    const auto r = static_cast<std::size_t>(region);
+    return linear_.at(r) ? nullptr : laws_[r].get();
+  }
+  // The region's small-strain constants, a view of its law (MaterialLaw::small_strain_material:
+  // a linear-elastic law's Material, a built-in nonlinear law's E, nu and rho): what the solver
+  // reads for the linear path's stiffness and stresses, the explicit stable step and contact.
   const Material& material(int region) const {
     return materials_.at(static_cast<std::size_t>(region));
   }
-  // A constitutive law (neo-hooke, j2-plasticity, ...) for every region / one region. A
-  // LinearElasticLaw is stored as its Material (the linear path); set_material() replaces a law.
-  void set_material_law(std::shared_ptr<const MaterialLaw> law);
-  void set_material_law(const std::string& region, std::shared_ptr<const MaterialLaw> law);
-  // The law of a region, or nullptr when the region is linear elastic (material(region)).
-  const MaterialLaw* material_law(int region) const {
-    return laws_.at(static_cast<std::size_t>(region)).get();
-  }
   // True when every region is linear elastic: the solver's factorise-once path applies.
   bool is_linear() const;
-  double density(int region) const;
+  double density(int region) const { return law(region).density(); }
   // Rupture: a failure criterion for every region / one region (none by default; see
   // FailureCriterion). Needs a law with plastic strain (j2-plasticity) to ever fail.
   void set_failure_criterion(const FailureCriterion& criterion);
@@ -67,9 +75,13 @@ class Model {
 
  private:
   void check_component(int component) const;
+  void assign(std::size_t region, std::shared_ptr<const MaterialLaw> law);
   Mesh mesh_;
+  std::vector<std::shared_ptr<const MaterialLaw>> laws_;  // per region, never null
+  // derived from laws_ by assign(), never set alone: whether each is a LinearElasticLaw, and its
+  // small-strain constants
+  std::vector<char> linear_;
   std::vector<Material> materials_;
-  std::vector<std::shared_ptr<const MaterialLaw>> laws_;  // per region; nullptr: linear elastic
   std::vector<FailureCriterion> failure_;                 // per region
   Hex8Formulation hex8_ = Hex8Formulation::IncompatibleModes;
   std::vector<DirichletCondition> dirichlet_;

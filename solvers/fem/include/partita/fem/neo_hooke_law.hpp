@@ -1,4 +1,5 @@
 #pragma once
+#include "partita/fem/material.hpp"
 #include "partita/fem/material_law.hpp"
 #include "partita/fem/material_law_registry.hpp"
 
@@ -19,6 +20,7 @@ class NeoHookeLaw final : public MaterialLaw {
 
   std::string_view name() const override { return "neo-hooke"; }
   double density() const override { return density_; }
+  Material small_strain_material() const override { return elastic_; }
   double dilatational_wave_speed() const override;
   double bulk_modulus() const override;
   void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
@@ -27,6 +29,7 @@ class NeoHookeLaw final : public MaterialLaw {
   double mu() const { return lame_.mu; }
 
  private:
+  Material elastic_;  // E, nu, rho as given
   LameConstants lame_;
   double density_ = 0.0;
 };
