@@ -20,9 +20,11 @@ from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Seque
 from . import _partita
 from ._errors import CaseError, Error, InternalError
 from ._result import Result, Summary, read_csv
+from ._solver import Field, Mesh, OutputFrame, Solver, SolverContext, quantity, register_solver, solvers
 
 __all__ = ["check", "run", "read", "sweep", "read_csv", "set_log_level", "Result", "Summary",
-           "Progress", "Error", "CaseError", "InternalError", "__version__"]
+           "Progress", "Error", "CaseError", "InternalError", "__version__", "Solver", "Mesh",
+           "Field", "OutputFrame", "SolverContext", "register_solver", "solvers", "quantity"]
 
 #: the version of the partita libraries the module is built from (as ``partita --version``)
 __version__: str = _partita.version()

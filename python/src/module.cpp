@@ -20,7 +20,7 @@ namespace py = pybind11;
 
 namespace partita::python {
 
-const coupling::Registries& registries() {
+const coupling::Registries& stock_registries() {
   static const coupling::Registries r = [] {
     coupling::Registries made;
     coupling::register_builtin(made);
@@ -93,9 +93,10 @@ py::dict check(const std::string& case_file, const std::vector<std::string>& ove
   py::dict out;
   std::vector<std::string> external;
   std::string name, output_dir;
+  const auto regs = registries();
   {
     py::gil_scoped_release release;  // a check builds every participant: it can take seconds
-    run::CaseRun c(case_file, registries(), options);
+    run::CaseRun c(case_file, *regs, options);
     external = c.external_participants();
     name = c.name();
     output_dir = c.output_dir().string();
@@ -122,8 +123,9 @@ PYBIND11_MODULE(_partita, m) {
   m.def("check", &check, py::arg("case_file"), py::arg("overrides"));
   m.def("solver_names", [] {
     std::vector<std::string> names;
-    for (const auto& e : registries().solvers.entries()) names.push_back(e.name);
+    for (const auto& e : registries()->solvers.entries()) names.push_back(e.name);
     return names;
   });
   bind_run(m);
+  bind_solver(m);
 }

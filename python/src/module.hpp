@@ -4,6 +4,7 @@
 // (the module, the version, errors, check) and run.cpp (run and sweep, on a worker thread while
 // the caller's thread keeps Python's signals and the progress callback).
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,7 +17,15 @@
 namespace partita::python {
 
 /// The registries of the stock `partita` executable: the core's and every in-tree adapter's.
-const coupling::Registries& registries();
+const coupling::Registries& stock_registries();
+
+/// solver.cpp: the registries the module's calls use: the stock ones and the solvers registered
+/// from Python (partita.register_solver). Call it with the GIL held; a call keeps its snapshot
+/// for its whole run (a solver registered meanwhile counts from the next call).
+std::shared_ptr<const coupling::Registries> registries();
+
+/// solver.cpp: _partita.add_solver and _partita.python_solver_names.
+void bind_solver(pybind11::module_& m);
 
 /// Where each "key=value" override comes from, for messages: "partita.run(set={'key': ...})".
 std::vector<SourceLocation> override_origins(const std::vector<std::string>& overrides,

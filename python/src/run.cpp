@@ -158,11 +158,12 @@ py::dict run_case(const std::string& case_file, const std::string& output, int t
   run::RunSummary summary;
   fs::path output_dir;
   std::int64_t reported = -1;
+  const auto regs = registries();
   auto work = [&] {
 #ifdef _OPENMP
     omp_set_num_threads(options.threads);  // this thread's OpenMP teams (as the executable's main)
 #endif
-    run::CaseRun c(case_file, registries(), options);
+    run::CaseRun c(case_file, *regs, options);
     now.windows = c.window_count();
     output_dir = c.output_dir();
     c.run();
@@ -213,7 +214,8 @@ py::dict sweep_case(const std::string& case_file, const std::string& output, int
           : fs::current_path() / "out" / config::Node::load_file(case_file, overrides).string("case");
   so.output_dir = dir;
   int status = 0;
-  auto work = [&] { status = app::run_sweep(registries(), so); };
+  const auto regs = registries();
+  auto work = [&] { status = app::run_sweep(*regs, so); };
   py::object raised = wait_for_worker(work, stop, poll, {});
   py::dict out;
   out["status"] = status;
