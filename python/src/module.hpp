@@ -24,7 +24,11 @@ const coupling::Registries& stock_registries();
 /// for its whole run (a solver registered meanwhile counts from the next call).
 std::shared_ptr<const coupling::Registries> registries();
 
-/// solver.cpp: _partita.add_solver and _partita.python_solver_names.
+/// solver.cpp: a case whose participant names a solver registered in Python is refused by a
+/// sweep (its variants are partita processes, which do not know it).
+void refuse_python_solvers(const std::string& case_file, const std::vector<std::string>& overrides);
+
+/// solver.cpp: _partita.add_solver, python_solver_names and quantity.
 void bind_solver(pybind11::module_& m);
 
 /// Where each "key=value" override comes from, for messages: "partita.run(set={'key': ...})".

@@ -193,6 +193,7 @@ py::dict sweep_case(const std::string& case_file, const std::string& output, int
                     int threads, const std::vector<std::string>& overrides, bool no_plots,
                     const std::string& executable, const std::string& log_level, double poll) {
   refuse_plugins(case_file, overrides);
+  refuse_python_solvers(case_file, overrides);
   if (jobs < 1) throw Error("jobs=" + std::to_string(jobs) + ": give 1 or more");
   if (!fs::exists(executable))
     throw Error("the partita executable that runs a sweep's variants is not at '" + executable +

@@ -408,6 +408,22 @@ void add_solver(const std::string& name, const std::string& doc) {
 
 std::shared_ptr<const coupling::Registries> registries() { return current_registries(); }
 
+void refuse_python_solvers(const std::string& case_file, const std::vector<std::string>& overrides) {
+  const std::vector<std::string>& names = python_solver_names();
+  if (names.empty()) return;
+  const config::Node root = config::Node::load_file(case_file, overrides);
+  if (!root.has("participants") || !root["participants"].is_map()) return;
+  for (const std::string& p : root["participants"].keys()) {
+    const config::Node pn = root["participants"][p];
+    if (!pn.is_map() || !pn.has("solver")) continue;
+    const std::string solver = pn["solver"].as_string();
+    if (std::find(names.begin(), names.end(), solver) != names.end())
+      pn["solver"].fail("'" + solver +
+                        "' is a solver registered in Python, which a sweep cannot use: its "
+                        "variants run as partita processes; run them with partita.run in a loop");
+  }
+}
+
 void bind_solver(py::module_& m) {
   m.def("add_solver", &add_solver, py::arg("name"), py::arg("doc"));
   m.def("python_solver_names", [] { return python_solver_names(); });
