@@ -76,6 +76,19 @@ class TubeSolid(partita.Solver):
         p, self.area, self.t = self.saved
         self.pressure[:] = p
 
+    def write_restart(self):
+        # what evolves, as bytes partita keeps in its restart file (partita.run(case, resume=DIR))
+        return np.concatenate([self.pressure, self.area, [self.t]]).tobytes()
+
+    def read_restart(self, data):
+        state = np.frombuffer(data, dtype=float)
+        if state.size != 2 * (self.cells + 1) + 1:
+            raise ValueError(f"the restart file holds {state.size} values, not those of {self.cells} cells")
+        n = self.cells + 1
+        self.pressure[:] = state[:n]
+        self.area = state[n:2 * n].copy()
+        self.t = float(state[-1])
+
     def monitors(self):
         return {"mid_area": (self.area[self.cells // 2], "m^2"), "max_area": (self.area.max(), "m^2")}
 

@@ -2,6 +2,7 @@
 partita's own: the 1D tube's wall in Python against the C++ wall, and the errors of a Python
 solver that raises or returns non-finite values."""
 
+import filecmp
 import sys
 
 import numpy as np
@@ -109,3 +110,26 @@ def test_a_solver_missing_a_method_is_refused(tmp_path):
                                             r"factory returned has no method meshes\(\)"):
         partita.check(CASES / "elastic_tube_1d" / "aitken.yaml",
                       set={"participants.solid.solver": "py-not-a-solver"})
+
+
+def test_a_sweep_refuses_a_solver_registered_in_python(tmp_path):
+    # a sweep's variants are partita processes, which know no solver registered in this one
+    with pytest.raises(partita.CaseError, match="registered in Python, which a sweep cannot use") as caught:
+        partita.sweep(CASES / "elastic_tube_1d" / "aitken.yaml", output=tmp_path,
+                      over={"participants.solid.youngs_modulus": [1.0e4, 2.0e4]},
+                      set={"participants.solid.solver": "py-tube-solid"})
+    assert caught.value.key == "participants.solid.solver"
+
+
+def test_a_python_solver_resumes_from_its_restart_bytes_bit_for_bit(tmp_path):
+    # write_restart()/read_restart(): a run resumed from the restart file after window 10 ends
+    # with the bytes of the uninterrupted run
+    case = CASES / "elastic_tube_1d" / "iqn-ils.yaml"
+    solid = {"participants.solid.solver": "py-tube-solid"}
+    whole = partita.run(case, output=tmp_path / "whole", threads=1, set={**solid, "time.end": 0.2})
+    partita.run(case, output=tmp_path / "cut", threads=1,
+                set={**solid, "time.end": 0.1, "output.restart": {"at_end": True}})
+    resumed = partita.run(case, resume=tmp_path / "cut", threads=1, set={**solid, "time.end": 0.2})
+    assert resumed.summary.resumed_from == 10 and whole.summary.windows == 20
+    for f in ("coupling.csv", "tube.csv"):
+        assert filecmp.cmp(tmp_path / "whole" / f, tmp_path / "cut" / f, shallow=False), f
