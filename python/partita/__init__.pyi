@@ -7,6 +7,9 @@ import pandas as pd
 
 from ._errors import CaseError as CaseError, Error as Error, InternalError as InternalError
 from ._result import Result as Result, Summary as Summary, read_csv as read_csv
+from ._solver import (Field as Field, Mesh as Mesh, OutputFrame as OutputFrame, Solver as Solver,
+                      SolverContext as SolverContext, quantity as quantity,
+                      register_solver as register_solver, solvers as solvers)
 
 __version__: str
 

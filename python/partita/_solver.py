@@ -76,7 +76,11 @@ class Solver:
 
     read() gets a read-only numpy view of the core's values, (n,) or (n, 3): valid during that
     call only (copy it, e.g. ``self.p[:] = values``, to keep it). write() returns an array of
-    that shape, which the core copies; a non-finite value stops the run."""
+    that shape, which the core copies; a non-finite value stops the run.
+
+    Optional, not defined here: ``write_restart() -> bytes`` with ``read_restart(data)`` keep
+    the state in restart files (without them a run with this solver writes none);
+    ``interface_work(mesh) -> float`` joins the interface energy audit."""
 
     def meshes(self) -> List[Mesh]:
         raise NotImplementedError("meshes()")
