@@ -89,9 +89,11 @@ py::object to_python(const config::Node& n) {
 class PythonSolver : public Solver {
  public:
   // Built under the GIL.
-  PythonSolver(std::string solver, std::string participant, py::object object)
+  PythonSolver(std::string solver, std::string participant, py::object object,
+               config::Node config)
       : who_("participant '" + participant + "' (Python solver '" + solver + "')"),
-        object_(std::move(object)) {
+        object_(std::move(object)),
+        config_(std::move(config)) {
     for (const char* required : {"meshes", "read", "write", "advance", "time", "save_checkpoint",
                                  "restore_checkpoint"})
       if (!py::hasattr(object_, required))
@@ -123,7 +125,7 @@ class PythonSolver : public Solver {
     call("mesh_requests()", [&] {
       for (const py::handle r : object_.attr("mesh_requests")()) {
         const auto pair = r.cast<std::pair<std::string, std::string>>();
-        out.push_back(MeshRequest{pair.first, pair.second, {}});
+        out.push_back(MeshRequest{pair.first, pair.second, config_});  // messages: its section
       }
     });
     return out;
@@ -374,6 +376,7 @@ class PythonSolver : public Solver {
 
   std::string who_;
   py::object object_;
+  config::Node config_;  // the participant's section, where messages about its requests point
   bool restart_ = false;
   mutable std::optional<std::vector<InterfaceMesh>> meshes_;
   std::vector<std::pair<std::string, std::string>> files_;
@@ -395,7 +398,7 @@ void add_solver(const std::string& name, const std::string& doc) {
                         py::object made = py::module_::import("partita._solver").attr("_build")(
                             name, c.name, to_python(c.config), c.case_dir.string(),
                             c.output_dir.string(), c.threads);
-                        return std::make_unique<PythonSolver>(name, c.name, std::move(made));
+                        return std::make_unique<PythonSolver>(name, c.name, std::move(made), c.config);
                       } catch (py::error_already_set& e) {
                         throw Error(who + ": its factory raised " + exception_text(e));
                       }

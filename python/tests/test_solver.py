@@ -133,3 +133,17 @@ def test_a_python_solver_resumes_from_its_restart_bytes_bit_for_bit(tmp_path):
     assert resumed.summary.resumed_from == 10 and whole.summary.windows == 20
     for f in ("coupling.csv", "tube.csv"):
         assert filecmp.cmp(tmp_path / "whole" / f, tmp_path / "cut" / f, shallow=False), f
+
+
+def test_a_mesh_request_of_a_python_solver_is_checked_at_its_section():
+    # mesh_requests(): the core hands over another participant's surface; the tube's nodes
+    # have no triangles, which the core refuses at the requesting participant's section
+    class AsksForNodes(tube_python_solid.TubeSolid):
+        def mesh_requests(self):
+            return [("fluid_nodes", "fluid.nodes")]
+
+    partita.register_solver("py-tube-solid-asking", AsksForNodes)
+    with pytest.raises(partita.CaseError, match="has no triangles") as caught:
+        partita.check(CASES / "elastic_tube_1d" / "aitken.yaml",
+                      set={"participants.solid.solver": "py-tube-solid-asking"})
+    assert caught.value.key == "participants.solid"
