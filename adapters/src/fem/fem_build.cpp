@@ -264,8 +264,10 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
     options.newton.max_cutbacks = static_cast<int>(nl.integer("max_cutbacks"));
     options.newton.max_line_search_steps = static_cast<int>(nl.integer("line_search_steps"));
     options.newton.energy_line_search = nl.string("line_search") == "energy";
-    // rigid indenters are contributions of the FE operator: the nonlinear path's, or on the
-    // linear path K u plus them (central difference only)
+    // rigid indenters are contributions of the FE operator. The linear path takes them on every
+    // integrator (K u plus them); a linear model with indenters in a static or Newmark analysis
+    // stays on the nonlinear path's element-by-element operator all the same, so that its results
+    // keep their bits (the linear path would be faster there)
     if (!c["indenters"].items().empty() &&
         !(model.is_linear() && options.integrator == fem::Integrator::CentralDifference))
       options.nonlinear_path = true;
