@@ -43,7 +43,6 @@ class BalanceAudit final : public Service {
   Eigen::ArrayXd norm_;
   std::vector<char> finite_;
   std::vector<Eigen::VectorXd> bounds_;  // per audited exchange: W^T omega (or empty)
-  bool bounds_ready_ = false;
 };
 
 }  // namespace partita::run
