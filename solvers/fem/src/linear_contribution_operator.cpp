@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "contribution_list.hpp"
 #include "partita/fem/error.hpp"
 
 namespace partita::fem {
@@ -13,23 +14,8 @@ LinearContributionOperator::LinearContributionOperator(const SparseMatrix& k, co
 LinearContributionOperator::~LinearContributionOperator() = default;
 
 void LinearContributionOperator::add_contribution(std::unique_ptr<OperatorContribution> contribution) {
-  if (!contribution) throw Error("linear operator: a null contribution was added");
-  auto groups = contribution->coupled_node_groups();
-  if (!groups.empty()) {
-    if (pattern_fixed_) {
-      throw Error("linear operator: contribution '" + std::string(contribution->name()) +
-                  "' couples nodes beyond the mesh's elements and was added after a tangent was "
-                  "assembled (add such contributions before the first implicit solve)");
-    }
-    // pattern: the mesh's node adjacency plus every contribution's coupled node groups
-    for (const auto& c : contributions_) {
-      auto g = c->coupled_node_groups();
-      groups.insert(groups.end(), std::make_move_iterator(g.begin()),
-                    std::make_move_iterator(g.end()));
-    }
-    assembler_ = std::make_unique<BlockAssembler>(mesh_, groups);
-  }
-  contributions_.push_back(std::move(contribution));
+  detail::add_contribution(contributions_, assembler_, mesh_, pattern_fixed_, std::move(contribution),
+                           "linear operator");
 }
 
 void LinearContributionOperator::map_stiffness(const SparseMatrix& tangent) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "contribution_list.hpp"
 #include "partita/fem/error.hpp"
 
 namespace partita::fem {
@@ -17,23 +18,8 @@ NonlinearOperator::NonlinearOperator(const Model& model)
 NonlinearOperator::~NonlinearOperator() = default;
 
 void NonlinearOperator::add_contribution(std::unique_ptr<OperatorContribution> contribution) {
-  if (!contribution) throw Error("nonlinear operator: a null contribution was added");
-  auto groups = contribution->coupled_node_groups();
-  if (!groups.empty()) {
-    if (pattern_fixed_) {
-      throw Error("nonlinear operator: contribution '" + std::string(contribution->name()) +
-                  "' couples nodes beyond the mesh's elements and was added after a tangent was "
-                  "assembled (add such contributions before the first implicit solve)");
-    }
-    // pattern: the mesh's node adjacency plus every contribution's coupled node groups
-    for (const auto& c : contributions_) {
-      auto g = c->coupled_node_groups();
-      groups.insert(groups.end(), std::make_move_iterator(g.begin()),
-                    std::make_move_iterator(g.end()));
-    }
-    assembler_ = std::make_unique<BlockAssembler>(mesh_, groups);
-  }
-  contributions_.push_back(std::move(contribution));
+  detail::add_contribution(contributions_, assembler_, mesh_, pattern_fixed_, std::move(contribution),
+                           "nonlinear operator");
 }
 
 void NonlinearOperator::evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f_int,
