@@ -96,4 +96,57 @@ void ParticleStore::read(BinaryReader& in) {
   }
 }
 
+std::size_t ParticleStore::packed_bytes_per_particle() const {
+  std::size_t bytes = 0;
+  for (const auto& c : columns_) bytes += c->width * c->element_size();
+  return bytes;
+}
+
+void ParticleStore::pack(const std::vector<int>& which, std::vector<std::byte>& out) const {
+  const std::size_t n = size();
+  for (const int i : which)
+    if (i < 0 || static_cast<std::size_t>(i) >= n)
+      throw Error("particle store: pack() of particle " + std::to_string(i) + " of " +
+                  std::to_string(n));
+  std::size_t at = out.size();
+  out.resize(at + which.size() * packed_bytes_per_particle());
+  for (const auto& c : columns_) {
+    c->pack(core_, which, out.data() + at);
+    at += which.size() * c->width * c->element_size();
+  }
+}
+
+std::size_t ParticleStore::unpack(const std::byte* data, std::size_t bytes) {
+  const std::size_t first = size();
+  const std::size_t row = packed_bytes_per_particle();
+  if (row == 0 || bytes % row != 0)
+    throw Error("particle store: unpack() of " + std::to_string(bytes) +
+                " bytes, not a whole number of particles of " + std::to_string(row) +
+                " bytes (packed by a store of another layout?)");
+  const std::size_t n = bytes / row;
+  for (auto& c : columns_) {
+    c->unpack(core_, n, data);
+    data += n * c->width * c->element_size();
+  }
+  std::int64_t next = next_id_;
+  for (std::size_t i = first; i < first + n; ++i) {
+    if (core_.id[i] < 0) {
+      const std::int64_t bad = core_.id[i];
+      for (auto& c : columns_) c->resize(core_, first);  // the store as it was
+      throw Error("particle store: unpack() found particle id " + std::to_string(bad) +
+                  " (ids are >= 0: packed by a store of another layout?)");
+    }
+    next = std::max(next, core_.id[i] + 1);
+  }
+  next_id_ = next;
+  return first;
+}
+
+std::string ParticleStore::layout() const {
+  std::string s;
+  for (const auto& c : columns_)
+    s += c->name + ":" + std::to_string(c->width) + "x" + std::to_string(c->element_size()) + ";";
+  return s;
+}
+
 }  // namespace partita::dem

@@ -11,6 +11,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <map>
 #include <random>
 #include <set>
@@ -191,6 +192,102 @@ TEST_CASE("dem: particle store: a permutation of 40,000 particles on 1 and 2 thr
     CHECK(wrong == 0);
   }
   set_num_threads(before);
+}
+
+TEST_CASE("dem: particle store: particles packed into bytes and unpacked into another store",
+          "[dem][lifecycle][pack]") {
+  // Two stores of one layout (as two subdomains of one system have): particles moved as bytes
+  // arrive with every array's rows and their ids, in the order asked; the rest is refused.
+  const auto make = [] {
+    ParticleStore s;
+    s.add_array<Eigen::Vector3d>("history", 3, Eigen::Vector3d::Constant(-1));
+    s.add_array<std::int64_t>("tag", 1, std::int64_t{7});
+    s.add_array<double>("empty_now", 0, 0.0);  // a history per wall plane with no plane yet
+    return s;
+  };
+  ParticleStore from = make(), to = make();
+  const int h_vec = from.find("history"), h_tag = from.find("tag");
+  const auto fill = [&](ParticleStore& s, std::size_t i, double x) {
+    s.core().position[i] = Eigen::Vector3d(x, -x, 0.5 * x);
+    s.core().velocity[i] = Eigen::Vector3d(2 * x, 0, 1);
+    s.core().radius[i] = 1.0 + x;
+    s.core().mass[i] = 3.0 + x;
+    s.core().material[i] = static_cast<int>(x) % 3;
+    s.array<std::int64_t>(h_tag)[i] = 5 * s.core().id[i] + 1;
+    for (int k = 0; k < 3; ++k)
+      s.array<Eigen::Vector3d>(h_vec)[3 * i + k] = Eigen::Vector3d::Constant(x + 0.25 * k);
+  };
+  for (int i = 0; i < 20; ++i) fill(from, from.add(100 + 3 * i), i);
+  for (int i = 0; i < 4; ++i) fill(to, to.add(), 50 + i);  // ids 0..3
+  REQUIRE(from.layout() == to.layout());
+  CHECK(from.packed_bytes_per_particle() ==
+        5 * 24 + 3 * 8 + 4 + 8 + 3 * 24 + 8);  // core, history, tag; the empty array none
+
+  const std::vector<int> which = {17, 2, 9, 0};
+  std::vector<std::byte> bytes = {std::byte{0xAB}};  // pack() appends
+  from.pack(which, bytes);
+  REQUIRE(bytes.size() == 1 + which.size() * from.packed_bytes_per_particle());
+  const std::size_t first = to.unpack(bytes.data() + 1, bytes.size() - 1);
+  CHECK(first == 4);
+  REQUIRE(to.size() == 8);
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    const auto i = static_cast<std::size_t>(which[k]);
+    const std::size_t j = first + k;
+    CHECK(to.core().id[j] == from.core().id[i]);
+    CHECK(to.core().position[j] == from.core().position[i]);
+    CHECK(to.core().velocity[j] == from.core().velocity[i]);
+    CHECK(to.core().radius[j] == from.core().radius[i]);
+    CHECK(to.core().mass[j] == from.core().mass[i]);
+    CHECK(to.core().material[j] == from.core().material[i]);
+    CHECK(to.array<std::int64_t>(h_tag)[j] == from.array<std::int64_t>(h_tag)[i]);
+    for (int c = 0; c < 3; ++c)
+      CHECK(to.array<Eigen::Vector3d>(h_vec)[3 * j + c] ==
+            from.array<Eigen::Vector3d>(h_vec)[3 * i + c]);
+  }
+  CHECK(to.core().position[3] == Eigen::Vector3d(53, -53, 26.5));  // its own untouched
+  CHECK(to.next_id() == 100 + 3 * 17 + 1);  // above every id it holds: no id handed out twice
+  CHECK(to.core().id[to.add()] == 100 + 3 * 17 + 1);
+
+  // all of them in a random order and back in id order: the same bytes as before
+  std::mt19937_64 rng(3);
+  ParticleStore round = make();
+  std::vector<std::byte> all;
+  from.pack(random_permutation(from.size(), rng), all);
+  round.unpack(all.data(), all.size());
+  std::vector<int> by_id(round.size());
+  for (std::size_t i = 0; i < round.size(); ++i)
+    by_id[static_cast<std::size_t>((round.core().id[i] - 100) / 3)] = static_cast<int>(i);
+  round.permute(by_id);
+  std::vector<std::byte> a, b;
+  std::vector<int> every(from.size());
+  for (std::size_t i = 0; i < every.size(); ++i) every[i] = static_cast<int>(i);
+  from.pack(every, a);
+  round.pack(every, b);
+  CHECK(a == b);
+
+  // refused, the store left as it was: a size that is no whole particle, a store of another
+  // layout, an index out of range
+  const std::size_t size = to.size();
+  CHECK_THROWS_AS(to.unpack(bytes.data() + 1, bytes.size() - 2), Error);
+  ParticleStore plain;  // the core arrays only: a particle of other bytes
+  REQUIRE(plain.layout() != to.layout());
+  std::vector<std::byte> short_rows;
+  plain.add();
+  plain.pack({0}, short_rows);
+  CHECK_THROWS_AS(to.unpack(short_rows.data(), short_rows.size()), Error);
+  CHECK(to.size() == size);
+  // a negative id (bytes that are not particles of this layout): refused after the arrays grew,
+  // and the store shrunk back. The ids of 4 particles follow 5 vector, 3 double and one int
+  // arrays of 4 rows each.
+  std::vector<std::byte> bad(bytes.begin() + 1, bytes.end());
+  const std::int64_t negative = -5;
+  std::memcpy(bad.data() + 4 * (5 * 24 + 3 * 8 + 4) + 8, &negative, 8);
+  CHECK_THROWS_AS(to.unpack(bad.data(), bad.size()), Error);
+  CHECK(to.size() == size);
+  CHECK(to.array<std::int64_t>(h_tag).size() == size);
+  std::vector<std::byte> none;
+  CHECK_THROWS_AS(from.pack({0, 20}, none), Error);
+  CHECK(none.empty());
 }
 
 TEST_CASE("dem: 10^3 random adds, removals and renumberings between steps, then save/restore",

@@ -27,10 +27,12 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstring>
 #include <cstdint>
 #include <memory>
 #include <new>
 #include <string>
+#include <type_traits>
 #include <typeinfo>
 #include <vector>
 
@@ -82,6 +84,24 @@ class ParticleStore {
   void write(BinaryWriter& out) const;
   void read(BinaryReader& in);
 
+  /// Particles as bytes, to move them between stores of the same layout (another process's
+  /// subdomain, a buffer for later): pack() appends to `out` every array's entries of the
+  /// particles `which`, in that order (array by array, each array's rows of those particles one
+  /// after the other: width x element size bytes a row), ids included; unpack() appends the
+  /// particles of such a buffer to this store, in the same order, with their ids, and raises the
+  /// next free id above them. Both stores must have the same arrays (names, element types and
+  /// widths, in the same order): layout() says what that is, and unpack() throws Error when the
+  /// buffer's size is not a whole number of particles of this layout. The bytes are the
+  /// elements' own (the state file's assumption: both ends have the same byte order and types).
+  /// Neither allocates beyond `out` growing and the arrays growing to their new size.
+  std::size_t packed_bytes_per_particle() const;
+  void pack(const std::vector<int>& which, std::vector<std::byte>& out) const;
+  /// Returns the index of the first unpacked particle (the store's former size).
+  std::size_t unpack(const std::byte* data, std::size_t bytes);
+  /// The arrays' names, widths and element sizes, as text (equal on two stores = packed
+  /// particles move between them).
+  std::string layout() const;
+
  private:
   struct Column {
     std::string name;
@@ -100,6 +120,11 @@ class ParticleStore {
     virtual void set_width(Particles& core, std::size_t width) = 0;
     virtual void write(const Particles& core, BinaryWriter& out) const = 0;
     virtual void read(Particles& core, BinaryReader& in) = 0;
+    // the rows of particles `which` as bytes at `out` (which.size() x width x element_size())
+    virtual void pack(const Particles& core, const std::vector<int>& which,
+                      std::byte* out) const = 0;
+    // appends n rows read from `in` (as pack() wrote them)
+    virtual void unpack(Particles& core, std::size_t n, const std::byte* in) = 0;
   };
   template <class T>
   struct TypedColumn;
@@ -178,6 +203,22 @@ struct ParticleStore::TypedColumn final : Column {
     out.value(static_cast<std::uint64_t>(width));
     out.value(static_cast<std::uint64_t>(sizeof(T)));
     out.array(data(core));
+  }
+  void pack(const Particles& core, const std::vector<int>& which,
+            std::byte* out) const override {
+    static_assert(std::is_standard_layout_v<T>, "raw bytes need a standard-layout type");
+    const std::vector<T>& v = data(core);
+    const std::size_t row = width * sizeof(T);
+    for (const int i : which) {
+      if (row > 0) std::memcpy(out, v.data() + static_cast<std::size_t>(i) * width, row);
+      out += row;
+    }
+  }
+  void unpack(Particles& core, std::size_t n, const std::byte* in) override {
+    std::vector<T>& v = data(core);
+    const std::size_t first = v.size();
+    v.resize(first + n * width);
+    if (n * width > 0) std::memcpy(v.data() + first, in, n * width * sizeof(T));
   }
   void read(Particles& core, BinaryReader& in) override {
     const std::string found = in.string("a particle array name");
