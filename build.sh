@@ -37,11 +37,12 @@ PACKAGES=(cmake ninja-build g++ pkg-config libeigen3-dev libyaml-cpp-dev libspdl
           catch2 libcli11-dev libnanoflann-dev python3 python3-numpy python3-matplotlib
           python3-vtk9 libsuitesparse-dev libopenblas0-serial zlib1g-dev
           libopenmpi-dev openmpi-bin bc procps
-          python3-dev pybind11-dev python3-pybind11 python3-pandas python3-pytest)
+          python3-dev pybind11-dev python3-pybind11 python3-pandas python3-pytest python3-mpi4py)
 # libopenmpi-dev, openmpi-bin: participants as processes (`partita run CASE --participant NAME`
 # under mpirun); bc and procps (pgrep) for the MPI tests' script.
 # python3-dev, pybind11-dev, python3-pybind11, python3-pandas, python3-pytest: the Python module
-# (python/, docs/python.md) for Debian's python3, its DataFrames and its pytest suite.
+# (python/, docs/python.md) for Debian's python3, its DataFrames and its pytest suite;
+# python3-mpi4py: the communicator a Python program may give partita.ExternalParticipant.
 # Only for `./build.sh test --sanitize` and `./build.sh fuzz`: clang and its runtime libraries
 # (libclang_rt.fuzzer, ASan, UBSan).
 SANITIZE_PACKAGES=(clang libclang-rt-dev)

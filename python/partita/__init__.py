@@ -18,13 +18,15 @@ from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Union
 
 from . import _partita
-from ._errors import CaseError, Error, InternalError
+from ._errors import CaseError, Error, InternalError, RunStopped, UsageError
+from ._external import ExternalParticipant
 from ._result import Result, Summary, read_csv
 from ._solver import Field, Mesh, OutputFrame, Solver, SolverContext, quantity, register_solver, solvers
 
 __all__ = ["check", "run", "read", "sweep", "read_csv", "set_log_level", "Result", "Summary",
            "Progress", "Error", "CaseError", "InternalError", "__version__", "Solver", "Mesh",
-           "Field", "OutputFrame", "SolverContext", "register_solver", "solvers", "quantity"]
+           "Field", "OutputFrame", "SolverContext", "register_solver", "solvers", "quantity",
+           "ExternalParticipant", "UsageError", "RunStopped"]
 
 #: the version of the partita libraries the module is built from (as ``partita --version``)
 __version__: str = _partita.version()

@@ -28,3 +28,13 @@ class CaseError(Error):
 
 class InternalError(Error):
     """A condition partita does not check for yet (a bug): the message says how to report it."""
+
+
+class UsageError(Error):
+    """partita.ExternalParticipant called out of order or with a name the participant did not
+    declare (a bug of the program)."""
+
+
+class RunStopped(Error):
+    """partita.ExternalParticipant: the run ended elsewhere (another participant failed, a signal,
+    or the controller refused this process at start-up); the message says which."""

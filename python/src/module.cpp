@@ -128,4 +128,9 @@ PYBIND11_MODULE(_partita, m) {
   });
   bind_run(m);
   bind_solver(m);
+#ifdef PARTITA_PYTHON_MPI
+  bind_external(m);
+#else
+  m.attr("has_mpi") = false;
+#endif
 }

@@ -11,6 +11,7 @@
 #include <pybind11/pybind11.h>
 
 #include "partita/interface/error.hpp"
+#include "partita/interface/solver.hpp"
 
 #include "partita/coupling/registries.hpp"
 
@@ -28,6 +29,10 @@ std::shared_ptr<const coupling::Registries> registries();
 /// sweep (its variants are partita processes, which do not know it).
 void refuse_python_solvers(const std::string& case_file, const std::vector<std::string>& overrides);
 
+/// solver.cpp: a partita.Mesh (or any object with its attributes: name, points, triangles,
+/// weights, reads, writes, prescribed) as an InterfaceMesh; errors name `who`.
+InterfaceMesh to_interface_mesh(pybind11::handle mesh, const std::string& who);
+
 /// solver.cpp: _partita.add_solver, python_solver_names and quantity.
 void bind_solver(pybind11::module_& m);
 
@@ -37,6 +42,10 @@ std::vector<SourceLocation> override_origins(const std::vector<std::string>& ove
 
 /// A case with a `plugins:` list is refused with a clear error (the module loads no plugins).
 void refuse_plugins(const std::string& case_file, const std::vector<std::string>& overrides);
+
+/// external.cpp (built where partita has MPI, PARTITA_PYTHON_MPI): _partita.ExternalParticipant,
+/// partita::mpi::ExternalParticipant for a Python program under mpirun.
+void bind_external(pybind11::module_& m);
 
 /// run.cpp: _partita.run and _partita.sweep.
 void bind_run(pybind11::module_& m);

@@ -319,60 +319,7 @@ class PythonSolver : public Solver {
                             who_, data, mesh));
   }
 
-  // A partita.Mesh (or any object with its attributes) as an InterfaceMesh.
-  InterfaceMesh to_mesh(py::handle m) const {
-    InterfaceMesh im;
-    const std::string name = py::str(m.attr("name")).cast<std::string>();
-    const auto pts = py::array_t<double, py::array::forcecast>::ensure(m.attr("points"));
-    if (!pts || pts.ndim() != 2 || pts.shape(1) != 3)
-      throw Error(who_ + ": mesh '" + name + "': points must be an array of shape (n, 3)");
-    Mesh::Points points(pts.shape(0), 3);
-    const auto p = pts.unchecked<2>();
-    for (py::ssize_t i = 0; i < pts.shape(0); ++i)
-      for (int j = 0; j < 3; ++j) points(i, j) = p(i, j);
-    Mesh::Triangles triangles(0, 3);
-    const py::object tri = m.attr("triangles");
-    if (!tri.is_none()) {
-      const auto t = py::array_t<int, py::array::forcecast>::ensure(tri);
-      if (!t || t.ndim() != 2 || t.shape(1) != 3)
-        throw Error(who_ + ": mesh '" + name + "': triangles must be an array of shape (m, 3)");
-      triangles.resize(t.shape(0), 3);
-      const auto tv = t.unchecked<2>();
-      for (py::ssize_t i = 0; i < t.shape(0); ++i)
-        for (int j = 0; j < 3; ++j) triangles(i, j) = tv(i, j);
-    }
-    im.mesh = Mesh(name, std::move(points), std::move(triangles));
-    const py::object weights = m.attr("weights");
-    if (!weights.is_none()) {
-      const auto w = py::array_t<double, py::array::forcecast>::ensure(weights);
-      if (!w || w.ndim() != 1)
-        throw Error(who_ + ": mesh '" + name + "': weights must be an array of shape (n,)");
-      im.mesh.set_weights(Eigen::Map<const Eigen::VectorXd>(w.data(), w.shape(0)));
-    }
-    const auto fields = [&](const char* which) {
-      std::vector<DataSpec> out;
-      for (const py::handle f : m.attr(which)) {
-        DataSpec d;
-        d.name = py::str(f.attr("name")).cast<std::string>();
-        d.components = f.attr("components").cast<int>();
-        d.unit = py::str(f.attr("unit")).cast<std::string>();
-        const std::string kind = py::str(f.attr("kind")).cast<std::string>();
-        if (d.components != 1 && d.components != 3)
-          throw Error(who_ + ": field '" + d.name + "' of mesh '" + name +
-                      "': components must be 1 or 3");
-        if (kind != "intensive" && kind != "extensive")
-          throw Error(who_ + ": field '" + d.name + "' of mesh '" + name +
-                      "': kind must be 'intensive' or 'extensive', not '" + kind + "'");
-        d.kind = kind == "extensive" ? DataKind::extensive : DataKind::intensive;
-        out.push_back(std::move(d));
-      }
-      return out;
-    };
-    im.reads = fields("reads");
-    im.writes = fields("writes");
-    im.prescribed = m.attr("prescribed").cast<bool>();
-    return im;
-  }
+  InterfaceMesh to_mesh(py::handle m) const { return to_interface_mesh(m, who_); }
 
   std::string who_;
   py::object object_;
@@ -425,6 +372,60 @@ void refuse_python_solvers(const std::string& case_file, const std::vector<std::
                         "' is a solver registered in Python, which a sweep cannot use: its "
                         "variants run as partita processes; run them with partita.run in a loop");
   }
+}
+
+InterfaceMesh to_interface_mesh(py::handle m, const std::string& who) {
+  InterfaceMesh im;
+  const std::string name = py::str(m.attr("name")).cast<std::string>();
+  const auto pts = py::array_t<double, py::array::forcecast>::ensure(m.attr("points"));
+  if (!pts || pts.ndim() != 2 || pts.shape(1) != 3)
+    throw Error(who + ": mesh '" + name + "': points must be an array of shape (n, 3)");
+  Mesh::Points points(pts.shape(0), 3);
+  const auto p = pts.unchecked<2>();
+  for (py::ssize_t i = 0; i < pts.shape(0); ++i)
+    for (int j = 0; j < 3; ++j) points(i, j) = p(i, j);
+  Mesh::Triangles triangles(0, 3);
+  const py::object tri = m.attr("triangles");
+  if (!tri.is_none()) {
+    const auto t = py::array_t<int, py::array::forcecast>::ensure(tri);
+    if (!t || t.ndim() != 2 || t.shape(1) != 3)
+      throw Error(who + ": mesh '" + name + "': triangles must be an array of shape (m, 3)");
+    triangles.resize(t.shape(0), 3);
+    const auto tv = t.unchecked<2>();
+    for (py::ssize_t i = 0; i < t.shape(0); ++i)
+      for (int j = 0; j < 3; ++j) triangles(i, j) = tv(i, j);
+  }
+  im.mesh = Mesh(name, std::move(points), std::move(triangles));
+  const py::object weights = m.attr("weights");
+  if (!weights.is_none()) {
+    const auto w = py::array_t<double, py::array::forcecast>::ensure(weights);
+    if (!w || w.ndim() != 1)
+      throw Error(who + ": mesh '" + name + "': weights must be an array of shape (n,)");
+    im.mesh.set_weights(Eigen::Map<const Eigen::VectorXd>(w.data(), w.shape(0)));
+  }
+  const auto fields = [&](const char* which) {
+    std::vector<DataSpec> out;
+    for (const py::handle f : m.attr(which)) {
+      DataSpec d;
+      d.name = py::str(f.attr("name")).cast<std::string>();
+      d.components = f.attr("components").cast<int>();
+      d.unit = py::str(f.attr("unit")).cast<std::string>();
+      const std::string kind = py::str(f.attr("kind")).cast<std::string>();
+      if (d.components != 1 && d.components != 3)
+        throw Error(who + ": field '" + d.name + "' of mesh '" + name +
+                    "': components must be 1 or 3");
+      if (kind != "intensive" && kind != "extensive")
+        throw Error(who + ": field '" + d.name + "' of mesh '" + name +
+                    "': kind must be 'intensive' or 'extensive', not '" + kind + "'");
+      d.kind = kind == "extensive" ? DataKind::extensive : DataKind::intensive;
+      out.push_back(std::move(d));
+    }
+    return out;
+  };
+  im.reads = fields("reads");
+  im.writes = fields("writes");
+  im.prescribed = m.attr("prescribed").cast<bool>();
+  return im;
 }
 
 void bind_solver(py::module_& m) {
