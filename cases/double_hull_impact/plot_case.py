@@ -14,13 +14,18 @@ Usage: plot_case.py FILLED_DIR [EMPTY_DIR] [--out DIR] [--driven DIR] [--rate OT
 Writes force_penetration.png, energy.png, inner_deflection.png, section_<k>.png (k = 1, 2, 3: the
 output frames nearest 1/3, 2/3 and all of the final penetration, cut at y = 0.181 m through the
 bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI units):
-  weight_balance          -(sum of granules.cXX.force_z) / (granules.mass g), averaged over the rows
+  weight_balance          -(sum of granules.cXX.force_z, or of section.yaml's granules.cavity_outer,
+                          _inner, _webs.force_z) / (granules.mass g), averaged over the rows
                           before the bow touches (penetration 0) after the first 2 ms (1: the
                           granules' weight rests on the hull); weight_balance_last: the same over
                           the last 20 % of those rows (the settled state); weight_balance_impulse
                           (with the monitor granules.momentum_z): over the same rows, (the cells'
                           and the bow's impulse on the granules - the change of their momentum) /
-                          the impulse of m g (1 also while the bed rings: Newton's second law)
+                          the impulse of m g (1 also while the bed rings: Newton's second law);
+                          hull_weight_balance (section.yaml): the same with the forces the
+                          hull's three cavity interfaces received; bed_on_inner_plate_N: the mean of
+                          granules.cavity_inner.force_z over those rows, the bed's load on the
+                          inner plate before the strike
   max_abs_energy_error[_empty]   largest |energy balance error| of energy.csv over the rows whose
                           indenter work exceeds 1 % of its final value
   quasi_static_ke_ratio[_empty]  max of (hull + granules kinetic energy) / (hull strain energy +
@@ -92,6 +97,7 @@ G = 9.81
 SECTION_Y = 0.181                 # the bow's axis (x = y = 0.181)
 BOW_RADIUS, BOW_LENGTH = 0.030, 0.030   # the capsule's radius; its cylinder's length unless vtk/hull_bow says
 CELLS = [f"c{i}{j}" for j in range(3) for i in range(3)]
+PARTS = ["cavity_outer", "cavity_inner", "cavity_webs"]   # section.yaml's interfaces, by part
 
 
 def note(msg):
@@ -266,8 +272,11 @@ def read_vtk(path):
 # ------------------------------------------------------------------------------------- numbers
 def weight_balance(run):
     cols = [f"granules.{c}.force_z" for c in CELLS]
+    if not run.has(*cols):   # the cavity's faces by part (section.yaml)
+        cols = [f"granules.{c}.force_z" for c in PARTS]
     if not run.has(*cols, "granules.mass"):
-        note(f"{run.label}: granules.cXX.force_z or granules.mass missing (weight_balance skipped)")
+        note(f"{run.label}: granules.cXX.force_z (or granules.cavity_*.force_z) or granules.mass "
+             "missing (weight_balance skipped)")
         return
     fz = sum(run.at(c) for c in cols)
     rows = np.nonzero((run.pen <= 0) & (run.t > 0.002))[0]
@@ -276,6 +285,16 @@ def weight_balance(run):
         return
     weight = run.at("granules.mass")[rows] * G
     key("weight_balance", float(np.mean(-fz[rows]) / np.mean(weight)))
+    hull_cols = [f"hull.{c}.force_z" for c in PARTS]
+    if run.has(*hull_cols):
+        # the same weight as the hull received it: the parts' interfaces share the nodes where a
+        # web meets a plate, and their forces add there
+        hz = sum(run.at(c) for c in hull_cols)
+        key("hull_weight_balance", float(np.mean(-hz[rows]) / np.mean(weight)))
+    if run.has("granules.cavity_inner.force_z"):
+        # what the bed presses on the inner plate before the strike (the granules' force on the
+        # mesh; +z: the plate pushed away from the cavity)
+        key("bed_on_inner_plate_N", float(np.mean(run.at("granules.cavity_inner.force_z")[rows])))
     last = rows[len(rows) - max(1, len(rows) // 5):]
     key("weight_balance_last", float(np.mean(-fz[last]) / np.mean(run.at("granules.mass")[last] * G)))
     # the impulse balance over the same rows (a bed that rings is not at rest, so the cells' force
@@ -553,7 +572,7 @@ def granule_items(run):
     """(area, upward force) of the inner plate's cavity faces from the granules' mesh or interface
     files at the last output frame, and the files' name; ([], None) without them."""
     faces = []
-    for c in CELLS:
+    for c in CELLS + ["cavity_inner"]:
         for name in (f"granules_{c}", f"granules_interface_{c}"):
             frames = pvd_frames(run.folder, name)
             if not frames:

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "masked_grid.hpp"
@@ -123,6 +124,28 @@ void check(const PanelSpec& s) {
 
 }  // namespace
 
+void place_webs_by_cells(PanelSpec& spec, int cells_x, int cells_y, double web_spacing) {
+  const double t = spec.web_thickness;
+  if (!(t > 0.0) || !std::isfinite(t))
+    throw Error("panel mesh: web_thickness must be > 0 m, got " + num(t));
+  for (const auto& [n, axis] : {std::pair{cells_x, "x"}, std::pair{cells_y, "y"}})
+    if (n < 1)
+      throw Error(std::string("panel mesh: the number of cells along ") + axis +
+                  " must be >= 1, got " + std::to_string(n));
+  if (!std::isfinite(web_spacing) || !(web_spacing >= 2.0 * t))
+    throw Error("panel mesh: web_spacing (centre to centre) must be at least 2 web_thickness (" +
+                num(2.0 * t) + " m: a cell at least as wide as a web), got " + num(web_spacing) +
+                " m");
+  // webs flush with both edges: the first at t / 2, the last at t / 2 + n * spacing
+  const auto place = [&](int n, std::vector<double>& webs, double& footprint) {
+    webs.clear();
+    for (int k = 0; k <= n; ++k) webs.push_back(0.5 * t + static_cast<double>(k) * web_spacing);
+    footprint = static_cast<double>(n) * web_spacing + t;
+  };
+  place(cells_x, spec.frames, spec.footprint_x);
+  place(cells_y, spec.stringers, spec.footprint_y);
+}
+
 Mesh make_panel_mesh(const PanelSpec& spec) {
   check(spec);
   const Axis x = web_axis(spec.origin.x(), spec.footprint_x, spec.frames, spec.web_thickness, spec,
@@ -161,6 +184,8 @@ Mesh make_panel_mesh(const PanelSpec& spec) {
     return in_web(c) ? 2 : -1;
   };
   static const std::array<std::string, 4> edges = {"xmin", "xmax", "ymin", "ymax"};
+  static const std::string cavity = "cavity", cavity_outer = "cavity_outer",
+                           cavity_inner = "cavity_inner", cavity_webs = "cavity_webs";
   grid.faces = [&](const detail::GridCell& c, int d, int upper, bool outside,
                    std::vector<std::string>& out) {
     if (outside) {
@@ -172,6 +197,10 @@ Mesh make_panel_mesh(const PanelSpec& spec) {
     across[d] += upper ? 1 : -1;
     out.push_back("cell_" + std::to_string(x.gap[static_cast<std::size_t>(across[0])]) + "_" +
                   std::to_string(y.gap[static_cast<std::size_t>(across[1])]));
+    // by part: a face toward the cavity along z is a plate's (the outer plate's on its upper
+    // side), in the plane a web's side
+    out.push_back(cavity);
+    out.push_back(d != 2 ? cavity_webs : upper ? cavity_outer : cavity_inner);
   };
   return detail::make_masked_grid_mesh(grid, spec.element);
 }

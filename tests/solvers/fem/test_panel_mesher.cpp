@@ -154,6 +154,7 @@ void check_analytic(const PanelSpec& s) {
 
   const auto gx = gaps(lx, s.frames, t), gy = gaps(ly, s.stringers, t);
   std::size_t cells = 0;
+  double floors = 0.0, sides = 0.0;  // the cells' floor areas and their webs' sides
   for (std::size_t i = 0; i < gx.size(); ++i) {
     for (std::size_t j = 0; j < gy.size(); ++j) {
       const std::string name = "cell_" + std::to_string(i) + "_" + std::to_string(j);
@@ -168,6 +169,8 @@ void check_analytic(const PanelSpec& s) {
       const int y_sides = !flush(y0, 0.0) + !flush(y1, ly);
       const Surface c = integrate(mesh, name);
       CHECK(c.area == Approx(2 * a * b + x_sides * b * h + y_sides * a * h).epsilon(1e-12));
+      floors += a * b;
+      sides += x_sides * b * h + y_sides * a * h;
       // every face element points into its cavity: a step along the normal from its centre
       // lands in the cell's box, a step back in the solid (outside the box)
       const Vec3 lo(s.origin.x() + x0, s.origin.y() + y0, z1);
@@ -193,6 +196,26 @@ void check_analytic(const PanelSpec& s) {
   std::size_t cell_faces = 0;
   for (const auto& f : mesh.face_names()) cell_faces += f.rfind("cell_", 0) == 0;
   CHECK(cell_faces == cells);
+
+  // the same faces by part: the plates' faces toward the cavity (the cells' floors and ceilings,
+  // at the cavity's planes, normals into it) and the webs' sides; "cavity" all of them
+  const Surface outer_side = integrate(mesh, "cavity_outer"),
+                inner_side = integrate(mesh, "cavity_inner"),
+                web_sides = integrate(mesh, "cavity_webs"), cavity = integrate(mesh, "cavity");
+  CHECK(outer_side.area == Approx(floors).epsilon(1e-12));
+  CHECK(outer_side.area_normal.z() == Approx(floors).epsilon(1e-12));
+  for (const auto& [x, n] : outer_side.centres) CHECK(x.z() == Approx(z1).epsilon(1e-14));
+  CHECK(inner_side.area == Approx(floors).epsilon(1e-12));
+  CHECK(inner_side.area_normal.z() == Approx(-floors).epsilon(1e-12));
+  for (const auto& [x, n] : inner_side.centres) CHECK(x.z() == Approx(z2).epsilon(1e-14));
+  if (sides > 0.0) {
+    CHECK(web_sides.area == Approx(sides).epsilon(1e-12));
+    for (const auto& [x, n] : web_sides.centres) CHECK(std::abs(n.z()) < 1e-14);
+  }
+  CHECK(cavity.area == Approx(2 * floors + sides).epsilon(1e-12));
+  CHECK(mesh.face("cavity").size() == mesh.face("cavity_outer").size() +
+                                          mesh.face("cavity_inner").size() +
+                                          (sides > 0.0 ? mesh.face("cavity_webs").size() : 0));
 }
 
 void check_conforming(const Mesh& mesh) {
@@ -211,13 +234,15 @@ void check_conforming(const Mesh& mesh) {
       std::sort(key.begin(), key.end());
       ++count[key];
     }
+  // (the cavity's faces by part, "cavity*", group faces that are in their cells' sets)
   std::map<std::vector<std::size_t>, int> named;
   for (const auto& name : mesh.face_names())
-    for (const SurfaceElement& f : mesh.face(name)) {
-      std::vector<std::size_t> key(f.node_span().begin(), f.node_span().end());
-      std::sort(key.begin(), key.end());
-      ++named[key];
-    }
+    if (name.rfind("cavity", 0) != 0)
+      for (const SurfaceElement& f : mesh.face(name)) {
+        std::vector<std::size_t> key(f.node_span().begin(), f.node_span().end());
+        std::sort(key.begin(), key.end());
+        ++named[key];
+      }
   std::size_t bad = 0, free_faces = 0;
   for (const auto& [key, n] : count) {
     if (n > 2) ++bad;
@@ -230,6 +255,25 @@ void check_conforming(const Mesh& mesh) {
   }
   CHECK(bad == 0);
   CHECK(named.size() == free_faces);
+  // the cavity's faces by part: "cavity" is the cells' faces, each in one part's set
+  const auto keys = [&](const std::string& name) {
+    std::map<std::vector<std::size_t>, int> k;
+    if (!mesh.has_face(name)) return k;
+    for (const SurfaceElement& f : mesh.face(name)) {
+      std::vector<std::size_t> key(f.node_span().begin(), f.node_span().end());
+      std::sort(key.begin(), key.end());
+      ++k[key];
+    }
+    return k;
+  };
+  std::map<std::vector<std::size_t>, int> cells, parts;
+  for (const auto& name : mesh.face_names())
+    if (name.rfind("cell_", 0) == 0)
+      for (const auto& [key, n] : keys(name)) cells[key] += n;
+  for (const char* part : {"cavity_outer", "cavity_inner", "cavity_webs"})
+    for (const auto& [key, n] : keys(part)) parts[key] += n;
+  CHECK(keys("cavity") == cells);
+  CHECK(parts == cells);
 }
 
 }  // namespace
@@ -374,4 +418,93 @@ TEST_CASE("panel mesh: bad input is refused with the rule", "[fem][panel]") {
     b.web_cells = 0;
     refused(b, "web_cells must be >= 1");
   }
+}
+
+TEST_CASE("panel mesh: the cells form places the webs flush with the edges", "[fem][panel]") {
+  PanelSpec s = closed_panel(ElementType::Hex8);
+  s.frames.clear();
+  s.stringers.clear();
+  place_webs_by_cells(s, 3, 2, 0.15);
+  const double t = s.web_thickness;
+  CHECK(s.footprint_x == Approx(3 * 0.15 + t).epsilon(1e-15));
+  CHECK(s.footprint_y == Approx(2 * 0.15 + t).epsilon(1e-15));
+  REQUIRE(s.frames.size() == 4);
+  REQUIRE(s.stringers.size() == 3);
+  for (std::size_t k = 0; k < s.frames.size(); ++k)
+    CHECK(s.frames[k] == Approx(t / 2 + static_cast<double>(k) * 0.15).epsilon(1e-15));
+  CHECK(s.stringers.back() == Approx(s.footprint_y - t / 2).epsilon(1e-15));
+  // every cell closed (clear width spacing - t), parts' areas analytic
+  for (auto type : {ElementType::Hex8, ElementType::Tet4}) {
+    INFO("element " << to_string(type));
+    s.element = type;
+    check_analytic(s);
+    check_conforming(make_panel_mesh(s));
+  }
+  const Mesh mesh = make_panel_mesh(s);
+  const double a = 0.15 - t, h = s.depth;
+  CHECK(integrate(mesh, "cavity_outer").area == Approx(6 * a * a).epsilon(1e-12));
+  CHECK(integrate(mesh, "cavity_webs").area == Approx(6 * 4 * a * h).epsilon(1e-12));
+  CHECK(mesh.has_face("cell_2_1"));
+  CHECK_FALSE(mesh.has_face("cell_3_0"));
+}
+
+TEST_CASE("panel mesh: the double hull's section from its cells is the hand-written one",
+          "[fem][panel]") {
+  // cases/double_hull_impact: 3 x 3 cells of 118 mm clear (webs of 2 mm at 120 mm), 80 mm deep,
+  // 2 mm plates, 20 mm elements; written by hand as a footprint and the webs' positions
+  PanelSpec hand;
+  hand.origin = Vec3::Zero();
+  hand.footprint_x = hand.footprint_y = 0.362;
+  hand.outer_thickness = hand.inner_thickness = hand.web_thickness = 0.002;
+  hand.depth = 0.080;
+  hand.frames = hand.stringers = {0.001, 0.121, 0.241, 0.361};
+  hand.element_size = 0.020;
+  PanelSpec cells = hand;
+  cells.frames.clear();
+  cells.stringers.clear();
+  place_webs_by_cells(cells, 3, 3, 0.120);
+  const Mesh a = make_panel_mesh(hand), b = make_panel_mesh(cells);
+  REQUIRE(a.num_nodes() == b.num_nodes());
+  REQUIRE(a.num_elements() == b.num_elements());
+  bool same_nodes = true;
+  for (std::size_t n = 0; n < a.num_nodes(); ++n)
+    same_nodes = same_nodes && (a.node(n).array() == b.node(n).array()).all();  // to the bit
+  CHECK(same_nodes);
+  bool same_elements = true;
+  for (std::size_t e = 0; e < a.num_elements(); ++e)
+    same_elements = same_elements && a.element(e).region == b.element(e).region &&
+                    a.element(e).nodes == b.element(e).nodes;
+  CHECK(same_elements);
+  REQUIRE(a.face_names() == b.face_names());
+  for (const auto& name : a.face_names()) {
+    INFO(name);
+    const auto &fa = a.face(name), &fb = b.face(name);
+    REQUIRE(fa.size() == fb.size());
+    bool same = true;
+    for (std::size_t k = 0; k < fa.size(); ++k)
+      same = same && std::equal(fa[k].node_span().begin(), fa[k].node_span().end(),
+                                fb[k].node_span().begin(), fb[k].node_span().end());
+    CHECK(same);
+  }
+  CHECK(a.face_names().size() == 9 + 4 + 6);  // the cells, the cavity by part, outer ... ymax
+}
+
+TEST_CASE("panel mesh: the cells form refuses bad counts and spacings", "[fem][panel]") {
+  const auto refused = [](int nx, int ny, double spacing, double t, const std::string& what) {
+    PanelSpec s;
+    s.web_thickness = t;
+    try {
+      place_webs_by_cells(s, nx, ny, spacing);
+    } catch (const Error& e) {
+      INFO(e.what());
+      CHECK(std::string(e.what()).find(what) != std::string::npos);
+      return;
+    }
+    FAIL("accepted: " << nx << " x " << ny << " at " << spacing);
+  };
+  refused(0, 3, 0.1, 0.002, "cells along x must be >= 1");
+  refused(3, -1, 0.1, 0.002, "cells along y must be >= 1");
+  refused(3, 3, 0.003, 0.002, "web_spacing (centre to centre) must be at least 2 web_thickness");
+  refused(3, 3, std::nan(""), 0.002, "web_spacing");
+  refused(3, 3, 0.1, 0.0, "web_thickness must be > 0");
 }

@@ -28,8 +28,11 @@ namespace partita::fem {
 // "cell_<i>_<j>" for each cavity cell: every face bounding it (the plates' faces toward the
 // cavity and the webs' sides), normals pointing into the cavity (as the hollow box's "inner").
 // Cells are numbered along x (i, from origin.x) and y (j) by the gaps between the webs; a gap
-// between a web and the footprint's edge is a cell open on that side (no face there). Node set
-// "all" as well.
+// between a web and the footprint's edge is a cell open on that side (no face there). The same
+// cavity faces grouped by part, whatever the number of cells: "cavity" (every cell's faces),
+// "cavity_outer" (the outer plate's faces toward the cavity, normal +z), "cavity_inner" (the
+// inner plate's, normal -z) and "cavity_webs" (the webs' sides); a face is in its cell's set, in
+// "cavity" and in one part's set. Node set "all" as well.
 struct PanelSpec {
   Vec3 origin = Vec3::Zero();     // min x, min y, and z of the outer plate's struck face [m]
   double footprint_x = 1.0;       // extent along x [m]
@@ -47,6 +50,15 @@ struct PanelSpec {
   int depth_cells = 0;            // cells over the depth (0: from element_size)
   ElementType element = ElementType::Hex8;
 };
+
+// The cells form of a panel: cells_x x cells_y cavity cells closed on every side, the webs'
+// mid-planes at web_spacing (centre to centre) from a web flush with the footprint's low edge
+// (at web_thickness / 2) to one flush with its high edge. Sets spec.frames, spec.stringers and
+// the footprint (cells * web_spacing + web_thickness along each axis); spec.web_thickness must be
+// set first. Each cell's clear width is web_spacing - web_thickness. Throws Error if a count is
+// < 1, web_thickness is not positive or web_spacing is not at least 2 web_thickness (the cells
+// would be thinner than a web).
+void place_webs_by_cells(PanelSpec& spec, int cells_x, int cells_y, double web_spacing);
 
 // Throws Error (stating the rule, the value and what is allowed) if a size or thickness is not
 // positive, a count is < 1 (depth_cells < 0), a web reaches beyond the footprint, two webs
