@@ -2,7 +2,7 @@
 """The filling of a double-hull section given by cells (section.yaml), from the case itself.
 
   make_section.py CASE.yaml [--set KEY=VALUE ...] [-o DIR] [--diameters "20 mm,16 mm"]
-                  [--porosity 0.5] [--fill-height H] [--seed 1] [--end 0.15]
+                  [--porosity 0.5] [--fill-height H] [--seed 1] [--end 0.15] [--stl-only]
 
 Reads the hull's panel (mesh.panel: origin or centre, cells, web_spacing, web_thickness,
 outer_thickness, depth) and the granules' materials, interactions and breakage from CASE, after the --set values
@@ -74,6 +74,7 @@ def main():
     ap.add_argument("--fill-height", help="height of the generated boxes above the outer plate [m] (default: the depth)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--end", type=float, default=0.15, help="settling time [s]")
+    ap.add_argument("--stl-only", action="store_true", help="write DIR/cells.stl alone")
     a = ap.parse_args()
 
     case = yaml.safe_load(Path(a.case).read_text())
@@ -140,6 +141,9 @@ def main():
                 f.write(f"  vertex {p[0]:.6f} {p[1]:.6f} {p[2]:.6f}\n")
             f.write(" endloop\nendfacet\n")
         f.write("endsolid cells\n")
+    if a.stl_only:
+        print(f"make_section: {out / 'cells.stl'} ({len(tris)} triangles)")
+        return
 
     boxes = [{"origin": [round(x0, 12), round(y0, 12), round(z0, 12)],
               "size": [round(x1 - x0, 12), round(y1 - y0, 12), round(fill_h, 12)]}
