@@ -602,7 +602,7 @@ def granule_items(run):
                     area_n[cl] += a / len(cl)
                 for v in np.nonzero(area_n > 0)[0]:
                     faces.append((area_n[v], force[v, 2]))
-            source = name.rsplit("_", 1)[0]
+            source = name if c in PARTS else name.rsplit("_", 1)[0] + "_cXX"
             break
     return faces, (source if faces else None)
 
@@ -665,7 +665,7 @@ def footprint(run, suffix=""):
     if source:
         key("footprint_fraction_90" + suffix, float(a[order][:n].sum() / cavity_area))
         key("inner_plate_granule_force" + suffix + "_N", float(up.sum() - bow_up))
-    note(f"{run.label}: footprint from " + " and ".join(x for x in (source and f"{source}_cXX", bow_up > 0 and "the bow's contact_force") if x) + " (last frame)")
+    note(f"{run.label}: footprint from " + " and ".join(x for x in (source, bow_up > 0 and "the bow's contact_force") if x) + " (last frame)")
 
 
 # ---------------------------------------------------------------------------------------- plots
