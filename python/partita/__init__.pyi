@@ -5,7 +5,9 @@ from typing import Any, Callable, Dict, Mapping, NamedTuple, Optional, Sequence,
 
 import pandas as pd
 
-from ._errors import CaseError as CaseError, Error as Error, InternalError as InternalError
+from ._errors import (CaseError as CaseError, Error as Error, InternalError as InternalError,
+                      RunStopped as RunStopped, UsageError as UsageError)
+from ._external import ExternalParticipant as ExternalParticipant
 from ._result import Result as Result, Summary as Summary, read_csv as read_csv
 from ._solver import (Field as Field, Mesh as Mesh, OutputFrame as OutputFrame, Solver as Solver,
                       SolverContext as SolverContext, quantity as quantity,
