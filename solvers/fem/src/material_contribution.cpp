@@ -174,8 +174,25 @@ MaterialContribution::MaterialContribution(const Model& model)
     element_erodes_[e] = c.erosion ? 1 : 0;
     erosion_ = erosion_ || c.erosion;
     failure_offset_ = alpha_end;
+    if (c.uses_damage()) {
+      // RTCL and BWH: the element's criterion, and its plate's normal (BWH)
+      if (element_damage_criterion_.empty()) {
+        element_damage_criterion_.assign(mesh_.num_elements(), nullptr);
+        element_normal_.assign(mesh_.num_elements(), Vec3::Zero());
+      }
+      const auto r = static_cast<std::size_t>(el.region);
+      if (region_damage_criteria_.size() <= r) region_damage_criteria_.resize(r + 1);
+      if (!region_damage_criteria_[r]) region_damage_criteria_[r] = std::make_unique<FailureCriterion>(c);
+      element_damage_criterion_[e] = region_damage_criteria_[r].get();
+      if (c.kind == FailureCriterion::Kind::Bwh) element_normal_[e] = failure_plate_normal(mesh_, el);
+    }
   }
   if (failure_offset_ != kNoFailure) alpha_end += mesh_.num_elements() + 1;
+  // RTCL and BWH: per point its damage and the eps_p at which it was last updated
+  if (!element_damage_criterion_.empty()) {
+    damage_offset_ = alpha_end;
+    alpha_end += 2 * weight_.size();
+  }
   if (reduced_hex8_) {
     enhanced_work_offset_ = alpha_end++;
     enhanced_work_trial_.assign(mesh_.num_elements(), 0.0);
@@ -433,12 +450,49 @@ void MaterialContribution::add_eroded_energy(double w) {
   trial_[i] = committed_[i];
 }
 
+double MaterialContribution::element_damage(std::size_t e) const {
+  if (damage_offset_ == kNoFailure || element_damage_criterion_[e] == nullptr) return -1.0;
+  double sum = 0.0;
+  for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q)
+    sum += committed_[damage_offset_ + 2 * q];
+  return sum / static_cast<double>(qp_offset_[e + 1] - qp_offset_[e]);
+}
+
+void MaterialContribution::update_damage() {
+  // each point's damage from the committed step: the stress of the last add() (at the
+  // committed u) and the increment of its committed eps_p since the last update
+  for (std::size_t e = 0; e < mesh_.num_elements(); ++e) {
+    const FailureCriterion* c = element_damage_criterion_[e];
+    if (c == nullptr || failed(e)) continue;
+    for (std::size_t q = qp_offset_[e]; q < qp_offset_[e + 1]; ++q) {
+      const double eps_p = element_law_[e]->equivalent_plastic_strain(
+          std::span<const double>(committed_)
+              .subspan(state_offset_[q], state_offset_[q + 1] - state_offset_[q]));
+      const std::size_t at = damage_offset_ + 2 * q;
+      const auto row = cauchy_.row(static_cast<Eigen::Index>(q));
+      Mat3 sigma;
+      sigma << row[0], row[3], row[5], row[3], row[1], row[4], row[5], row[4], row[2];
+      const double d = c->updated_damage(committed_[at], sigma, eps_p - committed_[at + 1],
+                                         element_failure_strain_[e], element_normal_[e]);
+      committed_[at] = trial_[at] = d;
+      committed_[at + 1] = trial_[at + 1] = eps_p;
+    }
+  }
+}
+
 std::vector<std::size_t> MaterialContribution::update_failures(double time) {
   std::vector<std::size_t> newly;
   if (failure_offset_ == kNoFailure) return newly;
-  // failed when the committed mean eps_p over the element's points reaches eps_f
+  if (damage_offset_ != kNoFailure) update_damage();
+  // failed when the committed mean eps_p over the element's points reaches eps_f (RTCL, BWH:
+  // when the mean damage reaches 1)
   for (std::size_t e = 0; e < mesh_.num_elements(); ++e) {
-    if (failed(e) || !(element_plastic_strain(e) >= element_failure_strain_[e])) continue;
+    if (failed(e)) continue;
+    if (damage_offset_ != kNoFailure && element_damage_criterion_[e] != nullptr) {
+      if (!(element_damage(e) >= 1.0)) continue;
+    } else if (!(element_plastic_strain(e) >= element_failure_strain_[e])) {
+      continue;
+    }
     committed_[failure_offset_ + e] = trial_[failure_offset_ + e] = time;
     newly.push_back(e);
     // erosion: its strain energy (at the committed u) and plastic work leave with it

@@ -76,6 +76,11 @@ bool StructuralSolver::element_eroded(std::size_t element) const {
          nonlinear_->material().eroded(element);
 }
 
+double StructuralSolver::element_damage(std::size_t element) const {
+  if (nonlinear_ == nullptr || !nonlinear_->material().has_failure_criteria()) return -1.0;
+  return nonlinear_->material().element_damage(element);
+}
+
 bool StructuralSolver::node_detached(std::size_t node) const {
   if (nonlinear_ == nullptr || !nonlinear_->material().has_failure_criteria()) return false;
   const Mesh& mesh = model_.mesh();
@@ -116,6 +121,7 @@ std::optional<FailureEvent> StructuralSolver::first_failure() const {
     f.time = material.failure_time(e);
     f.plastic_strain = material.element_plastic_strain(e);
     f.failure_strain = material.failure_strain(e);
+    f.damage = material.element_damage(e);
     first = f;
   }
   return first;

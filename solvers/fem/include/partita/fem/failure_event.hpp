@@ -13,7 +13,8 @@ struct FailureEvent {
   Vec3 centroid = Vec3::Zero();      // mean of its nodes, reference configuration [m]
   double time = 0.0;                 // end of the step in which it failed [s]
   double plastic_strain = 0.0;       // its mean equivalent plastic strain then
-  double failure_strain = 0.0;       // its eps_f
+  double failure_strain = 0.0;       // its eps_f (RTCL: eps_cr; BWH: eps_3)
+  double damage = -1.0;              // RTCL, BWH: its mean damage then (>= 1); else -1
 };
 
 }  // namespace partita::fem

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "partita/fem/element_integrator.hpp"
+#include "partita/fem/failure_criterion.hpp"
 #include "partita/fem/material_law.hpp"
 #include "partita/fem/model.hpp"
 #include "partita/fem/operator_contribution.hpp"
@@ -78,6 +79,11 @@ class MaterialContribution final : public OperatorContribution {
   bool failed(std::size_t e) const { return failure_time(e) >= 0.0; }
   bool eroded(std::size_t e) const { return element_erodes_[e] != 0 && failed(e); }
   double failure_strain(std::size_t e) const { return element_failure_strain_[e]; }
+  // RTCL and BWH (FailureCriterion::uses_damage()): the committed mean damage of element e's
+  // points, accumulated by update_failures() (before its check) from the stress of the last
+  // add() and the step's plastic strain increments, held in the committed state after the
+  // failure times; the element fails at 1. -1 for elements without such a criterion.
+  double element_damage(std::size_t e) const;
   std::size_t num_failed() const;
   // strain energy and plastic work of the eroded elements at erosion, plus what the solver adds
   // (the kinetic energy of their mass) [J]
@@ -173,6 +179,12 @@ class MaterialContribution final : public OperatorContribution {
   bool erosion_ = false;                         // some region erodes
   std::vector<double> element_failure_strain_;   // per element: eps_f (inf: none)
   std::vector<char> element_erodes_;             // per element: its region erodes
+  // RTCL and BWH: per point (damage, eps_p at its last update) from damage_offset_ in the state
+  std::size_t damage_offset_ = kNoFailure;
+  std::vector<std::unique_ptr<FailureCriterion>> region_damage_criteria_;
+  std::vector<const FailureCriterion*> element_damage_criterion_;  // per element (null: none)
+  std::vector<Vec3> element_normal_;  // per element: its plate's normal (BWH)
+  void update_damage();
   std::vector<double> element_energy_;           // per element: int W dV at the last add()
   // reduced Hex8: per element the enhanced strain's work of the last add() (enhanced_strain_work),
   // summed at commit into the state's slot enhanced_work_offset_ (kNoFailure: none)

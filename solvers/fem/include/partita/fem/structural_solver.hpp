@@ -163,8 +163,9 @@ class StructuralSolver final : private StructuralSystem {
   Eigen::VectorXd element_equivalent_plastic_strain() const;
   // --- rupture and energies by part (structural_solver_failure.cpp) ---
   // With a FailureCriterion in the model (nonlinear path), every step / static solve ends by
-  // marking the elements whose committed mean equivalent plastic strain reached their eps_f as
-  // failed at time(). With erosion (central difference only: static and Newmark refuse it at
+  // marking the elements whose committed mean equivalent plastic strain reached their eps_f
+  // (RTCL, BWH: whose points' mean damage reached 1, element_damage()) as failed at time().
+  // With erosion (central difference only: static and Newmark refuse it at
   // construction, as does stiffness-proportional damping, whose K0 would keep the element) a
   // failed element leaves the internal force and the lumped mass; its strain energy, plastic
   // work and the kinetic energy of its mass go to eroded_energy(); a node left without any
@@ -173,6 +174,8 @@ class StructuralSolver final : private StructuralSystem {
   std::size_t failed_elements() const;
   bool element_failed(std::size_t element) const;
   bool element_eroded(std::size_t element) const;
+  // RTCL, BWH: the committed mean damage of the element's points (-1 under other criteria)
+  double element_damage(std::size_t element) const;
   /// True when every element around `node` is eroded: the node has left the structure (and its
   /// surfaces: an indenter no longer touches it).
   bool node_detached(std::size_t node) const;
