@@ -123,3 +123,73 @@ TEST_CASE("fem adapter: erosion from YAML removes the failed strip, the balance 
   CHECK(std::abs(last[column(r, "strip.energy_balance")]) <
         0.01 * last[column(r, "strip.external_work")]);
 }
+
+TEST_CASE("fem adapter: rtcl and bwh from YAML fail the strip when uniaxial tension says",
+          "[app][fem][rupture]") {
+  // uniaxial stress (T = 1/3, alpha = 0): RTCL's damage is eps_p / eps_cr, so eps_cr = 0.02
+  // fails the strip when the constant eps_f = 0.02 does; BWH's limit is Hill's K (2n)^n, so
+  // K = 290 MPa / 0.4^0.2 with n = 0.2 fails it when sigma reaches 290 MPa, at the same time
+  const double t_f = 0.04 * (250e6 + 2e9 * 0.02) / 350e6;
+  const std::string k_mpa = std::to_string(290.0 / std::pow(0.4, 0.2));
+  for (const std::string failure :
+       {std::string("{criterion: rtcl, critical_strain: 0.02}"),
+        "{criterion: bwh, strength_coefficient: " + k_mpa + " MPa, hardening_exponent: 0.2}"}) {
+    INFO(failure);
+    const Run r = run_strip({"participants.strip.material.failure=" + failure});
+    const auto& last = r.rows.back();
+    CHECK(last[column(r, "strip.failed_elements")] == 3.0);
+    CHECK(last[column(r, "strip.first_failure_time")] == Approx(t_f).epsilon(0.02));
+    CHECK(r.log.find("mean damage") != std::string::npos);
+  }
+}
+
+TEST_CASE("fem adapter: the rtcl and bwh keys are refused by name where they do not belong",
+          "[app][fem][rupture]") {
+  const std::string strip =
+      quote((fs::path(PARTITA_SOURCE_DIR) / "tests/inputs/fem/strip_rupture.yaml").string());
+  const auto check = [&](const std::string& failure) {
+    return partita::test::run_command(quote(PARTITA_EXECUTABLE) + " check " + strip +
+                                      " --set " +
+                                      quote("participants.strip.material.failure=" + failure));
+  };
+  struct Bad {
+    std::string failure, message;
+  };
+  for (const Bad& b : {
+           Bad{"{criterion: rtcl}", "criterion rtcl needs 'critical_strain'"},
+           Bad{"{criterion: rtcl, critical_strain: 0.2, strain: 0.1}",
+               "failure.strain': strain belongs to criterion constant, not rtcl"},
+           Bad{"{criterion: rtcl, critical_strain: 0.2, uniform_strain: 0.1}",
+               "uniform_strain belongs to criterion gl, not rtcl"},
+           Bad{"{criterion: rtcl, critical_strain: 0.2, thickness: 0.01, neck_strain: 0.6, "
+               "hardening_exponent: 0.2}",
+               "critical_strain (eps_cr given) and the size scaling"},
+           Bad{"{criterion: rtcl, thickness: 0.01, hardening_exponent: 0.2}", "needs 'neck_strain'"},
+           Bad{"{criterion: bwh, hardening_exponent: 0.2}", "needs 'strength_coefficient'"},
+           Bad{"{criterion: bwh, strength_coefficient: 530 MPa, hardening_exponent: 1.5}",
+               "must be in (0, 1)"},
+           Bad{"{criterion: bwh, strength_coefficient: 530 MPa, hardening_exponent: 0.2, "
+               "critical_strain: 0.3}",
+               "critical_strain belongs to criterion rtcl, not bwh"},
+           Bad{"{criterion: gl, thickness: 0.01, strength_coefficient: 530 MPa}",
+               "strength_coefficient belongs to criterion bwh, not gl"},
+           Bad{"{criterion: constant, strain: 0.1, neck_strain: 0.6}",
+               "neck_strain belongs to criterion rtcl or bwh, not constant"},
+       }) {
+    INFO(b.failure);
+    const auto r = check(b.failure);
+    INFO(r.output);
+    CHECK(r.status != 0);
+    CHECK(r.output.find(b.message) != std::string::npos);
+  }
+  // a size-scaled RTCL and a scaled BWH with their units are valid
+  for (const std::string ok :
+       {std::string("{criterion: rtcl, thickness: 10 mm, hardening_exponent: 0.2, neck_strain: 0.6}"),
+        std::string("{criterion: bwh, strength_coefficient: 530 MPa, hardening_exponent: 0.2, "
+                    "thickness: 10 mm, neck_strain: 0.6, erosion: true}")}) {
+    INFO(ok);
+    const auto r = check(ok);
+    INFO(r.output);
+    CHECK(r.status == 0);
+  }
+}

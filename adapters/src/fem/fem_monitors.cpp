@@ -156,7 +156,9 @@ const MonitorTable<FemAdapter>& FemAdapter::monitor_table() {
                return a.solver_->energy_balance() + indenter_work;
              });
     // rupture and energies by part (fem_rupture.hpp)
-    t.scalar("failed_elements", "", "elements whose mean equivalent plastic strain reached eps_f",
+    t.scalar("failed_elements", "",
+             "elements whose mean equivalent plastic strain reached eps_f (rtcl, bwh: whose "
+             "points' mean damage reached 1)",
              [](const A& a) { return static_cast<double>(a.solver_->failed_elements()); });
     // -1 until an element fails (a monitor value must be finite: the core takes a non-finite one
     // for a diverging run)
