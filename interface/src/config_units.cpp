@@ -33,7 +33,9 @@ const std::vector<std::pair<std::string, double>>& equivalents(std::string_view 
   static const std::vector<std::pair<std::string, double>> energy = {
       {"N m", 1.0}, {"Nm", 1.0}, {"N mm", 1e-3}, {"Nmm", 1e-3}, {"kN m", 1e3}};
   static const std::vector<std::pair<std::string, double>> frequency = {{"1/s", 1.0}};
-  static const std::vector<std::pair<std::string, double>> rate = {{"Hz", 1.0}};
+  // ("40.4 1/s" reads as digit groups: "40.4 /s" is how a rate is written with a space)
+  static const std::vector<std::pair<std::string, double>> rate = {
+      {"Hz", 1.0}, {"/s", 1.0}, {"s^-1", 1.0}};
   if (unit == "Pa") return pressure;
   if (unit == "kg/m^3") return density;
   if (unit == "m/s") return speed;

@@ -91,8 +91,12 @@ Mat3 trial_elastic_left_cauchy_green(const Mat3& f, std::span<const double> comm
 
 }  // namespace
 
-FiniteStrainJ2Law::FiniteStrainJ2Law(double e, double nu, double rho, HardeningCurve hardening)
-    : elastic_{e, nu, rho}, density_(rho), hardening_(std::move(hardening)) {
+FiniteStrainJ2Law::FiniteStrainJ2Law(double e, double nu, double rho, HardeningCurve hardening,
+                                     std::optional<CowperSymonds> strain_rate)
+    : elastic_{e, nu, rho},
+      density_(rho),
+      hardening_(std::move(hardening)),
+      strain_rate_(std::move(strain_rate)) {
   validate_isotropic_constants("j2-plasticity-finite-strain", e, nu, rho);
   const auto lame = lame_constants(e, nu);
   shear_ = lame.mu;
@@ -108,8 +112,18 @@ void FiniteStrainJ2Law::initialise_state(std::span<double> state) const {
   pack_symmetric(Mat3::Identity(), state.subspan(0, 6));  // C_p^-1 = I at rest
 }
 
+double FiniteStrainJ2Law::return_increment(double s_norm, double alpha_n,
+                                           const MaterialStep& step) const {
+  if (!(s_norm - std::sqrt(2.0 / 3.0) * hardening_.yield_stress(alpha_n) > 0.0)) return 0.0;
+  if (!strain_rate_ || !step.dynamic) return hardening_.return_map_increment(shear_, s_norm, alpha_n);
+  // a dynamic step at the committed instant (dt = 0) leaves no time for viscous flow
+  if (!(step.time_increment > 0.0)) return 0.0;
+  return strain_rate_->return_map(hardening_, shear_, s_norm, alpha_n, step.time_increment).dg;
+}
+
 void FiniteStrainJ2Law::stress(const Mat3& f, std::span<const double> committed,
-                               std::span<double> trial, Mat3& p, double& energy) const {
+                               std::span<double> trial, Mat3& p, double& energy,
+                               const MaterialStep& step) const {
   const Mat3 be_tr = trial_elastic_left_cauchy_green(f, committed);
   const double g = shear_, k = bulk_;
   const double alpha_n = committed[6];
@@ -121,7 +135,7 @@ void FiniteStrainJ2Law::stress(const Mat3& f, std::span<const double> committed,
   const double j2 = 0.5 * y2.trace();
   const double rho = spectral_radius_bound(j2);
   if (!(rho <= kSeriesRadius)) {
-    spectral_stress(f, committed, trial, p, energy);
+    spectral_stress(f, committed, trial, p, energy, step);
     return;
   }
   // eps_tr = 1/2 ln b_e_tr = 1/2 (ln c I + ln(I + Y)); ln(I + Y) = l_i I + l_y Y + l_y2 Y^2
@@ -135,9 +149,7 @@ void FiniteStrainJ2Law::stress(const Mat3& f, std::span<const double> committed,
   // small-strain radial return on the log strains (coaxial with b_e_tr)
   const Mat3 s_tr = 2.0 * g * e_dev;
   const double s_norm = s_tr.norm();
-  double dg = 0.0;
-  if (s_norm - std::sqrt(2.0 / 3.0) * hardening_.yield_stress(alpha_n) > 0.0)
-    dg = hardening_.return_map_increment(g, s_norm, alpha_n);
+  const double dg = return_increment(s_norm, alpha_n, step);
   // tau = K tr(eps) I + s_tr - 2 G dg n = K tr I + theta s_tr;  dev eps_e = theta dev eps_tr
   const double theta = dg > 0.0 ? 1.0 - 2.0 * g * dg / s_norm : 1.0;
   const Mat3 tau = (k * tr) * id + theta * s_tr;
@@ -170,7 +182,8 @@ void FiniteStrainJ2Law::stress(const Mat3& f, std::span<const double> committed,
 }
 
 void FiniteStrainJ2Law::spectral_stress(const Mat3& f, std::span<const double> committed,
-                                        std::span<double> trial, Mat3& p, double& energy) const {
+                                        std::span<double> trial, Mat3& p, double& energy,
+                                        const MaterialStep& step) const {
   // b_e_tr = sum lambda_a^2 n_a n_a
   const Mat3 be_tr = trial_elastic_left_cauchy_green(f, committed);
   const double g = shear_, k = bulk_;
@@ -187,7 +200,7 @@ void FiniteStrainJ2Law::spectral_stress(const Mat3& f, std::span<const double> c
   Vec3 n = Vec3::Zero();
   if (s_norm - std::sqrt(2.0 / 3.0) * hardening_.yield_stress(alpha_n) > 0.0) {
     n = s_tr / s_norm;
-    dg = hardening_.return_map_increment(g, s_norm, alpha_n);
+    dg = return_increment(s_norm, alpha_n, step);
   }
   // tau_a = K tr(eps) + s_tr,a - 2 G dg n_a;  eps_e = eps_tr - dg n
   const Vec3 tau_principal = Vec3::Constant(k * tr) + s_tr - 2.0 * g * dg * n;
@@ -210,9 +223,10 @@ void FiniteStrainJ2Law::spectral_stress(const Mat3& f, std::span<const double> c
       0.5 * ((unpack_symmetric(committed.subspan(8, 6)) + tau).array() * deps_p.array()).sum();
   pack_symmetric(tau, trial.subspan(8, 6));
 }
-void FiniteStrainJ2Law::evaluate(const Mat3& f, std::span<const double> committed,
-                                 std::span<double> trial, MaterialResponse& r) const {
-  stress(f, committed, trial, r.stress, r.energy_density);
+void FiniteStrainJ2Law::evaluate_step(const Mat3& f, std::span<const double> committed,
+                                      std::span<double> trial, const MaterialStep& step,
+                                      MaterialResponse& r) const {
+  stress(f, committed, trial, r.stress, r.energy_density, step);
   // A(:, 3 k + L) = (P(F + h E_kL) - P(F - h E_kL)) / 2h
   constexpr double h = 1e-7;
   std::array<double, kStateSize> scratch{};
@@ -223,8 +237,8 @@ void FiniteStrainJ2Law::evaluate(const Mat3& f, std::span<const double> committe
       Mat3 fp = f, fm = f;
       fp(kk, l) += h;
       fm(kk, l) -= h;
-      stress(fp, committed, scratch, pp, w);
-      stress(fm, committed, scratch, pm, w);
+      stress(fp, committed, scratch, pp, w, step);
+      stress(fm, committed, scratch, pm, w, step);
       const Mat3 d = (pp - pm) / (2.0 * h);
       for (int i = 0; i < 3; ++i) {
         for (int jj = 0; jj < 3; ++jj) r.tangent(3 * i + jj, 3 * kk + l) = d(i, jj);
@@ -236,14 +250,19 @@ void FiniteStrainJ2Law::evaluate(const Mat3& f, std::span<const double> committe
 MaterialLawEntry finite_strain_j2_law_entry() {
   auto parameters = isotropic_parameters();
   for (auto& h : hardening_parameters()) parameters.push_back(std::move(h));
+  for (auto& r : strain_rate_parameters()) parameters.push_back(std::move(r));
   return {"j2-plasticity-finite-strain", "multiplicative, logarithmic strains",
           std::move(parameters),
           [](const MaterialParameters& p) -> std::shared_ptr<const MaterialLaw> {
             return std::make_shared<FiniteStrainJ2Law>(
                 p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density"),
-                hardening_curve_from("j2-plasticity-finite-strain", p));
+                hardening_curve_from("j2-plasticity-finite-strain", p),
+                strain_rate_from("j2-plasticity-finite-strain", p));
           },
-          [](const MaterialParameters& p) { return check_hardening("j2-plasticity-finite-strain", p); }};
+          [](const MaterialParameters& p) {
+            if (auto issue = check_hardening("j2-plasticity-finite-strain", p)) return issue;
+            return check_strain_rate("j2-plasticity-finite-strain", p);
+          }};
 }
 
 }  // namespace partita::fem

@@ -7,8 +7,12 @@
 
 namespace partita::fem {
 
-J2PlasticityLaw::J2PlasticityLaw(double e, double nu, double rho, HardeningCurve hardening)
-    : elastic_{e, nu, rho}, density_(rho), hardening_(std::move(hardening)) {
+J2PlasticityLaw::J2PlasticityLaw(double e, double nu, double rho, HardeningCurve hardening,
+                                 std::optional<CowperSymonds> strain_rate)
+    : elastic_{e, nu, rho},
+      density_(rho),
+      hardening_(std::move(hardening)),
+      strain_rate_(std::move(strain_rate)) {
   validate_isotropic_constants("j2-plasticity", e, nu, rho);
   const auto lame = lame_constants(e, nu);
   shear_ = lame.mu;
@@ -21,7 +25,7 @@ double J2PlasticityLaw::dilatational_wave_speed() const {
 
 void J2PlasticityLaw::evaluate_with(const Mat3& f, std::span<const double> committed,
                                     std::span<double> trial, MaterialResponse& r,
-                                    bool with_tangent) const {
+                                    bool with_tangent, const MaterialStep& step) const {
   const double g = shear_, k = bulk_;
   const double sqrt23 = std::sqrt(2.0 / 3.0);
   const Mat3 id = Mat3::Identity();
@@ -40,7 +44,17 @@ void J2PlasticityLaw::evaluate_with(const Mat3& f, std::span<const double> commi
 
   double dg = 0.0, theta = 1.0, theta_bar = 0.0;
   Mat3 n = Mat3::Zero();
-  if (f_tr > 0.0) {
+  // a rate-dependent dynamic step: the viscoplastic return (none at dt = 0: no time to flow)
+  const bool rate = strain_rate_ && step.dynamic;
+  if (f_tr > 0.0 && rate && step.time_increment > 0.0) {
+    n = s_tr / s_norm;
+    // Solve |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha) [1 + (sqrt(2/3) dg / (dt D))^(1/q)] = 0
+    const CowperSymonds::Return ret =
+        strain_rate_->return_map(hardening_, g, s_norm, alpha_n, step.time_increment);
+    dg = ret.dg;
+    theta = 1.0 - 2.0 * g * dg / s_norm;
+    theta_bar = 1.0 / (1.0 + ret.slope / (3.0 * g)) - (1.0 - theta);
+  } else if (f_tr > 0.0 && !rate) {
     n = s_tr / s_norm;
     // Solve |s_tr| - 2 G dg - sqrt(2/3) sigma_y(alpha_n + sqrt(2/3) dg) = 0
     dg = hardening_.return_map_increment(g, s_norm, alpha_n);
@@ -94,13 +108,17 @@ void J2PlasticityLaw::evaluate_with(const Mat3& f, std::span<const double> commi
 MaterialLawEntry j2_plasticity_law_entry() {
   auto parameters = isotropic_parameters();
   for (auto& h : hardening_parameters()) parameters.push_back(std::move(h));
+  for (auto& r : strain_rate_parameters()) parameters.push_back(std::move(r));
   return {"j2-plasticity", "small strain, isotropic hardening", std::move(parameters),
           [](const MaterialParameters& p) -> std::shared_ptr<const MaterialLaw> {
             return std::make_shared<J2PlasticityLaw>(
                 p.real("youngs_modulus"), p.real("poisson_ratio"), p.real("density"),
-                hardening_curve_from("j2-plasticity", p));
+                hardening_curve_from("j2-plasticity", p), strain_rate_from("j2-plasticity", p));
           },
-          [](const MaterialParameters& p) { return check_hardening("j2-plasticity", p); }};
+          [](const MaterialParameters& p) {
+            if (auto issue = check_hardening("j2-plasticity", p)) return issue;
+            return check_strain_rate("j2-plasticity", p);
+          }};
 }
 
 }  // namespace partita::fem

@@ -374,6 +374,8 @@ void MaterialContribution::evaluate_element(std::size_t e, const Eigen::VectorXd
 }
 
 void MaterialContribution::commit() {
+  committed_time_ = trial_time_;
+  step_.time_increment = 0.0;
   if (enhanced_work_offset_ != kNoFailure) {
     double w = committed_[enhanced_work_offset_];
     for (double we : enhanced_work_trial_) w += we;

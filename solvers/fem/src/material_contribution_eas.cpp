@@ -88,8 +88,8 @@ void MaterialContribution::evaluate_eas(std::size_t e, const ElementDisplacement
       const Mat3 f = Mat3::Identity() + ux.transpose() * gx;
       if (!law.small_strain()) require_not_inverted(e, f.determinant());
       const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
-      law.evaluate(f, std::span<const double>(committed_).subspan(s0, ns),
-                   std::span<double>(trial_).subspan(s0, ns), resp);
+      law.evaluate_step(f, std::span<const double>(committed_).subspan(s0, ns),
+                        std::span<double>(trial_).subspan(s0, ns), step_, resp);
       const double w = weight_[q];
       // f_(a i) += P_iJ dG_a/dX_J w   (a over the 11 nodes)
       const Grad11 pg = gx * (resp.stress.transpose() * w);

@@ -92,7 +92,7 @@ void MaterialContribution::evaluate_fbar(std::size_t e, const ElementDisplacemen
     const Mat3 fb = s * f[q];
     const std::size_t s0 = state_offset_[qp], ns = state_offset_[qp + 1] - s0;
     evaluate_point(law, fb, std::span<const double>(committed_).subspan(s0, ns),
-                   std::span<double>(trial_).subspan(s0, ns), ke != nullptr, resp);
+                   std::span<double>(trial_).subspan(s0, ns), step_, ke != nullptr, resp);
     const double w = weight_[qp];
     energy += resp.energy_density * w;
     const Mat3 sigma = cauchy_stress_of(law, resp.stress, fb);

@@ -35,7 +35,7 @@ void MaterialContribution::evaluate_plain(std::size_t e, const ElementDisplaceme
       if (!law.small_strain()) require_not_inverted(e, f.determinant());
       const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
       evaluate_point(law, f, std::span<const double>(committed_).subspan(s0, ns),
-                     std::span<double>(trial_).subspan(s0, ns), ke != nullptr, resp);
+                     std::span<double>(trial_).subspan(s0, ns), step_, ke != nullptr, resp);
       const double w = weight_[q];
       energy += resp.energy_density * w;
       // f_a,i += P_iJ dN_a/dX_J w

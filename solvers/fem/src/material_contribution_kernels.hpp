@@ -32,13 +32,15 @@ void add_material_stiffness(const Gradients& g, const Matrix9& a, double scale, 
   }
 }
 
-// The law at one point: with its tangent (implicit paths) or without it (explicit steps).
+// The law at one point over the step: with its tangent (implicit paths) or without it
+// (explicit steps).
 inline void evaluate_point(const MaterialLaw& law, const Mat3& f, std::span<const double> committed,
-                    std::span<double> trial, bool tangent, MaterialResponse& r) {
+                           std::span<double> trial, const MaterialStep& step, bool tangent,
+                           MaterialResponse& r) {
   if (tangent) {
-    law.evaluate(f, committed, trial, r);
+    law.evaluate_step(f, committed, trial, step, r);
   } else {
-    law.evaluate_stress(f, committed, trial, r);
+    law.evaluate_step_stress(f, committed, trial, step, r);
   }
 }
 

@@ -152,8 +152,8 @@ void MaterialContribution::evaluate_reduced(std::size_t e, const ElementDisplace
     const Mat3 f = Mat3::Identity() + un.transpose() * g + zeta * enhanced;
     if (!law.small_strain()) require_not_inverted(e, f.determinant());
     const std::size_t s0 = state_offset_[q], ns = state_offset_[q + 1] - s0;
-    law.evaluate_stress(f, std::span<const double>(committed_).subspan(s0, ns),
-                        std::span<double>(trial_).subspan(s0, ns), resp);
+    law.evaluate_step_stress(f, std::span<const double>(committed_).subspan(s0, ns),
+                             std::span<double>(trial_).subspan(s0, ns), step_, resp);
     const double w = weight_[q];
     energy += resp.energy_density * w;
     forces.noalias() += g * (resp.stress.transpose() * w);

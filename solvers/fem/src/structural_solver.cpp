@@ -136,6 +136,7 @@ void StructuralSolver::solve_static() {
   const auto t0 = Clock::now();
   const double factorisation_before = timings_.factorisation;
   last_was_static_ = true;
+  if (nonlinear_ != nullptr) nonlinear_->material().set_dynamic(false);  // rate terms off
   // the operator decides: K_ff factorised once and one solve (a constant tangent), or Newton
   // with load stepping; velocity = acceleration = 0
   static_.solve(*this, kin_, kin_.time);
@@ -198,6 +199,7 @@ void StructuralSolver::step(double dt) {
     throw Error("step(dt): dt must be > 0, got " + std::to_string(dt));
   assemble_mass();
   last_was_static_ = false;
+  if (nonlinear_ != nullptr) nonlinear_->material().set_dynamic(true);  // rate terms on
   const auto t0 = Clock::now();
   const double factorisation_before = timings_.factorisation;
   if (options_.integrator == Integrator::CentralDifference) {

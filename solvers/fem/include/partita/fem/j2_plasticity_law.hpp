@@ -3,6 +3,7 @@
 #include "partita/fem/material.hpp"
 #include "partita/fem/material_law.hpp"
 #include "partita/fem/material_law_registry.hpp"
+#include "partita/fem/strain_rate_law.hpp"
 
 namespace partita::fem {
 
@@ -19,10 +20,13 @@ namespace partita::fem {
 // external work, so a proportional path with linear hardening balances exactly), sigma (xx yy
 // zz xy yz zx). W = 1/2 (eps - eps_p) : C : (eps - eps_p) is the stored elastic energy (the
 // hardening energy is part of the plastic work).
+// With a strain-rate law (CowperSymonds, optional) a dynamic step's return solves for the
+// dynamic flow stress sigma_y(alpha) [1 + (d alpha / (dt D))^(1/q)] and the tangent's H is its
+// slope along the step (strain_rate_law.hpp); static steps and a law without it are as above.
 class J2PlasticityLaw final : public MaterialLaw {
  public:
   J2PlasticityLaw(double youngs_modulus, double poisson_ratio, double density,
-                  HardeningCurve hardening);
+                  HardeningCurve hardening, std::optional<CowperSymonds> strain_rate = {});
 
   std::string_view name() const override { return "j2-plasticity"; }
   bool small_strain() const override { return true; }
@@ -33,29 +37,41 @@ class J2PlasticityLaw final : public MaterialLaw {
   int state_size() const override { return 14; }
   void evaluate(const Mat3& f, std::span<const double> committed, std::span<double> trial,
                 MaterialResponse& response) const override {
-    evaluate_with(f, committed, trial, response, true);
+    evaluate_with(f, committed, trial, response, true, MaterialStep{});
   }
   // without the tangent loop (explicit steps)
   void evaluate_stress(const Mat3& f, std::span<const double> committed, std::span<double> trial,
                        MaterialResponse& response) const override {
-    evaluate_with(f, committed, trial, response, false);
+    evaluate_with(f, committed, trial, response, false, MaterialStep{});
+  }
+  void evaluate_step(const Mat3& f, std::span<const double> committed, std::span<double> trial,
+                     const MaterialStep& step, MaterialResponse& response) const override {
+    evaluate_with(f, committed, trial, response, true, step);
+  }
+  void evaluate_step_stress(const Mat3& f, std::span<const double> committed,
+                            std::span<double> trial, const MaterialStep& step,
+                            MaterialResponse& response) const override {
+    evaluate_with(f, committed, trial, response, false, step);
   }
   double plastic_work_density(std::span<const double> state) const override { return state[7]; }
   double equivalent_plastic_strain(std::span<const double> state) const override {
     return state[6];
   }
   const HardeningCurve& hardening() const { return hardening_; }
+  const std::optional<CowperSymonds>& strain_rate() const { return strain_rate_; }
 
  private:
   Material elastic_;  // E, nu, rho as given
   void evaluate_with(const Mat3& f, std::span<const double> committed, std::span<double> trial,
-                     MaterialResponse& response, bool with_tangent) const;
+                     MaterialResponse& response, bool with_tangent,
+                     const MaterialStep& step) const;
   double density_ = 0.0, bulk_ = 0.0, shear_ = 0.0;
   HardeningCurve hardening_;
+  std::optional<CowperSymonds> strain_rate_;
 };
 
 // Its registry entry: "j2-plasticity" from youngs_modulus, poisson_ratio, density and the
-// hardening (hardening_parameters()).
+// hardening (hardening_parameters()), optionally the strain-rate law (strain_rate_parameters()).
 MaterialLawEntry j2_plasticity_law_entry();
 
 }  // namespace partita::fem

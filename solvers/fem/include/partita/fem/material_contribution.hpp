@@ -40,6 +40,19 @@ class MaterialContribution final : public OperatorContribution {
            const BlockAssembler& assembler) override;
   // committed = trial (copied in blocks by the OpenMP threads)
   void commit() override;
+  // The time of the next add()s: rate-dependent laws read the time since the committed state
+  // (MaterialStep::time_increment); fraction 0 is the committed state itself, at t.
+  void set_time(double t, double fraction) override {
+    if (fraction == 0.0) committed_time_ = t;
+    trial_time_ = fraction == 0.0   ? t
+                  : fraction == 1.0 ? t
+                                    : committed_time_ + fraction * (t - committed_time_);
+    step_.time_increment = trial_time_ - committed_time_;
+  }
+  // Whether the next add()s belong to a dynamic analysis (rate terms of the laws on, see
+  // MaterialStep); StructuralSolver sets it for each analysis; off (static) until then.
+  void set_dynamic(bool dynamic) { step_.dynamic = dynamic; }
+  const MaterialStep& step() const { return step_; }
   double round_off() const override { return round_off_; }
   // int W dV at the u of the last add()
   double stored_energy() const override { return energy_; }
@@ -193,6 +206,9 @@ class MaterialContribution final : public OperatorContribution {
   MatrixX6 cauchy_;
   Eigen::VectorXd eqps_;
   PhaseSeconds phase_seconds_;
+  // what the laws are told of the step (set_time, set_dynamic); the committed and trial times
+  MaterialStep step_;
+  double committed_time_ = 0.0, trial_time_ = 0.0;
 };
 
 }  // namespace partita::fem

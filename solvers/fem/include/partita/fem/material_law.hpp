@@ -8,6 +8,19 @@
 
 namespace partita::fem {
 
+// What an evaluation knows of its step besides F and the history: the time from the committed
+// state to the evaluated one, for rate-dependent laws (the J2 laws' strain-rate hardening,
+// strain_rate_law.hpp). Rate-independent laws ignore it.
+//   dynamic false (static analyses, and callers that know no time: the default): rate terms off,
+//     the law as it is without them;
+//   dynamic true: time_increment dt >= 0 [s] is physical time since the committed state; a
+//     rate-dependent law takes its rates as increments over dt (dt = 0, an evaluation at the
+//     committed instant itself, leaves no time for viscous flow).
+struct MaterialStep {
+  double time_increment = 0.0;
+  bool dynamic = false;
+};
+
 // A constitutive law: stress and tangent from the deformation gradient F and the history of a
 // quadrature point. The law is stateless itself; the operator owns the history.
 //
@@ -51,6 +64,20 @@ class MaterialLaw {
   virtual void evaluate_stress(const Mat3& f, std::span<const double> committed,
                                std::span<double> trial, MaterialResponse& response) const {
     evaluate(f, committed, trial, response);
+  }
+  // evaluate() and evaluate_stress() over a step (MaterialStep): what the FE operator calls. The
+  // defaults ignore the step and call the forms above, so a rate-independent law defines only
+  // those; a rate-dependent law overrides these (and the forms above as these with a default
+  // MaterialStep).
+  virtual void evaluate_step(const Mat3& f, std::span<const double> committed,
+                             std::span<double> trial, const MaterialStep& /*step*/,
+                             MaterialResponse& response) const {
+    evaluate(f, committed, trial, response);
+  }
+  virtual void evaluate_step_stress(const Mat3& f, std::span<const double> committed,
+                                    std::span<double> trial, const MaterialStep& /*step*/,
+                                    MaterialResponse& response) const {
+    evaluate_stress(f, committed, trial, response);
   }
   // Plastic work per unit reference volume accumulated in a history [J/m^3] (0 if elastic).
   virtual double plastic_work_density(std::span<const double> state) const;
