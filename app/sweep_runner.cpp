@@ -50,6 +50,7 @@ int run_sweep(const coupling::Registries& registries, const SweepOptions& option
     run::RunOptions check;
     check.check_only = true;
     check.overrides = options.overrides;
+    check.override_origins = options.override_origins;
     check.threads = options.threads;
     const run::CaseRun checked(options.case_file, registries, check);
   }

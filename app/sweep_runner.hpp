@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "partita/coupling/registries.hpp"
+#include "partita/interface/error.hpp"
 
 namespace partita::app {
 
@@ -17,6 +18,9 @@ struct SweepOptions {
   std::filesystem::path case_file;
   std::filesystem::path output_dir;    ///< empty: out/<case name>/
   std::vector<std::string> overrides;  ///< the user's --set values (every variant gets them)
+  /// Where each override comes from, for the check's messages (empty: "command line (--set ...)";
+  /// a front end in another program names its own call).
+  std::vector<SourceLocation> override_origins;
   int jobs = 1;
   int threads = 1;  ///< threads of the whole sweep (shared by the jobs)
   std::string log_level = "info";

@@ -54,7 +54,8 @@ class External {
       int initialized = 0;
       MPI_Initialized(&initialized);
       if (!initialized)
-        throw Error(who_ + ": a communicator was given but MPI is not initialised (import "
+        throw Error(who_ +
+                    ": a communicator was given but MPI is not initialised (import "
                     "mpi4py.MPI first, or give no communicator)");
       options.comm = MPI_Comm_f2c(fortran_comm.cast<MPI_Fint>());
     }
@@ -76,8 +77,10 @@ class External {
 
   void add_mesh(py::handle mesh) {
     InterfaceMesh m = to_interface_mesh(mesh, who_);
-    for (const DataSpec& d : m.reads) shapes_[{m.mesh.name(), d.name}] = {m.mesh.size(), d.components};
-    for (const DataSpec& d : m.writes) shapes_[{m.mesh.name(), d.name}] = {m.mesh.size(), d.components};
+    for (const DataSpec& d : m.reads)
+      shapes_[{m.mesh.name(), d.name}] = {m.mesh.size(), d.components};
+    for (const DataSpec& d : m.writes)
+      shapes_[{m.mesh.name(), d.name}] = {m.mesh.size(), d.components};
     get().add_mesh(std::move(m));
   }
 
@@ -154,10 +157,11 @@ class External {
                       (a.ndim() == 2 && a.shape(0) == rows && a.shape(1) == cols);
     if (!fits) {
       std::string shape;
-      for (py::ssize_t d = 0; d < a.ndim(); ++d) shape += (d ? ", " : "") + std::to_string(a.shape(d));
-      throw mpi::UsageError(fmt::format("{}: {} got an array of shape ({}), not ({}{})", who_, what,
-                                        shape, rows,
-                                        cols == 1 ? std::string(",") : ", " + std::to_string(cols)));
+      for (py::ssize_t d = 0; d < a.ndim(); ++d)
+        shape += (d ? ", " : "") + std::to_string(a.shape(d));
+      throw mpi::UsageError(
+          fmt::format("{}: {} got an array of shape ({}), not ({}{})", who_, what, shape, rows,
+                      cols == 1 ? std::string(",") : ", " + std::to_string(cols)));
     }
     Eigen::MatrixXd m(rows, cols);
     const double* d = a.data();
@@ -167,9 +171,10 @@ class External {
       for (Eigen::Index j = 0; j < cols; ++j) {
         const double v = d[i * s0 + j * s1];
         if (!std::isfinite(v))
-          throw Error(fmt::format("{}: {} got {} at point {}{}: the program's state is no longer "
-                                  "physical", who_, what, v, i,
-                                  cols > 1 ? fmt::format(", component {}", j) : ""));
+          throw Error(
+              fmt::format("{}: {} got {} at point {}{}: the program's state is no longer "
+                          "physical",
+                          who_, what, v, i, cols > 1 ? fmt::format(", component {}", j) : ""));
         m(i, j) = v;
       }
     get().write(mesh, data, m);
@@ -209,8 +214,9 @@ void bind_external(py::module_& m) {
            py::arg("fortran_comm"), py::arg("peer_timeout"))
       .def("close", &External::close)
       .def("add_mesh", &External::add_mesh, py::arg("mesh"))
-      .def("set_stable_time_step",
-           [](External& e, double dt) { e.get().set_stable_time_step(dt); }, py::arg("dt"))
+      .def(
+          "set_stable_time_step", [](External& e, double dt) { e.get().set_stable_time_step(dt); },
+          py::arg("dt"))
       .def("set_restart_writer", &External::set_restart_writer, py::arg("writer"))
       .def("initialize", &External::initialize)
       .def("is_resuming", [](const External& e) { return e.get().is_resuming(); })
@@ -225,11 +231,12 @@ void bind_external(py::module_& m) {
            [](External& e) { return e.get().requires_reading_checkpoint(); })
       .def("read", &External::read, py::arg("mesh"), py::arg("data"), py::arg("relative_read_time"))
       .def("write", &External::write, py::arg("mesh"), py::arg("data"), py::arg("values"))
-      .def("set_monitor",
-           [](External& e, const std::string& name, double value, const std::string& unit) {
-             e.get().set_monitor(name, unit, value);
-           },
-           py::arg("name"), py::arg("value"), py::arg("unit"))
+      .def(
+          "set_monitor",
+          [](External& e, const std::string& name, double value, const std::string& unit) {
+            e.get().set_monitor(name, unit, value);
+          },
+          py::arg("name"), py::arg("value"), py::arg("unit"))
       .def("advance", &External::advance, py::arg("dt"))
       .def("finalize", &External::finalize);
 }

@@ -3,7 +3,8 @@
 // released, wakes every `poll` seconds to let Python handle its signals and to call the progress
 // callback. A KeyboardInterrupt (Ctrl-C) or an exception of the callback asks the run to stop
 // as SIGINT does for the executable: the window ends, a restart file is written, every CSV file
-// is flushed; the exception is handed back with the summary (the package raises it).
+// is flushed; the exception is handed back with the summary (the package raises it). A second
+// Ctrl-C meanwhile ends the process, as the executable's second SIGINT does.
 #include <atomic>
 #include <condition_variable>
 #include <csignal>
@@ -73,6 +74,7 @@ py::object wait_for_worker(const std::function<void()>& work, std::atomic<int>& 
     cv.notify_all();
   });
   py::object raised = py::none();
+  bool interrupted = false;  // a KeyboardInterrupt came
   const auto wait = std::chrono::duration<double>(poll > 0.0 ? poll : 0.1);
   for (;;) {
     bool finished = false;
@@ -92,7 +94,16 @@ py::object wait_for_worker(const std::function<void()>& work, std::atomic<int>& 
       }
     }
     if (failed) {
-      // the first exception stops the run; later ones (a second Ctrl-C) wait for its window
+      // A second Ctrl-C while the run stops after its window ends the process at once, as the
+      // executable's second SIGINT does (its handler is reset after the first, SA_RESETHAND):
+      // the run cannot be left half-way in this process. Other exceptions wait for the window.
+      const bool interrupt = PyErr_ExceptionMatches(PyExc_KeyboardInterrupt) != 0;
+      if (interrupt && interrupted) {
+        std::signal(SIGINT, SIG_DFL);
+        std::raise(SIGINT);
+      }
+      interrupted = interrupted || interrupt;
+      // the first exception stops the run
       PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
       PyErr_Fetch(&type, &value, &trace);
       PyErr_NormalizeException(&type, &value, &trace);
@@ -203,6 +214,14 @@ py::dict sweep_case(const std::string& case_file, const std::string& output, int
   so.case_file = case_file;
   so.output_dir = output;
   so.overrides = overrides;
+  // where a value was given, for a CaseError's file: partita.sweep(over=...) for the swept
+  // values (package: "sweep.parameters=..."), results=..., or set={'key': ...}
+  so.override_origins = override_origins(overrides, "sweep");
+  for (std::size_t i = 0; i < overrides.size(); ++i)
+    for (const char* arg : {"parameters", "results"})
+      if (overrides[i].rfind(std::string("sweep.") + arg + "=", 0) == 0)
+        so.override_origins[i].file =
+            std::string("partita.sweep(") + (arg[0] == 'p' ? "over" : "results") + "=...)";
   so.jobs = jobs;
   so.threads = thread_count(threads);
   so.plots = app::plots_wanted(no_plots);

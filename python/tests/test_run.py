@@ -5,6 +5,8 @@ import math
 import os
 import signal
 import subprocess
+import sys
+import time
 
 import pytest
 
@@ -150,3 +152,44 @@ def test_an_exception_of_the_progress_callback_stops_the_run_and_is_raised(spher
     assert r.summary.stopped_by_signal == signal.SIGINT
     assert r.summary.windows < round(0.05 / 1.0e-4)
     assert len(r.coupling) == r.summary.windows
+
+
+_SLOW_RUN = r"""
+import sys, time
+import partita
+sys.path.insert(0, sys.argv[1])
+import tube_python_solid
+
+class SlowWall(tube_python_solid.TubeSolid):
+    def advance(self, dt):  # a window of about 20 iterations takes 2 s
+        super().advance(dt)
+        time.sleep(0.1)
+
+partita.register_solver("py-slow-wall", SlowWall)
+def progress(p):
+    print("window", p.window, flush=True)
+partita.run(sys.argv[2], output=sys.argv[3], set={"participants.solid.solver": "py-slow-wall"},
+            progress=progress, poll=0.01)
+"""
+
+
+def test_a_second_ctrl_c_during_the_clean_stop_ends_the_process_as_the_cli_does(tmp_path):
+    # the executable's SIGINT handler is reset after the first signal (SA_RESETHAND): a second
+    # Ctrl-C while the run finishes its window ends the process at once, killed by SIGINT
+    from conftest import ROOT
+    child = subprocess.Popen([sys.executable, "-c", _SLOW_RUN, str(ROOT / "examples" / "python"),
+                              str(CASES / "elastic_tube_1d" / "iqn-ils.yaml"), str(tmp_path / "out")],
+                             stdout=subprocess.PIPE, text=True)
+    try:
+        assert child.stdout.readline().startswith("window")  # the run is under way
+        child.send_signal(signal.SIGINT)                       # the clean stop: the window goes on
+        time.sleep(0.3)
+        assert child.poll() is None
+        start = time.monotonic()
+        child.send_signal(signal.SIGINT)
+        assert child.wait(timeout=30) == -signal.SIGINT
+        assert time.monotonic() - start < 1.0                  # not after the window's end
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()

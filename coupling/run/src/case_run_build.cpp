@@ -188,8 +188,11 @@ void CaseRun::check_sweep_values(const fs::path& case_file, const Sweep& sweep) 
       try {
         CaseRun variant(case_file, registries_, o);
       } catch (const Error& e) {
-        throw Error(std::string(e.what()) + " (the swept value " + par.values[i] + " of " +
-                    par.key + ", as its variants will run it)");
+        const std::string swept = " (the swept value " + par.values[i] + " of " + par.key +
+                                  ", as its variants will run it)";
+        if (!e.where().file.empty() || !e.key_path().empty())  // the same text, still located
+          throw Error(e.where(), e.key_path(), e.detail() + swept);
+        throw Error(std::string(e.what()) + swept);
       }
     }
 }
