@@ -20,20 +20,20 @@ namespace partita::python {
 /// The registries of the stock `partita` executable: the core's and every in-tree adapter's.
 const coupling::Registries& stock_registries();
 
-/// solver.cpp: the registries the module's calls use: the stock ones and the solvers registered
+/// python_solver.cpp: the registries the module's calls use: the stock ones and the solvers registered
 /// from Python (partita.register_solver). Call it with the GIL held; a call keeps its snapshot
 /// for its whole run (a solver registered meanwhile counts from the next call).
 std::shared_ptr<const coupling::Registries> registries();
 
-/// solver.cpp: a case whose participant names a solver registered in Python is refused by a
+/// python_solver.cpp: a case whose participant names a solver registered in Python is refused by a
 /// sweep (its variants are partita processes, which do not know it).
 void refuse_python_solvers(const std::string& case_file, const std::vector<std::string>& overrides);
 
-/// solver.cpp: a partita.Mesh (or any object with its attributes: name, points, triangles,
+/// python_solver.cpp: a partita.Mesh (or any object with its attributes: name, points, triangles,
 /// weights, reads, writes, prescribed) as an InterfaceMesh; errors name `who`.
 InterfaceMesh to_interface_mesh(pybind11::handle mesh, const std::string& who);
 
-/// solver.cpp: _partita.add_solver, python_solver_names and quantity.
+/// python_solver.cpp: _partita.add_solver, python_solver_names and quantity.
 void bind_solver(pybind11::module_& m);
 
 /// Where each "key=value" override comes from, for messages: "partita.run(set={'key': ...})".
