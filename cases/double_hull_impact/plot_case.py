@@ -1,21 +1,42 @@
 #!/usr/bin/python3
 """The figures and headline numbers of a double-hull impact run (double_hull_impact.yaml,
-coarse.yaml), filled with granules and, optionally, against the empty hull (empty.yaml,
-coarse_empty.yaml).
+coarse.yaml, section.yaml with any cells, web_spacing, thicknesses or bow), filled with granules
+and, optionally, against the empty hull (empty.yaml, coarse_empty.yaml); or of an ensemble of
+packings against the empty hull.
 
 Usage: plot_case.py FILLED_DIR [EMPTY_DIR] [--out DIR] [--driven DIR] [--rate OTHER_DIR ...]
+                    [--case CASE.yaml [--set KEY=VALUE ...]] [--at MM,MM,...]
+       plot_case.py --ensemble FILLED_DIR FILLED_DIR ... [--empty EMPTY_DIR ...] [--out DIR]
+                    [--at MM,MM,...]
   FILLED_DIR, EMPTY_DIR: the runs' output folders (bow.csv, parts.csv, granules.csv, energy.csv,
   vtk/); PNGs go to DIR (default FILLED_DIR). --driven DIR: for a collision run (a free bow,
   collision.yaml), the driven run of the same hull it is compared with (the collision_* keys). The case test calls it as `plot_case.py OUT` with the
   filled run alone (checks.yaml: {script: plot_case.py, key: ...}). --rate OTHER_DIR: the same
   case with the bow at another speed (the quasi-static check: the rate_* keys, rate_force.png);
   repeated, each further run at yet another speed (keys rate2_*, rate3_*, ..., one figure).
+  --case CASE.yaml (with the run's --set values): the case the run was made from, for what its
+  output does not hold: the granules' gravity (the section's orientation in the pictures, the
+  weight's axis) and comminution limit (the fragments below it); without it gravity is -z.
+  --at: the penetrations [mm] of the pictures (sections, deflection maps) or of the ensemble's
+  energy shares, instead of 1/3, 2/3, 1 (25, 50, 75, 100 % for the ensemble) of the final one.
 
-Writes force_penetration.png, energy.png, inner_deflection.png, section_<k>.png (k = 1, 2, 3: the
-output frames nearest 1/3, 2/3 and all of the final penetration, cut at y = 0.181 m through the
-bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI units):
+The geometry is read from the run's VTK output (hull_geometry.py): the plates, webs and footprint
+from vtk/hull_fem's first frame (its region array), the bow's axis, radius, length and position
+from vtk/hull_bow; nothing is tied to one section.
+
+Writes force_penetration.png, energy.png, inner_deflection.png (the inner plate's centre over
+penetration), and from the VTK output (hull_pictures.py): section_<k>.png (k = 1, 2, 3: the output
+frames nearest 1/3, 2/3 and all of the final penetration, or --at: the section through the bow's
+axis, upright with gravity along the plates, with the deformed plates coloured by plastic strain,
+the eroded elements cut by it, the bow, the granules coloured intact / fragment / fragment below
+the comminution limit), inner_deflection_map.png (the inner plate's displacement along the bow's
+travel in plan at the same frames), rupture_pattern.png (both plates' plastic strain and eroded
+elements in plan at the last frame, and the crushed zone: the fragments in plan); the same with
+_empty for EMPTY_DIR (section_empty_<k>.png, ...). It prints key=value lines (SI units):
   weight_balance          -(sum of granules.cXX.force_z, or of section.yaml's granules.cavity_outer,
-                          _inner, _webs.force_z) / (granules.mass g), averaged over the rows
+                          _inner, _webs.force_z) / (granules.mass g) (with --case: the force
+                          along the case's gravity, e.g. force_y for an upright section with
+                          gravity along -y, over |g|), averaged over the rows
                           before the bow touches (penetration 0) after the first 2 ms (1: the
                           granules' weight rests on the hull); weight_balance_last: the same over
                           the last 20 % of those rows (the settled state); weight_balance_impulse
@@ -58,7 +79,8 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
   inner_deflection_final_{filled,empty}_m   hull.inner_centre.displacement_z at the last row
   broken_granules         granules.breakage.events at the last row
   footprint_area_90[_empty] [m^2] the smallest area of the inner plate's cavity faces (the cells' faces
-                          facing -z above mid-depth) carrying 90 % of the upward force on them, at
+                          on the inner plate's side of mid-depth, facing the outer plate) carrying
+                          90 % of the force on them pushing the inner plate outwards, at
                           the last output frame: the granules' (the DEM's mesh files vtk/granules_cXX
                           or the interface files vtk/granules_interface_cXX) and the bow's own
                           contact (the hull's point array contact_force, where the files have it);
@@ -79,25 +101,46 @@ bow's axis; section_empty_<k>.png for EMPTY_DIR) and prints key=value lines (SI 
                           (rate_max_force_dev_at_m): the largest |ratio - 1| where FILLED's force
                           is above 10 % of its largest +-1.5 mm mean; a second (third, ...) --rate:
                           the same keys as rate2_* (rate3_*, ...)
+With --ensemble (hull_ensemble.py; the runs interpolated on a common penetration grid up to the
+smallest final penetration of them all; spread: figures show the mean and the min-max band, keys
+give mean, sample standard deviation (ddof 1), min and max) it writes ensemble_curves.png (the
+bow's force, the inner plate's force d(energy)/d(penetration) with the bed's load on it where
+granules.cavity_inner.force_z exists, the inner plate's absorbed energy (plastic + elastic), each
+filled against empty, the outer plate's rupture marked), energy_shares.png and energy_shares.csv
+(outer plate, inner plate, webs, eroded elements, granules' friction, damping, crushing and the
+rest of the audit's stored + dissipated energy, at the --at penetrations; the CSV: penetration
+[mm], variant, term, mean/std/min/max [J], share of the total [%], runs) and prints:
+  ensemble_runs_{filled,empty}, ensemble_common_penetration_m
+  ensemble_energy_to_rupture_<variant>_{mean,std,min,max}_J (the hull's first failure: the outer
+                          plate), ensemble_rupture_penetration_<variant>_{mean,std,min,max}_m,
+                          ensemble_energy_to_inner_rupture_<variant>_{mean,std,min,max}_J,
+                          ensemble_inner_rupture_penetration_<variant>_{...}_m, each with
+                          _<variant>_runs (how many runs reached it)
+  ensemble_<q>_<at>_<variant>_{mean,std}_<unit>   q: inner_plate_energy [J], inner_plate_force [N],
+                          work [J] (the bow's), bed_on_inner_plate [N]; at: 25pct, 50pct, 75pct,
+                          100pct of the common penetration, or <mm>mm for --at (a dot as p)
+  ensemble_work_filled_minus_empty_final_J, ensemble_work_filled_spread_final_J   the mean
+                          filled work less the mean empty one at the common penetration, and the
+                          filled runs' range there
 A missing file or column skips its item with a note on stderr (plot_case: ...), never a traceback."""
 import csv
 import os
 import re
 import sys
 import textwrap
-import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from python_modules import require  # noqa: E402  (cases/python_modules.py: the missing-module check)
 
 require("numpy", "matplotlib")
 import numpy as np  # noqa: E402
+import hull_pictures as pictures  # noqa: E402  (the pictures from the VTK output)
+from hull_geometry import Geometry, pvd_frames, read_vtk  # noqa: E402  (the geometry read from the run)
 
 G = 9.81
-SECTION_Y = 0.181                 # the bow's axis (x = y = 0.181)
-BOW_RADIUS, BOW_LENGTH = 0.030, 0.030   # the capsule's radius; its cylinder's length unless vtk/hull_bow says
-CELLS = [f"c{i}{j}" for j in range(3) for i in range(3)]
+CELL_FORCE = re.compile(r"granules\.(c\d+)\.force_z$")   # double_hull_impact.yaml's cell interfaces cXY
 PARTS = ["cavity_outer", "cavity_inner", "cavity_webs"]   # section.yaml's interfaces, by part
+CASE = {"file": None, "sets": []}   # --case FILE and its --set values
 
 
 def note(msg):
@@ -120,6 +163,7 @@ class Run:
         if not os.path.isdir(folder):
             raise RuntimeError(f"{folder} is not a folder")
         self.folder, self.label = folder, label
+        self._geometry = False   # not read yet
         self.cols, self.kind = {}, {}
         for f in ("bow", "parts", "granules", "energy", "coupling"):
             self._read(os.path.join(folder, f + ".csv"))
@@ -158,6 +202,19 @@ class Run:
                 self.kind[name] = m.group(1)
             if name not in self.cols or os.path.basename(path) != "energy.csv":
                 self.cols.setdefault(name, (t, a[:, k]))
+
+    def geometry(self):
+        """The hull's and the bow's geometry from the run's VTK output (hull_geometry.Geometry,
+        with the case file of --case for gravity and the comminution limit), None with a note
+        when the files are missing."""
+        if self._geometry is False:
+            try:
+                self._geometry = Geometry.of_run(self.folder, CASE["file"], CASE["sets"])
+                note(f"{self.label}: {self._geometry.describe()}")
+            except (RuntimeError, OSError, KeyError, ValueError) as e:
+                note(f"{self.label}: the geometry not read ({e})")
+                self._geometry = None
+        return self._geometry
 
     def has(self, *names):
         return all(n in self.cols for n in names)
@@ -224,93 +281,54 @@ class Run:
         return t, float(np.interp(t, self.t, self.pen))
 
 
-def pvd_frames(folder, name):
-    """[(time, path)] of vtk/<name>.pvd, or [] with a note."""
-    path = os.path.join(folder, "vtk", name + ".pvd")
-    if not os.path.exists(path):
-        return []
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError:
-        note(f"{path} unreadable (a run still writing it?)")
-        return []
-    out = []
-    for d in root.iter("DataSet"):
-        f = os.path.join(os.path.dirname(path), d.get("file"))
-        if os.path.exists(f):
-            out.append((float(d.get("timestep")), f))
-    return out
-
-
-def read_vtk(path):
-    """(points, cells as lists of point ids, {array name: numpy array}) of a .vtu/.vtp file."""
-    import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
-    r = vtk.vtkXMLUnstructuredGridReader() if path.endswith(".vtu") else vtk.vtkXMLPolyDataReader()
-    r.SetFileName(path)
-    r.Update()
-    g = r.GetOutput()
-    pts = vtk_to_numpy(g.GetPoints().GetData()).astype(float) if g.GetPoints() else np.zeros((0, 3))
-    cells = []
-    if path.endswith(".vtu"):
-        arr = g.GetCells()
-        conn, off = vtk_to_numpy(arr.GetConnectivityArray()), vtk_to_numpy(arr.GetOffsetsArray())
-        cells = [conn[off[i]:off[i + 1]] for i in range(len(off) - 1)]
-    elif g.GetPolys() is not None and g.GetPolys().GetNumberOfCells():
-        arr = g.GetPolys()
-        conn, off = vtk_to_numpy(arr.GetConnectivityArray()), vtk_to_numpy(arr.GetOffsetsArray())
-        cells = [conn[off[i]:off[i + 1]] for i in range(len(off) - 1)]
-    data = {}
-    for att in (g.GetPointData(), g.GetCellData()):
-        for k in range(att.GetNumberOfArrays()):
-            a = att.GetArray(k)
-            data[a.GetName()] = vtk_to_numpy(a).astype(float).reshape(a.GetNumberOfTuples(), -1)
-    data["_cell_arrays"] = [g.GetCellData().GetArrayName(k) for k in range(g.GetCellData().GetNumberOfArrays())]
-    return pts, cells, data
-
-
 # ------------------------------------------------------------------------------------- numbers
 def weight_balance(run):
-    cols = [f"granules.{c}.force_z" for c in CELLS]
-    if not run.has(*cols):   # the cavity's faces by part (section.yaml)
-        cols = [f"granules.{c}.force_z" for c in PARTS]
+    # along gravity (the case's, with --case; else -z): sign * force / (m g) is the share of the
+    # weight that a force carries
+    geom = run.geometry()
+    g_vec = geom.gravity if geom is not None and geom.gravity is not None else np.array([0.0, 0.0, -G])
+    g_axis = int(np.argmax(np.abs(g_vec)))
+    ga, sign, g_abs = "xyz"[g_axis], -float(np.sign(g_vec[g_axis])), float(np.linalg.norm(g_vec))
+    cols = sorted(c for c in run.cols if CELL_FORCE.match(c))
+    if ga != "z" or not cols:   # the cavity's faces by part (section.yaml)
+        cols = [f"granules.{c}.force_{ga}" for c in PARTS]
     if not run.has(*cols, "granules.mass"):
-        note(f"{run.label}: granules.cXX.force_z (or granules.cavity_*.force_z) or granules.mass "
+        note(f"{run.label}: granules.cXX.force_z (or granules.cavity_*.force_{ga}) or granules.mass "
              "missing (weight_balance skipped)")
         return
-    fz = sum(run.at(c) for c in cols)
+    fz = sign * sum(run.at(c) for c in cols)
     rows = np.nonzero((run.pen <= 0) & (run.t > 0.002))[0]
     if not len(rows):
         note(f"{run.label}: no rows between 2 ms and first contact (weight_balance skipped)")
         return
-    weight = run.at("granules.mass")[rows] * G
+    weight = run.at("granules.mass")[rows] * g_abs
     key("weight_balance", float(np.mean(-fz[rows]) / np.mean(weight)))
-    hull_cols = [f"hull.{c}.force_z" for c in PARTS]
+    hull_cols = [f"hull.{c}.force_{ga}" for c in PARTS]
     if run.has(*hull_cols):
         # the same weight as the hull received it: the parts' interfaces share the nodes where a
         # web meets a plate, and their forces add there
-        hz = sum(run.at(c) for c in hull_cols)
+        hz = sign * sum(run.at(c) for c in hull_cols)
         key("hull_weight_balance", float(np.mean(-hz[rows]) / np.mean(weight)))
     if run.has("granules.cavity_inner.force_z"):
         # what the bed presses on the inner plate before the strike (the granules' force on the
         # mesh; +z: the plate pushed away from the cavity)
         key("bed_on_inner_plate_N", float(np.mean(run.at("granules.cavity_inner.force_z")[rows])))
     last = rows[len(rows) - max(1, len(rows) // 5):]
-    key("weight_balance_last", float(np.mean(-fz[last]) / np.mean(run.at("granules.mass")[last] * G)))
+    key("weight_balance_last", float(np.mean(-fz[last]) / np.mean(run.at("granules.mass")[last] * g_abs)))
     # the impulse balance over the same rows (a bed that rings is not at rest, so the cells' force
     # is its weight plus the rate of its momentum): (integral of the hull's and the bow's force on
     # the granules - the change of their momentum) / integral of m g
-    if not run.has("granules.momentum_z"):
-        note(f"{run.label}: no column granules.momentum_z (weight_balance_impulse skipped)")
+    if not run.has(f"granules.momentum_{ga}"):
+        note(f"{run.label}: no column granules.momentum_{ga} (weight_balance_impulse skipped)")
         return
     if len(rows) < 2:
         return
     on_bed = fz[rows]
-    if run.has("granules.bow.force_z"):
-        on_bed = on_bed + run.at("granules.bow.force_z")[rows]
+    if run.has(f"granules.bow.force_{ga}"):
+        on_bed = on_bed + sign * run.at(f"granules.bow.force_{ga}")[rows]
     t = run.t[rows]
     trap = lambda y: float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
-    p = run.at("granules.momentum_z")[rows]
+    p = sign * run.at(f"granules.momentum_{ga}")[rows]
     key("weight_balance_impulse", (trap(-on_bed) - float(p[-1] - p[0])) / trap(weight))
 
 
@@ -385,14 +403,10 @@ def milestones(run, suffix):
             if w is not None:
                 key("energy_to_inner_yield" + suffix + "_J", float(w[hit[0]]))
     if pw is not None and run.has("hull.failed_elements"):
-        # an eroded element's plastic work leaves its part's sum, which otherwise never falls:
-        # the first row whose failed count rises while the inner plate's plastic work falls
-        failed = run.at("hull.failed_elements")
-        hit = np.nonzero((np.diff(failed) > 0) & (np.diff(pw) < 0))[0]
-        if not len(hit):
+        k = inner_rupture_row(run)
+        if k is None:
             note(f"{run.label}: no element of the inner plate has failed")
         else:
-            k = hit[0] + 1
             key("inner_rupture_time" + suffix + "_s", float(run.t[k]))
             key("inner_rupture_penetration" + suffix + "_m", float(run.pen[k]))
             if w is not None:
@@ -405,6 +419,17 @@ def milestones(run, suffix):
         key("energy_final" + suffix + "_J", float(w[-1]))
     if run.has("hull.inner_centre.displacement_z"):
         key("inner_deflection_final" + suffix + "_m", float(run.at("hull.inner_centre.displacement_z")[-1]))
+
+
+def inner_rupture_row(run):
+    """The row of the inner plate's first failed element, None before it (or without the columns):
+    an eroded element's plastic work leaves its part's sum, which otherwise never falls, so the
+    first row whose hull.failed_elements rises while hull.inner_plate.plastic_work falls."""
+    if not run.has("hull.inner_plate.plastic_work", "hull.failed_elements"):
+        return None
+    pw, failed = run.at("hull.inner_plate.plastic_work"), run.at("hull.failed_elements")
+    hit = np.nonzero((np.diff(failed) > 0) & (np.diff(pw) < 0))[0]
+    return int(hit[0] + 1) if len(hit) else None
 
 
 def collision(run, driven):
@@ -571,8 +596,16 @@ def filled_against_empty(filled, empty):
 def granule_items(run):
     """(area, upward force) of the inner plate's cavity faces from the granules' mesh or interface
     files at the last output frame, and the files' name; ([], None) without them."""
-    faces = []
-    for c in CELLS + ["cavity_inner"]:
+    faces, source = [], None
+    geom = run.geometry()
+    if geom is None:
+        return faces, source
+    ax, up = geom.normal_axis, geom.inner_faces_up
+    mid = 0.5 * sum(geom.cavity)
+    vtk_dir = os.path.join(run.folder, "vtk")
+    cell_names = sorted(m.group(1) for m in map(re.compile(r"granules_(c\d+)\.pvd$").match,
+                                                 os.listdir(vtk_dir) if os.path.isdir(vtk_dir) else []) if m)
+    for c in cell_names + ["cavity_inner"]:
         for name in (f"granules_{c}", f"granules_interface_{c}"):
             frames = pvd_frames(run.folder, name)
             if not frames:
@@ -590,18 +623,18 @@ def granule_items(run):
                 p = pts[cl]
                 n = np.cross(p[1] - p[0], p[2] - p[0])
                 a = 0.5 * np.linalg.norm(n)
-                if a <= 0 or abs(n[2]) < 0.7 * 2 * a or p[:, 2].mean() < 0.042:
+                if a <= 0 or abs(n[ax]) < 0.7 * 2 * a or up * (p[:, ax].mean() - mid) < 0:
                     continue
                 top.append((i, cl, a))
             if per_cell:
                 for i, cl, a in top:
-                    faces.append((a, force[i, 2]))
+                    faces.append((a, up * force[i, ax]))
             else:   # nodal forces: each node stands for a third of its top triangles' area
                 area_n = np.zeros(len(pts))
                 for _, cl, a in top:
                     area_n[cl] += a / len(cl)
                 for v in np.nonzero(area_n > 0)[0]:
-                    faces.append((area_n[v], force[v, 2]))
+                    faces.append((area_n[v], up * force[v, ax]))
             source = name if c in PARTS else name.rsplit("_", 1)[0] + "_cXX"
             break
     return faces, (source if faces else None)
@@ -613,8 +646,10 @@ def bow_items(run):
     a quarter of the reference areas of the inner plate's element faces it is a corner of. None
     when the files have no contact_force (runs written without that array)."""
     frames = pvd_frames(run.folder, "hull_fem")
-    if not frames:
+    geom = run.geometry()
+    if not frames or geom is None:
         return None
+    ax, up = geom.normal_axis, geom.inner_faces_up
     pts, cells, data = read_vtk(frames[-1][1])
     if "contact_force" not in data or "region" not in data or "displacement" not in data:
         return None
@@ -625,15 +660,16 @@ def bow_items(run):
         if int(r) != 1 or len(cl) != 8:   # the inner plate's hexahedra
             continue
         cl = np.asarray(cl)
-        z = ref[cl, 2]
-        low = cl[np.argsort(z)[:4]]        # the cavity-facing (lower) face
+        z = up * ref[cl, ax]
+        low = cl[np.argsort(z)[:4]]        # the cavity-facing face
         p = ref[low]
         c = p.mean(axis=0)
-        ang = np.arctan2(p[:, 1] - c[1], p[:, 0] - c[0])
+        a1, a2 = geom.in_plane_axes
+        ang = np.arctan2(p[:, a2] - c[a2], p[:, a1] - c[a1])
         q = p[np.argsort(ang)]
         a = 0.5 * np.linalg.norm(np.cross(q[2] - q[0], q[3] - q[1]))
         area[low] += a / 4
-    fz = data["contact_force"][:, 2]
+    fz = up * data["contact_force"][:, ax]
     return [(area[v], fz[v]) for v in np.nonzero(area > 0)[0]]
 
 
@@ -813,116 +849,32 @@ def plot_deflection(runs, outdir, plt):
     save(fig, outdir, "inner_deflection.png")
 
 
-def hull_section(path):
-    """Quads (deformed x-z corner lists) of the hull's elements cut by y = SECTION_Y and their
-    equivalent plastic strain (None if absent); eroded (failed) elements are left out."""
-    pts, cells, data = read_vtk(path)
-    cur = pts + data["displacement"] if "displacement" in data else pts   # Points are the reference
-    peeq = data["equivalent_plastic_strain"][:, 0] if "equivalent_plastic_strain" in data else None
-    failed = data["failed"][:, 0] if "failed" in data and "failed" in data["_cell_arrays"] else None
-    edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)]
-    quads, values = [], []
-    for i, cl in enumerate(cells):
-        if len(cl) != 8 or (failed is not None and failed[i] > 0):
-            continue
-        y = pts[cl, 1]
-        if y.min() > SECTION_Y or y.max() <= SECTION_Y:
-            continue
-        cut = []
-        for a, b in edges:
-            ya, yb = y[a] - SECTION_Y, y[b] - SECTION_Y
-            if ya > yb:
-                a, b, ya, yb = b, a, yb, ya
-            if ya <= 0 < yb:   # half-open: a face lying in the plane belongs to the element above
-                s = -ya / (yb - ya)
-                cut.append(cur[cl[a]] + s * (cur[cl[b]] - cur[cl[a]]))
-        if len(cut) < 3:
-            continue
-        xz = np.array(cut)[:, [0, 2]]
-        c = xz.mean(axis=0)
-        xz = xz[np.argsort(np.arctan2(xz[:, 1] - c[1], xz[:, 0] - c[0]))]
-        quads.append(1e3 * xz)
-        values.append(peeq[i] if peeq is not None else 0.0)
-    return quads, (np.array(values) if peeq is not None else None)
-
-
-def plot_sections(run, outdir, plt, prefix):
+def plot_sections(run, outdir, plt, prefix, at_mm=None):
+    """section_<k>.png (the section through the bow's axis, hull_pictures.plot_section) at the
+    output frames nearest 1/3, 2/3 and all of the final penetration, or nearest each of at_mm;
+    with them, for the filled run, inner_deflection_map.png at the same frames and
+    rupture_pattern.png at the last."""
+    geom = run.geometry()
     hull = pvd_frames(run.folder, "hull_fem")
-    if not hull:
+    if geom is None or not hull:
         note(f"{run.label}: no vtk/hull_fem.pvd ({prefix}_<k>.png skipped)")
         return
     if len(run.t) <= run.contact:
         note(f"{run.label}: no contact yet ({prefix}_<k>.png skipped)")
         return
-    final = run.pen[-1]
-    frame_pen = [float(np.interp(t, run.t, run.pen)) for t, _ in hull]
-    chosen = []
-    for frac in (1 / 3, 2 / 3, 1.0):
-        k = int(np.argmin([abs(p - frac * final) for p in frame_pen]))
-        if k not in chosen:
-            chosen.append(k)
-    granule_frames = dict(pvd_frames(run.folder, "granules_particles"))
-    from matplotlib.collections import PatchCollection, PolyCollection
-    from matplotlib.patches import Circle
+    targets = [1e-3 * p for p in at_mm] if at_mm else [f * run.pen[-1] for f in (1 / 3, 2 / 3, 1.0)]
+    chosen, frame_pen = pictures.frames_at(run, hull, targets)
     for n, k in enumerate(chosen, 1):
-        t, path = hull[k]
-        fig, ax = plt.subplots(figsize=(10, 6.2))
-        quads, peeq = hull_section(path)
-        pc = PolyCollection(quads, edgecolors="k", linewidths=0.3)
-        if peeq is not None:
-            pc.set_array(peeq)
-            pc.set_cmap("plasma")
-            pc.set_clim(0, max(0.02, float(peeq.max()) if len(peeq) else 0.02))
-        else:
-            pc.set_facecolor("0.6")
-        ax.add_collection(pc)
-        if peeq is not None:
-            fig.colorbar(pc, ax=ax, fraction=0.04, pad=0.02, label="equivalent plastic strain (hull)")
-        gpath = granule_frames.get(t)
-        count = None
-        if gpath:
-            pts, _, data = read_vtk(gpath)
-            if "radius" in data:
-                r = data["radius"][:, 0]
-                dy = np.abs(pts[:, 1] - SECTION_Y)
-                cut = dy < r
-                rc = np.sqrt(r[cut] ** 2 - dy[cut] ** 2)
-                speed = np.linalg.norm(data["velocity"][cut], axis=1) if "velocity" in data else np.zeros(cut.sum())
-                circles = [Circle((1e3 * x, 1e3 * z), 1e3 * rr) for (x, _, z), rr in zip(pts[cut], rc)]
-                gc = PatchCollection(circles, cmap="viridis", edgecolors="k", linewidths=0.2, alpha=0.9)
-                gc.set_array(speed)
-                ax.add_collection(gc)
-                fig.colorbar(gc, ax=ax, orientation="horizontal", fraction=0.05, pad=0.13, aspect=50,
-                             label="granule speed [m/s] (circles: the spheres cut by the plane)")
-                count = int(cut.sum())
-        if run.has("hull.bow.z"):
-            zc = float(run.at("hull.bow.z", t))
-            ang = np.linspace(0, np.pi, 60)
-            half = bow_length(run.folder) / 2
-            xs = np.concatenate([SECTION_Y + BOW_RADIUS * np.cos(ang), SECTION_Y - BOW_RADIUS * np.cos(ang)])
-            zs = np.concatenate([zc + half + BOW_RADIUS * np.sin(ang), zc - half - BOW_RADIUS * np.sin(ang)])
-            xs, zs = np.append(xs, xs[0]), np.append(zs, zs[0])
-            ax.fill(1e3 * xs, 1e3 * zs, facecolor="0.85", edgecolor="k", lw=1.2, zorder=0)
-        p = float(np.interp(t, run.t, run.pen))
-        ax.set_title(f"{run.label}: section y = {1e3 * SECTION_Y:.0f} mm at t = {1e3 * t:.1f} ms, "
-                     f"penetration {1e3 * p:.1f} mm" + (f" ({count} granules cut)" if count is not None else ""),
-                     fontsize=10)
-        ax.set_xlim(-5, 367)
-        ax.set_ylim(-95, 110)
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("z [mm]")
-        save(fig, outdir, f"{prefix}_{n}.png")
-
-
-def bow_length(folder):
-    """The capsule's cylinder length from the bow's surface mesh (vtk/hull_bow_000000.vtp: its
-    extent along z less the two hemispheres), BOW_LENGTH when the file is missing."""
-    path = os.path.join(folder, "vtk", "hull_bow_000000.vtp")
-    if not os.path.exists(path):
-        return BOW_LENGTH
-    pts, _, _ = read_vtk(path)
-    return max(0.0, float(pts[:, 2].max() - pts[:, 2].min()) - 2 * BOW_RADIUS)
+        path = os.path.join(outdir, f"{prefix}_{n}.png")
+        pictures.plot_section(run, geom, hull[k], path, plt)
+        note(f"wrote {path}")
+    suffix = prefix[len("section"):]
+    path = os.path.join(outdir, f"inner_deflection_map{suffix}.png")
+    guarded(path, pictures.plot_deflection_maps, run, geom, chosen, hull, frame_pen, path, plt)
+    note(f"wrote {path}")
+    path = os.path.join(outdir, f"rupture_pattern{suffix}.png")
+    guarded(path, pictures.plot_rupture_pattern, run, geom, hull[-1], path, plt)
+    note(f"wrote {path}")
 
 
 def save(fig, outdir, name):
@@ -942,12 +894,28 @@ def guarded(what, f, *args):
 
 
 def main():
-    args, outdir, driven_dir, rate_dirs = [], None, None, []
+    args, outdir, driven_dir, rate_dirs, at_mm = [], None, None, [], None
+    ensemble, empties, into = None, [], args
     argv = sys.argv[1:]
     while argv:
         a = argv.pop(0)
-        if a == "--out" and argv:
+        if a == "--ensemble":
+            ensemble = into = []
+        elif a == "--empty":
+            into = empties
+        elif a == "--out" and argv:
             outdir = argv.pop(0)
+        elif a == "--case" and argv:
+            CASE["file"] = argv.pop(0)
+            if not os.path.isfile(CASE["file"]):
+                sys.exit(f"plot_case: --case {CASE['file']}: no such file")
+        elif a == "--set" and argv:
+            CASE["sets"].append(argv.pop(0))
+        elif a == "--at" and argv:
+            try:
+                at_mm = [float(x) for x in argv.pop(0).split(",")]
+            except ValueError:
+                sys.exit("plot_case: --at takes penetrations in mm separated by commas, e.g. --at 20,40,55")
         elif a == "--driven" and argv:
             driven_dir = argv.pop(0)
         elif a == "--rate" and argv:
@@ -955,7 +923,13 @@ def main():
         elif a in ("-h", "--help") or a.startswith("--"):
             sys.exit(__doc__)
         else:
-            args.append(a)
+            into.append(a)
+    if CASE["sets"] and not CASE["file"]:
+        sys.exit("plot_case: --set needs --case (the values change the case file's)")
+    if ensemble is not None or empties:
+        if args or not ensemble:
+            sys.exit("plot_case: --ensemble FILLED1 FILLED2 ... [--empty EMPTY1 ...] (no other run folders)")
+        return main_ensemble(ensemble, empties, outdir, at_mm)
     if not 1 <= len(args) <= 2:
         sys.exit(__doc__)
     runs = []
@@ -1009,9 +983,29 @@ def main():
     guarded("force_penetration.png", plot_force, runs, outdir, plt)
     guarded("energy.png", plot_energy, runs, outdir, plt)
     guarded("inner_deflection.png", plot_deflection, runs, outdir, plt)
-    guarded("section_<k>.png", plot_sections, filled, outdir, plt, "section")
+    guarded("section_<k>.png", plot_sections, filled, outdir, plt, "section", at_mm)
     if empty:
-        guarded("section_empty_<k>.png", plot_sections, empty, outdir, plt, "section_empty")
+        guarded("section_empty_<k>.png", plot_sections, empty, outdir, plt, "section_empty", at_mm)
+
+
+def main_ensemble(filled_dirs, empty_dirs, outdir, at_mm):
+    import hull_ensemble
+    filled, empty = [], []
+    for dirs, runs, label in ((filled_dirs, filled, "filled"), (empty_dirs, empty, "empty")):
+        for k, d in enumerate(dirs, 1):
+            try:
+                runs.append(Run(d, f"{label} {k}"))
+            except (RuntimeError, OSError) as e:
+                sys.exit(f"plot_case: {e}")
+    outdir = outdir or filled_dirs[0]
+    os.makedirs(outdir, exist_ok=True)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    try:
+        hull_ensemble.run_ensemble(filled, empty, outdir, at_mm, inner_rupture_row, key, note, plt)
+    except RuntimeError as e:
+        sys.exit(f"plot_case: --ensemble: {e}")
 
 
 if __name__ == "__main__":
