@@ -2,7 +2,8 @@
 """The filling of a double-hull section given by cells (section.yaml), from the case itself.
 
   make_section.py CASE.yaml [--set KEY=VALUE ...] [-o DIR] [--diameters "20 mm,16 mm"]
-                  [--porosity 0.5] [--fill-height H] [--seed 1] [--end 0.15] [--stl-only]
+                  [--fractions "1,1"] [--porosity 0.5] [--fill-height H] [--seed 1] [--end 0.15]
+                  [--closed] [--gravity-scale F] [--relax T] [--stl-only]
 
 Reads the hull's panel (mesh.panel: origin or centre, cells, web_spacing, web_thickness,
 outer_thickness, depth) and the granules' materials, interactions and breakage from CASE, after the --set values
@@ -17,6 +18,14 @@ writes into DIR (default: out/<case>-fill):
               end state (DIR/fill/granules.data after `partita run DIR/fill.yaml -o DIR/fill`)
               is the bed CASE reads with
               --set "participants.granules.particles={material: granule, file: <that path>}"
+With --closed the container is the cavities themselves (floors, webs and the inner plate's
+face: every cell closed), the boxes fill each cell whole, and the bed settles along the case's
+gravity, whichever way it points (a standing section: gravity along the plates, the bed against
+both plates from the start). --gravity-scale F settles under F times the case's gravity (a
+compacted fill in less simulated time: the bed's weight as under F times the height of granules);
+--relax T (with --closed) also writes relax.yaml: the settled bed (fill/granules.data beside it)
+relaxed for T seconds under the case's own gravity, its end state (DIR/relax/granules.data after
+`partita run DIR/relax.yaml -o DIR/relax`) being the bed the case reads.
 The defaults are coarse_fill.yaml's (16 and 20 mm granules at porosity 0.5 settled for 150 ms).
 """
 import argparse
@@ -74,6 +83,13 @@ def main():
     ap.add_argument("--fill-height", help="height of the generated boxes above the outer plate [m] (default: the depth)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--end", type=float, default=0.15, help="settling time [s]")
+    ap.add_argument("--fractions", help="share of each diameter by number (default: equal)")
+    ap.add_argument("--closed", action="store_true",
+                    help="the container is the closed cavities (inner plate's face included)")
+    ap.add_argument("--gravity-scale", type=float, default=1.0,
+                    help="settle under this multiple of the case's gravity")
+    ap.add_argument("--relax", type=float, help="with --closed: also write relax.yaml (T seconds at 1 g)")
+    ap.add_argument("--window", type=float, default=1.0e-4, help="coupling window of the fill runs [s]")
     ap.add_argument("--stl-only", action="store_true", help="write DIR/cells.stl alone")
     a = ap.parse_args()
 
@@ -107,6 +123,12 @@ def main():
         cx, cy, oz = (length(v, "centre") for v in panel["centre"])
         ox, oy = cx - 0.5 * (nx * s + t), cy - 0.5 * (ny * s + t)
     fill_h = length(a.fill_height, "--fill-height") if a.fill_height else h
+    if a.closed and fill_h > h:
+        sys.exit(f"make_section: --fill-height {fill_h} m exceeds the closed cavity's depth {h} m")
+    if not a.gravity_scale > 0:
+        sys.exit(f"make_section: --gravity-scale must be > 0, got {a.gravity_scale}")
+    if a.relax is not None and not (a.closed and a.relax > 0):
+        sys.exit("make_section: --relax T needs --closed and T > 0 (seconds)")
     if not 0 < fill_h:
         sys.exit(f"make_section: --fill-height must be > 0, got {fill_h}")
     granules = next((p for p in case["participants"].values() if p.get("solver") == "dem"), None)
@@ -117,7 +139,7 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
     # the cells' clear extents, as the panel mesher places the webs: mid-planes at t/2 + k s
     z0 = oz + t_o
-    z1 = z0 + h + 0.030
+    z1 = z0 + h if a.closed else z0 + h + 0.030
     xs = [(ox + 0.5 * t + i * s + 0.5 * t, ox + 0.5 * t + (i + 1) * s - 0.5 * t) for i in range(nx)]
     ys = [(oy + 0.5 * t + j * s + 0.5 * t, oy + 0.5 * t + (j + 1) * s - 0.5 * t) for j in range(ny)]
     tris = []
@@ -133,6 +155,8 @@ def main():
             quad((x1, y0, z0), (x1, y0, z1), (x1, y1, z1), (x1, y1, z0), (-1, 0, 0))
             quad((x0, y0, z0), (x0, y0, z1), (x1, y0, z1), (x1, y0, z0), (0, 1, 0))
             quad((x0, y1, z0), (x1, y1, z0), (x1, y1, z1), (x0, y1, z1), (0, -1, 0))
+            if a.closed:   # the inner plate's face
+                quad((x0, y0, z1), (x0, y1, z1), (x1, y1, z1), (x1, y0, z1), (0, 0, -1))
     with open(out / "cells.stl", "w") as f:
         f.write("solid cells\n")
         for n, *v in tris:
@@ -153,26 +177,52 @@ def main():
     dem = {"solver": "dem", "materials": granules["materials"]}
     if "interactions" in granules:
         dem["interactions"] = granules["interactions"]
-    dem["particles"] = {"material": material,
-                        "generate": {"boxes": boxes, "diameters": [d.strip() for d in a.diameters.split(",")],
-                                     "porosity": a.porosity, "seed": a.seed}}
+    generate = {"boxes": boxes, "diameters": [d.strip() for d in a.diameters.split(",")],
+                "porosity": a.porosity, "seed": a.seed}
+    if a.fractions:
+        try:
+            generate["fractions"] = [float(f) for f in a.fractions.split(",")]
+        except ValueError:
+            sys.exit(f"make_section: --fractions must be numbers separated by commas, got {a.fractions!r}")
+        if len(generate["fractions"]) != len(generate["diameters"]):
+            sys.exit(f"make_section: --fractions has {len(generate['fractions'])} values for "
+                     f"{len(generate['diameters'])} diameters")
+    dem["particles"] = {"material": material, "generate": generate}
     dem["meshes"] = [{"name": "cells", "stl": "cells.stl", "material": steel or material}]
     if "breakage" in granules:
         dem["breakage"] = granules["breakage"]
-    if "gravity" in granules:
-        dem["gravity"] = granules["gravity"]
+    gravity = granules.get("gravity", [0, 0, -9.81])
+    if a.gravity_scale != 1.0 or "gravity" in granules:
+        dem["gravity"] = [round(a.gravity_scale * float(g), 12) for g in gravity]
+    for k in ("rolling_friction", "time_step_fraction", "damping"):
+        if k in granules:
+            dem[k] = granules[k]
     dem["output"] = {"particles_file": "end"}
     fill = {"case": f"{case.get('case', 'section')}-fill",
-            "time": {"window": 1.0e-4, "end": a.end},
+            "time": {"window": a.window, "end": a.end},
             "participants": {"granules": dem},
             "monitors": [{"name": "settling", "quantities": [
-                "granules.kinetic_energy", "granules.cells.force_z", "granules.mass",
-                "granules.particles"]}],
-            "output": {"every": 0.05}}
+                "granules.kinetic_energy", "granules.cells.force_x", "granules.cells.force_y",
+                "granules.cells.force_z", "granules.mass", "granules.particles"]}],
+            "output": {"every": min(0.05, a.end)}}
     head = (f"# Written by make_section.py from {a.case} ({' '.join(a.set) or 'as written'}): "
             f"{nx} x {ny} cells at {s} m, the granules generated in each cell and settled "
             f"under gravity in cells.stl. Not to be edited: run make_section.py again.\n")
     (out / "fill.yaml").write_text(head + yaml.safe_dump(fill, sort_keys=False, default_flow_style=None))
+    if a.relax is not None:
+        relax = yaml.safe_load(yaml.safe_dump(fill))
+        relax["case"] = f"{case.get('case', 'section')}-relax"
+        relax["time"]["end"] = a.relax
+        relax["output"]["every"] = min(0.05, a.relax)
+        gr = relax["participants"]["granules"]
+        gr["particles"] = {"material": material, "file": "fill/granules.data"}
+        if "gravity" in granules:
+            gr["gravity"] = granules["gravity"]
+        else:
+            gr.pop("gravity", None)
+        (out / "relax.yaml").write_text(
+            head + f"# The bed of fill.yaml (run with -o {out}/fill) relaxed under the case's gravity.\n"
+            + yaml.safe_dump(relax, sort_keys=False, default_flow_style=None))
     print(f"make_section: {out / 'cells.stl'} ({len(tris)} triangles), {out / 'fill.yaml'} "
           f"({nx * ny} boxes of {xs[0][1] - xs[0][0]:.4g} x {ys[0][1] - ys[0][0]:.4g} x {fill_h:.4g} m)")
 
