@@ -10,9 +10,10 @@ smallest final penetration of all runs):
   bow force           the indenter's resisting force, smoothed over 4 % of that penetration
   inner plate energy  hull.inner_plate.plastic_work + hull.inner_plate.strain_energy (the intact
                       elements: exact up to the inner plate's first failed element)
-  inner plate force   d(inner plate energy)/d(penetration), smoothed as the bow force: the force
-                      with which the inner plate resists the bow's advance, whatever carries the
-                      load to it (the bed or the bow itself); with it, where the run has the column
+  inner plate force   d(inner plate energy)/d(penetration), smoothed as the bow force: the inner
+                      plate's share of the bow's force (the parts' shares add up to it where the
+                      motion is quasi-static), whatever carries the load to the inner plate (the
+                      bed or the bow itself); negative where it springs back; with it, where the run has the column
                       granules.cavity_inner.force_z, the bed's own load on the inner plate
   energy shares       outer plate, inner plate, webs (plastic work + elastic energy of the intact
                       elements), eroded elements (hull.eroded_energy), granules' friction, damping
@@ -103,20 +104,24 @@ class Ensemble:
     def milestones(self, inner_rupture_row):
         """Energy to each plate's first failure, per group, as mean/std/min/max."""
         for label, runs in self.groups:
-            outer, outer_p, inner, inner_p = [], [], [], []
+            outer, outer_p, inner, inner_p, inner_e = [], [], [], [], []
             for r in runs:
                 w = r.work()
                 rup = r.first_rupture()
                 if rup and w is not None:
                     outer.append(float(np.interp(rup[0], r.t, w)))
                     outer_p.append(rup[1])
+                e = inner_energy(r)
+                if rup and e is not None:
+                    inner_e.append(float(np.interp(rup[0], r.t, e)))
                 k = inner_rupture_row(r)
                 if k is not None and w is not None:
                     inner.append(float(w[k]))
                     inner_p.append(float(r.pen[k]))
             for name, values in (("energy_to_rupture", outer), ("rupture_penetration", outer_p),
-                                 ("energy_to_inner_rupture", inner), ("inner_rupture_penetration", inner_p)):
-                unit = "_J" if name.startswith("energy") else "_m"
+                                 ("energy_to_inner_rupture", inner), ("inner_rupture_penetration", inner_p),
+                                 ("inner_plate_energy_at_rupture", inner_e)):
+                unit = "_m" if name.endswith("penetration") else "_J"
                 self._stats_keys(f"ensemble_{name}_{label}{unit}", values, len(runs))
         return self
 
@@ -201,8 +206,8 @@ class Ensemble:
         fig, axes = plt.subplots(3, 1, figsize=(8, 10.5), sharex=True)
         colours = {"filled": "C0", "empty": "C3"}
         mm = 1e3 * self.grid
-        panels = (("force", 1e-3, "bow force [kN]"), ("inner_force", 1e-3, "inner plate's force\n"
-                                                                              "d(energy)/d(penetration) [kN]"),
+        panels = (("force", 1e-3, "bow force [kN]"), ("inner_force", 1e-3, "inner plate's share of it:\n"
+                                                                              "d(its energy)/d(penetration) [kN]"),
                   ("inner_energy", 1.0, "inner plate's absorbed energy [J]"))
         for ax, (q, scale, ylabel) in zip(axes, panels):
             for label, c in curves.items():

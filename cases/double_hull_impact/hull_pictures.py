@@ -248,8 +248,8 @@ def plot_deflection_maps(run, geom, chosen, frames, frame_pen, out_path, plt):
     for ax, (t, p, rects, w, failed) in zip(axes[0], maps):
         pc = PolyCollection(rects[~failed], edgecolors="none")
         pc.set_array(w[~failed])
-        pc.set_cmap("viridis")
-        pc.set_clim(min(0.0, float(w[~failed].min()) if (~failed).any() else 0.0), top)
+        pc.set_cmap("RdBu_r")        # red: pushed along the bow's travel, blue: back
+        pc.set_clim(-top, top)
         ax.add_collection(pc)
         if failed.any():
             ax.add_collection(PolyCollection(rects[failed], facecolors="k", edgecolors="k"))
@@ -322,5 +322,5 @@ def plot_rupture_pattern(run, geom, frame, out_path, plt):
 def save(fig, path, plt, tight=True):
     if tight:
         fig.tight_layout()
-    fig.savefig(path, dpi=120, bbox_inches="tight")
+    fig.savefig(path, dpi=120)
     plt.close(fig)

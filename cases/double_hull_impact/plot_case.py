@@ -115,8 +115,12 @@ rest of the audit's stored + dissipated energy, at the --at penetrations; the CS
                           plate), ensemble_rupture_penetration_<variant>_{mean,std,min,max}_m,
                           ensemble_energy_to_inner_rupture_<variant>_{mean,std,min,max}_J,
                           ensemble_inner_rupture_penetration_<variant>_{...}_m, each with
-                          _<variant>_runs (how many runs reached it)
-  ensemble_<q>_<at>_<variant>_{mean,std}_<unit>   q: inner_plate_energy [J], inner_plate_force [N],
+                          _<variant>_runs (how many runs reached it);
+                          ensemble_inner_plate_energy_at_rupture_<variant>_{...}_J: the inner
+                          plate's energy when the outer plate ruptures (before it / after it: the
+                          ensemble_inner_plate_energy_* keys below less this)
+  ensemble_<q>_<at>_<variant>_{mean,std}_<unit>   q: inner_plate_energy [J], inner_plate_force [N]
+                          (d(inner plate energy)/d(penetration): its share of the bow's force),
                           work [J] (the bow's), bed_on_inner_plate [N]; at: 25pct, 50pct, 75pct,
                           100pct of the common penetration, or <mm>mm for --at (a dot as p)
   ensemble_work_filled_minus_empty_final_J, ensemble_work_filled_spread_final_J   the mean
