@@ -102,7 +102,9 @@ class Ensemble:
 
     # ------------------------------------------------------------------ numbers
     def milestones(self, inner_rupture_row):
-        """Energy to each plate's first failure, per group, as mean/std/min/max."""
+        """Energy to each plate's first failure, per group, as mean/std/min/max; filled less
+        empty (the difference of the means, and relative to the empty mean)."""
+        means = {}
         for label, runs in self.groups:
             outer, outer_p, inner, inner_p, inner_e = [], [], [], [], []
             for r in runs:
@@ -123,6 +125,15 @@ class Ensemble:
                                  ("inner_plate_energy_at_rupture", inner_e)):
                 unit = "_m" if name.endswith("penetration") else "_J"
                 self._stats_keys(f"ensemble_{name}_{label}{unit}", values, len(runs))
+                s = stats(values)
+                if s is not None:
+                    means[(name, label)] = s[0]
+        for name in ("energy_to_rupture", "energy_to_inner_rupture"):
+            f, e = means.get((name, "filled")), means.get((name, "empty"))
+            if f is not None and e is not None:
+                self.key(f"ensemble_{name}_filled_minus_empty_J", f - e)
+                if e:
+                    self.key(f"ensemble_{name}_filled_over_empty", f / e)
         return self
 
     def _stats_keys(self, stem, values, n_runs):

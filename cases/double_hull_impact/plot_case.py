@@ -123,6 +123,8 @@ rest of the audit's stored + dissipated energy, at the --at penetrations; the CS
                           (d(inner plate energy)/d(penetration): its share of the bow's force),
                           work [J] (the bow's), bed_on_inner_plate [N]; at: 25pct, 50pct, 75pct,
                           100pct of the common penetration, or <mm>mm for --at (a dot as p)
+  ensemble_energy_to_rupture_filled_minus_empty_J, _filled_over_empty (and the same for
+                          energy_to_inner_rupture): the filled mean less (over) the empty mean
   ensemble_work_filled_minus_empty_final_J, ensemble_work_filled_spread_final_J   the mean
                           filled work less the mean empty one at the common penetration, and the
                           filled runs' range there
