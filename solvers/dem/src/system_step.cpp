@@ -34,6 +34,7 @@ std::int64_t now_ns() {
 
 void System::step(double dt) {
   const std::int64_t profile_start = profiling_ ? now_ns() : 0;
+  pair_energy_valid_ = false;  // (the pass below stores them again)
   prepare();
   if (!(dt > 0.0) || !std::isfinite(dt)) {
     std::ostringstream msg;
@@ -154,6 +155,9 @@ void System::step(double dt) {
       reduce_wall_and_mesh_forces(dt, true);
     }
   }
+  // the pass stored each listed pair's elastic energy (energy accounting; a step's pass always
+  // updates the histories and kicks)
+  pair_energy_valid_ = energy_tracking_;
   // the next step's bound starts from this one's (fused: the distances from the build positions
   // were not computed) or from the exact distances
   set_motion(fused ? bound : rebuild ? 0.0 : std::sqrt(moved2));
@@ -245,6 +249,8 @@ void System::start_load_pass(int parts) {
     dissipation_.resize(store_.size());
     block_energy_.resize((store_.size() + block_size - 1) / block_size);
     cross_energy_.resize(partition_.cross_pairs.size());
+    const std::size_t slots = neighbors_.neighbors_.size();
+    if (pair_energy_.size() < slots) pair_energy_.resize(slots + slots / 4);  // (headroom)
   }
 }
 
@@ -339,6 +345,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
                                        : (Load ? kernels.with_load : kernels.plain);
   DissipationSums* const diss = Energy ? dissipation_.data() : nullptr;
   PairEnergy* const cross_energy = Energy ? cross_energy_.data() : nullptr;
+  double* const pair_energy = Energy ? pair_energy_.data() : nullptr;
   // Drift: the integrator's first half of particle i (with kick = dt/2) and the start of its
   // force sums, as the loop before the pass does it (step(), which knows that no particle can
   // have moved beyond the skin)
@@ -497,6 +504,24 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       row_first[i_end - i_begin] = n_touch;
       batch(tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
             forces, energies);
+      if constexpr (Energy) {
+        // each listed pair's elastic energy at the step's end (positions final, histories
+        // updated), as elastic_energy() computes it; 0 without a doubt where the spheres are
+        // apart by more than rounding (no square root for them)
+        for (int i = i_begin; i < i_end; ++i) {
+          const Eigen::Vector3d& xi = packed[i].x;
+          for (int s = offsets[i]; s < offsets[i + 1]; ++s) {
+            const int j = neighbors[s];
+            const double rsum = p.radius[i] + p.radius[j];
+            pair_energy[s] =
+                !((xi - packed[j].x).squaredNorm() >= rsum * rsum * (1.0 + 1e-12))  // (NaN: in)
+                    ? sphere_pair_elastic_energy(model_.pair(material[i], material[j]), xi,
+                                                 packed[j].x, p.radius[i], p.radius[j],
+                                                 pairs.shear[s])
+                    : 0.0;
+          }
+        }
+      }
       BlockEnergy block_e;  // (Energy) this block's energies: powers x dt, spring energies
       for (int i = i_begin; i < i_end; ++i) {
         PackedParticle& qi = packed[i];
