@@ -214,7 +214,10 @@ class Ensemble:
 
     # ------------------------------------------------------------------ figures
     def plot_curves(self, curves, rupture_bands, path, plt):
-        fig, axes = plt.subplots(3, 1, figsize=(8, 10.5), sharex=True)
+        """The bow's force, the inner plate's share of it and its energy, filled against empty;
+        and the bow's work filled less the empty mean (each packing: the band)."""
+        both = "empty" in curves and "work" in curves["filled"] and "work" in curves["empty"]
+        fig, axes = plt.subplots(4 if both else 3, 1, figsize=(8, 13.5 if both else 10.5), sharex=True)
         colours = {"filled": "C0", "empty": "C3"}
         mm = 1e3 * self.grid
         panels = (("force", 1e-3, "bow force [kN]"), ("inner_force", 1e-3, "inner plate's share of it:\n"
@@ -238,6 +241,17 @@ class Ensemble:
                 ax.axvspan(1e3 * lo, 1e3 * hi + 0.05, color=colours[label], alpha=0.12, hatch="//")
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
+        if both:
+            ax = axes[3]
+            d = curves["filled"]["work"] - curves["empty"]["work"].mean(axis=0)
+            ax.fill_between(mm, d.min(axis=0), d.max(axis=0), color="C0", alpha=0.25, lw=0)
+            ax.plot(mm, d.mean(axis=0), color="C0", lw=1.6,
+                    label=f"filled less the empty mean: mean of {len(d)} (band: min-max)")
+            ax.axhline(0, color="k", lw=0.6)
+            ax.set_ylabel("bow's work, filled - empty [J]")
+            ax.grid(alpha=0.3)
+            for label, (lo, hi) in rupture_bands.items():
+                ax.axvspan(1e3 * lo, 1e3 * hi + 0.05, color=colours[label], alpha=0.12, hatch="//")
         if rupture_bands:
             axes[0].plot([], [], color="0.6", lw=6, alpha=0.4, label="the outer plate ruptures (hatched: the runs' range)")
         for ax in axes:
@@ -274,7 +288,7 @@ class Ensemble:
                     total = sum(parts)
                     axis.errorbar(x, bottom, yerr=[bottom - total.min(axis=0), total.max(axis=0) - bottom], fmt="none",
                                   ecolor="k", capsize=3, lw=0.8)
-                for xi, b in zip(x, bottom):
+                for xi, b in zip(x, bottom if parts else []):
                     axis.text(xi, b, f"{label}\n", ha="center", va="bottom", fontsize=7)
         for axis in (ax, gx):
             axis.set_xticks(np.arange(len(at_m)))

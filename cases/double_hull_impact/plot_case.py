@@ -106,7 +106,8 @@ smallest final penetration of them all; spread: figures show the mean and the mi
 give mean, sample standard deviation (ddof 1), min and max) it writes ensemble_curves.png (the
 bow's force, the inner plate's force d(energy)/d(penetration) with the bed's load on it where
 granules.cavity_inner.force_z exists, the inner plate's absorbed energy (plastic + elastic), each
-filled against empty, the outer plate's rupture marked), energy_shares.png and energy_shares.csv
+filled against empty, the outer plate's rupture marked; with empty runs the bow's work filled less
+the empty mean), energy_shares.png and energy_shares.csv
 (outer plate, inner plate, webs, eroded elements, granules' friction, damping, crushing and the
 rest of the audit's stored + dissipated energy, at the --at penetrations; the CSV: penetration
 [mm], variant, term, mean/std/min/max [J], share of the total [%], runs) and prints:
