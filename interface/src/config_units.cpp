@@ -33,7 +33,6 @@ const std::vector<std::pair<std::string, double>>& equivalents(std::string_view 
   static const std::vector<std::pair<std::string, double>> energy = {
       {"N m", 1.0}, {"Nm", 1.0}, {"N mm", 1e-3}, {"Nmm", 1e-3}, {"kN m", 1e3}};
   static const std::vector<std::pair<std::string, double>> frequency = {{"1/s", 1.0}};
-  // ("40.4 1/s" reads as digit groups: "40.4 /s" is how a rate is written with a space)
   static const std::vector<std::pair<std::string, double>> rate = {
       {"Hz", 1.0}, {"/s", 1.0}, {"s^-1", 1.0}};
   if (unit == "Pa") return pressure;
@@ -76,20 +75,31 @@ std::optional<double> parse_quantity(std::string_view text, std::string_view uni
   // and a decimal one to others, so neither is guessed.
   const bool comma_group = rest.size() >= 2 && rest[0] == ',' && std::isdigit(static_cast<unsigned char>(rest[1]));
   const std::string_view after_space = trim(rest);
+  // a unit that starts with a digit ("40.4 1/s") is the unit, not a digit group
+  const auto is_unit = [&](std::string_view t) {
+    if (t == unit) return true;
+    for (const auto& [name, factor] : equivalents(unit))
+      if (t == name) return true;
+    return false;
+  };
   const bool space_group = !comma_group && rest.size() > after_space.size() && !after_space.empty() &&
-                           std::isdigit(static_cast<unsigned char>(after_space[0]));
+                           std::isdigit(static_cast<unsigned char>(after_space[0])) &&
+                           !is_unit(after_space);
   if (comma_group || space_group) {
     if (why) {
       std::string digits(text.substr(0, static_cast<std::size_t>(r.ptr - text.data())));
-      std::string tail;
-      std::size_t i = 0;
-      const std::string_view r2 = comma_group ? rest : after_space;
+      // the groups: runs of digits and commas up to the unit (which may start with a digit)
+      std::string_view r2 = comma_group ? rest : after_space;
       std::string groups;
-      for (; i < r2.size() && (std::isdigit(static_cast<unsigned char>(r2[i])) || r2[i] == ',' ||
-                               r2[i] == ' ');
-           ++i)
-        if (r2[i] != ',' && r2[i] != ' ') groups += r2[i];
-      tail = std::string(trim(r2.substr(i)));
+      while (!r2.empty() && (std::isdigit(static_cast<unsigned char>(r2[0])) || r2[0] == ',') &&
+             !is_unit(r2)) {
+        std::size_t i = 0;
+        for (; i < r2.size() && (std::isdigit(static_cast<unsigned char>(r2[i])) || r2[i] == ',');
+             ++i)
+          if (r2[i] != ',') groups += r2[i];
+        r2 = trim(r2.substr(i));
+      }
+      const std::string tail(r2);
       const std::string u = tail.empty() ? std::string() : " " + tail;
       *why = "'" + std::string(text) + "' has digit groups separated by " +
              (comma_group ? "a comma" : "a space") +

@@ -96,6 +96,12 @@ TEST_CASE("units: digit groups are refused with the ways to write the number",
   CHECK_THAT(why, Catch::Contains("0.3"));
   CHECK_FALSE(parse_quantity("210 000 MPa", "Pa", &why));
   CHECK_THAT(why, Catch::Contains("210000 MPa"));
+  // a unit that starts with a digit is the unit, not a group: a rate of 40.4 per second
+  CHECK(*parse_quantity("40.4 1/s", "1/s") == Approx(40.4));
+  CHECK(*parse_quantity("40.4 /s", "1/s") == Approx(40.4));
+  CHECK(*parse_quantity("50 1/s", "Hz") == Approx(50.0));
+  CHECK_FALSE(parse_quantity("40 400 1/s", "1/s", &why));
+  CHECK_THAT(why, Catch::Contains("40400 1/s"));
   // and through a case file, with the key's place
   const auto spec = solid_spec();
   try {
