@@ -346,6 +346,24 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   DissipationSums* const diss = Energy ? dissipation_.data() : nullptr;
   PairEnergy* const cross_energy = Energy ? cross_energy_.data() : nullptr;
   double* const pair_energy = Energy ? pair_energy_.data() : nullptr;
+  // (Energy) each listed pair's elastic energy at the step's end, as elastic_energy() computes
+  // it (sphere_pair_elastic_energy at the final positions with the final history, into its
+  // slot): a pair found apart, whose history is settled, at once (0 without a square root where
+  // it is apart by more than rounding); the touching pairs once the kernel updated theirs
+  // (d2, rsum: the pass's |x_i - x_j|^2 and r_i + r_j, the packed copies of the store's radii)
+  auto apart_pair_energy = [&](int s, int i, int j, double d2, double rsum) {
+    return d2 >= rsum * rsum * (1.0 + 1e-12)
+               ? 0.0
+               : sphere_pair_elastic_energy(model_.pair(material[i], material[j]), packed[i].x,
+                                            packed[j].x, p.radius[i], p.radius[j],
+                                            pairs.shear[s]);
+  };
+  auto store_pair_energies = [&](const PairTask* t, int n) {
+    for (int k = 0; k < n; ++k)
+      pair_energy[t[k].s] = sphere_pair_elastic_energy(
+          model_.pair(material[t[k].i], material[t[k].j]), packed[t[k].i].x, packed[t[k].j].x,
+          p.radius[t[k].i], p.radius[t[k].j], pairs.shear[t[k].s]);
+  };
   // Drift: the integrator's first half of particle i (with kick = dt/2) and the start of its
   // force sums, as the loop before the pass does it (step(), which knows that no particle can
   // have moved beyond the skin)
@@ -397,17 +415,21 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         const PackedParticle& qj = packed[c.j];
         const Eigen::Vector3d d = qi.x - qj.x;
         const double rsum = qi.r + qj.r;
-        const bool touch = !(d.squaredNorm() >= rsum * rsum);  // (as the scalar kernel)
+        const double d2 = d.squaredNorm();
+        const bool touch = !(d2 >= rsum * rsum);  // (as the scalar kernel)
         if (static_cast<char>(touch) != pairs.touching[c.slot]) {
           pairs.touching[c.slot] = static_cast<char>(touch);
           if (!touch) pairs.shear[c.slot].setZero();  // parted: the history is settled
         }
+        if constexpr (Energy)
+          if (!touch) pair_energy[c.slot] = apart_pair_energy(c.slot, c.i, c.j, d2, rsum);
         tp.cross_force[k].touching = touch;
         chunk_tasks[n_touch] = PairTask{c.slot, c.i, c.j};
         n_touch += touch ? 1 : 0;
       }
       batch(chunk_tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
             chunk_forces, chunk_energy);
+      if constexpr (Energy) store_pair_energies(chunk_tasks, n_touch);
       const PairForce* o = chunk_forces;
       for (int k = k0; k < k1; ++k) {
         ThreadPartition::CrossForce& cf = tp.cross_force[k];
@@ -489,13 +511,16 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           const PackedParticle& qj = packed[j];
           const Eigen::Vector3d d = qi.x - qj.x;
           const double rsum = qi.r + qj.r;
-          const bool touch = !(d.squaredNorm() >= rsum * rsum);  // (as the scalar kernel)
+          const double d2 = d.squaredNorm();
+          const bool touch = !(d2 >= rsum * rsum);  // (as the scalar kernel)
           // the flag changes only where a contact starts or ends (rare: a predictable branch,
           // unlike one on the flag or on the test themselves)
           if (static_cast<char>(touch) != pairs.touching[s]) {
             pairs.touching[s] = static_cast<char>(touch);
             if (!touch) pairs.shear[s].setZero();  // parted: the history is settled
           }
+          if constexpr (Energy)
+            if (!touch) pair_energy[s] = apart_pair_energy(s, i, j, d2, rsum);
           tasks[n_touch] = PairTask{s, i, j};
           n_touch += touch ? 1 : 0;
         }
@@ -504,24 +529,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       row_first[i_end - i_begin] = n_touch;
       batch(tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
             forces, energies);
-      if constexpr (Energy) {
-        // each listed pair's elastic energy at the step's end (positions final, histories
-        // updated), as elastic_energy() computes it; 0 without a doubt where the spheres are
-        // apart by more than rounding (no square root for them)
-        for (int i = i_begin; i < i_end; ++i) {
-          const Eigen::Vector3d& xi = packed[i].x;
-          for (int s = offsets[i]; s < offsets[i + 1]; ++s) {
-            const int j = neighbors[s];
-            const double rsum = p.radius[i] + p.radius[j];
-            pair_energy[s] =
-                !((xi - packed[j].x).squaredNorm() >= rsum * rsum * (1.0 + 1e-12))  // (NaN: in)
-                    ? sphere_pair_elastic_energy(model_.pair(material[i], material[j]), xi,
-                                                 packed[j].x, p.radius[i], p.radius[j],
-                                                 pairs.shear[s])
-                    : 0.0;
-          }
-        }
-      }
+      if constexpr (Energy) store_pair_energies(tasks, n_touch);
       BlockEnergy block_e;  // (Energy) this block's energies: powers x dt, spring energies
       for (int i = i_begin; i < i_end; ++i) {
         PackedParticle& qi = packed[i];
