@@ -40,8 +40,15 @@ void DemAdapter::read(std::string_view mesh, std::string_view data, const Eigen:
   bool centres = false;
   CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
   if (centres && data == "attached") {
-    for (Eigen::Index t = 0; t < values.rows(); ++t)
-      system_.set_triangle_active(cm.id, static_cast<int>(t), values(t, 0) >= 0.5);
+    // every window, mostly unchanged: only the triangles whose state changes are set (setting
+    // one to its state is a no-op); a count that does not fit goes through the checked call
+    const dem::TriangleMesh& m = system_.mesh(cm.id);
+    const bool fits = values.rows() == m.triangle_count();
+    for (Eigen::Index t = 0; t < values.rows(); ++t) {
+      const bool active = values(t, 0) >= 0.5;
+      if (!fits || active != m.triangle_active(static_cast<int>(t)))
+        system_.set_triangle_active(cm.id, static_cast<int>(t), active);
+    }
     return;
   }
   if (centres || data != "displacement")

@@ -132,6 +132,8 @@ void CaseRun::build_energy_balance(const config::Node& root) {
   if (en.has("tolerance")) s.tolerance = en.real("tolerance");
   s.stop = en.string("on_exceeded") == "stop";
   if (en.has("floor")) s.floor = en.real("floor");
+  if (en.has("every_windows"))
+    settings_->energy_every = static_cast<int>(en.integer("every_windows"));
   s.coupling_column = !settings_->energy_pairs.empty();
   s.count_coupling = en.string("coupling") == "counted";
   if (s.count_coupling && settings_->energy_pairs.empty())
@@ -147,6 +149,7 @@ void CaseRun::build_monitors(const config::Node& root) {
   for (const config::Node& m : root["monitors"].items()) {
     Monitors::Monitor mon;
     mon.name = m.string("name");
+    if (m.has("every_windows")) mon.every = static_cast<int>(m.integer("every_windows"));
     if (mon.name.empty() || mon.name.find('/') != std::string::npos || mon.name == "coupling")
       m["name"].fail(
           "a monitor name becomes DIR/<name>.csv: it must be non-empty, without '/', and not "
@@ -211,7 +214,8 @@ void CaseRun::build_services() {
   std::vector<Service*> csv_files;
   csv_files.push_back(&add(
       std::make_unique<CouplingCsv>(output_dir_ / "coupling.csv", *scheme_, balance, *energy_audit)));
-  auto& monitors = add(std::make_unique<Monitors>(output_dir_, s.monitors, s.energy_terms));
+  auto& monitors =
+      add(std::make_unique<Monitors>(output_dir_, s.monitors, s.energy_terms, s.energy_every));
   csv_files.push_back(&monitors);
   if (s.energy) {
     csv_files.push_back(&add(std::make_unique<EnergyBalanceService>(

@@ -131,6 +131,17 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
       std::make_shared<Spec>("monitor", "a CSV time series DIR/<name>.csv of solver quantities");
   monitor->string("name", "file name without .csv").required();
   monitor->strings("quantities", "participant.quantity of each column").required();
+  monitor
+      ->integer("every_windows",
+                "a row every this many windows (and the initial state and the last window): the "
+                "participants are asked for the quantities only in windows where a monitor or "
+                "the energy balance records, which saves the passes over particles and contacts "
+                "that some quantities take (a DEM's elastic_energy, kinetic_energy); a "
+                "non-finite value then stops the run at the next recorded window, up to this "
+                "many windows late (the participants' own state checks still run every window)")
+      .min(1)
+      .max(1000000000)
+      .def(1);
   auto monitor_plot = std::make_shared<Spec>(
       "monitor plot",
       "quantities of the monitor drawn against another of its quantities instead of time "
@@ -146,7 +157,8 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
 
   auto energy = std::make_shared<Spec>(
       "energy",
-      "the energy balance of the whole coupled system, DIR/energy.csv at every window: the "
+      "the energy balance of the whole coupled system, DIR/energy.csv at every window (or every "
+      "energy.every_windows): the "
       "named monitor quantities (participant.quantity, in J) by role, their sums and `energy "
       "balance error [-]` = (stored + dissipated - inputs - initial) / scale, initial = the same "
       "sum at t = 0, scale = max(sum |inputs|, sum |stored| + sum |dissipated|, floor)");
@@ -178,6 +190,15 @@ std::shared_ptr<const config::Spec> case_spec(const Registries& registries) {
              "run's largest error; default none")
       .unit("J")
       .positive();
+  energy
+      ->integer("every_windows",
+                "a row of energy.csv every this many windows (and the initial state and the last "
+                "window); its terms are cumulative works and present energies, so a sampled "
+                "balance misses nothing but the windows between (the largest error is read over "
+                "the rows written)")
+      .min(1)
+      .max(1000000000)
+      .def(1);
 
   auto output = std::make_shared<Spec>("output", "VTK output under DIR/vtk");
   output->real("every", "simulated time between frames (default: first and last frame only)")

@@ -32,6 +32,7 @@ struct CaseRun::ServiceSettings {
   // the energy balance (null without an energy section) and its terms in its order
   std::unique_ptr<coupling::EnergyBalance> energy;
   std::vector<std::pair<coupling::Participant*, std::string>> energy_terms;
+  int energy_every = 1;  // energy.every: the balance's row every this many windows
 };
 
 }  // namespace partita::run

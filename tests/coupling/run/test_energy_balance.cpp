@@ -420,3 +420,37 @@ TEST_CASE("energy balance: unknown or unfit terms are clear errors at the key",
   CHECK(e.find("unknown participant 'sprin'") != std::string::npos);
   CHECK(e.find("did you mean 'spring'") != std::string::npos);
 }
+
+TEST_CASE("energy balance and monitors sampled every N windows: the rows of the run straight "
+          "through at the initial state, every N-th window and the last",
+          "[coupling][case][energy][monitors]") {
+  RemoveScratch cleanup;
+  // 0.0205 s of 1e-4 s windows: 205 windows, the last not a multiple of 7
+  const auto text = [](const std::string& every) {
+    return oscillator_case("", every.empty() ? "" : "  every_windows: " + every + "\n", 0.0205) +
+           "monitors:\n  - {name: m, quantities: [mass.kinetic_energy, spring.elastic_energy]" +
+           (every.empty() ? "" : ", every_windows: " + every) +
+           "}\n  - {name: all, quantities: [mass.kinetic_energy]}\n";
+  };
+  run_case("each", text(""));
+  run_case("sampled", text("7"));
+  const auto lines = [](const fs::path& p) {
+    std::vector<std::string> v;
+    std::istringstream in(read_text(p));
+    for (std::string l; std::getline(in, l);) v.push_back(l);
+    return v;
+  };
+  for (const std::string file : {"energy.csv", "m.csv"}) {
+    const std::vector<std::string> each = lines(base() / "each" / "out" / file);
+    const std::vector<std::string> sampled = lines(base() / "sampled" / "out" / file);
+    REQUIRE(each.size() == 1 + 1 + 205);  // the header, t = 0, the windows
+    std::vector<std::string> expected = {each[0]};
+    for (std::size_t w = 0; w <= 205; ++w)
+      if (w % 7 == 0 || w == 205) expected.push_back(each[1 + w]);
+    INFO(file);
+    CHECK(sampled == expected);
+  }
+  // a monitor without every_windows keeps its row at every window
+  CHECK(read_text(base() / "sampled" / "out" / "all.csv") ==
+        read_text(base() / "each" / "out" / "all.csv"));
+}

@@ -22,6 +22,7 @@ EnergyBalanceService::EnergyBalanceService(const std::filesystem::path& file,
       csv_(file, "time", "s", balance_->columns()) {}
 
 void EnergyBalanceService::observe(FinishedWindow& w) {
+  if (!monitors_.extra_due(w)) return;  // (energy.every: a sampled balance, its terms cumulative)
   const double created = audit_.created();  // the interfaces' net created energy
   monitors_.extra_values(terms_);
   EnergyBalance& balance = *balance_;

@@ -16,10 +16,11 @@ using namespace coupling;
 namespace fs = std::filesystem;
 
 Monitors::Monitors(const fs::path& output_dir, std::vector<Monitor> monitors,
-                   std::vector<std::pair<Participant*, std::string>> extra)
+                   std::vector<std::pair<Participant*, std::string>> extra, int extra_every)
     : output_dir_(output_dir),
       monitors_(std::move(monitors)),
       extra_(std::move(extra)),
+      extra_every_(extra_every),
       columns_of_(monitors_.size() + 1) {
   for (const auto& m : monitors_) {
     std::vector<std::pair<std::string, std::string>> mc;
@@ -61,6 +62,10 @@ void Monitors::values_of(const std::vector<Column>& cols, std::vector<double>& o
 }
 
 void Monitors::observe(FinishedWindow& w) {
+  // sampled series (every > 1): nothing is asked in a window that none records
+  bool any = !extra_.empty() && extra_due(w);
+  for (const Monitor& m : monitors_) any = any || due(w, m.every);
+  if (!any) return;
   for (Asked& a : wanted_) {
     Stopwatch clock;  // the solver computes its quantities: its time, not the core's
     a.values = a.p->monitor_values(a.names);
@@ -74,6 +79,7 @@ void Monitors::observe(FinishedWindow& w) {
             w.window, w.time, a.p->name(), mv.name, mv.value, mv.unit));
   }
   for (std::size_t mi = 0; mi < monitors_.size(); ++mi) {
+    if (!due(w, monitors_[mi].every)) continue;
     values_of(columns_of_[mi], row_);
     Stopwatch csv_clock;  // formatting the row: output time, not the core's
     csv_[mi].record(w.time, row_);
