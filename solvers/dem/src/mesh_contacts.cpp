@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <string>
 
 namespace partita::dem {
 
@@ -382,6 +384,91 @@ void MeshContacts::read(BinaryReader& in, std::size_t particles) {
          slot_[r + 1] - slot_[r] <= max_contacts && count_[r] >= 0 &&
          count_[r] <= slot_[r + 1] - slot_[r];
   if (!ok) throw Error("corrupt state: the mesh contact rows do not agree");
+}
+
+// ---- contacts that travel with their particles ----------------------------------------------
+
+void MeshContacts::pack(const std::vector<int>& which, std::vector<std::byte>& out) const {
+  for (const int i : which) {
+    const auto it = std::lower_bound(particle_.begin(), particle_.end(), i);
+    const int r = it != particle_.end() && *it == i ? static_cast<int>(it - particle_.begin()) : -1;
+    const std::int32_t count = r >= 0 ? count_[r] : 0;
+    std::size_t at = out.size();
+    out.resize(at + sizeof count + static_cast<std::size_t>(count) * packed_contact_bytes);
+    std::memcpy(out.data() + at, &count, sizeof count);
+    at += sizeof count;
+    for (int c = 0; c < count; ++c) {
+      const auto k = static_cast<std::size_t>(slot_[r] + c);
+      std::memcpy(out.data() + at, &key_[k], sizeof(std::int64_t));
+      std::memcpy(out.data() + at + 8, shear_[k].data(), 3 * sizeof(double));
+      std::memcpy(out.data() + at + 32, &record_[k], sizeof(MeshContactRecord));
+      at += packed_contact_bytes;
+    }
+  }
+}
+
+std::size_t MeshContacts::check_packed(const std::byte* data, std::size_t bytes, std::size_t n,
+                                       const std::vector<TriangleMesh>& meshes) {
+  std::size_t at = 0;
+  for (std::size_t p = 0; p < n; ++p) {
+    std::int32_t count = 0;
+    if (bytes - at < sizeof count)
+      throw Error("the mesh contacts of particle " + std::to_string(p) +
+                  " of the message are cut short");
+    std::memcpy(&count, data + at, sizeof count);
+    at += sizeof count;
+    if (count < 0 || count > max_contacts)
+      throw Error("particle " + std::to_string(p) + " of the message has " +
+                  std::to_string(count) + " mesh contacts; a particle keeps 0 to " +
+                  std::to_string(max_contacts));
+    if ((bytes - at) / packed_contact_bytes < static_cast<std::size_t>(count))
+      throw Error("the mesh contacts of particle " + std::to_string(p) +
+                  " of the message are cut short");
+    for (int c = 0; c < count; ++c, at += packed_contact_bytes) {
+      MeshContactRecord rec;
+      std::memcpy(static_cast<void*>(&rec), data + at + 32, sizeof rec);
+      const bool mesh_ok = rec.mesh >= 0 && rec.mesh < static_cast<int>(meshes.size());
+      if (!mesh_ok || rec.triangle < 0 || rec.triangle >= meshes[rec.mesh].triangle_count())
+        throw Error("particle " + std::to_string(p) + " of the message touches triangle " +
+                    std::to_string(rec.triangle) + " of mesh " + std::to_string(rec.mesh) +
+                    ", which this system does not have (" + std::to_string(meshes.size()) +
+                    " meshes): set the receiver up with the sender's meshes");
+    }
+  }
+  return at;
+}
+
+void MeshContacts::unpack(int first, std::size_t n, const std::byte* data) {
+  // the counts first (rows only for particles with contacts), then the layout: the rows there
+  // are, followed by the new particles' rows
+  std::size_t rows = particle_.size(), slots = key_.size();
+  std::size_t at = 0;
+  for (std::size_t p = 0; p < n; ++p) {
+    std::int32_t count = 0;
+    std::memcpy(&count, data + at, sizeof count);
+    at += sizeof count + static_cast<std::size_t>(count) * packed_contact_bytes;
+    if (count > 0) ++rows, slots += static_cast<std::size_t>(count);
+  }
+  start_layout(rows, slots);
+  for (std::size_t r = 0; r < particle_.size(); ++r)
+    add_row(particle_[r], slot_[r + 1] - slot_[r], static_cast<int>(r));
+  at = 0;
+  for (std::size_t p = 0; p < n; ++p) {
+    std::int32_t count = 0;
+    std::memcpy(&count, data + at, sizeof count);
+    at += sizeof count;
+    if (count == 0) continue;
+    add_row(first + static_cast<int>(p), count, -1);
+    new_count_.back() = count;
+    const auto dst = static_cast<std::size_t>(new_slot_[new_slot_.size() - 2]);
+    for (int c = 0; c < count; ++c, at += packed_contact_bytes) {
+      std::memcpy(&new_key_[dst + c], data + at, sizeof(std::int64_t));
+      std::memcpy(new_shear_[dst + c].data(), data + at + 8, 3 * sizeof(double));
+      std::memcpy(static_cast<void*>(&new_record_[dst + c]), data + at + 32,
+                  sizeof(MeshContactRecord));
+    }
+  }
+  finish_layout();
 }
 
 }  // namespace partita::dem

@@ -116,14 +116,34 @@ void ParticleStore::pack(const std::vector<int>& which, std::vector<std::byte>& 
   }
 }
 
-std::size_t ParticleStore::unpack(const std::byte* data, std::size_t bytes) {
-  const std::size_t first = size();
-  const std::size_t row = packed_bytes_per_particle();
+namespace {
+
+std::size_t whole_particles(std::size_t bytes, std::size_t row) {
   if (row == 0 || bytes % row != 0)
     throw Error("particle store: unpack() of " + std::to_string(bytes) +
                 " bytes, not a whole number of particles of " + std::to_string(row) +
                 " bytes (packed by a store of another layout?)");
-  const std::size_t n = bytes / row;
+  return bytes / row;
+}
+
+}  // namespace
+
+void ParticleStore::packed_ids(const std::byte* data, std::size_t bytes,
+                               std::vector<std::int64_t>& ids) const {
+  const std::size_t n = whole_particles(bytes, packed_bytes_per_particle());
+  ids.resize(n);
+  for (const auto& c : columns_) {
+    if (c->name == "id" && c->type() == typeid(std::int64_t) && c->width == 1) {
+      if (n > 0) std::memcpy(ids.data(), data, n * sizeof(std::int64_t));
+      return;
+    }
+    data += n * c->width * c->element_size();
+  }
+}
+
+std::size_t ParticleStore::unpack(const std::byte* data, std::size_t bytes) {
+  const std::size_t first = size();
+  const std::size_t n = whole_particles(bytes, packed_bytes_per_particle());
   for (auto& c : columns_) {
     c->unpack(core_, n, data);
     data += n * c->width * c->element_size();
@@ -147,6 +167,20 @@ std::string ParticleStore::layout() const {
   for (const auto& c : columns_)
     s += c->name + ":" + std::to_string(c->width) + "x" + std::to_string(c->element_size()) + ";";
   return s;
+}
+
+std::uint64_t ParticleStore::layout_hash() const {
+  std::uint64_t h = 0xcbf29ce484222325ull;  // FNV-1a, 64 bits
+  const auto mix = [&h](const void* data, std::size_t n) {
+    const auto* b = static_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < n; ++k) h = (h ^ b[k]) * 0x100000001b3ull;
+  };
+  for (const auto& c : columns_) {
+    mix(c->name.data(), c->name.size());
+    const std::uint64_t sizes[3] = {c->name.size(), c->width, c->element_size()};
+    mix(sizes, sizeof sizes);
+  }
+  return h;
 }
 
 }  // namespace partita::dem

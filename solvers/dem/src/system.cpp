@@ -423,6 +423,7 @@ void System::rebuild_lists() {
   verlet_.forget_motion();  // (its distances were from the last build's positions)
   neighbors_.build(store_.core(), walls_.planes(), meshes_);
   pairs_follow_lists();
+  pairs_.place_waiting(neighbors_, store_.core().id);  // (histories of particles received)
   mesh_contacts_.follow_build(neighbors_);
   partition_.invalidate();
   lists_current_ = true;

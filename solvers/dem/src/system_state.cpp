@@ -86,6 +86,7 @@ void System::restore_state(const SystemState& s) {
   std::istringstream in(s.body_, std::ios::binary);
   BinaryReader r(in);
   read_body(r);
+  pairs_.clear_waiting();  // (received histories belong to the state that was replaced)
   verlet_.store_replaced();
   partition_.invalidate();
   prepared_ = false;  // time step and scratch for the restored particle set; lists come with it

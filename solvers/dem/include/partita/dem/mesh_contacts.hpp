@@ -141,6 +141,22 @@ class MeshContacts {
   /// The meshes' triangle and vertex forces from the contacts of the last pass.
   void reduce(std::vector<TriangleMesh>& meshes) const;
 
+  /// A particle's contacts as bytes, to move it to another System (another subdomain): pack()
+  /// appends, for each particle of `which` in order, its contact count (int32) and that many
+  /// contacts (feature key, tangential history, record: packed_contact_bytes each; a particle
+  /// without a row has none). check_packed() reads such bytes for n particles against the
+  /// receiver's meshes and returns how many bytes they take; it throws Error when they do not
+  /// fit (a count above max_contacts, a mesh or triangle the receiver does not have, bytes
+  /// missing). unpack() appends rows for the particles first, first + 1, ... (the receiver's
+  /// newest, so the rows stay in particle order) from checked bytes; the next follow_build()
+  /// keeps them as it keeps every particle's contacts.
+  static constexpr std::size_t packed_contact_bytes =
+      sizeof(std::int64_t) + 3 * sizeof(double) + sizeof(MeshContactRecord);
+  void pack(const std::vector<int>& which, std::vector<std::byte>& out) const;
+  static std::size_t check_packed(const std::byte* data, std::size_t bytes, std::size_t n,
+                                  const std::vector<TriangleMesh>& meshes);
+  void unpack(int first, std::size_t n, const std::byte* data);
+
   /// Writes / reads the rows (System's state). read() throws Error when they are inconsistent
   /// or name a particle >= `particles`.
   void write(BinaryWriter& out) const;

@@ -100,6 +100,7 @@ class NeighborList {
   friend class System;
   friend class ThreadPartition;
   friend class MeshContacts;
+  friend class PairContacts;
 
   struct Grid {
     Eigen::Vector3d origin = Eigen::Vector3d::Zero();

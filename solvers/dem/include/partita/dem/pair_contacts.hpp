@@ -11,6 +11,17 @@
 // starts at zero) and marks every slot touching, so that the next force pass settles forces and
 // histories. No allocation once sized. The material-pair parameters live in the ContactModel's
 // table. The kernel is inline: the force pass keeps the compiler's whole view of the loop.
+//
+// Histories that travel (particles moved to another System, another subdomain's): pack() writes
+// the histories of the pairs of chosen particles as records keyed by particle ids (id_i, id_j,
+// the spring of i relative to j, touching); the receiver keeps them waiting (add_waiting()) until
+// its next list build, and place_waiting() then puts each one into the slot of its pair (the
+// sign changed where the receiver numbers the two the other way round, as follow() does). A
+// record whose pair the build did not list is dropped: the two spheres are then further apart
+// than the cut-off, and the force pass would have settled (zeroed) that history anyway. A slot
+// whose pair the build carried over from the receiver's own previous build keeps that history.
+// The contact law keeps no other per-pair state (rolling resistance is a torque of the moment,
+// mu_r F_n R* w/|w|, without a spring), so the record is all a pair carries.
 
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
@@ -21,6 +32,8 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -60,6 +73,34 @@ class PairContacts {
   Pass pass(const Particles& p) {
     return Pass{shear_.data(), touching_.data(), p.mass.data(), p.material.data()};
   }
+
+  /// A pair's history keyed by particle ids: the tangential spring of particle id_i relative to
+  /// id_j and the touching flag; packed as 41 bytes (two int64, three doubles, one byte).
+  struct Record {
+    std::int64_t id_i = -1, id_j = -1;
+    Eigen::Vector3d shear = Eigen::Vector3d::Zero();
+    char touching = 0;
+  };
+  static constexpr std::size_t record_bytes = 2 * sizeof(std::int64_t) + 3 * sizeof(double) + 1;
+  /// Appends to `out` the records of the listed pairs (lists `nl`, the slots this object
+  /// follows) that have a history (a nonzero spring: a pair without one is what the receiver's
+  /// build starts a new pair with) and a chosen particle (chosen[i] != 0), then the waiting
+  /// records that name an id in `chosen_ids` (sorted); returns how many it appended.
+  std::size_t pack(const NeighborList& nl, const std::vector<std::int64_t>& id,
+                   const std::vector<char>& chosen, const std::vector<std::int64_t>& chosen_ids,
+                   std::vector<std::byte>& out) const;
+  /// Reads `count` packed records at `data`; throws Error (nothing changed) when one has a
+  /// negative id, two equal ids or a spring that is not finite.
+  static void check_packed(const std::byte* data, std::size_t count);
+  /// Adds `count` packed records (checked) to the waiting ones.
+  void add_waiting(const std::byte* data, std::size_t count);
+  std::size_t waiting_count() const { return waiting_.size(); }
+  void clear_waiting() { waiting_.clear(); }
+  /// After the lists' build() and follow(): every waiting record into the slot of its pair
+  /// (particles by id; dropped when a particle is missing or the pair is not listed, kept out
+  /// where the slot's history came from the previous build); the waiting list is emptied. No
+  /// allocation once the scratch has had the particle count.
+  void place_waiting(const NeighborList& nl, const std::vector<std::int64_t>& id);
 
   /// Writes / reads the histories and flags (in the state format, between the neighbour list's
   /// rows and its build references: see System::write_body()). read() throws Error when their
@@ -127,6 +168,8 @@ class PairContacts {
   std::vector<Eigen::Vector3d> shear_;  // per slot: tangential spring
   std::vector<char> touching_;          // per slot: overlap > 0 in the last force pass
   std::vector<Eigen::Vector3d> new_shear_;  // scratch of follow()
+  std::vector<Record> waiting_;             // records received, until the next build
+  std::vector<std::pair<std::int64_t, int>> index_of_id_;  // scratch of place_waiting()
 };
 
 }  // namespace partita::dem

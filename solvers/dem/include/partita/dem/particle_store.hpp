@@ -98,9 +98,16 @@ class ParticleStore {
   void pack(const std::vector<int>& which, std::vector<std::byte>& out) const;
   /// Returns the index of the first unpacked particle (the store's former size).
   std::size_t unpack(const std::byte* data, std::size_t bytes);
+  /// The ids of the particles in such a buffer, in order, into `ids` (cleared first), without
+  /// changing the store: to check a buffer before unpack(). Throws Error as unpack() does when
+  /// the size is not a whole number of particles.
+  void packed_ids(const std::byte* data, std::size_t bytes, std::vector<std::int64_t>& ids) const;
   /// The arrays' names, widths and element sizes, as text (equal on two stores = packed
   /// particles move between them).
   std::string layout() const;
+  /// A 64-bit hash (FNV-1a) of what layout() says, computed without allocating: for a message's
+  /// header, so that a receiver refuses particles packed by a store of another layout.
+  std::uint64_t layout_hash() const;
 
  private:
   struct Column {

@@ -123,6 +123,22 @@ class System {
   /// Renumbers the particles: new index k holds old particle order[k] (a permutation); ids,
   /// every per-particle array and the contact histories follow.
   void renumber_particles(const std::vector<int>& order);
+  /// Particles moved to another System set up alike (another subdomain's; system_migration.cpp
+  /// says what travels): pack_particles() appends to `out` one message with particles `which`
+  /// (indices, each once) and everything they carry: every store array (core values, forces of
+  /// the last pass, plane histories, the hooks' arrays such as breakage strengths), their mesh
+  /// contacts, and the histories of their pairs keyed by particle ids. The particles stay
+  /// (remove_particles() takes them out). unpack_particles() appends a message's particles in
+  /// its order and returns the index of the first; their pair histories wait for the next list
+  /// build and go into the slots of those pairs. It throws Error, the system unchanged, when the
+  /// bytes are not such a message from a system of the same layout, or name a particle id this
+  /// system holds already. (Both first size the plane histories for the planes, as a step does:
+  /// a system that has not stepped yet has none.)
+  void pack_particles(const std::vector<int>& which, std::vector<std::byte>& out);
+  std::size_t unpack_particles(const std::byte* data, std::size_t bytes);
+  /// Pair histories received and not yet placed (until the next list build; not part of a saved
+  /// state: move particles between steps, not between save_state() and a step).
+  std::size_t waiting_pair_histories() const { return pairs_.waiting_count(); }
   /// Every per-particle array (core and registered). Register arrays with
   /// store().add_array(); change the particle set only through add_particle() and
   /// remove_particles().
@@ -455,6 +471,10 @@ class System {
   long sorts_ = 0;
   CellOrder cell_order_;
   std::vector<int> new_of_old_;  // scratch of remove_particles() / renumber_particles()
+  // scratch of pack_particles() / unpack_particles() (kept: no allocation once grown)
+  std::vector<char> chosen_;
+  std::vector<std::int64_t> chosen_ids_;
+  std::vector<std::int64_t> message_ids_;
 };
 
 }  // namespace partita::dem

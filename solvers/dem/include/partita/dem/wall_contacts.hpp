@@ -63,6 +63,9 @@ class WallContacts {
 
   /// Sizes the histories and the block sums for n particles (no allocation when unchanged).
   void resize(ParticleStore& store, std::size_t n);
+  /// Sizes the histories alone (one per plane): what resize() does to the store, e.g. before
+  /// particles are packed for another system (whose store must have the same widths).
+  void size_histories(ParticleStore& store) const { store.set_width(h_shear_, planes_.size()); }
   /// Wall totals from the block sums of n particles (fixed order: blocks, then planes).
   void reduce(std::size_t n);
   /// Adds to work[wall] the work the walls' motion did on the particles in the last pass over a
