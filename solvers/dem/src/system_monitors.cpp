@@ -110,8 +110,11 @@ double System::elastic_energy() const {
   const int n = static_cast<int>(p.size());
   const Eigen::Vector3d no_shear = Eigen::Vector3d::Zero();
   auto pair_energy = [&](int i, int j, const Eigen::Vector3d& shear) {
-    return sphere_pair_elastic_energy(model_.pair(p.material[i], p.material[j]), p.position[i],
-                                      p.position[j], p.radius[i], p.radius[j], shear);
+    const double rsum = p.radius[i] + p.radius[j];
+    const double delta = rsum - (p.position[i] - p.position[j]).norm();
+    if (delta <= 0.0) return 0.0;
+    return hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
+                                p.radius[i] * p.radius[j] / rsum, shear);
   };
   // The contacts of the last force pass, with their histories. Without lists for the present
   // particles (before the first step, or after a change of the particle set until the next step)
@@ -138,17 +141,11 @@ double System::elastic_energy() const {
     if (at == last || *at != j) return no_shear;
     return pairs_.shear(static_cast<std::size_t>(at - lists.neighbors_.begin()));
   };
-  // After a step's pass with energy accounting the pairs' energies are those it stored per slot
-  // (the same expression at the same positions and histories), summed in the same order.
-  if (current && pair_energy_valid_ && prepared_ && pair_energy_.size() >= lists.neighbors_.size())
-    for (int i = 0; i < n; ++i)
-      for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) e += pair_energy_[s];
-  else
-    for (int i = 0; i < n; ++i)
-      for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
-        const int j = nl.neighbors_[s];
-        e += pair_energy(i, j, current ? pairs_.shear(s) : kept_shear(i, j));
-      }
+  for (int i = 0; i < n; ++i)
+    for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
+      const int j = nl.neighbors_[s];
+      e += pair_energy(i, j, current ? pairs_.shear(s) : kept_shear(i, j));
+    }
   const std::size_t np = planes.size();
   const bool have_shear = plane_shear.size() == p.size() * np;
   for (int i = 0; i < n; ++i)

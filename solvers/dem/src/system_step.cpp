@@ -34,7 +34,6 @@ std::int64_t now_ns() {
 
 void System::step(double dt) {
   const std::int64_t profile_start = profiling_ ? now_ns() : 0;
-  pair_energy_valid_ = false;  // (the pass below stores them again)
   prepare();
   if (!(dt > 0.0) || !std::isfinite(dt)) {
     std::ostringstream msg;
@@ -155,9 +154,6 @@ void System::step(double dt) {
       reduce_wall_and_mesh_forces(dt, true);
     }
   }
-  // the pass stored each listed pair's elastic energy (energy accounting; a step's pass always
-  // updates the histories and kicks)
-  pair_energy_valid_ = energy_tracking_;
   // the next step's bound starts from this one's (fused: the distances from the build positions
   // were not computed) or from the exact distances
   set_motion(fused ? bound : rebuild ? 0.0 : std::sqrt(moved2));
@@ -249,8 +245,6 @@ void System::start_load_pass(int parts) {
     dissipation_.resize(store_.size());
     block_energy_.resize((store_.size() + block_size - 1) / block_size);
     cross_energy_.resize(partition_.cross_pairs.size());
-    const std::size_t slots = neighbors_.neighbors_.size();
-    if (pair_energy_.size() < slots) pair_energy_.resize(slots + slots / 4);  // (headroom)
   }
 }
 
@@ -345,25 +339,6 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
                                        : (Load ? kernels.with_load : kernels.plain);
   DissipationSums* const diss = Energy ? dissipation_.data() : nullptr;
   PairEnergy* const cross_energy = Energy ? cross_energy_.data() : nullptr;
-  double* const pair_energy = Energy ? pair_energy_.data() : nullptr;
-  // (Energy) each listed pair's elastic energy at the step's end, as elastic_energy() computes
-  // it (sphere_pair_elastic_energy at the final positions with the final history, into its
-  // slot): a pair found apart, whose history is settled, at once (0 without a square root where
-  // it is apart by more than rounding); the touching pairs once the kernel updated theirs
-  // (d2, rsum: the pass's |x_i - x_j|^2 and r_i + r_j, the packed copies of the store's radii)
-  auto apart_pair_energy = [&](int s, int i, int j, double d2, double rsum) {
-    return d2 >= rsum * rsum * (1.0 + 1e-12)
-               ? 0.0
-               : sphere_pair_elastic_energy(model_.pair(material[i], material[j]), packed[i].x,
-                                            packed[j].x, p.radius[i], p.radius[j],
-                                            pairs.shear[s]);
-  };
-  auto store_pair_energies = [&](const PairTask* t, int n) {
-    for (int k = 0; k < n; ++k)
-      pair_energy[t[k].s] = sphere_pair_elastic_energy(
-          model_.pair(material[t[k].i], material[t[k].j]), packed[t[k].i].x, packed[t[k].j].x,
-          p.radius[t[k].i], p.radius[t[k].j], pairs.shear[t[k].s]);
-  };
   // Drift: the integrator's first half of particle i (with kick = dt/2) and the start of its
   // force sums, as the loop before the pass does it (step(), which knows that no particle can
   // have moved beyond the skin)
@@ -415,21 +390,17 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         const PackedParticle& qj = packed[c.j];
         const Eigen::Vector3d d = qi.x - qj.x;
         const double rsum = qi.r + qj.r;
-        const double d2 = d.squaredNorm();
-        const bool touch = !(d2 >= rsum * rsum);  // (as the scalar kernel)
+        const bool touch = !(d.squaredNorm() >= rsum * rsum);  // (as the scalar kernel)
         if (static_cast<char>(touch) != pairs.touching[c.slot]) {
           pairs.touching[c.slot] = static_cast<char>(touch);
           if (!touch) pairs.shear[c.slot].setZero();  // parted: the history is settled
         }
-        if constexpr (Energy)
-          if (!touch) pair_energy[c.slot] = apart_pair_energy(c.slot, c.i, c.j, d2, rsum);
         tp.cross_force[k].touching = touch;
         chunk_tasks[n_touch] = PairTask{c.slot, c.i, c.j};
         n_touch += touch ? 1 : 0;
       }
       batch(chunk_tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
             chunk_forces, chunk_energy);
-      if constexpr (Energy) store_pair_energies(chunk_tasks, n_touch);
       const PairForce* o = chunk_forces;
       for (int k = k0; k < k1; ++k) {
         ThreadPartition::CrossForce& cf = tp.cross_force[k];
@@ -511,16 +482,13 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           const PackedParticle& qj = packed[j];
           const Eigen::Vector3d d = qi.x - qj.x;
           const double rsum = qi.r + qj.r;
-          const double d2 = d.squaredNorm();
-          const bool touch = !(d2 >= rsum * rsum);  // (as the scalar kernel)
+          const bool touch = !(d.squaredNorm() >= rsum * rsum);  // (as the scalar kernel)
           // the flag changes only where a contact starts or ends (rare: a predictable branch,
           // unlike one on the flag or on the test themselves)
           if (static_cast<char>(touch) != pairs.touching[s]) {
             pairs.touching[s] = static_cast<char>(touch);
             if (!touch) pairs.shear[s].setZero();  // parted: the history is settled
           }
-          if constexpr (Energy)
-            if (!touch) pair_energy[s] = apart_pair_energy(s, i, j, d2, rsum);
           tasks[n_touch] = PairTask{s, i, j};
           n_touch += touch ? 1 : 0;
         }
@@ -529,7 +497,6 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       row_first[i_end - i_begin] = n_touch;
       batch(tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
             forces, energies);
-      if constexpr (Energy) store_pair_energies(tasks, n_touch);
       BlockEnergy block_e;  // (Energy) this block's energies: powers x dt, spring energies
       for (int i = i_begin; i < i_end; ++i) {
         PackedParticle& qi = packed[i];

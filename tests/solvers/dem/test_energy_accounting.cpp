@@ -320,36 +320,3 @@ TEST_CASE("dem energy: the elastic energy before the first step leaves the run a
   REQUIRE(x_asked.size() == x_not.size());
   for (std::size_t i = 0; i < x_asked.size(); ++i) CHECK(x_asked[i] == x_not[i]);
 }
-
-TEST_CASE("dem energy: the elastic energy after a step is that of the contacts of the moment, "
-          "recomputed from the positions and histories, to the bit, on any thread count",
-          "[dem][energy][threads]") {
-  // With the accounting on, the force pass stores each listed pair's energy and elastic_energy()
-  // sums those; a restored state (the same positions and histories, nothing stored) has it
-  // computed from the positions again: both must give the same bits, whatever the threads (the
-  // cross pairs between the threads' parts included).
-  const Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi(6e-3, 6e-3, 6e-3);
-  const Packing pk = test::two_size_packing(lo, hi, 1.6e-3, 1.2e-3, 0.7, 5);
-  for (const int threads : {1, 2}) {
-    const int before = max_threads();
-    set_num_threads(threads);
-    System sys = energy_system(0.5, 0.4);
-    sys.set_gravity({0, 0, -9.81});
-    sys.add_particles(pk.positions, pk.radii, 0);
-    sys.add_box(lo, hi, 0, 0b011111);
-    const double dt = 0.1 * sys.rayleigh_time_step();
-    int checked = 0;
-    for (int k = 0; k < 6; ++k) {
-      sys.run(2000, dt);
-      const double stored = sys.elastic_energy();
-      sys.restore_state(sys.save_state());
-      const double recomputed = sys.elastic_energy();
-      INFO(threads << " thread(s), check " << k << ": " << stored << " J against " << recomputed
-                   << " J");
-      CHECK(std::memcmp(&stored, &recomputed, sizeof(double)) == 0);
-      checked += stored > 0.0 ? 1 : 0;
-    }
-    CHECK(checked > 0);  // the bed was in contact (energy stored) at a check at least
-    set_num_threads(before);
-  }
-}

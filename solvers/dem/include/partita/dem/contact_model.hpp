@@ -216,16 +216,4 @@ inline double hertz_elastic_energy(const PairParameters& p, double delta, double
   return 8.0 / 15.0 * p.e_star * a * delta * delta + 0.5 * 8.0 * p.g_star * a * shear.squaredNorm();
 }
 
-/// Elastic energy of the pair of spheres (xi, ri), (xj, rj) with the tangential spring `shear`, 0
-/// where they do not overlap: System::elastic_energy() and the force pass's per-pair values
-/// (energy accounting) take it from this one expression, so both give the same bits.
-inline double sphere_pair_elastic_energy(const PairParameters& p, const Eigen::Vector3d& xi,
-                                         const Eigen::Vector3d& xj, double ri, double rj,
-                                         const Eigen::Vector3d& shear) {
-  const double rsum = ri + rj;
-  const double delta = rsum - (xi - xj).norm();
-  if (delta <= 0.0) return 0.0;
-  return hertz_elastic_energy(p, delta, ri * rj / rsum, shear);
-}
-
 }  // namespace partita::dem

@@ -432,12 +432,6 @@ class System {
   std::vector<DissipationSums> dissipation_;
   std::vector<BlockEnergy> block_energy_;
   std::vector<PairEnergy> cross_energy_;
-  // per pair slot of neighbors_, the pair's elastic energy at the end of the last step's force
-  // pass (sphere_pair_elastic_energy, filled by the pass with energy accounting);
-  // elastic_energy() sums them while they hold: from that pass until the next change (a step's
-  // start, a change that unprepares the system)
-  std::vector<double> pair_energy_;
-  bool pair_energy_valid_ = false;
   bool set_change_pending_ = false;
   double energy_dt_ = 0.0;  // the step the energies' half-step term is taken for
   // sum_i dt/2 (F.v + T.omega) + dt^2/8 (|F|^2/m + |T|^2/I) with the forces of the last pass:
