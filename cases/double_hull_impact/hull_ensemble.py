@@ -101,12 +101,28 @@ class Ensemble:
         self.window = 0.04 * self.end
 
     # ------------------------------------------------------------------ numbers
-    def milestones(self, inner_rupture_row):
-        """Energy to each plate's first failure, per group, as mean/std/min/max; filled less
-        empty (the difference of the means, and relative to the empty mean)."""
+    def milestones(self, part_rupture_row):
+        """Energy to the hull's and to each part's first failure, per group, as mean/std/min/max;
+        filled less empty (the difference of the means, and relative to the empty mean)."""
         means = {}
         for label, runs in self.groups:
             outer, outer_p, inner, inner_p, inner_e = [], [], [], [], []
+            by_part = {"outer": ([], []), "webs": ([], [])}
+            for r in runs:
+                w = r.work()
+                for tag, part in (("outer", "outer_plate"), ("webs", "webs")):
+                    k = part_rupture_row(r, part)
+                    if k is not None and w is not None:
+                        by_part[tag][0].append(float(w[k]))
+                        by_part[tag][1].append(float(r.pen[k]))
+            for tag, (energies, pens) in by_part.items():
+                for name, values in ((f"energy_to_{tag}_rupture", energies),
+                                     (f"{tag}_rupture_penetration", pens)):
+                    unit = "_m" if name.endswith("penetration") else "_J"
+                    self._stats_keys(f"ensemble_{name}_{label}{unit}", values, len(runs))
+                    s = stats(values)
+                    if s is not None:
+                        means[(name, label)] = s[0]
             for r in runs:
                 w = r.work()
                 rup = r.first_rupture()
@@ -116,7 +132,7 @@ class Ensemble:
                 e = inner_energy(r)
                 if rup and e is not None:
                     inner_e.append(float(np.interp(rup[0], r.t, e)))
-                k = inner_rupture_row(r)
+                k = part_rupture_row(r, "inner_plate")
                 if k is not None and w is not None:
                     inner.append(float(w[k]))
                     inner_p.append(float(r.pen[k]))
@@ -128,7 +144,8 @@ class Ensemble:
                 s = stats(values)
                 if s is not None:
                     means[(name, label)] = s[0]
-        for name in ("energy_to_rupture", "energy_to_inner_rupture"):
+        for name in ("energy_to_rupture", "energy_to_inner_rupture", "energy_to_outer_rupture",
+                     "energy_to_webs_rupture"):
             f, e = means.get((name, "filled")), means.get((name, "empty"))
             if f is not None and e is not None:
                 self.key(f"ensemble_{name}_filled_minus_empty_J", f - e)
@@ -305,14 +322,14 @@ class Ensemble:
         plt.close(fig)
 
 
-def run_ensemble(filled, empty, outdir, at_mm, inner_rupture_row, key, note, plt):
+def run_ensemble(filled, empty, outdir, at_mm, part_rupture_row, key, note, plt):
     """Everything of --ensemble: keys on stdout, ensemble_curves.png, energy_shares.png and
     energy_shares.csv in outdir."""
     ens = Ensemble(filled, empty, key, note)
     key("ensemble_runs_filled", float(len(filled)), "{:.0f}")
     key("ensemble_runs_empty", float(len(empty)), "{:.0f}")
     key("ensemble_common_penetration_m", ens.end)
-    ens.milestones(inner_rupture_row)
+    ens.milestones(part_rupture_row)
     if at_mm:
         kept = [p for p in at_mm if 1e-3 * p <= ens.end]
         if len(kept) < len(at_mm):

@@ -71,9 +71,13 @@ _empty for EMPTY_DIR (section_empty_<k>.png, ...). It prints key=value lines (SI
   inner_yield_penetration_{filled,empty}_m, energy_to_inner_yield_{filled,empty}_J   the same at the
                           first row with hull.inner_plate.plastic_work > 0
   inner_rupture_penetration_{filled,empty}_m, energy_to_inner_rupture_{filled,empty}_J   the same at
-                          the inner plate's first failed element: the first row whose
-                          hull.failed_elements rises while hull.inner_plate.plastic_work falls (an
-                          eroded element's plastic work leaves its part's sum)
+                          the inner plate's first failed element: the first row where
+                          hull.inner_plate.first_failure_time is set, or (runs without that
+                          column) whose hull.failed_elements rises while
+                          hull.inner_plate.plastic_work falls (an eroded element's plastic work
+                          leaves its part's sum); outer_rupture_*, webs_rupture_*,
+                          energy_to_{outer,webs}_rupture_*: the same for the outer plate and the
+                          webs (the hull's first failure, rupture_*, is any part's)
   powder_events, powder_mass_kg   granules.breakage.powder_* at the last row (below_limit: powder)
   energy_final_{filled,empty}_J   indenter work at the last row
   inner_deflection_final_{filled,empty}_m   hull.inner_centre.displacement_z at the last row
@@ -112,9 +116,11 @@ the empty mean), energy_shares.png and energy_shares.csv
 rest of the audit's stored + dissipated energy, at the --at penetrations; the CSV: penetration
 [mm], variant, term, mean/std/min/max [J], share of the total [%], runs) and prints:
   ensemble_runs_{filled,empty}, ensemble_common_penetration_m
-  ensemble_energy_to_rupture_<variant>_{mean,std,min,max}_J (the hull's first failure: the outer
-                          plate), ensemble_rupture_penetration_<variant>_{mean,std,min,max}_m,
-                          ensemble_energy_to_inner_rupture_<variant>_{mean,std,min,max}_J,
+  ensemble_energy_to_rupture_<variant>_{mean,std,min,max}_J (the hull's first failure, any
+                          part), ensemble_rupture_penetration_<variant>_{mean,std,min,max}_m,
+                          ensemble_energy_to_{outer,webs,inner}_rupture_<variant>_{...}_J (each
+                          part's first failure, part_rupture_row),
+                          ensemble_{outer,webs}_rupture_penetration_<variant>_{...}_m,
                           ensemble_inner_rupture_penetration_<variant>_{...}_m, each with
                           _<variant>_runs (how many runs reached it);
                           ensemble_inner_plate_energy_at_rupture_<variant>_{...}_J: the inner
@@ -418,6 +424,12 @@ def milestones(run, suffix):
             key("inner_rupture_penetration" + suffix + "_m", float(run.pen[k]))
             if w is not None:
                 key("energy_to_inner_rupture" + suffix + "_J", float(w[k]))
+    for part, tag in (("outer_plate", "outer"), ("webs", "webs")):
+        k = part_rupture_row(run, part)
+        if k is not None:
+            key(f"{tag}_rupture_penetration{suffix}_m", float(run.pen[k]))
+            if w is not None:
+                key(f"energy_to_{tag}_rupture{suffix}_J", float(w[k]))
     if run.has("granules.breakage.powder_events"):
         key("powder_events", float(run.at("granules.breakage.powder_events")[-1]))
     if run.has("granules.breakage.powder_mass"):
@@ -428,15 +440,28 @@ def milestones(run, suffix):
         key("inner_deflection_final" + suffix + "_m", float(run.at("hull.inner_centre.displacement_z")[-1]))
 
 
-def inner_rupture_row(run):
-    """The row of the inner plate's first failed element, None before it (or without the columns):
-    an eroded element's plastic work leaves its part's sum, which otherwise never falls, so the
-    first row whose hull.failed_elements rises while hull.inner_plate.plastic_work falls."""
-    if not run.has("hull.inner_plate.plastic_work", "hull.failed_elements"):
+PARTS = ("outer_plate", "webs", "inner_plate")
+
+
+def part_rupture_row(run, part):
+    """The row of a part's (outer_plate, webs, inner_plate) first failed element, None before it
+    (or without the columns): the first row where hull.<part>.first_failure_time is set when the
+    run records it; else, for an eroding hull, the first row whose hull.failed_elements rises while
+    hull.<part>.plastic_work falls (an eroded element's plastic work leaves its part's sum, which
+    otherwise never falls)."""
+    if run.has(f"hull.{part}.first_failure_time"):
+        hit = np.nonzero(run.at(f"hull.{part}.first_failure_time") >= 0)[0]
+        return int(hit[0]) if len(hit) else None
+    if not run.has(f"hull.{part}.plastic_work", "hull.failed_elements"):
         return None
-    pw, failed = run.at("hull.inner_plate.plastic_work"), run.at("hull.failed_elements")
+    pw, failed = run.at(f"hull.{part}.plastic_work"), run.at("hull.failed_elements")
     hit = np.nonzero((np.diff(failed) > 0) & (np.diff(pw) < 0))[0]
     return int(hit[0] + 1) if len(hit) else None
+
+
+def inner_rupture_row(run):
+    """The row of the inner plate's first failed element (part_rupture_row)."""
+    return part_rupture_row(run, "inner_plate")
 
 
 def collision(run, driven):
@@ -1010,7 +1035,7 @@ def main_ensemble(filled_dirs, empty_dirs, outdir, at_mm):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     try:
-        hull_ensemble.run_ensemble(filled, empty, outdir, at_mm, inner_rupture_row, key, note, plt)
+        hull_ensemble.run_ensemble(filled, empty, outdir, at_mm, part_rupture_row, key, note, plt)
     except RuntimeError as e:
         sys.exit(f"plot_case: --ensemble: {e}")
 

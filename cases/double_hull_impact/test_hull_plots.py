@@ -225,5 +225,45 @@ class EnsembleTest(unittest.TestCase):
         self.assertIsNone(hull_ensemble.stats([None]))
 
 
+class PartRuptureTest(unittest.TestCase):
+    """Each part's first failed element: from hull.<part>.first_failure_time where the run records
+    it, else from the part's plastic work falling as the failed count rises (an eroded element's
+    plastic work leaves its part's sum)."""
+
+    def run_with(self, per_part_times):
+        import plot_case
+        r = FakeRun(1.0)
+        n = len(r.t)
+        failed = np.zeros(n)
+        failed[30:] += 1          # a web element fails at row 30,
+        failed[60:] += 1          # an inner plate element at row 60
+        r.cols["hull.failed_elements"] = failed
+        r.cols["hull.webs.plastic_work"] = r.cols["hull.webs.plastic_work"].copy()
+        r.cols["hull.webs.plastic_work"][30:] -= 0.2
+        r.cols["hull.inner_plate.plastic_work"] = r.cols["hull.inner_plate.plastic_work"].copy()
+        r.cols["hull.inner_plate.plastic_work"][60:] -= 0.2
+        if per_part_times:
+            for part, row in (("webs", 30), ("inner_plate", 60), ("outer_plate", None)):
+                ft = -np.ones(n)
+                if row is not None:
+                    ft[row:] = r.t[row]
+                r.cols[f"hull.{part}.first_failure_time"] = ft
+        return plot_case, r
+
+    def test_from_the_plastic_work_of_each_part(self):
+        plot_case, r = self.run_with(per_part_times=False)
+        self.assertEqual(plot_case.part_rupture_row(r, "webs"), 30)
+        self.assertEqual(plot_case.part_rupture_row(r, "inner_plate"), 60)
+        self.assertIsNone(plot_case.part_rupture_row(r, "outer_plate"))
+        self.assertEqual(plot_case.inner_rupture_row(r), 60)
+
+    def test_from_the_parts_failure_times(self):
+        plot_case, r = self.run_with(per_part_times=True)
+        r.cols["hull.webs.plastic_work"] = 10 * r.pen     # the columns, not the heuristic, decide
+        self.assertEqual(plot_case.part_rupture_row(r, "webs"), 30)
+        self.assertEqual(plot_case.part_rupture_row(r, "inner_plate"), 60)
+        self.assertIsNone(plot_case.part_rupture_row(r, "outer_plate"))
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -106,6 +106,14 @@ TEST_CASE("fem adapter: a strip's first failure time, its log line and the energ
       CHECK(sum == Approx(row[column(r, "strip." + s)]).epsilon(1e-8).margin(1e-12));  // CSV digits
     }
   }
+  // by part: each part's one element fails at t_f (a uniform strip), the parts add up
+  for (const char* part : {"left", "middle", "all"}) {
+    INFO(part);
+    const std::string p = std::string("strip.") + part;
+    CHECK(last[column(r, p + ".failed_elements")] == 1.0);
+    CHECK(last[column(r, p + ".first_failure_time")] == Approx(t_f).epsilon(0.02));
+    CHECK(r.rows.front()[column(r, p + ".first_failure_time")] == -1.0);
+  }
   CHECK(std::abs(last[column(r, "strip.energy_balance")]) <
         0.01 * last[column(r, "strip.external_work")]);
 }
@@ -120,6 +128,19 @@ TEST_CASE("fem adapter: erosion from YAML removes the failed strip, the balance 
   CHECK(last[column(r, "strip.eroded_energy")] > 0.0);
   CHECK(last[column(r, "strip.first_failure_time")] ==
         Approx(0.04 * (250e6 + 2e9 * 0.02) / 350e6).epsilon(0.02));
+  // by part, at every row: the parts' failed elements add up to the total and the earliest of
+  // their first failures is the strip's
+  for (const auto& row : r.rows) {
+    double count = 0.0, first = -1.0;
+    for (const char* part : {"left", "middle", "all"}) {
+      const std::string p = std::string("strip.") + part;
+      count += row[column(r, p + ".failed_elements")];
+      const double t = row[column(r, p + ".first_failure_time")];
+      if (t >= 0.0 && (first < 0.0 || t < first)) first = t;
+    }
+    CHECK(count == row[column(r, "strip.failed_elements")]);
+    CHECK(first == row[column(r, "strip.first_failure_time")]);
+  }
   CHECK(std::abs(last[column(r, "strip.energy_balance")]) <
         0.01 * last[column(r, "strip.external_work")]);
 }

@@ -186,6 +186,25 @@ const MonitorTable<FemAdapter>& FemAdapter::monitor_table() {
               out({regions[i]}, {e.plastic_work[i], e.strain_energy[i], e.kinetic_energy[i]});
           },
           [](const A& a) { return a.solver_->mesh().region_names().size() >= 2; });
+    t.add({{"<region>.failed_elements", "",
+            "with two or more element regions (parts) and a failure criterion: failed elements "
+            "per region"},
+           {"<region>.first_failure_time", "s",
+            "... when the region's first element failed (-1 until then)"}},
+          [](const A& a, const Out& out) {
+            const fem::StructuralSolver& s = *a.solver_;
+            const auto& regions = s.mesh().region_names();
+            std::vector<double> count(regions.size(), 0.0), first(regions.size(), -1.0);
+            for (std::size_t e = 0; e < s.mesh().num_elements(); ++e) {
+              const double t = s.element_failure_time(e);
+              if (t < 0.0) continue;
+              const auto r = static_cast<std::size_t>(s.mesh().elements()[e].region);
+              count[r] += 1.0;
+              if (first[r] < 0.0 || t < first[r]) first[r] = t;
+            }
+            for (std::size_t i = 0; i < regions.size(); ++i) out({regions[i]}, {count[i], first[i]});
+          },
+          [](const A& a) { return a.solver_->mesh().region_names().size() >= 2; });
     t.scalar("newton_iterations", "",
              "Newton iterations of the last step (nonlinear materials; 0 on the linear path)",
              [](const A& a) { return static_cast<double>(a.solver_->newton_iterations()); });

@@ -76,6 +76,11 @@ bool StructuralSolver::element_eroded(std::size_t element) const {
          nonlinear_->material().eroded(element);
 }
 
+double StructuralSolver::element_failure_time(std::size_t element) const {
+  if (!element_failed(element)) return -1.0;
+  return nonlinear_->material().failure_time(element);
+}
+
 double StructuralSolver::element_damage(std::size_t element) const {
   if (nonlinear_ == nullptr || !nonlinear_->material().has_failure_criteria()) return -1.0;
   return nonlinear_->material().element_damage(element);

@@ -174,6 +174,8 @@ class StructuralSolver final : private StructuralSystem {
   std::size_t failed_elements() const;
   bool element_failed(std::size_t element) const;
   bool element_eroded(std::size_t element) const;
+  // When the element failed (the end of that step) [s]; -1 while it has not.
+  double element_failure_time(std::size_t element) const;
   // RTCL, BWH: the committed mean damage of the element's points (-1 under other criteria)
   double element_damage(std::size_t element) const;
   /// True when every element around `node` is eroded: the node has left the structure (and its
