@@ -232,6 +232,36 @@ class System {
   /// walls, meshes, hooks); throws Error on a bad magic, another version or a truncated stream.
   void read_state(std::istream& in);
 
+  // ---- a step in phases (a bed split into subdomains: SubdomainStepper drives them) ---------
+  /// step() cut where the subdomains of a split bed exchange data (subdomain.hpp): the same
+  /// operations as step()'s path without the fused pass, in the same order, for one System.
+  /// 1. phase_drift(dt): the walls' and meshes' motion of the step, the integrator's first half
+  ///    (v += dt/2 F/m, x += dt v, omega += dt/2 T/I) and the start of the force sums; returns the
+  ///    largest squared displacement since the last list build of the particles with
+  ///    skip[i] == 0 (skip: empty, or one flag per particle).
+  /// 2. a ghost's values from its owner: set_phase_motion(); or, at a list build, particles
+  ///    removed, added, renumbered, then phase_build().
+  /// 3. phase_forces(dt, true): forces at the new positions, histories updated, the closing kick.
+  /// 4. phase_finish(dt): the meshes' positions of the step, the hooks, time and step count.
+  /// Before the first phase_drift() the forces of a pass must be there: phase_forces(dt, false)
+  /// (no kick, no history update: what step() does before its first step). Throws Error with the
+  /// energy accounting on (its sums are per System; not available in phases yet), on a bad dt
+  /// (as step()), or when phase_drift() finds no forces.
+  double phase_drift(double dt, const std::vector<char>& skip);
+  /// Whether a step whose largest squared particle displacement since the build is `moved2`
+  /// needs new lists (a plane or mesh vertex that moved more than skin/2 also makes it).
+  bool phase_needs_rebuild(double moved2) const;
+  /// Position, velocity and angular velocity of particle i in the step's working state.
+  void phase_motion(std::size_t i, Eigen::Vector3d& x, Eigen::Vector3d& v,
+                    Eigen::Vector3d& w) const;
+  void set_phase_motion(std::size_t i, const Eigen::Vector3d& x, const Eigen::Vector3d& v,
+                        const Eigen::Vector3d& w);
+  /// New lists for the current particles and positions (always built; no renumbering: throws
+  /// Error when set_sort_interval() is not 0).
+  void phase_build();
+  void phase_forces(double dt, bool step);
+  void phase_finish(double dt);
+
   // ---- access and monitors ------------------------------------------------------------------
   const Particles& particles() const {
     sync_particles();

@@ -1,0 +1,219 @@
+#pragma once
+// A bed split into subdomains (DomainDecomposition's boxes), each a System of its own, stepping
+// to the same bits whatever the number of subdomains: positions and velocities of every particle
+// id after any number of steps equal those of the bed in one subdomain stepped the same way.
+//
+// Why the bits can be the same. A particle's force is a sum in a fixed order over its local
+// numbering (System::evaluate_forces(): the pairs (k, i) in ascending k, then (i, j) in
+// ascending j, planes, meshes), and a pair's force and history update depend on its two
+// particles' values and the order of the two alone. So an owned particle sees the same sum on any
+// split when (1) every particle it can touch is there (its ghosts), with the values the owner
+// has, (2) its pairs' histories are the same, and (3) the local numbering of the particles a
+// subdomain holds is their order in ONE order of all particles, the same on every subdomain.
+//  (1) Ghosts: at a list build, every particle within `ghost distance` = 2 R_max + skin of
+//      another box (DomainDecomposition::near()) is copied to that box's subdomain with all it
+//      carries (System::pack_particles()); a listed pair has its particles within
+//      R_i + R_j + skin at the build, so an owned particle's every listed pair is listed where
+//      it is owned. Between builds each step sends the ghosts' position, velocity and angular
+//      velocity after the integrator's first half (the values the force pass reads); the forces
+//      a subdomain computes on its ghosts are discarded (the ghost's kick is overwritten at the
+//      next refresh, and the ghost itself replaced at the next build).
+//  (2) Histories: a pair between an owned particle and a ghost is listed and evaluated on both
+//      sides with the same inputs in the same order, so both keep the same history. At a build
+//      every subdomain drops its ghosts and receives them again, each with the histories of its
+//      pairs as its owner holds them (exact: an owner lists every pair of its particles), and a
+//      particle that changes owner travels with its histories (System::pack_particles(): pair
+//      records keyed by particle ids, placed at the build; plane and mesh histories in the
+//      particle's arrays); a pair carried over by the receiver's own lists keeps its history
+//      (both agree).
+//  (3) The order: the cell of a GLOBAL grid (origin and cell size fixed for the run: the
+//      decomposition's bounds and 2 R_max + skin at the start), then the particle id, applied at
+//      every list build, after migration and the ghosts' exchange, by owned particles and ghosts
+//      alike. Every subdomain's numbering is then a subsequence of one order, and the lists'
+//      rows and every sum run in the same relative order. (The classical System orders by a
+//      stable sort over its own bounding box every N builds and then by append order, which
+//      depends on the set a System holds; so one subdomain stepped here differs from the same
+//      bed stepped with System::step(), and the reference of a split run is this stepper with one
+//      subdomain.)
+//  The rebuild decision is global: the largest displacement since the build over every owned
+//  particle (a max: the same in any order), so all subdomains rebuild on the same steps as one
+//  subdomain would; migration (DomainDecomposition::owner() of the positions after the first
+//  half) and ghosts are then settled before the lists are built.
+//
+// What is not the same on any split yet:
+//  - Wall and mesh forces (System::wall_force(), mesh_force(), triangle_forces()) are per System
+//    and include the ghosts' contacts; summed over the subdomains they count a ghost's contact
+//    twice and sum in another order. The fix: per-particle contributions of the owned particles,
+//    summed over the subdomains in the global order (by the order key), as the particle force
+//    sums are.
+//  - Energy sums: SubdomainStepper::kinetic_energy() and linear_momentum() are the same on any
+//    split (exact sums over the owned particles, ExactSum, rounded once: they may differ from
+//    System::kinetic_energy()'s ordered sum in the last bits); the contacts' elastic energy is
+//    not summed over a split yet (System::elastic_energy() of a subdomain counts its ghosts'
+//    contacts; the fix: each pair counted where the first of its two in the global order is
+//    owned, planes and meshes where the particle is owned, into an ExactSum). The energy
+//    accounting is refused in phases (System::phase_drift()).
+//  - Hooks that change the particle set (breakage's fragments) are not handled: fragment ids
+//    must be unique over the subdomains and the new particles need ghosts.
+//  - An empty subdomain skips its System's phases (its planes do not advance: moving walls with
+//    an empty subdomain are not supported yet).
+//
+// Call order: SubdomainStepper(systems, transport, decomposition, skin) with each System set up
+// alike (materials, interactions, gravity, walls, meshes; the particles in any subdomain, ids
+// unique over all), then start(dt) (migration, ghosts, lists, the first forces), then step(dt)
+// or run(); set_decomposition() re-cuts the bed at the next list build.
+//
+// The byte formats (both ends have the same byte order and types, as for state files):
+//   at a build, to each subdomain d: "PSDM" (u32 magic), version (u32), the migrants' message
+//     size (u64), the ghosts' message size (u64), then the two System::pack_particles()
+//     messages (either absent when it holds no particle);
+//   between builds, to each subdomain that holds ghosts of this one: "PGHR", version, the count
+//     n (u64), then n times id (i64), x, v, omega (9 doubles), in the order of this subdomain's
+//     numbering (the receiver holds them in the same relative order).
+
+#include "partita/dem/domain_decomposition.hpp"
+#include "partita/dem/exact_sum.hpp"
+#include "partita/dem/subdomain_transport.hpp"
+#include "partita/dem/system.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace partita::dem {
+
+/// The order of particles over every subdomain: by the cell of a fixed grid (cells of `cell`
+/// over [lo, hi], ordered by z, then y, then x; a position outside is in the nearest cell), then
+/// by id.
+class GlobalOrder {
+ public:
+  GlobalOrder() = default;
+  /// Throws Error unless lo < hi and cell > 0 (finite).
+  GlobalOrder(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double cell);
+  std::uint64_t cell(const Eigen::Vector3d& x) const;
+  /// order[k]: the index of the k-th particle in this order; false when it is the identity.
+  bool compute(const Particles& p, std::vector<int>& order);
+
+ private:
+  Eigen::Vector3d lo_ = Eigen::Vector3d::Zero();
+  double cell_ = 1.0;
+  Eigen::Matrix<std::int64_t, 3, 1> count_ = Eigen::Matrix<std::int64_t, 3, 1>::Ones();
+  std::vector<std::pair<std::pair<std::uint64_t, std::int64_t>, int>> keys_;  // scratch
+};
+
+/// One subdomain: its System (owned particles and ghosts) and what it sends and receives.
+/// SubdomainStepper calls the phases; they are public for a driver of another shape.
+class Subdomain {
+ public:
+  /// Registers the per-particle array "subdomain_owner" (-1: owned, else the owner's rank).
+  Subdomain(System& system, int rank, int parts);
+  System& system() { return *sys_; }
+  const System& system() const { return *sys_; }
+  int rank() const { return rank_; }
+  /// Whether particle i is a ghost (since the last build).
+  bool is_ghost(std::size_t i) const { return i < ghost_.size() && ghost_[i] != 0; }
+  std::size_t owned_count() const;
+  std::size_t ghost_count() const { return sys_->particle_count() - owned_count(); }
+  /// Particles received as owned (migrated here) since the start.
+  long migrated_in() const { return migrated_in_; }
+
+  // ---- phases ----
+  /// The first half of the step; returns 1 when this subdomain's lists need a rebuild, else 0.
+  double drift(double dt);
+  void pack_refresh(SubdomainMail& out);
+  void unpack_refresh(const SubdomainMail& in);
+  /// At a build: the particles that change owner and the ghost copies for every other subdomain
+  /// (positions of now); what stays, changes role or leaves is noted for unpack_moves().
+  void pack_moves(const DomainDecomposition& d, double ghost_distance, SubdomainMail& out);
+  /// Removes the ghosts and the particles that left, appends what arrived, renumbers in the
+  /// global order, builds the lists, notes what to send and receive until the next build.
+  void unpack_moves(const SubdomainMail& in, GlobalOrder& order, const DomainDecomposition& d,
+                    double ghost_distance);
+  void forces(double dt, bool step);
+  void finish(double dt);
+  double max_radius();
+  /// Adds the owned particles' kinetic energy (translational + rotational, System::
+  /// kinetic_energy()'s terms) to sums[0] and their linear momentum m v to sums[1..3].
+  void add_kinetic(ExactSum* sums);
+
+ private:
+  std::vector<int>& owner_array() { return sys_->store().array<int>(h_owner_); }
+
+  System* sys_;
+  int rank_ = 0;
+  int h_owner_ = -1;
+  long migrated_in_ = 0;
+  std::vector<char> ghost_;               // per particle, since the last build
+  std::vector<std::vector<int>> send_;    // per rank: owned particles that are ghosts there
+  std::vector<std::vector<int>> recv_;    // per rank: the ghosts it owns
+  // pack_moves() -> unpack_moves()
+  std::vector<char> remove_;
+  std::vector<std::pair<int, int>> become_ghost_;  // (index, new owner)
+  // scratch
+  std::vector<std::vector<int>> migrants_, ghosts_;
+  std::vector<int> near_, order_;
+};
+
+/// Steps the local subdomains of a split bed (all of them with InProcessTransport).
+class SubdomainStepper {
+ public:
+  struct Options {
+    /// How far from a box a particle is a ghost there; < 0: 2 R_max + skin (what the lists
+    /// need; less breaks the split's bits: a test's knob).
+    double ghost_distance = -1.0;
+  };
+  /// systems[k]: local subdomain transport.local()[k]'s System. Sets the skin of every System
+  /// (all must be alike) and the sort interval to 0. Throws Error when the counts do not match
+  /// the transport's or the decomposition's.
+  SubdomainStepper(std::vector<System*> systems, SubdomainTransport& transport,
+                   const DomainDecomposition& decomposition, double skin, Options options);
+  SubdomainStepper(std::vector<System*> systems, SubdomainTransport& transport,
+                   const DomainDecomposition& decomposition, double skin)
+      : SubdomainStepper(std::move(systems), transport, decomposition, skin, Options{}) {}
+
+  /// Migration, ghosts, lists and the forces of a pass without a kick (before the first step).
+  void start(double dt);
+  void step(double dt);
+  void run(long steps, double dt);
+  /// A new decomposition (same bounds), used from the next list build on (a rebalance: the
+  /// bits do not change, only where the particles are stepped).
+  void set_decomposition(const DomainDecomposition& decomposition);
+  const DomainDecomposition& decomposition() const { return decomposition_; }
+
+  int local_count() const { return static_cast<int>(subdomains_.size()); }
+  Subdomain& subdomain(int k) { return subdomains_[static_cast<std::size_t>(k)]; }
+  const Subdomain& subdomain(int k) const { return subdomains_[static_cast<std::size_t>(k)]; }
+  /// List builds since start() (start()'s included), the same on every subdomain.
+  long builds() const { return builds_; }
+  long steps() const { return steps_; }
+  /// Kinetic energy [J] and linear momentum [kg m/s] of the owned particles of every subdomain:
+  /// exact sums rounded once, the same bits on any split (collective: every process calls it).
+  double kinetic_energy();
+  Eigen::Vector3d linear_momentum();
+
+ private:
+  void redistribute();
+  // sums_[4 k + q]: local subdomain k's kinetic energy (q = 0) and momentum (1..3), then summed
+  // over every subdomain into totals_
+  void kinetic_sums();
+  std::vector<ExactSum> sums_;
+  ExactSum totals_[4];
+
+  std::vector<Subdomain> subdomains_;
+  SubdomainTransport* transport_;
+  DomainDecomposition decomposition_, next_;
+  bool next_pending_ = false;
+  bool started_ = false;
+  double skin_ = 0.0;
+  Options options_;
+  double ghost_distance_ = 0.0;
+  GlobalOrder order_;
+  long builds_ = 0, steps_ = 0;
+  std::vector<SubdomainMail> out_, in_;
+  std::vector<double> values_;
+};
+
+}  // namespace partita::dem

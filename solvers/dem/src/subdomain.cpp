@@ -1,0 +1,455 @@
+// A bed split into subdomains stepping to the same bits on any split (subdomain.hpp says why and
+// how), and the in-process transport.
+#include "partita/dem/subdomain.hpp"
+
+#include "partita/dem/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <string>
+
+namespace partita::dem {
+
+namespace {
+
+constexpr std::uint32_t moves_magic = 0x4d445350u;    // "PSDM"
+constexpr std::uint32_t refresh_magic = 0x52484750u;  // "PGHR"
+constexpr std::uint32_t format_version = 1;
+constexpr std::size_t moves_header = 4 + 4 + 8 + 8;
+constexpr std::size_t refresh_header = 4 + 4 + 8;
+constexpr std::size_t refresh_row = 8 + 9 * 8;
+
+template <class T>
+void append(std::vector<std::byte>& out, const T& v) {
+  const std::size_t at = out.size();
+  out.resize(at + sizeof v);
+  std::memcpy(out.data() + at, &v, sizeof v);
+}
+template <class T>
+T get(const std::byte* at) {
+  T v;
+  std::memcpy(&v, at, sizeof v);
+  return v;
+}
+void append_vector(std::vector<std::byte>& out, const Eigen::Vector3d& v) {
+  for (int d = 0; d < 3; ++d) append(out, v[d]);
+}
+Eigen::Vector3d get_vector(const std::byte* at) {
+  return {get<double>(at), get<double>(at + 8), get<double>(at + 16)};
+}
+
+std::string from(int rank, int source) {
+  return "subdomain " + std::to_string(rank) + ": the message from subdomain " +
+         std::to_string(source);
+}
+
+}  // namespace
+
+// ---- InProcessTransport ---------------------------------------------------------------------
+
+InProcessTransport::InProcessTransport(int parts) {
+  if (parts < 1)
+    throw Error("InProcessTransport: the number of subdomains must be >= 1, got " +
+                std::to_string(parts));
+  for (int r = 0; r < parts; ++r) local_.push_back(r);
+}
+
+void InProcessTransport::exchange(std::vector<SubdomainMail>& out, std::vector<SubdomainMail>& in) {
+  const auto p = static_cast<std::size_t>(parts());
+  if (out.size() != p) throw Error("InProcessTransport::exchange: need one outbox per subdomain");
+  in.resize(p);
+  for (std::size_t d = 0; d < p; ++d) {
+    in[d].resize(p);
+    if (out[d].size() != p)
+      throw Error("InProcessTransport::exchange: need one buffer per subdomain in each outbox");
+  }
+  for (std::size_t s = 0; s < p; ++s)
+    for (std::size_t d = 0; d < p; ++d) {
+      in[d][s].swap(out[s][d]);
+      out[s][d].clear();
+    }
+}
+
+double InProcessTransport::max(const std::vector<double>& values) {
+  double m = -std::numeric_limits<double>::infinity();
+  for (const double v : values) m = std::max(m, v);
+  return m;
+}
+
+// ---- GlobalOrder ----------------------------------------------------------------------------
+
+GlobalOrder::GlobalOrder(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double cell)
+    : lo_(lo), cell_(cell) {
+  if (!(cell > 0.0) || !std::isfinite(cell) || !lo.allFinite() || !hi.allFinite() ||
+      !(lo.array() < hi.array()).all()) {
+    std::ostringstream msg;
+    msg << "GlobalOrder: need lo < hi (finite) and a cell size > 0, got lo " << lo.transpose()
+        << ", hi " << hi.transpose() << ", cell " << cell;
+    throw Error(msg.str());
+  }
+  for (int d = 0; d < 3; ++d)
+    count_[d] = std::max<std::int64_t>(
+        1, std::min<std::int64_t>(std::int64_t{1} << 20,
+                                  static_cast<std::int64_t>(std::ceil((hi[d] - lo[d]) / cell))));
+}
+
+std::uint64_t GlobalOrder::cell(const Eigen::Vector3d& x) const {
+  std::int64_t c[3];
+  for (int d = 0; d < 3; ++d) {
+    const double f = std::floor((x[d] - lo_[d]) / cell_);
+    c[d] = f < 0.0 ? 0 : f >= static_cast<double>(count_[d]) ? count_[d] - 1
+                                                              : static_cast<std::int64_t>(f);
+  }
+  return static_cast<std::uint64_t>((c[2] * count_[1] + c[1]) * count_[0] + c[0]);
+}
+
+bool GlobalOrder::compute(const Particles& p, std::vector<int>& order) {
+  const std::size_t n = p.size();
+  keys_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) keys_[i] = {{cell(p.position[i]), p.id[i]}, static_cast<int>(i)};
+  std::sort(keys_.begin(), keys_.end());
+  order.resize(n);
+  bool identity = true;
+  for (std::size_t k = 0; k < n; ++k) {
+    order[k] = keys_[k].second;
+    identity = identity && order[k] == static_cast<int>(k);
+  }
+  return !identity;
+}
+
+// ---- Subdomain ------------------------------------------------------------------------------
+
+Subdomain::Subdomain(System& system, int rank, int parts) : sys_(&system), rank_(rank) {
+  ParticleStore& store = sys_->store();
+  h_owner_ = store.find("subdomain_owner");
+  if (h_owner_ < 0) h_owner_ = store.add_array<int>("subdomain_owner", 1, -1);
+  send_.resize(static_cast<std::size_t>(parts));
+  recv_.resize(static_cast<std::size_t>(parts));
+  migrants_.resize(static_cast<std::size_t>(parts));
+  ghosts_.resize(static_cast<std::size_t>(parts));
+}
+
+std::size_t Subdomain::owned_count() const {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < sys_->particle_count(); ++i) n += is_ghost(i) ? 0 : 1;
+  return n;
+}
+
+double Subdomain::max_radius() {
+  double r = 0.0;
+  for (const double ri : sys_->store_unsynced().core().radius) r = std::max(r, ri);
+  return r;
+}
+
+double Subdomain::drift(double dt) {
+  if (sys_->particle_count() == 0) return 0.0;
+  const double moved2 = sys_->phase_drift(dt, ghost_);
+  return sys_->phase_needs_rebuild(moved2) ? 1.0 : 0.0;
+}
+
+void Subdomain::pack_refresh(SubdomainMail& out) {
+  const std::vector<std::int64_t>& id = sys_->store_unsynced().core().id;
+  Eigen::Vector3d x, v, w;
+  for (std::size_t r = 0; r < send_.size(); ++r) {
+    std::vector<std::byte>& o = out[r];
+    o.clear();
+    if (send_[r].empty()) continue;
+    append(o, refresh_magic);
+    append(o, format_version);
+    append(o, static_cast<std::uint64_t>(send_[r].size()));
+    for (const int i : send_[r]) {
+      sys_->phase_motion(static_cast<std::size_t>(i), x, v, w);
+      append(o, id[i]);
+      append_vector(o, x);
+      append_vector(o, v);
+      append_vector(o, w);
+    }
+  }
+}
+
+void Subdomain::unpack_refresh(const SubdomainMail& in) {
+  const std::vector<std::int64_t>& id = sys_->store_unsynced().core().id;
+  for (std::size_t s = 0; s < recv_.size(); ++s) {
+    static const std::vector<std::byte> none;
+    const std::vector<std::byte>& m = s < in.size() ? in[s] : none;
+    const std::vector<int>& ghosts = recv_[s];
+    if (m.empty() && ghosts.empty()) continue;
+    const std::size_t n = ghosts.size();
+    if (m.size() < refresh_header || get<std::uint32_t>(m.data()) != refresh_magic ||
+        get<std::uint32_t>(m.data() + 4) != format_version ||
+        get<std::uint64_t>(m.data() + 8) != n || m.size() != refresh_header + n * refresh_row)
+      throw Error(from(rank_, static_cast<int>(s)) +
+                  " is not the refresh of the " + std::to_string(n) +
+                  " ghosts it owns here (another format version, or the subdomains disagree on "
+                  "the ghosts since the last build)");
+    const std::byte* at = m.data() + refresh_header;
+    for (std::size_t k = 0; k < n; ++k, at += refresh_row) {
+      const int i = ghosts[k];
+      if (get<std::int64_t>(at) != id[i])
+        throw Error(from(rank_, static_cast<int>(s)) + " names particle id " +
+                    std::to_string(get<std::int64_t>(at)) + " where ghost " + std::to_string(k) +
+                    " is id " + std::to_string(id[i]));
+      sys_->set_phase_motion(static_cast<std::size_t>(i), get_vector(at + 8), get_vector(at + 32),
+                             get_vector(at + 56));
+    }
+  }
+}
+
+void Subdomain::pack_moves(const DomainDecomposition& d, double ghost_distance,
+                           SubdomainMail& out) {
+  const std::size_t n = sys_->particle_count();
+  const Particles& p = sys_->particles();  // (positions of now)
+  for (auto& m : migrants_) m.clear();
+  for (auto& g : ghosts_) g.clear();
+  remove_.assign(n, 0);
+  become_ghost_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (is_ghost(i)) {  // replaced by its owner's copy
+      remove_[i] = 1;
+      continue;
+    }
+    const Eigen::Vector3d& x = p.position[i];
+    const int owner = d.owner(x);
+    d.near(x, ghost_distance, near_);  // (boxes other than the owner's)
+    bool ghost_here = false;
+    for (const int r : near_) {
+      if (r == rank_)
+        ghost_here = true;
+      else
+        ghosts_[static_cast<std::size_t>(r)].push_back(static_cast<int>(i));
+    }
+    if (owner == rank_) continue;
+    migrants_[static_cast<std::size_t>(owner)].push_back(static_cast<int>(i));
+    if (ghost_here)
+      become_ghost_.emplace_back(static_cast<int>(i), owner);
+    else
+      remove_[i] = 1;
+  }
+  for (std::size_t r = 0; r < out.size(); ++r) {
+    std::vector<std::byte>& o = out[r];
+    o.clear();
+    if (migrants_[r].empty() && ghosts_[r].empty()) continue;
+    append(o, moves_magic);
+    append(o, format_version);
+    append(o, std::uint64_t{0});
+    append(o, std::uint64_t{0});
+    std::size_t start = o.size();
+    if (!migrants_[r].empty()) sys_->pack_particles(migrants_[r], o);
+    const std::uint64_t migrant_bytes = o.size() - start;
+    start = o.size();
+    if (!ghosts_[r].empty()) sys_->pack_particles(ghosts_[r], o);
+    const std::uint64_t ghost_bytes = o.size() - start;
+    std::memcpy(o.data() + 8, &migrant_bytes, 8);
+    std::memcpy(o.data() + 16, &ghost_bytes, 8);
+  }
+}
+
+void Subdomain::unpack_moves(const SubdomainMail& in, GlobalOrder& order,
+                             const DomainDecomposition& d, double ghost_distance) {
+  // every message checked before the first change
+  for (std::size_t s = 0; s < in.size(); ++s) {
+    const std::vector<std::byte>& m = in[s];
+    if (m.empty()) continue;
+    if (m.size() < moves_header || get<std::uint32_t>(m.data()) != moves_magic ||
+        get<std::uint32_t>(m.data() + 4) != format_version ||
+        get<std::uint64_t>(m.data() + 8) + get<std::uint64_t>(m.data() + 16) !=
+            m.size() - moves_header)
+      throw Error(from(rank_, static_cast<int>(s)) +
+                  " is not a message of particles moving at a list build (\"PSDM\", version " +
+                  std::to_string(format_version) + ") or is cut short");
+  }
+  {
+    std::vector<int>& owner = owner_array();
+    for (const auto& [i, o] : become_ghost_) owner[static_cast<std::size_t>(i)] = o;
+  }
+  if (remove_.size() == sys_->particle_count()) sys_->remove_particles(remove_);
+  remove_.clear();
+  become_ghost_.clear();
+  for (std::size_t s = 0; s < in.size(); ++s) {
+    const std::vector<std::byte>& m = in[s];
+    if (m.empty()) continue;
+    const auto migrant_bytes = static_cast<std::size_t>(get<std::uint64_t>(m.data() + 8));
+    const auto ghost_bytes = static_cast<std::size_t>(get<std::uint64_t>(m.data() + 16));
+    const std::byte* at = m.data() + moves_header;
+    if (migrant_bytes > 0) {
+      const std::size_t first = sys_->unpack_particles(at, migrant_bytes);
+      std::vector<int>& owner = owner_array();
+      for (std::size_t i = first; i < owner.size(); ++i) owner[i] = -1;
+      migrated_in_ += static_cast<long>(owner.size() - first);
+    }
+    if (ghost_bytes > 0) {
+      const std::size_t first = sys_->unpack_particles(at + migrant_bytes, ghost_bytes);
+      std::vector<int>& owner = owner_array();
+      for (std::size_t i = first; i < owner.size(); ++i) owner[i] = static_cast<int>(s);
+    }
+  }
+  // the global order, the lists, and who sends what until the next build
+  for (auto& l : send_) l.clear();
+  for (auto& l : recv_) l.clear();
+  ghost_.clear();
+  if (sys_->particle_count() == 0) return;
+  if (order.compute(sys_->particles(), order_)) sys_->renumber_particles(order_);
+  sys_->phase_build();
+  const std::vector<int>& owner = owner_array();
+  const Particles& p = sys_->particles();
+  const std::size_t n = p.size();
+  ghost_.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (owner[i] >= 0) {
+      ghost_[i] = 1;
+      recv_[static_cast<std::size_t>(owner[i])].push_back(static_cast<int>(i));
+      continue;
+    }
+    d.near(p.position[i], ghost_distance, near_);
+    for (const int r : near_) send_[static_cast<std::size_t>(r)].push_back(static_cast<int>(i));
+  }
+}
+
+void Subdomain::add_kinetic(ExactSum* sums) {
+  const Particles& p = sys_->particles();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (is_ghost(i)) continue;
+    sums[0].add(0.5 * p.mass[i] * p.velocity[i].squaredNorm() +
+               0.5 * p.inertia[i] * p.angular_velocity[i].squaredNorm());
+    for (int k = 0; k < 3; ++k) sums[1 + k].add(p.mass[i] * p.velocity[i][k]);
+  }
+}
+
+void Subdomain::forces(double dt, bool step) {
+  if (sys_->particle_count() > 0) sys_->phase_forces(dt, step);
+}
+
+void Subdomain::finish(double dt) {
+  if (sys_->particle_count() > 0) sys_->phase_finish(dt);
+}
+
+// ---- SubdomainStepper -----------------------------------------------------------------------
+
+SubdomainStepper::SubdomainStepper(std::vector<System*> systems, SubdomainTransport& transport,
+                                   const DomainDecomposition& decomposition, double skin,
+                                   Options options)
+    : transport_(&transport),
+      decomposition_(decomposition),
+      skin_(skin),
+      options_(options) {
+  const std::vector<int>& local = transport.local();
+  if (systems.size() != local.size() || decomposition.parts() != transport.parts()) {
+    std::ostringstream msg;
+    msg << "SubdomainStepper: " << systems.size() << " systems for the " << local.size()
+        << " local subdomains of the transport, which has " << transport.parts()
+        << " subdomains in all, and a decomposition into " << decomposition.parts()
+        << "; give one System per local subdomain and a decomposition into as many boxes as "
+           "subdomains";
+    throw Error(msg.str());
+  }
+  const int parts = transport.parts();
+  for (std::size_t k = 0; k < systems.size(); ++k) {
+    if (systems[k] == nullptr) throw Error("SubdomainStepper: system " + std::to_string(k) + " is null");
+    systems[k]->set_skin(skin);
+    systems[k]->set_sort_interval(0);
+    subdomains_.emplace_back(*systems[k], local[k], parts);
+  }
+  out_.assign(systems.size(), SubdomainMail(static_cast<std::size_t>(parts)));
+  in_.assign(systems.size(), SubdomainMail(static_cast<std::size_t>(parts)));
+  values_.assign(systems.size(), 0.0);
+}
+
+void SubdomainStepper::set_decomposition(const DomainDecomposition& d) {
+  if (d.parts() != decomposition_.parts() || d.bounds().lo != decomposition_.bounds().lo ||
+      d.bounds().hi != decomposition_.bounds().hi)
+    throw Error(
+        "SubdomainStepper::set_decomposition: a new decomposition must have as many boxes and "
+        "the same bounds as the first (the global order's grid is fixed for the run)");
+  next_ = d;
+  next_pending_ = true;
+}
+
+void SubdomainStepper::redistribute() {
+  for (std::size_t k = 0; k < subdomains_.size(); ++k) values_[k] = subdomains_[k].max_radius();
+  const double r_max = transport_->max(values_);
+  if (!(r_max > 0.0))
+    throw Error("SubdomainStepper: the split bed has no particles; add some first");
+  ghost_distance_ = options_.ghost_distance >= 0.0 ? options_.ghost_distance : 2.0 * r_max + skin_;
+  if (!started_) {
+    const DomainDecomposition::Box& b = decomposition_.bounds();
+    order_ = GlobalOrder(b.lo, b.hi, 2.0 * r_max + skin_);
+  }
+  if (next_pending_) {
+    decomposition_ = next_;
+    next_pending_ = false;
+  }
+  for (std::size_t k = 0; k < subdomains_.size(); ++k)
+    subdomains_[k].pack_moves(decomposition_, ghost_distance_, out_[k]);
+  transport_->exchange(out_, in_);
+  for (std::size_t k = 0; k < subdomains_.size(); ++k)
+    subdomains_[k].unpack_moves(in_[k], order_, decomposition_, ghost_distance_);
+  ++builds_;
+}
+
+void SubdomainStepper::start(double dt) {
+  redistribute();
+  started_ = true;
+  for (Subdomain& s : subdomains_) s.forces(dt, false);
+}
+
+void SubdomainStepper::step(double dt) {
+  if (!started_) start(dt);
+  for (std::size_t k = 0; k < subdomains_.size(); ++k) values_[k] = subdomains_[k].drift(dt);
+  const bool rebuild = transport_->max(values_) > 0.0;
+  if (rebuild) {
+    redistribute();
+  } else {
+    for (std::size_t k = 0; k < subdomains_.size(); ++k) subdomains_[k].pack_refresh(out_[k]);
+    transport_->exchange(out_, in_);
+    for (std::size_t k = 0; k < subdomains_.size(); ++k) subdomains_[k].unpack_refresh(in_[k]);
+  }
+  for (Subdomain& s : subdomains_) s.forces(dt, true);
+  for (Subdomain& s : subdomains_) s.finish(dt);
+  ++steps_;
+}
+
+// Every subdomain sends its partial sums to every subdomain (itself included); each adds them up
+// (exact: in any order).
+void SubdomainStepper::kinetic_sums() {
+  const std::size_t local = subdomains_.size();
+  sums_.resize(4 * local);
+  for (std::size_t k = 0; k < local; ++k) {
+    for (int q = 0; q < 4; ++q) sums_[4 * k + q].clear();
+    subdomains_[k].add_kinetic(&sums_[4 * k]);
+    for (std::vector<std::byte>& o : out_[k]) {
+      o.resize(4 * ExactSum::byte_size);
+      for (int q = 0; q < 4; ++q) sums_[4 * k + q].write(o.data() + q * ExactSum::byte_size);
+    }
+  }
+  transport_->exchange(out_, in_);
+  for (ExactSum& t : totals_) t.clear();
+  ExactSum part;
+  for (const std::vector<std::byte>& m : in_[0]) {
+    if (m.size() != 4 * ExactSum::byte_size)
+      throw Error("SubdomainStepper: a subdomain's kinetic sums have " + std::to_string(m.size()) +
+                  " bytes, not " + std::to_string(4 * ExactSum::byte_size));
+    for (int q = 0; q < 4; ++q) {
+      part.read(m.data() + q * ExactSum::byte_size);
+      totals_[q].add(part);
+    }
+  }
+}
+
+double SubdomainStepper::kinetic_energy() {
+  kinetic_sums();
+  return totals_[0].value();
+}
+
+Eigen::Vector3d SubdomainStepper::linear_momentum() {
+  kinetic_sums();
+  return {totals_[1].value(), totals_[2].value(), totals_[3].value()};
+}
+
+void SubdomainStepper::run(long steps, double dt) {
+  for (long s = 0; s < steps; ++s) step(dt);
+}
+
+}  // namespace partita::dem

@@ -1,0 +1,133 @@
+// System: a step cut into phases, for a bed split into subdomains (subdomain.hpp drives them).
+//
+// The phases are step()'s operations on the path without the fused pass (the first half in a loop
+// of its own, then the rebuild decision, then the forces and the kick), in the same order:
+//   phase_drift     walls_.advance(), the meshes' velocities from their motion, the first half
+//                   and the start of the force sums, particle by particle
+//   (the caller)    the rebuild decision, made for all subdomains at once; ghosts' values from
+//                   their owners, or at a build the particles that move between subdomains
+//   phase_build     the lists (rebuild_lists(), with the pair histories received placed)
+//   phase_forces    compute_forces() with the kick
+//   phase_finish    what step() does after its force pass
+// What differs from step(): the fused pass is never taken (it gives the same bits as the loop of
+// its own, and needs the motion bound of the last step that a ghost's values would not update),
+// the rebuild decision is the caller's, and the lists are renumbered by the caller (its global
+// order) instead of by set_sort_interval().
+#include "partita/dem/system.hpp"
+
+#include "partita/dem/error.hpp"
+#include "parallel_pass.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace partita::dem {
+
+double System::phase_drift(double dt, const std::vector<char>& skip) {
+  if (energy_tracking_)
+    throw Error(
+        "phase_drift: the energy accounting is not available in a step taken in phases (a split "
+        "bed); turn it off (set_energy_tracking(false))");
+  prepare();
+  if (!(dt > 0.0) || !std::isfinite(dt)) {
+    std::ostringstream msg;
+    msg << "phase_drift: the time step must be > 0 s, got " << dt;
+    throw Error(msg.str());
+  }
+  constexpr double kStepTolerance = 1e-9;  // (as step())
+  if (dt > rayleigh_dt_ * (1.0 + kStepTolerance)) {
+    std::ostringstream msg;
+    msg.precision(6);
+    msg << "phase_drift: time step " << dt << " s is above the Rayleigh time step " << rayleigh_dt_
+        << " s of the smallest particle; use a fraction of it (rayleigh_time_step())";
+    throw Error(msg.str());
+  }
+  if (!forces_valid_)
+    throw Error(
+        "phase_drift: the particles have no forces of a force pass yet; call "
+        "phase_forces(dt, false) after the first phase_build()");
+  const std::size_t n = store_.size();
+  if (!skip.empty() && skip.size() != n)
+    throw Error("phase_drift: need one skip flag per particle (" + std::to_string(n) + "), got " +
+                std::to_string(skip.size()));
+  if (!verlet_.loaded()) verlet_.load(store_.core());
+  verlet_.moved();
+  for (TriangleMesh& m : meshes_) {
+    if (!m.velocity_from_motion_) continue;
+    detail::parallel_pass(m.vertex_count(), [&](int v) {
+      m.velocity_[v] = (m.position_[v] - m.position_last_step_[v]) / dt;
+    });
+  }
+  walls_.advance(dt);
+  const VelocityVerlet::Pass verlet = verlet_.pass(store_.core());
+  const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
+  const bool have_build = x_build.size() == n;
+  const double half = 0.5 * dt;
+  double moved2 = have_build ? 0.0 : std::numeric_limits<double>::infinity();
+  const long count = static_cast<long>(n);
+#pragma omp parallel for schedule(static) reduction(max : moved2) if (count >= 1024)
+  for (long k = 0; k < count; ++k) {
+    const int i = static_cast<int>(k);
+    const Eigen::Vector3d& x = verlet.first_half(i, dt, half);
+    if (have_build && (skip.empty() || !skip[k]))
+      moved2 = std::max(moved2, (x - x_build[k]).squaredNorm());
+    start_sums(i);
+  }
+  return moved2;
+}
+
+bool System::phase_needs_rebuild(double moved2) const {
+  return neighbors_.needs_rebuild(moved2, walls_.planes(), meshes_);
+}
+
+void System::phase_motion(std::size_t i, Eigen::Vector3d& x, Eigen::Vector3d& v,
+                          Eigen::Vector3d& w) const {
+  check_particle(i, "phase_motion");
+  if (verlet_.loaded()) {
+    const PackedParticle& q = verlet_.particle(i);
+    x = q.x, v = q.v, w = q.w;
+  } else {
+    const Particles& p = store_.core();
+    x = p.position[i], v = p.velocity[i], w = p.angular_velocity[i];
+  }
+}
+
+void System::set_phase_motion(std::size_t i, const Eigen::Vector3d& x, const Eigen::Vector3d& v,
+                              const Eigen::Vector3d& w) {
+  check_particle(i, "set_phase_motion");
+  if (!verlet_.loaded())
+    throw Error("set_phase_motion: only between phase_drift() and phase_forces()");
+  PackedParticle& q = verlet_.particle(i);
+  q.x = x, q.v = v, q.w = w;
+}
+
+void System::phase_build() {
+  if (sort_interval_ > 0)
+    throw Error(
+        "phase_build: the particles of a step taken in phases are numbered by the caller; set "
+        "set_sort_interval(0)");
+  prepared_ = false;
+  lists_current_ = false;
+  prepare();  // (rayleigh_dt_, history sizes, the lists)
+}
+
+void System::phase_forces(double dt, bool step) {
+  prepare();
+  compute_forces(dt, step, step ? 0.5 * dt : 0.0, false);
+  forces_valid_ = true;
+}
+
+void System::phase_finish(double dt) {
+  verlet_.forget_motion();  // (a later step() takes the exact path)
+  for (TriangleMesh& m : meshes_)
+    detail::parallel_pass(m.vertex_count(),
+                          [&](int v) { m.position_last_step_[v] = m.position_[v]; });
+  for (int k = 0; k < hooks_.size(); ++k) hooks_[k].post_force(*this, dt);
+  time_ += dt;
+  ++steps_;
+  for (int k = 0; k < hooks_.size(); ++k) hooks_[k].end_of_step(*this, dt);
+}
+
+}  // namespace partita::dem

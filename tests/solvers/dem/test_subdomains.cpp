@@ -1,0 +1,357 @@
+// A bed split into subdomains (SubdomainStepper) steps to the same bits on any split: positions,
+// velocities and angular velocities per particle id equal those of the same bed in one subdomain,
+// with list rebuilds, particles crossing the cuts, tangential histories against each other and
+// the walls, and a re-cut in the middle of the run; without ghosts the bits differ (the test can
+// fail).
+
+#include "dem_test_helpers.hpp"
+
+#include "partita/dem/domain_decomposition.hpp"
+#include "partita/dem/error.hpp"
+#include "partita/dem/exact_sum.hpp"
+#include "partita/dem/subdomain.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <cstring>
+#include <map>
+#include <memory>
+
+using namespace partita::dem;
+
+namespace {
+
+constexpr double kWidth = 8e-3, kHeight = 18e-3;
+constexpr double kSkin = 0.05e-3;
+const Eigen::Vector3d kLo = Eigen::Vector3d::Zero();
+const Eigen::Vector3d kHi(kWidth, kWidth, kHeight);
+
+// A polydisperse bed (three sizes) thrown about in a closed box of planes with friction under
+// gravity: the particles collide, cross the cuts and settle; pairs and planes keep tangential
+// springs.
+struct Bed {
+  Eigen::MatrixX3d x;
+  Eigen::VectorXd r;
+  Eigen::MatrixX3d v;
+};
+
+const Bed& bed() {
+  static const Bed b = [] {
+    PackingSpec spec;
+    spec.lo = kLo;
+    spec.hi = kHi;
+    spec.diameters = {1.0e-3, 0.8e-3, 0.6e-3};
+    spec.fractions = {1.0, 1.0, 1.0};
+    spec.porosity = 0.6;
+    spec.seed = 11;
+    const Packing pk = PackingGenerator::generate(spec);
+    Bed out{pk.positions, pk.radii, Eigen::MatrixX3d(pk.positions.rows(), 3)};
+    // velocities of up to 0.3 m/s each way and 0.2 m/s down, from a hash of the index
+    std::uint64_t h = 0x9e3779b97f4a7c15ull;
+    auto next = [&] {
+      h ^= h >> 33, h *= 0xff51afd7ed558ccdull, h ^= h >> 33, h += 0x9e3779b97f4a7c15ull;
+      return static_cast<double>(h >> 11) / 9007199254740992.0;  // [0, 1)
+    };
+    for (Eigen::Index i = 0; i < out.x.rows(); ++i)
+      out.v.row(i) << 0.6 * next() - 0.3, 0.6 * next() - 0.3, 0.6 * next() - 0.5;
+    return out;
+  }();
+  return b;
+}
+
+// One subdomain's System: the same set-up on every subdomain, the particles of `keep` (their
+// index is their id).
+std::unique_ptr<System> subdomain_system(const std::vector<int>& keep) {
+  auto sys = std::make_unique<System>();
+  const int m = sys->add_material({1.0e7, 0.3, 2500.0});
+  sys->add_interaction(m, m, {0.5, 0.5, 0.05});
+  sys->set_gravity({0, 0, -9.81});
+  const Bed& b = bed();
+  for (const int i : keep)
+    sys->add_particle(b.x.row(i).transpose(), b.r[i], m, b.v.row(i).transpose(),
+                      Eigen::Vector3d::Zero(), i);
+  sys->add_box(kLo, kHi, m);
+  return sys;
+}
+
+// The transport with the pair records taken out of the messages of a list build (System::
+// pack_particles() inside "PSDM" frames, subdomain.hpp): the histories do not travel.
+class WithoutHistories final : public SubdomainTransport {
+ public:
+  WithoutHistories(SubdomainTransport& inner, System& any) : inner_(inner), any_(any) {}
+  int parts() const override { return inner_.parts(); }
+  const std::vector<int>& local() const override { return inner_.local(); }
+  double max(const std::vector<double>& values) override { return inner_.max(values); }
+  void exchange(std::vector<SubdomainMail>& out, std::vector<SubdomainMail>& in) override {
+    for (SubdomainMail& mail : out)
+      for (std::vector<std::byte>& m : mail)
+        if (m.size() >= 24 && read<std::uint32_t>(m.data()) == 0x4d445350u) m = strip(m);
+    inner_.exchange(out, in);
+  }
+
+ private:
+  template <class T>
+  static T read(const std::byte* at) {
+    T v;
+    std::memcpy(&v, at, sizeof v);
+    return v;
+  }
+  // one System::pack_particles() message without its records (header 41 bytes: n at 16, the
+  // record count at 24; records of 41 bytes after the particles)
+  std::vector<std::byte> strip_message(const std::byte* m, std::size_t bytes) const {
+    const auto n = read<std::uint64_t>(m + 16), records = read<std::uint64_t>(m + 24);
+    const std::size_t pairs_at = 41 + n * any_.store_unsynced().packed_bytes_per_particle();
+    std::vector<std::byte> out(m, m + pairs_at);
+    out.insert(out.end(), m + pairs_at + records * 41, m + bytes);
+    const std::uint64_t none = 0;
+    std::memcpy(out.data() + 24, &none, 8);
+    return out;
+  }
+  std::vector<std::byte> strip(const std::vector<std::byte>& m) const {
+    const auto a = read<std::uint64_t>(m.data() + 8), b = read<std::uint64_t>(m.data() + 16);
+    std::vector<std::byte> out(m.begin(), m.begin() + 24);
+    std::vector<std::byte> ma, mb;
+    if (a > 0) ma = strip_message(m.data() + 24, a);
+    if (b > 0) mb = strip_message(m.data() + 24 + a, b);
+    const std::uint64_t sa = ma.size(), sb = mb.size();
+    std::memcpy(out.data() + 8, &sa, 8);
+    std::memcpy(out.data() + 16, &sb, 8);
+    out.insert(out.end(), ma.begin(), ma.end());
+    out.insert(out.end(), mb.begin(), mb.end());
+    return out;
+  }
+  SubdomainTransport& inner_;
+  System& any_;  // a System of the split (the particles' packed size)
+};
+
+struct State {
+  Eigen::Vector3d x, v, w;
+};
+
+struct Run {
+  std::map<std::int64_t, State> state;  // owned particles by id
+  long builds = 0;
+  long migrated = 0;
+  std::size_t ghosts_at_end = 0;
+  double kinetic = 0.0;              // SubdomainStepper::kinetic_energy() at the end
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+  double system_kinetic = 0.0;  // System::kinetic_energy() summed over the subdomains
+  bool recut = false;  // the re-cut moved some box and the stepper took it up
+};
+
+// The bed split into `parts` subdomains, `steps` steps; `recut_at` > 0: a new bisection of the
+// positions of that step from then on.
+Run run_split(int parts, long steps, SubdomainStepper::Options options = {}, long recut_at = 0,
+              bool without_histories = false) {
+  const Bed& b = bed();
+  std::vector<Eigen::Vector3d> x0;
+  for (Eigen::Index i = 0; i < b.x.rows(); ++i) x0.push_back(b.x.row(i).transpose());
+  const DomainDecomposition d = DomainDecomposition::bisection(x0, kLo, kHi, parts);
+  std::vector<std::vector<int>> keep(static_cast<std::size_t>(parts));
+  for (std::size_t i = 0; i < x0.size(); ++i) keep[d.owner(x0[i])].push_back(static_cast<int>(i));
+  std::vector<std::unique_ptr<System>> systems;
+  std::vector<System*> raw;
+  for (int k = 0; k < parts; ++k) {
+    systems.push_back(subdomain_system(keep[k]));
+    raw.push_back(systems.back().get());
+  }
+  InProcessTransport in_process(parts);
+  WithoutHistories stripped(in_process, *systems[0]);
+  SubdomainTransport& transport =
+      without_histories ? static_cast<SubdomainTransport&>(stripped) : in_process;
+  SubdomainStepper stepper(raw, transport, d, kSkin, options);
+  const double dt = 0.25 * systems[0]->rayleigh_time_step();
+  Run out;
+  for (long s = 0; s < steps; ++s) {
+    if (recut_at > 0 && s == recut_at) {
+      std::vector<Eigen::Vector3d> x;
+      for (int k = 0; k < parts; ++k) {
+        const Subdomain& sd = stepper.subdomain(k);
+        const Particles& p = systems[k]->particles();
+        for (std::size_t i = 0; i < p.size(); ++i)
+          if (!sd.is_ghost(i)) x.push_back(p.position[i]);
+      }
+      const DomainDecomposition recut = DomainDecomposition::bisection(x, kLo, kHi, parts);
+      for (int k = 0; k < parts; ++k)
+        out.recut = out.recut || recut.box(k).lo != d.box(k).lo || recut.box(k).hi != d.box(k).hi;
+      stepper.set_decomposition(recut);
+    }
+    stepper.step(dt);
+  }
+  bool owned_once = true;
+  for (int k = 0; k < parts; ++k) {
+    const Subdomain& sd = stepper.subdomain(k);
+    const Particles& p = systems[k]->particles();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (sd.is_ghost(i)) continue;
+      owned_once = owned_once && out.state.count(p.id[i]) == 0;
+      out.state[p.id[i]] = {p.position[i], p.velocity[i], p.angular_velocity[i]};
+    }
+    out.migrated += sd.migrated_in();
+    out.ghosts_at_end += sd.ghost_count();
+  }
+  REQUIRE(owned_once);  // every particle in one subdomain
+  out.kinetic = stepper.kinetic_energy();
+  out.momentum = stepper.linear_momentum();
+  for (int k = 0; k < parts; ++k) out.system_kinetic += systems[k]->kinetic_energy();
+  out.builds = stepper.builds();
+  if (recut_at > 0) {  // the re-cut was taken up (at a list build after it)
+    bool taken = false;
+    for (int k = 0; k < parts; ++k) {
+      const DomainDecomposition::Box& box = stepper.decomposition().box(k);
+      taken = taken || box.lo != d.box(k).lo || box.hi != d.box(k).hi;
+    }
+    out.recut = out.recut && taken;
+  }
+  return out;
+}
+
+// How many particles differ from the reference in any bit of x, v or omega, or are missing.
+std::size_t differing(const Run& a, const Run& ref) {
+  REQUIRE(a.state.size() == ref.state.size());
+  std::size_t n = 0;
+  for (const auto& [id, s] : ref.state) {
+    const auto it = a.state.find(id);
+    n += it == a.state.end() || it->second.x != s.x || it->second.v != s.v || it->second.w != s.w
+             ? 1
+             : 0;
+  }
+  return n;
+}
+
+constexpr long kSteps = 300;
+
+const Run& reference() {
+  static const Run r = run_split(1, kSteps);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("dem: subdomains: a split bed steps to the bits of one subdomain on 2, 3 and 4",
+          "[dem][subdomains]") {
+  const Run& ref = reference();
+  REQUIRE(ref.state.size() == static_cast<std::size_t>(bed().x.rows()));
+  REQUIRE(ref.state.size() > 1000);
+  REQUIRE(ref.builds >= 4);  // several list builds over the run
+  REQUIRE(ref.migrated == 0);
+  // the particles moved: not the start's positions
+  std::size_t moved = 0;
+  for (const auto& [id, s] : ref.state)
+    moved += (s.x - bed().x.row(id).transpose()).norm() > kSkin ? 1 : 0;
+  REQUIRE(moved > ref.state.size() / 2);
+  for (const int parts : {2, 3, 4}) {
+    CAPTURE(parts);
+    const Run split = run_split(parts, kSteps);
+    CHECK(split.builds == ref.builds);
+    CHECK(split.migrated > 0);  // particles crossed the cuts
+    CHECK(split.ghosts_at_end > 0);
+    CHECK(differing(split, ref) == 0);
+    // the exact sums over the owned particles: the same bits
+    CHECK(split.kinetic == ref.kinetic);
+    CHECK(split.momentum == ref.momentum);
+    // each System's own sum counts its ghosts too
+    CHECK(split.system_kinetic > ref.kinetic);
+  }
+  // the exact sum against the ordered one of one System (no ghosts): rounding apart
+  CHECK(ref.kinetic > 0.0);
+  CHECK(std::abs(ref.kinetic - ref.system_kinetic) <= 1e-13 * ref.kinetic);
+}
+
+TEST_CASE("dem: subdomains: without ghosts the split differs (the comparison can fail)",
+          "[dem][subdomains]") {
+  SubdomainStepper::Options no_ghosts;
+  no_ghosts.ghost_distance = 0.0;
+  const Run split = run_split(2, kSteps, no_ghosts);
+  CHECK(split.ghosts_at_end == 0);
+  CHECK(differing(split, reference()) > 0);
+}
+
+TEST_CASE("dem: subdomains: without the histories of the ghosts' pairs the split differs",
+          "[dem][subdomains]") {
+  const Run split = run_split(2, kSteps, {}, 0, true);
+  CHECK(split.ghosts_at_end > 0);
+  CHECK(differing(split, reference()) > 0);
+}
+
+TEST_CASE("dem: subdomains: a re-cut in the middle of the run keeps the bits",
+          "[dem][subdomains]") {
+  const Run split = run_split(3, kSteps, {}, kSteps / 2);
+  CHECK(split.recut);
+  CHECK(differing(split, reference()) == 0);
+}
+
+TEST_CASE("dem: subdomains: bad set-ups and messages are refused", "[dem][subdomains]") {
+  InProcessTransport transport(2);
+  const DomainDecomposition d = DomainDecomposition::bisection({}, kLo, kHi, 2);
+  auto a = subdomain_system({0, 1});
+  CHECK_THROWS_AS(SubdomainStepper({a.get()}, transport, d, kSkin), Error);
+  CHECK_THROWS_AS(InProcessTransport(0), Error);
+  CHECK_THROWS_AS(GlobalOrder(kLo, kHi, 0.0), Error);
+  // a message that is not a build's
+  auto b = subdomain_system({2, 3});
+  Subdomain sd(*b, 1, 2);
+  GlobalOrder order(kLo, kHi, 1e-3);
+  SubdomainMail in(2);
+  in[0] = std::vector<std::byte>(12, std::byte{7});
+  CHECK_THROWS_AS(sd.unpack_moves(in, order, d, 1e-3), Error);
+  CHECK(b->particle_count() == 2);
+}
+
+TEST_CASE("dem: exact sums: the exact sum rounded once, in any order and split", "[dem][subdomains]") {
+  // cancellation an ordered sum loses
+  ExactSum a;
+  for (const double x : {1e16, 1.0, -1e16}) a.add(x);
+  CHECK(a.value() == 1.0);
+  // ten times 0.1: the exact sum 10 * 0.1000000000000000055511151231257827 rounds to 1
+  ExactSum b;
+  double naive = 0.0;
+  for (int k = 0; k < 10; ++k) b.add(0.1), naive += 0.1;
+  CHECK(naive != 1.0);
+  CHECK(b.value() == 1.0);
+  // no overflow in between; negative results; the smallest subnormal; zero
+  ExactSum c;
+  for (const double x : {1e308, 1e308, -1e308}) c.add(x);
+  CHECK(c.value() == 1e308);
+  ExactSum d;
+  for (const double x : {-3.5, 1.25, 4.9e-324}) d.add(x);
+  CHECK(d.value() == -2.25);
+  ExactSum e;
+  e.add(4.9e-324);
+  CHECK(e.value() == 4.9e-324);
+  ExactSum z;
+  z.add(2.0), z.add(-2.0);
+  CHECK(z.value() == 0.0);
+  ExactSum inf;
+  inf.add(1.0), inf.add(std::numeric_limits<double>::infinity());
+  CHECK(std::isinf(inf.value()));
+  // terms of mixed signs and magnitudes: the same bits in reverse order and summed in three
+  // parts merged (through bytes) in another order
+  std::vector<double> terms;
+  std::uint64_t h = 12345;
+  for (int k = 0; k < 5000; ++k) {
+    h = h * 6364136223846793005ull + 1442695040888963407ull;
+    const double mant = static_cast<double>(h >> 11) / 9007199254740992.0 - 0.5;
+    terms.push_back(std::ldexp(mant, static_cast<int>(h % 80) - 40));
+  }
+  ExactSum forward, backward, parts[3];
+  for (const double x : terms) forward.add(x);
+  for (auto it = terms.rbegin(); it != terms.rend(); ++it) backward.add(*it);
+  for (std::size_t k = 0; k < terms.size(); ++k) parts[k % 3].add(terms[k]);
+  std::vector<std::byte> bytes(ExactSum::byte_size);
+  ExactSum merged, copy;
+  for (const int k : {2, 0, 1}) {
+    parts[k].write(bytes.data());
+    copy.read(bytes.data());
+    merged.add(copy);
+  }
+  CHECK(forward.value() == backward.value());
+  CHECK(merged.value() == forward.value());
+  // and close to a long double sum (correctly rounded to within the long sum's own error)
+  long double sum = 0.0L;
+  for (const double x : terms) sum += x;
+  CHECK(std::abs(forward.value() - static_cast<double>(sum)) <= 1e-12 * std::abs(static_cast<double>(sum)));
+}
