@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <sstream>
 
@@ -198,6 +199,7 @@ std::string FemAdapter::check_state() const {
   if (!u.allFinite())
     return "the displacement has non-finite values: the structural step failed; check the "
            "loads, constraints (a free rigid-body motion) and the coupled forces";
+  if (const double w = solver_->strain_energy(); !std::isfinite(w)) return non_finite_energy_report();
   const double d = solver_->max_displacement();
   if (d > model_size_)
     return fmt::format(
@@ -207,6 +209,41 @@ std::string FemAdapter::check_state() const {
         "damping or a smaller time.window)",
         d, model_size_);
   return {};
+}
+
+// Where a non-finite stored energy comes from: the parts' elements (with the first element whose
+// mean plastic strain is not finite, where the law has one) or an indenter's contact springs.
+std::string FemAdapter::non_finite_energy_report() const {
+  std::string where;
+  const auto& regions = solver_->mesh().region_names();
+  const fem::RegionEnergies e = solver_->region_energies();
+  for (std::size_t r = 0; r < e.strain_energy.size(); ++r)
+    if (!std::isfinite(e.strain_energy[r]))
+      where += fmt::format("{}part '{}'", where.empty() ? "" : ", ",
+                           regions.empty() ? std::string("all") : regions[r]);
+  const Eigen::VectorXd eqps = solver_->element_equivalent_plastic_strain();
+  for (Eigen::Index k = 0; k < eqps.size(); ++k) {
+    if (std::isfinite(eqps[k])) continue;
+    const auto el = static_cast<std::size_t>(k);
+    fem::Vec3 c = fem::Vec3::Zero();
+    const auto nodes = solver_->mesh().elements()[el].node_span();
+    for (const auto n : nodes) c += solver_->mesh().node(n);
+    c /= static_cast<double>(nodes.size());
+    where += fmt::format("{}element {} at ({:.4g}, {:.4g}, {:.4g}) m{} has a non-finite plastic "
+                         "strain",
+                         where.empty() ? "" : "; ", el, c.x(), c.y(), c.z(),
+                         solver_->element_failed(el) ? " (failed)" : "");
+    break;
+  }
+  for (const auto& ind : indenters_)
+    if (!std::isfinite(ind.contact->stored_energy()))
+      where += fmt::format("{}the contact springs of indenter '{}'", where.empty() ? "" : "; ",
+                           ind.contact->name());
+  return fmt::format(
+      "the stored (strain) energy is not finite at t = {:.6g} s (in {}): an element's state or a "
+      "contact has diverged; reduce the time step (analysis.mass_scaling_time_step, "
+      "time.window), or check the material and the contact's stiffness",
+      solver_->time(), where.empty() ? "no part or indenter in particular" : where);
 }
 
 void FemAdapter::write_restart(BinaryWriter& out) const {

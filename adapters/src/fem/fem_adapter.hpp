@@ -121,6 +121,7 @@ class FemAdapter : public Solver {
   std::vector<PointMonitor> points_;
   FailureLog failure_log_;  // logs the first failed element
   // rigid indenters (indenters:, see indenter_config.hpp); the solver owns the contacts
+  std::string non_finite_energy_report() const;
   struct Indenter {
     std::string name;
     Eigen::Vector3d reference;  // its `position`: the monitors' N.x, N.y, N.z at rest

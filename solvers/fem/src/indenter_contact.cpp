@@ -136,7 +136,9 @@ void IndenterContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMa
     gap_trial_[j] = s.gap;
     const Vec3& force_before = force_committed_[j];
     const bool touched_before = force_before.squaredNorm() > 0.0;
-    if (!(s.gap < 0.0) || (detached_ && detached_(node))) {  // apart, or eroded away
+    // apart, eroded away, or without a face left to touch (every face around the node eroded
+    // while an element still holds it: no penalty stiffness)
+    if (!(s.gap < 0.0) || (detached_ && detached_(node)) || !(k_normal_[j] > 0.0)) {
       if (friction) ft_trial_[j].setZero();
       force_trial_[j].setZero();
       // released during the step: the force acted over the part g < 0, down from p_0

@@ -471,6 +471,43 @@ TEST_CASE("indenter contact: detached nodes take no contact force", "[fem][conta
   }
 }
 
+// A node whose contact faces have all eroded while it still belongs to an element (a web's node
+// on the struck face, held by the web) has no penalty stiffness left: it touches nothing, and its
+// springs store nothing (with friction, 0 / 0 would read as a non-finite energy).
+TEST_CASE("indenter contact: a node without a face left takes no force and stores no energy",
+          "[fem][contact][rupture]") {
+  const Model model = small_block();
+  const BlockAssembler assembler(model.mesh());
+  const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
+  IndenterContact contact(
+      "t", model, "zmax",
+      RigidIndenter(std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0, 0, -1)),
+                    VelocityTable({{0.0, Vec3::Zero()}})),
+      {1.0, 0.3, 1.0});
+  const Mesh& mesh = model.mesh();
+  const auto centre = [&](std::size_t e) {
+    Vec3 c = Vec3::Zero();
+    for (const auto node : mesh.element(e).node_span()) c += mesh.node(node);
+    return Vec3(c / static_cast<double>(mesh.element(e).node_span().size()));
+  };
+  // the top layer's last column of elements (x > 15 mm) eroded: the top face's nodes at x = 20 mm
+  // have no face left, those at x = 15 mm keep half their faces
+  contact.set_eroded([&](std::size_t e) { return centre(e).x() > 0.015 && centre(e).z() > 0.005; });
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  contact.add(u, f, nullptr, assembler);  // at the committed state: the stiffnesses follow erosion
+  CHECK(contact.active_nodes() == 20);
+  CHECK(std::isfinite(contact.stored_energy()));
+  CHECK(contact.stored_energy() > 0.0);
+  for (std::size_t node = 0; node < mesh.num_nodes(); ++node) {
+    const auto at = 3 * static_cast<Eigen::Index>(node);
+    if (mesh.node(node).x() > 0.0199 && mesh.node(node).z() > 0.0099)
+      CHECK(f.segment<3>(at).norm() == 0.0);
+    else if (mesh.node(node).z() > 0.0099)
+      CHECK(f.segment<3>(at).norm() > 0.0);
+  }
+}
+
 TEST_CASE("free indenter: an external force decelerates it as F/m, its work is the change of kinetic energy",
           "[fem][contact]") {
   // no contact: a constant force F on a body of mass m moving at v0; velocity Verlet integrates a
