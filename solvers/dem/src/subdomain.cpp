@@ -413,12 +413,17 @@ void SubdomainStepper::step(double dt) {
 
 // Every subdomain sends its partial sums to every subdomain (itself included); each adds them up
 // (exact: in any order).
-void SubdomainStepper::kinetic_sums() {
+void SubdomainStepper::global_sums(bool elastic) {
   const std::size_t local = subdomains_.size();
   sums_.resize(4 * local);
   for (std::size_t k = 0; k < local; ++k) {
     for (int q = 0; q < 4; ++q) sums_[4 * k + q].clear();
-    subdomains_[k].add_kinetic(&sums_[4 * k]);
+    if (subdomains_[k].system().particle_count() == 0)
+      ;  // (nothing to add)
+    else if (elastic)
+      subdomains_[k].add_elastic(sums_[4 * k]);
+    else
+      subdomains_[k].add_kinetic(&sums_[4 * k]);
     for (std::vector<std::byte>& o : out_[k]) {
       o.resize(4 * ExactSum::byte_size);
       for (int q = 0; q < 4; ++q) sums_[4 * k + q].write(o.data() + q * ExactSum::byte_size);
@@ -429,7 +434,7 @@ void SubdomainStepper::kinetic_sums() {
   ExactSum part;
   for (const std::vector<std::byte>& m : in_[0]) {
     if (m.size() != 4 * ExactSum::byte_size)
-      throw Error("SubdomainStepper: a subdomain's kinetic sums have " + std::to_string(m.size()) +
+      throw Error("SubdomainStepper: a subdomain's partial sums have " + std::to_string(m.size()) +
                   " bytes, not " + std::to_string(4 * ExactSum::byte_size));
     for (int q = 0; q < 4; ++q) {
       part.read(m.data() + q * ExactSum::byte_size);
@@ -439,12 +444,17 @@ void SubdomainStepper::kinetic_sums() {
 }
 
 double SubdomainStepper::kinetic_energy() {
-  kinetic_sums();
+  global_sums(false);
+  return totals_[0].value();
+}
+
+double SubdomainStepper::elastic_energy() {
+  global_sums(true);
   return totals_[0].value();
 }
 
 Eigen::Vector3d SubdomainStepper::linear_momentum() {
-  kinetic_sums();
+  global_sums(false);
   return {totals_[1].value(), totals_[2].value(), totals_[3].value()};
 }
 

@@ -23,10 +23,11 @@
 // particle of the step is there, and a pair the build does not list is out of reach anyway.
 // A pair between two particles of different messages comes in both; both records agree.
 //
-// What the MPI layer (outside solvers/dem) still has to do around these two calls: choose the
-// particles leaving each subdomain (DomainDecomposition::owner() of their positions) on the
-// steps when the lists are rebuilt, send each destination its message, remove_particles() the
-// senders' copies, and unpack_particles() what arrives before the next step. With the energy
+// Around these two calls, SubdomainStepper (subdomain.hpp) chooses the particles leaving each
+// subdomain and its ghosts for the others (DomainDecomposition::owner() and near() of their
+// positions) on the steps when the lists are rebuilt, sends each destination its messages
+// through a SubdomainTransport, removes the senders' copies and unpacks what arrives before the
+// lists are built. With the energy
 // accounting on, remove_particles() books the leaving particles' energy as a change of the
 // particle set (energies().breakage); summed over the subdomains the receiver's matching change
 // is not booked, so a migrating run must sum its energies with that in mind. The ids a System

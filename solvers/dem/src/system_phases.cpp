@@ -16,6 +16,7 @@
 #include "partita/dem/system.hpp"
 
 #include "partita/dem/error.hpp"
+#include "partita/dem/exact_sum.hpp"
 #include "parallel_pass.hpp"
 
 #include <algorithm>
@@ -128,6 +129,51 @@ void System::phase_finish(double dt) {
   time_ += dt;
   ++steps_;
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].end_of_step(*this, dt);
+}
+
+void System::add_elastic_energy(const std::vector<char>& skip, ExactSum& sum) const {
+  sync_particles();
+  const Particles& p = store_.core();
+  const NeighborList& nl = neighbors_;
+  if (!lists_current_ || nl.offsets_.size() != p.size() + 1 ||
+      pairs_.slot_count() != nl.neighbors_.size() || skip.size() != p.size())
+    throw Error(
+        "add_elastic_energy: needs the lists of the current particles (take a step after a "
+        "change of the particle set) and one flag per particle (" +
+        std::to_string(p.size()) + "), got " + std::to_string(skip.size()));
+  const_cast<ContactModel&>(model_).update();
+  const int n = static_cast<int>(p.size());
+  for (int i = 0; i < n; ++i) {  // (the terms as elastic_energy() takes them)
+    if (skip[i]) continue;
+    for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
+      const int j = nl.neighbors_[s];
+      const double rsum = p.radius[i] + p.radius[j];
+      const double delta = rsum - (p.position[i] - p.position[j]).norm();
+      if (delta <= 0.0) continue;
+      sum.add(hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
+                                   p.radius[i] * p.radius[j] / rsum, pairs_.shear(s)));
+    }
+  }
+  const std::vector<Eigen::Vector3d>& plane_shear = walls_.shear(store_);
+  const std::vector<PlaneWall>& planes = walls_.planes();
+  const std::size_t np = planes.size();
+  const bool have_shear = plane_shear.size() == p.size() * np;
+  const Eigen::Vector3d no_shear = Eigen::Vector3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    if (skip[i]) continue;
+    for (std::size_t k = 0; k < np; ++k) {
+      const double delta = p.radius[i] - (p.position[i] - planes[k].point).dot(planes[k].normal);
+      if (delta <= 0.0) continue;
+      sum.add(hertz_elastic_energy(model_.pair(p.material[i], planes[k].material), delta,
+                                   p.radius[i], have_shear ? plane_shear[i * np + k] : no_shear));
+    }
+  }
+  mesh_contacts_.for_each_contact(
+      [&](int i, const MeshContactRecord& rec, const Eigen::Vector3d& shear) {
+        if (skip[i]) return;
+        sum.add(hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta,
+                                     rec.r_eff, shear));
+      });
 }
 
 }  // namespace partita::dem

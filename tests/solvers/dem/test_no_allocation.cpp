@@ -1,11 +1,14 @@
 // The step loop allocates no memory once its arrays have their size: not in a plain step, not in
-// a step that rebuilds the neighbour lists, with one thread or two. The global operator new of
+// a step that rebuilds the neighbour lists, with one thread or two; nor a split bed's step between
+// its list builds. The global operator new of
 // the test program is replaced by one that counts (forwarding to malloc).
 
 #include "dem_test_helpers.hpp"
 
 #include "partita/dem/breakage.hpp"
+#include "partita/dem/domain_decomposition.hpp"
 #include "partita/dem/parallel.hpp"
+#include "partita/dem/subdomain.hpp"
 #include "partita/dem/system.hpp"
 
 #include <catch2/catch.hpp>
@@ -173,4 +176,41 @@ TEST_CASE("dem: steps with breakage enabled but nothing breaking allocate no mem
     if (PARTITA_COUNT_ALLOCATIONS) CHECK(made == 0);
   }
   set_num_threads(before);
+}
+
+TEST_CASE("dem: a split bed's steps between list builds allocate no memory",
+          "[dem][performance][subdomains]") {
+  // the drifting bed cut in two across its motion: particles cross the cut at the builds; the
+  // steps between them refresh the ghosts through buffers that keep their size
+  System a = drifting_bed(), b = drifting_bed();
+  std::vector<Eigen::Vector3d> x(a.particles().position.begin(), a.particles().position.end());
+  const DomainDecomposition d = DomainDecomposition::bisection(
+      x, Eigen::Vector3d::Zero(), Eigen::Vector3d(12e-3, 12e-3, 12e-3), 2);
+  std::vector<char> not_a(x.size()), not_b(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    not_a[i] = d.owner(x[i]) != 0;
+    not_b[i] = d.owner(x[i]) != 1;
+  }
+  a.remove_particles(not_a);
+  b.remove_particles(not_b);
+  InProcessTransport transport(2);
+  SubdomainStepper stepper({&a, &b}, transport, d, 0.06e-3);
+  const double dt = 0.2 * a.rayleigh_time_step();
+  stepper.run(100, dt);  // first steps size the arrays and buffers
+  long made = 0, quiet_steps = 0;
+  const long builds = stepper.builds();
+  for (int s = 0; s < 300; ++s) {
+    const long before = stepper.builds(), count = allocations.load();
+    stepper.step(dt);
+    if (stepper.builds() != before) continue;
+    made += allocations.load() - count;
+    ++quiet_steps;
+  }
+  INFO(made << " allocations in " << quiet_steps << " steps between builds, "
+            << stepper.builds() - builds << " builds");
+  CHECK(stepper.builds() - builds >= 2);
+  CHECK(quiet_steps > 100);
+  CHECK(stepper.subdomain(0).migrated_in() + stepper.subdomain(1).migrated_in() > 0);
+  CHECK(stepper.subdomain(0).ghost_count() > 0);
+  if (PARTITA_COUNT_ALLOCATIONS) CHECK(made == 0);
 }

@@ -20,21 +20,21 @@
 // positions equal to a cut go to the upper side with all equal ones, so shuffled input gives the
 // same boxes. Where many particles share one coordinate the counts can differ from the targets.
 //
-// How a DEM spread over processes uses it (the MPI layer, outside solvers/dem, is still to be
-// written; what exists: this class and System::pack_particles() / unpack_particles()):
-//  - on a step when the lists are rebuilt, each process sends the particles whose owner() is
-//    another subdomain to that subdomain (one message per destination, pack_particles(), then
-//    remove_particles()), and appends what it receives (unpack_particles()): the pair histories
-//    find their pairs at the build that follows;
+// How a DEM spread over subdomains uses it (SubdomainStepper, subdomain.hpp, does all of it over
+// a SubdomainTransport; the MPI transport, outside solvers/dem, is still to be written):
+//  - on a step when the lists are rebuilt (on every subdomain at once), each subdomain sends the
+//    particles whose owner() is another subdomain to that subdomain (System::pack_particles(),
+//    then remove_particles()), and appends what it receives (unpack_particles()): the pair
+//    histories find their pairs at the build that follows;
 //  - ghosts: the particles within the cut-off plus the skin of another box (near(x, 2 R_max +
-//    skin)) are copied to that subdomain each step (positions and velocities; their ids), so that
-//    every pair with an owned particle is listed where that particle is owned; a pair between an
-//    owned particle and a ghost is evaluated by both owners (the same history on both sides);
+//    skin)) are copied to that subdomain at each build and their positions and velocities
+//    refreshed every step, so that every pair with an owned particle is listed where that
+//    particle is owned; a pair between an owned particle and a ghost is evaluated by both owners
+//    (the same history on both sides);
 //  - sums that do not depend on the split: the force pass adds a particle's contacts in index
-//    order, so the receiving System must number its particles and ghosts alike on every process
-//    (by id, or by cell and then id), and wall and mesh forces are summed over the processes in a
-//    fixed order of the particles' ids, not of the ranks;
-//  - ids handed out at run time (fragments) must be unique over the processes (a range per rank).
+//    order, so every subdomain numbers its particles and ghosts in one order (GlobalOrder: by the
+//    cell of a fixed grid, then id); wall and mesh forces are still summed per subdomain;
+//  - ids handed out at run time (fragments) must be unique over the subdomains (not yet).
 
 #include <Eigen/Core>
 

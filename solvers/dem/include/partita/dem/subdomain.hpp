@@ -48,11 +48,10 @@
 //    sums are.
 //  - Energy sums: SubdomainStepper::kinetic_energy() and linear_momentum() are the same on any
 //    split (exact sums over the owned particles, ExactSum, rounded once: they may differ from
-//    System::kinetic_energy()'s ordered sum in the last bits); the contacts' elastic energy is
-//    not summed over a split yet (System::elastic_energy() of a subdomain counts its ghosts'
-//    contacts; the fix: each pair counted where the first of its two in the global order is
-//    owned, planes and meshes where the particle is owned, into an ExactSum). The energy
-//    accounting is refused in phases (System::phase_drift()).
+//    System::kinetic_energy()'s ordered sum in the last bits), and so is elastic_energy() (each
+//    pair counted where the first of its two in the global order is owned, planes and meshes
+//    where the particle is owned). The energy accounting (System::energies()) is refused in
+//    phases (System::phase_drift()).
 //  - Hooks that change the particle set (breakage's fragments) are not handled: fragment ids
 //    must be unique over the subdomains and the new particles need ghosts.
 //  - An empty subdomain skips its System's phases (its planes do not advance: moving walls with
@@ -138,6 +137,7 @@ class Subdomain {
   /// Adds the owned particles' kinetic energy (translational + rotational, System::
   /// kinetic_energy()'s terms) to sums[0] and their linear momentum m v to sums[1..3].
   void add_kinetic(ExactSum* sums);
+  void add_elastic(ExactSum& sum) const { sys_->add_elastic_energy(ghost_, sum); }
 
  private:
   std::vector<int>& owner_array() { return sys_->store().array<int>(h_owner_); }
@@ -193,12 +193,16 @@ class SubdomainStepper {
   /// exact sums rounded once, the same bits on any split (collective: every process calls it).
   double kinetic_energy();
   Eigen::Vector3d linear_momentum();
+  /// The contacts' elastic energy [J] (System::elastic_energy()'s terms), each contact counted
+  /// once over the subdomains (System::add_elastic_energy() without the ghosts): an exact sum,
+  /// the same bits on any split (collective). After a step.
+  double elastic_energy();
 
  private:
   void redistribute();
-  // sums_[4 k + q]: local subdomain k's kinetic energy (q = 0) and momentum (1..3), then summed
-  // over every subdomain into totals_
-  void kinetic_sums();
+  // sums_[4 k + q]: local subdomain k's kinetic energy (q = 0) and momentum (1..3), or its
+  // elastic energy (q = 0, elastic), then summed over every subdomain into totals_
+  void global_sums(bool elastic);
   std::vector<ExactSum> sums_;
   ExactSum totals_[4];
 

@@ -75,6 +75,8 @@
 
 namespace partita::dem {
 
+class ExactSum;
+
 class System {
  public:
   /// Contacts one particle keeps with mesh features (faces, edges, vertices) at a time; further
@@ -261,6 +263,14 @@ class System {
   void phase_build();
   void phase_forces(double dt, bool step);
   void phase_finish(double dt);
+  /// Adds to `sum` the elastic energy (as elastic_energy()) of the contacts of the last force
+  /// pass that belong to the particles with skip[i] == 0 (one flag per particle): the pairs
+  /// (i, j), i < j, their plane and mesh contacts. With skip = a split bed's ghosts, every
+  /// contact is counted once over the subdomains (a pair where the first of its two particles in
+  /// the common order is owned), each term with the bits one subdomain would give it. Throws
+  /// Error without the lists of the current particles (before the first step, after a change of
+  /// the particle set) or with another number of flags.
+  void add_elastic_energy(const std::vector<char>& skip, ExactSum& sum) const;
 
   // ---- access and monitors ------------------------------------------------------------------
   const Particles& particles() const {
