@@ -318,6 +318,22 @@ void Subdomain::add_kinetic(ExactSum* sums) {
   }
 }
 
+void Subdomain::add_wall_forces(ExactSum* sums) const {
+  const std::vector<Eigen::Vector3d>& reaction = sys_->wall_reactions();
+  const std::vector<PlaneWall>& planes = sys_->planes();
+  const std::size_t n = sys_->particle_count(), np = planes.size();
+  if (reaction.size() != n * np)
+    throw Error("subdomain " + std::to_string(rank_) +
+                ": the planes' reactions are not recorded (System::set_wall_reactions(true) "
+                "before the first force pass)");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (is_ghost(i)) continue;
+    for (std::size_t k = 0; k < np; ++k)
+      for (int c = 0; c < 3; ++c)
+        sums[3 * planes[k].wall + c].add(reaction[i * np + k][c]);
+  }
+}
+
 void Subdomain::forces(double dt, bool step) {
   if (sys_->particle_count() > 0) sys_->phase_forces(dt, step);
 }
@@ -350,6 +366,7 @@ SubdomainStepper::SubdomainStepper(std::vector<System*> systems, SubdomainTransp
     if (systems[k] == nullptr) throw Error("SubdomainStepper: system " + std::to_string(k) + " is null");
     systems[k]->set_skin(skin);
     systems[k]->set_sort_interval(0);
+    systems[k]->set_wall_reactions(true);
     subdomains_.emplace_back(*systems[k], local[k], parts);
   }
   out_.assign(systems.size(), SubdomainMail(static_cast<std::size_t>(parts)));
@@ -413,48 +430,65 @@ void SubdomainStepper::step(double dt) {
 
 // Every subdomain sends its partial sums to every subdomain (itself included); each adds them up
 // (exact: in any order).
-void SubdomainStepper::global_sums(bool elastic) {
+void SubdomainStepper::global_sums(Sums what) {
   const std::size_t local = subdomains_.size();
-  sums_.resize(4 * local);
+  const int walls = subdomains_[0].system().wall_count();
+  const std::size_t m = what == Sums::kinetic ? 4 : what == Sums::elastic ? 1 : 3 * walls;
+  sums_.resize(m * local);
+  totals_.resize(m);
   for (std::size_t k = 0; k < local; ++k) {
-    for (int q = 0; q < 4; ++q) sums_[4 * k + q].clear();
-    if (subdomains_[k].system().particle_count() == 0)
+    ExactSum* sums = sums_.data() + m * k;
+    for (std::size_t q = 0; q < m; ++q) sums[q].clear();
+    const Subdomain& sd = subdomains_[k];
+    if (sd.system().particle_count() == 0)
       ;  // (nothing to add)
-    else if (elastic)
-      subdomains_[k].add_elastic(sums_[4 * k]);
+    else if (what == Sums::kinetic)
+      subdomains_[k].add_kinetic(sums);
+    else if (what == Sums::elastic)
+      sd.add_elastic(sums[0]);
     else
-      subdomains_[k].add_kinetic(&sums_[4 * k]);
+      sd.add_wall_forces(sums);
     for (std::vector<std::byte>& o : out_[k]) {
-      o.resize(4 * ExactSum::byte_size);
-      for (int q = 0; q < 4; ++q) sums_[4 * k + q].write(o.data() + q * ExactSum::byte_size);
+      o.resize(m * ExactSum::byte_size);
+      for (std::size_t q = 0; q < m; ++q) sums[q].write(o.data() + q * ExactSum::byte_size);
     }
   }
   transport_->exchange(out_, in_);
   for (ExactSum& t : totals_) t.clear();
   ExactSum part;
-  for (const std::vector<std::byte>& m : in_[0]) {
-    if (m.size() != 4 * ExactSum::byte_size)
-      throw Error("SubdomainStepper: a subdomain's partial sums have " + std::to_string(m.size()) +
-                  " bytes, not " + std::to_string(4 * ExactSum::byte_size));
-    for (int q = 0; q < 4; ++q) {
-      part.read(m.data() + q * ExactSum::byte_size);
+  for (const std::vector<std::byte>& msg : in_[0]) {
+    if (msg.size() != m * ExactSum::byte_size)
+      throw Error("SubdomainStepper: a subdomain's partial sums have " +
+                  std::to_string(msg.size()) + " bytes, not " +
+                  std::to_string(m * ExactSum::byte_size) + " (the subdomains differ)");
+    for (std::size_t q = 0; q < m; ++q) {
+      part.read(msg.data() + q * ExactSum::byte_size);
       totals_[q].add(part);
     }
   }
 }
 
 double SubdomainStepper::kinetic_energy() {
-  global_sums(false);
+  global_sums(Sums::kinetic);
   return totals_[0].value();
 }
 
 double SubdomainStepper::elastic_energy() {
-  global_sums(true);
+  global_sums(Sums::elastic);
   return totals_[0].value();
 }
 
+Eigen::Vector3d SubdomainStepper::wall_force(int wall) {
+  if (wall < 0 || wall >= subdomains_[0].system().wall_count())
+    throw Error("SubdomainStepper::wall_force: no wall " + std::to_string(wall) + "; there are " +
+                std::to_string(subdomains_[0].system().wall_count()));
+  global_sums(Sums::walls);
+  const std::size_t w = 3 * static_cast<std::size_t>(wall);
+  return {totals_[w].value(), totals_[w + 1].value(), totals_[w + 2].value()};
+}
+
 Eigen::Vector3d SubdomainStepper::linear_momentum() {
-  global_sums(false);
+  global_sums(Sums::kinetic);
   return {totals_[1].value(), totals_[2].value(), totals_[3].value()};
 }
 

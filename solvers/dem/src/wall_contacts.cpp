@@ -97,6 +97,7 @@ void WallContacts::resize(ParticleStore& store, std::size_t n) {
   block_force_.assign(((n + ThreadPartition::block_size - 1) / ThreadPartition::block_size) * np,
                       Eigen::Vector3d::Zero());
   wall_force_.resize(wall_count_, Eigen::Vector3d::Zero());
+  if (record_) reaction_.assign(n * np, Eigen::Vector3d::Zero());
 }
 
 // Each plane's total over the blocks in block order, then each wall's over its planes in plane

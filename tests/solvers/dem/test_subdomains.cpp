@@ -141,6 +141,9 @@ struct Run {
   Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
   double system_kinetic = 0.0;  // System::kinetic_energy() summed over the subdomains
   double elastic = 0.0;         // SubdomainStepper::elastic_energy() at the end
+  Eigen::Vector3d wall = Eigen::Vector3d::Zero();  // SubdomainStepper::wall_force(0)
+  Eigen::Vector3d system_wall = Eigen::Vector3d::Zero();  // System::wall_force(0), summed
+  double face_scale = 0.0;  // the sum of |face force| over the box's faces, summed
   double system_elastic = 0.0;  // System::elastic_energy() summed over the subdomains
   bool recut = false;  // the re-cut moved some box and the stepper took it up
 };
@@ -200,7 +203,10 @@ Run run_split(int parts, long steps, SubdomainStepper::Options options = {}, lon
   out.kinetic = stepper.kinetic_energy();
   out.momentum = stepper.linear_momentum();
   out.elastic = stepper.elastic_energy();
+  out.wall = stepper.wall_force(0);
   for (int k = 0; k < parts; ++k) {
+    out.system_wall += systems[k]->wall_force(0);
+    for (int face = 0; face < 6; ++face) out.face_scale += systems[k]->wall_face_force(0, face)->norm();
     out.system_kinetic += systems[k]->kinetic_energy();
     out.system_elastic += systems[k]->elastic_energy();
   }
@@ -261,6 +267,7 @@ TEST_CASE("dem: subdomains: a split bed steps to the bits of one subdomain on 2,
     CHECK(split.kinetic == ref.kinetic);
     CHECK(split.momentum == ref.momentum);
     CHECK(split.elastic == ref.elastic);
+    CHECK(split.wall == ref.wall);
     // each System's own sum counts its ghosts too
     CHECK(split.system_kinetic > ref.kinetic);
   }
@@ -275,6 +282,9 @@ TEST_CASE("dem: subdomains: a split bed steps to the bits of one subdomain on 2,
   CHECK(std::abs(ref.kinetic - ref.system_kinetic) <= 1e-12 * ref.kinetic);
   CHECK(ref.elastic > 0.0);
   CHECK(std::abs(ref.elastic - ref.system_elastic) <= 1e-12 * ref.elastic);
+  // the walls: touched, and the exact sum against the block sums of one System (rounding apart)
+  CHECK(ref.face_scale > 0.0);
+  CHECK((ref.wall - ref.system_wall).norm() <= 1e-12 * ref.face_scale);
 }
 
 TEST_CASE("dem: subdomains: without ghosts the split differs (the comparison can fail)",

@@ -40,12 +40,13 @@
 //  subdomain would; migration (DomainDecomposition::owner() of the positions after the first
 //  half) and ghosts are then settled before the lists are built.
 //
-// What is not the same on any split yet:
-//  - Wall and mesh forces (System::wall_force(), mesh_force(), triangle_forces()) are per System
-//    and include the ghosts' contacts; summed over the subdomains they count a ghost's contact
-//    twice and sum in another order. The fix: per-particle contributions of the owned particles,
-//    summed over the subdomains in the global order (by the order key), as the particle force
-//    sums are.
+// Sums over the split, and what is not handled yet:
+//  - Wall forces: SubdomainStepper::wall_force() is the same on any split (each owned particle's
+//    reaction on each plane, System::set_wall_reactions(), in an exact sum); it may differ from
+//    System::wall_force()'s block sums in the last bits. Each System's own wall_force(),
+//    mesh_force() and triangle_forces() include its ghosts' contacts. Mesh forces over a split are
+//    not summed yet (the fix is the same: the mesh contacts' records of the owned particles,
+//    MeshContacts::for_each_contact(), summed per triangle into exact sums).
 //  - Energy sums: SubdomainStepper::kinetic_energy() and linear_momentum() are the same on any
 //    split (exact sums over the owned particles, ExactSum, rounded once: they may differ from
 //    System::kinetic_energy()'s ordered sum in the last bits), and so is elastic_energy() (each
@@ -138,6 +139,8 @@ class Subdomain {
   /// kinetic_energy()'s terms) to sums[0] and their linear momentum m v to sums[1..3].
   void add_kinetic(ExactSum* sums);
   void add_elastic(ExactSum& sum) const { sys_->add_elastic_energy(ghost_, sum); }
+  /// Adds the owned particles' reactions on the planes to sums[3 w + c] (wall w, component c).
+  void add_wall_forces(ExactSum* sums) const;
 
  private:
   std::vector<int>& owner_array() { return sys_->store().array<int>(h_owner_); }
@@ -197,14 +200,18 @@ class SubdomainStepper {
   /// once over the subdomains (System::add_elastic_energy() without the ghosts): an exact sum,
   /// the same bits on any split (collective). After a step.
   double elastic_energy();
+  /// The force the particles exert on a wall (all its planes) [N] in the last pass: the owned
+  /// particles' reactions in an exact sum, the same bits on any split (collective).
+  Eigen::Vector3d wall_force(int wall);
 
  private:
   void redistribute();
-  // sums_[4 k + q]: local subdomain k's kinetic energy (q = 0) and momentum (1..3), or its
-  // elastic energy (q = 0, elastic), then summed over every subdomain into totals_
-  void global_sums(bool elastic);
-  std::vector<ExactSum> sums_;
-  ExactSum totals_[4];
+  // what global_sums() adds up: per local subdomain, kinetic energy and momentum (4 sums), the
+  // elastic energy (1) or the walls' forces (3 per wall)
+  enum class Sums { kinetic, elastic, walls };
+  // sums_[m k + q]: local subdomain k's sum q, then summed over every subdomain into totals_
+  void global_sums(Sums what);
+  std::vector<ExactSum> sums_, totals_;
 
   std::vector<Subdomain> subdomains_;
   SubdomainTransport* transport_;

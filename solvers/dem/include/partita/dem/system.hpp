@@ -271,6 +271,15 @@ class System {
   /// Error without the lists of the current particles (before the first step, after a change of
   /// the particle set) or with another number of flags.
   void add_elastic_energy(const std::vector<char>& skip, ExactSum& sum) const;
+  /// Records in every force pass each particle's reaction on each plane (off by default):
+  /// wall_reactions()[i * planes().size() + k], the force particle i exerted on plane k in the
+  /// last pass (zero without contact; wall_force() sums them per block), for sums in an order of
+  /// the caller's (a split bed's wall totals, SubdomainStepper::wall_force()).
+  void set_wall_reactions(bool on) {
+    walls_.set_recording(on);
+    prepared_ = false;  // (sizes them)
+  }
+  const std::vector<Eigen::Vector3d>& wall_reactions() const { return walls_.reactions(); }
 
   // ---- access and monitors ------------------------------------------------------------------
   const Particles& particles() const {

@@ -92,6 +92,7 @@ class WallContacts {
     int np;
     Eigen::Vector3d* shear;        // N x np histories
     Eigen::Vector3d* block_force;  // blocks x np sums
+    Eigen::Vector3d* reaction = nullptr;  // N x np reactions of the pass (recording), or null
 
     /// The sums of block b, zeroed: the kernel adds each plane's reaction there.
     Eigen::Vector3d* start_block(int b) const {
@@ -113,8 +114,17 @@ class WallContacts {
   };
   Pass pass(ParticleStore& store) {
     return Pass{planes_.data(), static_cast<int>(planes_.size()),
-                store.array<Eigen::Vector3d>(h_shear_).data(), block_force_.data()};
+                store.array<Eigen::Vector3d>(h_shear_).data(), block_force_.data(),
+                record_ && reaction_.size() == store.size() * planes_.size() ? reaction_.data()
+                                                                            : nullptr};
   }
+  /// Whether each force pass records every particle's reaction on every plane (off by default):
+  /// reactions()[i * planes + k], the force particle i exerted on plane k (zero without
+  /// contact), the terms of the plane's total, for sums in an order of one's own (a split bed's,
+  /// SubdomainStepper::wall_force()). Sized by resize() (a pass before it records nothing).
+  void set_recording(bool on) { record_ = on; }
+  bool recording() const { return record_; }
+  const std::vector<Eigen::Vector3d>& reactions() const { return reaction_; }
 
   /// The planes (positions move) / the wall totals, for System's state.
   void write(BinaryWriter& out) const;
@@ -129,6 +139,8 @@ class WallContacts {
   std::vector<Eigen::Vector3d> block_force_;  // blocks x planes
   std::vector<Eigen::Vector3d> wall_force_;   // per wall
   std::vector<Eigen::Vector3d> plane_force_;  // per plane: reduce()'s sums over the blocks
+  bool record_ = false;
+  std::vector<Eigen::Vector3d> reaction_;  // N x planes (record_)
 };
 
 template <bool Load, bool Energy>
@@ -138,6 +150,9 @@ PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(
     Eigen::Vector3d& t, double& load, Eigen::Vector3d* block, DissipationSums* sums,
     WallDissipation* wd) const {
   const double ri = qi.r;
+  Eigen::Vector3d* const react = reaction ? reaction + static_cast<std::size_t>(i) * np : nullptr;
+  if (react)
+    for (int k = 0; k < np; ++k) react[k].setZero();
   for (int k = 0; k < np; ++k) {
     if (np <= 64) {  // jump to the next plane near i
       if (mask == 0) break;
@@ -173,6 +188,7 @@ PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(
       load = std::max(load, fn * kw * kw);
     }
     block[k] -= fw;
+    if (react) react[k] = -fw;
   }
 }
 
