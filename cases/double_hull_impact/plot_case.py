@@ -440,9 +440,6 @@ def milestones(run, suffix):
         key("inner_deflection_final" + suffix + "_m", float(run.at("hull.inner_centre.displacement_z")[-1]))
 
 
-PARTS = ("outer_plate", "webs", "inner_plate")
-
-
 def part_rupture_row(run, part):
     """The row of a part's (outer_plate, webs, inner_plate) first failed element, None before it
     (or without the columns): the first row where hull.<part>.first_failure_time is set when the
