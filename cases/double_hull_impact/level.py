@@ -2,7 +2,7 @@
 """Strike a settled bed off level: remove every granule whose top (z + r) is above a height
 (LAMMPS data as partita writes it). The step between fill.yaml (the bed settled under gravity,
 standing above the cavities' top) and the relaxation under the inner plate (fill.yaml again,
-reading the levelled file, with a lid at z = 82 mm: README.md "Files and runs").
+reading the levelled file, with a lid at z = 82 mm: README.md "Variants, commands and times").
 
 Usage: level.py IN.data OUT.data Z      (the shipped settled.data: Z = 0.082, the cavities' top)"""
 import sys

@@ -6,8 +6,8 @@
 // its 10^6 granules' packing took 18 of the test's 22 s of CPU; every key is still read and
 // validated and the set-up built, with 3 thousand granules.
 // cases/double_hull_impact/seeds.yaml reads a bed that the case's own commands make first
-// (make_section.py, then the fill's two runs, into out/seeds-bed: README.md "The seeds'
-// granules"); it is checked with a small generated bed in one cell instead of that file.
+// (make_section.py, then the fill's two runs, into out/seeds-bed: README.md "Variants, commands
+// and times"); it is checked with a small generated bed in one cell instead of that file.
 
 #include <catch2/catch.hpp>
 

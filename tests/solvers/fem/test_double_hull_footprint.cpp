@@ -284,8 +284,8 @@ TEST_CASE("double hull: the footprint check with the case's finite-strain J2",
   }
 }
 
-// The numbers of cases/double_hull_impact/README.md ("Check: indenter against a prescribed
-// footprint"): half the speed, the geometric footprint prescribed instead of the nodes in
+// The numbers of cases/double_hull_impact/README.md ("Checks": indenter against a prescribed
+// footprint): half the speed, the geometric footprint prescribed instead of the nodes in
 // contact, the case's 3 x 3 hull with 20 and 10 mm elements, the finite-strain J2 law. Hidden
 // (2.7 min of one core): ./build/tests/partita_tests "[double_hull_readme]"
 TEST_CASE("double hull: footprint check on the case's hulls (README numbers)",
