@@ -251,7 +251,26 @@ class Geometry:
         c = self.bow_centre_start()
         struck = self.outer[0] if self.inner_faces_up > 0 else self.outer[1]
         origin = c + (struck - c[n_ax]) / axis[n_ax] * axis if abs(axis[n_ax]) > 1e-9 else c
-        return origin, normal, horizontal, vertical
+        self.section_offset = self.off_web(origin, normal)
+        return origin + self.section_offset, normal, horizontal, vertical
+
+    def off_web(self, origin, normal):
+        """The shift that moves a section plane lying in a web (a bow struck at a web, or at a
+        crossing) to the middle of the next cell, so that it cuts the bed rather than the web's
+        own plane; zero otherwise."""
+        k = int(np.argmax(np.abs(normal)))
+        if abs(normal[k]) < 0.999 or self.web_thickness is None or len(self.in_plane_axes) < 2:
+            return np.zeros(3)
+        a1, a2 = self.in_plane_axes
+        webs = self.frames if k == a1 else self.stringers if k == a2 else []
+        s = self.web_spacing()
+        if not len(webs) or not s:
+            return np.zeros(3)
+        if np.min(np.abs(np.asarray(webs) - origin[k])) > self.web_thickness:
+            return np.zeros(3)
+        shift = np.zeros(3)
+        shift[k] = 0.5 * s if origin[k] + 0.5 * s <= max(webs) else -0.5 * s
+        return shift
 
     def describe(self):
         nx, ny = self.cells()

@@ -86,7 +86,8 @@ def first_granule_ids(folder):
 
 
 def bow_outline(geom, centre, origin, h, v):
-    """The bow's outline in the section (its axis in the plane) [mm], or None."""
+    """The bow's outline in the section (its axis parallel to the plane, at distance d from it:
+    a capsule's cut is the capsule of radius sqrt(R^2 - d^2)) [mm], or None."""
     if centre is None or geom.bow_radius is None:
         return None
     a = geom.bow_axis
@@ -96,7 +97,10 @@ def bow_outline(geom, centre, origin, h, v):
     u /= np.linalg.norm(u)
     p = np.array([-u[1], u[0]])
     c = np.array([(centre - origin) @ h, (centre - origin) @ v])
-    half, r = geom.bow_length / 2, geom.bow_radius
+    d = float((centre - origin) @ np.cross(h, v))
+    if abs(d) >= geom.bow_radius:
+        return None
+    half, r = geom.bow_length / 2, float(np.sqrt(geom.bow_radius ** 2 - d * d))
     ang = np.linspace(-np.pi / 2, np.pi / 2, 40)
     front = [c + half * u + r * (np.cos(t) * u + np.sin(t) * p) for t in ang]
     back = [c - half * u + r * (-np.cos(t) * u - np.sin(t) * p) for t in ang]
@@ -129,7 +133,11 @@ def plot_section(run, geom, frame, out_path, plt, title_extra=""):
     from matplotlib.patches import Circle, Patch
     t, path = frame
     origin, normal, h, v = geom.section_basis()
-    fig, ax = plt.subplots(figsize=(10, 6.6))
+    (x0, x1), (y0, y1) = section_limits(geom, origin, h, v)
+    # the figure shaped to the section (an upright one is tall and narrow), room for the colour
+    # bar and the legend
+    aspect = (x1 - x0) / max(y1 - y0, 1e-9)
+    fig, ax = plt.subplots(figsize=(min(12.0, max(6.5, 6.0 * aspect + 3.0)), 6.6 if aspect >= 1 else 8.0))
     intact, peeq, eroded = cut_hull(path, origin, normal, h, v)
     pc = PolyCollection(intact, edgecolors="k", linewidths=0.3)
     if peeq is not None and len(peeq):
@@ -178,15 +186,17 @@ def plot_section(run, geom, frame, out_path, plt, title_extra=""):
     if handles:
         ax.legend(handles=handles, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
     p = float(np.interp(t, run.t, run.pen))
-    (x0, x1), (y0, y1) = section_limits(geom, origin, h, v)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     ax.set_aspect("equal")
     name = lambda e: "-".join(AXES[i] if e[i] > 0 else "-" + AXES[i] for i in range(3) if abs(e[i]) > 0.5) or "oblique"
-    ax.set_xlabel(f"along {name(h)} from the bow's axis at the struck face [mm]")
+    ax.set_xlabel(f"along {name(h)} from the bow's axis at the struck face [mm]"
+                  + (f"\n(plane {1e3 * np.linalg.norm(geom.section_offset):.0f} mm off the bow's axis: "
+                     "the middle of the next cell,\nnot the web struck)"
+                     if np.any(geom.section_offset) else ""), fontsize=9)
     ax.set_ylabel(f"along {name(v)} [mm]" + (" (up)" if geom.gravity is not None else ""))
     plane = " = ".join([AXES[int(np.argmax(np.abs(normal)))], f"{1e3 * float(origin[int(np.argmax(np.abs(normal)))]):.0f} mm"])
-    ax.set_title(f"{run.label}: section {plane} at t = {1e3 * t:.1f} ms, penetration {1e3 * p:.1f} mm"
+    ax.set_title(f"{run.label}: section {plane} at t = {1e3 * t:.1f} ms,\npenetration {1e3 * p:.1f} mm"
                  + (f" ({count} granules cut)" if count is not None else "") + title_extra, fontsize=10)
     save(fig, out_path, plt)
 

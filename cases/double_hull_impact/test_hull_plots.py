@@ -163,6 +163,29 @@ class GeometryTest(unittest.TestCase):
                                           ["participants.granules.gravity=[-9.81, 0, 0]"])
         np.testing.assert_allclose(g.section_basis()[3], [1, 0, 0], atol=1e-9)
 
+    def test_section_through_a_web_moves_to_the_next_cells_middle(self):
+        # upright, the plane through the bow's axis is x = S + T/2: the middle frame's own plane
+        upright = hull_geometry.Geometry.of_run(self.folder, write_case(self.folder, [0, -9.81, 0]))
+        origin, normal, h, v = upright.section_basis()
+        np.testing.assert_allclose(upright.section_offset, [S / 2, 0, 0], atol=1e-12)
+        self.assertAlmostEqual(origin[0], S + T / 2 + S / 2, delta=1e-12)
+        # flat, the plane y = centre is mid-cell already: not moved
+        flat = hull_geometry.Geometry.of_run(self.folder, write_case(self.folder, [0, 0, -9.81]))
+        flat.section_basis()
+        np.testing.assert_allclose(flat.section_offset, 0.0, atol=0)
+
+    def test_bow_outline_in_a_plane_off_its_axis(self):
+        g = hull_geometry.Geometry.of_run(self.folder, write_case(self.folder, [0, 0, -9.81]))
+        origin, normal, h, v = g.section_basis()
+        centre = g.bow_centre(0.0)
+        width = lambda xy: xy[:, 0].max() - xy[:, 0].min()
+        full = hull_pictures.bow_outline(g, centre, origin, h, v)
+        self.assertAlmostEqual(width(full), 2e3 * R, delta=1e-6)
+        d = 0.6 * R      # the capsule cut off its axis: radius sqrt(R^2 - d^2)
+        off = hull_pictures.bow_outline(g, centre, origin + d * normal, h, v)
+        self.assertAlmostEqual(width(off), 2e3 * np.sqrt(R * R - d * d), delta=1e-6)
+        self.assertIsNone(hull_pictures.bow_outline(g, centre, origin + 1.1 * R * normal, h, v))
+
     def test_section_cuts_every_element_the_plane_crosses(self):
         g = hull_geometry.Geometry.of_run(self.folder)
         origin, normal, h, v = g.section_basis()
