@@ -5,9 +5,10 @@
 // cases/scale/scale.yaml is checked with a smaller granule box: check builds each participant, and
 // its 10^6 granules' packing took 18 of the test's 22 s of CPU; every key is still read and
 // validated and the set-up built, with 3 thousand granules.
-// cases/double_hull_impact/seeds.yaml reads a bed that the case's own commands make first
-// (make_section.py, then the fill's two runs, into out/seeds-bed: README.md "Variants, commands
-// and times"); it is checked with a small generated bed in one cell instead of that file.
+// cases/double_hull_impact/seeds.yaml (and seeds_collision.yaml) reads a bed that the case's
+// own commands make first (make_section.py, then the fill's two runs, into out/seeds-bed:
+// README.md "Variants, commands and times"); it is checked with a small generated bed in one
+// cell instead of that file.
 
 #include <catch2/catch.hpp>
 
@@ -36,7 +37,7 @@ TEST_CASE("shipped cases: partita check accepts every case file under cases/",
     std::string smaller;
     if (dir == "scale" && file == "scale.yaml")
       smaller = " --set 'participants.granules.particles.generate.box.size=[0.05, 0.05, 0.05]'";
-    if (dir == "double_hull_impact" && file == "seeds.yaml")
+    if (dir == "double_hull_impact" && (file == "seeds.yaml" || file == "seeds_collision.yaml"))
       smaller =
           " --set 'participants.granules.particles={material: granule, generate: {box: {origin: "
           "[0.005, 0.005, 0.005], size: [0.03, 0.03, 0.03]}, diameters: [4 mm, 3.125 mm, 2.5 mm], "
