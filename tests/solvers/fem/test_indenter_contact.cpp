@@ -440,18 +440,19 @@ TEST_CASE("flat punch, Newmark: quasi-static force and energy", "[fem][contact]"
   CHECK(c.indenter().work() == Approx(s.strain_energy() + s.kinetic_energy()).epsilon(0.01));
 }
 
+// A plane at rest 10 um into small_block()'s whole top face (5 x 5 nodes).
+RigidIndenter plane_into_top_face() {
+  return RigidIndenter(std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0, 0, -1)),
+                       VelocityTable({{0.0, Vec3::Zero()}}));
+}
+
 // Erosion takes nodes off the contact surface: a node whose elements have all eroded touches
 // nothing (set_detached, wired to StructuralSolver::node_detached by the FEM adapter).
 TEST_CASE("indenter contact: detached nodes take no contact force", "[fem][contact][rupture]") {
   const Model model = small_block();
   const BlockAssembler assembler(model.mesh());
   const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
-  // a plane 10 um into the whole top face (5 x 5 nodes)
-  IndenterContact contact(
-      "t", model, "zmax",
-      RigidIndenter(std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0, 0, -1)),
-                    VelocityTable({{0.0, Vec3::Zero()}})),
-      {1.0, 0.0, 1.0});
+  IndenterContact contact("t", model, "zmax", plane_into_top_face(), {1.0, 0.0, 1.0});
   contact.set_time(1.0, 1.0);
   const Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
   Eigen::VectorXd f_all = Eigen::VectorXd::Zero(n);
@@ -479,11 +480,7 @@ TEST_CASE("indenter contact: a node without a face left takes no force and store
   const Model model = small_block();
   const BlockAssembler assembler(model.mesh());
   const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
-  IndenterContact contact(
-      "t", model, "zmax",
-      RigidIndenter(std::make_shared<PlaneShape>(Vec3(0, 0, 0.01 - 1e-5), Vec3(0, 0, -1)),
-                    VelocityTable({{0.0, Vec3::Zero()}})),
-      {1.0, 0.3, 1.0});
+  IndenterContact contact("t", model, "zmax", plane_into_top_face(), {1.0, 0.3, 1.0});
   const Mesh& mesh = model.mesh();
   const auto centre = [&](std::size_t e) {
     Vec3 c = Vec3::Zero();
