@@ -189,11 +189,19 @@ double FailureCriterion::updated_damage(double damage, const Mat3& sigma, double
     return damage + rtcl_weight(mean / eq) * d_eps_p / critical;
   }
   if (kind != Kind::Bwh) return damage;
-  // principal stresses of the in-plane part (the plate's plane, normal `normal`)
+  // BWH is a forming-limit criterion of plane stress: the neck (or shear band) forms along the
+  // strain path that J2 flow gives, and that path depends on the deviator alone. A solid element
+  // of a plate carries a through-thickness stress sigma_33 where a web or a contact presses it;
+  // the criterion reads the plane-stress state with the same deviator in the plate's plane,
+  // (sigma_11 - sigma_33, sigma_22 - sigma_33, sigma_12), so that a pressure (or a tension)
+  // through the thickness is not taken for in-plane tension. The transverse shears are left out,
+  // as in a shell. Principal stresses of that in-plane state (plane normal `normal`):
   const Vec3 helper = std::abs(normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   const Vec3 e1 = normal.cross(helper).normalized();
   const Vec3 e2 = normal.cross(e1);
-  const double s11 = e1.dot(sigma * e1), s22 = e2.dot(sigma * e2), s12 = e1.dot(sigma * e2);
+  const double s33 = normal.dot(sigma * normal);
+  const double s11 = e1.dot(sigma * e1) - s33, s22 = e2.dot(sigma * e2) - s33,
+               s12 = e1.dot(sigma * e2);
   const double centre = 0.5 * (s11 + s22);
   const double radius = std::hypot(0.5 * (s11 - s22), s12);
   const double major = centre + radius, minor = centre - radius;

@@ -214,3 +214,48 @@ TEST_CASE("rupture: BWH fails a plate cell when its major stress reaches the lim
   tets.fix("xmin", {0, 1, 2});
   CHECK_THROWS_WITH(StructuralSolver(std::move(tets)), Catch::Contains("hexahedral"));
 }
+
+TEST_CASE("rupture: BWH reads the in-plane state with the deviator of the 3D stress",
+          "[fem][rupture]") {
+  // the criterion is a plane-stress forming limit: a stress through the thickness shifts the
+  // in-plane stresses it sees (J2 flow, and so the strain path, depend on the deviator alone)
+  const double k = 530e6, n = 0.2;
+  const FailureCriterion c = FailureCriterion::bwh(k, n);
+  const double crit = c.failure_strain(0.0);
+  const Vec3 normal = Vec3(1.0, 2.0, 2.0) / 3.0;  // a plate that is not aligned with the axes
+  const Vec3 helper = Vec3::UnitX();
+  const Vec3 a = normal.cross(helper).normalized(), b = normal.cross(a);
+  auto state = [&](double s_a, double s_b, double s_ab, double s_n) {
+    return Mat3(s_a * a * a.transpose() + s_b * b * b.transpose() +
+                s_ab * (a * b.transpose() + b * a.transpose()) + s_n * normal * normal.transpose());
+  };
+  const double d_eps = 1e-3;
+  // uniaxial in-plane tension at 90 % of the limit: D = 0.9
+  const double limit = bwh_limit_stress(0.0, k, n, crit);
+  const double plane = c.updated_damage(0.0, state(0.9 * limit, 0.0, 0.0, 0.0), d_eps, crit, normal);
+  CHECK(plane == Approx(0.9).epsilon(1e-12));
+  // a hydrostatic stress added (tension or pressure) changes nothing
+  for (const double p : {-400e6, 250e6}) {
+    const Mat3 s = state(0.9 * limit, 0.0, 0.0, 0.0) + p * Mat3::Identity();
+    CHECK(c.updated_damage(0.0, s, d_eps, crit, normal) == Approx(plane).epsilon(1e-12));
+  }
+  // a tension through the thickness (a web pulling on the plate) with the same in-plane stresses
+  // is less in-plane tension: sigma_1 = 0.9 limit - 0.3 limit, sigma_2 = -0.3 limit
+  {
+    const double s1 = 0.6 * limit, s2 = -0.3 * limit;
+    const double expect = s1 / bwh_limit_stress(s2 / s1, k, n, crit);
+    CHECK(c.updated_damage(0.0, state(0.9 * limit, 0.0, 0.0, 0.3 * limit), d_eps, crit, normal) ==
+          Approx(expect).epsilon(1e-12));
+  }
+  // a pressure through the thickness alone is equibiaxial in-plane tension to the criterion
+  // (the plate thins as under equibiaxial stretching)
+  {
+    const double q = 0.5 * limit;
+    const double expect = q / bwh_limit_stress(1.0, k, n, crit);
+    CHECK(c.updated_damage(0.0, state(0.0, 0.0, 0.0, -q), d_eps, crit, normal) ==
+          Approx(expect).epsilon(1e-12));
+  }
+  // in-plane shear, with or without a hydrostatic stress, keeps alpha = -1: no neck
+  CHECK(c.updated_damage(0.0, state(0.0, 0.0, 300e6, 0.0), d_eps, crit, normal) == 0.0);
+  CHECK(c.updated_damage(0.0, state(200e6, 200e6, 300e6, 200e6), d_eps, crit, normal) == 0.0);
+}

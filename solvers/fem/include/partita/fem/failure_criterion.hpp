@@ -100,7 +100,8 @@ struct FailureCriterion {
   double failure_strain(double element_length) const;
   // RTCL and BWH: a point's damage after a committed step that ended at Cauchy stress `sigma`
   // with plastic strain increment d_eps_p >= 0; `critical` is failure_strain(l_e) of its
-  // element and `normal` the unit normal of its plate (BWH).
+  // element and `normal` the unit normal of its plate (BWH: the in-plane stresses less the
+  // stress through the thickness, the plane-stress state with the same deviator).
   double updated_damage(double damage, const Mat3& sigma, double d_eps_p, double critical,
                         const Vec3& normal) const;
 };
