@@ -79,6 +79,78 @@ double InProcessTransport::max(const std::vector<double>& values) {
   return m;
 }
 
+// ---- MeshForceSums --------------------------------------------------------------------------
+
+void MeshForceSums::reset(int vertices) {
+  slot_.assign(static_cast<std::size_t>(vertices), -1);
+  vertex_.clear();
+  for (ExactSum& t : total_) t.clear();
+}
+
+ExactSum* MeshForceSums::vertex_sums(int vertex) {
+  int& slot = slot_[static_cast<std::size_t>(vertex)];
+  if (slot < 0) {
+    slot = static_cast<int>(vertex_.size());
+    vertex_.push_back(vertex);
+    if (sums_.size() < 3 * vertex_.size()) sums_.resize(3 * vertex_.size());
+    for (int c = 0; c < 3; ++c) sums_[3 * static_cast<std::size_t>(slot) + c].clear();
+  }
+  return sums_.data() + 3 * static_cast<std::size_t>(slot);
+}
+
+void MeshForceSums::add_vertex(int vertex, const Eigen::Vector3d& f) {
+  ExactSum* s = vertex_sums(vertex);
+  for (int c = 0; c < 3; ++c) s[c].add(f[c]);
+}
+
+void MeshForceSums::add_total(const Eigen::Vector3d& f) {
+  for (int c = 0; c < 3; ++c) total_[c].add(f[c]);
+}
+
+void MeshForceSums::write(std::vector<std::byte>& out) const {
+  constexpr std::size_t b = ExactSum::byte_size;
+  std::size_t at = out.size();
+  out.resize(at + 8 + 3 * b + vertex_.size() * (8 + 3 * b));
+  const std::uint64_t n = vertex_.size();
+  std::memcpy(out.data() + at, &n, 8);
+  at += 8;
+  for (const ExactSum& t : total_) t.write(out.data() + at), at += b;
+  for (std::size_t k = 0; k < vertex_.size(); ++k) {
+    const std::int64_t v = vertex_[k];
+    std::memcpy(out.data() + at, &v, 8);
+    at += 8;
+    for (int c = 0; c < 3; ++c) sums_[3 * k + c].write(out.data() + at), at += b;
+  }
+}
+
+void MeshForceSums::add_message(const std::vector<std::byte>& in, const std::string& source) {
+  constexpr std::size_t b = ExactSum::byte_size;
+  const auto n = in.size() >= 8 ? get<std::uint64_t>(in.data()) : 0;
+  if (in.size() < 8 + 3 * b || (in.size() - 8 - 3 * b) % (8 + 3 * b) != 0 ||
+      (in.size() - 8 - 3 * b) / (8 + 3 * b) != n)
+    throw Error(source + " is not a mesh's force sums (" + std::to_string(in.size()) +
+                " bytes; the subdomains differ)");
+  ExactSum part;
+  const std::byte* at = in.data() + 8;
+  for (ExactSum& t : total_) part.read(at), t.add(part), at += b;
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const auto v = get<std::int64_t>(at);
+    at += 8;
+    if (v < 0 || static_cast<std::size_t>(v) >= slot_.size())
+      throw Error(source + " names vertex " + std::to_string(v) + " of a mesh of " +
+                  std::to_string(slot_.size()) + " vertices (the subdomains' meshes differ)");
+    ExactSum* s = vertex_sums(static_cast<int>(v));
+    for (int c = 0; c < 3; ++c) part.read(at), s[c].add(part), at += b;
+  }
+}
+
+void MeshForceSums::values(Eigen::MatrixX3d& vertex, Eigen::Vector3d& total) const {
+  vertex.setZero(static_cast<Eigen::Index>(slot_.size()), 3);
+  for (std::size_t k = 0; k < vertex_.size(); ++k)
+    for (int c = 0; c < 3; ++c) vertex(vertex_[k], c) = sums_[3 * k + c].value();
+  for (int c = 0; c < 3; ++c) total[c] = total_[c].value();
+}
+
 // ---- GlobalOrder ----------------------------------------------------------------------------
 
 GlobalOrder::GlobalOrder(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double cell)
@@ -144,9 +216,12 @@ double Subdomain::max_radius() {
   return r;
 }
 
+// An empty subdomain moves its walls and meshes (phase_drift() without particles) and asks for
+// no build: the others' lists decide, and its walls' and meshes' positions at its last build may
+// be old.
 double Subdomain::drift(double dt) {
-  if (sys_->particle_count() == 0) return 0.0;
   const double moved2 = sys_->phase_drift(dt, ghost_);
+  if (sys_->particle_count() == 0) return 0.0;
   return sys_->phase_needs_rebuild(moved2) ? 1.0 : 0.0;
 }
 
@@ -281,9 +356,13 @@ void Subdomain::unpack_moves(const SubdomainMail& in, GlobalOrder& order,
       migrated_in_ += static_cast<long>(owner.size() - first);
     }
     if (ghost_bytes > 0) {
+      // the owner is the box that holds it now, not the sender: a particle that leaves the
+      // sender for another subdomain is sent here as a ghost by the sender, and refreshed by
+      // its new owner until the next build
       const std::size_t first = sys_->unpack_particles(at + migrant_bytes, ghost_bytes);
       std::vector<int>& owner = owner_array();
-      for (std::size_t i = first; i < owner.size(); ++i) owner[i] = static_cast<int>(s);
+      const std::vector<Eigen::Vector3d>& x = sys_->particles().position;
+      for (std::size_t i = first; i < owner.size(); ++i) owner[i] = d.owner(x[i]);
     }
   }
   // the global order, the lists, and who sends what until the next build
@@ -334,13 +413,24 @@ void Subdomain::add_wall_forces(ExactSum* sums) const {
   }
 }
 
+void Subdomain::add_mesh_forces(int mesh, MeshForceSums& sums) const {
+  if (sys_->particle_count() == 0) return;  // (rows of particles that left are gone)
+  const TriangleMesh& m = sys_->mesh(mesh);
+  sys_->mesh_contacts().for_each_contact(
+      [&](int i, const MeshContactRecord& rec, const Eigen::Vector3d&) {
+        if (rec.mesh != mesh || is_ghost(static_cast<std::size_t>(i))) return;
+        const auto& tri = m.triangle(rec.triangle);
+        // the terms MeshContacts::reduce() subtracts from the vertices' forces, exactly
+        for (int k = 0; k < 3; ++k) sums.add_vertex(tri[k], -(rec.barycentric[k] * rec.force));
+        sums.add_total(-rec.force);
+      });
+}
+
 void Subdomain::forces(double dt, bool step) {
   if (sys_->particle_count() > 0) sys_->phase_forces(dt, step);
 }
 
-void Subdomain::finish(double dt) {
-  if (sys_->particle_count() > 0) sys_->phase_finish(dt);
-}
+void Subdomain::finish(double dt) { sys_->phase_finish(dt); }
 
 // ---- SubdomainStepper -----------------------------------------------------------------------
 
@@ -490,6 +580,66 @@ Eigen::Vector3d SubdomainStepper::wall_force(int wall) {
 Eigen::Vector3d SubdomainStepper::linear_momentum() {
   global_sums(Sums::kinetic);
   return {totals_[1].value(), totals_[2].value(), totals_[3].value()};
+}
+
+// Each local subdomain's owned contacts into its sums, sent to every subdomain; each adds them
+// up (exact: in any order) and rounds; then the triangles' shares as MeshContacts::reduce()
+// takes them (the same operations on the same vertex forces).
+void SubdomainStepper::mesh_sums(int mesh) {
+  const System& first = subdomains_[0].system();
+  if (mesh < 0 || mesh >= first.mesh_count())
+    throw Error("SubdomainStepper: no mesh " + std::to_string(mesh) + "; there are " +
+                std::to_string(first.mesh_count()));
+  const TriangleMesh& m = first.mesh(mesh);
+  const int nv = m.vertex_count();
+  mesh_parts_.resize(subdomains_.size());
+  for (std::size_t k = 0; k < subdomains_.size(); ++k) {
+    if (subdomains_[k].system().mesh_count() != first.mesh_count() ||
+        subdomains_[k].system().mesh(mesh).vertex_count() != nv)
+      throw Error("SubdomainStepper: the subdomains' meshes differ (every subdomain holds every "
+                  "mesh, set up alike)");
+    MeshForceSums& part = mesh_parts_[k];
+    part.reset(nv);
+    subdomains_[k].add_mesh_forces(mesh, part);
+    out_[k][0].clear();
+    part.write(out_[k][0]);
+    for (std::size_t d = 1; d < out_[k].size(); ++d) out_[k][d] = out_[k][0];
+  }
+  transport_->exchange(out_, in_);
+  mesh_all_.reset(nv);
+  for (std::size_t s = 0; s < in_[0].size(); ++s)
+    mesh_all_.add_message(in_[0][s], "SubdomainStepper: the mesh forces of subdomain " +
+                                         std::to_string(s));
+  mesh_all_.values(mesh_vertex_, mesh_total_);
+  // each vertex's share: 1 / (its active triangles), as TriangleMesh keeps it
+  mesh_share_.assign(static_cast<std::size_t>(nv), 0.0);
+  for (int t = 0; t < m.triangle_count(); ++t)
+    if (m.triangle_active(t))
+      for (const int v : m.triangle(t)) mesh_share_[static_cast<std::size_t>(v)] += 1.0;
+  for (double& share : mesh_share_) share = share > 0.0 ? 1.0 / share : 0.0;
+  mesh_triangle_.setZero(m.triangle_count(), 3);
+  for (int t = 0; t < m.triangle_count(); ++t) {
+    if (!m.triangle_active(t)) continue;
+    const auto& tri = m.triangle(t);
+    mesh_triangle_.row(t) = mesh_share_[tri[0]] * mesh_vertex_.row(tri[0]) +
+                            mesh_share_[tri[1]] * mesh_vertex_.row(tri[1]) +
+                            mesh_share_[tri[2]] * mesh_vertex_.row(tri[2]);
+  }
+}
+
+const Eigen::MatrixX3d& SubdomainStepper::triangle_forces(int mesh) {
+  mesh_sums(mesh);
+  return mesh_triangle_;
+}
+
+const Eigen::MatrixX3d& SubdomainStepper::vertex_forces(int mesh) {
+  mesh_sums(mesh);
+  return mesh_vertex_;
+}
+
+Eigen::Vector3d SubdomainStepper::mesh_force(int mesh) {
+  mesh_sums(mesh);
+  return mesh_total_;
 }
 
 void SubdomainStepper::run(long steps, double dt) {

@@ -9,6 +9,9 @@
 //   phase_build     the lists (rebuild_lists(), with the pair histories received placed)
 //   phase_forces    compute_forces() with the kick
 //   phase_finish    what step() does after its force pass
+// A System without particles (a split bed's empty subdomain) takes phase_drift() (the walls' and
+// meshes' motion only) and phase_finish(): its walls and meshes are where every other
+// subdomain's are when particles arrive.
 // What differs from step(): the fused pass is never taken (it gives the same bits as the loop of
 // its own, and needs the motion bound of the last step that a ghost's values would not update),
 // the rebuild decision is the caller's, and the lists are renumbered by the caller (its global
@@ -31,12 +34,27 @@ double System::phase_drift(double dt, const std::vector<char>& skip) {
     throw Error(
         "phase_drift: the energy accounting is not available in a step taken in phases (a split "
         "bed); turn it off (set_energy_tracking(false))");
-  prepare();
   if (!(dt > 0.0) || !std::isfinite(dt)) {
     std::ostringstream msg;
     msg << "phase_drift: the time step must be > 0 s, got " << dt;
     throw Error(msg.str());
   }
+  // the meshes' velocities from their motion since the last step (where the caller gave none)
+  // and the walls' positions after this step
+  const auto move_walls_and_meshes = [&] {
+    for (TriangleMesh& m : meshes_) {
+      if (!m.velocity_from_motion_) continue;
+      detail::parallel_pass(m.vertex_count(), [&](int v) {
+        m.velocity_[v] = (m.position_[v] - m.position_last_step_[v]) / dt;
+      });
+    }
+    walls_.advance(dt);
+  };
+  if (store_.size() == 0) {  // an empty subdomain: its walls and meshes move all the same
+    move_walls_and_meshes();
+    return 0.0;
+  }
+  prepare();
   constexpr double kStepTolerance = 1e-9;  // (as step())
   if (dt > rayleigh_dt_ * (1.0 + kStepTolerance)) {
     std::ostringstream msg;
@@ -55,13 +73,7 @@ double System::phase_drift(double dt, const std::vector<char>& skip) {
                 std::to_string(skip.size()));
   if (!verlet_.loaded()) verlet_.load(store_.core());
   verlet_.moved();
-  for (TriangleMesh& m : meshes_) {
-    if (!m.velocity_from_motion_) continue;
-    detail::parallel_pass(m.vertex_count(), [&](int v) {
-      m.velocity_[v] = (m.position_[v] - m.position_last_step_[v]) / dt;
-    });
-  }
-  walls_.advance(dt);
+  move_walls_and_meshes();
   const VelocityVerlet::Pass verlet = verlet_.pass(store_.core());
   const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
   const bool have_build = x_build.size() == n;

@@ -5,6 +5,7 @@
 // fail).
 
 #include "dem_test_helpers.hpp"
+#include "subdomain_test_helpers.hpp"
 
 #include "partita/dem/domain_decomposition.hpp"
 #include "partita/dem/error.hpp"
@@ -33,33 +34,10 @@ const Eigen::Vector3d kHi(kWidth, kWidth, kHeight);
 // A polydisperse bed (three sizes) thrown about in a closed box of planes with friction under
 // gravity: the particles collide, cross the cuts and settle; pairs and planes keep tangential
 // springs.
-struct Bed {
-  Eigen::MatrixX3d x;
-  Eigen::VectorXd r;
-  Eigen::MatrixX3d v;
-};
+using Bed = test::ThrownBed;
 
 const Bed& bed() {
-  static const Bed b = [] {
-    PackingSpec spec;
-    spec.lo = kLo;
-    spec.hi = kHi;
-    spec.diameters = {1.0e-3, 0.8e-3, 0.6e-3};
-    spec.fractions = {1.0, 1.0, 1.0};
-    spec.porosity = 0.6;
-    spec.seed = 11;
-    const Packing pk = PackingGenerator::generate(spec);
-    Bed out{pk.positions, pk.radii, Eigen::MatrixX3d(pk.positions.rows(), 3)};
-    // velocities of up to 0.3 m/s each way and 0.2 m/s down, from a hash of the index
-    std::uint64_t h = 0x9e3779b97f4a7c15ull;
-    auto next = [&] {
-      h ^= h >> 33, h *= 0xff51afd7ed558ccdull, h ^= h >> 33, h += 0x9e3779b97f4a7c15ull;
-      return static_cast<double>(h >> 11) / 9007199254740992.0;  // [0, 1)
-    };
-    for (Eigen::Index i = 0; i < out.x.rows(); ++i)
-      out.v.row(i) << 0.6 * next() - 0.3, 0.6 * next() - 0.3, 0.6 * next() - 0.5;
-    return out;
-  }();
+  static const Bed b = test::thrown_bed(kLo, kHi, 11, 0x9e3779b97f4a7c15ull);
   return b;
 }
 
@@ -78,62 +56,21 @@ std::unique_ptr<System> subdomain_system(const std::vector<int>& keep) {
   return sys;
 }
 
-// The transport with the pair records taken out of the messages of a list build (System::
-// pack_particles() inside "PSDM" frames, subdomain.hpp): the histories do not travel.
-class WithoutHistories final : public SubdomainTransport {
- public:
-  WithoutHistories(SubdomainTransport& inner, System& any) : inner_(inner), any_(any) {}
-  int parts() const override { return inner_.parts(); }
-  const std::vector<int>& local() const override { return inner_.local(); }
-  double max(const std::vector<double>& values) override { return inner_.max(values); }
-  void exchange(std::vector<SubdomainMail>& out, std::vector<SubdomainMail>& in) override {
-    for (SubdomainMail& mail : out)
-      for (std::vector<std::byte>& m : mail)
-        if (m.size() >= 24 && read<std::uint32_t>(m.data()) == 0x4d445350u) m = strip(m);
-    inner_.exchange(out, in);
-  }
-
- private:
-  template <class T>
-  static T read(const std::byte* at) {
-    T v;
-    std::memcpy(&v, at, sizeof v);
-    return v;
-  }
-  // one System::pack_particles() message without its records (header 41 bytes: n at 16, the
-  // record count at 24; records of 41 bytes after the particles)
-  std::vector<std::byte> strip_message(const std::byte* m, std::size_t bytes) const {
-    const auto n = read<std::uint64_t>(m + 16), records = read<std::uint64_t>(m + 24);
-    const std::size_t pairs_at = 41 + n * any_.store_unsynced().packed_bytes_per_particle();
-    std::vector<std::byte> out(m, m + pairs_at);
-    out.insert(out.end(), m + pairs_at + records * 41, m + bytes);
-    const std::uint64_t none = 0;
-    std::memcpy(out.data() + 24, &none, 8);
-    return out;
-  }
-  std::vector<std::byte> strip(const std::vector<std::byte>& m) const {
-    const auto a = read<std::uint64_t>(m.data() + 8), b = read<std::uint64_t>(m.data() + 16);
-    std::vector<std::byte> out(m.begin(), m.begin() + 24);
-    std::vector<std::byte> ma, mb;
-    if (a > 0) ma = strip_message(m.data() + 24, a);
-    if (b > 0) mb = strip_message(m.data() + 24 + a, b);
-    const std::uint64_t sa = ma.size(), sb = mb.size();
-    std::memcpy(out.data() + 8, &sa, 8);
-    std::memcpy(out.data() + 16, &sb, 8);
-    out.insert(out.end(), ma.begin(), ma.end());
-    out.insert(out.end(), mb.begin(), mb.end());
-    return out;
-  }
-  SubdomainTransport& inner_;
-  System& any_;  // a System of the split (the particles' packed size)
-};
-
-struct State {
-  Eigen::Vector3d x, v, w;
-};
+// One System::pack_particles() message without its pair records (header 41 bytes: n at 16, the
+// record count at 24; records of 41 bytes after the particles): the histories do not travel.
+std::vector<std::byte> without_records(System& any, const std::byte* m, std::size_t bytes) {
+  using test::read_at;
+  const auto n = read_at<std::uint64_t>(m + 16), records = read_at<std::uint64_t>(m + 24);
+  const std::size_t pairs_at = 41 + n * any.store_unsynced().packed_bytes_per_particle();
+  std::vector<std::byte> out(m, m + pairs_at);
+  out.insert(out.end(), m + pairs_at + records * 41, m + bytes);
+  const std::uint64_t none = 0;
+  std::memcpy(out.data() + 24, &none, 8);
+  return out;
+}
 
 struct Run {
-  std::map<std::int64_t, State> state;  // owned particles by id
+  test::MotionById state;  // owned particles by id
   long builds = 0;
   long migrated = 0;
   std::size_t ghosts_at_end = 0;
@@ -165,7 +102,9 @@ Run run_split(int parts, long steps, SubdomainStepper::Options options = {}, lon
     raw.push_back(systems.back().get());
   }
   InProcessTransport in_process(parts);
-  WithoutHistories stripped(in_process, *systems[0]);
+  test::RewritingTransport stripped(in_process, [&](const std::byte* m, std::size_t bytes) {
+    return without_records(*systems[0], m, bytes);
+  });
   SubdomainTransport& transport =
       without_histories ? static_cast<SubdomainTransport&>(stripped) : in_process;
   SubdomainStepper stepper(raw, transport, d, kSkin, options);
@@ -173,14 +112,8 @@ Run run_split(int parts, long steps, SubdomainStepper::Options options = {}, lon
   Run out;
   for (long s = 0; s < steps; ++s) {
     if (recut_at > 0 && s == recut_at) {
-      std::vector<Eigen::Vector3d> x;
-      for (int k = 0; k < parts; ++k) {
-        const Subdomain& sd = stepper.subdomain(k);
-        const Particles& p = systems[k]->particles();
-        for (std::size_t i = 0; i < p.size(); ++i)
-          if (!sd.is_ghost(i)) x.push_back(p.position[i]);
-      }
-      const DomainDecomposition recut = DomainDecomposition::bisection(x, kLo, kHi, parts);
+      const DomainDecomposition recut =
+          DomainDecomposition::bisection(test::owned_positions(stepper), kLo, kHi, parts);
       for (int k = 0; k < parts; ++k)
         out.recut = out.recut || recut.box(k).lo != d.box(k).lo || recut.box(k).hi != d.box(k).hi;
       stepper.set_decomposition(recut);
@@ -222,18 +155,7 @@ Run run_split(int parts, long steps, SubdomainStepper::Options options = {}, lon
   return out;
 }
 
-// How many particles differ from the reference in any bit of x, v or omega, or are missing.
-std::size_t differing(const Run& a, const Run& ref) {
-  REQUIRE(a.state.size() == ref.state.size());
-  std::size_t n = 0;
-  for (const auto& [id, s] : ref.state) {
-    const auto it = a.state.find(id);
-    n += it == a.state.end() || it->second.x != s.x || it->second.v != s.v || it->second.w != s.w
-             ? 1
-             : 0;
-  }
-  return n;
-}
+std::size_t differing(const Run& a, const Run& ref) { return test::differing(a.state, ref.state); }
 
 constexpr long kSteps = 300;
 

@@ -44,9 +44,27 @@
 //  - Wall forces: SubdomainStepper::wall_force() is the same on any split (each owned particle's
 //    reaction on each plane, System::set_wall_reactions(), in an exact sum); it may differ from
 //    System::wall_force()'s block sums in the last bits. Each System's own wall_force(),
-//    mesh_force() and triangle_forces() include its ghosts' contacts. Mesh forces over a split are
-//    not summed yet (the fix is the same: the mesh contacts' records of the owned particles,
-//    MeshContacts::for_each_contact(), summed per triangle into exact sums).
+//    mesh_force() and triangle_forces() include its ghosts' contacts.
+//  - Triangle meshes (STL walls, the coupling's FE surfaces): every subdomain holds every mesh
+//    whole, moved alike (set_vertex_positions() on each System before the step), as the coupling
+//    hands over the whole surface. A particle's contacts with the meshes are evaluated where it
+//    is owned and, as a ghost, where its copies are (the same inputs: the same records and
+//    histories); its mesh histories travel with it at a migration and come with each ghost copy
+//    (MeshContacts::pack()). SubdomainStepper::triangle_forces(), vertex_forces() and
+//    mesh_force() are the same on any split: each vertex's force an exact sum over the OWNED
+//    particles' contact records (a ghost's are its owner's, counted there), rounded once, and
+//    the triangles' shares taken from those as MeshContacts::reduce() takes them. Why not each
+//    System's sums added up: they count the ghosts' contacts twice, and a sum of per-subdomain
+//    rounded sums depends on the split. They may differ from one System's triangle_forces()
+//    (vertex sums rounded contact by contact) in the last bits. The messages carry only the
+//    vertices the contacts touched. The energy accounting's mesh work is not summed (the
+//    accounting is refused in phases).
+//  - An empty subdomain (no particle, not even a ghost) still moves its walls and meshes and
+//    advances its time (phase_drift() and phase_finish() without particles): a moving wall or
+//    mesh is where it should be when particles reach it. It asks for no list build.
+//  - Ghosts: a ghost's owner is the box that holds it at the build (DomainDecomposition::owner()),
+//    not the subdomain that sent the copy: a particle leaving subdomain a for b that is also a
+//    ghost in c is sent to c by a, and refreshed by b until the next build.
 //  - Energy sums: SubdomainStepper::kinetic_energy() and linear_momentum() are the same on any
 //    split (exact sums over the owned particles, ExactSum, rounded once: they may differ from
 //    System::kinetic_energy()'s ordered sum in the last bits), and so is elastic_energy() (each
@@ -55,8 +73,8 @@
 //    phases (System::phase_drift()).
 //  - Hooks that change the particle set (breakage's fragments) are not handled: fragment ids
 //    must be unique over the subdomains and the new particles need ghosts.
-//  - An empty subdomain skips its System's phases (its planes do not advance: moving walls with
-//    an empty subdomain are not supported yet).
+//  - Wall servos and other hooks that read a wall's force read their own System's (partial, with
+//    ghosts): they would steer each subdomain's wall apart; not handled.
 //
 // Call order: SubdomainStepper(systems, transport, decomposition, skin) with each System set up
 // alike (materials, interactions, gravity, walls, meshes; the particles in any subdomain, ids
@@ -69,7 +87,9 @@
 //     messages (either absent when it holds no particle);
 //   between builds, to each subdomain that holds ghosts of this one: "PGHR", version, the count
 //     n (u64), then n times id (i64), x, v, omega (9 doubles), in the order of this subdomain's
-//     numbering (the receiver holds them in the same relative order).
+//     numbering (the receiver holds them in the same relative order);
+//   a collective sum, to every subdomain: the partial exact sums (ExactSum::write(), in a fixed
+//     order), or for a mesh MeshForceSums::write()'s layout.
 
 #include "partita/dem/domain_decomposition.hpp"
 #include "partita/dem/exact_sum.hpp"
@@ -78,6 +98,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -102,6 +123,32 @@ class GlobalOrder {
   double cell_ = 1.0;
   Eigen::Matrix<std::int64_t, 3, 1> count_ = Eigen::Matrix<std::int64_t, 3, 1>::Ones();
   std::vector<std::pair<std::pair<std::uint64_t, std::int64_t>, int>> keys_;  // scratch
+};
+
+/// The force on one mesh's vertices as exact sums (three per vertex, only for the vertices a
+/// contact touched: a coupled surface has 10^5 vertices, a subdomain's contacts touch a few) and
+/// the total; as bytes for the transport. No allocation once the arrays have grown.
+class MeshForceSums {
+ public:
+  /// Empties the sums for a mesh of `vertices` vertices.
+  void reset(int vertices);
+  void add_vertex(int vertex, const Eigen::Vector3d& f);
+  void add_total(const Eigen::Vector3d& f);
+  /// Appends the sums: the touched count (u64), the total (3 ExactSum), then per touched vertex
+  /// its index (i64) and 3 ExactSum.
+  void write(std::vector<std::byte>& out) const;
+  /// Adds the sums of a message that write() made for a mesh with as many vertices; throws
+  /// Error (naming `source`) when it does not fit.
+  void add_message(const std::vector<std::byte>& in, const std::string& source);
+  /// The sums rounded: the vertices' forces (untouched ones zero) and the total.
+  void values(Eigen::MatrixX3d& vertex, Eigen::Vector3d& total) const;
+
+ private:
+  ExactSum* vertex_sums(int vertex);  // (makes them)
+  std::vector<int> slot_;             // per vertex: the index of its sums, -1: none
+  std::vector<int> vertex_;           // per index: the vertex
+  std::vector<ExactSum> sums_;        // 3 per index (x, y, z)
+  ExactSum total_[3];
 };
 
 /// One subdomain: its System (owned particles and ghosts) and what it sends and receives.
@@ -141,6 +188,10 @@ class Subdomain {
   void add_elastic(ExactSum& sum) const { sys_->add_elastic_energy(ghost_, sum); }
   /// Adds the owned particles' reactions on the planes to sums[3 w + c] (wall w, component c).
   void add_wall_forces(ExactSum* sums) const;
+  /// Adds the owned particles' contacts with mesh `mesh` in the last pass to `sums` (each
+  /// contact's reaction to its triangle's vertices with the contact point's barycentric weights,
+  /// as MeshContacts::reduce() shares it, and to the total); the ghosts' contacts are left out.
+  void add_mesh_forces(int mesh, MeshForceSums& sums) const;
 
  private:
   std::vector<int>& owner_array() { return sys_->store().array<int>(h_owner_); }
@@ -203,8 +254,30 @@ class SubdomainStepper {
   /// The force the particles exert on a wall (all its planes) [N] in the last pass: the owned
   /// particles' reactions in an exact sum, the same bits on any split (collective).
   Eigen::Vector3d wall_force(int wall);
+  /// The force the particles exert on mesh `mesh`'s triangles [N] in the last pass, as
+  /// System::triangle_forces() defines it (each contact's reaction on its triangle's vertices
+  /// with the barycentric weights, a vertex's force shared equally among its active triangles),
+  /// with every vertex's force an exact sum over the owned particles' contacts, rounded once:
+  /// the same bits on any split (collective). It may differ from one System's
+  /// triangle_forces(), whose vertex sums are rounded contact by contact, in the last bits.
+  /// Valid until the next call of triangle_forces(), vertex_forces() or mesh_force().
+  const Eigen::MatrixX3d& triangle_forces(int mesh);
+  /// The same sums per vertex (System::vertex_forces()); collective.
+  const Eigen::MatrixX3d& vertex_forces(int mesh);
+  /// The total force on mesh `mesh` [N]: the owned particles' reactions in one exact sum (the
+  /// same bits on any split; System::mesh_force() adds the rounded triangle forces); collective.
+  Eigen::Vector3d mesh_force(int mesh);
 
  private:
+  // the owned contacts with `mesh` summed over every subdomain into mesh_vertex_, mesh_triangle_
+  // and mesh_total_
+  void mesh_sums(int mesh);
+  std::vector<MeshForceSums> mesh_parts_;  // per local subdomain
+  MeshForceSums mesh_all_;
+  Eigen::MatrixX3d mesh_vertex_, mesh_triangle_;
+  Eigen::Vector3d mesh_total_ = Eigen::Vector3d::Zero();
+  std::vector<double> mesh_share_;
+
   void redistribute();
   // what global_sums() adds up: per local subdomain, kinetic energy and momentum (4 sums), the
   // elastic energy (1) or the walls' forces (3 per wall)

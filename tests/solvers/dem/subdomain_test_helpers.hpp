@@ -1,0 +1,125 @@
+#pragma once
+// Shared pieces of the split-bed tests (SubdomainStepper): a polydisperse bed thrown about, a
+// transport that rewrites the particle messages of a list build on their way (to show what the
+// bits need: take something out, and the split must differ), the owned particles' positions (for
+// a re-cut) and the comparison of particle states by id.
+
+#include "partita/dem/packing_generator.hpp"
+#include "partita/dem/subdomain.hpp"
+#include "partita/dem/subdomain_transport.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace partita::dem::test {
+
+template <class T>
+T read_at(const std::byte* at) {
+  T v;
+  std::memcpy(&v, at, sizeof v);
+  return v;
+}
+
+/// Passes every exchange on to `inner`, with each System::pack_particles() message inside the
+/// "PSDM" frames of a list build (subdomain.hpp: magic, version, the migrants' and the ghosts'
+/// message sizes, then the two messages) replaced by rewrite(message, bytes).
+class RewritingTransport final : public SubdomainTransport {
+ public:
+  using Rewrite = std::function<std::vector<std::byte>(const std::byte* message, std::size_t bytes)>;
+  RewritingTransport(SubdomainTransport& inner, Rewrite rewrite)
+      : inner_(inner), rewrite_(std::move(rewrite)) {}
+  int parts() const override { return inner_.parts(); }
+  const std::vector<int>& local() const override { return inner_.local(); }
+  double max(const std::vector<double>& values) override { return inner_.max(values); }
+  void exchange(std::vector<SubdomainMail>& out, std::vector<SubdomainMail>& in) override {
+    for (SubdomainMail& mail : out)
+      for (std::vector<std::byte>& m : mail)
+        if (m.size() >= 24 && read_at<std::uint32_t>(m.data()) == 0x4d445350u) m = frame(m);
+    inner_.exchange(out, in);
+  }
+
+ private:
+  std::vector<std::byte> frame(const std::vector<std::byte>& m) const {
+    const auto a = read_at<std::uint64_t>(m.data() + 8), b = read_at<std::uint64_t>(m.data() + 16);
+    std::vector<std::byte> out(m.begin(), m.begin() + 24);
+    std::vector<std::byte> ma, mb;
+    if (a > 0) ma = rewrite_(m.data() + 24, a);
+    if (b > 0) mb = rewrite_(m.data() + 24 + a, b);
+    const std::uint64_t sa = ma.size(), sb = mb.size();
+    std::memcpy(out.data() + 8, &sa, 8);
+    std::memcpy(out.data() + 16, &sb, 8);
+    out.insert(out.end(), ma.begin(), ma.end());
+    out.insert(out.end(), mb.begin(), mb.end());
+    return out;
+  }
+  SubdomainTransport& inner_;
+  Rewrite rewrite_;
+};
+
+/// A packing of three sizes (1, 0.8 and 0.6 mm in equal numbers, porosity 0.6) in [lo, hi], with
+/// velocities of up to 0.3 m/s each way and 0.2 m/s down from a hash that starts at `hash`.
+struct ThrownBed {
+  Eigen::MatrixX3d x;
+  Eigen::VectorXd r;
+  Eigen::MatrixX3d v;
+};
+inline ThrownBed thrown_bed(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                            std::uint64_t seed, std::uint64_t hash) {
+  PackingSpec spec;
+  spec.lo = lo;
+  spec.hi = hi;
+  spec.diameters = {1.0e-3, 0.8e-3, 0.6e-3};
+  spec.fractions = {1.0, 1.0, 1.0};
+  spec.porosity = 0.6;
+  spec.seed = seed;
+  const Packing pk = PackingGenerator::generate(spec);
+  ThrownBed out{pk.positions, pk.radii, Eigen::MatrixX3d(pk.positions.rows(), 3)};
+  std::uint64_t h = hash;
+  auto next = [&] {
+    h ^= h >> 33, h *= 0xff51afd7ed558ccdull, h ^= h >> 33, h += 0x9e3779b97f4a7c15ull;
+    return static_cast<double>(h >> 11) / 9007199254740992.0;  // [0, 1)
+  };
+  for (Eigen::Index i = 0; i < out.x.rows(); ++i)
+    out.v.row(i) << 0.6 * next() - 0.3, 0.6 * next() - 0.3, 0.6 * next() - 0.5;
+  return out;
+}
+
+/// The positions of the particles the local subdomains own (for a re-cut by bisection).
+inline std::vector<Eigen::Vector3d> owned_positions(const SubdomainStepper& stepper) {
+  std::vector<Eigen::Vector3d> x;
+  for (int k = 0; k < stepper.local_count(); ++k) {
+    const Subdomain& sd = stepper.subdomain(k);
+    const Particles& p = sd.system().particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (!sd.is_ghost(i)) x.push_back(p.position[i]);
+  }
+  return x;
+}
+
+/// A particle's motion at the end of a run, and the owned particles of a split by id.
+struct MotionState {
+  Eigen::Vector3d x, v, w;
+};
+using MotionById = std::map<std::int64_t, MotionState>;
+
+/// How many particles differ from the reference in any bit of x, v or omega, or are missing.
+inline std::size_t differing(const MotionById& a, const MotionById& ref) {
+  REQUIRE(a.size() == ref.size());
+  std::size_t n = 0;
+  for (const auto& [id, s] : ref) {
+    const auto it = a.find(id);
+    n += it == a.end() || it->second.x != s.x || it->second.v != s.v || it->second.w != s.w ? 1
+                                                                                            : 0;
+  }
+  return n;
+}
+
+}  // namespace partita::dem::test

@@ -1,0 +1,296 @@
+// A split bed with a triangle-mesh wall (SubdomainStepper): a polydisperse bed with friction in
+// a box, pressed by a plate mesh moved and deformed through set_vertex_positions() every step (as
+// the coupling moves an FE surface) and squeezed by a moving side plane, steps to the same bits
+// on 1, 2, 3 and 4 subdomains, and the mesh's force per triangle and in total, summed over the
+// subdomains' owned particles, is the same on any split; each System's own mesh forces count
+// its ghosts' contacts and differ (the comparison can fail). A split whose subdomain is empty
+// at first (its walls and mesh must move all the same) keeps the bits once particles reach it.
+
+#include "subdomain_test_helpers.hpp"
+
+#include "partita/dem/domain_decomposition.hpp"
+#include "partita/dem/error.hpp"
+#include "partita/dem/subdomain.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <numbers>
+
+using namespace partita::dem;
+
+namespace {
+
+constexpr double kWidth = 12e-3, kBedHeight = 8e-3, kBoxHeight = 16e-3;
+constexpr double kSkin = 0.1e-3;
+constexpr double kPlateStart = kBedHeight + 0.3e-3;  // the plate's height at first
+constexpr double kPlateSpeed = 0.8;                  // down [m/s]
+constexpr double kBulge = 0.3e-3;                    // the plate's sag at the end [m]
+constexpr double kSideSpeed = 0.5;                   // the +x plane, inwards [m/s]
+constexpr int kCells = 8;                            // the plate: kCells^2 squares, 2 triangles each
+constexpr long kSteps = 300;
+const Eigen::Vector3d kLo = Eigen::Vector3d::Zero();
+const Eigen::Vector3d kHi(kWidth, kWidth, kBoxHeight);
+// the decomposition's bounds: the bed and the plate's way, tallest upright (a bisection cuts
+// across z first, then upright: on 3 and 4 subdomains the plate spans several)
+const Eigen::Vector3d kCutHi(kWidth, kWidth, 13e-3);
+
+using Bed = test::ThrownBed;
+
+const Bed& bed() {
+  static const Bed b =
+      test::thrown_bed(kLo, Eigen::Vector3d(kWidth, kWidth, kBedHeight), 5, 0x2545f4914f6cdd1dull);
+  return b;
+}
+
+// The plate's vertices at time t: a (kCells + 1)^2 grid over the box's width, going down at
+// kPlateSpeed and sagging in the middle by up to kBulge at the end of the run (time t_end).
+Eigen::MatrixX3d plate(double t, double t_end) {
+  Eigen::MatrixX3d x((kCells + 1) * (kCells + 1), 3);
+  const double sag = kBulge * t / t_end;
+  for (int j = 0; j <= kCells; ++j)
+    for (int i = 0; i <= kCells; ++i) {
+      const double a = kWidth * i / kCells, b = kWidth * j / kCells;
+      x.row(j * (kCells + 1) + i) << a, b,
+          kPlateStart - kPlateSpeed * t -
+              sag * std::sin(std::numbers::pi * a / kWidth) * std::sin(std::numbers::pi * b / kWidth);
+    }
+  return x;
+}
+
+TriangleMesh::Triangles plate_triangles() {
+  TriangleMesh::Triangles t(2 * kCells * kCells, 3);
+  int k = 0;
+  for (int j = 0; j < kCells; ++j)
+    for (int i = 0; i < kCells; ++i) {
+      const int v = j * (kCells + 1) + i;
+      t.row(k++) << v, v + 1, v + kCells + 2;
+      t.row(k++) << v, v + kCells + 2, v + kCells + 1;
+    }
+  return t;
+}
+
+// One subdomain's System, alike on every subdomain: the box without its +x face (wall 0), the
+// +x plane moving inwards (wall 1), the plate (mesh 0), the particles of `keep` (id = index).
+std::unique_ptr<System> subdomain_system(const std::vector<int>& keep) {
+  auto sys = std::make_unique<System>();
+  const int m = sys->add_material({1.0e7, 0.3, 2500.0});
+  sys->add_interaction(m, m, {0.5, 0.5, 0.05});
+  sys->set_gravity({0, 0, -9.81});
+  const Bed& b = bed();
+  for (const int i : keep)
+    sys->add_particle(b.x.row(i).transpose(), b.r[i], m, b.v.row(i).transpose(),
+                      Eigen::Vector3d::Zero(), i);
+  sys->add_box(kLo, kHi, m, 0b111101);
+  sys->add_plane({kWidth, 0, 0}, {-1, 0, 0}, m, {-kSideSpeed, 0, 0});
+  sys->add_mesh(plate(0.0, 1.0), plate_triangles(), m);
+  return sys;
+}
+
+double time_step() {
+  static const double dt = 0.25 * subdomain_system({0, 1, 2})->rayleigh_time_step();
+  return dt;
+}
+
+// One System::pack_particles() message (header 41 bytes: n at 16, pair records at 24, the mesh
+// bytes at 32; the particles, the records of 41 bytes, then per particle a count (int32) and its
+// contacts) with every particle's count 0: a particle arrives without its tangential springs on
+// the plate. Adds the contacts taken out to `stripped`.
+std::vector<std::byte> without_mesh_contacts(System& any, const std::byte* m, std::size_t bytes,
+                                             long& stripped) {
+  using test::read_at;
+  const auto n = read_at<std::uint64_t>(m + 16), records = read_at<std::uint64_t>(m + 24);
+  const std::size_t mesh_at =
+      41 + n * any.store_unsynced().packed_bytes_per_particle() + records * 41;
+  stripped += static_cast<long>((bytes - mesh_at - 4 * n) / MeshContacts::packed_contact_bytes);
+  std::vector<std::byte> out(m, m + mesh_at);
+  out.resize(mesh_at + 4 * n, std::byte{0});
+  const std::uint64_t mesh_bytes = 4 * n;
+  std::memcpy(out.data() + 32, &mesh_bytes, 8);
+  return out;
+}
+
+struct Run {
+  test::MotionById state;  // owned particles by id
+  long builds = 0, migrated = 0;
+  std::size_t ghosts_at_end = 0;
+  bool empty_at_first = false;  // some subdomain held no particle after the first step
+  bool all_owning_at_end = true;
+  Eigen::MatrixX3d triangle, vertex;     // SubdomainStepper's, at the end
+  Eigen::Vector3d total = Eigen::Vector3d::Zero();
+  Eigen::MatrixX3d system_triangle;      // System::triangle_forces(0) summed over the subdomains
+  Eigen::Vector3d system_total = Eigen::Vector3d::Zero();  // System::mesh_force(0) summed
+  Eigen::Vector3d wall = Eigen::Vector3d::Zero();          // SubdomainStepper::wall_force(1)
+  std::size_t contacts = 0;  // the owned particles' mesh contacts at the end
+  long stripped = 0;         // mesh contacts taken out of the messages (without_mesh_histories)
+};
+
+std::vector<Eigen::Vector3d> start_positions() {
+  const Bed& b = bed();
+  std::vector<Eigen::Vector3d> x0;
+  for (Eigen::Index i = 0; i < b.x.rows(); ++i) x0.push_back(b.x.row(i).transpose());
+  return x0;
+}
+
+// The bed split by `d` (parts = its boxes), kSteps steps; `recut_at` > 0: a bisection of the
+// positions of that step from then on.
+Run run_split(const DomainDecomposition& d, long recut_at = 0,
+              bool without_mesh_histories = false) {
+  const int parts = d.parts();
+  const std::vector<Eigen::Vector3d> x0 = start_positions();
+  std::vector<std::vector<int>> keep(static_cast<std::size_t>(parts));
+  for (std::size_t i = 0; i < x0.size(); ++i) keep[d.owner(x0[i])].push_back(static_cast<int>(i));
+  std::vector<std::unique_ptr<System>> systems;
+  std::vector<System*> raw;
+  for (int k = 0; k < parts; ++k) {
+    systems.push_back(subdomain_system(keep[k]));
+    raw.push_back(systems.back().get());
+  }
+  InProcessTransport in_process(parts);
+  long stripped = 0;
+  test::RewritingTransport stripping(in_process, [&](const std::byte* m, std::size_t bytes) {
+    return without_mesh_contacts(*systems[0], m, bytes, stripped);
+  });
+  SubdomainTransport& transport =
+      without_mesh_histories ? static_cast<SubdomainTransport&>(stripping) : in_process;
+  SubdomainStepper stepper(raw, transport, d, kSkin);
+  const double dt = time_step(), t_end = kSteps * dt;
+  Run out;
+  for (long s = 0; s < kSteps; ++s) {
+    if (recut_at > 0 && s == recut_at)
+      stepper.set_decomposition(
+          DomainDecomposition::bisection(test::owned_positions(stepper), kLo, kCutHi, parts));
+    const Eigen::MatrixX3d xp = plate((s + 1) * dt, t_end);  // the plate at the step's end
+    for (System* sys : raw) sys->set_vertex_positions(0, xp);
+    stepper.step(dt);
+    if (s == 0)
+      for (System* sys : raw) out.empty_at_first = out.empty_at_first || sys->particle_count() == 0;
+  }
+  for (int k = 0; k < parts; ++k) {
+    const Subdomain& sd = stepper.subdomain(k);
+    const Particles& p = systems[k]->particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (!sd.is_ghost(i)) out.state[p.id[i]] = {p.position[i], p.velocity[i], p.angular_velocity[i]};
+    sd.system().mesh_contacts().for_each_contact(
+        [&](int i, const MeshContactRecord&, const Eigen::Vector3d&) {
+          out.contacts += sd.is_ghost(static_cast<std::size_t>(i)) ? 0 : 1;
+        });
+    out.migrated += sd.migrated_in();
+    out.ghosts_at_end += sd.ghost_count();
+    out.all_owning_at_end = out.all_owning_at_end && sd.owned_count() > 0;
+  }
+  out.triangle = stepper.triangle_forces(0);
+  out.vertex = stepper.vertex_forces(0);
+  out.total = stepper.mesh_force(0);
+  out.wall = stepper.wall_force(1);
+  out.system_triangle.setZero(out.triangle.rows(), 3);
+  for (int k = 0; k < parts; ++k) {
+    out.system_triangle += systems[k]->triangle_forces(0);
+    out.system_total += systems[k]->mesh_force(0);
+  }
+  out.builds = stepper.builds();
+  out.stripped = stripped;
+  return out;
+}
+
+Run run_bisection(int parts) {
+  return run_split(DomainDecomposition::bisection(start_positions(), kLo, kCutHi, parts));
+}
+
+std::size_t differing(const Run& a, const Run& ref) { return test::differing(a.state, ref.state); }
+
+// The sum of |force| over the triangles (the scale of a rounding difference).
+double scale(const Eigen::MatrixX3d& f) { return f.rowwise().norm().sum(); }
+
+const Run& reference() {
+  static const Run r = run_bisection(1);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("dem: subdomains: a bed pressed by a moving mesh plate steps to the same bits and "
+          "mesh forces on 1 to 4 subdomains",
+          "[dem][subdomains]") {
+  const Run& ref = reference();
+  REQUIRE(ref.state.size() == static_cast<std::size_t>(bed().x.rows()));
+  REQUIRE(ref.state.size() > 1000);
+  REQUIRE(ref.builds >= 10);
+  // the plate presses the bed: many contacts, most triangles loaded, the bed pushes it up
+  REQUIRE(ref.contacts > 50);
+  int loaded = 0;
+  for (Eigen::Index t = 0; t < ref.triangle.rows(); ++t) loaded += ref.triangle.row(t).norm() > 0.0;
+  CHECK(loaded > ref.triangle.rows() / 2);
+  CHECK(ref.total.z() > 0.0);
+  CHECK(ref.wall.x() > 0.0);  // the moving side plane is pushed outwards (+x)
+  // contracts: the triangles' and the vertices' forces add up to the total (rounding apart), and
+  // one subdomain's exact sums agree with the System's own sums (rounding apart)
+  const double s = scale(ref.triangle);
+  CHECK((ref.triangle.colwise().sum().transpose() - ref.total).norm() <= 1e-12 * s);
+  CHECK((ref.vertex.colwise().sum().transpose() - ref.total).norm() <= 1e-12 * s);
+  CHECK((ref.triangle - ref.system_triangle).cwiseAbs().maxCoeff() <= 1e-12 * s);
+  CHECK((ref.total - ref.system_total).norm() <= 1e-12 * s);
+  for (const int parts : {2, 3, 4}) {
+    CAPTURE(parts);
+    const Run split = run_bisection(parts);
+    CHECK(split.builds == ref.builds);
+    CHECK(split.migrated > 0);
+    CHECK(split.ghosts_at_end > 0);
+    CHECK(differing(split, ref) == 0);
+    CHECK(split.contacts == ref.contacts);
+    CHECK(split.triangle == ref.triangle);
+    CHECK(split.vertex == ref.vertex);
+    CHECK(split.total == ref.total);
+    CHECK(split.wall == ref.wall);
+    // where the plate spans several subdomains, each System's own sums count its ghosts'
+    // contacts with the plate too: not the bed's forces
+    if (parts >= 3) {
+      CHECK((split.system_triangle - ref.triangle).cwiseAbs().maxCoeff() > 1e-6 * s);
+      CHECK(split.system_total.z() > ref.total.z());
+    }
+  }
+}
+
+TEST_CASE("dem: subdomains: a subdomain empty at first moves its walls and mesh and keeps the "
+          "bits when particles reach it",
+          "[dem][subdomains]") {
+  // cuts made for the bed and twice as many points again near the top of the bounds: two boxes
+  // above the bed hold nothing (no ghost either); then a bisection of the particles gives every subdomain some
+  std::vector<Eigen::Vector3d> x = start_positions();
+  const std::size_t n = x.size();
+  for (std::size_t k = 0; k < 2 * n; ++k)
+    x.emplace_back(kWidth * (k % 97) / 97.0, kWidth * (k % 89) / 89.0, kCutHi.z() - 0.5e-3);
+  const DomainDecomposition d = DomainDecomposition::bisection(x, kLo, kCutHi, 3);
+  const Run split = run_split(d, kSteps / 3);
+  CHECK(split.empty_at_first);
+  CHECK(split.all_owning_at_end);
+  CHECK(differing(split, reference()) == 0);
+  CHECK(split.triangle == reference().triangle);
+  CHECK(split.wall == reference().wall);
+}
+
+TEST_CASE("dem: subdomains: without the mesh histories in the messages the split differs",
+          "[dem][subdomains]") {
+  const Run split = run_split(
+      DomainDecomposition::bisection(start_positions(), kLo, kCutHi, 3), 0, true);
+  CHECK(split.stripped > 0);
+  CHECK(differing(split, reference()) > 0);
+}
+
+TEST_CASE("dem: subdomains: the mesh sums refuse a mesh the split does not have",
+          "[dem][subdomains]") {
+  const std::vector<Eigen::Vector3d> x0 = start_positions();
+  const DomainDecomposition d = DomainDecomposition::bisection(x0, kLo, kCutHi, 2);
+  std::vector<int> a, b;
+  for (std::size_t i = 0; i < x0.size(); ++i) (d.owner(x0[i]) == 0 ? a : b).push_back(static_cast<int>(i));
+  auto sa = subdomain_system(a), sb = subdomain_system(b);
+  InProcessTransport transport(2);
+  SubdomainStepper stepper({sa.get(), sb.get()}, transport, d, kSkin);
+  stepper.step(time_step());
+  CHECK_THROWS_AS(stepper.triangle_forces(1), Error);
+  CHECK_THROWS_AS(stepper.mesh_force(-1), Error);
+  CHECK(stepper.mesh_force(0).allFinite());
+}
