@@ -438,6 +438,7 @@ void DemAdapter::add_breakage(const config::Node& b) {
   p.restore_mass = b.string("mass") == "restored";
   p.seed = static_cast<std::uint64_t>(b.integer("seed"));
   breakage_ = system_.add_hook(std::make_unique<dem::Breakage>(p));
+  system_.set_local_fragment_insertion(b.string("lists") == "local");
   double d_max = 0.0;
   for (double r : system_.particles().radius) d_max = std::max(d_max, 2.0 * r);
   if (p.comminution_limit > d_max)

@@ -169,6 +169,17 @@ std::shared_ptr<Spec> make_spec() {
                {"lost", "restored"})
       .def("lost");
   breakage->integer("seed", "seed of the strengths and fragment orientations").min(0).def(1);
+  breakage
+      ->choice("lists",
+               "how the neighbour lists take in a breakage's fragments: search (the next step "
+               "searches every pair again, renumbers the particles when sort_interval asks at a "
+               "build and computes the forces again) or local (a fragment's pairs are found "
+               "among its parent's listed neighbours, the lists stay valid and the particles keep "
+               "their order; each fragment starts with its parent's accelerations until the next "
+               "force pass): the same physics, different rounding; local spares a crushing bed "
+               "most of its neighbour searches",
+               {"search", "local"})
+      .def("search");
 
   auto s = std::make_shared<Spec>(
       "dem", "native DEM (solvers/dem): Hertz-Mindlin spheres, planes, triangle meshes");

@@ -111,36 +111,76 @@ void Breakage::end_of_step(System& system, double /*dt*/) {
   if (!broken_.empty() || !powder_.empty()) crush(system, broken_, powder_);
 }
 
-double Breakage::contact_energy(const System& system, std::size_t i) const {
+namespace {
+
+// Hertz: 8/15 E* sqrt(R*) delta^(5/2)
+double hertz(double e_star, double r_eff, double delta) {
+  return 8.0 / 15.0 * e_star * std::sqrt(r_eff) * std::pow(delta, 2.5);
+}
+
+}  // namespace
+
+double Breakage::contact_energy(const System& system, std::size_t i, const int* first,
+                                const int* last) const {
   const Particles& p = system.particles();
   const ContactModel& model = system.contact_model();
   const Eigen::Vector3d& x = p.position[i];
   const double r = p.radius[i];
-  // Hertz: 8/15 E* sqrt(R*) delta^(5/2)
-  auto hertz = [](double e_star, double r_eff, double delta) {
-    return 8.0 / 15.0 * e_star * std::sqrt(r_eff) * std::pow(delta, 2.5);
-  };
   double e = 0.0;
-  for (std::size_t j = 0; j < p.size(); ++j) {
-    if (j == i) continue;
+  auto pair = [&](std::size_t j) {
     const double delta = r + p.radius[j] - (x - p.position[j]).norm();
     if (delta > 0.0)
       e += hertz(model.pair(p.material[i], p.material[j]).e_star,
                  r * p.radius[j] / (r + p.radius[j]), delta);
+  };
+  const bool listed = first != nullptr;
+  if (listed) {
+    for (const int* j = first; j != last; ++j) pair(static_cast<std::size_t>(*j));
+  } else {
+    for (std::size_t j = 0; j < p.size(); ++j)
+      if (j != i) pair(j);
   }
   for (const PlaneWall& w : system.planes()) {
     const double delta = r - (x - w.point).dot(w.normal);
     if (delta > 0.0) e += hertz(model.pair(p.material[i], w.material).e_star, r, delta);
   }
-  for (int m = 0; m < system.mesh_count(); ++m) {  // the nearest triangle of each mesh
-    const TriangleMesh& mesh = system.mesh(m);
-    double d2 = std::numeric_limits<double>::max();
-    for (int t = 0; t < mesh.triangle_count(); ++t)
-      d2 = std::min(d2, (mesh.closest_point(t, x).point - x).squaredNorm());
-    const double delta = r - std::sqrt(d2);
-    if (delta > 0.0) e += hertz(model.pair(p.material[i], mesh.material()).e_star, r, delta);
+  // the nearest triangle of each mesh (listed: among the particle's candidates, which hold every
+  // triangle it can touch)
+  mesh_d2_.assign(system.mesh_count(), std::numeric_limits<double>::max());
+  if (listed) {
+    const NeighborList& nl = system.neighbor_list();
+    for (const MeshCandidate* c = nl.mesh_candidates_begin(i); c != nl.mesh_candidates_end(i); ++c)
+      mesh_d2_[c->mesh] = std::min(
+          mesh_d2_[c->mesh], (system.mesh(c->mesh).closest_point(c->triangle, x).point - x).squaredNorm());
+  } else {
+    for (int m = 0; m < system.mesh_count(); ++m) {
+      const TriangleMesh& mesh = system.mesh(m);
+      for (int t = 0; t < mesh.triangle_count(); ++t)
+        mesh_d2_[m] = std::min(mesh_d2_[m], (mesh.closest_point(t, x).point - x).squaredNorm());
+    }
+  }
+  for (int m = 0; m < system.mesh_count(); ++m) {
+    const double delta = r - std::sqrt(mesh_d2_[m]);
+    if (delta > 0.0) e += hertz(model.pair(p.material[i], system.mesh(m).material()).e_star, r, delta);
   }
   return e;
+}
+
+double Breakage::contact_energy(const System& system, std::size_t i) const {
+  return contact_energy(system, i, nullptr, nullptr);
+}
+
+double Breakage::contact_energies(const System& system, const std::vector<std::size_t>& which) {
+  double sum = 0.0;
+  if (!system.lists_current()) {
+    for (std::size_t i : which) sum += contact_energy(system, i);
+    return sum;
+  }
+  system.neighbor_list().listed_neighbours(which, nb_offsets_, nb_items_);
+  for (std::size_t k = 0; k < which.size(); ++k)
+    sum += contact_energy(system, which[k], nb_items_.data() + nb_offsets_[k],
+                          nb_items_.data() + nb_offsets_[k + 1]);
+  return sum;
 }
 
 void Breakage::break_particles(System& system, const std::vector<std::size_t>& indices) {
@@ -150,23 +190,41 @@ void Breakage::break_particles(System& system, const std::vector<std::size_t>& i
 void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
                      const std::vector<std::size_t>& powder) {
   if (fragment.empty() && powder.empty()) return;
-  const std::vector<std::size_t> parents = fragment;  // (fragment may be broken_)
+  parents_ = fragment;  // (fragment may be broken_)
   const Particles& p = system.particles();
   const std::size_t n = p.size();
-  struct Fragment {
-    Eigen::Vector3d x, v, w;
-    double r, m, inertia;
-    int material;
-  };
-  std::vector<Fragment> fragments;
+  fragments_.clear();
   std::vector<char> remove(n, 0);
-  double released = 0.0;
   const int nf = pattern_.size();
-  for (std::size_t i : parents) {
+  for (std::size_t i : parents_) {
     if (i >= n || remove[i])
       throw Error("break_particles: bad or repeated index " + std::to_string(i));
     remove[i] = 1;
-    released += contact_energy(system, i);
+  }
+  for (std::size_t i : powder) {
+    if (i >= n || remove[i]) throw Error("crush: bad or repeated index " + std::to_string(i));
+    remove[i] = 1;
+  }
+  // the contact energy the parents and the powder had (in the order they are listed)
+  added_ = parents_;
+  added_.insert(added_.end(), powder.begin(), powder.end());
+  double released = 0.0;
+  {
+    // (summed in the order parents, then powder, each particle's energy added once: as the
+    // particles are taken)
+    if (system.lists_current()) {
+      system.neighbor_list().listed_neighbours(added_, nb_offsets_, nb_items_);
+    }
+  }
+  auto energy_of = [&](std::size_t k) {
+    return system.lists_current()
+               ? contact_energy(system, added_[k], nb_items_.data() + nb_offsets_[k],
+                                nb_items_.data() + nb_offsets_[k + 1])
+               : contact_energy(system, added_[k]);
+  };
+  for (std::size_t k = 0; k < parents_.size(); ++k) {
+    const std::size_t i = parents_[k];
+    released += energy_of(k);
     const double r = p.radius[i], mass = p.mass[i], ip = p.inertia[i];
     const Eigen::Vector3d x = p.position[i], v = p.velocity[i], w = p.angular_velocity[i];
     const double rho = system.contact_model().material(p.material[i]).density;
@@ -179,71 +237,75 @@ void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
         std::sqrt(u1) * std::cos(two_pi * u3), std::sqrt(1.0 - u1) * std::sin(two_pi * u2),
         std::sqrt(1.0 - u1) * std::cos(two_pi * u2), std::sqrt(u1) * std::sin(two_pi * u3));
     const Eigen::Matrix3d rot = q.normalized().toRotationMatrix();
-    const std::size_t first = fragments.size();
+    const std::size_t first = fragments_.size();
     double m_f = 0.0, j_f = 0.0, i_s = 0.0;  // fragments' mass, orbital and own inertia
-    for (int k = 0; k < nf; ++k) {
-      Fragment f;
-      const Eigen::Vector3d c = r * (rot * pattern_.centre(k));
-      f.r = shrink * r * pattern_.radius(k);
-      f.x = x + c;
-      f.v = v + w.cross(c);  // the parent's rigid motion
-      f.w = w;
-      f.m = rho * 4.0 / 3.0 * std::numbers::pi * f.r * f.r * f.r;
-      f.inertia = 0.4 * f.m * f.r * f.r;
+    for (int k2 = 0; k2 < nf; ++k2) {
+      System::Fragment f;
+      const Eigen::Vector3d c = r * (rot * pattern_.centre(k2));
+      f.parent = i;
+      f.radius = shrink * r * pattern_.radius(k2);
+      f.position = x + c;
+      f.velocity = v + w.cross(c);  // the parent's rigid motion
+      f.angular_velocity = w;
+      f.mass = rho * 4.0 / 3.0 * std::numbers::pi * f.radius * f.radius * f.radius;
+      f.inertia = 0.4 * f.mass * f.radius * f.radius;
       f.material = p.material[i];
-      m_f += f.m;
-      j_f += f.m * 2.0 / 3.0 * c.squaredNorm();  // isotropic second moment: sum m (|c|^2 I - c c^T)
+      m_f += f.mass;
+      j_f += f.mass * 2.0 / 3.0 * c.squaredNorm();  // isotropic second moment: sum m (|c|^2 I - c c^T)
       i_s += f.inertia;
-      fragments.push_back(f);
+      fragments_.push_back(f);
     }
     const double missing = mass - m_f;
     const double i_missing = ip - j_f - i_s;  // the lost material's inertia about the centre
     if (parameters_.restore_mass) {
       const double scale = mass / m_f;
       const double extra = std::max(0.0, scale * (ip / scale - j_f - i_s)) / nf;
-      for (std::size_t k = first; k < fragments.size(); ++k) {
-        fragments[k].m *= scale;
-        fragments[k].inertia = fragments[k].inertia * scale + extra;
+      for (std::size_t k2 = first; k2 < fragments_.size(); ++k2) {
+        fragments_[k2].mass *= scale;
+        fragments_[k2].inertia = fragments_[k2].inertia * scale + extra;
       }
       counters_.mass_restored += missing;
       counters_.fragment_mass += mass;
     } else {
+      for (std::size_t k2 = first; k2 < fragments_.size(); ++k2) fragments_[k2].mass = 0.0;  // (the material's)
       counters_.mass_lost += missing;
       counters_.fragment_mass += m_f;
       released += 0.5 * missing * v.squaredNorm() + 0.5 * i_missing * w.squaredNorm();
     }
     ++counters_.events;
   }
-  for (std::size_t i : powder) {  // removed whole: their motion and contacts leave with them
-    if (i >= n || remove[i])
-      throw Error("crush: bad or repeated index " + std::to_string(i));
-    remove[i] = 1;
-    const double e = contact_energy(system, i) + 0.5 * p.mass[i] * p.velocity[i].squaredNorm() +
+  for (std::size_t k = 0; k < powder.size(); ++k) {  // removed whole: their motion and contacts leave with them
+    const std::size_t i = powder[k];
+    const double e = energy_of(parents_.size() + k) + 0.5 * p.mass[i] * p.velocity[i].squaredNorm() +
                      0.5 * p.inertia[i] * p.angular_velocity[i].squaredNorm();
     ++counters_.powder_events;
     counters_.powder_mass += p.mass[i];
     counters_.powder_energy += e;
     released += e;
   }
-  system.remove_particles(remove);
-  std::vector<std::size_t> added;
-  added.reserve(fragments.size());
-  for (const Fragment& f : fragments) {
-    const std::size_t k = system.add_particle(f.x, f.r, f.material, f.v, f.w);
-    if (parameters_.restore_mass) system.set_particle_mass(k, f.m, f.inertia);
-    added.push_back(k);
-    const double d = 2.0 * f.r;
+  const std::size_t first = system.replace_particles(remove, fragments_);
+  added_.clear();
+  for (std::size_t k = 0; k < fragments_.size(); ++k) {
+    added_.push_back(first + k);
+    const double d = 2.0 * fragments_[k].radius;
     if (counters_.smallest_fragment == 0.0 || d < counters_.smallest_fragment)
       counters_.smallest_fragment = d;
   }
   ParticleStore& store = system.store_unsynced();
   std::vector<double>& strength = store.array<double>(h_strength_);
-  for (std::size_t k : added) {
+  for (std::size_t k : added_) {
     strength[k] = draw_strength(store.core().id[k], 2.0 * store.core().radius[k]);
     set_limit(system, k, strength[k]);
   }
-  for (std::size_t k : added) released -= contact_energy(system, k);
-  counters_.fragments += static_cast<std::int64_t>(added.size());
+  if (!added_.empty() && system.lists_current()) {
+    system.neighbor_list().listed_neighbours(added_, nb_offsets_, nb_items_);
+    for (std::size_t k = 0; k < added_.size(); ++k)
+      released -= contact_energy(system, added_[k], nb_items_.data() + nb_offsets_[k],
+                                 nb_items_.data() + nb_offsets_[k + 1]);
+  } else {
+    for (std::size_t k : added_) released -= contact_energy(system, k);
+  }
+  counters_.fragments += static_cast<std::int64_t>(added_.size());
   counters_.energy_released += released;
 }
 

@@ -169,6 +169,97 @@ void System::remove_particles(const std::vector<char>& remove) {
   particles_changed();
 }
 
+std::size_t System::replace_particles(const std::vector<char>& remove,
+                                      const std::vector<Fragment>& fragments) {
+  sync_particles();
+  const std::size_t n = store_.size();
+  if (remove.size() != n) {
+    std::ostringstream msg;
+    msg << "replace_particles: need one flag per particle (" << n << "), got " << remove.size();
+    throw Error(msg.str());
+  }
+  const Particles& p = store_.core();
+  bool inside = true;  // every fragment's sphere within its parent's
+  for (std::size_t k = 0; k < fragments.size(); ++k) {
+    const Fragment& f = fragments[k];
+    if (f.parent >= n || !remove[f.parent]) {
+      std::ostringstream msg;
+      msg << "replace_particles: fragment " << k << " names parent " << f.parent
+          << ", which is not a particle removed in the same change";
+      throw Error(msg.str());
+    }
+    inside = inside && (f.position - p.position[f.parent]).norm() + f.radius <= p.radius[f.parent];
+  }
+  const bool local = local_fragments_ && inside && lists_current_ && neighbors_.built() &&
+                     neighbors_.position_at_build_.size() == n;
+  if (!local) {
+    remove_particles(remove);
+    std::size_t first = store_.size();
+    for (std::size_t k = 0; k < fragments.size(); ++k) {
+      const Fragment& f = fragments[k];
+      const std::size_t i =
+          add_particle(f.position, f.radius, f.material, f.velocity, f.angular_velocity);
+      if (k == 0) first = i;
+      if (f.mass > 0.0) set_particle_mass(i, f.mass, f.inertia);
+    }
+    return first;
+  }
+  // Check every fragment before the set changes (the system stays as it was on an error).
+  for (std::size_t k = 0; k < fragments.size(); ++k) {
+    const Fragment& f = fragments[k];
+    const std::string what = "replace_particles: fragment " + std::to_string(k);
+    if (!(f.radius > 0.0) || !std::isfinite(f.radius) || !f.position.allFinite() ||
+        !f.velocity.allFinite() || !f.angular_velocity.allFinite() ||
+        (f.mass > 0.0 && !(std::isfinite(f.mass) && f.inertia > 0.0 && std::isfinite(f.inertia)))) {
+      std::ostringstream msg;
+      msg << what << ": radius, position, velocities, mass and moment of inertia must be finite, "
+          << "radius > 0 m and (with a mass) mass and moment of inertia > 0";
+      throw Error(msg.str());
+    }
+    model_.check_material(f.material, what);
+  }
+  note_set_change();
+  offspring_.resize(fragments.size());
+  // (the parents' values are read before the store moves its rows)
+  std::vector<ParentShare>& share = share_;
+  share.resize(fragments.size());
+  for (std::size_t k = 0; k < fragments.size(); ++k) {
+    const Fragment& f = fragments[k];
+    const std::size_t q = f.parent;
+    offspring_[k] = {static_cast<int>(q), f.position - p.position[q]};
+    share[k] = {p.force[q], p.torque[q], p.mass[q], p.inertia[q]};
+  }
+  store_.remove(remove, new_of_old_);
+  const int kept = static_cast<int>(store_.size());
+  for (std::size_t k = 0; k < fragments.size(); ++k) {
+    const Fragment& f = fragments[k];
+    const std::size_t i = store_.add(-1);
+    Particles& c = store_.core();
+    const double rho = model_.material(f.material).density;
+    const double m = f.mass > 0.0 ? f.mass : rho * 4.0 / 3.0 * std::numbers::pi * f.radius * f.radius * f.radius;
+    const double inertia = f.mass > 0.0 ? f.inertia : 0.4 * m * f.radius * f.radius;
+    c.position[i] = f.position;
+    c.velocity[i] = f.velocity;
+    c.angular_velocity[i] = f.angular_velocity;
+    c.radius[i] = f.radius;
+    c.mass[i] = m;
+    c.inertia[i] = inertia;
+    c.material[i] = f.material;
+    c.force[i] = m / share[k].mass * share[k].force;
+    c.torque[i] = inertia / share[k].inertia * share[k].torque;
+  }
+  neighbors_.insert_offspring(new_of_old_, kept, offspring_, store_.core());
+  pairs_follow_lists();
+  mesh_contacts_.renumber(new_of_old_);
+  mesh_contacts_.follow_build(neighbors_);
+  // the step prepares again (time step, histories' sizes) with the lists as they are
+  prepared_ = false;
+  verlet_.invalidate();
+  partition_.invalidate();
+  ++local_insertions_;
+  return static_cast<std::size_t>(kept);
+}
+
 void System::renumber_particles(const std::vector<int>& order) {
   sync_particles();
   const std::size_t n = store_.size();
@@ -461,8 +552,10 @@ void System::settle_set_change(bool provisional) {
   const double after =
       kinetic_energy() + half_step_term(energy_dt_) + potential_energy() + elastic_energy();
   energies_.breakage += set_change_before_ - after;
-  if (provisional)
-    set_change_before_ = after;  // (the next step's start books its own change from here)
+  // (the next step's start books its own change from here; with the lists current and the
+  // forces valid it changes nothing: no search, no force pass, and the change is settled)
+  if (provisional && !(lists_current() && forces_valid_))
+    set_change_before_ = after;
   else
     set_change_pending_ = false;
 }

@@ -34,13 +34,15 @@
 // inertia is raised by an equal share of the parent's I_p = 2/5 M R^2 minus the set's inertia
 // about the parent's centre, so linear and angular momentum and kinetic energy are those of the
 // parent. Particles broken in one step are handled in ascending index; the set changes at the end
-// of the step (the next step rebuilds the lists and the new fragments' contacts act from its force
-// pass). Smaller fragments lower the Rayleigh step: read System::rayleigh_time_step() again.
+// of the step through System::replace_particles() (by default the next step searches the lists again
+// and the new fragments' contacts act from its force pass; with local fragment insertion the
+// fragments join their parent's neighbours in the lists at once). Smaller fragments lower the Rayleigh step: read System::rayleigh_time_step() again.
 
 #include "partita/dem/breakage_counters.hpp"
 #include "partita/dem/breakage_parameters.hpp"
 #include "partita/dem/fragment_pattern.hpp"
 #include "partita/dem/step_hook.hpp"
+#include "partita/dem/system.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -83,8 +85,16 @@ class Breakage final : public StepHook {
              const std::vector<std::size_t>& powder);
 
  private:
-  // elastic (normal Hertz) energy of particle i's contacts at the current positions
+  // elastic (normal Hertz) energy of particle i's contacts at the current positions: with the
+  // system's lists current, from its listed neighbours [first, last) (ascending) and its mesh
+  // candidates; otherwise by looking at every particle and triangle (the same value: the same
+  // contacts in the same order)
+  double contact_energy(const System& system, std::size_t i, const int* first,
+                        const int* last) const;
   double contact_energy(const System& system, std::size_t i) const;
+  // the sum of contact_energy() over `which`, from the listed neighbours when the lists are
+  // current
+  double contact_energies(const System& system, const std::vector<std::size_t>& which);
 
   BreakageParameters parameters_;
   FragmentPattern pattern_;
@@ -97,6 +107,10 @@ class Breakage final : public StepHook {
   int h_limit_ = -1;
   std::vector<std::size_t> broken_;  // scratch (reserved: no allocation while nothing breaks)
   std::vector<std::size_t> powder_;  // (the same, for the particles crushed to powder)
+  std::vector<std::size_t> parents_, added_;            // scratch of crush()
+  std::vector<System::Fragment> fragments_;             // (the same)
+  std::vector<int> nb_offsets_, nb_items_;              // (the same: listed neighbours)
+  mutable std::vector<double> mesh_d2_;                 // (contact_energy(): per mesh)
 };
 
 }  // namespace partita::dem

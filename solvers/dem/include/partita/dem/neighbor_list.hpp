@@ -26,6 +26,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -76,6 +77,38 @@ class NeighborList {
   void renumber(const std::vector<int>& new_of_old);
   /// Same, where new_of_old[i] < 0 marks a removed particle (its pairs are dropped) and `new_count` is the number of particles after the change.
   void renumber(const std::vector<int>& new_of_old, int new_count);
+  /// A particle born inside another at run time (a fragment): the index of the particle it
+  /// replaces (before the change) and its centre relative to that particle's centre.
+  struct Offspring {
+    int parent = 0;
+    Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  };
+  /// Takes in a change of the particle set without a search: the particles with
+  /// new_of_old[i] < 0 are gone, the others keep their order (new_of_old ascending, `kept` of
+  /// them), and born.size() particles were appended (indices kept, kept + 1, ...; `p` is the set
+  /// after the change), each lying inside the particle it replaces (|offset| + R_new <= R_parent,
+  /// the parent among those gone). A newborn's reference position is its parent's at the build
+  /// plus its offset, so its displacement since the build is its parent's; every particle within
+  /// R_new + R_j + skin of that reference was within R_parent + R_j + skin of the parent's, so
+  /// its pairs are found among the parent's listed neighbours (and the newborns of neighbouring
+  /// parents) and the lists stay valid until the usual displacement test says otherwise. Its
+  /// planes and mesh candidates are its parent's. Each row stays ascending; the pairs already
+  /// listed keep their slot sources (slot_sources()), the new ones have none. Requires lists
+  /// built for the set before the change (built(), one row per particle); throws Error if not.
+  void insert_offspring(const std::vector<int>& new_of_old, int kept,
+                        const std::vector<Offspring>& born, const Particles& p);
+  /// The listed neighbours of each particle in `which` (distinct indices with rows), both
+  /// halves, ascending: those of which[k] are items[offsets[k] .. offsets[k + 1]). One pass over
+  /// the pairs. While the lists are valid every particle touching one of them is among them.
+  void listed_neighbours(const std::vector<std::size_t>& which, std::vector<int>& offsets,
+                         std::vector<int>& items) const;
+  /// The mesh triangles listed near particle i (within R + skin at the build): [first, last).
+  const MeshCandidate* mesh_candidates_begin(std::size_t i) const {
+    return mesh_candidates_.data() + (mesh_offsets_.size() > i + 1 ? mesh_offsets_[i] : 0);
+  }
+  const MeshCandidate* mesh_candidates_end(std::size_t i) const {
+    return mesh_candidates_.data() + (mesh_offsets_.size() > i + 1 ? mesh_offsets_[i + 1] : 0);
+  }
   /// Whether the lists were built for the current particles (cleared by renumber()).
   bool built() const { return valid_ && !position_at_build_.empty(); }
   /// The slot mapping of the last build() or renumber() (one entry per slot; empty after
@@ -94,6 +127,12 @@ class NeighborList {
   std::uint64_t plane_mask(std::size_t i) const { return plane_mask_[i]; }
 
   std::size_t pair_count() const { return neighbors_.size(); }
+  /// Calls visit(i, j) for every listed pair (i < j): rows in order, each row ascending.
+  template <class Visit>
+  void for_each_pair(Visit&& visit) const {
+    for (std::size_t i = 0; i + 1 < offsets_.size(); ++i)
+      for (int s = offsets_[i]; s < offsets_[i + 1]; ++s) visit(static_cast<int>(i), neighbors_[s]);
+  }
   long build_count() const { return builds_; }
 
  private:
@@ -141,6 +180,14 @@ class NeighborList {
   std::vector<std::uint64_t> plane_mask_;
   // scratch reused between builds
   std::vector<int> new_offsets_, new_neighbors_, counts_;
+  // scratch of insert_offspring()
+  std::vector<int> parent_of_, parent_nb_offsets_, parent_nb_, born_offsets_, born_items_;
+  mutable std::vector<int> mark_, mark_counts_;  // scratch of listed_neighbours()
+  std::vector<std::pair<int, int>> added_pairs_;
+  std::vector<Eigen::Vector3d> born_reference_;
+  std::vector<std::uint64_t> born_mask_;
+  std::vector<int> new_mesh_offsets_;
+  std::vector<MeshCandidate> new_mesh_candidates_;
   // particle-triangle candidates
   std::vector<int> tri_cell_start_;
   std::vector<MeshCandidate> tri_cell_items_;

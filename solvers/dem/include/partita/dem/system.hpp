@@ -122,6 +122,35 @@ class System {
   /// Removes the particles with remove[i] != 0 (one flag per particle); the others keep their
   /// order, ids and contact histories. The next step rebuilds the lists and recomputes forces.
   void remove_particles(const std::vector<char>& remove);
+  /// A particle that takes the place of part of another at run time (a fragment).
+  struct Fragment {
+    std::size_t parent = 0;  ///< index of the particle it replaces (removed in the same change)
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+    double radius = 0.0;
+    double mass = 0.0;     ///< [kg]; <= 0: from the material's density
+    double inertia = 0.0;  ///< [kg m^2] (with mass > 0)
+    int material = 0;
+  };
+  /// Removes the particles flagged in `remove` and appends `fragments` in their order, in one
+  /// change of the set; returns the index of the first fragment. Each fragment's parent must be
+  /// among the removed. By default this is remove_particles() followed by add_particle() (and
+  /// set_particle_mass() where a mass is given) for each fragment: the next step searches the
+  /// lists again, renumbers the particles when set_sort_interval() asks for it at a build, and
+  /// computes the forces again. With set_local_fragment_insertion(true), lists built for the set
+  /// before the change and every fragment's sphere inside its parent's, the lists take the
+  /// fragments in without a search (NeighborList::insert_offspring(): a fragment's pairs are
+  /// found among its parent's listed neighbours) and stay valid; no renumbering; each fragment
+  /// starts with its parent's accelerations (the shares of the parent's last force and torque by
+  /// mass and moment of inertia) until the next force pass, the other particles keep their
+  /// forces. A bed that crushes then pays no neighbour search and no force pass for a change.
+  std::size_t replace_particles(const std::vector<char>& remove,
+                                const std::vector<Fragment>& fragments);
+  void set_local_fragment_insertion(bool on) { local_fragments_ = on; }
+  bool local_fragment_insertion() const { return local_fragments_; }
+  /// How many changes of the set replace_particles() took in without a search.
+  long local_insertions() const { return local_insertions_; }
   /// Renumbers the particles: new index k holds old particle order[k] (a permutation); ids,
   /// every per-particle array and the contact histories follow.
   void renumber_particles(const std::vector<int>& order);
@@ -289,6 +318,13 @@ class System {
   std::size_t particle_count() const { return store_.size(); }
   const ContactModel& contact_model() const { return model_; }
   const NeighborList& neighbor_list() const { return neighbors_; }
+  /// Whether the neighbour lists are those of the current particle set (every touching pair and
+  /// mesh contact is among them): true after a step, false after a change of the set that the
+  /// next step searches for again.
+  bool lists_current() const {
+    return lists_current_ && neighbors_.built() &&
+           neighbors_.position_at_build_.size() == store_.size();
+  }
   /// The mesh contacts: rows of the particles near a mesh at the last list build (row_count()),
   /// their contacts of the last force pass (contact_count()).
   const MeshContacts& mesh_contacts() const { return mesh_contacts_; }
@@ -514,6 +550,14 @@ class System {
   long sorts_ = 0;
   CellOrder cell_order_;
   std::vector<int> new_of_old_;  // scratch of remove_particles() / renumber_particles()
+  bool local_fragments_ = false;
+  long local_insertions_ = 0;
+  std::vector<NeighborList::Offspring> offspring_;  // scratch of replace_particles()
+  struct ParentShare {
+    Eigen::Vector3d force, torque;
+    double mass, inertia;
+  };
+  std::vector<ParentShare> share_;  // (the same)
   // scratch of pack_particles() / unpack_particles() (kept: no allocation once grown)
   std::vector<char> chosen_;
   std::vector<std::int64_t> chosen_ids_;
