@@ -9,7 +9,8 @@
 // breakage events, list builds, local insertions, and the ratio of the two times.
 // Wall-clock on a possibly shared machine: read with care.
 //
-// usage: bench_crushing [--granules N] [--steps S] [--settle S]
+// usage: bench_crushing [--granules N] [--steps S] [--settle S] [--energy] [--only search|local]
+// (--energy: with the energy accounting, as the double hull's cases run)
 
 #include "partita/dem/breakage.hpp"
 #include "partita/dem/packing_generator.hpp"
@@ -32,7 +33,7 @@ struct Result {
   long steps = 0, events = 0, builds = 0, local = 0, particles = 0;
 };
 
-Result run(const Packing& pk, double box, bool local, long settle, long steps) {
+Result run(const Packing& pk, double box, bool local, long settle, long steps, bool energy) {
   System sys;
   const int glass = sys.add_material({4.0e9, 0.22, 2500.0});
   sys.add_interaction(glass, glass, {0.5, 0.5, 0.1});
@@ -47,6 +48,7 @@ Result run(const Packing& pk, double box, bool local, long settle, long steps) {
   (void)platen;
   sys.set_sort_interval(10);
   sys.set_local_fragment_insertion(local);
+  sys.set_energy_tracking(energy);
   BreakageParameters b;
   b.limit_strength = 20e6;
   b.reference_size = 4e-3;
@@ -80,6 +82,8 @@ Result run(const Packing& pk, double box, bool local, long settle, long steps) {
 int main(int argc, char** argv) {
   double granules = 50000;
   long steps = 400, settle = 100;
+  bool energy = false;
+  std::string only;  // search or local: that run alone (for a profiler)
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--granules" && i + 1 < argc) {
@@ -88,8 +92,12 @@ int main(int argc, char** argv) {
       steps = std::stol(argv[++i]);
     } else if (a == "--settle" && i + 1 < argc) {
       settle = std::stol(argv[++i]);
+    } else if (a == "--only" && i + 1 < argc) {
+      only = argv[++i];
+    } else if (a == "--energy") {
+      energy = true;
     } else {
-      std::fprintf(stderr, "usage: bench_crushing [--granules N] [--steps S] [--settle S]\n");
+      std::fprintf(stderr, "usage: bench_crushing [--granules N] [--steps S] [--settle S] [--energy] [--only search|local]\n");
       return 2;
     }
   }
@@ -107,17 +115,19 @@ int main(int argc, char** argv) {
   spec.seed = 1;
   const Packing pk = PackingGenerator::generate(spec);
   std::printf("bench_crushing: %ld granules in a %.3f m box, platen at 2 m/s, %d thread(s); %ld steps "
-              "untimed, %ld timed\n",
-              static_cast<long>(pk.radii.size()), box, max_threads(), settle, steps);
+              "untimed, %ld timed%s\n",
+              static_cast<long>(pk.radii.size()), box, max_threads(), settle, steps,
+              energy ? ", energy accounting" : "");
   std::printf("%-8s %9s %9s %14s %8s %8s %8s %10s\n", "lists", "time [s]", "steps/s",
               "particle-st/s", "events", "builds", "local", "particles");
   Result r[2];
   for (int k = 0; k < 2; ++k) {
-    r[k] = run(pk, box, k == 1, settle, steps);
+    if (!only.empty() && only != (k == 1 ? "local" : "search")) continue;
+    r[k] = run(pk, box, k == 1, settle, steps, energy);
     std::printf("%-8s %9.2f %9.1f %14.3e %8ld %8ld %8ld %10ld\n", k == 1 ? "local" : "search",
                 r[k].seconds, r[k].steps / r[k].seconds, r[k].particles * r[k].steps / r[k].seconds,
                 r[k].events, r[k].builds, r[k].local, r[k].particles);
   }
-  std::printf("ratio search/local time: %.2f\n", r[0].seconds / r[1].seconds);
+  if (only.empty()) std::printf("ratio search/local time: %.2f\n", r[0].seconds / r[1].seconds);
   return 0;
 }
