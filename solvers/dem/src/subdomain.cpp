@@ -387,6 +387,13 @@ void Subdomain::unpack_moves(const SubdomainMail& in, GlobalOrder& order,
   }
 }
 
+void Subdomain::pack_owned(std::vector<std::byte>& out) {
+  near_.clear();
+  for (std::size_t i = 0; i < sys_->particle_count(); ++i)
+    if (!is_ghost(i)) near_.push_back(static_cast<int>(i));
+  sys_->pack_particles(near_, out);
+}
+
 void Subdomain::add_kinetic(ExactSum* sums) {
   const Particles& p = sys_->particles();
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -500,6 +507,14 @@ void SubdomainStepper::start(double dt) {
   redistribute();
   started_ = true;
   for (Subdomain& s : subdomains_) s.forces(dt, false);
+}
+
+void SubdomainStepper::resume() {
+  if (started_)
+    throw Error("SubdomainStepper::resume: the stepper has started already; resume() replaces "
+                "start() for the particles of a restart");
+  redistribute();
+  started_ = true;
 }
 
 void SubdomainStepper::step(double dt) {

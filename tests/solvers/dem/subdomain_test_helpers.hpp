@@ -33,7 +33,8 @@ T read_at(const std::byte* at) {
 /// message sizes, then the two messages) replaced by rewrite(message, bytes).
 class RewritingTransport final : public SubdomainTransport {
  public:
-  using Rewrite = std::function<std::vector<std::byte>(const std::byte* message, std::size_t bytes)>;
+  using Rewrite =
+      std::function<std::vector<std::byte>(const std::byte* message, std::size_t bytes)>;
   RewritingTransport(SubdomainTransport& inner, Rewrite rewrite)
       : inner_(inner), rewrite_(std::move(rewrite)) {}
   int parts() const override { return inner_.parts(); }
@@ -116,8 +117,7 @@ inline std::size_t differing(const MotionById& a, const MotionById& ref) {
   std::size_t n = 0;
   for (const auto& [id, s] : ref) {
     const auto it = a.find(id);
-    n += it == a.end() || it->second.x != s.x || it->second.v != s.v || it->second.w != s.w ? 1
-                                                                                            : 0;
+    n += it == a.end() || it->second.x != s.x || it->second.v != s.v || it->second.w != s.w ? 1 : 0;
   }
   return n;
 }

@@ -3,8 +3,10 @@
 // the coupling moves an FE surface) and squeezed by a moving side plane, steps to the same bits
 // on 1, 2, 3 and 4 subdomains, and the mesh's force per triangle and in total, summed over the
 // subdomains' owned particles, is the same on any split; each System's own mesh forces count
-// its ghosts' contacts and differ (the comparison can fail). A split whose subdomain is empty
-// at first (its walls and mesh must move all the same) keeps the bits once particles reach it.
+// its ghosts' contacts and differ (the comparison can fail), and without the mesh histories in
+// the build messages the split differs. A split whose subdomain is empty at first (its walls
+// and mesh must move all the same) keeps the bits once particles reach it. A restart written on
+// P subdomains resumes on M with the bits of 1 on 1.
 
 #include "subdomain_test_helpers.hpp"
 
@@ -19,6 +21,8 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <sstream>
+#include <utility>
 
 using namespace partita::dem;
 
@@ -30,7 +34,7 @@ constexpr double kPlateStart = kBedHeight + 0.3e-3;  // the plate's height at fi
 constexpr double kPlateSpeed = 0.8;                  // down [m/s]
 constexpr double kBulge = 0.3e-3;                    // the plate's sag at the end [m]
 constexpr double kSideSpeed = 0.5;                   // the +x plane, inwards [m/s]
-constexpr int kCells = 8;                            // the plate: kCells^2 squares, 2 triangles each
+constexpr int kCells = 8;  // the plate: kCells^2 squares, 2 triangles each
 constexpr long kSteps = 300;
 const Eigen::Vector3d kLo = Eigen::Vector3d::Zero();
 const Eigen::Vector3d kHi(kWidth, kWidth, kBoxHeight);
@@ -56,7 +60,8 @@ Eigen::MatrixX3d plate(double t, double t_end) {
       const double a = kWidth * i / kCells, b = kWidth * j / kCells;
       x.row(j * (kCells + 1) + i) << a, b,
           kPlateStart - kPlateSpeed * t -
-              sag * std::sin(std::numbers::pi * a / kWidth) * std::sin(std::numbers::pi * b / kWidth);
+              sag * std::sin(std::numbers::pi * a / kWidth) *
+                  std::sin(std::numbers::pi * b / kWidth);
     }
   return x;
 }
@@ -119,9 +124,9 @@ struct Run {
   std::size_t ghosts_at_end = 0;
   bool empty_at_first = false;  // some subdomain held no particle after the first step
   bool all_owning_at_end = true;
-  Eigen::MatrixX3d triangle, vertex;     // SubdomainStepper's, at the end
+  Eigen::MatrixX3d triangle, vertex;  // SubdomainStepper's, at the end
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
-  Eigen::MatrixX3d system_triangle;      // System::triangle_forces(0) summed over the subdomains
+  Eigen::MatrixX3d system_triangle;  // System::triangle_forces(0) summed over the subdomains
   Eigen::Vector3d system_total = Eigen::Vector3d::Zero();  // System::mesh_force(0) summed
   Eigen::Vector3d wall = Eigen::Vector3d::Zero();          // SubdomainStepper::wall_force(1)
   std::size_t contacts = 0;  // the owned particles' mesh contacts at the end
@@ -135,11 +140,44 @@ std::vector<Eigen::Vector3d> start_positions() {
   return x0;
 }
 
-// The bed split by `d` (parts = its boxes), kSteps steps; `recut_at` > 0: a bisection of the
-// positions of that step from then on.
-Run run_split(const DomainDecomposition& d, long recut_at = 0,
-              bool without_mesh_histories = false) {
-  const int parts = d.parts();
+// What a run does besides stepping: a re-cut (a bisection of the positions of step recut_at
+// from then on), the mesh contacts taken out of the build messages, a restart at step
+// restart_at on restart_parts subdomains.
+struct Plan {
+  long recut_at = 0;
+  bool without_mesh_histories = false;
+  long restart_at = 0;
+  int restart_parts = 1;
+};
+
+// A restart of `old` (its systems `old_systems`) on `parts` subdomains: each old subdomain's
+// owned particles and the first one's System state (walls, plate, time), new Systems restored
+// from that state with its particles removed, the particles unpacked into the first of them.
+std::vector<std::unique_ptr<System>> restart_systems(
+    SubdomainStepper& old, const std::vector<std::unique_ptr<System>>& old_systems, int parts) {
+  std::vector<std::vector<std::byte>> owned(old_systems.size());
+  for (int k = 0; k < old.local_count(); ++k)
+    if (old.subdomain(k).owned_count() > 0) old.subdomain(k).pack_owned(owned[k]);
+  std::stringstream world;
+  old_systems[0]->write_state(world);
+  std::vector<std::unique_ptr<System>> systems;
+  for (int j = 0; j < parts; ++j) {
+    auto sys = subdomain_system({});
+    sys->store().add_array<int>("subdomain_owner", 1, -1);  // (as the old split's Systems)
+    world.seekg(0);
+    sys->read_state(world);
+    sys->remove_particles(std::vector<char>(sys->particle_count(), 1));
+    if (j == 0)
+      for (const std::vector<std::byte>& m : owned)
+        if (!m.empty()) sys->unpack_particles(m.data(), m.size());
+    systems.push_back(std::move(sys));
+  }
+  return systems;
+}
+
+// The bed split by `d` (parts = its boxes), kSteps steps.
+Run run_split(const DomainDecomposition& d, const Plan& plan = {}) {
+  int parts = d.parts();
   const std::vector<Eigen::Vector3d> x0 = start_positions();
   std::vector<std::vector<int>> keep(static_cast<std::size_t>(parts));
   for (std::size_t i = 0; i < x0.size(); ++i) keep[d.owner(x0[i])].push_back(static_cast<int>(i));
@@ -149,31 +187,48 @@ Run run_split(const DomainDecomposition& d, long recut_at = 0,
     systems.push_back(subdomain_system(keep[k]));
     raw.push_back(systems.back().get());
   }
-  InProcessTransport in_process(parts);
+  auto in_process = std::make_unique<InProcessTransport>(parts);
   long stripped = 0;
-  test::RewritingTransport stripping(in_process, [&](const std::byte* m, std::size_t bytes) {
+  test::RewritingTransport stripping(*in_process, [&](const std::byte* m, std::size_t bytes) {
     return without_mesh_contacts(*systems[0], m, bytes, stripped);
   });
-  SubdomainTransport& transport =
-      without_mesh_histories ? static_cast<SubdomainTransport&>(stripping) : in_process;
-  SubdomainStepper stepper(raw, transport, d, kSkin);
+  SubdomainTransport* transport =
+      plan.without_mesh_histories ? static_cast<SubdomainTransport*>(&stripping) : in_process.get();
+  auto stepper = std::make_unique<SubdomainStepper>(raw, *transport, d, kSkin);
   const double dt = time_step(), t_end = kSteps * dt;
   Run out;
   for (long s = 0; s < kSteps; ++s) {
-    if (recut_at > 0 && s == recut_at)
-      stepper.set_decomposition(
-          DomainDecomposition::bisection(test::owned_positions(stepper), kLo, kCutHi, parts));
+    if (plan.recut_at > 0 && s == plan.recut_at)
+      stepper->set_decomposition(
+          DomainDecomposition::bisection(test::owned_positions(*stepper), kLo, kCutHi, parts));
+    if (plan.restart_at > 0 && s == plan.restart_at) {
+      std::vector<std::unique_ptr<System>> next =
+          restart_systems(*stepper, systems, plan.restart_parts);
+      parts = plan.restart_parts;
+      const Particles& p = next[0]->particles();
+      const std::vector<Eigen::Vector3d> x(p.position.begin(), p.position.end());
+      raw.clear();
+      for (auto& sys : next) raw.push_back(sys.get());
+      auto next_transport = std::make_unique<InProcessTransport>(parts);
+      auto next_stepper = std::make_unique<SubdomainStepper>(
+          raw, *next_transport, DomainDecomposition::bisection(x, kLo, kCutHi, parts), kSkin);
+      stepper = std::move(next_stepper);  // (the old stepper before its systems)
+      systems = std::move(next);
+      in_process = std::move(next_transport);
+      stepper->resume();
+    }
     const Eigen::MatrixX3d xp = plate((s + 1) * dt, t_end);  // the plate at the step's end
     for (System* sys : raw) sys->set_vertex_positions(0, xp);
-    stepper.step(dt);
+    stepper->step(dt);
     if (s == 0)
       for (System* sys : raw) out.empty_at_first = out.empty_at_first || sys->particle_count() == 0;
   }
   for (int k = 0; k < parts; ++k) {
-    const Subdomain& sd = stepper.subdomain(k);
+    const Subdomain& sd = stepper->subdomain(k);
     const Particles& p = systems[k]->particles();
     for (std::size_t i = 0; i < p.size(); ++i)
-      if (!sd.is_ghost(i)) out.state[p.id[i]] = {p.position[i], p.velocity[i], p.angular_velocity[i]};
+      if (!sd.is_ghost(i))
+        out.state[p.id[i]] = {p.position[i], p.velocity[i], p.angular_velocity[i]};
     sd.system().mesh_contacts().for_each_contact(
         [&](int i, const MeshContactRecord&, const Eigen::Vector3d&) {
           out.contacts += sd.is_ghost(static_cast<std::size_t>(i)) ? 0 : 1;
@@ -182,16 +237,16 @@ Run run_split(const DomainDecomposition& d, long recut_at = 0,
     out.ghosts_at_end += sd.ghost_count();
     out.all_owning_at_end = out.all_owning_at_end && sd.owned_count() > 0;
   }
-  out.triangle = stepper.triangle_forces(0);
-  out.vertex = stepper.vertex_forces(0);
-  out.total = stepper.mesh_force(0);
-  out.wall = stepper.wall_force(1);
+  out.triangle = stepper->triangle_forces(0);
+  out.vertex = stepper->vertex_forces(0);
+  out.total = stepper->mesh_force(0);
+  out.wall = stepper->wall_force(1);
   out.system_triangle.setZero(out.triangle.rows(), 3);
   for (int k = 0; k < parts; ++k) {
     out.system_triangle += systems[k]->triangle_forces(0);
     out.system_total += systems[k]->mesh_force(0);
   }
-  out.builds = stepper.builds();
+  out.builds = stepper->builds();
   out.stripped = stripped;
   return out;
 }
@@ -200,10 +255,14 @@ Run run_bisection(int parts) {
   return run_split(DomainDecomposition::bisection(start_positions(), kLo, kCutHi, parts));
 }
 
-std::size_t differing(const Run& a, const Run& ref) { return test::differing(a.state, ref.state); }
+std::size_t differing(const Run& a, const Run& ref) {
+  return test::differing(a.state, ref.state);
+}
 
 // The sum of |force| over the triangles (the scale of a rounding difference).
-double scale(const Eigen::MatrixX3d& f) { return f.rowwise().norm().sum(); }
+double scale(const Eigen::MatrixX3d& f) {
+  return f.rowwise().norm().sum();
+}
 
 const Run& reference() {
   static const Run r = run_bisection(1);
@@ -212,9 +271,10 @@ const Run& reference() {
 
 }  // namespace
 
-TEST_CASE("dem: subdomains: a bed pressed by a moving mesh plate steps to the same bits and "
-          "mesh forces on 1 to 4 subdomains",
-          "[dem][subdomains]") {
+TEST_CASE(
+    "dem: subdomains: a bed pressed by a moving mesh plate steps to the same bits and "
+    "mesh forces on 1 to 4 subdomains",
+    "[dem][subdomains]") {
   const Run& ref = reference();
   REQUIRE(ref.state.size() == static_cast<std::size_t>(bed().x.rows()));
   REQUIRE(ref.state.size() > 1000);
@@ -254,17 +314,21 @@ TEST_CASE("dem: subdomains: a bed pressed by a moving mesh plate steps to the sa
   }
 }
 
-TEST_CASE("dem: subdomains: a subdomain empty at first moves its walls and mesh and keeps the "
-          "bits when particles reach it",
-          "[dem][subdomains]") {
+TEST_CASE(
+    "dem: subdomains: a subdomain empty at first moves its walls and mesh and keeps the "
+    "bits when particles reach it",
+    "[dem][subdomains]") {
   // cuts made for the bed and twice as many points again near the top of the bounds: two boxes
-  // above the bed hold nothing (no ghost either); then a bisection of the particles gives every subdomain some
+  // above the bed hold nothing (no ghost either); then a bisection of the particles gives every
+  // subdomain some
   std::vector<Eigen::Vector3d> x = start_positions();
   const std::size_t n = x.size();
   for (std::size_t k = 0; k < 2 * n; ++k)
     x.emplace_back(kWidth * (k % 97) / 97.0, kWidth * (k % 89) / 89.0, kCutHi.z() - 0.5e-3);
   const DomainDecomposition d = DomainDecomposition::bisection(x, kLo, kCutHi, 3);
-  const Run split = run_split(d, kSteps / 3);
+  Plan plan;
+  plan.recut_at = kSteps / 3;
+  const Run split = run_split(d, plan);
   CHECK(split.empty_at_first);
   CHECK(split.all_owning_at_end);
   CHECK(differing(split, reference()) == 0);
@@ -274,18 +338,49 @@ TEST_CASE("dem: subdomains: a subdomain empty at first moves its walls and mesh 
 
 TEST_CASE("dem: subdomains: without the mesh histories in the messages the split differs",
           "[dem][subdomains]") {
-  const Run split = run_split(
-      DomainDecomposition::bisection(start_positions(), kLo, kCutHi, 3), 0, true);
+  Plan plan;
+  plan.without_mesh_histories = true;
+  const Run split =
+      run_split(DomainDecomposition::bisection(start_positions(), kLo, kCutHi, 3), plan);
   CHECK(split.stripped > 0);
   CHECK(differing(split, reference()) > 0);
 }
 
-TEST_CASE("dem: subdomains: the mesh sums refuse a mesh the split does not have",
+TEST_CASE("dem: subdomains: a restart written on P subdomains resumes on M with the same bits",
           "[dem][subdomains]") {
+  const auto restarted = [](int written, int resumed) {
+    Plan plan;
+    plan.restart_at = kSteps / 2;
+    plan.restart_parts = resumed;
+    return run_split(DomainDecomposition::bisection(start_positions(), kLo, kCutHi, written), plan);
+  };
+  const Run one = restarted(1, 1);
+  REQUIRE(one.state.size() == reference().state.size());
+  CHECK(one.builds >= 5);  // (after the restart)
+  // the restart carries everything: the run goes on as it would have, up to rounding (a list
+  // build at the restart may renumber particles: their contacts summed in another order)
+  double off = 0.0;
+  for (const auto& [id, s] : reference().state)
+    off = std::max(off, (one.state.at(id).x - s.x).norm());
+  CHECK(off < 1e-6);
+  for (const auto& [written, resumed] : std::vector<std::pair<int, int>>{{2, 3}, {3, 1}, {4, 2}}) {
+    CAPTURE(written, resumed);
+    const Run split = restarted(written, resumed);
+    CHECK(differing(split, one) == 0);
+    CHECK(split.triangle == one.triangle);
+    CHECK(split.wall == one.wall);
+  }
+}
+
+TEST_CASE(
+    "dem: subdomains: the mesh sums refuse a mesh the split does not have, resume() a "
+    "started run",
+    "[dem][subdomains]") {
   const std::vector<Eigen::Vector3d> x0 = start_positions();
   const DomainDecomposition d = DomainDecomposition::bisection(x0, kLo, kCutHi, 2);
   std::vector<int> a, b;
-  for (std::size_t i = 0; i < x0.size(); ++i) (d.owner(x0[i]) == 0 ? a : b).push_back(static_cast<int>(i));
+  for (std::size_t i = 0; i < x0.size(); ++i)
+    (d.owner(x0[i]) == 0 ? a : b).push_back(static_cast<int>(i));
   auto sa = subdomain_system(a), sb = subdomain_system(b);
   InProcessTransport transport(2);
   SubdomainStepper stepper({sa.get(), sb.get()}, transport, d, kSkin);
@@ -293,4 +388,5 @@ TEST_CASE("dem: subdomains: the mesh sums refuse a mesh the split does not have"
   CHECK_THROWS_AS(stepper.triangle_forces(1), Error);
   CHECK_THROWS_AS(stepper.mesh_force(-1), Error);
   CHECK(stepper.mesh_force(0).allFinite());
+  CHECK_THROWS_AS(stepper.resume(), Error);  // (a started stepper)
 }

@@ -65,6 +65,11 @@
 //  - Ghosts: a ghost's owner is the box that holds it at the build (DomainDecomposition::owner()),
 //    not the subdomain that sent the copy: a particle leaving subdomain a for b that is also a
 //    ghost in c is sent to c by a, and refreshed by b until the next build.
+//  - Restarts: a split bed's owned particles (Subdomain::pack_owned(): arrays, forces, pair
+//    histories by id, plane and mesh histories) with one subdomain's System state for the walls,
+//    meshes and time resume on any number of subdomains (SubdomainStepper::resume()), with the
+//    same bits whatever the split that wrote them and the split that resumes. The restart file
+//    that holds them (one per process or gathered) is not written yet.
 //  - Energy sums: SubdomainStepper::kinetic_energy() and linear_momentum() are the same on any
 //    split (exact sums over the owned particles, ExactSum, rounded once: they may differ from
 //    System::kinetic_energy()'s ordered sum in the last bits), and so is elastic_energy() (each
@@ -79,7 +84,10 @@
 // Call order: SubdomainStepper(systems, transport, decomposition, skin) with each System set up
 // alike (materials, interactions, gravity, walls, meshes; the particles in any subdomain, ids
 // unique over all), then start(dt) (migration, ghosts, lists, the first forces), then step(dt)
-// or run(); set_decomposition() re-cuts the bed at the next list build.
+// or run(); set_decomposition() re-cuts the bed at the next list build. A restart on another
+// split: each subdomain's Subdomain::pack_owned() and one subdomain's System state (the walls,
+// meshes and time, alike on all); new Systems restored from that state with its particles
+// removed, the messages unpacked into any of them, then resume() instead of start().
 //
 // The byte formats (both ends have the same byte order and types, as for state files):
 //   at a build, to each subdomain d: "PSDM" (u32 magic), version (u32), the migrants' message
@@ -186,6 +194,11 @@ class Subdomain {
   /// kinetic_energy()'s terms) to sums[0] and their linear momentum m v to sums[1..3].
   void add_kinetic(ExactSum* sums);
   void add_elastic(ExactSum& sum) const { sys_->add_elastic_energy(ghost_, sum); }
+  /// Appends the owned particles as one System::pack_particles() message (everything they carry:
+  /// arrays, forces of the last pass, pair histories by id, plane and mesh histories): with the
+  /// world's state (walls, meshes, time: any subdomain's System state, they are alike) what a
+  /// restart needs, whatever the split (SubdomainStepper::resume()).
+  void pack_owned(std::vector<std::byte>& out);
   /// Adds the owned particles' reactions on the planes to sums[3 w + c] (wall w, component c).
   void add_wall_forces(ExactSum* sums) const;
   /// Adds the owned particles' contacts with mesh `mesh` in the last pass to `sums` (each
@@ -230,6 +243,14 @@ class SubdomainStepper {
 
   /// Migration, ghosts, lists and the forces of a pass without a kick (before the first step).
   void start(double dt);
+  /// Instead of start() for particles that bring the forces of their last pass (a restart: the
+  /// pack_owned() messages of a split bed unpacked into any of these Systems, each set up with
+  /// the world's state): migration, ghosts and lists, no force pass. The steps that follow are
+  /// the same bits whatever the split that wrote the restart and whatever this one. They may
+  /// differ from the run that went on without the restart in the last bits: that one builds its
+  /// lists on other steps, and a build renumbers the particles (a particle's contacts summed in
+  /// another order).
+  void resume();
   void step(double dt);
   void run(long steps, double dt);
   /// A new decomposition (same bounds), used from the next list build on (a rebalance: the
