@@ -123,12 +123,15 @@ void MeshForceSums::write(std::vector<std::byte>& out) const {
   }
 }
 
-void MeshForceSums::add_message(const std::vector<std::byte>& in, const std::string& source) {
+void MeshForceSums::add_message(const std::vector<std::byte>& in, int source_rank) {
+  const auto source = [&] {
+    return "SubdomainStepper: the mesh forces of subdomain " + std::to_string(source_rank);
+  };
   constexpr std::size_t b = ExactSum::byte_size;
   const auto n = in.size() >= 8 ? get<std::uint64_t>(in.data()) : 0;
   if (in.size() < 8 + 3 * b || (in.size() - 8 - 3 * b) % (8 + 3 * b) != 0 ||
       (in.size() - 8 - 3 * b) / (8 + 3 * b) != n)
-    throw Error(source + " is not a mesh's force sums (" + std::to_string(in.size()) +
+    throw Error(source() + " are not a mesh's force sums (" + std::to_string(in.size()) +
                 " bytes; the subdomains differ)");
   ExactSum part;
   const std::byte* at = in.data() + 8;
@@ -137,7 +140,7 @@ void MeshForceSums::add_message(const std::vector<std::byte>& in, const std::str
     const auto v = get<std::int64_t>(at);
     at += 8;
     if (v < 0 || static_cast<std::size_t>(v) >= slot_.size())
-      throw Error(source + " names vertex " + std::to_string(v) + " of a mesh of " +
+      throw Error(source() + " name vertex " + std::to_string(v) + " of a mesh of " +
                   std::to_string(slot_.size()) + " vertices (the subdomains' meshes differ)");
     ExactSum* s = vertex_sums(static_cast<int>(v));
     for (int c = 0; c < 3; ++c) part.read(at), s[c].add(part), at += b;
@@ -622,9 +625,7 @@ void SubdomainStepper::mesh_sums(int mesh) {
   }
   transport_->exchange(out_, in_);
   mesh_all_.reset(nv);
-  for (std::size_t s = 0; s < in_[0].size(); ++s)
-    mesh_all_.add_message(in_[0][s], "SubdomainStepper: the mesh forces of subdomain " +
-                                         std::to_string(s));
+  for (std::size_t s = 0; s < in_[0].size(); ++s) mesh_all_.add_message(in_[0][s], static_cast<int>(s));
   mesh_all_.values(mesh_vertex_, mesh_total_);
   // each vertex's share: 1 / (its active triangles), as TriangleMesh keeps it
   mesh_share_.assign(static_cast<std::size_t>(nv), 0.0);

@@ -389,4 +389,15 @@ TEST_CASE(
   CHECK_THROWS_AS(stepper.mesh_force(-1), Error);
   CHECK(stepper.mesh_force(0).allFinite());
   CHECK_THROWS_AS(stepper.resume(), Error);  // (a started stepper)
+  // a message of sums cut short, or naming a vertex the mesh does not have
+  MeshForceSums sums, other;
+  sums.reset(4);
+  sums.add_vertex(3, Eigen::Vector3d(1, 2, 3));
+  std::vector<std::byte> m;
+  sums.write(m);
+  other.reset(3);
+  CHECK_THROWS_AS(other.add_message(m, 1), Error);
+  m.pop_back();
+  other.reset(4);
+  CHECK_THROWS_AS(other.add_message(m, 1), Error);
 }

@@ -146,8 +146,8 @@ class MeshForceSums {
   /// its index (i64) and 3 ExactSum.
   void write(std::vector<std::byte>& out) const;
   /// Adds the sums of a message that write() made for a mesh with as many vertices; throws
-  /// Error (naming `source`) when it does not fit.
-  void add_message(const std::vector<std::byte>& in, const std::string& source);
+  /// Error (naming subdomain `source`) when it does not fit.
+  void add_message(const std::vector<std::byte>& in, int source);
   /// The sums rounded: the vertices' forces (untouched ones zero) and the total.
   void values(Eigen::MatrixX3d& vertex, Eigen::Vector3d& total) const;
 
