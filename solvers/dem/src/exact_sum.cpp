@@ -96,4 +96,36 @@ void ExactSum::read(const std::byte* in) {
   std::memcpy(&special_, in + sizeof limb_ + 8, 8);
 }
 
+std::pair<int, int> ExactSum::used() const {
+  int first = 0, last = limb_count;
+  while (first < limb_count && limb_[first] == 0) ++first;
+  if (first == limb_count) return {0, 0};
+  while (limb_[last - 1] == 0) --last;
+  return {first, last - first};
+}
+
+std::size_t ExactSum::compact_size() const { return 2 + 8 * static_cast<std::size_t>(used().second) + 16; }
+
+void ExactSum::write_compact(std::byte* out) const {
+  const auto [first, count] = used();
+  out[0] = static_cast<std::byte>(first);
+  out[1] = static_cast<std::byte>(count);
+  std::memcpy(out + 2, limb_.data() + first, 8 * static_cast<std::size_t>(count));
+  std::memcpy(out + 2 + 8 * count, &pending_, 8);
+  std::memcpy(out + 2 + 8 * count + 8, &special_, 8);
+}
+
+std::size_t ExactSum::read_compact(const std::byte* in, std::size_t bytes) {
+  if (bytes < 18) return 0;
+  const int first = static_cast<int>(in[0]), count = static_cast<int>(in[1]);
+  const std::size_t size = 18 + 8 * static_cast<std::size_t>(count);
+  if (first + count > limb_count || bytes < size) return 0;
+  limb_.fill(0);
+  std::memcpy(limb_.data() + first, in + 2, 8 * static_cast<std::size_t>(count));
+  std::memcpy(&pending_, in + 2 + 8 * count, 8);
+  std::memcpy(&special_, in + 2 + 8 * count + 8, 8);
+  if (pending_ < 0 || pending_ >= (std::int64_t{1} << 30)) return 0;
+  return size;
+}
+
 }  // namespace partita::dem

@@ -107,44 +107,60 @@ void MeshForceSums::add_total(const Eigen::Vector3d& f) {
   for (int c = 0; c < 3; ++c) total_[c].add(f[c]);
 }
 
+// The sums in ExactSum's compact form (a vertex's force is a sum of a few terms of like size: a
+// few of the 70 limbs in use, some 60 bytes a sum instead of 576).
 void MeshForceSums::write(std::vector<std::byte>& out) const {
-  constexpr std::size_t b = ExactSum::byte_size;
+  std::size_t size = 8;
+  for (const ExactSum& t : total_) size += t.compact_size();
+  for (std::size_t k = 0; k < 3 * vertex_.size(); ++k) size += sums_[k].compact_size();
+  size += 8 * vertex_.size();
   std::size_t at = out.size();
-  out.resize(at + 8 + 3 * b + vertex_.size() * (8 + 3 * b));
+  out.resize(at + size);
   const std::uint64_t n = vertex_.size();
   std::memcpy(out.data() + at, &n, 8);
   at += 8;
-  for (const ExactSum& t : total_) t.write(out.data() + at), at += b;
+  for (const ExactSum& t : total_) t.write_compact(out.data() + at), at += t.compact_size();
   for (std::size_t k = 0; k < vertex_.size(); ++k) {
     const std::int64_t v = vertex_[k];
     std::memcpy(out.data() + at, &v, 8);
     at += 8;
-    for (int c = 0; c < 3; ++c) sums_[3 * k + c].write(out.data() + at), at += b;
+    for (int c = 0; c < 3; ++c) {
+      const ExactSum& e = sums_[3 * k + c];
+      e.write_compact(out.data() + at);
+      at += e.compact_size();
+    }
   }
 }
 
 void MeshForceSums::add_message(const std::vector<std::byte>& in, int source_rank) {
-  const auto source = [&] {
-    return "SubdomainStepper: the mesh forces of subdomain " + std::to_string(source_rank);
+  const auto refuse = [&](const std::string& why) {
+    throw Error("SubdomainStepper: the mesh forces of subdomain " + std::to_string(source_rank) +
+                " " + why + " (the subdomains differ)");
   };
-  constexpr std::size_t b = ExactSum::byte_size;
-  const auto n = in.size() >= 8 ? get<std::uint64_t>(in.data()) : 0;
-  if (in.size() < 8 + 3 * b || (in.size() - 8 - 3 * b) % (8 + 3 * b) != 0 ||
-      (in.size() - 8 - 3 * b) / (8 + 3 * b) != n)
-    throw Error(source() + " are not a mesh's force sums (" + std::to_string(in.size()) +
-                " bytes; the subdomains differ)");
+  const std::byte* at = in.data();
+  const std::byte* const end = in.data() + in.size();
   ExactSum part;
-  const std::byte* at = in.data() + 8;
-  for (ExactSum& t : total_) part.read(at), t.add(part), at += b;
+  const auto read_sum = [&](ExactSum& into) {
+    const std::size_t took = part.read_compact(at, static_cast<std::size_t>(end - at));
+    if (took == 0) refuse("are cut short or not a mesh's force sums");
+    into.add(part);
+    at += took;
+  };
+  if (in.size() < 8) refuse("are cut short or not a mesh's force sums");
+  const auto n = get<std::uint64_t>(at);
+  at += 8;
+  for (ExactSum& t : total_) read_sum(t);
   for (std::uint64_t k = 0; k < n; ++k) {
+    if (end - at < 8) refuse("are cut short or not a mesh's force sums");
     const auto v = get<std::int64_t>(at);
     at += 8;
     if (v < 0 || static_cast<std::size_t>(v) >= slot_.size())
-      throw Error(source() + " name vertex " + std::to_string(v) + " of a mesh of " +
-                  std::to_string(slot_.size()) + " vertices (the subdomains' meshes differ)");
+      refuse("name vertex " + std::to_string(v) + " of a mesh of " +
+             std::to_string(slot_.size()) + " vertices");
     ExactSum* s = vertex_sums(static_cast<int>(v));
-    for (int c = 0; c < 3; ++c) part.read(at), s[c].add(part), at += b;
+    for (int c = 0; c < 3; ++c) read_sum(s[c]);
   }
+  if (at != end) refuse("have bytes after their last vertex");
 }
 
 void MeshForceSums::values(Eigen::MatrixX3d& vertex, Eigen::Vector3d& total) const {

@@ -298,6 +298,19 @@ TEST_CASE("dem: exact sums: the exact sum rounded once, in any order and split",
   }
   CHECK(forward.value() == backward.value());
   CHECK(merged.value() == forward.value());
+  // the compact form carries the same sum in fewer bytes where few limbs are in use, and
+  // refuses bytes cut short
+  for (const ExactSum* x : {&forward, &a, &z}) {
+    std::vector<std::byte> compact(x->compact_size());
+    x->write_compact(compact.data());
+    ExactSum back;
+    CHECK(back.read_compact(compact.data(), compact.size()) == compact.size());
+    CHECK(back.value() == x->value());
+    CHECK(back.read_compact(compact.data(), compact.size() - 1) == 0);
+  }
+  ExactSum force;  // terms of one magnitude (a vertex's force): a few limbs
+  for (int k = 1; k <= 100; ++k) force.add(0.37 * k);
+  CHECK(force.compact_size() <= 18 + 8 * 4);
   // and close to a long double sum (correctly rounded to within the long sum's own error)
   long double sum = 0.0L;
   for (const double x : terms) sum += x;

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 
 namespace partita::dem {
 
@@ -31,12 +32,23 @@ class ExactSum {
   static constexpr std::size_t byte_size = 70 * 8 + 8 + 8;
   void write(std::byte* out) const;
   void read(const std::byte* in);
+  /// A shorter form for messages of many sums (a mesh's vertex forces over a split bed): only the
+  /// limbs in use (a sum of terms of a few magnitudes uses a few of the 70), compact_size()
+  /// bytes: the first limb in use and their count (u8 each), the limbs (i64), the additions
+  /// since the carries were propagated (i64) and the non-finite terms' sum (f64).
+  std::size_t compact_size() const;
+  void write_compact(std::byte* out) const;
+  /// Reads what write_compact() wrote from at most `bytes` bytes; returns the bytes it took, 0
+  /// when they do not hold a compact sum (cut short, or limbs out of range).
+  std::size_t read_compact(const std::byte* in, std::size_t bytes);
 
  private:
   static constexpr int limb_bits = 32;
   static constexpr int offset = 1126;  // bit 0 of limb 0 weighs 2^-1126
   static constexpr int limb_count = 70;
   void normalize();
+  // the limbs in use: [first, first + count)
+  std::pair<int, int> used() const;
 
   std::array<std::int64_t, limb_count> limb_{};
   std::int64_t pending_ = 0;  // additions since the last normalize()

@@ -142,8 +142,8 @@ class MeshForceSums {
   void reset(int vertices);
   void add_vertex(int vertex, const Eigen::Vector3d& f);
   void add_total(const Eigen::Vector3d& f);
-  /// Appends the sums: the touched count (u64), the total (3 ExactSum), then per touched vertex
-  /// its index (i64) and 3 ExactSum.
+  /// Appends the sums: the touched count (u64), the total (3 ExactSum::write_compact()), then per
+  /// touched vertex its index (i64) and 3 compact ExactSum.
   void write(std::vector<std::byte>& out) const;
   /// Adds the sums of a message that write() made for a mesh with as many vertices; throws
   /// Error (naming subdomain `source`) when it does not fit.
