@@ -12,6 +12,7 @@
 
 #include "partita/dem/domain_decomposition.hpp"
 #include "partita/dem/error.hpp"
+#include "partita/dem/parallel.hpp"
 #include "partita/dem/subdomain.hpp"
 
 #include <catch2/catch.hpp>
@@ -334,6 +335,17 @@ TEST_CASE(
   CHECK(differing(split, reference()) == 0);
   CHECK(split.triangle == reference().triangle);
   CHECK(split.wall == reference().wall);
+}
+
+TEST_CASE("dem: subdomains: the mesh forces of a split bed do not depend on the thread count",
+          "[dem][subdomains]") {
+  const int threads = max_threads();
+  set_num_threads(threads == 1 ? 2 : 1);
+  const Run split = run_bisection(3);
+  set_num_threads(threads);
+  CHECK(differing(split, reference()) == 0);
+  CHECK(split.triangle == reference().triangle);
+  CHECK(split.total == reference().total);
 }
 
 TEST_CASE("dem: subdomains: without the mesh histories in the messages the split differs",
