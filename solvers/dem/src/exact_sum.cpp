@@ -104,7 +104,9 @@ std::pair<int, int> ExactSum::used() const {
   return {first, last - first};
 }
 
-std::size_t ExactSum::compact_size() const { return 2 + 8 * static_cast<std::size_t>(used().second) + 16; }
+std::size_t ExactSum::compact_size() const {
+  return 2 + 8 * static_cast<std::size_t>(used().second) + 16;
+}
 
 void ExactSum::write_compact(std::byte* out) const {
   const auto [first, count] = used();

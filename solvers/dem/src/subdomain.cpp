@@ -641,7 +641,8 @@ void SubdomainStepper::mesh_sums(int mesh) {
   }
   transport_->exchange(out_, in_);
   mesh_all_.reset(nv);
-  for (std::size_t s = 0; s < in_[0].size(); ++s) mesh_all_.add_message(in_[0][s], static_cast<int>(s));
+  for (std::size_t s = 0; s < in_[0].size(); ++s)
+    mesh_all_.add_message(in_[0][s], static_cast<int>(s));
   mesh_all_.values(mesh_vertex_, mesh_total_);
   // each vertex's share: 1 / (its active triangles), as TriangleMesh keeps it
   mesh_share_.assign(static_cast<std::size_t>(nv), 0.0);
