@@ -6,7 +6,8 @@
 // (20 MPa at 4 mm, Weibull m 10, fragments equal-4 down to 2 mm, mass restored). Both runs
 // start from the same bed and take the same steps; the first `--settle` steps (same in both,
 // nothing breaks yet) are not timed. Prints per run: seconds, steps/s, particle-steps/s,
-// breakage events, list builds, local insertions, and the ratio of the two times.
+// breakage events, list builds, local insertions, the energy balance error (--energy), and the
+// ratio of the two times.
 // Wall-clock on a possibly shared machine: read with care.
 //
 // usage: bench_crushing [--granules N] [--steps S] [--settle S] [--energy] [--only search|local]
@@ -31,6 +32,7 @@ namespace {
 struct Result {
   double seconds = 0.0;
   long steps = 0, events = 0, builds = 0, local = 0, particles = 0;
+  double balance = 0.0;  // energy balance error (--energy)
 };
 
 Result run(const Packing& pk, double box, bool local, long settle, long steps, bool energy) {
@@ -74,6 +76,7 @@ Result run(const Packing& pk, double box, bool local, long settle, long steps, b
   r.builds = sys.neighbor_list().build_count() - builds0;
   r.local = sys.local_insertions();
   r.particles = particle_steps / std::max(steps, 1L);
+  r.balance = energy ? sys.energy_balance_error() : 0.0;
   return r;
 }
 
@@ -118,15 +121,15 @@ int main(int argc, char** argv) {
               "untimed, %ld timed%s\n",
               static_cast<long>(pk.radii.size()), box, max_threads(), settle, steps,
               energy ? ", energy accounting" : "");
-  std::printf("%-8s %9s %9s %14s %8s %8s %8s %10s\n", "lists", "time [s]", "steps/s",
-              "particle-st/s", "events", "builds", "local", "particles");
+  std::printf("%-8s %9s %9s %14s %8s %8s %8s %10s %9s\n", "lists", "time [s]", "steps/s",
+              "particle-st/s", "events", "builds", "local", "particles", "balance");
   Result r[2];
   for (int k = 0; k < 2; ++k) {
     if (!only.empty() && only != (k == 1 ? "local" : "search")) continue;
     r[k] = run(pk, box, k == 1, settle, steps, energy);
-    std::printf("%-8s %9.2f %9.1f %14.3e %8ld %8ld %8ld %10ld\n", k == 1 ? "local" : "search",
+    std::printf("%-8s %9.2f %9.1f %14.3e %8ld %8ld %8ld %10ld %9.2e\n", k == 1 ? "local" : "search",
                 r[k].seconds, r[k].steps / r[k].seconds, r[k].particles * r[k].steps / r[k].seconds,
-                r[k].events, r[k].builds, r[k].local, r[k].particles);
+                r[k].events, r[k].builds, r[k].local, r[k].particles, r[k].balance);
   }
   if (only.empty()) std::printf("ratio search/local time: %.2f\n", r[0].seconds / r[1].seconds);
   return 0;

@@ -218,7 +218,20 @@ std::size_t System::replace_particles(const std::vector<char>& remove,
     }
     model_.check_material(f.material, what);
   }
-  note_set_change();
+  // The energy the change takes out of KE + PE + E_el is booked here from the particles it
+  // touches (the whole bed's sums before and after differ by just that), unless an earlier change
+  // since the last step is pending (then the step's end books both over the whole bed).
+  const bool book = energy_tracking_ && energies_.started && !set_change_pending_;
+  double before = 0.0;
+  if (book) {
+    set_members_.assign(n, 0);
+    set_which_.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      if (remove[i]) set_members_[i] = 1, set_which_.push_back(i);
+    before = set_energy(set_which_, set_members_);
+  } else {
+    note_set_change();
+  }
   offspring_.resize(fragments.size());
   // (the parents' values are read before the store moves its rows)
   std::vector<ParentShare>& share = share_;
@@ -257,6 +270,15 @@ std::size_t System::replace_particles(const std::vector<char>& remove,
   verlet_.invalidate();
   partition_.invalidate();
   ++local_insertions_;
+  if (book) {
+    const std::size_t n_after = store_.size();
+    resize_histories();  // (the planes' histories of the fragments: none yet)
+    set_members_.assign(n_after, 0);
+    set_which_.clear();
+    for (std::size_t i = static_cast<std::size_t>(kept); i < n_after; ++i)
+      set_members_[i] = 1, set_which_.push_back(i);
+    energies_.breakage += before - set_energy(set_which_, set_members_);
+  }
   return static_cast<std::size_t>(kept);
 }
 
@@ -558,6 +580,58 @@ void System::settle_set_change(bool provisional) {
     set_change_before_ = after;
   else
     set_change_pending_ = false;
+}
+
+// The part of KE + PE + E_el (and the half-step term) that a change of the particles flagged in
+// `in` (listed in `which`) can alter: their own kinetic, potential and half-step terms, and every
+// contact one of them is in (pairs with their histories, planes, the last pass's mesh contacts
+// with the meshes' half-step power). The difference of this before and after a local change
+// (System::replace_particles()) is the difference of the whole bed's sums, term by term.
+double System::set_energy(const std::vector<std::size_t>& which, const std::vector<char>& in) const {
+  const_cast<ContactModel&>(model_).update();
+  const Particles& p = store_.core();
+  const double h = 0.5 * energy_dt_, h2 = 0.125 * energy_dt_ * energy_dt_;
+  const std::vector<PlaneWall>& planes = walls_.planes();
+  const std::vector<Eigen::Vector3d>& plane_shear = walls_.shear(store_);
+  const std::size_t np = planes.size();
+  const bool have_shear = plane_shear.size() == p.size() * np;
+  const Eigen::Vector3d no_shear = Eigen::Vector3d::Zero();
+  double e = 0.0;
+  for (const std::size_t i : which) {
+    const Eigen::Vector3d &v = p.velocity[i], &w = p.angular_velocity[i], &f = p.force[i],
+                          &t = p.torque[i];
+    e += 0.5 * p.mass[i] * v.squaredNorm() + 0.5 * p.inertia[i] * w.squaredNorm();
+    e += h * (f.dot(v) + t.dot(w)) + h2 * (f.squaredNorm() / p.mass[i] + t.squaredNorm() / p.inertia[i]);
+    e -= p.mass[i] * gravity_.dot(p.position[i]);
+    for (std::size_t k = 0; k < np; ++k) {
+      const double delta = p.radius[i] - (p.position[i] - planes[k].point).dot(planes[k].normal);
+      if (delta <= 0.0) continue;
+      e += hertz_elastic_energy(model_.pair(p.material[i], planes[k].material), delta, p.radius[i],
+                                have_shear ? plane_shear[i * np + k] : no_shear);
+    }
+  }
+  const NeighborList& nl = neighbors_;
+  const int rows = static_cast<int>(nl.offsets_.size()) - 1;
+  for (int i = 0; i < rows; ++i)
+    for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
+      const int j = nl.neighbors_[s];
+      if (!in[i] && !in[j]) continue;
+      const double rsum = p.radius[i] + p.radius[j];
+      const double delta = rsum - (p.position[i] - p.position[j]).norm();
+      if (delta <= 0.0) continue;
+      e += hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
+                                p.radius[i] * p.radius[j] / rsum, pairs_.shear(s));
+    }
+  mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec, const Eigen::Vector3d& shear) {
+    if (!in[i]) return;
+    e += hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta, rec.r_eff, shear);
+    const TriangleMesh& m = meshes_[rec.mesh];
+    const auto& tri = m.triangle(rec.triangle);
+    e += h * rec.force.dot(rec.barycentric[0] * m.velocity_[tri[0]] +
+                           rec.barycentric[1] * m.velocity_[tri[1]] +
+                           rec.barycentric[2] * m.velocity_[tri[2]]);
+  });
+  return e;
 }
 
 double System::energy_balance_error() const {

@@ -558,6 +558,9 @@ class System {
     double mass, inertia;
   };
   std::vector<ParentShare> share_;  // (the same)
+  std::vector<char> set_members_;   // (the same: the particles whose energy a change alters)
+  std::vector<std::size_t> set_which_;
+  double set_energy(const std::vector<std::size_t>& which, const std::vector<char>& in) const;
   // scratch of pack_particles() / unpack_particles() (kept: no allocation once grown)
   std::vector<char> chosen_;
   std::vector<std::int64_t> chosen_ids_;
