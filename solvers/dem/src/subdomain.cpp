@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <istream>
+#include <ostream>
 #include <sstream>
 #include <string>
 
@@ -677,6 +679,88 @@ Eigen::Vector3d SubdomainStepper::mesh_force(int mesh) {
 
 void SubdomainStepper::run(long steps, double dt) {
   for (long s = 0; s < steps; ++s) step(dt);
+}
+
+// ---- SplitRestart ---------------------------------------------------------------------------
+
+namespace {
+constexpr std::uint32_t restart_magic = 0x53525350u;  // "PSRS"
+constexpr std::uint32_t restart_version = 1;
+
+template <class T>
+void put_value(std::ostream& out, const T& v) {
+  out.write(reinterpret_cast<const char*>(&v), sizeof v);
+}
+template <class T>
+T get_value(std::istream& in, const char* what) {
+  T v;
+  if (!in.read(reinterpret_cast<char*>(&v), sizeof v))
+    throw Error(std::string("SplitRestart::read: the stream ends before ") + what);
+  return v;
+}
+void get_bytes(std::istream& in, char* to, std::size_t n, const char* what) {
+  if (!in.read(to, static_cast<std::streamsize>(n)))
+    throw Error(std::string("SplitRestart::read: the stream ends inside ") + what);
+}
+}  // namespace
+
+SplitRestart SplitRestart::gather(SubdomainStepper& stepper) {
+  SplitRestart r;
+  std::ostringstream world(std::ios::binary);
+  stepper.subdomain(0).system().write_state(world);
+  r.world_ = std::move(world).str();
+  r.owned_.resize(static_cast<std::size_t>(stepper.local_count()));
+  for (int k = 0; k < stepper.local_count(); ++k)
+    if (stepper.subdomain(k).owned_count() > 0)
+      stepper.subdomain(k).pack_owned(r.owned_[static_cast<std::size_t>(k)]);
+  return r;
+}
+
+void SplitRestart::write(std::ostream& out) const {
+  put_value(out, restart_magic);
+  put_value(out, restart_version);
+  put_value(out, static_cast<std::uint64_t>(world_.size()));
+  out.write(world_.data(), static_cast<std::streamsize>(world_.size()));
+  put_value(out, static_cast<std::uint64_t>(owned_.size()));
+  for (const std::vector<std::byte>& m : owned_) {
+    put_value(out, static_cast<std::uint64_t>(m.size()));
+    out.write(reinterpret_cast<const char*>(m.data()), static_cast<std::streamsize>(m.size()));
+  }
+}
+
+SplitRestart SplitRestart::read(std::istream& in) {
+  if (get_value<std::uint32_t>(in, "its magic") != restart_magic)
+    throw Error("SplitRestart::read: not a split bed's restart (no \"PSRS\" at the start)");
+  if (const auto v = get_value<std::uint32_t>(in, "its version"); v != restart_version)
+    throw Error("SplitRestart::read: format version " + std::to_string(v) + "; this build reads " +
+                std::to_string(restart_version));
+  SplitRestart r;
+  r.world_.resize(get_value<std::uint64_t>(in, "the world's size"));
+  get_bytes(in, r.world_.data(), r.world_.size(), "the world's state");
+  r.owned_.resize(get_value<std::uint64_t>(in, "the number of parts"));
+  for (std::vector<std::byte>& m : r.owned_) {
+    m.resize(get_value<std::uint64_t>(in, "a part's size"));
+    get_bytes(in, reinterpret_cast<char*>(m.data()), m.size(), "a part's particles");
+  }
+  return r;
+}
+
+void SplitRestart::restore(const std::vector<System*>& systems) const {
+  for (std::size_t j = 0; j < systems.size(); ++j) {
+    System& sys = *systems[j];
+    if (sys.particle_count() > 0)
+      throw Error("SplitRestart::restore: system " + std::to_string(j) + " holds " +
+                  std::to_string(sys.particle_count()) +
+                  " particles; give Systems set up alike without particles");
+    ParticleStore& store = sys.store();
+    if (store.find("subdomain_owner") < 0) store.add_array<int>("subdomain_owner", 1, -1);
+    std::istringstream world(world_, std::ios::binary);
+    sys.read_state(world);
+    sys.remove_particles(std::vector<char>(sys.particle_count(), 1));
+    if (j == 0)
+      for (const std::vector<std::byte>& m : owned_)
+        if (!m.empty()) sys.unpack_particles(m.data(), m.size());
+  }
 }
 
 }  // namespace partita::dem

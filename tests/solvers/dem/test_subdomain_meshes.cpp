@@ -151,28 +151,19 @@ struct Plan {
   int restart_parts = 1;
 };
 
-// A restart of `old` (its systems `old_systems`) on `parts` subdomains: each old subdomain's
-// owned particles and the first one's System state (walls, plate, time), new Systems restored
-// from that state with its particles removed, the particles unpacked into the first of them.
-std::vector<std::unique_ptr<System>> restart_systems(
-    SubdomainStepper& old, const std::vector<std::unique_ptr<System>>& old_systems, int parts) {
-  std::vector<std::vector<std::byte>> owned(old_systems.size());
-  for (int k = 0; k < old.local_count(); ++k)
-    if (old.subdomain(k).owned_count() > 0) old.subdomain(k).pack_owned(owned[k]);
-  std::stringstream world;
-  old_systems[0]->write_state(world);
+// A restart of `old` on `parts` subdomains: written to a stream (SplitRestart), read back into
+// new Systems set up alike.
+std::vector<std::unique_ptr<System>> restart_systems(SubdomainStepper& old, int parts) {
+  std::stringstream file;
+  SplitRestart::gather(old).write(file);
+  const SplitRestart restart = SplitRestart::read(file);
   std::vector<std::unique_ptr<System>> systems;
+  std::vector<System*> raw;
   for (int j = 0; j < parts; ++j) {
-    auto sys = subdomain_system({});
-    sys->store().add_array<int>("subdomain_owner", 1, -1);  // (as the old split's Systems)
-    world.seekg(0);
-    sys->read_state(world);
-    sys->remove_particles(std::vector<char>(sys->particle_count(), 1));
-    if (j == 0)
-      for (const std::vector<std::byte>& m : owned)
-        if (!m.empty()) sys->unpack_particles(m.data(), m.size());
-    systems.push_back(std::move(sys));
+    systems.push_back(subdomain_system({}));
+    raw.push_back(systems.back().get());
   }
+  restart.restore(raw);
   return systems;
 }
 
@@ -203,8 +194,7 @@ Run run_split(const DomainDecomposition& d, const Plan& plan = {}) {
       stepper->set_decomposition(
           DomainDecomposition::bisection(test::owned_positions(*stepper), kLo, kCutHi, parts));
     if (plan.restart_at > 0 && s == plan.restart_at) {
-      std::vector<std::unique_ptr<System>> next =
-          restart_systems(*stepper, systems, plan.restart_parts);
+      std::vector<std::unique_ptr<System>> next = restart_systems(*stepper, plan.restart_parts);
       parts = plan.restart_parts;
       const Particles& p = next[0]->particles();
       const std::vector<Eigen::Vector3d> x(p.position.begin(), p.position.end());
@@ -386,7 +376,7 @@ TEST_CASE("dem: subdomains: a restart written on P subdomains resumes on M with 
 
 TEST_CASE(
     "dem: subdomains: the mesh sums refuse a mesh the split does not have, resume() a "
-    "started run",
+    "started run, a restart Systems with particles or bytes that are not one",
     "[dem][subdomains]") {
   const std::vector<Eigen::Vector3d> x0 = start_positions();
   const DomainDecomposition d = DomainDecomposition::bisection(x0, kLo, kCutHi, 2);
@@ -401,6 +391,16 @@ TEST_CASE(
   CHECK_THROWS_AS(stepper.mesh_force(-1), Error);
   CHECK(stepper.mesh_force(0).allFinite());
   CHECK_THROWS_AS(stepper.resume(), Error);  // (a started stepper)
+  // a restart into Systems that hold particles, or from a stream that is not one or ends early
+  const SplitRestart restart = SplitRestart::gather(stepper);
+  CHECK(restart.parts() == 2);
+  CHECK_THROWS_AS(restart.restore({sa.get()}), Error);
+  std::stringstream file;
+  restart.write(file);
+  const std::string bytes = file.str();
+  std::istringstream cut(bytes.substr(0, bytes.size() - 1)), junk("not a restart at all");
+  CHECK_THROWS_AS(SplitRestart::read(cut), Error);
+  CHECK_THROWS_AS(SplitRestart::read(junk), Error);
   // a message of sums cut short, or naming a vertex the mesh does not have
   MeshForceSums sums, other;
   sums.reset(4);

@@ -68,8 +68,8 @@
 //  - Restarts: a split bed's owned particles (Subdomain::pack_owned(): arrays, forces, pair
 //    histories by id, plane and mesh histories) with one subdomain's System state for the walls,
 //    meshes and time resume on any number of subdomains (SubdomainStepper::resume()), with the
-//    same bits whatever the split that wrote them and the split that resumes. The restart file
-//    that holds them (one per process or gathered) is not written yet.
+//    same bits whatever the split that wrote them and the split that resumes; SplitRestart
+//    writes and reads them as one stream for an in-process split (over processes: not yet).
 //  - Energy sums: SubdomainStepper::kinetic_energy() and linear_momentum() are the same on any
 //    split (exact sums over the owned particles, ExactSum, rounded once: they may differ from
 //    System::kinetic_energy()'s ordered sum in the last bits), and so is elastic_energy() (each
@@ -106,6 +106,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 #include <utility>
 #include <vector>
@@ -319,6 +320,31 @@ class SubdomainStepper {
   long builds_ = 0, steps_ = 0;
   std::vector<SubdomainMail> out_, in_;
   std::vector<double> values_;
+};
+
+/// A split bed's restart: the world (one subdomain's System state: walls, meshes, time; alike on
+/// every subdomain) and every subdomain's owned particles (Subdomain::pack_owned()), as one
+/// stream. Resumed on any number of Systems set up alike (restore(), then a SubdomainStepper
+/// over them and resume()), with the same bits whatever the split that wrote it.
+/// Stream: "PSRS" (u32), version (u32), the world's size (u64) and its SystemState::write()
+/// bytes, the number of parts (u64), then per part its size (u64) and its message.
+class SplitRestart {
+ public:
+  /// From the local subdomains of `stepper` (every subdomain of an in-process split; a split
+  /// over processes would gather the parts, not done yet). After a step.
+  static SplitRestart gather(SubdomainStepper& stepper);
+  void write(std::ostream& out) const;
+  /// Throws Error on another magic or version, or a stream that ends early.
+  static SplitRestart read(std::istream& in);
+  /// Gives each of `systems` (set up alike, without particles) the world's state, and the first
+  /// of them every particle (SubdomainStepper::resume() spreads them). Throws Error when a
+  /// System holds particles or does not fit the world's set-up.
+  void restore(const std::vector<System*>& systems) const;
+  std::size_t parts() const { return owned_.size(); }
+
+ private:
+  std::string world_;
+  std::vector<std::vector<std::byte>> owned_;
 };
 
 }  // namespace partita::dem
