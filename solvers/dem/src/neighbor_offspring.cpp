@@ -41,33 +41,11 @@ void NeighborList::insert_offspring(const std::vector<int>& new_of_old, int kept
     const int q = parent_of_[born[k].parent];
     born_items_[born_offsets_[q] + counts_[q]++] = k;
   }
-  // Every listed neighbour of each parent (both halves: rows before it and its own row).
-  parent_nb_offsets_.assign(parents + 1, 0);
-  for (int pass = 0; pass < 2; ++pass) {
-    if (pass == 1) {
-      for (int q = 0; q < parents; ++q) parent_nb_offsets_[q + 1] += parent_nb_offsets_[q];
-      parent_nb_.resize(parent_nb_offsets_[parents]);
-      counts_.assign(parents, 0);
-    }
-    for (int i = 0; i < old_n; ++i) {
-      const int pi = parent_of_[i];
-      for (int s = offsets_[i]; s < offsets_[i + 1]; ++s) {
-        const int j = neighbors_[s], pj = parent_of_[j];
-        if (pi >= 0) {
-          if (pass == 0)
-            ++parent_nb_offsets_[pi + 1];
-          else
-            parent_nb_[parent_nb_offsets_[pi] + counts_[pi]++] = j;
-        }
-        if (pj >= 0) {
-          if (pass == 0)
-            ++parent_nb_offsets_[pj + 1];
-          else
-            parent_nb_[parent_nb_offsets_[pj] + counts_[pj]++] = i;
-        }
-      }
-    }
-  }
+  // Every listed neighbour of each parent (both halves), in the parents' order.
+  parent_list_.resize(parents);
+  for (int q = 0; q < old_n; ++q)
+    if (parent_of_[q] >= 0) parent_list_[parent_of_[q]] = static_cast<std::size_t>(q);
+  listed_neighbours(parent_list_, parent_nb_offsets_, parent_nb_);
   // The newborns' references: the parent's position at the build plus the offset (so that the
   // displacement since the build is the parent's), and the parent's planes.
   born_reference_.resize(nb);

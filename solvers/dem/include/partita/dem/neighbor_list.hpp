@@ -183,6 +183,7 @@ class NeighborList {
   // scratch of insert_offspring()
   std::vector<int> parent_of_, parent_nb_offsets_, parent_nb_, born_offsets_, born_items_;
   mutable std::vector<int> mark_, mark_counts_;  // scratch of listed_neighbours()
+  std::vector<std::size_t> parent_list_;  // (insert_offspring(): the parents in order)
   std::vector<std::pair<int, int>> added_pairs_;
   std::vector<Eigen::Vector3d> born_reference_;
   std::vector<std::uint64_t> born_mask_;
