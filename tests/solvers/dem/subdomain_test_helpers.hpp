@@ -2,9 +2,10 @@
 // Shared pieces of the split-bed tests (SubdomainStepper): a polydisperse bed thrown about, a
 // transport that rewrites the particle messages of a list build on their way (to show what the
 // bits need: take something out, and the split must differ), the owned particles' positions (for
-// a re-cut) and the comparison of particle states by id.
+// a re-cut) and the comparison of particle states by id; the beds are subdomain_beds.hpp's.
 
-#include "partita/dem/packing_generator.hpp"
+#include "subdomain_beds.hpp"
+
 #include "partita/dem/subdomain.hpp"
 #include "partita/dem/subdomain_transport.hpp"
 
@@ -64,34 +65,6 @@ class RewritingTransport final : public SubdomainTransport {
   SubdomainTransport& inner_;
   Rewrite rewrite_;
 };
-
-/// A packing of three sizes (1, 0.8 and 0.6 mm in equal numbers, porosity 0.6) in [lo, hi], with
-/// velocities of up to 0.3 m/s each way and 0.2 m/s down from a hash that starts at `hash`.
-struct ThrownBed {
-  Eigen::MatrixX3d x;
-  Eigen::VectorXd r;
-  Eigen::MatrixX3d v;
-};
-inline ThrownBed thrown_bed(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-                            std::uint64_t seed, std::uint64_t hash) {
-  PackingSpec spec;
-  spec.lo = lo;
-  spec.hi = hi;
-  spec.diameters = {1.0e-3, 0.8e-3, 0.6e-3};
-  spec.fractions = {1.0, 1.0, 1.0};
-  spec.porosity = 0.6;
-  spec.seed = seed;
-  const Packing pk = PackingGenerator::generate(spec);
-  ThrownBed out{pk.positions, pk.radii, Eigen::MatrixX3d(pk.positions.rows(), 3)};
-  std::uint64_t h = hash;
-  auto next = [&] {
-    h ^= h >> 33, h *= 0xff51afd7ed558ccdull, h ^= h >> 33, h += 0x9e3779b97f4a7c15ull;
-    return static_cast<double>(h >> 11) / 9007199254740992.0;  // [0, 1)
-  };
-  for (Eigen::Index i = 0; i < out.x.rows(); ++i)
-    out.v.row(i) << 0.6 * next() - 0.3, 0.6 * next() - 0.3, 0.6 * next() - 0.5;
-  return out;
-}
 
 /// The positions of the particles the local subdomains own (for a re-cut by bisection).
 inline std::vector<Eigen::Vector3d> owned_positions(const SubdomainStepper& stepper) {

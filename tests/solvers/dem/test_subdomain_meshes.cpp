@@ -51,33 +51,11 @@ const Bed& bed() {
   return b;
 }
 
-// The plate's vertices at time t: a (kCells + 1)^2 grid over the box's width, going down at
-// kPlateSpeed and sagging in the middle by up to kBulge at the end of the run (time t_end).
-Eigen::MatrixX3d plate(double t, double t_end) {
-  Eigen::MatrixX3d x((kCells + 1) * (kCells + 1), 3);
-  const double sag = kBulge * t / t_end;
-  for (int j = 0; j <= kCells; ++j)
-    for (int i = 0; i <= kCells; ++i) {
-      const double a = kWidth * i / kCells, b = kWidth * j / kCells;
-      x.row(j * (kCells + 1) + i) << a, b,
-          kPlateStart - kPlateSpeed * t -
-              sag * std::sin(std::numbers::pi * a / kWidth) *
-                  std::sin(std::numbers::pi * b / kWidth);
-    }
-  return x;
-}
-
-TriangleMesh::Triangles plate_triangles() {
-  TriangleMesh::Triangles t(2 * kCells * kCells, 3);
-  int k = 0;
-  for (int j = 0; j < kCells; ++j)
-    for (int i = 0; i < kCells; ++i) {
-      const int v = j * (kCells + 1) + i;
-      t.row(k++) << v, v + 1, v + kCells + 2;
-      t.row(k++) << v, v + kCells + 2, v + kCells + 1;
-    }
-  return t;
-}
+// The plate: a (kCells + 1)^2 grid over the box's width, going down at kPlateSpeed and sagging in
+// the middle by up to kBulge at the end of the run (time t_end).
+const test::SaggingPlate kPlate{kWidth, kCells, kPlateStart, kPlateSpeed, kBulge};
+Eigen::MatrixX3d plate(double t, double t_end) { return kPlate.vertices(t, t_end); }
+TriangleMesh::Triangles plate_triangles() { return kPlate.triangles(); }
 
 // One subdomain's System, alike on every subdomain: the box without its +x face (wall 0), the
 // +x plane moving inwards (wall 1), the plate (mesh 0), the particles of `keep` (id = index).

@@ -21,7 +21,7 @@
 // same boxes. Where many particles share one coordinate the counts can differ from the targets.
 //
 // How a DEM spread over subdomains uses it (SubdomainStepper, subdomain.hpp, does all of it over
-// a SubdomainTransport; the MPI transport, outside solvers/dem, is still to be written):
+// a SubdomainTransport: in one process, or one subdomain a rank over MPI with partita::dem_mpi):
 //  - on a step when the lists are rebuilt (on every subdomain at once), each subdomain sends the
 //    particles whose owner() is another subdomain to that subdomain (System::pack_particles(),
 //    then remove_particles()), and appends what it receives (unpack_particles()): the pair

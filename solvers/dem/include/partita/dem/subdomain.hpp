@@ -1,7 +1,9 @@
 #pragma once
 // A bed split into subdomains (DomainDecomposition's boxes), each a System of its own, stepping
 // to the same bits whatever the number of subdomains: positions and velocities of every particle
-// id after any number of steps equal those of the bed in one subdomain stepped the same way.
+// id after any number of steps equal those of the bed in one subdomain stepped the same way,
+// whether the subdomains are in one process (InProcessTransport) or one a rank over MPI
+// (MpiSubdomainTransport, library partita::dem_mpi; tests/solvers/dem/mpi/ compare the bits).
 //
 // Why the bits can be the same. A particle's force is a sum in a fixed order over its local
 // numbering (System::evaluate_forces(): the pairs (k, i) in ascending k, then (i, j) in
@@ -225,7 +227,8 @@ class Subdomain {
   std::vector<int> near_, order_;
 };
 
-/// Steps the local subdomains of a split bed (all of them with InProcessTransport).
+/// Steps the local subdomains of a split bed (all of them with InProcessTransport, one a rank with
+// MpiSubdomainTransport).
 class SubdomainStepper {
  public:
   struct Options {

@@ -10,10 +10,10 @@
 //                      content (the senders clear them before they write).
 //   max(values)        values[k]: local subdomain k's number; returns the largest over all
 //                      subdomains (the rebuild decision: any subdomain's wish makes all rebuild).
-// InProcessTransport: every subdomain in this process (tests, and a bed split in one process);
-// an MPI transport (one subdomain a rank, the MPI layer outside solvers/dem) sends the non-empty
-// buffers to their ranks and receives from the ranks that sent (sizes first), and takes the max
-// with an all-reduce.
+// InProcessTransport: every subdomain in this process (tests, and a bed split in one process).
+// MpiSubdomainTransport (one subdomain a rank; library partita::dem_mpi in solvers/dem/mpi, so that
+// partita::dem stays free of MPI): the sizes first, then the non-empty buffers to their ranks, and
+// the max from every rank's number, every wait with a deadline (partita/dem/mpi_transport.hpp).
 
 #include <cstddef>
 #include <vector>
