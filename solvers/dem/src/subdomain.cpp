@@ -704,19 +704,30 @@ void get_bytes(std::istream& in, char* to, std::size_t n, const char* what) {
 }
 }  // namespace
 
+// Each local subdomain sends its owned particles to subdomain 0 (an exchange with one non-empty
+// buffer a subdomain); subdomain 0's process receives every part, in the order of the ranks.
 SplitRestart SplitRestart::gather(SubdomainStepper& stepper) {
+  SubdomainTransport& transport = stepper.transport();
+  const auto local = static_cast<std::size_t>(stepper.local_count());
+  std::vector<SubdomainMail> out(local, SubdomainMail(static_cast<std::size_t>(transport.parts())));
+  std::vector<SubdomainMail> in;
+  for (std::size_t k = 0; k < local; ++k)
+    if (stepper.subdomain(static_cast<int>(k)).owned_count() > 0)
+      stepper.subdomain(static_cast<int>(k)).pack_owned(out[k][0]);
+  transport.exchange(out, in);
   SplitRestart r;
+  if (transport.local()[0] != 0) return r;  // (held by subdomain 0's process)
   std::ostringstream world(std::ios::binary);
   stepper.subdomain(0).system().write_state(world);
   r.world_ = std::move(world).str();
-  r.owned_.resize(static_cast<std::size_t>(stepper.local_count()));
-  for (int k = 0; k < stepper.local_count(); ++k)
-    if (stepper.subdomain(k).owned_count() > 0)
-      stepper.subdomain(k).pack_owned(r.owned_[static_cast<std::size_t>(k)]);
+  r.owned_ = std::move(in[0]);
   return r;
 }
 
 void SplitRestart::write(std::ostream& out) const {
+  if (!holds())
+    throw Error("SplitRestart::write: this process holds no restart (a split bed's restart is "
+                "gathered on the process of subdomain 0: write it there)");
   put_value(out, restart_magic);
   put_value(out, restart_version);
   put_value(out, static_cast<std::uint64_t>(world_.size()));
@@ -745,7 +756,24 @@ SplitRestart SplitRestart::read(std::istream& in) {
   return r;
 }
 
-void SplitRestart::restore(const std::vector<System*>& systems) const {
+void SplitRestart::restore(const std::vector<System*>& systems) const { restore(systems, 0); }
+
+void SplitRestart::restore(const std::vector<System*>& systems,
+                           const SubdomainTransport& transport) const {
+  if (systems.size() != transport.local().size())
+    throw Error("SplitRestart::restore: " + std::to_string(systems.size()) +
+                " systems for the " + std::to_string(transport.local().size()) +
+                " local subdomains of the transport");
+  const std::vector<int>& local = transport.local();
+  const auto first = std::find(local.begin(), local.end(), 0);
+  restore(systems, first == local.end() ? -1 : static_cast<int>(first - local.begin()));
+}
+
+// particles_to: the index of the System that takes every particle (-1: none)
+void SplitRestart::restore(const std::vector<System*>& systems, int particles_to) const {
+  if (!holds())
+    throw Error("SplitRestart::restore: this holds no restart (read one, or restore on the "
+                "process that gathered it)");
   for (std::size_t j = 0; j < systems.size(); ++j) {
     System& sys = *systems[j];
     if (sys.particle_count() > 0)
@@ -757,7 +785,7 @@ void SplitRestart::restore(const std::vector<System*>& systems) const {
     std::istringstream world(world_, std::ios::binary);
     sys.read_state(world);
     sys.remove_particles(std::vector<char>(sys.particle_count(), 1));
-    if (j == 0)
+    if (static_cast<int>(j) == particles_to)
       for (const std::vector<std::byte>& m : owned_)
         if (!m.empty()) sys.unpack_particles(m.data(), m.size());
   }

@@ -354,7 +354,8 @@ TEST_CASE("dem: subdomains: a restart written on P subdomains resumes on M with 
 
 TEST_CASE(
     "dem: subdomains: the mesh sums refuse a mesh the split does not have, resume() a "
-    "started run, a restart Systems with particles or bytes that are not one",
+    "started run, a restart Systems with particles or bytes that are not one; a restart held "
+    "elsewhere is not written",
     "[dem][subdomains]") {
   const std::vector<Eigen::Vector3d> x0 = start_positions();
   const DomainDecomposition d = DomainDecomposition::bisection(x0, kLo, kCutHi, 2);
@@ -379,6 +380,19 @@ TEST_CASE(
   std::istringstream cut(bytes.substr(0, bytes.size() - 1)), junk("not a restart at all");
   CHECK_THROWS_AS(SplitRestart::read(cut), Error);
   CHECK_THROWS_AS(SplitRestart::read(junk), Error);
+  // none held (a split over processes gathers it on subdomain 0's process only)
+  const SplitRestart none;
+  CHECK_FALSE(none.holds());
+  CHECK(restart.holds());
+  std::stringstream empty;
+  CHECK_THROWS_AS(none.write(empty), Error);
+  CHECK_THROWS_AS(none.restore({sa.get()}), Error);
+  // restored with a transport: the world everywhere, the particles to subdomain 0's System
+  auto ra = subdomain_system({}), rb = subdomain_system({});
+  restart.restore({ra.get(), rb.get()}, transport);
+  CHECK(ra->particle_count() == x0.size());
+  CHECK(rb->particle_count() == 0);
+  CHECK_THROWS_AS(restart.restore({ra.get()}, transport), Error);  // (one System for two)
   // a message of sums cut short, or naming a vertex the mesh does not have
   MeshForceSums sums, other;
   sums.reset(4);

@@ -2,6 +2,7 @@
 // same bed in one subdomain in one process:
 //   mpirun -n N partita_dem_mpi_subdomains BED [--deadline S] [--piece BYTES]
 //                                              [--stall RANK STEP SECONDS] [--no-ghosts]
+//                                              [--restart WRITERS READERS STEP FILE]
 // BED: gravity (a polydisperse bed thrown about in a closed box under gravity), pressed (a bed
 // pressed by a plate mesh moved and deformed every step, squeezed by a moving side plane) or
 // crossing (a long box whose particles fly along it at up to 1.8 m/s: many cross the cuts).
@@ -14,7 +15,11 @@
 // RANK sleeps SECONDS before step STEP; the others must end the run past the deadline (--deadline,
 // seconds) with a message naming it (exit status 3, MPI_Abort). --no-ghosts: the split without
 // ghosts (SubdomainStepper::Options::ghost_distance 0), whose bits must differ (the comparison
-// can fail).
+// can fail). --restart (on max(WRITERS, READERS) ranks): the first WRITERS ranks step the bed to
+// step STEP and gather its SplitRestart to rank 0, which writes the stream to FILE; the first
+// READERS ranks read it, each restores it (rank 0 takes the particles, resume() sends them to
+// their owners) and they step on to the end: the bits of one subdomain written and resumed in one
+// process (a resumed run may differ from an uninterrupted one in the last bits: subdomain.hpp).
 
 #include "../subdomain_beds.hpp"
 
@@ -26,7 +31,10 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <functional>
+#include <iterator>
+#include <sstream>
 #include <map>
 #include <memory>
 #include <string>
@@ -206,34 +214,44 @@ struct Knobs {
   SubdomainStepper::Options options;  // ghost_distance 0: no ghosts (the bits must differ)
 };
 
-// The bed split by a bisection into transport.parts() boxes, this process's subdomain stepped
-// over `transport` (one local subdomain).
-Result run(const Bed& bed, SubdomainTransport& transport, const Knobs& knobs) {
-  const Stall& stall = knobs.stall;
-  const int parts = transport.parts(), rank = transport.local()[0];
+std::vector<Eigen::Vector3d> start_positions(const Bed& bed) {
   std::vector<Eigen::Vector3d> x0;
   for (Eigen::Index i = 0; i < bed.particles->x.rows(); ++i)
     x0.push_back(bed.particles->x.row(i).transpose());
-  const DomainDecomposition d = DomainDecomposition::bisection(x0, bed.lo, bed.cut_hi, parts);
-  std::vector<int> keep, all;
-  for (std::size_t i = 0; i < x0.size(); ++i) {
-    all.push_back(static_cast<int>(i));
-    if (d.owner(x0[i]) == rank) keep.push_back(static_cast<int>(i));
-  }
-  const double dt = 0.25 * bed.system(all)->rayleigh_time_step();  // (alike on every rank)
-  std::unique_ptr<System> sys = bed.system(keep);
-  SubdomainStepper stepper({sys.get()}, transport, d, bed.skin, knobs.options);
-  for (long s = 0; s < bed.steps; ++s) {
-    if (s == stall.step && rank == stall.rank) {
-      std::fprintf(stderr, "rank %d: sleeping %g s before step %ld\n", rank, stall.seconds, s);
-      std::this_thread::sleep_for(std::chrono::duration<double>(stall.seconds));
+  return x0;
+}
+
+// The time step: a quarter of the Rayleigh time of the whole bed (alike on every rank).
+double time_step(const Bed& bed) {
+  std::vector<int> all(static_cast<std::size_t>(bed.particles->x.rows()));
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  return 0.25 * bed.system(all)->rayleigh_time_step();
+}
+
+// A bisection of the bed's starting positions into `parts` boxes.
+DomainDecomposition cut(const Bed& bed, int parts) {
+  return DomainDecomposition::bisection(start_positions(bed), bed.lo, bed.cut_hi, parts);
+}
+
+// Steps [from, to) of the bed (the meshes moved before each).
+void step_range(const Bed& bed, SubdomainStepper& stepper, System& sys, long from, long to,
+                double dt, const Knobs& knobs) {
+  const int rank = stepper.subdomain(0).rank();
+  for (long s = from; s < to; ++s) {
+    if (s == knobs.stall.step && rank == knobs.stall.rank) {
+      std::fprintf(stderr, "rank %d: sleeping %g s before step %ld\n", rank, knobs.stall.seconds, s);
+      std::this_thread::sleep_for(std::chrono::duration<double>(knobs.stall.seconds));
     }
-    if (bed.before_step) bed.before_step(*sys, s, dt);
+    if (bed.before_step) bed.before_step(sys, s, dt);
     stepper.step(dt);
   }
+}
+
+// This subdomain's owned particles and the collective sums at the end.
+Result result(const Bed& bed, SubdomainStepper& stepper, System& sys, double dt) {
   Result r;
   const Subdomain& sd = stepper.subdomain(0);
-  const Particles& p = sys->particles();
+  const Particles& p = sys.particles();
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (sd.is_ghost(i)) continue;
     Motion m;
@@ -247,8 +265,8 @@ Result run(const Bed& bed, SubdomainTransport& transport, const Knobs& knobs) {
   r.sums.push_back(stepper.kinetic_energy());
   add(stepper.linear_momentum());
   r.sums.push_back(stepper.elastic_energy());
-  for (int w = 0; w < sys->wall_count(); ++w) add(stepper.wall_force(w));
-  for (int m = 0; m < sys->mesh_count(); ++m) {
+  for (int w = 0; w < sys.wall_count(); ++w) add(stepper.wall_force(w));
+  for (int m = 0; m < sys.mesh_count(); ++m) {
     add(stepper.mesh_force(m));
     add(Eigen::VectorXd(stepper.triangle_forces(m).reshaped()));
     add(Eigen::VectorXd(stepper.vertex_forces(m).reshaped()));
@@ -260,17 +278,62 @@ Result run(const Bed& bed, SubdomainTransport& transport, const Knobs& knobs) {
   return r;
 }
 
+// The bed split by a bisection into transport.parts() boxes, this process's subdomain stepped
+// over `transport` (one local subdomain) from the start to the end.
+Result run(const Bed& bed, SubdomainTransport& transport, const Knobs& knobs) {
+  const DomainDecomposition d = cut(bed, transport.parts());
+  std::vector<int> keep;
+  const std::vector<Eigen::Vector3d> x0 = start_positions(bed);
+  for (std::size_t i = 0; i < x0.size(); ++i)
+    if (d.owner(x0[i]) == transport.local()[0]) keep.push_back(static_cast<int>(i));
+  const double dt = time_step(bed);
+  std::unique_ptr<System> sys = bed.system(keep);
+  SubdomainStepper stepper({sys.get()}, transport, d, bed.skin, knobs.options);
+  step_range(bed, stepper, *sys, 0, bed.steps, dt, knobs);
+  return result(bed, stepper, *sys, dt);
+}
+
+// The same to step `at` over `writers`; the SplitRestart stream it gathers (on the process of
+// subdomain 0; empty on the others).
+std::string write_restart(const Bed& bed, SubdomainTransport& writers, long at) {
+  const DomainDecomposition d = cut(bed, writers.parts());
+  std::vector<int> keep;
+  const std::vector<Eigen::Vector3d> x0 = start_positions(bed);
+  for (std::size_t i = 0; i < x0.size(); ++i)
+    if (d.owner(x0[i]) == writers.local()[0]) keep.push_back(static_cast<int>(i));
+  std::unique_ptr<System> sys = bed.system(keep);
+  SubdomainStepper stepper({sys.get()}, writers, d, bed.skin);
+  step_range(bed, stepper, *sys, 0, at, time_step(bed), {});
+  const SplitRestart restart = SplitRestart::gather(stepper);
+  if (!restart.holds()) return {};
+  std::ostringstream out(std::ios::binary);
+  restart.write(out);
+  return std::move(out).str();
+}
+
+// A restart stream (read by every process) resumed over `readers` from step `at` to the end.
+Result resume(const Bed& bed, SubdomainTransport& readers, const std::string& stream, long at) {
+  std::istringstream in(stream, std::ios::binary);
+  const SplitRestart restart = SplitRestart::read(in);
+  std::unique_ptr<System> sys = bed.system({});
+  restart.restore({sys.get()}, readers);
+  SubdomainStepper stepper({sys.get()}, readers, cut(bed, readers.parts()), bed.skin);
+  stepper.resume();
+  const double dt = time_step(bed);
+  step_range(bed, stepper, *sys, at, bed.steps, dt, {});
+  return result(bed, stepper, *sys, dt);
+}
+
 bool same_bits(const double* a, const double* b, int n) { return std::memcmp(a, b, 8 * n) == 0; }
 
-// Rank 0: every rank's result against the bed stepped in one subdomain; prints what differs.
-bool compare(const std::string& name, const Bed& bed, const std::vector<Result>& ranks) {
-  InProcessTransport one(1);
-  const Result ref = run(bed, one, {});
+// Rank 0: every rank's result against `ref`, the bed stepped in one subdomain; prints what
+// differs. name: what ran.
+bool compare(const std::string& name, const Bed& bed, const std::vector<Result>& ranks,
+             const Result& ref) {
   const auto n = static_cast<std::size_t>(bed.particles->x.rows());
   bool ok = true;
   const auto fail = [&](const std::string& what) {
-    std::fprintf(stderr, "FAILED: %s bed on %zu ranks: %s\n", name.c_str(), ranks.size(),
-                 what.c_str());
+    std::fprintf(stderr, "FAILED: %s: %s\n", name.c_str(), what.c_str());
     ok = false;
   };
   if (ref.owned.size() != n) fail("the reference holds " + std::to_string(ref.owned.size()) + " particles");
@@ -316,9 +379,9 @@ bool compare(const std::string& name, const Bed& bed, const std::vector<Result>&
            std::to_string(bed.min_migrated));
     if (ghosts == 0) fail("no ghosts at the end");
   }
-  std::printf("%s bed on %zu ranks: %zu particles, %g ms, %lld list builds, %lld particles changed rank, "
+  std::printf("%s: %zu particles, %g ms, %lld list builds, %lld particles changed rank, "
               "%lld ghosts at the end, %zu collective sums: %s\n",
-              name.c_str(), ranks.size(), n, 1e3 * ref.time, static_cast<long long>(ref.builds),
+              name.c_str(), n, 1e3 * ref.time, static_cast<long long>(ref.builds),
               static_cast<long long>(migrated), static_cast<long long>(ghosts), ref.sums.size(),
               ok ? "the bits of one subdomain" : "DIFFERENT");
   return ok;
@@ -327,9 +390,68 @@ bool compare(const std::string& name, const Bed& bed, const std::vector<Result>&
 int usage(const char* why) {
   std::fprintf(stderr,
                "%s\nusage: mpirun -n N partita_dem_mpi_subdomains gravity|pressed|crossing "
-               "[--deadline S] [--piece BYTES] [--stall RANK STEP SECONDS] [--no-ghosts]\n",
+               "[--deadline S] [--piece BYTES] [--stall RANK STEP SECONDS] [--no-ghosts]\n"
+               "       [--restart WRITERS READERS STEP FILE] (on max(WRITERS, READERS) ranks)\n",
                why);
   return 2;
+}
+
+// Every rank's result to rank 0, through the transport (its deadline included); on the others
+// none.
+std::vector<Result> gather_results(MpiSubdomainTransport& transport, const Result& mine) {
+  std::vector<SubdomainMail> out(1, SubdomainMail(static_cast<std::size_t>(transport.parts())));
+  std::vector<SubdomainMail> in;
+  out[0][0] = pack(mine);
+  transport.exchange(out, in);
+  std::vector<Result> ranks;
+  if (transport.rank() == 0)
+    for (const std::vector<std::byte>& m : in[0]) ranks.push_back(unpack(m));
+  return ranks;
+}
+
+// The bed stepped to step `at` on the first `writers` ranks, its SplitRestart gathered to rank 0
+// and written to `file`, read by the first `readers` ranks and resumed to the end, against the
+// same in one subdomain written and resumed in one process.
+int restarted(const std::string& name, const Bed& bed, double deadline, int writers, int readers,
+              long at, const std::string& file, int rank) {
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (writers < 1 || readers < 1 || size != std::max(writers, readers) || at >= bed.steps)
+    return usage(("--restart: run on max(WRITERS, READERS) ranks, a step before the " +
+                  std::to_string(bed.steps) + "th")
+                     .c_str());
+  MpiSubdomainTransport world(MPI_COMM_WORLD, deadline);
+  MPI_Comm write_comm, read_comm;
+  MPI_Comm_split(MPI_COMM_WORLD, rank < writers ? 0 : MPI_UNDEFINED, rank, &write_comm);
+  MPI_Comm_split(MPI_COMM_WORLD, rank < readers ? 0 : MPI_UNDEFINED, rank, &read_comm);
+  if (write_comm != MPI_COMM_NULL) {
+    MpiSubdomainTransport transport(write_comm, deadline);
+    const std::string stream = write_restart(bed, transport, at);
+    if (rank == 0) {
+      std::ofstream out(file, std::ios::binary);
+      out.write(stream.data(), static_cast<std::streamsize>(stream.size()));
+      if (!out.flush()) throw Error("cannot write " + file);
+    }
+  }
+  world.max({0.0});  // (the stream is written)
+  std::vector<Result> ranks;
+  if (read_comm != MPI_COMM_NULL) {
+    std::ifstream in(file, std::ios::binary);
+    const std::string stream((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    MpiSubdomainTransport transport(read_comm, deadline);
+    ranks = gather_results(transport, resume(bed, transport, stream, at));
+  }
+  for (MPI_Comm* c : {&write_comm, &read_comm})
+    if (*c != MPI_COMM_NULL) MPI_Comm_free(c);
+  if (rank != 0) return 0;
+  std::remove(file.c_str());  // (every reader has read it: their results are here)
+  InProcessTransport one(1), other(1);
+  const Result ref = resume(bed, other, write_restart(bed, one, at), at);
+  return compare(name + " bed written on " + std::to_string(writers) + " ranks at step " +
+                     std::to_string(at) + ", resumed on " + std::to_string(readers),
+                 bed, ranks, ref)
+             ? 0
+             : 1;
 }
 
 int main_mpi(int argc, char** argv, int rank) {
@@ -345,10 +467,16 @@ int main_mpi(int argc, char** argv, int rank) {
   long piece = 0;
   Knobs knobs;
   Stall& stall = knobs.stall;
+  int writers = 0, readers = 0;
+  long restart_at = 0;
+  std::string file;
   for (int k = 2; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--deadline" && k + 1 < argc)
       deadline = std::stod(argv[++k]);
+    else if (a == "--restart" && k + 4 < argc)
+      writers = std::stoi(argv[k + 1]), readers = std::stoi(argv[k + 2]),
+      restart_at = std::stol(argv[k + 3]), file = argv[k + 4], k += 4;
     else if (a == "--no-ghosts")
       knobs.options.ghost_distance = 0.0;
     else if (a == "--piece" && k + 1 < argc)
@@ -359,18 +487,16 @@ int main_mpi(int argc, char** argv, int rank) {
     else
       return usage(("unknown argument '" + a + "'").c_str());
   }
+  if (restart_at > 0) return restarted(name, bed, deadline, writers, readers, restart_at, file, rank);
   MpiSubdomainTransport transport(MPI_COMM_WORLD, deadline);
   if (piece > 0) transport.set_piece_bytes(static_cast<std::uint64_t>(piece));
-  const Result mine = run(bed, transport, knobs);
-  // every rank's result to rank 0, through the transport (its deadline included)
-  std::vector<SubdomainMail> out(1, SubdomainMail(static_cast<std::size_t>(transport.parts())));
-  std::vector<SubdomainMail> in;
-  out[0][0] = pack(mine);
-  transport.exchange(out, in);
+  const std::vector<Result> ranks = gather_results(transport, run(bed, transport, knobs));
   if (rank != 0) return 0;
-  std::vector<Result> ranks;
-  for (const std::vector<std::byte>& m : in[0]) ranks.push_back(unpack(m));
-  return compare(name, bed, ranks) ? 0 : 1;
+  InProcessTransport one(1);
+  return compare(name + " bed on " + std::to_string(ranks.size()) + " ranks", bed, ranks,
+                 run(bed, one, {}))
+             ? 0
+             : 1;
 }
 
 }  // namespace

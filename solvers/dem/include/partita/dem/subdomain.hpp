@@ -71,7 +71,10 @@
 //    histories by id, plane and mesh histories) with one subdomain's System state for the walls,
 //    meshes and time resume on any number of subdomains (SubdomainStepper::resume()), with the
 //    same bits whatever the split that wrote them and the split that resumes; SplitRestart
-//    writes and reads them as one stream for an in-process split (over processes: not yet).
+//    writes and reads them as one stream, gathered to the process of subdomain 0 (in one
+//    process, or from the ranks of an MPI split), and restores it on any number of subdomains
+//    in one process or on ranks (each process reads the stream; the process of subdomain 0
+//    takes every particle, resume()'s first build sends each to its owner).
 //  - Energy sums: SubdomainStepper::kinetic_energy() and linear_momentum() are the same on any
 //    split (exact sums over the owned particles, ExactSum, rounded once: they may differ from
 //    System::kinetic_energy()'s ordered sum in the last bits), and so is elastic_energy() (each
@@ -261,6 +264,7 @@ class SubdomainStepper {
   /// bits do not change, only where the particles are stepped).
   void set_decomposition(const DomainDecomposition& decomposition);
   const DomainDecomposition& decomposition() const { return decomposition_; }
+  SubdomainTransport& transport() { return *transport_; }
 
   int local_count() const { return static_cast<int>(subdomains_.size()); }
   Subdomain& subdomain(int k) { return subdomains_[static_cast<std::size_t>(k)]; }
@@ -328,14 +332,19 @@ class SubdomainStepper {
 /// A split bed's restart: the world (one subdomain's System state: walls, meshes, time; alike on
 /// every subdomain) and every subdomain's owned particles (Subdomain::pack_owned()), as one
 /// stream. Resumed on any number of Systems set up alike (restore(), then a SubdomainStepper
-/// over them and resume()), with the same bits whatever the split that wrote it.
+/// over them and resume()), with the same bits whatever the split that wrote it, in one process
+/// or over processes (each reads the stream and restores it with its transport).
 /// Stream: "PSRS" (u32), version (u32), the world's size (u64) and its SystemState::write()
 /// bytes, the number of parts (u64), then per part its size (u64) and its message.
 class SplitRestart {
  public:
-  /// From the local subdomains of `stepper` (every subdomain of an in-process split; a split
-  /// over processes would gather the parts, not done yet). After a step.
+  /// Every subdomain's owned particles, gathered through the stepper's transport to the process
+  /// that steps subdomain 0, which holds the restart (holds()); on the others it is empty.
+  /// Collective (every process calls it), after a step.
   static SplitRestart gather(SubdomainStepper& stepper);
+  /// Whether this holds a restart (gathered here, or read).
+  bool holds() const { return !world_.empty(); }
+  /// Throws Error when it holds none (gathered on another process).
   void write(std::ostream& out) const;
   /// Throws Error on another magic or version, or a stream that ends early.
   static SplitRestart read(std::istream& in);
@@ -343,9 +352,14 @@ class SplitRestart {
   /// of them every particle (SubdomainStepper::resume() spreads them). Throws Error when a
   /// System holds particles or does not fit the world's set-up.
   void restore(const std::vector<System*>& systems) const;
+  /// The same for the local subdomains of `transport` (systems[k]: local()[k]'s System) of a
+  /// split over processes: every process restores the world; the particles go to the System of
+  /// subdomain 0, on its process only (resume() sends each to its owner).
+  void restore(const std::vector<System*>& systems, const SubdomainTransport& transport) const;
   std::size_t parts() const { return owned_.size(); }
 
  private:
+  void restore(const std::vector<System*>& systems, int particles_to) const;
   std::string world_;
   std::vector<std::vector<std::byte>> owned_;
 };
