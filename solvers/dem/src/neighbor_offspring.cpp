@@ -2,6 +2,7 @@
 // lists without a search, and listed_neighbours().
 #include "partita/dem/error.hpp"
 #include "partita/dem/neighbor_list.hpp"
+#include "partita/dem/parallel.hpp"
 
 #include <algorithm>
 #include <string>
@@ -144,6 +145,52 @@ void NeighborList::insert_offspring(const std::vector<int>& new_of_old, int kept
   }
 }
 
+namespace {
+
+// The slots s of rows [0, rows) whose pair (i, neighbors[s]) has a member (member(i) or
+// member(j)), as (i, s) in the list's order. The rows are cut into blocks, scanned on the threads
+// (each block into its own scratch), and the blocks' hits joined in block order: the same list
+// whatever the number of threads.
+template <class Member>
+void scan_touching(const std::vector<int>& offsets, const std::vector<int>& neighbors, Member member,
+                   std::vector<std::vector<std::pair<int, int>>>& blocks,
+                   std::vector<std::pair<int, int>>& out) {
+  out.clear();
+  const int rows = static_cast<int>(offsets.size()) - 1;
+  if (rows <= 0) return;
+  const int nb = rows >= parallel_pass_min ? std::max(1, max_threads()) : 1;
+  if (static_cast<int>(blocks.size()) < nb) blocks.resize(nb);
+  auto scan = [&](int b) {
+    std::vector<std::pair<int, int>>& hits = blocks[b];
+    hits.clear();
+    const int first = static_cast<int>(static_cast<long long>(rows) * b / nb);
+    const int last = static_cast<int>(static_cast<long long>(rows) * (b + 1) / nb);
+    for (int i = first; i < last; ++i) {
+      const bool in_i = member(i);
+      for (int s = offsets[i]; s < offsets[i + 1]; ++s)
+        if (in_i || member(neighbors[s])) hits.emplace_back(i, s);
+    }
+  };
+  if (nb == 1) {
+    scan(0);
+  } else {
+#pragma omp parallel for schedule(static, 1)
+    for (int b = 0; b < nb; ++b) scan(b);
+  }
+  for (int b = 0; b < nb; ++b) out.insert(out.end(), blocks[b].begin(), blocks[b].end());
+}
+
+}  // namespace
+
+void NeighborList::slots_touching(const std::vector<char>& in,
+                                  std::vector<std::pair<int, int>>& out) const {
+  const std::size_t rows = offsets_.empty() ? 0 : offsets_.size() - 1;
+  if (in.size() < rows)
+    throw Error("slots_touching: need one flag per listed particle (" + std::to_string(rows) +
+                "), got " + std::to_string(in.size()));
+  scan_touching(offsets_, neighbors_, [&](int i) { return in[i] != 0; }, touching_blocks_, out);
+}
+
 void NeighborList::listed_neighbours(const std::vector<std::size_t>& which,
                                      std::vector<int>& offsets, std::vector<int>& items) const {
   const int rows = static_cast<int>(offsets_.size()) - 1;
@@ -156,33 +203,23 @@ void NeighborList::listed_neighbours(const std::vector<std::size_t>& which,
       throw Error("listed_neighbours: bad or repeated particle index " + std::to_string(i));
     slot_of[i] = k;
   }
+  scan_touching(offsets_, neighbors_, [&](int i) { return slot_of[i] >= 0; }, touching_blocks_,
+                touching_);
+  // the hits in row order: each particle's neighbours come out ascending (those before it from
+  // their rows, then its own row)
   offsets.assign(m + 1, 0);
-  for (int pass = 0; pass < 2; ++pass) {
-    if (pass == 1) {
-      for (int k = 0; k < m; ++k) offsets[k + 1] += offsets[k];
-      items.resize(offsets[m]);
-      mark_counts_.assign(m, 0);
-    }
-    // rows in ascending order: each particle's neighbours come out ascending (those before it
-    // from their rows, then its own row)
-    for (int i = 0; i < rows; ++i) {
-      const int ki = slot_of[i];
-      for (int s = offsets_[i]; s < offsets_[i + 1]; ++s) {
-        const int j = neighbors_[s], kj = slot_of[j];
-        if (ki >= 0) {
-          if (pass == 0)
-            ++offsets[ki + 1];
-          else
-            items[offsets[ki] + mark_counts_[ki]++] = j;
-        }
-        if (kj >= 0) {
-          if (pass == 0)
-            ++offsets[kj + 1];
-          else
-            items[offsets[kj] + mark_counts_[kj]++] = i;
-        }
-      }
-    }
+  for (const auto& [i, s] : touching_) {
+    const int ki = slot_of[i], kj = slot_of[neighbors_[s]];
+    if (ki >= 0) ++offsets[ki + 1];
+    if (kj >= 0) ++offsets[kj + 1];
+  }
+  for (int k = 0; k < m; ++k) offsets[k + 1] += offsets[k];
+  items.resize(offsets[m]);
+  mark_counts_.assign(m, 0);
+  for (const auto& [i, s] : touching_) {
+    const int j = neighbors_[s], ki = slot_of[i], kj = slot_of[j];
+    if (ki >= 0) items[offsets[ki] + mark_counts_[ki]++] = j;
+    if (kj >= 0) items[offsets[kj] + mark_counts_[kj]++] = i;
   }
 }
 

@@ -611,17 +611,15 @@ double System::set_energy(const std::vector<std::size_t>& which, const std::vect
     }
   }
   const NeighborList& nl = neighbors_;
-  const int rows = static_cast<int>(nl.offsets_.size()) - 1;
-  for (int i = 0; i < rows; ++i)
-    for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
-      const int j = nl.neighbors_[s];
-      if (!in[i] && !in[j]) continue;
-      const double rsum = p.radius[i] + p.radius[j];
-      const double delta = rsum - (p.position[i] - p.position[j]).norm();
-      if (delta <= 0.0) continue;
-      e += hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
-                                p.radius[i] * p.radius[j] / rsum, pairs_.shear(s));
-    }
+  nl.slots_touching(in, touching_);  // (the pairs in the list's order: a fixed sum)
+  for (const auto& [i, s] : touching_) {
+    const int j = nl.neighbors_[s];
+    const double rsum = p.radius[i] + p.radius[j];
+    const double delta = rsum - (p.position[i] - p.position[j]).norm();
+    if (delta <= 0.0) continue;
+    e += hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
+                              p.radius[i] * p.radius[j] / rsum, pairs_.shear(s));
+  }
   mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec, const Eigen::Vector3d& shear) {
     if (!in[i]) return;
     e += hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta, rec.r_eff, shear);

@@ -20,15 +20,19 @@ template <class Term>
 double ordered_sum(std::ptrdiff_t n, Term term) {
   const std::ptrdiff_t chunk = parallel_pass_min;
   const std::ptrdiff_t chunks = (n + chunk - 1) / chunk;
-  std::vector<double> part(static_cast<std::size_t>(chunks), 0.0);
+  // the chunks' sums: the calling thread's buffer, kept between calls (no allocation in a step),
+  // shared with the team by a plain pointer (each thread's `scratch` is its own)
+  thread_local std::vector<double> scratch;
+  scratch.assign(static_cast<std::size_t>(chunks), 0.0);
+  double* const part = scratch.data();
 #pragma omp parallel for schedule(static) if (chunks > 1)
   for (std::ptrdiff_t c = 0; c < chunks; ++c) {
     double s = 0.0;
     for (std::ptrdiff_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i) s += term(i);
-    part[static_cast<std::size_t>(c)] = s;
+    part[c] = s;
   }
   double total = 0.0;
-  for (const double s : part) total += s;
+  for (std::ptrdiff_t c = 0; c < chunks; ++c) total += part[c];
   return total;
 }
 

@@ -99,9 +99,14 @@ class NeighborList {
                         const std::vector<Offspring>& born, const Particles& p);
   /// The listed neighbours of each particle in `which` (distinct indices with rows), both
   /// halves, ascending: those of which[k] are items[offsets[k] .. offsets[k + 1]). One pass over
-  /// the pairs. While the lists are valid every particle touching one of them is among them.
+  /// the pairs, on the threads. While the lists are valid every particle touching one of them is
+  /// among them.
   void listed_neighbours(const std::vector<std::size_t>& which, std::vector<int>& offsets,
                          std::vector<int>& items) const;
+  /// The listed pairs with a particle flagged in `in` (one flag per row), as (row i, slot s): the
+  /// pair (i, neighbors()[s]). In the list's order (rows ascending, each row's slots ascending)
+  /// whatever the number of threads; one pass over the pairs, on the threads.
+  void slots_touching(const std::vector<char>& in, std::vector<std::pair<int, int>>& out) const;
   /// The mesh triangles listed near particle i (within R + skin at the build): [first, last).
   const MeshCandidate* mesh_candidates_begin(std::size_t i) const {
     return mesh_candidates_.data() + (mesh_offsets_.size() > i + 1 ? mesh_offsets_[i] : 0);
@@ -183,6 +188,8 @@ class NeighborList {
   // scratch of insert_offspring()
   std::vector<int> parent_of_, parent_nb_offsets_, parent_nb_, born_offsets_, born_items_;
   mutable std::vector<int> mark_, mark_counts_;  // scratch of listed_neighbours()
+  mutable std::vector<std::pair<int, int>> touching_;                   // (the same)
+  mutable std::vector<std::vector<std::pair<int, int>>> touching_blocks_;  // (scan's blocks)
   std::vector<std::size_t> parent_list_;  // (insert_offspring(): the parents in order)
   std::vector<std::pair<int, int>> added_pairs_;
   std::vector<Eigen::Vector3d> born_reference_;

@@ -560,6 +560,7 @@ class System {
   std::vector<ParentShare> share_;  // (the same)
   std::vector<char> set_members_;   // (the same: the particles whose energy a change alters)
   std::vector<std::size_t> set_which_;
+  mutable std::vector<std::pair<int, int>> touching_;  // (set_energy(): the pairs it reads)
   double set_energy(const std::vector<std::size_t>& which, const std::vector<char>& in) const;
   // scratch of pack_particles() / unpack_particles() (kept: no allocation once grown)
   std::vector<char> chosen_;
