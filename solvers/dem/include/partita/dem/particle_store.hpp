@@ -225,7 +225,10 @@ struct ParticleStore::TypedColumn final : Column {
     std::vector<T>& v = data(core);
     const std::size_t first = v.size();
     v.resize(first + n * width);
-    if (n * width > 0) std::memcpy(v.data() + first, in, n * width * sizeof(T));
+    // (through a byte pointer: T is standard layout and trivially copyable in its bytes, e.g.
+    // Eigen::Vector3d, whose non-trivial copy-assignment -Wclass-memaccess would flag)
+    if (n * width > 0)
+      std::memcpy(static_cast<void*>(v.data() + first), in, n * width * sizeof(T));
   }
   void read(Particles& core, BinaryReader& in) override {
     const std::string found = in.string("a particle array name");
