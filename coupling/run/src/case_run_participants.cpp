@@ -106,6 +106,14 @@ void CaseRun::build_participants(const config::Node& root) {
             " participants needs a coupling section (scheme and exchanges); only a case with one "
             "participant runs without one");
 
+  if (options_.ranks && options_.ranks->size() > 1 && names.size() != 1)
+    ps.fail(fmt::format(
+        "this case has {} participants ({}) and runs on {} ranks (mpirun -n {}): a case of one "
+        "participant runs on several ranks; run each participant in a process of its own, e.g. "
+        "mpirun -n 1 partita run CASE --participant {} : -n 1 partita run CASE --participant {}",
+        names.size(), join_names(names), options_.ranks->size(), options_.ranks->size(),
+        names[0], names[1]));
+
   // substeps
   std::map<std::string, Substeps> substeps;
   if (coupling.has("substeps")) {
@@ -183,6 +191,7 @@ void CaseRun::build_participants(const config::Node& root) {
     }
     if (!runs_here(name)) continue;  // another process builds it
     SolverContext ctx{name, validated, case_dir_, output_dir_, options_.threads};
+    ctx.ranks = options_.ranks;  // (a case of one participant: checked above)
     log::get("coupling")->debug("setting up participant '{}' ({})", name, entry.name);
     Stopwatch setup;
     std::unique_ptr<Solver> solver = entry.factory(ctx);

@@ -44,6 +44,7 @@
 #include "partita/interface/config.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/mesh.hpp"
+#include "partita/interface/participant_ranks.hpp"
 #include "partita/interface/vtk_xml.hpp"
 
 namespace partita {
@@ -198,6 +199,10 @@ struct SolverContext {
   std::filesystem::path case_dir;    ///< folder of the case file (relative inputs)
   std::filesystem::path output_dir;  ///< the run's output folder
   int threads = 1;                   ///< threads the solver may use
+  /// The processes this participant runs on (mpirun -n N partita run CASE for a case of one
+  /// participant; participant_ranks.hpp); null: this process alone. A solver that does not run
+  /// on several ranks ignores it (the run is then refused on more than one).
+  std::shared_ptr<ParticipantRanks> ranks = nullptr;
 };
 
 using SolverFactory = std::function<std::unique_ptr<Solver>(const SolverContext&)>;

@@ -59,6 +59,7 @@
 #include "partita/coupling/registries.hpp"
 #include "partita/interface/config.hpp"
 #include "partita/interface/output.hpp"
+#include "partita/interface/participant_ranks.hpp"
 #include "partita/run/run_summary.hpp"
 
 namespace partita::coupling {
@@ -104,6 +105,10 @@ struct RunOptions {
     std::vector<std::pair<std::string, Channel*>> servers;
     Channel* controller = nullptr;
   } distributed;
+  /// The processes of `mpirun -n N partita run CASE` (participant_ranks.hpp): a case of one
+  /// participant runs it on all of them (its solver gets them in SolverContext::ranks); a case
+  /// of several is refused on more than one. Null: one process.
+  std::shared_ptr<ParticipantRanks> ranks = nullptr;
 };
 
 class CaseRun {

@@ -1,0 +1,74 @@
+#pragma once
+// The processes one participant runs on: `mpirun -n N partita run CASE` for a case of one
+// participant gives that participant the N processes of mpirun (its ranks), through
+// SolverContext::ranks. Without it (null) a solver runs in its one process, as always.
+//
+// Rank 0 leads: the run (the coupling core, the services, every file the run writes) lives in
+// its process and drives its solver through the Solver contract, as in one process. The solver
+// on rank 0 passes what the others must do on to them (its own messages, over the communicator);
+// every other rank builds the case alike (the same participant, the same solver set up from the
+// same section) and then only follows: the solver hands the app the loop that does so (claim()),
+// and the app runs it (follow()) until rank 0's solver says the run has ended.
+//
+// A solver that does not run on several ranks leaves the handle alone; the app then refuses a run
+// on more than one rank, naming the participant and its solver.
+//
+// The communicator is MPI's (an MPI_Comm, passed as a pointer to it so that interface/ does not
+// include mpi.h); only a solver built with MPI reads it.
+
+#include <functional>
+#include <string>
+#include <utility>
+
+namespace partita {
+
+class ParticipantRanks {
+ public:
+  /// rank of size processes; communicator: a pointer to their MPI_Comm (alive while the run
+  /// is); deadline: seconds any one wait for another rank may take.
+  ParticipantRanks(int rank, int size, const void* communicator, double deadline)
+      : rank_(rank), size_(size), communicator_(communicator), deadline_(deadline) {}
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  /// Rank 0: the process the run drives.
+  bool leads() const { return rank_ == 0; }
+  /// A pointer to the MPI_Comm of the participant's processes.
+  const void* communicator() const { return communicator_; }
+  double deadline() const { return deadline_; }
+
+  /// The solver runs on these ranks. On a rank other than 0, `follow` is how it follows rank
+  /// 0's solver: it returns the exit status when rank 0's solver ends the run (0 after a run
+  /// that finished, non-zero after one that failed on rank 0), and throws on a failure of its
+  /// own. On rank 0, `end` tells the others that the run has ended with a status (a failure on
+  /// rank 0 outside the solver's calls: the app calls end(), the solver object still alive).
+  void claim(std::function<int()> follow, std::function<void(int)> end) {
+    claimed_ = true;
+    follow_ = std::move(follow);
+    end_ = std::move(end);
+  }
+  bool claimed() const { return claimed_; }
+  /// Runs the loop the solver claimed with (ranks other than 0).
+  int follow() const { return follow_ ? follow_() : 0; }
+  /// (rank 0) Ends the others' loops with `status` (nothing when they have ended already).
+  void end(int status) const {
+    if (end_) end_(status);
+  }
+
+  /// Set by the solver when a rank failed or stopped answering in the middle of what all ranks
+  /// do together: the others cannot finish with it, and the app must end them all (MPI_Abort)
+  /// after printing the message.
+  void set_broken() { broken_ = true; }
+  bool broken() const { return broken_; }
+
+ private:
+  int rank_ = 0, size_ = 1;
+  const void* communicator_ = nullptr;
+  double deadline_ = 600.0;
+  bool claimed_ = false;
+  bool broken_ = false;
+  std::function<int()> follow_;
+  std::function<void(int)> end_;
+};
+
+}  // namespace partita
