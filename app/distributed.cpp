@@ -1,5 +1,6 @@
 // Participants as processes over MPI (distributed.hpp): MPI start-up, the processes' names, the
-// channels between the controller and the other processes, and the failure paths.
+// channels between the controller and the other processes, and the failure paths; and a case of
+// one participant on the ranks of mpirun (run_on_ranks()).
 #include "distributed.hpp"
 
 #include <chrono>
@@ -14,6 +15,7 @@
 #include "partita/run/remote_participant.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
+#include "partita/interface/participant_ranks.hpp"
 
 #ifdef PARTITA_MPI
 #include "partita/mpi/mpi_channel.hpp"
@@ -27,9 +29,22 @@ bool started_with_others() {
   return false;
 }
 
+bool started_by_mpirun() {
+  for (const char* var : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"})
+    if (const char* v = std::getenv(var); v && *v) return true;
+  return false;
+}
+
 #ifndef PARTITA_MPI
 
 bool distributed_available() { return false; }
+
+int run_on_ranks(const coupling::Registries&, RanksOptions) {
+  std::cerr << "partita: error: this process was started by mpirun with others, and this partita "
+               "was built without MPI: it cannot run a case on several ranks (install "
+               "libopenmpi-dev and openmpi-bin, e.g. ./build.sh deps, and build again)\n";
+  return 1;
+}
 
 int run_distributed(const coupling::Registries&, DistributedOptions) {
   std::cerr << "partita: error: --participant runs participants as separate processes over MPI, "
@@ -41,6 +56,90 @@ int run_distributed(const coupling::Registries&, DistributedOptions) {
 #else
 
 bool distributed_available() { return true; }
+
+int run_on_ranks(const coupling::Registries& registries, RanksOptions o) {
+  int provided = 0;
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  static MPI_Comm world = MPI_COMM_WORLD;  // (the handle points to it)
+  auto ranks = std::make_shared<ParticipantRanks>(rank, size, &world, o.peer_timeout);
+  run::RunOptions& ro = o.run;
+  ro.ranks = ranks;
+  if (rank != 0) {
+    // the others build the case alike and write nothing: rank 0's solver drives theirs; their
+    // set-up's log lines would be rank 0's again
+    ro.check_only = true;
+    ro.check_sweep_values = false;
+    if (log::get("app")->level() < spdlog::level::warn) log::set_level(spdlog::level::warn);
+  }
+  std::unique_ptr<run::CaseRun> c;
+  // the solver (its transport) goes before MPI_Finalize; after a failure in the middle of what
+  // the ranks do together, every rank ends at once (the others may wait in a collective)
+  auto end = [&](int status, bool abort) {
+    if (abort) MPI_Abort(MPI_COMM_WORLD, status == 0 ? 1 : status);
+    c.reset();
+    MPI_Finalize();
+    return status;
+  };
+  auto say = [&](const std::exception& e) {
+    const std::string what = dynamic_cast<const Error*>(&e) != nullptr
+                                 ? std::string(e.what())
+                                 : "internal error: " + std::string(e.what());
+    // every rank builds and meets the same errors: rank 0 says them; another rank speaks for a
+    // failure of its own (which broke the ranks' work together)
+    if (rank == 0)
+      std::cerr << "partita: error: " << what << "\n";
+    else if (ranks->broken())
+      std::cerr << "partita: error: rank " << rank << " of " << size << ": " << what << "\n";
+  };
+  try {
+    c = std::make_unique<run::CaseRun>(o.case_file, registries, ro);
+  } catch (const std::exception& e) {
+    say(e);
+    return end(1, ranks->broken());
+  }
+  if (!ranks->claimed() && size > 1) {
+    if (rank == 0)
+      std::cerr << "partita: error: " << o.case_file.string() << ": its participant's solver "
+                << "does not run on several ranks (mpirun -n " << size
+                << "); run the case in one process, without mpirun (a DEM participant runs on "
+                   "several ranks)\n";
+    return end(1, false);
+  }
+  if (o.install_stop_handlers) o.install_stop_handlers();
+  int status = 0;
+  try {
+    if (rank == 0) {
+      c->run();
+      if (const int signal = c->summary().stopped_by_signal; signal != 0) {
+        std::cout << "partita run: stopped by signal " << signal << " after window "
+                  << c->summary().windows << "; output in " << c->output_dir().string() << "/";
+        if (!c->summary().last_restart.empty())
+          std::cout << "; continue with: mpirun -n " << size << " partita run "
+                    << o.case_file.string() << " --resume " << c->output_dir().string();
+        std::cout << "\n";
+        status = 128 + signal;
+      }
+      ranks->end(status);  // (the solver's finalize() ended the others' loops already)
+      if (status == 0 && o.on_finished) o.on_finished(*c);
+    } else {
+      status = ranks->follow();
+    }
+  } catch (const std::exception& e) {
+    if (rank == 0 && !ranks->broken()) {
+      try {
+        ranks->end(1);
+      } catch (...) {
+        ranks->set_broken();
+      }
+    }
+    say(e);
+    return end(1, ranks->broken());
+  }
+  return end(status, false);
+}
 
 int run_distributed(const coupling::Registries& registries, DistributedOptions o) {
   int provided = 0;

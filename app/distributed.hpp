@@ -43,6 +43,28 @@ bool distributed_available();
 /// Run this process's part of a distributed run; returns the exit status (0, 1, 128 + signal).
 int run_distributed(const coupling::Registries& registries, DistributedOptions options);
 
+/// `mpirun -n N partita run CASE` (no --participant): a case of one participant runs on the N
+/// processes (ParticipantRanks, through SolverContext::ranks): rank 0 runs the case (the coupling
+/// core, the services, every file), its solver leads the others, which build the case alike and
+/// follow it. A case of several participants, or a solver that does not run on ranks, is refused
+/// on more than one process; on one (mpirun -n 1) a case whose solver does not take the ranks
+/// runs as without mpirun. Returns the exit status (0, 1, 128 + signal); a failure in the middle
+/// of what the ranks do together (or a rank that does not answer within peer_timeout) ends them
+/// all (MPI_Abort) after the message.
+struct RanksOptions {
+  std::filesystem::path case_file;
+  run::RunOptions run;
+  double peer_timeout = 600.0;  ///< [s] the longest wait for another rank
+  std::function<void()> install_stop_handlers;
+  /// Called on rank 0 after a run that finished (plots, scripts, the last line).
+  std::function<void(const run::CaseRun&)> on_finished;
+};
+int run_on_ranks(const coupling::Registries& registries, RanksOptions options);
+
+/// True when this process was started by mpirun (OMPI_COMM_WORLD_SIZE, PMI_SIZE or PMIX_SIZE
+/// set, to any number).
+bool started_by_mpirun();
+
 /// True when this process was started by mpirun with others (OMPI_COMM_WORLD_SIZE > 1, or
 /// PMI_SIZE > 1): a run without --participant there would run the whole case in every process.
 bool started_with_others();

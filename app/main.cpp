@@ -1,6 +1,7 @@
 // partita: the command line. A thin main over the libraries:
 //   partita run CASE.yaml [--output DIR] [--threads N] [--log-level L] [--resume DIR] [--no-plots]
 //   mpirun -n 1 partita run CASE --participant A : -n 1 partita run CASE --participant B
+//   mpirun -n N partita run CASE           (a case of one DEM participant, on N ranks)
 //   partita check CASE.yaml
 //   partita list
 //   partita docs [NAME]
@@ -178,8 +179,8 @@ int main(int argc, char** argv) {
                   "their own (under mpirun, one process per participant: mpirun -n 1 partita run "
                   "CASE --participant A : -n 1 partita run CASE --participant B)");
   run->add_option("--peer-timeout", peer_timeout,
-                  "With --participant: the longest wait for another process's message [s] "
-                  "(default 600): a stuck process ends the run after it")
+                  "With --participant, or on several ranks: the longest wait for another "
+                  "process's message [s] (default 600): a stuck process ends the run after it")
       ->check(CLI::PositiveNumber);
   run->add_option("--set", overrides,
                   "Change a value of the case: KEY.PATH=VALUE with map keys joined by dots and "
@@ -275,11 +276,26 @@ int main(int argc, char** argv) {
       };
       return partita::app::run_distributed(registries, d);
     }
-    if (partita::app::started_with_others())
-      throw partita::Error(
-          "this process was started by mpirun with others, without --participant: every process "
-          "would run the whole case; give each process its participant, e.g. mpirun -n 1 partita "
-          "run CASE --participant A : -n 1 partita run CASE --participant B");
+    // mpirun -n N partita run CASE: a case of one participant on the N ranks
+    if (partita::app::started_by_mpirun() &&
+        (partita::app::distributed_available() || partita::app::started_with_others())) {
+      if (!no_sweep && resume_dir.empty() && partita::app::has_sweep(case_file, overrides))
+        throw partita::Error(
+            case_file + " has a sweep section, and this process was started by mpirun: a sweep "
+            "runs its variants each in a process of its own (run it without mpirun), or give "
+            "--no-sweep to run the case as written on the ranks");
+      partita::app::RanksOptions r;
+      r.case_file = case_file;
+      r.run = options;
+      r.peer_timeout = peer_timeout;
+      r.install_stop_handlers = install_stop_handlers;
+      r.on_finished = [&](const partita::run::CaseRun& c) {
+        finish(c.output_dir());
+        partita::app::run_scripts(c.scripts(), c.output_dir());
+        std::cout << "partita run: finished; output in " << c.output_dir().string() << "/\n";
+      };
+      return partita::app::run_on_ranks(registries, r);
+    }
     if (!no_sweep && resume_dir.empty() && partita::app::has_sweep(case_file, overrides)) {
       install_stop_handlers();
       partita::app::SweepOptions so;

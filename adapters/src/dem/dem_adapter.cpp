@@ -3,6 +3,7 @@
 // case: dem_build.cpp; its monitors: dem_monitors.cpp.
 
 #include "dem_adapter.hpp"
+#include "dem_ranks.hpp"
 
 #include <fmt/format.h>
 #include <algorithm>
@@ -21,6 +22,19 @@
 
 namespace partita::adapters {
 
+namespace {
+
+// What a split over ranks does not handle yet, asked of the solver at run time.
+[[noreturn]] void not_on_ranks(const std::string& participant, const std::string& what) {
+  throw Error("dem '" + participant + "': " + what +
+              " is not yet on several ranks (mpirun -n N partita run CASE splits the bed over "
+              "N ranks); run this case in one process, without mpirun");
+}
+
+}  // namespace
+
+DemAdapter::~DemAdapter() = default;
+
 const dem::Breakage* DemAdapter::breakage() const {
   return breakage_ < 0 ? nullptr : &static_cast<const dem::Breakage&>(system_.hook(breakage_));
 }
@@ -37,6 +51,7 @@ std::size_t DemAdapter::find(std::string_view mesh, bool* centres) const {
 }
 
 void DemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
+  if (on_ranks()) not_on_ranks(name_, "reading coupled data ('" + std::string(data) + "')");
   bool centres = false;
   CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
   if (centres && data == "attached") {
@@ -61,6 +76,7 @@ void DemAdapter::read(std::string_view mesh, std::string_view data, const Eigen:
 }
 
 void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
+  if (on_ranks()) not_on_ranks(name_, "writing coupled data ('" + std::string(data) + "')");
   bool centres = false;
   const CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
   if (!centres) {
@@ -84,6 +100,7 @@ void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
 }
 
 double DemAdapter::stable_time_step() const {
+  if (on_ranks()) return ranks_->stable;  // over every particle at the start (the set is fixed)
   // dt_R is a minimum over the particles (O(N) square roots): recomputed only when the particle
   // set changed (breakage adds fragments), not at every step that asks for it.
   // (Restoring a checkpoint or a restart file resets stable_for_count_.)
@@ -96,6 +113,10 @@ double DemAdapter::stable_time_step() const {
 }
 
 void DemAdapter::advance(double dt) {
+  if (on_ranks()) {
+    lead_advance(dt);
+    return;
+  }
   // walls with a velocity table move with the factor at the middle of the step (exact
   // displacement where the step lies within one row interval of the table)
   for (const auto& w : walls_)
@@ -130,12 +151,14 @@ std::optional<double> DemAdapter::interface_work(std::string_view mesh) const {
 }
 
 void DemAdapter::save_checkpoint() {
+  if (on_ranks()) not_on_ranks(name_, "a checkpoint (an implicit coupling scheme)");
   checkpoint_ = system_.save_state();
   for (auto& cm : meshes_dem_) cm.audit.save_checkpoint();
   has_checkpoint_ = true;
 }
 
 void DemAdapter::restore_checkpoint() {
+  if (on_ranks()) not_on_ranks(name_, "a checkpoint (an implicit coupling scheme)");
   if (!has_checkpoint_)
     throw Error("dem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
   system_.restore_state(checkpoint_);
@@ -144,6 +167,10 @@ void DemAdapter::restore_checkpoint() {
 }
 
 void DemAdapter::write_output(const OutputFrame& frame) {
+  if (on_ranks()) {
+    lead_output(frame);
+    return;
+  }
   files_.clear();
   const std::string pfile = fmt::format("{}_particles_{:06d}.vtp", frame.prefix, frame.index);
   write_particles_vtp(system_, frame.vtk_directory / pfile, frame.vtk);
@@ -162,6 +189,10 @@ void DemAdapter::write_output(const OutputFrame& frame) {
 }
 
 void DemAdapter::finalize() {
+  if (on_ranks()) {
+    end_others(0);  // the others' loops end with the run (nothing of theirs is left to write)
+    return;
+  }
   if (particles_file_ != "none") write_particles_file(output_dir_ / (name_ + ".data"));
 }
 
@@ -192,6 +223,15 @@ void DemAdapter::write_grading(const OutputFrame& frame) const {
 }
 
 void DemAdapter::write_restart(BinaryWriter& out) const {
+  if (on_ranks()) {
+    // the split bed's restart (dem::SplitRestart: gathered to rank 0), resumed on any number of
+    // ranks
+    out.section("dem on ranks");
+    out.bytes(lead_restart());
+    out.section("dem interface work");
+    for (const auto& cm : meshes_dem_) cm.audit.save(out);
+    return;
+  }
   out.section("dem");
   std::ostringstream state;
   system_.write_state(state);  // the DEM's own versioned format: particles with ids, contact
@@ -202,6 +242,14 @@ void DemAdapter::write_restart(BinaryWriter& out) const {
 }
 
 void DemAdapter::read_restart(BinaryReader& in) {
+  if (on_ranks()) {
+    in.expect_section("dem on ranks");
+    if (const std::string astray = lead_resume(in.bytes(), in.source()); !astray.empty())
+      throw Error(in.source() + ": the DEM state of '" + name_ + "' cannot be resumed: " + astray);
+    in.expect_section("dem interface work");
+    for (auto& cm : meshes_dem_) cm.audit.load(in, "vertices of mesh '" + cm.name + "'");
+    return;
+  }
   in.expect_section("dem");
   std::istringstream state(in.bytes());
   try {
@@ -270,14 +318,19 @@ double DemAdapter::default_lost_margin() const {
   return std::max((domain_hi_ - domain_lo_).maxCoeff(), kLostDiameters * d_max);
 }
 
-std::string DemAdapter::check_state() const { return particle_astray(false); }
+std::string DemAdapter::check_state() const {
+  return on_ranks() ? lead_check() : particle_astray(false);
+}
 
 std::string DemAdapter::particle_astray(bool restored) const {
   // the first particle (lowest index) that is not finite or lies beyond the margin, if any
   const std::ptrdiff_t astray = system_.first_particle_astray(domain_lo_, domain_hi_, lost_margin_);
   if (astray < 0) return {};
+  return astray_message(static_cast<std::size_t>(astray), restored);
+}
+
+std::string DemAdapter::astray_message(std::size_t i, bool restored) const {
   const dem::Particles& p = system_.particles();
-  const auto i = static_cast<std::size_t>(astray);
   if (restored)
     return fmt::format(
         "particle id {} (index {}) at ({:.6g}, {:.6g}, {:.6g}) m with velocity ({:.6g}, {:.6g}, "

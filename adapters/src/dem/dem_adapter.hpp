@@ -35,6 +35,10 @@
 // every-output} the particles are written as a LAMMPS data file that particles: {file: ...} reads
 // back bit for bit: <output>/<participant>.data at finalize() (and
 // <output>/particles/<participant>_<frame>.data at each output time).
+//
+// On several ranks (SolverContext::ranks: mpirun -n N partita run CASE, a DEM-only case): the bed
+// split over the ranks, one subdomain each, rank 0 leading the others (dem_ranks.cpp, which says
+// what is handled and what is refused).
 
 #include <array>
 #include <cstdint>
@@ -56,6 +60,7 @@ namespace partita::adapters {
 class DemAdapter : public Solver {
  public:
   explicit DemAdapter(const SolverContext& context);
+  ~DemAdapter() override;
 
   const std::vector<InterfaceMesh>& meshes() const override { return meshes_; }
   void read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) override;
@@ -161,6 +166,44 @@ class DemAdapter : public Solver {
   std::vector<std::int64_t> tracked_;
   mutable std::vector<std::size_t> tracked_index_;
   mutable std::vector<std::array<double, 6>> tracked_last_;
+
+  // ---- on several ranks (dem_ranks.cpp): the bed split over the participant's ranks ----
+  struct OnRanks;  // dem_ranks.hpp
+  std::unique_ptr<OnRanks> ranks_;  // null: one process (system_ holds the whole bed)
+  bool on_ranks() const { return ranks_ != nullptr; }
+  /// At the end of the constructor with SolverContext::ranks: refuses what a split does not
+  /// handle yet (naming the key), keeps this rank's particles, sets up the stepper, claims the
+  /// ranks.
+  void setup_ranks(const SolverContext& context);
+  /// (rank 0) The command `bytes` to every other rank; (the others) the next command.
+  void tell_others(const std::vector<std::byte>& bytes) const;
+  std::vector<std::byte> next_command() const;
+  /// (rank 0) What the Solver contract asks, told to the others and done together.
+  void lead_advance(double dt);
+  std::vector<MonitorValue> lead_monitors(const std::vector<std::string>& names) const;
+  std::string lead_check() const;
+  void lead_output(const OutputFrame& frame);
+  std::string lead_restart() const;
+  /// The restart stream resumed on every rank; the check of the state (empty: fine).
+  std::string lead_resume(const std::string& stream, const std::string& source);
+  /// What every rank does for a command (collective); each starts the stepper first if no
+  /// command has (its first force pass, on every rank at the same command).
+  void ranks_start() const;
+  void ranks_advance(double dt);
+  void ranks_monitors(std::uint32_t groups) const;
+  std::string ranks_check() const;
+  void ranks_output(const OutputFrame& frame);
+  std::string ranks_restart() const;
+  void ranks_resume(const std::string& stream);
+  /// (ranks other than 0) Follows rank 0's commands until it ends the run: the exit status.
+  int follow();
+  /// (rank 0) Tells the others that the run has ended with `status` (after a failure here).
+  void end_others(int status);
+  /// (rank 0) The monitor groups that `names` need; throws Error for a quantity not on ranks.
+  std::uint32_t ranks_monitor_groups(const std::vector<std::string>& names) const;
+  std::vector<std::string> ranks_monitor_names() const;
+  /// check_state()'s message for particle i (not finite or astray).
+  std::string astray_message(std::size_t i, bool restored) const;
 };
 
 }  // namespace partita::adapters

@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "dem_adapter.hpp"
+#include "dem_ranks.hpp"
 #include "partita/dem/breakage.hpp"
 #include "partita/dem/error.hpp"
 #include "partita/dem/lammps_data.hpp"
@@ -424,6 +425,8 @@ DemAdapter::DemAdapter(const SolverContext& context)
                             : fmt::format(" ({} handed over by other participants)",
                                           requests_.size()),
           system_.rayleigh_time_step(), stable_time_step());
+  // mpirun -n N partita run CASE: the bed split over the participant's ranks (dem_ranks.cpp)
+  if (context.ranks) setup_ranks(context);
 }
 
 void DemAdapter::add_breakage(const config::Node& b) {

@@ -1,11 +1,13 @@
 // The DEM adapter's monitor quantities (MonitorTable): each declared once, with its unit and doc
 // (`partita docs dem`) and how the adapter gets it. Those that take a pass over every particle or
 // pair (the kinetic energy, the mass, the contacts, the stable step) are computed only when a case
-// records them.
+// records them. On several ranks (dem_ranks.cpp) the quantities a split sums over the ranks come
+// from its last collective pass (OnRanks); the others are refused there.
 
 #include <algorithm>
 
 #include "dem_adapter.hpp"
+#include "dem_ranks.hpp"
 
 namespace partita::adapters {
 
@@ -23,10 +25,14 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
     const auto broken = [](const A& a) { return a.breakage() != nullptr; };
     MonitorTable<A> t;
     t.scalar("kinetic_energy", "J", "translational plus rotational kinetic energy of the particles",
-             [](const A& a) { return a.system_.kinetic_energy(); });
-    t.scalar("particles", "", "number of particles",
-             [](const A& a) { return static_cast<double>(a.system_.particle_count()); });
+             [](const A& a) {
+               return a.on_ranks() ? a.ranks_->kinetic : a.system_.kinetic_energy();
+             });
+    t.scalar("particles", "", "number of particles", [](const A& a) {
+      return a.on_ranks() ? a.ranks_->particles : static_cast<double>(a.system_.particle_count());
+    });
     t.scalar("mass", "kg", "total mass of the particles", [](const A& a) {
+      if (a.on_ranks()) return a.ranks_->mass;
       double mass = 0.0;
       for (const double m : a.system_.particles().mass) mass += m;
       return mass;
@@ -35,7 +41,9 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
                    "linear momentum sum m v of the particles, x (its change over an interval is "
                    "gravity's and the walls' and meshes' impulse on the particles: the weight "
                    "check of a bed that is not at rest)"),
-          [](const A& a, const Out& out) { out({}, a.system_.linear_momentum()); });
+          [](const A& a, const Out& out) {
+            out({}, a.on_ranks() ? a.ranks_->momentum : a.system_.linear_momentum());
+          });
     t.scalar("contacts_per_particle", "", "mean number of particle-particle contacts",
              [](const A& a) { return a.system_.mean_contacts_per_particle(); });
     t.scalar("friction_work", "J",
@@ -67,7 +75,10 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
              },
              energies);
     t.scalar("elastic_energy", "J", "elastic energy stored in the contacts (normal and tangential)",
-             [](const A& a) { return a.system_.elastic_energy(); }, energies);
+             [](const A& a) {
+               return a.on_ranks() ? a.ranks_->elastic : a.system_.elastic_energy();
+             },
+             [](const A& a) { return a.system_.energy_tracking() || a.on_ranks(); });
     t.scalar("energy_balance_error", "",
              "(wall_work + gravity_work - dKE - d elastic_energy - friction_work - damping_work - "
              "breakage_energy - stiffening_work) / (initial KE + initial elastic energy + the "
@@ -77,7 +88,9 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
     // monitor column takes (the last of that name)
     t.add(xyz_rows("<mesh>.force", "N", "total contact force of the particles on a mesh, x"),
           [](const A& a, const Out& out) {
-            for (const auto& m : a.meshes_dem_) out({m.name}, a.system_.mesh_force(m.id));
+            for (std::size_t k = 0; k < a.meshes_dem_.size(); ++k)
+              out({a.meshes_dem_[k].name}, a.on_ranks() ? a.ranks_->mesh_force[k]
+                                                        : a.system_.mesh_force(a.meshes_dem_[k].id));
           });
     t.add({{"<mesh>.work", "J",
             "work of one mesh's motion on the particles since the start (a coupled FE surface: "
@@ -94,7 +107,9 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
                    "total contact force of the particles on a wall (a plane, or all faces of a "
                    "box), x"),
           [](const A& a, const Out& out) {
-            for (const auto& w : a.walls_) out({w.name}, a.system_.wall_force(w.id));
+            for (std::size_t k = 0; k < a.walls_.size(); ++k)
+              out({a.walls_[k].name},
+                  a.on_ranks() ? a.ranks_->wall_force[k] : a.system_.wall_force(a.walls_[k].id));
           });
     t.add({{"<wall>.work", "J", "work of one wall's motion on the particles since the start"}},
           [](const A& a, const Out& out) {
@@ -117,7 +132,8 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
                       a.system_.wall_face_force(w.id, face).value_or(Eigen::Vector3d(0.0, 0.0, 0.0)));
           });
     // monitor_particles: found by id (indices change when the particles are renumbered); a
-    // particle that breakage removed keeps its last state
+    // particle that breakage removed keeps its last state; on ranks, the state the last
+    // collective pass gathered
     std::vector<QuantityDoc> tracked = xyz_rows(
         "particle.<id>", "m",
         "position of the particle with that id (the ids listed in monitor_particles), x", ".");
@@ -126,11 +142,15 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
     t.add(tracked, [](const A& a, const Out& out) {
       const dem::Particles& p = a.system_.particles();
       for (std::size_t k = 0; k < a.tracked_.size(); ++k) {
+        std::array<double, 6>& last = a.tracked_last_[k];
+        if (a.on_ranks()) {
+          out({std::to_string(a.tracked_[k])}, {last[0], last[1], last[2], last[3], last[4], last[5]});
+          continue;
+        }
         std::size_t& i = a.tracked_index_[k];
         if (i >= p.size() || p.id[i] != a.tracked_[k])  // renumbered (or removed): find it again
           i = static_cast<std::size_t>(std::find(p.id.begin(), p.id.end(), a.tracked_[k]) -
                                        p.id.begin());
-        std::array<double, 6>& last = a.tracked_last_[k];
         if (i < p.size())
           for (int c = 0; c < 3; ++c) {
             last[static_cast<std::size_t>(c)] = p.position[i][c];
@@ -170,9 +190,14 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
   return table;
 }
 
-std::vector<MonitorValue> DemAdapter::monitors() const { return monitor_values({}); }
+std::vector<MonitorValue> DemAdapter::monitors() const {
+  return on_ranks() ? monitor_table().values(*this, {}) : monitor_values({});
+}
 
 std::vector<MonitorValue> DemAdapter::monitor_values(const std::vector<std::string>& names) const {
+  // (on ranks, monitors() is what the run's set-up asks for the names and units, on every rank
+  // alike: the values of the last collective pass, none at the start)
+  if (on_ranks()) return lead_monitors(names);
   return monitor_table().values(*this, names);
 }
 

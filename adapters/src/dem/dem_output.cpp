@@ -1,6 +1,10 @@
 #include "partita/adapters/dem_output.hpp"
 
+#include <bit>
+#include <string>
+
 #include "partita/dem/system.hpp"
+#include "partita/interface/output.hpp"
 
 namespace partita::adapters {
 
@@ -33,14 +37,47 @@ void write_particles_vtp(const dem::Particles& p, const std::filesystem::path& p
 void write_mesh_vtp(const dem::System& system, int mesh, const std::filesystem::path& path,
                     const vtk::Options& options) {
   const dem::TriangleMesh& m = system.mesh(mesh);
+  write_mesh_vtp(system, mesh, path, options, m.vertex_forces(), m.triangle_forces());
+}
+
+void write_mesh_vtp(const dem::System& system, int mesh, const std::filesystem::path& path,
+                    const vtk::Options& options, const Eigen::MatrixX3d& vertex_forces,
+                    const Eigen::MatrixX3d& triangle_forces) {
+  const dem::TriangleMesh& m = system.mesh(mesh);
   vtk::PolyData piece;
   piece.points = xyz("", m.positions());
   piece.polys = vtk::Cells::uniform(m.triangles().empty() ? nullptr : m.triangles().front().data(),
                                     m.triangles().size(), 3);
   piece.point_data = {xyz("velocity", m.velocities()),
-                      vtk::DataArray::rows("force", m.vertex_forces())};
-  piece.cell_data = {vtk::DataArray::rows("force", m.triangle_forces())};
+                      vtk::DataArray::rows("force", vertex_forces)};
+  piece.cell_data = {vtk::DataArray::rows("force", triangle_forces)};
   vtk::write(path, piece, options);
+}
+
+void write_particles_pvtp(const std::filesystem::path& path, const std::vector<std::string>& pieces,
+                          const vtk::Options& options) {
+  static_assert(std::endian::native == std::endian::little, "the pieces are little endian");
+  // the arrays of write_particles_vtp(), with the types it writes them in: the points and ids
+  // exact, the fields Float64 or Float32 (the precision option)
+  const std::string field = options.precision == vtk::Precision::float32 ? "Float32" : "Float64";
+  std::string s =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PPolyData\" version=\"1.0\" "
+      "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <PPolyData GhostLevel=\"0\">\n"
+      "    <PPointData>\n";
+  const auto array = [&](const std::string& type, const std::string& name, int components) {
+    s += "      <PDataArray type=\"" + type + "\" Name=\"" + name + "\" NumberOfComponents=\"" +
+         std::to_string(components) + "\"/>\n";
+  };
+  array(field, "radius", 1);
+  array("Int64", "id", 1);
+  array(field, "velocity", 3);
+  array(field, "angular_velocity", 3);
+  array(field, "force", 3);
+  s += "    </PPointData>\n    <PPoints>\n"
+       "      <PDataArray type=\"Float64\" NumberOfComponents=\"3\"/>\n    </PPoints>\n";
+  for (const std::string& piece : pieces) s += "    <Piece Source=\"" + piece + "\"/>\n";
+  s += "  </PPolyData>\n</VTKFile>\n";
+  write_file_atomically(path, s);
 }
 
 }  // namespace partita::adapters

@@ -5,6 +5,10 @@
 // bench_vtk times the particle file on arrays of its own.
 
 #include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
 
 #include "partita/interface/vtk_xml.hpp"
 
@@ -26,5 +30,16 @@ void write_particles_vtp(const dem::Particles& particles, const std::filesystem:
 /// particles' force on each vertex), cell array force [N] (on each triangle).
 void write_mesh_vtp(const dem::System& system, int mesh, const std::filesystem::path& path,
                     const vtk::Options& options);
+/// The same with the forces given (vertices x 3 and triangles x 3 [N]: a bed split over ranks
+/// sums them over the ranks).
+void write_mesh_vtp(const dem::System& system, int mesh, const std::filesystem::path& path,
+                    const vtk::Options& options, const Eigen::MatrixX3d& vertex_forces,
+                    const Eigen::MatrixX3d& triangle_forces);
+
+/// The particles of a bed split over ranks as one parallel PolyData file (.pvtp) whose pieces
+/// are `pieces` (file names beside it, each written by write_particles_vtp() with the same
+/// options): ParaView opens the pieces as one data set. Written atomically.
+void write_particles_pvtp(const std::filesystem::path& path, const std::vector<std::string>& pieces,
+                          const vtk::Options& options);
 
 }  // namespace partita::adapters

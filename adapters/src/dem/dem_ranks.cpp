@@ -1,0 +1,626 @@
+// The DEM adapter on several ranks: `mpirun -n N partita run CASE` for a case whose one
+// participant is a DEM (SolverContext::ranks, participant_ranks.hpp).
+//
+// The bed is split into N subdomains, one a rank (dem::SubdomainStepper over
+// dem::MpiSubdomainTransport; subdomain.hpp says why the split steps to the same bits on any N):
+// every rank builds the participant alike from the case (materials, walls, meshes and every
+// particle, generated or read), keeps the particles that its box of a bisection of the starting
+// positions owns, and steps them. The decomposition's bounds are the domain's box (walls, meshes,
+// particles at the start) grown by 2 R_max + skin on every side, the same on every N: the global
+// order's grid, and so every sum, does not depend on N. The skin is the case's, or 10 % of the
+// largest radius (as one System's default).
+//
+// Rank 0 is the run's: the run drives its adapter through the Solver contract, and the adapter
+// tells the others what to do (a command, through the transport) before doing it with them:
+//   advance dt       every rank steps its subdomain (walls moved by their tables alike);
+//   monitors groups  the sums the quantities asked for need, each an exact sum over the owned
+//                    particles rounded once (SubdomainStepper: kinetic energy, momentum, elastic
+//                    energy, each wall's and mesh's force), the monitor particles' states gathered
+//                    from their owners: the same bits on any N;
+//   check            every rank's astray owned particle of lowest id to rank 0;
+//   output frame     every rank writes its owned particles as one piece
+//                    (<prefix>_particles_<frame>_<rank>.vtp), rank 0 the .pvtp that joins them
+//                    (the series' file: ParaView opens the pieces as one) and the meshes with the
+//                    forces summed over the ranks;
+//   restart          dem::SplitRestart gathered to rank 0 (one stream, resumed on any number of
+//                    ranks);
+//   resume stream    every rank restores it (rank 0 takes the particles, the first list build
+//                    sends each to its owner) and checks its particles;
+//   finish / end     the others' loop ends (finalize(): status 0; a failure on rank 0: the
+//                    status the app gives, end_others()).
+// The others run follow() (the loop the adapter claims the ranks with) until finish or end.
+//
+// Not handled on a split yet, refused at set-up naming the key: breakage (fragment ids unique over
+// the ranks, new particles' ghosts), wall servos (each rank would steer its wall by its own part
+// of the force), the energy accounting, output.particles_file, meshes taken from another
+// participant (the coupling); at run time: the monitor quantities not listed above
+// (contacts_per_particle, the faces of a box wall), coupled data, checkpoints.
+//
+// The split path gives the same bytes on every N, N = 1 under mpirun included. It is not the path
+// of one process without mpirun (one dem::System stepped whole): the split numbers the particles
+// by a global grid and sums forces on walls and meshes in exact sums, so the two differ in the
+// last bits, and so do their monitors (README, "A DEM-only case on N ranks").
+//
+// A failure: on rank 0 before a command (a refused quantity, a file it cannot write) the app ends
+// the others with end_others(); during a command on any rank (or a rank that does not answer
+// within the deadline) the ranks are marked broken and the app ends them all (MPI_Abort) after
+// the message.
+
+#include "dem_adapter.hpp"
+#include "dem_ranks.hpp"
+
+#include <fmt/format.h>
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <sstream>
+
+#include "partita/adapters/dem_output.hpp"
+#include "partita/dem/error.hpp"
+#include "partita/interface/error.hpp"
+#include "partita/interface/log.hpp"
+#include "partita/interface/registry.hpp"
+
+#ifdef PARTITA_DEM_MPI
+#include <mpi.h>
+
+#include "partita/dem/mpi_transport.hpp"
+#endif
+
+namespace partita::adapters {
+
+namespace {
+
+using config::Node;
+
+enum class Command : std::uint32_t {
+  advance = 1,
+  monitors,
+  check,
+  output,
+  restart,
+  resume,
+  finish,
+  end
+};
+
+// the monitor groups (what ranks_monitors() sums)
+constexpr std::uint32_t kKinetic = 1, kElastic = 2, kWalls = 4, kMeshes = 8, kTracked = 16;
+
+// A message's bytes.
+class Bytes {
+ public:
+  explicit Bytes(Command c) { put(static_cast<std::uint32_t>(c)); }
+  Bytes() = default;
+  template <class T>
+  Bytes& put(const T& v) {
+    const std::size_t at = b_.size();
+    b_.resize(at + sizeof v);
+    std::memcpy(b_.data() + at, &v, sizeof v);
+    return *this;
+  }
+  Bytes& put(const std::string& s) {
+    put(static_cast<std::uint64_t>(s.size()));
+    const std::size_t at = b_.size();
+    b_.resize(at + s.size());
+    if (!s.empty()) std::memcpy(b_.data() + at, s.data(), s.size());
+    return *this;
+  }
+  std::vector<std::byte>& bytes() { return b_; }
+
+ private:
+  std::vector<std::byte> b_;
+};
+
+class Reader {
+ public:
+  explicit Reader(const std::vector<std::byte>& b) : b_(b) {}
+  template <class T>
+  T get() {
+    T v{};
+    need(sizeof v);
+    std::memcpy(&v, b_.data() + at_, sizeof v);
+    at_ += sizeof v;
+    return v;
+  }
+  std::string string() {
+    const auto n = get<std::uint64_t>();
+    need(n);
+    std::string s(reinterpret_cast<const char*>(b_.data() + at_), n);
+    at_ += n;
+    return s;
+  }
+  bool done() const { return at_ == b_.size(); }
+
+ private:
+  void need(std::size_t n) const {
+    if (n > b_.size() - at_)
+      throw Error("dem on ranks: a message from another rank ends early (" +
+                  std::to_string(b_.size()) + " bytes)");
+  }
+  const std::vector<std::byte>& b_;
+  std::size_t at_ = 0;
+};
+
+const char* const kComponents[] = {"x", "y", "z", "vx", "vy", "vz"};
+
+}  // namespace
+
+// ---- set-up ----------------------------------------------------------------------------------
+
+void DemAdapter::setup_ranks(const SolverContext& context) {
+  const std::shared_ptr<ParticipantRanks>& ranks = context.ranks;
+  const Node& c = context.config;
+  const auto refuse = [&](const Node& key, const std::string& what) {
+    key.fail(fmt::format(
+        "{} is not yet on several ranks (mpirun -n {} partita run splits the DEM bed over the "
+        "ranks); run this case in one process, without mpirun",
+        what, ranks->size()));
+  };
+  if (c.has("breakage")) refuse(c["breakage"], "breakage (fragments born at run time)");
+  for (const Node& w : c["walls"].items())
+    if (w.has("servo")) refuse(w["servo"], "a wall servo");
+  if (c.has("energy_accounting") && c.boolean("energy_accounting"))
+    refuse(c["energy_accounting"], "the energy accounting");
+  if (particles_file_ != "none")
+    refuse(c["output"]["particles_file"], "output.particles_file (the particles as a data file)");
+  for (const Node& m : c["meshes"].items())
+    if (m.has("from")) refuse(m["from"], "a mesh taken from another participant (coupling)");
+#ifndef PARTITA_DEM_MPI
+  throw Error("dem '" + name_ + "': this partita was built without the DEM's MPI transport "
+              "(partita::dem_mpi): it cannot run on several ranks");
+#else
+  auto o = std::make_unique<OnRanks>();
+  o->ranks = ranks;
+  const dem::Particles& p = system_.particles();
+  if (p.size() == 0) c["particles"].fail("a DEM on several ranks needs particles at the start");
+  double r_max = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    r_max = std::max(r_max, p.radius[i]);
+    o->mass += p.mass[i];
+  }
+  o->particles = static_cast<double>(p.size());
+  o->stable = stable_time_step();
+  o->skin = c.has("skin") ? c.real("skin") : 0.1 * r_max;
+  o->wall_force.assign(walls_.size(), Eigen::Vector3d::Zero());
+  o->mesh_force.assign(meshes_dem_.size(), Eigen::Vector3d::Zero());
+  try {
+    const Eigen::Vector3d pad = Eigen::Vector3d::Constant(2.0 * r_max + o->skin);
+    o->decomposition = dem::DomainDecomposition::bisection(p.position, domain_lo_ - pad,
+                                                           domain_hi_ + pad, ranks->size());
+    std::vector<char> elsewhere(p.size(), 0);
+    for (std::size_t i = 0; i < p.size(); ++i)
+      elsewhere[i] = o->decomposition.owner(p.position[i]) != ranks->rank();
+    system_.remove_particles(elsewhere);
+    const MPI_Comm comm = *static_cast<const MPI_Comm*>(ranks->communicator());
+    o->transport = std::make_unique<dem::MpiSubdomainTransport>(comm, ranks->deadline());
+    o->stepper = std::make_unique<dem::SubdomainStepper>(std::vector<dem::System*>{&system_},
+                                                         *o->transport, o->decomposition, o->skin);
+  } catch (const dem::PeerTimeout& e) {
+    ranks->set_broken();
+    throw Error("dem '" + name_ + "' on rank " + std::to_string(ranks->rank()) + ": " + e.what());
+  } catch (const dem::Error& e) {
+    c.fail(std::string("DEM model of participant '") + name_ + "' on ranks: " + e.what());
+  }
+  const auto size = static_cast<std::size_t>(ranks->size());
+  o->out.assign(1, dem::SubdomainMail(size));
+  o->in.assign(1, dem::SubdomainMail(size));
+  ranks_ = std::move(o);
+  if (ranks->leads()) {
+    log::get("adapters")
+        ->info("dem '{}': on {} rank(s), {} particles on rank 0, skin {:.3g} m", name_,
+               ranks->size(), system_.particle_count(), ranks_->skin);
+    ranks->claim(nullptr, [this](int status) { end_others(status); });
+  } else {
+    ranks->claim([this] { return follow(); }, nullptr);
+  }
+#endif
+}
+
+// ---- commands --------------------------------------------------------------------------------
+
+// Collective work: a failure in it leaves the ranks unable to go on together (the transport's
+// PeerTimeout, a dem::Error, says which rank it met).
+template <class F>
+static auto together(ParticipantRanks& ranks, F&& f) {
+  try {
+    return f();
+  } catch (const dem::Error& e) {
+    ranks.set_broken();
+    throw Error("the DEM on rank " + std::to_string(ranks.rank()) + ": " + e.what());
+  } catch (...) {
+    ranks.set_broken();
+    throw;
+  }
+}
+
+void DemAdapter::tell_others(const std::vector<std::byte>& bytes) const {
+  OnRanks& o = *ranks_;
+  if (o.ranks->size() == 1) return;
+  for (std::size_t d = 0; d < o.out[0].size(); ++d)
+    if (d == 0)
+      o.out[0][d].clear();
+    else
+      o.out[0][d] = bytes;
+  together(*o.ranks, [&] { o.transport->exchange(o.out, o.in); });
+}
+
+std::vector<std::byte> DemAdapter::next_command() const {
+  OnRanks& o = *ranks_;
+  for (auto& b : o.out[0]) b.clear();
+  o.transport->exchange(o.out, o.in);
+  if (o.in[0][0].size() < 4)
+    throw Error("dem '" + name_ + "' on rank " + std::to_string(o.ranks->rank()) +
+                ": rank 0 sent no command");
+  return std::move(o.in[0][0]);
+}
+
+int DemAdapter::follow() {
+  OnRanks& o = *ranks_;
+  return together(*o.ranks, [&] {
+    for (;;) {
+      const std::vector<std::byte> message = next_command();
+      Reader in(message);
+      switch (static_cast<Command>(in.get<std::uint32_t>())) {
+        case Command::advance:
+          ranks_advance(in.get<double>());
+          break;
+        case Command::monitors:
+          ranks_monitors(in.get<std::uint32_t>());
+          break;
+        case Command::check:
+          ranks_check();
+          break;
+        case Command::output: {
+          OutputFrame f;
+          f.vtk_directory = in.string();
+          f.prefix = in.string();
+          f.index = in.get<int>();
+          f.time = in.get<double>();
+          f.vtk.format = in.get<vtk::Format>();
+          f.vtk.precision = in.get<vtk::Precision>();
+          f.vtk.zlib_level = in.get<int>();
+          f.vtk.block_size = in.get<std::size_t>();
+          ranks_output(f);
+          break;
+        }
+        case Command::restart:
+          ranks_restart();
+          break;
+        case Command::resume:
+          ranks_resume(in.string());
+          ranks_check();
+          break;
+        case Command::finish:
+          return 0;
+        case Command::end:
+          return in.get<int>();
+        default:
+          throw Error("dem '" + name_ + "' on rank " + std::to_string(o.ranks->rank()) +
+                      ": an unknown command from rank 0");
+      }
+    }
+  });
+}
+
+void DemAdapter::end_others(int status) {
+  OnRanks& o = *ranks_;
+  if (!o.ranks->leads() || o.ended || o.ranks->broken()) return;
+  o.ended = true;
+  Bytes b(status == 0 ? Command::finish : Command::end);
+  b.put(status);
+  tell_others(b.bytes());
+}
+
+// ---- advance ---------------------------------------------------------------------------------
+
+// The first command starts the stepper on every rank: migration to the owners, ghosts, lists and
+// a force pass without a kick at the stable step (which no step of the run exceeds; a pass without
+// a kick updates no history), so that the quantities at t = 0 have forces, as every later one.
+void DemAdapter::ranks_start() const {
+  OnRanks& o = *ranks_;
+  if (o.started) return;
+  together(*o.ranks, [&] { o.stepper->start(o.stable); });
+  o.started = true;
+  o.forces = true;
+}
+
+void DemAdapter::lead_advance(double dt) {
+  Bytes b(Command::advance);
+  b.put(dt);
+  tell_others(b.bytes());
+  ranks_advance(dt);
+}
+
+void DemAdapter::ranks_advance(double dt) {
+  OnRanks& o = *ranks_;
+  // walls with a velocity table move with the factor at the middle of the step, alike on every
+  // rank (as advance() in one process)
+  for (const auto& w : walls_)
+    if (w.moving) system_.set_wall_velocity(w.id, w.velocity * w.table(system_.time() + 0.5 * dt));
+  ranks_start();
+  together(*o.ranks, [&] {
+    try {
+      o.stepper->step(dt);
+    } catch (const dem::Error& e) {
+      throw Error(fmt::format("dem '{}' on rank {} at t = {:.6g} s: {}", name_, o.ranks->rank(),
+                              system_.time(), e.what()));
+    }
+  });
+  o.forces = true;
+  // (the meshes do not move on ranks: no coupled data is read, so their work stays 0)
+}
+
+// ---- monitors --------------------------------------------------------------------------------
+
+std::vector<std::string> DemAdapter::ranks_monitor_names() const {
+  std::vector<std::string> n = {"kinetic_energy", "particles", "mass", "momentum_x",
+                                "momentum_y", "momentum_z", "elastic_energy"};
+  for (const auto& m : meshes_dem_)
+    for (const char* c : {"x", "y", "z"}) n.push_back(m.name + ".force_" + c);
+  for (const auto& w : walls_)
+    for (const char* c : {"x", "y", "z"}) n.push_back(w.name + ".force_" + c);
+  for (const std::int64_t id : tracked_)
+    for (const char* c : kComponents) n.push_back(fmt::format("particle.{}.{}", id, c));
+  return n;
+}
+
+std::uint32_t DemAdapter::ranks_monitor_groups(const std::vector<std::string>& names) const {
+  std::uint32_t groups = 0;
+  for (const std::string& q : names) {
+    const auto is = [&](const std::string& prefix, std::initializer_list<const char*> rows) {
+      for (const char* r : rows)
+        if (q == prefix + r) return true;
+      return false;
+    };
+    bool known = false;
+    if (q == "kinetic_energy" || is("momentum_", {"x", "y", "z"})) groups |= kKinetic, known = true;
+    if (q == "particles" || q == "mass") known = true;
+    if (q == "elastic_energy") groups |= kElastic, known = true;
+    for (const auto& m : meshes_dem_)
+      if (is(m.name + ".force_", {"x", "y", "z"})) groups |= kMeshes, known = true;
+    for (const auto& w : walls_)
+      if (is(w.name + ".force_", {"x", "y", "z"})) groups |= kWalls, known = true;
+    for (const std::int64_t id : tracked_)
+      if (is(fmt::format("particle.{}.", id), {"x", "y", "z", "vx", "vy", "vz"}))
+        groups |= kTracked, known = true;
+    if (!known)
+      throw Error(fmt::format(
+          "dem '{}': the monitor quantity '{}.{}' (monitors: quantities) is not yet on several "
+          "ranks (mpirun -n {} partita run splits the bed over the ranks); on several ranks a "
+          "DEM reports {}; or run this case in one process, without mpirun",
+          name_, name_, q, ranks_->ranks->size(), join_names(ranks_monitor_names())));
+  }
+  return groups;
+}
+
+std::vector<MonitorValue> DemAdapter::lead_monitors(const std::vector<std::string>& names) const {
+  const std::vector<std::string> all = names.empty() ? ranks_monitor_names() : names;
+  const std::uint32_t groups = ranks_monitor_groups(all);  // (refused before telling the others)
+  if (groups != 0) {
+    Bytes b(Command::monitors);
+    b.put(groups);
+    tell_others(b.bytes());
+    ranks_monitors(groups);
+  }
+  return monitor_table().values(*this, all);
+}
+
+void DemAdapter::ranks_monitors(std::uint32_t groups) const {
+  OnRanks& o = *ranks_;
+  ranks_start();
+  dem::SubdomainStepper& s = *o.stepper;
+  together(*o.ranks, [&] {
+    if (groups & kKinetic) {
+      o.kinetic = s.kinetic_energy();
+      o.momentum = s.linear_momentum();
+    }
+    // the forces of a pass: none after a resume before its first step
+    if (groups & kElastic) o.elastic = o.forces ? s.elastic_energy() : 0.0;
+    if (groups & kWalls)
+      for (std::size_t k = 0; k < walls_.size(); ++k)
+        o.wall_force[k] = o.forces ? s.wall_force(walls_[k].id) : Eigen::Vector3d::Zero();
+    if (groups & kMeshes)
+      for (std::size_t k = 0; k < meshes_dem_.size(); ++k)
+        o.mesh_force[k] = o.forces ? s.mesh_force(meshes_dem_[k].id) : Eigen::Vector3d::Zero();
+    if (groups & kTracked) {
+      // each monitored particle's state from the rank that owns it
+      const dem::Subdomain& sd = s.subdomain(0);
+      const dem::Particles& p = system_.particles();
+      Bytes mine;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        if (sd.is_ghost(i)) continue;
+        const auto k = std::find(tracked_.begin(), tracked_.end(), p.id[i]) - tracked_.begin();
+        if (k == static_cast<std::ptrdiff_t>(tracked_.size())) continue;
+        mine.put(static_cast<std::uint64_t>(k));
+        for (int c = 0; c < 3; ++c) mine.put(p.position[i][c]);
+        for (int c = 0; c < 3; ++c) mine.put(p.velocity[i][c]);
+      }
+      const auto take = [&](const std::vector<std::byte>& from) {
+        Reader in(from);
+        while (!in.done()) {
+          auto& last = tracked_last_.at(in.get<std::uint64_t>());
+          for (double& v : last) v = in.get<double>();
+        }
+      };
+      for (auto& b : o.out[0]) b.clear();
+      if (!o.ranks->leads()) {
+        o.out[0][0] = mine.bytes();
+        o.transport->exchange(o.out, o.in);
+      } else {
+        take(mine.bytes());
+        if (o.ranks->size() > 1) {
+          o.transport->exchange(o.out, o.in);
+          for (std::size_t r = 1; r < o.in[0].size(); ++r) take(o.in[0][r]);
+        }
+      }
+    }
+  });
+}
+
+// ---- the state check -------------------------------------------------------------------------
+
+std::string DemAdapter::lead_check() const {
+  tell_others(Bytes(Command::check).bytes());
+  return ranks_check();
+}
+
+std::string DemAdapter::ranks_check() const {
+  OnRanks& o = *ranks_;
+  ranks_start();
+  // this rank's owned particle of lowest id that is not finite or lies beyond the domain and
+  // lost_margin (as System::first_particle_astray() in one process)
+  const dem::Subdomain& sd = o.stepper->subdomain(0);
+  const dem::Particles& p = system_.particles();
+  std::int64_t id = std::numeric_limits<std::int64_t>::max();
+  std::string message;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (sd.is_ghost(i) || p.id[i] >= id) continue;
+    const Eigen::Vector3d& x = p.position[i];
+    if (!x.allFinite() || !p.velocity[i].allFinite() ||
+        std::max((domain_lo_ - x).maxCoeff(), (x - domain_hi_).maxCoeff()) > lost_margin_) {
+      id = p.id[i];
+      message = astray_message(i, false);
+    }
+  }
+  return together(*o.ranks, [&]() -> std::string {
+    for (auto& b : o.out[0]) b.clear();
+    if (!o.ranks->leads()) {
+      if (!message.empty()) o.out[0][0] = Bytes().put(id).put(message).bytes();
+      o.transport->exchange(o.out, o.in);
+      return {};
+    }
+    if (o.ranks->size() > 1) {
+      o.transport->exchange(o.out, o.in);
+      for (std::size_t r = 1; r < o.in[0].size(); ++r) {
+        if (o.in[0][r].empty()) continue;
+        Reader in(o.in[0][r]);
+        const auto other = in.get<std::int64_t>();
+        std::string text = in.string();
+        if (other < id) id = other, message = std::move(text);
+      }
+    }
+    return message;
+  });
+}
+
+// ---- output ----------------------------------------------------------------------------------
+
+void DemAdapter::lead_output(const OutputFrame& frame) {
+  Bytes b(Command::output);
+  b.put(frame.vtk_directory.string()).put(frame.prefix).put(frame.index).put(frame.time);
+  b.put(frame.vtk.format).put(frame.vtk.precision).put(frame.vtk.zlib_level);
+  b.put(frame.vtk.block_size);
+  tell_others(b.bytes());
+  ranks_output(frame);
+}
+
+void DemAdapter::ranks_output(const OutputFrame& frame) {
+  OnRanks& o = *ranks_;
+  ranks_start();
+  const int rank = o.ranks->rank();
+  const std::string stem = fmt::format("{}_particles_{:06d}", frame.prefix, frame.index);
+  // this rank's owned particles, one piece
+  {
+    const dem::Subdomain& sd = o.stepper->subdomain(0);
+    const dem::Particles& p = system_.particles();
+    dem::Particles owned;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (sd.is_ghost(i)) continue;
+      owned.position.push_back(p.position[i]);
+      owned.velocity.push_back(p.velocity[i]);
+      owned.angular_velocity.push_back(p.angular_velocity[i]);
+      owned.force.push_back(p.force[i]);
+      owned.radius.push_back(p.radius[i]);
+      owned.id.push_back(p.id[i]);
+    }
+    write_particles_vtp(owned, frame.vtk_directory / fmt::format("{}_{}.vtp", stem, rank),
+                        frame.vtk);
+  }
+  // the meshes with the forces summed over the ranks (collective), written by rank 0
+  std::vector<std::pair<Eigen::MatrixX3d, Eigen::MatrixX3d>> forces;  // vertices, triangles
+  together(*o.ranks, [&] {
+    for (const auto& m : meshes_dem_) {
+      const dem::TriangleMesh& tm = system_.mesh(m.id);
+      Eigen::MatrixX3d v = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(tm.positions().size()), 3);
+      Eigen::MatrixX3d t = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(tm.triangle_count()), 3);
+      if (o.forces) {
+        t = o.stepper->triangle_forces(m.id);
+        v = o.stepper->vertex_forces(m.id);
+      }
+      forces.emplace_back(std::move(v), std::move(t));
+    }
+  });
+  if (!o.ranks->leads()) return;
+  files_.clear();
+  std::vector<std::string> pieces;
+  for (int r = 0; r < o.ranks->size(); ++r) pieces.push_back(fmt::format("{}_{}.vtp", stem, r));
+  write_particles_pvtp(frame.vtk_directory / (stem + ".pvtp"), pieces, frame.vtk);
+  files_.emplace_back("particles", stem + ".pvtp");
+  for (std::size_t k = 0; k < meshes_dem_.size(); ++k) {
+    const auto& m = meshes_dem_[k];
+    const std::string mfile = fmt::format("{}_{}_{:06d}.vtp", frame.prefix, m.name, frame.index);
+    write_mesh_vtp(system_, m.id, frame.vtk_directory / mfile, frame.vtk, forces[k].first,
+                   forces[k].second);
+    files_.emplace_back(m.name, mfile);
+  }
+}
+
+// ---- restart ---------------------------------------------------------------------------------
+
+std::string DemAdapter::lead_restart() const {
+  tell_others(Bytes(Command::restart).bytes());
+  return ranks_restart();
+}
+
+std::string DemAdapter::ranks_restart() const {
+  OnRanks& o = *ranks_;
+  ranks_start();
+  return together(*o.ranks, [&]() -> std::string {
+    const dem::SplitRestart r = dem::SplitRestart::gather(*o.stepper);
+    if (!r.holds()) return {};
+    std::ostringstream out(std::ios::binary);
+    r.write(out);
+    return std::move(out).str();
+  });
+}
+
+std::string DemAdapter::lead_resume(const std::string& stream, const std::string& source) {
+  // read here first: a stream that is not a split bed's is refused before the others resume it
+  try {
+    std::istringstream in(stream, std::ios::binary);
+    (void)dem::SplitRestart::read(in);
+  } catch (const dem::Error& e) {
+    throw Error(source + ": the DEM state of '" + name_ + "' on ranks: " + e.what());
+  }
+  Bytes b(Command::resume);
+  b.put(stream);
+  tell_others(b.bytes());
+  ranks_resume(stream);
+  return ranks_check();
+}
+
+void DemAdapter::ranks_resume(const std::string& stream) {
+  OnRanks& o = *ranks_;
+  together(*o.ranks, [&] {
+    try {
+      std::istringstream in(stream, std::ios::binary);
+      const dem::SplitRestart r = dem::SplitRestart::read(in);
+      // Systems alike without particles, then the restart's world and (on rank 0) every particle;
+      // a new stepper over them, whose first build sends each particle to its owner
+      o.stepper.reset();
+      system_.remove_particles(std::vector<char>(system_.particle_count(), 1));
+      r.restore({&system_}, *o.transport);
+      o.stepper = std::make_unique<dem::SubdomainStepper>(std::vector<dem::System*>{&system_},
+                                                           *o.transport, o.decomposition, o.skin);
+      o.stepper->resume();
+      o.started = true;
+      o.forces = false;
+    } catch (const dem::Error& e) {
+      throw Error(fmt::format("dem '{}' on rank {}: resuming the restart: {}", name_,
+                              o.ranks->rank(), e.what()));
+    }
+  });
+}
+
+}  // namespace partita::adapters

@@ -1,0 +1,39 @@
+#pragma once
+// The DEM adapter's state on several ranks (dem_ranks.cpp says how the split runs): the bed split
+// into one subdomain a rank (dem::SubdomainStepper over dem::MpiSubdomainTransport), and the
+// monitor values of the last collective pass.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "partita/dem/domain_decomposition.hpp"
+#include "partita/dem/subdomain.hpp"
+#include "partita/dem/subdomain_transport.hpp"
+#include "partita/interface/participant_ranks.hpp"
+
+namespace partita::adapters {
+
+struct DemAdapter::OnRanks {
+  std::shared_ptr<ParticipantRanks> ranks;
+  std::unique_ptr<dem::SubdomainTransport> transport;  // MpiSubdomainTransport
+  std::unique_ptr<dem::SubdomainStepper> stepper;      // over the adapter's System
+  dem::DomainDecomposition decomposition;              // of the starting positions
+  double skin = 0.0;
+  bool started = false;  // the stepper's start() or resume() done
+  bool forces = false;   // a force pass since the start or the resume (forces to report)
+  bool ended = false;    // (rank 0) the others were told the run has ended
+  // fixed for the run (no particle is born or removed on a split): over every particle
+  double particles = 0.0, mass = 0.0, stable = 0.0;
+  // the monitors' values of the last collective pass (rank 0)
+  double kinetic = 0.0, elastic = 0.0;
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> wall_force;  // by walls_ index
+  std::vector<Eigen::Vector3d> mesh_force;  // by meshes_dem_ index
+  // the transport's buffers (one local subdomain)
+  std::vector<dem::SubdomainMail> out, in;
+};
+
+}  // namespace partita::adapters

@@ -1,0 +1,132 @@
+#!/usr/bin/env bash
+# A DEM-only case on N ranks (mpirun -n N partita run CASE), run by ctest (tests/CMakeLists.txt):
+#   dem_ranks.sh PARTITA SCENARIO
+# Scenarios (the case: tests/mpi/dem_ranks_bed.yaml, a bed dropped in a box, pressed by a lid):
+#   identical   the case on 1, 2, 3 and 4 ranks: every CSV file the same bytes on every N; the
+#               monitors hold the contracts of the run (one row per window, the particle count
+#               constant, the bed falling under gravity at the start, the lid pressing it at the
+#               end); each VTK frame's .pvtp joins one piece per rank whose particles add up to
+#               the bed, every rank's first piece holding some
+#   resume      written on 2 ranks to 10 ms (restart file), resumed on 3 to 20 ms, against written
+#               on 4 and resumed on 1: the same bytes (a split bed's restart does not depend on the
+#               splits that write and read it)
+#   refused     on 2 ranks, what a split does not handle yet (breakage, a wall servo, the energy
+#               accounting, a monitor quantity it does not sum): exit status 1, one message naming
+#               the key and saying "not yet on several ranks", every process ended within 60 s
+# OpenMPI refuses to run as root unless told (CI runs as root); --oversubscribe: 4 ranks on fewer
+# cores. One OpenMP thread a rank.
+set -uo pipefail
+P=$(realpath "$1")
+SCENARIO=$2
+HERE=$(cd "$(dirname "$0")" && pwd)
+CASE=$HERE/dem_ranks_bed.yaml
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 PARTITA_LOG_LEVEL=${PARTITA_LOG_LEVEL:-warn}
+export OMPI_MCA_rmaps_base_oversubscribe=1 PARTITA_NO_PLOTS=1 OMP_NUM_THREADS=1
+MPIRUN=(mpirun --oversubscribe)
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+cd "$WORK"
+
+fail() { echo "FAILED: $*" >&2; exit 1; }
+
+# ranks N DIR [args...]: the case on N ranks into DIR
+ranks() {
+  local n=$1 dir=$2
+  shift 2
+  "${MPIRUN[@]}" -n "$n" "$P" run "$CASE" -o "$dir" --threads 1 "$@" > "$dir.log" 2>&1 ||
+    { local s=$?; cat "$dir.log" >&2; fail "the case on $n rank(s) exited with $s"; }
+}
+
+# same DIR_A DIR_B: every CSV file of A in B, byte for byte (and as many)
+same() {
+  local a=$1 b=$2 f n=0
+  for f in "$a"/*.csv; do
+    cmp "$f" "$b/$(basename "$f")" || fail "$(basename "$f"): $a and $b differ"
+    n=$((n + 1))
+  done
+  [ "$n" -ge 2 ] || fail "$a holds $n CSV files"
+  [ "$(ls "$b"/*.csv | wc -l)" -eq "$n" ] || fail "$b holds other CSV files than $a"
+}
+
+case $SCENARIO in
+identical)
+  for n in 1 2 3 4; do
+    start=$(date +%s.%N)
+    ranks $n r$n
+    echo "$n rank(s): $(echo "$(date +%s.%N) - $start" | bc) s"
+  done
+  for n in 2 3 4; do same r1 r$n; done
+  python3 - r1/bed.csv r1/coupling.csv << 'EOF' || fail "the monitors of the run"
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+head, data = rows[0], [[float(v) for v in r] for r in rows[1:]]
+col = {h.split(' [')[0]: k for k, h in enumerate(head)}
+windows = len(list(csv.reader(open(sys.argv[2])))) - 1
+assert len(data) == windows + 1, (len(data), windows)   # t = 0 and every window
+n = {r[col['bed.particles']] for r in data}
+assert len(n) == 1 and 100 < n.pop() < 1000, 'the particle count changes or is not a few hundred'
+assert len({r[col['bed.mass']] for r in data}) == 1, 'the mass changes'
+# released at rest: the bed falls under gravity (p_z < 0, growing) before it meets the floor
+t1 = next(r for r in data if r[0] >= 1e-3)
+assert data[0][col['bed.momentum_z']] == 0.0 and t1[col['bed.momentum_z']] < 0.0, t1
+# at the end the lid (coming down from 10 ms) and the floor hold the bed between them
+end = data[-1]
+assert end[col['bed.lid.force_z']] > 0.0 and end[col['bed.floor.force_z']] < 0.0, end
+assert end[col['bed.elastic_energy']] > 0.0, end
+print('monitors:', len(data), 'rows, the contracts hold')
+EOF
+  # each frame's .pvtp joins one piece per rank, whose particles add up to the bed
+  total=$(python3 -c "import csv; r=list(csv.reader(open('r1/bed.csv'))); h=[x.split(' [')[0] for x in r[0]].index('bed.particles'); print(int(float(r[1][h])))")
+  for n in 1 2 3 4; do
+    frames=(r$n/vtk/bed_particles_*.pvtp)
+    [ ${#frames[@]} -ge 4 ] || fail "$n rank(s): ${#frames[@]} .pvtp frames"
+    grep -q "bed_particles_000000.pvtp" r$n/vtk/bed_particles.pvd || fail "$n rank(s): the series names no .pvtp"
+    for f in "${frames[@]}"; do
+      [ "$(grep -c '<Piece Source=' "$f")" -eq $n ] || fail "$f: not $n pieces"
+      sum=0
+      for piece in $(sed -n 's/.*<Piece Source="\([^"]*\)".*/\1/p' "$f"); do
+        c=$(grep -ao '<Piece NumberOfPoints="[0-9]*"' "r$n/vtk/$piece" | grep -o '[0-9]*')
+        [ -n "$c" ] || fail "r$n/vtk/$piece: no piece"
+        # (the boxes cut the starting bed: every rank holds some at the start, the settled bed
+        # may leave a box)
+        case $f in *_000000.pvtp) [ "$c" -gt 0 ] || fail "r$n/vtk/$piece: no particle on this rank" ;; esac
+        sum=$((sum + c))
+      done
+      [ "$sum" -eq "$total" ] || fail "$f: $sum particles in its pieces, the bed has $total"
+    done
+  done
+  echo "the CSV files of 1, 2, 3 and 4 ranks are the same bytes; the frames join $total particles"
+  ;;
+resume)
+  ranks 2 a --set time.end=0.01 --set output.restart.at_end=true
+  "${MPIRUN[@]}" -n 3 "$P" run "$CASE" --resume a --threads 1 --set time.end=0.02 > a2.log 2>&1 ||
+    { cat a2.log >&2; fail "resumed on 3 ranks"; }
+  ranks 4 b --set time.end=0.01 --set output.restart.at_end=true
+  "${MPIRUN[@]}" -n 1 "$P" run "$CASE" --resume b --threads 1 --set time.end=0.02 > b2.log 2>&1 ||
+    { cat b2.log >&2; fail "resumed on 1 rank"; }
+  same a b
+  [ "$(tail -n 1 a/bed.csv | cut -d, -f1)" = 0.02 ] || fail "the resumed run did not reach 20 ms: $(tail -n 1 a/bed.csv)"
+  echo "written on 2 and resumed on 3, written on 4 and resumed on 1: the same bytes"
+  ;;
+refused)
+  expect() {  # expect KEY [--set ...]: refused on 2 ranks, naming KEY
+    local key=$1
+    shift
+    local start=$(date +%s)
+    timeout 60 "${MPIRUN[@]}" -n 2 "$P" run "$CASE" -o x --threads 1 "$@" > x.log 2>&1
+    local status=$?
+    [ $status -ne 0 ] && [ $status -ne 124 ] || { cat x.log >&2; fail "$key: exit status $status"; }
+    grep -q "not yet on several ranks" x.log || { cat x.log >&2; fail "$key: no 'not yet on several ranks'"; }
+    grep -q -- "$key" x.log || { cat x.log >&2; fail "$key: the message does not name it"; }
+    [ "$(grep -c 'partita: error' x.log)" -eq 1 ] || { cat x.log >&2; fail "$key: not one message"; }
+    echo "$key: refused in $(($(date +%s) - start)) s: $(grep 'partita: error' x.log | cut -c1-160)..."
+  }
+  expect "participants.bed.breakage" --set 'participants.bed.breakage={limit_strength: 1 MPa, reference_size: 2 mm, weibull_modulus: 3, comminution_limit: 0.5 mm}'
+  expect "participants.bed.walls\[1\].servo" --set 'participants.bed.walls[1]={name: lid, plane: {point: [0, 0, 18 mm], normal: [0, 0, -1]}, material: grain, servo: {force: 1, max_velocity: 0.1}}'
+  expect "participants.bed.energy_accounting" --set participants.bed.energy_accounting=true
+  expect "bed.contacts_per_particle" --set 'monitors[0].quantities[0]=bed.contacts_per_particle'
+  ;;
+*)
+  fail "unknown scenario $SCENARIO"
+  ;;
+esac
