@@ -4,12 +4,16 @@
 # Scenarios (the case: tests/mpi/dem_ranks_bed.yaml, a bed dropped in a box, pressed by a lid):
 #   identical   the case on 1, 2, 3 and 4 ranks: every CSV file the same bytes on every N; the
 #               monitors hold the contracts of the run (one row per window, the particle count
-#               constant, the bed falling under gravity at the start, the lid pressing it at the
-#               end); each VTK frame's .pvtp joins one piece per rank whose particles add up to
+#               constant, the bed falling under gravity at the start, the lid pressing it onto
+#               the floor and against the box's sides at the end); each VTK frame's .pvtp joins one piece per rank whose particles add up to
 #               the bed, every rank's first piece holding some
 #   resume      written on 2 ranks to 10 ms (restart file), resumed on 3 to 20 ms, against written
 #               on 4 and resumed on 1: the same bytes (a split bed's restart does not depend on the
 #               splits that write and read it)
+#   lost        a particle leaves the domain: the run stops with exit status 1 and one message
+#               naming it, the same on 1 and 3 ranks
+#   stalled     rank 1 stopped (SIGSTOP) mid-run with --peer-timeout 3: every process ends within
+#               15 s, non-zero, the message naming rank 1
 #   refused     on 2 ranks, what a split does not handle yet (breakage, a wall servo, the energy
 #               accounting, a monitor quantity it does not sum): exit status 1, one message naming
 #               the key and saying "not yet on several ranks", every process ended within 60 s
@@ -73,6 +77,8 @@ assert data[0][col['bed.momentum_z']] == 0.0 and t1[col['bed.momentum_z']] < 0.0
 end = data[-1]
 assert end[col['bed.lid.force_z']] > 0.0 and end[col['bed.floor.force_z']] < 0.0, end
 assert end[col['bed.elastic_energy']] > 0.0, end
+# and pushes the box's side faces outwards
+assert end[col['bed.box.xmin.force_x']] < 0.0 and end[col['bed.box.ymax.force_y']] > 0.0, end
 print('monitors:', len(data), 'rows, the contracts hold')
 EOF
   # each frame's .pvtp joins one piece per rank, whose particles add up to the bed
@@ -95,6 +101,23 @@ EOF
       [ "$sum" -eq "$total" ] || fail "$f: $sum particles in its pieces, the bed has $total"
     done
   done
+  # what a reader of the .pvtp expects of each piece: the point arrays it declares (name, type,
+  # components) are the piece's, in order, and so is the points' type
+  python3 - r4/vtk/bed_particles_000002.pvtp << 'EOF' || fail "a .pvtp does not describe its pieces"
+import os, re, sys
+pv = open(sys.argv[1]).read()
+arrays = lambda text, tag: re.findall(r'<%s type="(\w+)"(?: Name="(\w+)")? NumberOfComponents="(\d)"' % tag, text)
+point_data = arrays(pv.split('<PPoints>')[0], 'PDataArray')
+points = arrays(pv.split('<PPoints>')[1], 'PDataArray')
+pieces = re.findall(r'<Piece Source="([^"]+)"/>', pv)
+assert len(pieces) == 4 and len(point_data) == 5 and len(points) == 1, (pieces, point_data)
+for piece in pieces:
+    head = open(os.path.join(os.path.dirname(sys.argv[1]), piece), 'rb').read()
+    head = head.split(b'<AppendedData')[0].decode()
+    assert arrays(head.split('<PointData>')[1].split('</PointData>')[0], 'DataArray') == point_data, piece
+    assert arrays(head.split('<Points>')[1].split('</Points>')[0], 'DataArray') == points, piece
+print("the .pvtp declares its pieces' arrays")
+EOF
   echo "the CSV files of 1, 2, 3 and 4 ranks are the same bytes; the frames join $total particles"
   ;;
 resume)
@@ -125,6 +148,49 @@ refused)
   expect "participants.bed.walls\[1\].servo" --set 'participants.bed.walls[1]={name: lid, plane: {point: [0, 0, 18 mm], normal: [0, 0, -1]}, material: grain, servo: {force: 1, max_velocity: 0.1}}'
   expect "participants.bed.energy_accounting" --set participants.bed.energy_accounting=true
   expect "bed.contacts_per_particle" --set 'monitors[0].quantities[0]=bed.contacts_per_particle'
+  ;;
+lost)
+  # gravity upwards, the lid replaced by a floor far below, lost_margin 1 mm: the rising bed leaves
+  # the domain; the run stops with the state check's message, the same on 1 and 3 ranks
+  lost=(--set 'participants.bed.gravity=[0, 0, 500]' --set 'participants.bed.walls[1].plane.point=[0, 0, -1]'
+        --set 'participants.bed.walls[1].plane.normal=[0, 0, 1]' --set 'participants.bed.walls[1].velocity=[0, 0, 0]'
+        --set 'participants.bed.lost_margin=1 mm')
+  for n in 1 3; do
+    start=$(date +%s)
+    timeout 60 "${MPIRUN[@]}" -n $n "$P" run "$CASE" -o l$n --threads 1 "${lost[@]}" > l$n.log 2>&1
+    status=$?
+    [ $status -eq 1 ] || { cat l$n.log >&2; fail "a lost particle on $n rank(s): exit status $status"; }
+    [ "$(grep -c 'partita: error' l$n.log)" -eq 1 ] || { cat l$n.log >&2; fail "$n rank(s): not one message"; }
+    grep 'partita: error' l$n.log | grep -q 'particle [0-9]* is lost' || { cat l$n.log >&2; fail "$n rank(s): no lost particle named"; }
+    echo "$n rank(s): stopped in $(($(date +%s) - start)) s: $(grep 'partita: error' l$n.log | cut -c1-110)..."
+  done
+  [ "$(grep 'partita: error' l1.log)" = "$(grep 'partita: error' l3.log)" ] || fail "the messages on 1 and 3 ranks differ"
+  ;;
+stalled)
+  # rank 1 stopped (SIGSTOP) mid-run with --peer-timeout 3: every process ends within 15 s, the
+  # message naming rank 1
+  timeout 120 "${MPIRUN[@]}" -n 2 "$P" run "$CASE" -o s --threads 1 --peer-timeout 3 --set time.end=1 > s.log 2>&1 &
+  run=$!
+  for _ in $(seq 1 600); do
+    compgen -G "s/vtk/*_000001.pvtp" > /dev/null && break
+    sleep 0.05
+  done
+  victim=
+  for p in $(pgrep -x partita); do  # (this test's: started in its folder)
+    [ "$(readlink /proc/"$p"/cwd)" = "$WORK" ] &&
+      tr '\0' '\n' < /proc/"$p"/environ 2> /dev/null | grep -qx "OMPI_COMM_WORLD_RANK=1" && victim=$p
+  done
+  [ -n "$victim" ] || { kill $run; fail "no rank 1 found"; }
+  start=$(date +%s)
+  kill -STOP "$victim"
+  wait $run
+  status=$?
+  took=$(($(date +%s) - start))
+  kill -CONT "$victim" 2> /dev/null
+  [ $status -ne 0 ] || fail "the run ended with status 0"
+  [ $took -le 15 ] || fail "the run ended $took s after rank 1 stopped"
+  grep 'partita: error' s.log | grep -q "rank 1 is stuck or gone" || { cat s.log >&2; fail "rank 1 is not named"; }
+  echo "rank 1 stopped: every process ended after $took s, status $status: $(grep -m1 'partita: error' s.log | cut -c1-150)..."
   ;;
 *)
   fail "unknown scenario $SCENARIO"

@@ -125,11 +125,15 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
                    "xmax, ymin, ymax, zmin, zmax; e.g. walls.zmin.force_z, the floor's load); the "
                    "faces' forces add up to <wall>.force_*, x"),
           [](const A& a, const Out& out) {
-            for (const auto& w : a.walls_)
+            for (std::size_t k = 0; k < a.walls_.size(); ++k) {
+              const auto& w = a.walls_[k];
               for (int face = 0; face < 6; ++face)  // a box wall's closed faces, each on its own
                 if (w.faces & (1u << face))
                   out({w.name, kFaces[static_cast<std::size_t>(face)]},
-                      a.system_.wall_face_force(w.id, face).value_or(Eigen::Vector3d(0.0, 0.0, 0.0)));
+                      a.on_ranks() ? a.ranks_->face_force[k][static_cast<std::size_t>(face)]
+                                   : a.system_.wall_face_force(w.id, face).value_or(
+                                         Eigen::Vector3d(0.0, 0.0, 0.0)));
+            }
           });
     // monitor_particles: found by id (indices change when the particles are renumbered); a
     // particle that breakage removed keeps its last state; on ranks, the state the last

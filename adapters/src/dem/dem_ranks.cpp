@@ -15,8 +15,8 @@
 //   advance dt       every rank steps its subdomain (walls moved by their tables alike);
 //   monitors groups  the sums the quantities asked for need, each an exact sum over the owned
 //                    particles rounded once (SubdomainStepper: kinetic energy, momentum, elastic
-//                    energy, each wall's and mesh's force), the monitor particles' states gathered
-//                    from their owners: the same bits on any N;
+//                    energy, each wall's, box face's and mesh's force), the monitor particles'
+//                    states gathered from their owners: the same bits on any N;
 //   check            every rank's astray owned particle of lowest id to rank 0;
 //   output frame     every rank writes its owned particles as one piece
 //                    (<prefix>_particles_<frame>_<rank>.vtp), rank 0 the .pvtp that joins them
@@ -34,7 +34,7 @@
 // the ranks, new particles' ghosts), wall servos (each rank would steer its wall by its own part
 // of the force), the energy accounting, output.particles_file, meshes taken from another
 // participant (the coupling); at run time: the monitor quantities not listed above
-// (contacts_per_particle, the faces of a box wall), coupled data, checkpoints.
+// (contacts_per_particle), coupled data, checkpoints.
 //
 // The split path gives the same bytes on every N, N = 1 under mpirun included. It is not the path
 // of one process without mpirun (one dem::System stepped whole): the split numbers the particles
@@ -85,7 +85,8 @@ enum class Command : std::uint32_t {
 };
 
 // the monitor groups (what ranks_monitors() sums)
-constexpr std::uint32_t kKinetic = 1, kElastic = 2, kWalls = 4, kMeshes = 8, kTracked = 16;
+constexpr std::uint32_t kKinetic = 1, kElastic = 2, kWalls = 4, kMeshes = 8, kTracked = 16,
+                        kFaceGroup = 32;
 
 // A message's bytes.
 class Bytes {
@@ -183,6 +184,9 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
   o->stable = stable_time_step();
   o->skin = c.has("skin") ? c.real("skin") : 0.1 * r_max;
   o->wall_force.assign(walls_.size(), Eigen::Vector3d::Zero());
+  std::array<Eigen::Vector3d, 6> none;
+  none.fill(Eigen::Vector3d::Zero());
+  o->face_force.assign(walls_.size(), none);
   o->mesh_force.assign(meshes_dem_.size(), Eigen::Vector3d::Zero());
   try {
     const Eigen::Vector3d pad = Eigen::Vector3d::Constant(2.0 * r_max + o->skin);
@@ -360,6 +364,12 @@ std::vector<std::string> DemAdapter::ranks_monitor_names() const {
     for (const char* c : {"x", "y", "z"}) n.push_back(m.name + ".force_" + c);
   for (const auto& w : walls_)
     for (const char* c : {"x", "y", "z"}) n.push_back(w.name + ".force_" + c);
+  for (const auto& w : walls_)
+    for (int face = 0; face < 6; ++face)
+      if (w.faces & (1u << face))
+        for (const char* c : {"x", "y", "z"})
+          n.push_back(w.name + "." + std::string(kFaces[static_cast<std::size_t>(face)]) +
+                      ".force_" + c);
   for (const std::int64_t id : tracked_)
     for (const char* c : kComponents) n.push_back(fmt::format("particle.{}.{}", id, c));
   return n;
@@ -379,8 +389,14 @@ std::uint32_t DemAdapter::ranks_monitor_groups(const std::vector<std::string>& n
     if (q == "elastic_energy") groups |= kElastic, known = true;
     for (const auto& m : meshes_dem_)
       if (is(m.name + ".force_", {"x", "y", "z"})) groups |= kMeshes, known = true;
-    for (const auto& w : walls_)
+    for (const auto& w : walls_) {
       if (is(w.name + ".force_", {"x", "y", "z"})) groups |= kWalls, known = true;
+      for (int face = 0; face < 6; ++face)
+        if ((w.faces & (1u << face)) &&
+            is(w.name + "." + std::string(kFaces[static_cast<std::size_t>(face)]) + ".force_",
+               {"x", "y", "z"}))
+          groups |= kFaceGroup, known = true;
+    }
     for (const std::int64_t id : tracked_)
       if (is(fmt::format("particle.{}.", id), {"x", "y", "z", "vx", "vy", "vz"}))
         groups |= kTracked, known = true;
@@ -417,9 +433,28 @@ void DemAdapter::ranks_monitors(std::uint32_t groups) const {
     }
     // the forces of a pass: none after a resume before its first step
     if (groups & kElastic) o.elastic = o.forces ? s.elastic_energy() : 0.0;
-    if (groups & kWalls)
+    if (groups & kWalls) {
+      const std::vector<Eigen::Vector3d>* f = o.forces ? &s.wall_forces() : nullptr;
       for (std::size_t k = 0; k < walls_.size(); ++k)
-        o.wall_force[k] = o.forces ? s.wall_force(walls_[k].id) : Eigen::Vector3d::Zero();
+        o.wall_force[k] = f ? (*f)[static_cast<std::size_t>(walls_[k].id)] : Eigen::Vector3d::Zero();
+    }
+    if (groups & kFaceGroup) {
+      // a box wall's face k is its plane of normal +e_axis (k even) or -e_axis (k odd), as
+      // dem::WallContacts::face_force() finds it
+      const std::vector<Eigen::Vector3d>* f = o.forces ? &s.plane_forces() : nullptr;
+      const std::vector<dem::PlaneWall>& planes = system_.planes();
+      for (std::size_t k = 0; k < walls_.size(); ++k)
+        for (int face = 0; face < 6; ++face) {
+          Eigen::Vector3d& v = o.face_force[k][static_cast<std::size_t>(face)];
+          v.setZero();
+          for (std::size_t q = 0; f && q < planes.size(); ++q)
+            if (planes[q].wall == walls_[k].id &&
+                planes[q].normal[face / 2] == (face % 2 == 0 ? 1.0 : -1.0)) {
+              v = (*f)[q];
+              break;
+            }
+        }
+    }
     if (groups & kMeshes)
       for (std::size_t k = 0; k < meshes_dem_.size(); ++k)
         o.mesh_force[k] = o.forces ? s.mesh_force(meshes_dem_[k].id) : Eigen::Vector3d::Zero();

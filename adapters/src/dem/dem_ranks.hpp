@@ -3,6 +3,7 @@
 // into one subdomain a rank (dem::SubdomainStepper over dem::MpiSubdomainTransport), and the
 // monitor values of the last collective pass.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -31,6 +32,7 @@ struct DemAdapter::OnRanks {
   double kinetic = 0.0, elastic = 0.0;
   Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> wall_force;  // by walls_ index
+  std::vector<std::array<Eigen::Vector3d, 6>> face_force;  // by walls_ index, face (a box's)
   std::vector<Eigen::Vector3d> mesh_force;  // by meshes_dem_ index
   // the transport's buffers (one local subdomain)
   std::vector<dem::SubdomainMail> out, in;

@@ -441,6 +441,20 @@ void Subdomain::add_wall_forces(ExactSum* sums) const {
   }
 }
 
+void Subdomain::add_plane_forces(ExactSum* sums) const {
+  const std::vector<Eigen::Vector3d>& reaction = sys_->wall_reactions();
+  const std::size_t n = sys_->particle_count(), np = sys_->planes().size();
+  if (reaction.size() != n * np)
+    throw Error("subdomain " + std::to_string(rank_) +
+                ": the planes' reactions are not recorded (System::set_wall_reactions(true) "
+                "before the first force pass)");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (is_ghost(i)) continue;
+    for (std::size_t k = 0; k < np; ++k)
+      for (int c = 0; c < 3; ++c) sums[3 * k + c].add(reaction[i * np + k][c]);
+  }
+}
+
 void Subdomain::add_mesh_forces(int mesh, MeshForceSums& sums) const {
   if (sys_->particle_count() == 0) return;  // (rows of particles that left are gone)
   const TriangleMesh& m = sys_->mesh(mesh);
@@ -558,8 +572,12 @@ void SubdomainStepper::step(double dt) {
 // (exact: in any order).
 void SubdomainStepper::global_sums(Sums what) {
   const std::size_t local = subdomains_.size();
-  const int walls = subdomains_[0].system().wall_count();
-  const std::size_t m = what == Sums::kinetic ? 4 : what == Sums::elastic ? 1 : 3 * walls;
+  const auto walls = static_cast<std::size_t>(subdomains_[0].system().wall_count());
+  const std::size_t planes = subdomains_[0].system().planes().size();
+  const std::size_t m = what == Sums::kinetic   ? 4
+                        : what == Sums::elastic ? 1
+                        : what == Sums::walls   ? 3 * walls
+                                                : 3 * planes;
   sums_.resize(m * local);
   totals_.resize(m);
   for (std::size_t k = 0; k < local; ++k) {
@@ -572,8 +590,10 @@ void SubdomainStepper::global_sums(Sums what) {
       subdomains_[k].add_kinetic(sums);
     else if (what == Sums::elastic)
       sd.add_elastic(sums[0]);
-    else
+    else if (what == Sums::walls)
       sd.add_wall_forces(sums);
+    else
+      sd.add_plane_forces(sums);
     for (std::vector<std::byte>& o : out_[k]) {
       o.resize(m * ExactSum::byte_size);
       for (std::size_t q = 0; q < m; ++q) sums[q].write(o.data() + q * ExactSum::byte_size);
@@ -611,6 +631,22 @@ Eigen::Vector3d SubdomainStepper::wall_force(int wall) {
   global_sums(Sums::walls);
   const std::size_t w = 3 * static_cast<std::size_t>(wall);
   return {totals_[w].value(), totals_[w + 1].value(), totals_[w + 2].value()};
+}
+
+const std::vector<Eigen::Vector3d>& SubdomainStepper::wall_forces() {
+  global_sums(Sums::walls);
+  forces_.resize(totals_.size() / 3);
+  for (std::size_t w = 0; w < forces_.size(); ++w)
+    forces_[w] = {totals_[3 * w].value(), totals_[3 * w + 1].value(), totals_[3 * w + 2].value()};
+  return forces_;
+}
+
+const std::vector<Eigen::Vector3d>& SubdomainStepper::plane_forces() {
+  global_sums(Sums::planes);
+  forces_.resize(totals_.size() / 3);
+  for (std::size_t k = 0; k < forces_.size(); ++k)
+    forces_[k] = {totals_[3 * k].value(), totals_[3 * k + 1].value(), totals_[3 * k + 2].value()};
+  return forces_;
 }
 
 Eigen::Vector3d SubdomainStepper::linear_momentum() {

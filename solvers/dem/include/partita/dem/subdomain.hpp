@@ -45,7 +45,8 @@
 // Sums over the split, and what is not handled yet:
 //  - Wall forces: SubdomainStepper::wall_force() is the same on any split (each owned particle's
 //    reaction on each plane, System::set_wall_reactions(), in an exact sum); it may differ from
-//    System::wall_force()'s block sums in the last bits. Each System's own wall_force(),
+//    System::wall_force()'s block sums in the last bits; plane_forces() gives each plane's (a box
+//    wall's faces) the same way. Each System's own wall_force(),
 //    mesh_force() and triangle_forces() include its ghosts' contacts.
 //  - Triangle meshes (STL walls, the coupling's FE surfaces): every subdomain holds every mesh
 //    whole, moved alike (set_vertex_positions() on each System before the step), as the coupling
@@ -207,6 +208,8 @@ class Subdomain {
   void pack_owned(std::vector<std::byte>& out);
   /// Adds the owned particles' reactions on the planes to sums[3 w + c] (wall w, component c).
   void add_wall_forces(ExactSum* sums) const;
+  /// The same per plane: sums[3 k + c] (plane k of System::planes(), component c).
+  void add_plane_forces(ExactSum* sums) const;
   /// Adds the owned particles' contacts with mesh `mesh` in the last pass to `sums` (each
   /// contact's reaction to its triangle's vertices with the contact point's barycentric weights,
   /// as MeshContacts::reduce() shares it, and to the total); the ghosts' contacts are left out.
@@ -283,6 +286,12 @@ class SubdomainStepper {
   /// The force the particles exert on a wall (all its planes) [N] in the last pass: the owned
   /// particles' reactions in an exact sum, the same bits on any split (collective).
   Eigen::Vector3d wall_force(int wall);
+  /// Every wall's wall_force() from one collective round (by wall id).
+  const std::vector<Eigen::Vector3d>& wall_forces();
+  /// The force the particles exert on each plane (System::planes(): a box wall's faces are its
+  /// planes) [N] in the last pass, exact sums over the owned particles, the same bits on any
+  /// split (collective; one round for all planes).
+  const std::vector<Eigen::Vector3d>& plane_forces();
   /// The force the particles exert on mesh `mesh`'s triangles [N] in the last pass, as
   /// System::triangle_forces() defines it (each contact's reaction on its triangle's vertices
   /// with the barycentric weights, a vertex's force shared equally among its active triangles),
@@ -309,8 +318,9 @@ class SubdomainStepper {
 
   void redistribute();
   // what global_sums() adds up: per local subdomain, kinetic energy and momentum (4 sums), the
-  // elastic energy (1) or the walls' forces (3 per wall)
-  enum class Sums { kinetic, elastic, walls };
+  // elastic energy (1), the walls' forces (3 per wall) or the planes' forces (3 per plane)
+  enum class Sums { kinetic, elastic, walls, planes };
+  std::vector<Eigen::Vector3d> forces_;  // wall_forces(), plane_forces()
   // sums_[m k + q]: local subdomain k's sum q, then summed over every subdomain into totals_
   void global_sums(Sums what);
   std::vector<ExactSum> sums_, totals_;
