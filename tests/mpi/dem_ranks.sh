@@ -14,6 +14,8 @@
 #               naming it, the same on 1 and 3 ranks
 #   stalled     rank 1 stopped (SIGSTOP) mid-run with --peer-timeout 3: every process ends within
 #               15 s, non-zero, the message naming rank 1
+#   signal      SIGINT to mpirun mid-run on 2 ranks: every process ends within 10 s after the
+#               window, with a restart file, which resumes on 3 ranks to the end
 #   refused     on 2 ranks, what a split does not handle yet (breakage, a wall servo, the energy
 #               accounting, a monitor quantity it does not sum): exit status 1, one message naming
 #               the key and saying "not yet on several ranks", every process ended within 60 s
@@ -191,6 +193,29 @@ stalled)
   [ $took -le 15 ] || fail "the run ended $took s after rank 1 stopped"
   grep 'partita: error' s.log | grep -q "rank 1 is stuck or gone" || { cat s.log >&2; fail "rank 1 is not named"; }
   echo "rank 1 stopped: every process ended after $took s, status $status: $(grep -m1 'partita: error' s.log | cut -c1-150)..."
+  ;;
+signal)
+  # SIGINT to mpirun mid-run (it passes SIGTERM on): rank 0 finishes the window, writes the
+  # restart file with the others and every process ends within 10 s; the restart resumes on 3
+  # ranks to the end
+  still=(--set 'participants.bed.walls[1].velocity=[0, 0, 0]')  # (a lid at rest: a long run)
+  "${MPIRUN[@]}" -n 2 "$P" run "$CASE" -o g --threads 1 --set time.end=1 "${still[@]}" > g.log 2>&1 &
+  run=$!
+  for _ in $(seq 1 600); do
+    compgen -G "g/vtk/*_000001.pvtp" > /dev/null && break
+    sleep 0.05
+  done
+  start=$(date +%s)
+  kill -INT $run
+  wait $run
+  took=$(($(date +%s) - start))
+  [ $took -le 10 ] || fail "the run ended $took s after SIGINT"
+  grep -q "stopped by signal" g.log || { cat g.log >&2; fail "no stop by signal"; }
+  compgen -G "g/restart/w*.bin" > /dev/null || { cat g.log >&2; fail "no restart file"; }
+  "${MPIRUN[@]}" -n 3 "$P" run "$CASE" --resume g --threads 1 --set time.end=0.1 "${still[@]}" > g2.log 2>&1 ||
+    { cat g2.log >&2; fail "resumed on 3 ranks"; }
+  [ "$(tail -n 1 g/bed.csv | cut -d, -f1)" = 0.1 ] || fail "the resumed run did not reach 0.1 s"
+  echo "SIGINT: every process ended after $took s with a restart file ($(ls g/restart)), resumed on 3 ranks to 0.1 s"
   ;;
 *)
   fail "unknown scenario $SCENARIO"
