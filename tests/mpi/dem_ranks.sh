@@ -18,7 +18,8 @@
 #               window, with a restart file, which resumes on 3 ranks to the end
 #   refused     on 2 ranks, what a split does not handle yet (breakage, a wall servo, the energy
 #               accounting, a monitor quantity it does not sum): exit status 1, one message naming
-#               the key and saying "not yet on several ranks", every process ended within 60 s
+#               the key and saying "not yet on several ranks", every process ended within 60 s;
+#               a case of two participants, naming them and --participant
 # OpenMPI refuses to run as root unless told (CI runs as root); --oversubscribe: 4 ranks on fewer
 # cores. One OpenMP thread a rank.
 set -uo pipefail
@@ -150,6 +151,14 @@ refused)
   expect "participants.bed.walls\[1\].servo" --set 'participants.bed.walls[1]={name: lid, plane: {point: [0, 0, 18 mm], normal: [0, 0, -1]}, material: grain, servo: {force: 1, max_velocity: 0.1}}'
   expect "participants.bed.energy_accounting" --set participants.bed.energy_accounting=true
   expect "bed.contacts_per_particle" --set 'monitors[0].quantities[0]=bed.contacts_per_particle'
+  # a case of two participants on 2 ranks: refused, naming them and --participant
+  timeout 60 "${MPIRUN[@]}" -n 2 "$P" run "$HERE/../../cases/uniaxial_compaction/steel.yaml" -o y \
+    --threads 1 > y.log 2>&1
+  status=$?
+  [ $status -ne 0 ] && [ $status -ne 124 ] || { cat y.log >&2; fail "two participants: exit status $status"; }
+  grep 'partita: error' y.log | grep -q "2 participants (plate, granules).*--participant" ||
+    { cat y.log >&2; fail "two participants: not refused naming them"; }
+  echo "two participants: $(grep 'partita: error' y.log | cut -c1-150)..."
   ;;
 lost)
   # gravity upwards, the lid replaced by a floor far below, lost_margin 1 mm: the rising bed leaves
