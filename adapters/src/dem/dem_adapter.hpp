@@ -190,6 +190,7 @@ class DemAdapter : public Solver {
   /// command has (its first force pass, on every rank at the same command).
   void ranks_start() const;
   void ranks_advance(double dt);
+  void ranks_rebalance();
   void ranks_monitors(std::uint32_t groups) const;
   std::string ranks_check() const;
   void ranks_output(const OutputFrame& frame);

@@ -85,6 +85,10 @@ enum class Command : std::uint32_t {
 };
 
 // the monitor groups (what ranks_monitors() sums)
+// the load's check (ranks_rebalance())
+constexpr long kBalanceEvery = 200;
+constexpr double kImbalance = 1.25;
+
 constexpr std::uint32_t kKinetic = 1, kElastic = 2, kWalls = 4, kMeshes = 8, kTracked = 16,
                         kFaceGroup = 32;
 
@@ -311,6 +315,10 @@ void DemAdapter::end_others(int status) {
   OnRanks& o = *ranks_;
   if (!o.ranks->leads() || o.ended || o.ranks->broken()) return;
   o.ended = true;
+  if (o.ranks->size() > 1)
+    log::get("adapters")
+        ->info("dem '{}' on {} ranks: the bed was cut again {} time(s) as the load drifted", name_,
+               o.ranks->size(), o.rebalances);
   Bytes b(status == 0 ? Command::finish : Command::end);
   b.put(status);
   tell_others(b.bytes());
@@ -353,6 +361,58 @@ void DemAdapter::ranks_advance(double dt) {
   });
   o.forces = true;
   // (the meshes do not move on ranks: no coupled data is read, so their work stays 0)
+  if (o.stepper->steps() % kBalanceEvery == 0) ranks_rebalance();
+}
+
+// The load drifts as the bed moves (a bed settling empties the upper boxes, a bed flowing down a
+// chute fills the lower ones): every kBalanceEvery steps the ranks compare their owned counts,
+// and when the largest exceeds the mean by more than kImbalance the bed is cut again by the same
+// bisection, from the positions of now (every rank gathers every owned position: 24 bytes a
+// particle to each rank, rare), with the same bounds. The stepper takes the new boxes at its next
+// list build; the results do not change (the sums run in the global order, whatever the boxes),
+// only where each particle is stepped. Why not a finer rule (cost per particle, contacts): the
+// counts are what each rank knows at once, and the pass per particle is most of a step.
+void DemAdapter::ranks_rebalance() {
+  OnRanks& o = *ranks_;
+  together(*o.ranks, [&] {
+    const dem::Subdomain& sd = o.stepper->subdomain(0);
+    const double owned = static_cast<double>(sd.owned_count());
+    const double most = o.transport->max({owned});
+    const double mean = o.particles / o.ranks->size();
+    if (!(most > kImbalance * mean)) return;
+    const dem::Particles& p = system_.particles();
+    Bytes mine;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (!sd.is_ghost(i)) mine.put(p.position[i].x()).put(p.position[i].y()).put(p.position[i].z());
+    const auto me = static_cast<std::size_t>(o.ranks->rank());
+    for (std::size_t d = 0; d < o.out[0].size(); ++d)
+      if (d == me)
+        o.out[0][d].clear();
+      else
+        o.out[0][d] = mine.bytes();
+    o.transport->exchange(o.out, o.in);
+    std::vector<Eigen::Vector3d> all;
+    all.reserve(static_cast<std::size_t>(o.particles));
+    const auto take = [&](const std::vector<std::byte>& from) {
+      Reader in(from);
+      while (!in.done()) {
+        const double x = in.get<double>(), y = in.get<double>();
+        all.emplace_back(x, y, in.get<double>());
+      }
+    };
+    take(mine.bytes());
+    for (std::size_t r = 0; r < o.in[0].size(); ++r)
+      if (r != me) take(o.in[0][r]);
+    const dem::DomainDecomposition::Box& b = o.decomposition.bounds();
+    o.decomposition = dem::DomainDecomposition::bisection(all, b.lo, b.hi, o.ranks->size());
+    o.stepper->set_decomposition(o.decomposition);
+    ++o.rebalances;
+    if (o.ranks->leads())
+      log::get("adapters")
+          ->debug("dem '{}' at t = {:.6g} s: the bed cut again ({} particles on the fullest rank, "
+                  "{:.4g} on average)",
+                  name_, system_.time(), most, mean);
+  });
 }
 
 // ---- monitors --------------------------------------------------------------------------------

@@ -21,11 +21,12 @@ struct DemAdapter::OnRanks {
   std::shared_ptr<ParticipantRanks> ranks;
   std::unique_ptr<dem::SubdomainTransport> transport;  // MpiSubdomainTransport
   std::unique_ptr<dem::SubdomainStepper> stepper;      // over the adapter's System
-  dem::DomainDecomposition decomposition;              // of the starting positions
+  dem::DomainDecomposition decomposition;              // the boxes (the last cut)
   double skin = 0.0;
   bool started = false;  // the stepper's start() or resume() done
   bool forces = false;   // a force pass since the start or the resume (forces to report)
   bool ended = false;    // (rank 0) the others were told the run has ended
+  long rebalances = 0;   // cuts made again as the load drifted (DemAdapter::ranks_rebalance())
   // fixed for the run (no particle is born or removed on a split): over every particle
   double particles = 0.0, mass = 0.0, stable = 0.0;
   // the monitors' values of the last collective pass (rank 0)
