@@ -8,7 +8,8 @@
 #               the floor and against the box's sides at the end); each VTK frame's .pvtp joins
 #               one piece per rank whose particles add up to the bed, every piece holding some,
 #               the fullest at the end at most 1.5 times the mean (the bed cut again as the load
-#               drifts), and declares the pieces' arrays as they hold them
+#               drifts), and declares the pieces' arrays as they hold them; the particles file
+#               (output.particles_file) the same bytes on every N, read back as the bed at the end
 #   resume      written on 2 ranks to 10 ms (restart file), resumed on 3 to 20 ms, against written
 #               on 4 and resumed on 1: the same bytes (a split bed's restart does not depend on the
 #               splits that write and read it)
@@ -46,9 +47,10 @@ ranks() {
     { local s=$?; cat "$dir.log" >&2; fail "the case on $n rank(s) exited with $s"; }
 }
 
-# same DIR_A DIR_B: every CSV file of A in B, byte for byte (and as many)
+# same DIR_A DIR_B: every CSV file of A in B, byte for byte (and as many), and the particles file
 same() {
   local a=$1 b=$2 f n=0
+  cmp "$a/bed.data" "$b/bed.data" || fail "bed.data (the particles file): $a and $b differ"
   for f in "$a"/*.csv; do
     cmp "$f" "$b/$(basename "$f")" || fail "$(basename "$f"): $a and $b differ"
     n=$((n + 1))
@@ -85,6 +87,18 @@ assert end[col['bed.elastic_energy']] > 0.0, end
 # and pushes the box's side faces outwards
 assert end[col['bed.box.xmin.force_x']] < 0.0 and end[col['bed.box.ymax.force_y']] > 0.0, end
 print('monitors:', len(data), 'rows, the contracts hold')
+EOF
+  # the particles file reads back (particles: {file: ...}) as the bed it was written from: at the
+  # start of a run from it, the count, the mass and particle 7's height are those at the end
+  ranks 2 back --set "participants.bed.particles={material: grain, file: $WORK/r1/bed.data}" \
+    --set time.end=2e-4 --set participants.bed.output.particles_file=none
+  python3 - r1/bed.csv back/bed.csv << 'EOF' || fail "the particles file does not read back"
+import csv, sys
+end, start = list(csv.reader(open(sys.argv[1]))), list(csv.reader(open(sys.argv[2])))
+col = {h.split(' [')[0]: k for k, h in enumerate(end[0])}
+for q in ('bed.particles', 'bed.mass', 'bed.particle.7.z'):
+    assert end[-1][col[q]] == start[1][col[q]], (q, end[-1][col[q]], start[1][col[q]])
+print('the particles file reads back: count, mass and particle 7 as at the end')
 EOF
   # each frame's .pvtp joins one piece per rank, whose particles add up to the bed
   total=$(python3 -c "import csv; r=list(csv.reader(open('r1/bed.csv'))); h=[x.split(' [')[0] for x in r[0]].index('bed.particles'); print(int(float(r[1][h])))")

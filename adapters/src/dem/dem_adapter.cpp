@@ -190,6 +190,7 @@ void DemAdapter::write_output(const OutputFrame& frame) {
 
 void DemAdapter::finalize() {
   if (on_ranks()) {
+    if (particles_file_ != "none") lead_particles_file(output_dir_ / (name_ + ".data"));
     end_others(0);  // the others' loops end with the run (nothing of theirs is left to write)
     return;
   }
@@ -197,11 +198,16 @@ void DemAdapter::finalize() {
 }
 
 void DemAdapter::write_particles_file(const std::filesystem::path& file) const {
+  write_particles_file(system_.particles(), file);
+}
+
+void DemAdapter::write_particles_file(const dem::Particles& particles,
+                                      const std::filesystem::path& file) const {
   std::vector<double> density;
   for (int m = 0; m < system_.contact_model().material_count(); ++m)
     density.push_back(system_.contact_model().material(m).density);
   try {
-    dem::LammpsData::of(system_.particles(), density)
+    dem::LammpsData::of(particles, density)
         .write(file.string(),
                fmt::format("partita DEM '{}' at t = {:.17g} s", name_, system_.time()));
   } catch (const dem::Error& e) {

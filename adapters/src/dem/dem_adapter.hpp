@@ -121,6 +121,7 @@ class DemAdapter : public Solver {
   void write_grading(const OutputFrame& frame) const;
   /// The particles as a LAMMPS data file (dem::LammpsData), written atomically.
   void write_particles_file(const std::filesystem::path& file) const;
+  void write_particles_file(const dem::Particles& particles, const std::filesystem::path& file) const;
 
   std::string name_;
   std::filesystem::path output_dir_;
@@ -184,6 +185,8 @@ class DemAdapter : public Solver {
   std::string lead_check() const;
   void lead_output(const OutputFrame& frame);
   std::string lead_restart() const;
+  /// (finalize() with output.particles_file) The particles file written from every rank's.
+  void lead_particles_file(const std::filesystem::path& file);
   /// The restart stream resumed on every rank; the check of the state (empty: fine).
   std::string lead_resume(const std::string& stream, const std::string& source);
   /// What every rank does for a command (collective); each starts the stepper first if no
@@ -196,6 +199,9 @@ class DemAdapter : public Solver {
   void ranks_output(const OutputFrame& frame);
   std::string ranks_restart() const;
   void ranks_resume(const std::string& stream);
+  /// Every owned particle to rank 0, in the order of their ids (there; empty elsewhere).
+  dem::Particles ranks_particles() const;
+  void ranks_particles_file(const std::filesystem::path& file) const;
   /// (ranks other than 0) Follows rank 0's commands until it ends the run: the exit status.
   int follow();
   /// (rank 0) Tells the others that the run has ended with `status` (after a failure here).

@@ -5,7 +5,8 @@
 // dem::MpiSubdomainTransport; subdomain.hpp says why the split steps to the same bits on any N):
 // every rank builds the participant alike from the case (materials, walls, meshes and every
 // particle, generated or read), keeps the particles that its box of a bisection of the starting
-// positions owns, and steps them. The decomposition's bounds are the domain's box (walls, meshes,
+// positions owns, and steps them; the bed is cut again as the load drifts (ranks_rebalance()).
+// The decomposition's bounds are the domain's box (walls, meshes,
 // particles at the start) grown by 2 R_max + skin on every side, the same on every N: the global
 // order's grid, and so every sum, does not depend on N. The skin is the case's, or 10 % of the
 // largest radius (as one System's default).
@@ -26,15 +27,18 @@
 //                    ranks);
 //   resume stream    every rank restores it (rank 0 takes the particles, the first list build
 //                    sends each to its owner) and checks its particles;
+//   particles file   (output.particles_file, at finalize(); every-output: with each frame) every
+//                    owned particle to rank 0, which writes them in the order of their ids (the
+//                    same file on any N);
 //   finish / end     the others' loop ends (finalize(): status 0; a failure on rank 0: the
 //                    status the app gives, end_others()).
 // The others run follow() (the loop the adapter claims the ranks with) until finish or end.
 //
 // Not handled on a split yet, refused at set-up naming the key: breakage (fragment ids unique over
 // the ranks, new particles' ghosts), wall servos (each rank would steer its wall by its own part
-// of the force), the energy accounting, output.particles_file, meshes taken from another
-// participant (the coupling); at run time: the monitor quantities not listed above
-// (contacts_per_particle), coupled data, checkpoints.
+// of the force), the energy accounting, meshes taken from another participant (the coupling); at
+// run time: the monitor quantities not listed above (contacts_per_particle), coupled data,
+// checkpoints.
 //
 // The split path gives the same bytes on every N, N = 1 under mpirun included. It is not the path
 // of one process without mpirun (one dem::System stepped whole): the split numbers the particles
@@ -81,7 +85,8 @@ enum class Command : std::uint32_t {
   restart,
   resume,
   finish,
-  end
+  end,
+  particles_file
 };
 
 // the monitor groups (what ranks_monitors() sums)
@@ -167,8 +172,6 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
     if (w.has("servo")) refuse(w["servo"], "a wall servo");
   if (c.has("energy_accounting") && c.boolean("energy_accounting"))
     refuse(c["energy_accounting"], "the energy accounting");
-  if (particles_file_ != "none")
-    refuse(c["output"]["particles_file"], "output.particles_file (the particles as a data file)");
   for (const Node& m : c["meshes"].items())
     if (m.has("from")) refuse(m["from"], "a mesh taken from another participant (coupling)");
 #ifndef PARTITA_DEM_MPI
@@ -298,6 +301,9 @@ int DemAdapter::follow() {
         case Command::resume:
           ranks_resume(in.string());
           ranks_check();
+          break;
+        case Command::particles_file:
+          ranks_particles_file(in.string());
           break;
         case Command::finish:
           return 0;
@@ -646,6 +652,11 @@ void DemAdapter::ranks_output(const OutputFrame& frame) {
       forces.emplace_back(std::move(v), std::move(t));
     }
   });
+  if (particles_file_ == "every-output") {
+    const std::filesystem::path dir = frame.vtk_directory.parent_path() / "particles";
+    if (o.ranks->leads()) std::filesystem::create_directories(dir);
+    ranks_particles_file(dir / fmt::format("{}_{:06d}.data", frame.prefix, frame.index));
+  }
   if (!o.ranks->leads()) return;
   files_.clear();
   std::vector<std::string> pieces;
@@ -659,6 +670,82 @@ void DemAdapter::ranks_output(const OutputFrame& frame) {
                    forces[k].second);
     files_.emplace_back(m.name, mfile);
   }
+}
+
+// ---- the particles file ----------------------------------------------------------------------
+
+dem::Particles DemAdapter::ranks_particles() const {
+  OnRanks& o = *ranks_;
+  ranks_start();
+  const dem::Subdomain& sd = o.stepper->subdomain(0);
+  const dem::Particles& p = system_.particles();
+  Bytes mine;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (sd.is_ghost(i)) continue;
+    mine.put(p.id[i]).put(p.material[i]).put(p.radius[i]).put(p.mass[i]);
+    for (const Eigen::Vector3d* v : {&p.position[i], &p.velocity[i], &p.angular_velocity[i]})
+      mine.put(v->x()).put(v->y()).put(v->z());
+  }
+  return together(*o.ranks, [&] {
+    dem::Particles all;
+    for (auto& b : o.out[0]) b.clear();
+    if (!o.ranks->leads()) {
+      o.out[0][0] = mine.bytes();
+      o.transport->exchange(o.out, o.in);
+      return all;
+    }
+    if (o.ranks->size() > 1) o.transport->exchange(o.out, o.in);
+    struct Row {
+      std::int64_t id;
+      int material;
+      double radius, mass;
+      Eigen::Vector3d x, v, w;
+    };
+    std::vector<Row> rows;
+    rows.reserve(static_cast<std::size_t>(o.particles));
+    const auto take = [&](const std::vector<std::byte>& from) {
+      Reader in(from);
+      while (!in.done()) {
+        Row r;
+        r.id = in.get<std::int64_t>();
+        r.material = in.get<int>();
+        r.radius = in.get<double>();
+        r.mass = in.get<double>();
+        for (Eigen::Vector3d* v : {&r.x, &r.v, &r.w})
+          for (int c = 0; c < 3; ++c) (*v)[c] = in.get<double>();
+        rows.push_back(r);
+      }
+    };
+    take(mine.bytes());
+    for (std::size_t r = 1; r < o.in[0].size() && o.ranks->size() > 1; ++r) take(o.in[0][r]);
+    std::sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.id < b.id; });
+    all.reserve(rows.size());
+    for (const Row& r : rows) {
+      all.id.push_back(r.id);
+      all.material.push_back(r.material);
+      all.radius.push_back(r.radius);
+      all.mass.push_back(r.mass);
+      all.inertia.push_back(0.4 * r.mass * r.radius * r.radius);
+      all.position.push_back(r.x);
+      all.velocity.push_back(r.v);
+      all.angular_velocity.push_back(r.w);
+      all.force.push_back(Eigen::Vector3d::Zero());
+      all.torque.push_back(Eigen::Vector3d::Zero());
+    }
+    return all;
+  });
+}
+
+void DemAdapter::lead_particles_file(const std::filesystem::path& file) {
+  Bytes b(Command::particles_file);
+  b.put(file.string());
+  tell_others(b.bytes());
+  ranks_particles_file(file);
+}
+
+void DemAdapter::ranks_particles_file(const std::filesystem::path& file) const {
+  const dem::Particles all = ranks_particles();
+  if (ranks_->ranks->leads()) write_particles_file(all, file);
 }
 
 // ---- restart ---------------------------------------------------------------------------------
