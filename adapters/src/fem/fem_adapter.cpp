@@ -115,11 +115,16 @@ void FemAdapter::write(std::string_view mesh, std::string_view data, Eigen::Matr
   Part part = Part::nodes;
   const Interface& i = interfaces_[find_interface(mesh, &part)];
   if (part == Part::centres && data == "attached") {
-    // 1 while the element under the triangle is in the structure, 0 once eroded
+    // 1 while the element under the triangle is in the structure and its face is exposed (on
+    // the boundary, or the element across eroded), 0 otherwise
+    const std::size_t none = solver_->mesh().num_elements();
     values.resize(static_cast<Eigen::Index>(i.triangle_elements.size()), 1);
-    for (std::size_t t = 0; t < i.triangle_elements.size(); ++t)
+    for (std::size_t t = 0; t < i.triangle_elements.size(); ++t) {
+      const std::size_t across = i.triangle_across[t];
+      const bool exposed = across == none || solver_->element_eroded(across);
       values(static_cast<Eigen::Index>(t), 0) =
-          solver_->element_eroded(i.triangle_elements[t]) ? 0.0 : 1.0;
+          exposed && !solver_->element_eroded(i.triangle_elements[t]) ? 1.0 : 0.0;
+    }
     return;
   }
   if (part != Part::nodes || data != "displacement")

@@ -74,6 +74,9 @@ class FemAdapter : public Solver {
     std::vector<std::size_t> nodes;  // global node ids of the face mesh
     std::vector<double> qp_weights;  // area of each quadrature point [m^2]
     std::vector<std::size_t> triangle_elements;  // the volume element under each triangle
+    // the element across each triangle's face (num_elements(): none, a face of the boundary):
+    // the triangle is attached while its element is in and the one across is not
+    std::vector<std::size_t> triangle_across;
     Eigen::MatrixX3d nodal_forces;   // last "force" read
     Eigen::MatrixX3d tractions;      // last "traction" read
     bool has_forces = false;

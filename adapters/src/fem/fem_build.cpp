@@ -113,6 +113,32 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
   const Node& c = context.config;
   try {
     fem::Mesh mesh = build_mesh(c["mesh"], context.case_dir);
+    // faces between elements (eroding contact)
+    for (const Node& i : c["mesh"]["interior_faces"].items()) {
+      const std::string iname = i.string("name");
+      std::vector<int> regions;  // empty: every region
+      if (i.has("regions")) {
+        const auto wanted = i.strings("regions");
+        if (wanted.empty())
+          i["regions"].fail("an empty list: name the regions whose shared faces it holds, or "
+                            "leave the key out for every region");
+        for (const auto& r : wanted) {
+          require_name(i["regions"], r, mesh.region_names(), "region");
+          regions.push_back(mesh.region(r));
+        }
+      }
+      if (mesh.has_face(iname))
+        i["name"].fail("the mesh has a face '" + iname + "' already; choose another name (faces: " +
+                       join_names(mesh.face_names()) + ")");
+      const std::size_t added = mesh.add_interior_faces(iname, regions);
+      if (added == 0)
+        i["regions"].fail("no two elements of these regions share a face: nothing for erosion "
+                          "to expose");
+      log::get("adapters")->info("fem '{}': face '{}': {} face elements (each face between two "
+                                 "elements, from either side), in contact once erosion exposes "
+                                 "them",
+                                 context.name, iname, added);
+    }
     const Node mat = c["material"];
     fem::Model model = build_fem_model(std::move(mesh), mat);
     const std::string hex8 = c["mesh"].string("hex8");
@@ -326,6 +352,8 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
           centroids.row(static_cast<Eigen::Index>(t)) += fm.positions.row(v) / 3.0;
         itf.triangle_elements.push_back(
             fm.cell_elements[static_cast<std::size_t>(fm.triangle_cells[t])]);
+        itf.triangle_across.push_back(
+            fm.cell_across[static_cast<std::size_t>(fm.triangle_cells[t])]);
       }
       InterfaceMesh centres;
       centres.mesh = Mesh(itf.name + "_centres", centroids);

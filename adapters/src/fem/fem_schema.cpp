@@ -70,6 +70,17 @@ std::shared_ptr<Spec> make_spec() {
                {"incompatible-modes", "full", "f-bar", "reduced"})
       .def("incompatible-modes");
   mesh->one_of({"box", "panel", "gmsh"});
+  auto interior = std::make_shared<Spec>(
+      "interior_face",
+      "a face of the faces that two elements share (each once from either side, oriented out "
+      "of its own element), for eroding contact: a coupling interface or an indenter on it "
+      "touches a face only once erosion has exposed it (its element in, the element across "
+      "eroded), so a granule or the bow that enters an eroded element's hole meets the faces "
+      "around it");
+  interior->string("name", "the face's name (not one the mesh has)").required();
+  interior->strings("regions",
+                    "only the faces of elements in these regions (default: every region)");
+  mesh->list("interior_faces", "faces between elements, exposed by erosion", interior);
 
   auto constraint = std::make_shared<Spec>("constraint", "a Dirichlet condition on a node set");
   constraint
@@ -136,7 +147,7 @@ std::shared_ptr<Spec> make_spec() {
       .required();
 
   auto interface = std::make_shared<Spec>("interface", "a coupling interface on a face");
-  interface->string("name", "interface name: meshes <name> (nodes), <name>_quadrature (quadrature points) and <name>_centres (writes 'attached' per triangle of <name>: 0 once its element is eroded)")
+  interface->string("name", "interface name: meshes <name> (nodes), <name>_quadrature (quadrature points) and <name>_centres (writes 'attached' per triangle of <name>: 1 while its element is in and its face exposed: on the boundary, or, on a face of mesh.interior_faces, once the element across has eroded)")
       .required();
   interface->string("face", "the face it lies on").required();
 

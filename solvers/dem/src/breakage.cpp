@@ -144,19 +144,23 @@ double Breakage::contact_energy(const System& system, std::size_t i, const int* 
     const double delta = r - (x - w.point).dot(w.normal);
     if (delta > 0.0) e += hertz(model.pair(p.material[i], w.material).e_star, r, delta);
   }
-  // the nearest triangle of each mesh (listed: among the particle's candidates, which hold every
-  // triangle it can touch)
+  // the nearest active triangle of each mesh (listed: among the particle's candidates, which
+  // hold every triangle it can touch; a triangle taken out of the contacts touches nothing)
   mesh_d2_.assign(system.mesh_count(), std::numeric_limits<double>::max());
   if (listed) {
     const NeighborList& nl = system.neighbor_list();
-    for (const MeshCandidate* c = nl.mesh_candidates_begin(i); c != nl.mesh_candidates_end(i); ++c)
-      mesh_d2_[c->mesh] = std::min(
-          mesh_d2_[c->mesh], (system.mesh(c->mesh).closest_point(c->triangle, x).point - x).squaredNorm());
+    for (const MeshCandidate* c = nl.mesh_candidates_begin(i); c != nl.mesh_candidates_end(i); ++c) {
+      const TriangleMesh& mesh = system.mesh(c->mesh);
+      if (!mesh.triangle_active(c->triangle)) continue;
+      mesh_d2_[c->mesh] =
+          std::min(mesh_d2_[c->mesh], (mesh.closest_point(c->triangle, x).point - x).squaredNorm());
+    }
   } else {
     for (int m = 0; m < system.mesh_count(); ++m) {
       const TriangleMesh& mesh = system.mesh(m);
       for (int t = 0; t < mesh.triangle_count(); ++t)
-        mesh_d2_[m] = std::min(mesh_d2_[m], (mesh.closest_point(t, x).point - x).squaredNorm());
+        if (mesh.triangle_active(t))
+          mesh_d2_[m] = std::min(mesh_d2_[m], (mesh.closest_point(t, x).point - x).squaredNorm());
     }
   }
   for (int m = 0; m < system.mesh_count(); ++m) {

@@ -59,8 +59,10 @@ IndenterContact::IndenterContact(std::string name, const Model& model,
       throw Error("contact '" + name_ + "': the face '" + face + "' is named twice");
     const auto& elements = mesh_.face(face);  // throws, listing the faces, if unknown
     std::vector<std::size_t> owners;           // the volume element each face element bounds
+    std::vector<std::size_t> across;           // and the one across (a face between elements)
     try {
       owners = mesh_.face_owners(face);
+      across = mesh_.face_across(face);
     } catch (const Error& e) {
       throw Error("contact '" + name_ + "': " + e.what());
     }
@@ -80,6 +82,7 @@ IndenterContact::IndenterContact(std::string name, const Model& model,
       face_stiffness_.push_back(options_.penalty_factor * modulus * (area / nf) / h);
       face_elements_.push_back(s);
       face_owner_.push_back(owners[f]);
+      face_across_.push_back(across[f]);
     }
   }
   for (std::size_t j = 0; j < nodes_.size(); ++j) node_slot_[nodes_[j]] = j;
@@ -99,8 +102,11 @@ IndenterContact::IndenterContact(std::string name, const Model& model,
 void IndenterContact::sum_penalty_stiffness() {
   // in the face elements' order, as the first sum: the same bits while nothing is eroded
   k_normal_.assign(nodes_.size(), 0.0);
+  const std::size_t none = mesh_.num_elements();
   for (std::size_t f = 0; f < face_elements_.size(); ++f) {
     if (eroded_ && eroded_(face_owner_[f])) continue;
+    // a face between two elements touches only once erosion has taken the element across
+    if (face_across_[f] != none && !(eroded_ && eroded_(face_across_[f]))) continue;
     for (auto n : face_elements_[f].node_span()) k_normal_[node_slot_[n]] += face_stiffness_[f];
   }
 }

@@ -1,6 +1,7 @@
 #include "partita/fem/mesh.hpp"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <sstream>
 #include <unordered_map>
@@ -270,33 +271,105 @@ std::vector<std::size_t> Mesh::face_nodes(const std::string& name) const {
   return ids;
 }
 
-std::vector<std::size_t> Mesh::face_owners(const std::string& name) const {
-  const auto& faces = face(name);  // throws, listing the faces, if unknown
-  // node -> elements, to find the volume element each face element bounds
-  std::vector<std::vector<std::size_t>> node_elements(nodes_.size());
-  for (std::size_t e = 0; e < elements_.size(); ++e)
-    for (auto n : elements_[e].node_span()) node_elements[n].push_back(e);
-  std::vector<std::size_t> owners;
-  owners.reserve(faces.size());
+namespace {
+
+// For each surface element of `faces`: its owner (the element that has its corners; of two, the
+// one it points away from) and the element across (the other, or elements.size()).
+std::vector<std::array<std::size_t, 2>> face_sides(const std::vector<Vec3>& nodes,
+                                                   const std::vector<Element>& elements,
+                                                   const std::vector<SurfaceElement>& faces,
+                                                   const std::string& name) {
+  std::vector<std::vector<std::size_t>> node_elements(nodes.size());
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    for (auto n : elements[e].node_span()) node_elements[n].push_back(e);
+  const auto centroid = [&](std::span<const std::size_t> ids) {
+    Vec3 c = Vec3::Zero();
+    for (auto n : ids) c += nodes[n];
+    return Vec3(c / static_cast<double>(ids.size()));
+  };
+  std::vector<std::array<std::size_t, 2>> sides;
+  sides.reserve(faces.size());
   for (const auto& s : faces) {
     const int corners = corner_count(s.type);
-    std::size_t owner = elements_.size();
+    std::array<std::size_t, 2> found = {elements.size(), elements.size()};
+    int count = 0;
     for (auto e : node_elements[s.nodes[0]]) {
-      const auto en = elements_[e].node_span();
+      const auto en = elements[e].node_span();
       bool all = true;
       for (int c = 1; c < corners && all; ++c)
         all = std::find(en.begin(), en.end(), s.nodes[static_cast<std::size_t>(c)]) != en.end();
-      if (all) {
-        owner = e;
-        break;
-      }
+      if (all && count < 2) found[static_cast<std::size_t>(count++)] = e;
     }
-    if (owner == elements_.size())
+    if (count == 0)
       throw Error("a face element of '" + name +
                   "' bounds no volume element (a face read from a file that is not the mesh's?)");
-    owners.push_back(owner);
+    if (count == 2) {  // a face between two elements: its owner is the one it points away from
+      const auto& x = s.nodes;
+      const Vec3 normal = corners == 3 ? Vec3((nodes[x[1]] - nodes[x[0]]).cross(nodes[x[2]] - nodes[x[0]]))
+                                       : Vec3((nodes[x[2]] - nodes[x[0]]).cross(nodes[x[3]] - nodes[x[1]]));
+      const Vec3 face_centre =
+          centroid(std::span<const std::size_t>(x.data(), static_cast<std::size_t>(corners)));
+      if (normal.dot(face_centre - centroid(elements[found[0]].node_span())) < 0.0)
+        std::swap(found[0], found[1]);
+    }
+    sides.push_back(found);
   }
+  return sides;
+}
+
+}  // namespace
+
+std::vector<std::size_t> Mesh::face_owners(const std::string& name) const {
+  const auto sides = face_sides(nodes_, elements_, face(name), name);  // face() throws if unknown
+  std::vector<std::size_t> owners(sides.size());
+  for (std::size_t k = 0; k < sides.size(); ++k) owners[k] = sides[k][0];
   return owners;
+}
+
+std::vector<std::size_t> Mesh::face_across(const std::string& name) const {
+  const auto sides = face_sides(nodes_, elements_, face(name), name);
+  std::vector<std::size_t> across(sides.size());
+  for (std::size_t k = 0; k < sides.size(); ++k) across[k] = sides[k][1];
+  return across;
+}
+
+std::size_t Mesh::add_interior_faces(const std::string& name, const std::vector<int>& regions) {
+  if (has_face(name))
+    throw Error("Mesh::add_interior_faces: the mesh has a face '" + name +
+                "' already; choose another name");
+  const auto wanted = [&](const Element& e) {
+    return regions.empty() || std::find(regions.begin(), regions.end(), e.region) != regions.end();
+  };
+  // every local face of every element, keyed by its corners: a key met twice is shared
+  std::unordered_map<FaceKey, int, FaceKeyHash> seen;
+  for (const auto& e : elements_) {
+    for (int f = 0; f < local_face_count(e.type); ++f) {
+      const auto local = local_face_nodes(e.type, f);
+      std::array<std::size_t, 4> corners{};
+      const int nc = corner_count(local_face_type(e.type, f));
+      for (int a = 0; a < nc; ++a) corners[static_cast<std::size_t>(a)] = e.nodes[local[a]];
+      ++seen[make_key({corners.data(), static_cast<std::size_t>(nc)})];
+    }
+  }
+  std::vector<SurfaceElement>& out = faces_[name];
+  for (const auto& e : elements_) {
+    if (!wanted(e)) continue;
+    for (int f = 0; f < local_face_count(e.type); ++f) {
+      const auto local = local_face_nodes(e.type, f);
+      const FaceType type = local_face_type(e.type, f);
+      std::array<std::size_t, 4> corners{};
+      const int nc = corner_count(type);
+      for (int a = 0; a < nc; ++a) corners[static_cast<std::size_t>(a)] = e.nodes[local[a]];
+      if (seen.at(make_key({corners.data(), static_cast<std::size_t>(nc)})) < 2) continue;
+      SurfaceElement s;
+      s.type = type;
+      for (std::size_t a = 0; a < local.size(); ++a) s.nodes[a] = e.nodes[local[a]];
+      out.push_back(s);
+    }
+  }
+  const std::size_t added = out.size();
+  if (added == 0) faces_.erase(name);  // (no shared face: no face of that name)
+  return added;
 }
 
 }  // namespace partita::fem

@@ -107,6 +107,7 @@ FaceMesh StructuralSolver::face_mesh(const std::string& face) const {
     fm.triangle_cells.resize(fm.triangles.size(), static_cast<int>(fm.cells.size()) - 1);
   }
   fm.cell_elements = mesh().face_owners(face);
+  fm.cell_across = mesh().face_across(face);
   return fm;
 }
 

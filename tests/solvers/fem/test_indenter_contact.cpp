@@ -505,6 +505,53 @@ TEST_CASE("indenter contact: a node without a face left takes no force and store
   }
 }
 
+// Eroding contact: the faces between elements (Mesh::add_interior_faces()) in the contact
+// touch only where the element across has eroded. A plane 5 mm into the block's top layer: with
+// the top layer's last column (x > 15 mm) eroded, the top face leaves 20 of its 25 nodes in
+// contact (as above), and the faces erosion exposed bring the 10 nodes of the bottom layer's top
+// faces under the hole (x = 15 and 20 mm, z = 5 mm); nothing before any erosion.
+TEST_CASE("indenter contact: the faces erosion exposes join the contact", "[fem][contact][rupture]") {
+  BoxSpec b;
+  b.size = Vec3(0.02, 0.02, 0.01);
+  b.cells = {4, 4, 2};
+  Mesh block = make_box_mesh(b);
+  block.add_interior_faces("between");
+  const Model model(block, Material{70e9, 0.3, 2700});
+  const Mesh& mesh = model.mesh();
+  const BlockAssembler assembler(mesh);
+  const auto n = static_cast<Eigen::Index>(3 * mesh.num_nodes());
+  const auto plane = [] {
+    return RigidIndenter(std::make_shared<PlaneShape>(Vec3(0, 0, 0.005 - 1e-5), Vec3(0, 0, -1)),
+                         VelocityTable({{0.0, Vec3::Zero()}}));
+  };
+  const auto centre = [&](std::size_t e) {
+    Vec3 c = Vec3::Zero();
+    for (const auto node : mesh.element(e).node_span()) c += mesh.node(node);
+    return Vec3(c / static_cast<double>(mesh.element(e).node_span().size()));
+  };
+  const auto column = [&](std::size_t e) { return centre(e).x() > 0.015 && centre(e).z() > 0.005; };
+  const Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+  IndenterContact eroding("t", model, std::vector<std::string>{"zmax", "between"}, plane(),
+                          {1.0, 0.0, 1.0});
+  IndenterContact top_only("t", model, std::vector<std::string>{"zmax"}, plane(), {1.0, 0.0, 1.0});
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  eroding.add(u, f, nullptr, assembler);
+  CHECK(eroding.active_nodes() == 25);  // nothing eroded: the faces between elements touch nothing
+  eroding.set_eroded([&](std::size_t e) { return column(e); });
+  top_only.set_eroded([&](std::size_t e) { return column(e); });
+  f.setZero();
+  eroding.add(u, f, nullptr, assembler);
+  CHECK(eroding.active_nodes() == 30);
+  for (std::size_t node = 0; node < mesh.num_nodes(); ++node) {
+    const Vec3& x = mesh.node(node);
+    if (std::abs(x.z() - 0.005) < 1e-9 && x.x() > 0.0149)
+      CHECK(f.segment<3>(3 * static_cast<Eigen::Index>(node)).z() != 0.0);
+  }
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+  top_only.add(u, g, nullptr, assembler);
+  CHECK(top_only.active_nodes() == 20);
+}
+
 TEST_CASE("free indenter: an external force decelerates it as F/m, its work is the change of kinetic energy",
           "[fem][contact]") {
   // no contact: a constant force F on a body of mass m moving at v0; velocity Verlet integrates a

@@ -22,6 +22,8 @@ struct FaceMesh {
   std::vector<std::array<int, 3>> triangles;
   std::vector<int> triangle_cells;         // the cell each triangle lies on
   std::vector<std::size_t> cell_elements;  // the volume element each cell bounds (global id)
+  // the element on each cell's other side (Mesh::face_across(): num_elements() on the boundary)
+  std::vector<std::size_t> cell_across;
 };
 
 }  // namespace partita::fem

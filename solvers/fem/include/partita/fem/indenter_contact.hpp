@@ -112,7 +112,9 @@ class IndenterContact final : public OperatorContribution {
   /// configuration (a refresh after an erosion, a restored state) k_n is summed again over the
   /// face elements whose volume element is intact, so that a node on the edge of a hole keeps
   /// the stiffness of the elements it still has, in proportion to its mass (its k_n / m_i, and
-  /// with it the stable step, stays that of the intact surface); default: none.
+  /// with it the stable step, stays that of the intact surface); default: none. A face between
+  /// two elements (Mesh::add_interior_faces()) counts once the element across has eroded: the
+  /// indenter meets the faces that erosion exposes (a web under a torn plate).
   void set_eroded(std::function<bool(std::size_t element)> eroded) { eroded_ = std::move(eroded); }
 
   const RigidIndenter& indenter() const { return indenter_; }
@@ -162,6 +164,7 @@ class IndenterContact final : public OperatorContribution {
   // element it bounds and its factor E A_f / (n_f h_f)
   std::vector<SurfaceElement> face_elements_;
   std::vector<std::size_t> face_owner_;
+  std::vector<std::size_t> face_across_;  // the element across a face (num_elements(): none)
   std::vector<double> face_stiffness_;
   std::vector<std::size_t> node_slot_;  // mesh node -> its index in nodes_ (face nodes only)
   void sum_penalty_stiffness();  // k_normal_ from the face elements (the intact ones)

@@ -32,6 +32,12 @@ class Mesh {
   // `name` (created if needed); returns how many moved. (Regions of a box mesh.)
   std::size_t assign_region_where(const std::string& name,
                                   const std::function<bool(const Vec3&)>& pred);
+  // Adds the face `name` of the faces that two elements share (the faces between elements, that
+  // erosion of one of them exposes), each once from either side, oriented outward from its own
+  // element: face_owners() gives that element, face_across() the other. regions: only the faces
+  // of elements in these regions (region indices; empty: every element). Throws Error if the
+  // face `name` exists. Returns the number of face elements added.
+  std::size_t add_interior_faces(const std::string& name, const std::vector<int>& regions = {});
   // Drops nodes that no element uses and renumbers nodes, sets and faces.
   void remove_unused_nodes();
   // Replaces every face element by the matching local face of the volume element it lies on
@@ -64,8 +70,12 @@ class Mesh {
   // Sorted unique nodes of a face.
   std::vector<std::size_t> face_nodes(const std::string& name) const;
   // The volume element each surface element of a face bounds (the first element that has its
-  // corners), in the face's order. Throws Error for a surface element that bounds none.
+  // corners; where two elements have them, the one the face points away from), in the face's
+  // order. Throws Error for a surface element that bounds none.
   std::vector<std::size_t> face_owners(const std::string& name) const;
+  // The element on the other side of each surface element of a face (the element that shares
+  // its corners and is not its owner), num_elements() where there is none (the boundary).
+  std::vector<std::size_t> face_across(const std::string& name) const;
 
  private:
   std::vector<Vec3> nodes_;
