@@ -89,10 +89,12 @@ int run_on_ranks(const coupling::Registries& registries, RanksOptions o) {
                                  : "internal error: " + std::string(e.what());
     // every rank builds and meets the same errors: rank 0 says them; another rank speaks for a
     // failure of its own (which broke the ranks' work together)
+    // (one write: the ranks' lines reach mpirun's output whole)
     if (rank == 0)
-      std::cerr << "partita: error: " << what << "\n";
+      std::cerr << ("partita: error: " + what + "\n") << std::flush;
     else if (ranks->broken())
-      std::cerr << "partita: error: rank " << rank << " of " << size << ": " << what << "\n";
+      std::cerr << fmt::format("partita: error: rank {} of {}: {}\n", rank, size, what)
+                << std::flush;
   };
   try {
     c = std::make_unique<run::CaseRun>(o.case_file, registries, ro);
@@ -102,10 +104,11 @@ int run_on_ranks(const coupling::Registries& registries, RanksOptions o) {
   }
   if (!ranks->claimed() && size > 1) {
     if (rank == 0)
-      std::cerr << "partita: error: " << o.case_file.string() << ": its participant's solver "
-                << "does not run on several ranks (mpirun -n " << size
-                << "); run the case in one process, without mpirun (a DEM participant runs on "
-                   "several ranks)\n";
+      std::cerr << fmt::format(
+          "partita: error: {}: its participant's solver does not run on several ranks (mpirun "
+          "-n {}); run the case in one process, without mpirun (a DEM participant runs on "
+          "several ranks)\n",
+          o.case_file.string(), size);
     return end(1, false);
   }
   if (o.install_stop_handlers) o.install_stop_handlers();

@@ -45,7 +45,10 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
             out({}, a.on_ranks() ? a.ranks_->momentum : a.system_.linear_momentum());
           });
     t.scalar("contacts_per_particle", "", "mean number of particle-particle contacts",
-             [](const A& a) { return a.system_.mean_contacts_per_particle(); });
+             [](const A& a) {
+               return a.on_ranks() ? a.ranks_->contacts_per_particle
+                                   : a.system_.mean_contacts_per_particle();
+             });
     t.scalar("friction_work", "J",
              "(with energy_accounting: true, as the monitors down to energy_balance_error and "
              "<mesh>.work, <wall>.work) energy dissipated by Coulomb sliding in all contacts since "

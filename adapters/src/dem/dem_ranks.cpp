@@ -16,8 +16,8 @@
 //   advance dt       every rank steps its subdomain (walls moved by their tables alike);
 //   monitors groups  the sums the quantities asked for need, each an exact sum over the owned
 //                    particles rounded once (SubdomainStepper: kinetic energy, momentum, elastic
-//                    energy, each wall's, box face's and mesh's force), the monitor particles'
-//                    states gathered from their owners: the same bits on any N;
+//                    energy, each wall's, box face's and mesh's force, the contacts), the monitor
+//                    particles' states gathered from their owners: the same bits on any N;
 //   check            every rank's astray owned particle of lowest id to rank 0;
 //   output frame     every rank writes its owned particles as one piece
 //                    (<prefix>_particles_<frame>_<rank>.vtp), rank 0 the .pvtp that joins them
@@ -37,8 +37,8 @@
 // Not handled on a split yet, refused at set-up naming the key: breakage (fragment ids unique over
 // the ranks, new particles' ghosts), wall servos (each rank would steer its wall by its own part
 // of the force), the energy accounting, meshes taken from another participant (the coupling); at
-// run time: the monitor quantities not listed above (contacts_per_particle), coupled data,
-// checkpoints.
+// run time: a monitor quantity not listed above (none of the DEM's today: a guard for new ones),
+// coupled data, checkpoints.
 //
 // The split path gives the same bytes on every N, N = 1 under mpirun included. It is not the path
 // of one process without mpirun (one dem::System stepped whole): the split numbers the particles
@@ -95,7 +95,7 @@ constexpr long kBalanceEvery = 200;
 constexpr double kImbalance = 1.25;
 
 constexpr std::uint32_t kKinetic = 1, kElastic = 2, kWalls = 4, kMeshes = 8, kTracked = 16,
-                        kFaceGroup = 32;
+                        kFaceGroup = 32, kContacts = 64;
 
 // A message's bytes.
 class Bytes {
@@ -424,8 +424,9 @@ void DemAdapter::ranks_rebalance() {
 // ---- monitors --------------------------------------------------------------------------------
 
 std::vector<std::string> DemAdapter::ranks_monitor_names() const {
-  std::vector<std::string> n = {"kinetic_energy", "particles", "mass", "momentum_x",
-                                "momentum_y", "momentum_z", "elastic_energy"};
+  std::vector<std::string> n = {"kinetic_energy", "particles",  "mass",
+                                "momentum_x",     "momentum_y", "momentum_z",
+                                "elastic_energy", "contacts_per_particle"};
   for (const auto& m : meshes_dem_)
     for (const char* c : {"x", "y", "z"}) n.push_back(m.name + ".force_" + c);
   for (const auto& w : walls_)
@@ -453,6 +454,7 @@ std::uint32_t DemAdapter::ranks_monitor_groups(const std::vector<std::string>& n
     if (q == "kinetic_energy" || is("momentum_", {"x", "y", "z"})) groups |= kKinetic, known = true;
     if (q == "particles" || q == "mass") known = true;
     if (q == "elastic_energy") groups |= kElastic, known = true;
+    if (q == "contacts_per_particle") groups |= kContacts, known = true;
     for (const auto& m : meshes_dem_)
       if (is(m.name + ".force_", {"x", "y", "z"})) groups |= kMeshes, known = true;
     for (const auto& w : walls_) {
@@ -499,6 +501,9 @@ void DemAdapter::ranks_monitors(std::uint32_t groups) const {
     }
     // the forces of a pass: none after a resume before its first step
     if (groups & kElastic) o.elastic = o.forces ? s.elastic_energy() : 0.0;
+    // 2 contacts / N, as System::mean_contacts_per_particle() (N fixed: the particle count)
+    if (groups & kContacts)
+      o.contacts_per_particle = 2.0 * static_cast<double>(s.contact_count()) / o.particles;
     if (groups & kWalls) {
       const std::vector<Eigen::Vector3d>* f = o.forces ? &s.wall_forces() : nullptr;
       for (std::size_t k = 0; k < walls_.size(); ++k)

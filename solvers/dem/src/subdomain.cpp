@@ -441,6 +441,17 @@ void Subdomain::add_wall_forces(ExactSum* sums) const {
   }
 }
 
+void Subdomain::add_contacts(ExactSum& sum) const {
+  const Particles& p = sys_->particles();
+  double count = 0.0;  // (an integer: exact)
+  sys_->neighbor_list().for_each_pair([&](int i, int j) {
+    if (is_ghost(static_cast<std::size_t>(i))) return;
+    const double rsum = p.radius[i] + p.radius[j];
+    if ((p.position[i] - p.position[j]).squaredNorm() < rsum * rsum) count += 1.0;
+  });
+  sum.add(count);
+}
+
 void Subdomain::add_plane_forces(ExactSum* sums) const {
   const std::vector<Eigen::Vector3d>& reaction = sys_->wall_reactions();
   const std::size_t n = sys_->particle_count(), np = sys_->planes().size();
@@ -574,10 +585,10 @@ void SubdomainStepper::global_sums(Sums what) {
   const std::size_t local = subdomains_.size();
   const auto walls = static_cast<std::size_t>(subdomains_[0].system().wall_count());
   const std::size_t planes = subdomains_[0].system().planes().size();
-  const std::size_t m = what == Sums::kinetic   ? 4
-                        : what == Sums::elastic ? 1
-                        : what == Sums::walls   ? 3 * walls
-                                                : 3 * planes;
+  const std::size_t m = what == Sums::kinetic                              ? 4
+                        : what == Sums::elastic || what == Sums::contacts ? 1
+                        : what == Sums::walls                              ? 3 * walls
+                                                                           : 3 * planes;
   sums_.resize(m * local);
   totals_.resize(m);
   for (std::size_t k = 0; k < local; ++k) {
@@ -590,6 +601,8 @@ void SubdomainStepper::global_sums(Sums what) {
       subdomains_[k].add_kinetic(sums);
     else if (what == Sums::elastic)
       sd.add_elastic(sums[0]);
+    else if (what == Sums::contacts)
+      sd.add_contacts(sums[0]);
     else if (what == Sums::walls)
       sd.add_wall_forces(sums);
     else
@@ -622,6 +635,11 @@ double SubdomainStepper::kinetic_energy() {
 double SubdomainStepper::elastic_energy() {
   global_sums(Sums::elastic);
   return totals_[0].value();
+}
+
+std::size_t SubdomainStepper::contact_count() {
+  global_sums(Sums::contacts);
+  return static_cast<std::size_t>(totals_[0].value());
 }
 
 Eigen::Vector3d SubdomainStepper::wall_force(int wall) {

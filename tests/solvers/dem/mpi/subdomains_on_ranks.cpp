@@ -8,8 +8,9 @@
 // crossing (a long box whose particles fly along it at up to 1.8 m/s: many cross the cuts).
 // Every rank builds the same bed, keeps the particles its box of a bisection into N owns and
 // steps them with SubdomainStepper; every particle's id, x, v, omega and every rank's collective
-// sums (kinetic and elastic energy, momentum, the walls' forces, each at once and all in one
-// round, the planes' forces, the mesh's force, per triangle and per vertex) go to rank 0 (through the transport), which steps the bed in one subdomain
+// sums (kinetic and elastic energy, the contacts, momentum, the walls' forces, each at once and
+// all in one round, the planes' forces, the mesh's force, per triangle and per vertex) go to
+// rank 0 (through the transport), which steps the bed in one subdomain
 // (InProcessTransport) and compares them bit for bit: exit status 1 and a message on the first
 // difference. --piece: the largest MPI message of the transport (cut and joined). --stall: rank
 // RANK sleeps SECONDS before step STEP; the others must end the run past the deadline (--deadline,
@@ -265,6 +266,7 @@ Result result(const Bed& bed, SubdomainStepper& stepper, System& sys, double dt)
   r.sums.push_back(stepper.kinetic_energy());
   add(stepper.linear_momentum());
   r.sums.push_back(stepper.elastic_energy());
+  r.sums.push_back(static_cast<double>(stepper.contact_count()));
   for (int w = 0; w < sys.wall_count(); ++w) add(stepper.wall_force(w));
   for (const Eigen::Vector3d& f : stepper.wall_forces()) add(f);
   for (const Eigen::Vector3d& f : stepper.plane_forces()) add(f);

@@ -201,6 +201,10 @@ class Subdomain {
   /// kinetic_energy()'s terms) to sums[0] and their linear momentum m v to sums[1..3].
   void add_kinetic(ExactSum* sums);
   void add_elastic(ExactSum& sum) const { sys_->add_elastic_energy(ghost_, sum); }
+  /// Adds the particle-particle contacts (listed pairs that overlap, System::contact_count()'s
+  /// terms) whose first particle in the global order is owned here: each contact once over the
+  /// subdomains (its pair is listed in that particle's row, where it is owned).
+  void add_contacts(ExactSum& sum) const;
   /// Appends the owned particles as one System::pack_particles() message (everything they carry:
   /// arrays, forces of the last pass, pair histories by id, plane and mesh histories): with the
   /// world's state (walls, meshes, time: any subdomain's System state, they are alike) what a
@@ -283,6 +287,9 @@ class SubdomainStepper {
   /// once over the subdomains (System::add_elastic_energy() without the ghosts): an exact sum,
   /// the same bits on any split (collective). After a step.
   double elastic_energy();
+  /// The particle-particle contacts (System::contact_count()), each counted once over the
+  /// subdomains (collective). After a step.
+  std::size_t contact_count();
   /// The force the particles exert on a wall (all its planes) [N] in the last pass: the owned
   /// particles' reactions in an exact sum, the same bits on any split (collective).
   Eigen::Vector3d wall_force(int wall);
@@ -318,8 +325,9 @@ class SubdomainStepper {
 
   void redistribute();
   // what global_sums() adds up: per local subdomain, kinetic energy and momentum (4 sums), the
-  // elastic energy (1), the walls' forces (3 per wall) or the planes' forces (3 per plane)
-  enum class Sums { kinetic, elastic, walls, planes };
+  // elastic energy (1), the walls' forces (3 per wall), the planes' forces (3 per plane) or the
+  // contacts (1)
+  enum class Sums { kinetic, elastic, walls, planes, contacts };
   std::vector<Eigen::Vector3d> forces_;  // wall_forces(), plane_forces()
   // sums_[m k + q]: local subdomain k's sum q, then summed over every subdomain into totals_
   void global_sums(Sums what);
