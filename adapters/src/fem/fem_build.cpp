@@ -132,8 +132,8 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
                        join_names(mesh.face_names()) + ")");
       const std::size_t added = mesh.add_interior_faces(iname, regions);
       if (added == 0)
-        i["regions"].fail("no two elements of these regions share a face: nothing for erosion "
-                          "to expose");
+        (i.has("regions") ? i["regions"] : i)
+            .fail("no two elements of these regions share a face: nothing for erosion to expose");
       log::get("adapters")->info("fem '{}': face '{}': {} face elements (each face between two "
                                  "elements, from either side), in contact once erosion exposes "
                                  "them",
