@@ -17,11 +17,13 @@
 #               naming it, the same on 1 and 3 ranks
 #   stalled     rank 1 stopped (SIGSTOP) mid-run with --peer-timeout 3: every process ends within
 #               15 s, non-zero, the message naming rank 1
+#   servo       the lid as a servo wall to 1 N: the same bytes on 1 and 3 ranks, the lid's force
+#               within 2 % of its target at the end
 #   signal      SIGINT to mpirun mid-run on 2 ranks: every process ends within 10 s after the
 #               window, with a restart file, which resumes on 3 ranks to the end
-#   refused     on 2 ranks, what a split does not handle yet (breakage, a wall servo, the energy
-#               accounting): exit status 1, one message naming
-#               the key and saying "not yet on several ranks", every process ended within 60 s;
+#   refused     on 2 ranks, what a split does not handle yet (breakage, the energy accounting):
+#               exit status 1, one message naming the key and saying "not yet on several ranks",
+#               every process ended within 60 s;
 #               a case of two participants, naming them and --participant
 # OpenMPI refuses to run as root unless told (CI runs as root); --oversubscribe: 4 ranks on fewer
 # cores. One OpenMP thread a rank.
@@ -170,7 +172,6 @@ refused)
     echo "$key: refused in $(($(date +%s) - start)) s: $(grep 'partita: error' x.log | cut -c1-160)..."
   }
   expect "participants.bed.breakage" --set 'participants.bed.breakage={limit_strength: 1 MPa, reference_size: 2 mm, weibull_modulus: 3, comminution_limit: 0.5 mm}'
-  expect "participants.bed.walls\[1\].servo" --set 'participants.bed.walls[1]={name: lid, plane: {point: [0, 0, 18 mm], normal: [0, 0, -1]}, material: grain, servo: {force: 1, max_velocity: 0.1}}'
   expect "participants.bed.energy_accounting" --set participants.bed.energy_accounting=true
   # a case of two participants on 2 ranks: refused, naming them and --participant
   timeout 60 "${MPIRUN[@]}" -n 2 "$P" run "$HERE/../../cases/uniaxial_compaction/steel.yaml" -o y \
@@ -247,6 +248,22 @@ signal)
     { cat g2.log >&2; fail "resumed on 3 ranks"; }
   [ "$(tail -n 1 g/bed.csv | cut -d, -f1)" = 0.1 ] || fail "the resumed run did not reach 0.1 s"
   echo "SIGINT: every process ended after $took s with a restart file ($(ls g/restart)), resumed on 3 ranks to 0.1 s"
+  ;;
+servo)
+  # the lid as a servo wall to 1 N (the law applied with the force summed over the ranks): the
+  # same bytes on 1 and 3 ranks, and the lid holds the bed at its target at the end
+  servo=(--set 'participants.bed.walls[1]={name: lid, plane: {point: [0, 0, 18 mm], normal: [0, 0, -1]}, material: grain, servo: {force: 1 N, max_velocity: 0.5}}')
+  ranks 1 v1 "${servo[@]}"
+  ranks 3 v3 "${servo[@]}"
+  same v1 v3
+  python3 - v3/bed.csv << 'EOF' || fail "the servo lid does not hold its target"
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+k = [h.split(' [')[0] for h in rows[0]].index('bed.lid.force_z')
+f = float(rows[-1][k])
+assert abs(f - 1.0) < 0.02, f   # the particles push the lid back with the target force
+print('the servo lid holds', f, 'N of 1 N at the end')
+EOF
   ;;
 *)
   fail "unknown scenario $SCENARIO"

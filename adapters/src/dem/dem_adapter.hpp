@@ -43,6 +43,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -50,6 +51,7 @@
 #include "partita/dem/breakage.hpp"
 #include "partita/dem/packing_generator.hpp"
 #include "partita/dem/system.hpp"
+#include "partita/dem/wall_servo.hpp"
 #include "partita/interface/interface_work.hpp"
 #include "partita/interface/monitor_table.hpp"
 #include "partita/interface/solver.hpp"
@@ -111,6 +113,9 @@ class DemAdapter : public Solver {
     bool moving = false;                                 // velocity from a table
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // times table(t)
     TimeTable table;
+    // on several ranks, a servo's law applied by the adapter with the force summed over the
+    // ranks (dem_ranks.cpp); in one process the System's dem::WallServo hook
+    std::optional<dem::WallServoParameters> servo;
   };
   /// One entry of `materials` (dem_schema.cpp).
   static std::shared_ptr<const config::Spec> material_spec();

@@ -286,7 +286,13 @@ DemAdapter::DemAdapter(const SolverContext& context)
         sp.force = s.real("force");
         sp.max_velocity = s.real("max_velocity");
         sp.gain = s.has("gain") ? s.real("gain") : sp.max_velocity / sp.force;
-        system_.add_hook(std::make_unique<dem::WallServo>(sp));
+        auto servo = std::make_unique<dem::WallServo>(sp);  // (checks the parameters)
+        // on several ranks each System holds a part of the wall's force: the adapter applies the
+        // servo's law with the force summed over the ranks (dem_ranks.cpp)
+        if (context.ranks)
+          wall.servo = sp;
+        else
+          system_.add_hook(std::move(servo));
       }
       walls_.push_back(wall);
     }

@@ -34,9 +34,12 @@
 //                    status the app gives, end_others()).
 // The others run follow() (the loop the adapter claims the ranks with) until finish or end.
 //
+// Wall servos: the adapter applies dem::WallServo's law after each step with the wall's force
+// summed over the ranks (the hook on each rank's System would steer by that rank's part).
+//
 // Not handled on a split yet, refused at set-up naming the key: breakage (fragment ids unique over
-// the ranks, new particles' ghosts), wall servos (each rank would steer its wall by its own part
-// of the force), the energy accounting, meshes taken from another participant (the coupling); at
+// the ranks, new particles' ghosts), the energy accounting, meshes taken from another participant
+// (the coupling); at
 // run time: a monitor quantity not listed above (none of the DEM's today: a guard for new ones),
 // coupled data, checkpoints.
 //
@@ -168,8 +171,6 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
         what, ranks->size()));
   };
   if (c.has("breakage")) refuse(c["breakage"], "breakage (fragments born at run time)");
-  for (const Node& w : c["walls"].items())
-    if (w.has("servo")) refuse(w["servo"], "a wall servo");
   if (c.has("energy_accounting") && c.boolean("energy_accounting"))
     refuse(c["energy_accounting"], "the energy accounting");
   for (const Node& m : c["meshes"].items())
@@ -366,6 +367,17 @@ void DemAdapter::ranks_advance(double dt) {
     }
   });
   o.forces = true;
+  // servo walls: dem::WallServo::end_of_step()'s law, v = clamp(gain (F_target - F_n), -v_max,
+  // v_max) along the normal, F_n = -F_wall . n with the wall's force summed over the ranks (an
+  // exact sum: the same velocity on every rank and every N)
+  for (const auto& w : walls_) {
+    if (!w.servo) continue;
+    const dem::WallServoParameters& sp = *w.servo;
+    const Eigen::Vector3d f = together(*o.ranks, [&] { return o.stepper->wall_force(w.id); });
+    const double v = std::clamp(sp.gain * (sp.force + f.dot(sp.normal)), -sp.max_velocity,
+                                sp.max_velocity);
+    system_.set_wall_velocity(w.id, v * sp.normal);
+  }
   // (the meshes do not move on ranks: no coupled data is read, so their work stays 0)
   if (o.stepper->steps() % kBalanceEvery == 0) ranks_rebalance();
 }
