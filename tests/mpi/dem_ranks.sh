@@ -12,7 +12,7 @@
 #               (output.particles_file) the same bytes on every N, read back as the bed at the end
 #   resume      written on 2 ranks to 10 ms (restart file), resumed on 3 to 20 ms, against written
 #               on 4 and resumed on 1: the same bytes (a split bed's restart does not depend on the
-#               splits that write and read it)
+#               splits that write and read it); resumed without mpirun it is refused, saying why
 #   lost        a particle leaves the domain: the run stops with exit status 1 and one message
 #               naming it, the same on 1 and 3 ranks
 #   stalled     rank 1 stopped (SIGSTOP) mid-run with --peer-timeout 3: every process ends within
@@ -149,6 +149,15 @@ EOF
   ;;
 resume)
   ranks 2 a --set time.end=0.01 --set output.restart.at_end=true
+  # (a restart file written on ranks does not resume without mpirun: refused, saying so; the
+  # bouncing sphere, whose monitors one process reports too)
+  sphere=$HERE/../../cases/bouncing_sphere/bouncing_sphere.yaml
+  "${MPIRUN[@]}" -n 2 "$P" run "$sphere" -o crossed --threads 1 --set time.end=0.004 \
+    --set output.restart.at_end=true > crossed.log 2>&1 || { cat crossed.log >&2; fail "the sphere on 2 ranks"; }
+  "$P" run "$sphere" --resume crossed --threads 1 --set time.end=0.008 > crossed.log 2>&1 &&
+    fail "a restart file of ranks resumed without mpirun"
+  grep -q "written on ranks, mpirun -n N partita run, resumes on ranks" crossed.log ||
+    { cat crossed.log >&2; fail "the refusal does not say why"; }
   "${MPIRUN[@]}" -n 3 "$P" run "$CASE" --resume a --threads 1 --set time.end=0.02 > a2.log 2>&1 ||
     { cat a2.log >&2; fail "resumed on 3 ranks"; }
   ranks 4 b --set time.end=0.01 --set output.restart.at_end=true

@@ -248,15 +248,28 @@ void DemAdapter::write_restart(BinaryWriter& out) const {
 }
 
 void DemAdapter::read_restart(BinaryReader& in) {
+  // a restart file of a run on ranks (mpirun -n N partita run) holds the split bed in a section
+  // of its own: it resumes on ranks, and one written without mpirun resumes without
+  const auto expect = [&](const char* section, const char* hint) {
+    try {
+      in.expect_section(section);
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) + hint);
+    }
+  };
   if (on_ranks()) {
-    in.expect_section("dem on ranks");
+    expect("dem on ranks",
+           " (a restart file written without mpirun resumes without mpirun: the DEM on ranks "
+           "keeps its own section)");
     if (const std::string astray = lead_resume(in.bytes(), in.source()); !astray.empty())
       throw Error(in.source() + ": the DEM state of '" + name_ + "' cannot be resumed: " + astray);
     in.expect_section("dem interface work");
     for (auto& cm : meshes_dem_) cm.audit.load(in, "vertices of mesh '" + cm.name + "'");
     return;
   }
-  in.expect_section("dem");
+  expect("dem",
+         " (a restart file written on ranks, mpirun -n N partita run, resumes on ranks: "
+         "mpirun -n M partita run CASE --resume DIR)");
   std::istringstream state(in.bytes());
   try {
     system_.read_state(state);
