@@ -9,7 +9,8 @@
 #               one piece per rank whose particles add up to the bed, every piece holding some,
 #               the fullest at the end at most 1.5 times the mean (the bed cut again as the load
 #               drifts), and declares the pieces' arrays as they hold them; the particles file
-#               (output.particles_file) the same bytes on every N, read back as the bed at the end
+#               (output.particles_file) the same bytes on every N, read back as the bed at the end;
+#               a run on 2 ranks into the 4-rank run's folder leaves none of its pieces
 #   resume      written on 2 ranks to 10 ms (restart file), resumed on 3 to 20 ms, against written
 #               on 4 and resumed on 1: the same bytes (a split bed's restart does not depend on the
 #               splits that write and read it); resumed without mpirun it is refused, saying why
@@ -145,6 +146,10 @@ for piece in pieces:
     assert arrays(head.split('<Points>')[1].split('</Points>')[0], 'DataArray') == points, piece
 print("the .pvtp declares its pieces' arrays")
 EOF
+  # a new run into a folder of a run on more ranks leaves none of the earlier pieces
+  ranks 2 r4
+  stale=$(ls r4/vtk | grep -c '^bed_particles_[0-9]*_[23]\.vtp$')
+  [ "$stale" -eq 0 ] || fail "$stale pieces of the 4-rank run left beside the 2-rank run's"
   echo "the CSV files of 1, 2, 3 and 4 ranks are the same bytes; the frames join $total particles"
   ;;
 resume)

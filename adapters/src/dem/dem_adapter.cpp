@@ -172,6 +172,8 @@ void DemAdapter::write_output(const OutputFrame& frame) {
     return;
   }
   files_.clear();
+  // (a new run's first frame: the pieces of an earlier run on ranks into this folder go)
+  if (frame.index == 0) remove_particle_pieces(frame.vtk_directory, frame.prefix);
   const std::string pfile = fmt::format("{}_particles_{:06d}.vtp", frame.prefix, frame.index);
   write_particles_vtp(system_, frame.vtk_directory / pfile, frame.vtk);
   files_.emplace_back("particles", pfile);

@@ -1,5 +1,6 @@
 #include "partita/adapters/dem_output.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <string>
 
@@ -52,6 +53,28 @@ void write_mesh_vtp(const dem::System& system, int mesh, const std::filesystem::
                       vtk::DataArray::rows("force", vertex_forces)};
   piece.cell_data = {vtk::DataArray::rows("force", triangle_forces)};
   vtk::write(path, piece, options);
+}
+
+int remove_particle_pieces(const std::filesystem::path& directory, const std::string& prefix) {
+  // <prefix>_particles_ then 6 digits, '_', digits, ".vtp"
+  const std::string head = prefix + "_particles_";
+  int removed = 0;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.size() < head.size() + 6 + 2 + 4 || name.compare(0, head.size(), head) != 0 ||
+        !name.ends_with(".vtp"))
+      continue;
+    const std::string_view rest =
+        std::string_view(name).substr(head.size(), name.size() - head.size() - 4);
+    const auto digits = [](std::string_view t) {
+      return !t.empty() && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    if (rest.size() < 8 || rest[6] != '_' || !digits(rest.substr(0, 6)) || !digits(rest.substr(7)))
+      continue;
+    if (std::filesystem::remove(entry.path(), ec)) ++removed;
+  }
+  return removed;
 }
 
 void write_particles_pvtp(const std::filesystem::path& path, const std::vector<std::string>& pieces,

@@ -625,6 +625,9 @@ std::string DemAdapter::ranks_check() const {
 // ---- output ----------------------------------------------------------------------------------
 
 void DemAdapter::lead_output(const OutputFrame& frame) {
+  // a new run's first frame: the pieces of an earlier run into this folder go (an earlier run on
+  // more ranks would leave pieces no .pvtp lists), before any rank writes its own
+  if (frame.index == 0) remove_particle_pieces(frame.vtk_directory, frame.prefix);
   Bytes b(Command::output);
   b.put(frame.vtk_directory.string()).put(frame.prefix).put(frame.index).put(frame.time);
   b.put(frame.vtk.format).put(frame.vtk.precision).put(frame.vtk.zlib_level);

@@ -41,5 +41,9 @@ void write_mesh_vtp(const dem::System& system, int mesh, const std::filesystem::
 /// options): ParaView opens the pieces as one data set. Written atomically.
 void write_particles_pvtp(const std::filesystem::path& path, const std::vector<std::string>& pieces,
                           const vtk::Options& options);
+/// Removes the pieces <prefix>_particles_<frame>_<rank>.vtp in `directory` (those of an earlier
+/// run on ranks: the .pvd series an earlier run leaves lists its .pvtp files, whose removal leaves
+/// the pieces); returns how many.
+int remove_particle_pieces(const std::filesystem::path& directory, const std::string& prefix);
 
 }  // namespace partita::adapters
