@@ -91,9 +91,10 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
     // monitor column takes (the last of that name)
     t.add(xyz_rows("<mesh>.force", "N", "total contact force of the particles on a mesh, x"),
           [](const A& a, const Out& out) {
-            for (std::size_t k = 0; k < a.meshes_dem_.size(); ++k)
-              out({a.meshes_dem_[k].name}, a.on_ranks() ? a.ranks_->mesh_force[k]
-                                                        : a.system_.mesh_force(a.meshes_dem_[k].id));
+            for (std::size_t k = 0; k < a.meshes_dem_.size(); ++k) {
+              const auto& m = a.meshes_dem_[k];
+              out({m.name}, a.on_ranks() ? a.ranks_->mesh_force[k] : a.system_.mesh_force(m.id));
+            }
           });
     t.add({{"<mesh>.work", "J",
             "work of one mesh's motion on the particles since the start (a coupled FE surface: "
@@ -150,8 +151,9 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
       const dem::Particles& p = a.system_.particles();
       for (std::size_t k = 0; k < a.tracked_.size(); ++k) {
         std::array<double, 6>& last = a.tracked_last_[k];
-        if (a.on_ranks()) {
-          out({std::to_string(a.tracked_[k])}, {last[0], last[1], last[2], last[3], last[4], last[5]});
+        if (a.on_ranks()) {  // (gathered from the owner by the last collective pass)
+          out({std::to_string(a.tracked_[k])},
+              {last[0], last[1], last[2], last[3], last[4], last[5]});
           continue;
         }
         std::size_t& i = a.tracked_index_[k];

@@ -68,7 +68,8 @@ int remove_particle_pieces(const std::filesystem::path& directory, const std::st
     const std::string_view rest =
         std::string_view(name).substr(head.size(), name.size() - head.size() - 4);
     const auto digits = [](std::string_view t) {
-      return !t.empty() && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+      return !t.empty() &&
+             std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
     };
     if (rest.size() < 8 || rest[6] != '_' || !digits(rest.substr(0, 6)) || !digits(rest.substr(7)))
       continue;

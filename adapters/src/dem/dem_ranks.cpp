@@ -53,8 +53,8 @@
 // within the deadline) the ranks are marked broken and the app ends them all (MPI_Abort) after
 // the message.
 
-#include "dem_adapter.hpp"
 #include "dem_ranks.hpp"
+#include "dem_adapter.hpp"
 
 #include <fmt/format.h>
 #include <algorithm>
@@ -176,7 +176,8 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
   for (const Node& m : c["meshes"].items())
     if (m.has("from")) refuse(m["from"], "a mesh taken from another participant (coupling)");
 #ifndef PARTITA_DEM_MPI
-  throw Error("dem '" + name_ + "': this partita was built without the DEM's MPI transport "
+  throw Error("dem '" + name_ +
+              "': this partita was built without the DEM's MPI transport "
               "(partita::dem_mpi): it cannot run on several ranks");
 #else
   auto o = std::make_unique<OnRanks>();
@@ -374,8 +375,8 @@ void DemAdapter::ranks_advance(double dt) {
     if (!w.servo) continue;
     const dem::WallServoParameters& sp = *w.servo;
     const Eigen::Vector3d f = together(*o.ranks, [&] { return o.stepper->wall_force(w.id); });
-    const double v = std::clamp(sp.gain * (sp.force + f.dot(sp.normal)), -sp.max_velocity,
-                                sp.max_velocity);
+    const double v =
+        std::clamp(sp.gain * (sp.force + f.dot(sp.normal)), -sp.max_velocity, sp.max_velocity);
     system_.set_wall_velocity(w.id, v * sp.normal);
   }
   // (the meshes do not move on ranks: no coupled data is read, so their work stays 0)
@@ -401,7 +402,8 @@ void DemAdapter::ranks_rebalance() {
     const dem::Particles& p = system_.particles();
     Bytes mine;
     for (std::size_t i = 0; i < p.size(); ++i)
-      if (!sd.is_ghost(i)) mine.put(p.position[i].x()).put(p.position[i].y()).put(p.position[i].z());
+      if (!sd.is_ghost(i))
+        mine.put(p.position[i].x()).put(p.position[i].y()).put(p.position[i].z());
     const auto me = static_cast<std::size_t>(o.ranks->rank());
     for (std::size_t d = 0; d < o.out[0].size(); ++d)
       if (d == me)
@@ -427,18 +429,19 @@ void DemAdapter::ranks_rebalance() {
     ++o.rebalances;
     if (o.ranks->leads())
       log::get("adapters")
-          ->debug("dem '{}' at t = {:.6g} s: the bed cut again ({} particles on the fullest rank, "
-                  "{:.4g} on average)",
-                  name_, system_.time(), most, mean);
+          ->debug(
+              "dem '{}' at t = {:.6g} s: the bed cut again ({} particles on the fullest rank, "
+              "{:.4g} on average)",
+              name_, system_.time(), most, mean);
   });
 }
 
 // ---- monitors --------------------------------------------------------------------------------
 
 std::vector<std::string> DemAdapter::ranks_monitor_names() const {
-  std::vector<std::string> n = {"kinetic_energy", "particles",  "mass",
-                                "momentum_x",     "momentum_y", "momentum_z",
-                                "elastic_energy", "contacts_per_particle"};
+  std::vector<std::string> n = {
+      "kinetic_energy", "particles",  "mass",           "momentum_x",
+      "momentum_y",     "momentum_z", "elastic_energy", "contacts_per_particle"};
   for (const auto& m : meshes_dem_)
     for (const char* c : {"x", "y", "z"}) n.push_back(m.name + ".force_" + c);
   for (const auto& w : walls_)
@@ -519,7 +522,8 @@ void DemAdapter::ranks_monitors(std::uint32_t groups) const {
     if (groups & kWalls) {
       const std::vector<Eigen::Vector3d>* f = o.forces ? &s.wall_forces() : nullptr;
       for (std::size_t k = 0; k < walls_.size(); ++k)
-        o.wall_force[k] = f ? (*f)[static_cast<std::size_t>(walls_[k].id)] : Eigen::Vector3d::Zero();
+        o.wall_force[k] =
+            f ? (*f)[static_cast<std::size_t>(walls_[k].id)] : Eigen::Vector3d::Zero();
     }
     if (groups & kFaceGroup) {
       // a box wall's face k is its plane of normal +e_axis (k even) or -e_axis (k odd), as
@@ -663,8 +667,10 @@ void DemAdapter::ranks_output(const OutputFrame& frame) {
   together(*o.ranks, [&] {
     for (const auto& m : meshes_dem_) {
       const dem::TriangleMesh& tm = system_.mesh(m.id);
-      Eigen::MatrixX3d v = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(tm.positions().size()), 3);
-      Eigen::MatrixX3d t = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(tm.triangle_count()), 3);
+      Eigen::MatrixX3d v =
+          Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(tm.positions().size()), 3);
+      Eigen::MatrixX3d t =
+          Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(tm.triangle_count()), 3);
       if (o.forces) {
         t = o.stepper->triangle_forces(m.id);
         v = o.stepper->vertex_forces(m.id);
@@ -814,7 +820,7 @@ void DemAdapter::ranks_resume(const std::string& stream) {
       system_.remove_particles(std::vector<char>(system_.particle_count(), 1));
       r.restore({&system_}, *o.transport);
       o.stepper = std::make_unique<dem::SubdomainStepper>(std::vector<dem::System*>{&system_},
-                                                           *o.transport, o.decomposition, o.skin);
+                                                          *o.transport, o.decomposition, o.skin);
       o.stepper->resume();
       o.started = true;
       o.forces = false;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include "dem_adapter.hpp"
 #include "partita/dem/domain_decomposition.hpp"
 #include "partita/dem/subdomain.hpp"
 #include "partita/dem/subdomain_transport.hpp"
@@ -32,9 +33,9 @@ struct DemAdapter::OnRanks {
   // the monitors' values of the last collective pass (rank 0)
   double kinetic = 0.0, elastic = 0.0, contacts_per_particle = 0.0;
   Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3d> wall_force;  // by walls_ index
+  std::vector<Eigen::Vector3d> wall_force;                 // by walls_ index
   std::vector<std::array<Eigen::Vector3d, 6>> face_force;  // by walls_ index, face (a box's)
-  std::vector<Eigen::Vector3d> mesh_force;  // by meshes_dem_ index
+  std::vector<Eigen::Vector3d> mesh_force;                 // by meshes_dem_ index
   // the transport's buffers (one local subdomain)
   std::vector<dem::SubdomainMail> out, in;
 };
