@@ -287,13 +287,15 @@ void DemAdapter::read_restart(BinaryReader& in) {
   for (auto& cm : meshes_dem_) cm.audit.load(in, "vertices of mesh '" + cm.name + "'");
 }
 
-void DemAdapter::add_coupling_mesh(const std::string& name, const Mesh& mesh, int material) {
+void DemAdapter::add_coupling_mesh(const std::string& name, const Mesh& mesh, int material,
+                                   bool one_sided) {
   CouplingMesh cm;
   cm.name = name;
   cm.reference = mesh.points();
   cm.positions = mesh.points();
   cm.areas = mesh.triangle_areas();
   cm.id = system_.add_mesh(mesh.points(), mesh.triangles(), material);
+  system_.set_mesh_one_sided(cm.id, one_sided);
   cm.audit = InterfaceWork::motion(mesh.points(), system_.vertex_forces(cm.id));
   InterfaceMesh vertices;
   vertices.mesh = Mesh(name, mesh.points(), mesh.triangles());
@@ -322,7 +324,7 @@ void DemAdapter::receive_mesh(const std::string& name, const Mesh& mesh) {
   for (std::size_t k = 0; k < requests_.size(); ++k)
     if (requests_[k].name == name) {
       try {
-        add_coupling_mesh(name, mesh, request_materials_[k]);
+        add_coupling_mesh(name, mesh, request_materials_[k], request_one_sided_[k] != 0);
       } catch (const dem::Error& e) {
         requests_[k].where.fail(std::string("cannot use this surface as a contact mesh: ") +
                                 e.what());

@@ -164,7 +164,9 @@ class DemAdapter : public Solver {
   // meshes taken from other participants (meshes: [{from: participant.mesh}]), with materials
   std::vector<MeshRequest> requests_;
   std::vector<int> request_materials_;
-  void add_coupling_mesh(const std::string& name, const Mesh& mesh, int material);
+  std::vector<char> request_one_sided_;
+  void add_coupling_mesh(const std::string& name, const Mesh& mesh, int material,
+                         bool one_sided);
   int breakage_ = -1;  // hook index of the breakage model, -1: off
   // monitor_particles: the ids whose position and velocity are monitor quantities
   // particle.<id>.x|y|z|vx|vy|vz, the index where each was last found (ids are stable, indices

@@ -301,6 +301,7 @@ DemAdapter::DemAdapter(const SolverContext& context)
     for (const Node& m : c["meshes"].items()) {
       CouplingMesh cm;
       cm.name = m.string("name");
+      const bool one_sided = m.has("one_sided") && m.boolean("one_sided");
       for (const auto& other : meshes_dem_)
         if (other.name == cm.name) m["name"].fail("mesh name '" + cm.name + "' is used twice");
       Mesh mesh;
@@ -309,6 +310,7 @@ DemAdapter::DemAdapter(const SolverContext& context)
           if (r.name == cm.name) m["name"].fail("mesh name '" + cm.name + "' is used twice");
         requests_.push_back(MeshRequest{cm.name, m.string("from"), m["from"]});
         request_materials_.push_back(material_id(m["material"]));
+        request_one_sided_.push_back(one_sided ? 1 : 0);
         continue;
       }
       if (m.has("stl")) {
@@ -331,7 +333,7 @@ DemAdapter::DemAdapter(const SolverContext& context)
       } else {
         mesh = rectangle(m["rectangle"], cm.name);
       }
-      add_coupling_mesh(cm.name, mesh, material_id(m["material"]));
+      add_coupling_mesh(cm.name, mesh, material_id(m["material"]), one_sided);
     }
     // Every pair that can touch needs an interaction: particles with walls and meshes, and with
     // each other where two particles exist (or fragments will: breakage). A single particle never

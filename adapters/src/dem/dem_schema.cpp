@@ -121,6 +121,13 @@ std::shared_ptr<Spec> make_spec() {
                "participant.mesh of another participant (e.g. an FE interface face): its surface, "
                "handed over at set-up, becomes this contact mesh (follow its displacement through "
                "an exchange)");
+  mesh->boolean("one_sided",
+                "contacts from the outer side only, for the closed surface of a body (an FE "
+                "surface taken with from:, an STL with outward normals): a face pushes along its "
+                "outward normal, also a particle whose centre has passed behind it (less than its "
+                "radius deep), which two-sided contacts would push on through a thin plate; "
+                "edges and vertices touch from outside only (default false: two-sided, each "
+                "contact along centre - closest point)");
   mesh->one_of({"stl", "rectangle", "from"});
 
   auto breakage = std::make_shared<Spec>(

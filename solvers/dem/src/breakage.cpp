@@ -144,27 +144,37 @@ double Breakage::contact_energy(const System& system, std::size_t i, const int* 
     const double delta = r - (x - w.point).dot(w.normal);
     if (delta > 0.0) e += hertz(model.pair(p.material[i], w.material).e_star, r, delta);
   }
-  // the nearest active triangle of each mesh (listed: among the particle's candidates, which
-  // hold every triangle it can touch; a triangle taken out of the contacts touches nothing)
-  mesh_d2_.assign(system.mesh_count(), std::numeric_limits<double>::max());
+  // the deepest overlap with an active triangle of each mesh (listed: among the particle's
+  // candidates, which hold every triangle it can touch; a triangle taken out of the contacts
+  // touches nothing); two-sided: the nearest triangle's. One-sided (MeshContacts::evaluate()):
+  // a centre in front of any triangle within reach is outside the body (the deepest of those);
+  // a centre behind every one inside it (the shallowest face: the way out).
+  constexpr double none = -std::numeric_limits<double>::max();
+  mesh_overlap_.assign(system.mesh_count(), none);
+  mesh_inside_.assign(system.mesh_count(), std::numeric_limits<double>::max());
+  const auto deepest = [&](int m, int t) {
+    const TriangleMesh& mesh = system.mesh(m);
+    if (!mesh.triangle_active(t)) return;
+    bool behind = false;
+    const double delta = mesh.overlap(t, x, r, &behind);
+    if (behind)
+      mesh_inside_[m] = std::min(mesh_inside_[m], delta);
+    else if (delta > 0.0 || !mesh.one_sided())
+      mesh_overlap_[m] = std::max(mesh_overlap_[m], delta);
+  };
   if (listed) {
     const NeighborList& nl = system.neighbor_list();
-    for (const MeshCandidate* c = nl.mesh_candidates_begin(i); c != nl.mesh_candidates_end(i); ++c) {
-      const TriangleMesh& mesh = system.mesh(c->mesh);
-      if (!mesh.triangle_active(c->triangle)) continue;
-      mesh_d2_[c->mesh] =
-          std::min(mesh_d2_[c->mesh], (mesh.closest_point(c->triangle, x).point - x).squaredNorm());
-    }
+    for (const MeshCandidate* c = nl.mesh_candidates_begin(i); c != nl.mesh_candidates_end(i); ++c)
+      deepest(c->mesh, c->triangle);
   } else {
-    for (int m = 0; m < system.mesh_count(); ++m) {
-      const TriangleMesh& mesh = system.mesh(m);
-      for (int t = 0; t < mesh.triangle_count(); ++t)
-        if (mesh.triangle_active(t))
-          mesh_d2_[m] = std::min(mesh_d2_[m], (mesh.closest_point(t, x).point - x).squaredNorm());
-    }
+    for (int m = 0; m < system.mesh_count(); ++m)
+      for (int t = 0; t < system.mesh(m).triangle_count(); ++t) deepest(m, t);
   }
+  for (int m = 0; m < system.mesh_count(); ++m)
+    if (mesh_overlap_[m] <= 0.0 && mesh_inside_[m] != std::numeric_limits<double>::max())
+      mesh_overlap_[m] = mesh_inside_[m];
   for (int m = 0; m < system.mesh_count(); ++m) {
-    const double delta = r - std::sqrt(mesh_d2_[m]);
+    const double delta = mesh_overlap_[m];
     if (delta > 0.0) e += hertz(model.pair(p.material[i], system.mesh(m).material()).e_star, r, delta);
   }
   return e;

@@ -37,6 +37,8 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     int mesh, triangle, type, feature;
     TriangleClosestPoint cp;
     double dist2;
+    double delta;  // overlap
+    bool behind;   // one-sided mesh: the centre behind the face's plane
     Eigen::Vector3d normal;
   };
   // Order of preference: faces, edges, vertices, then by distance (the order of acceptance).
@@ -53,6 +55,7 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
   Candidate cand[max_candidates + 1];
   int nc = 0;
   int worst = -1;  // index of the least preferred kept candidate once the array is full
+  bool any_behind = false;
   const Eigen::Vector3d& x = q.x;
   const double r = q.r;
   for (int k = nl.mesh_offsets_[i]; k < nl.mesh_offsets_[i + 1]; ++k) {
@@ -71,13 +74,38 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
                     ? m.triangle_edges(mc.triangle)[c.cp.local_index]
                     : m.triangle(mc.triangle)[c.cp.local_index];
     const double dist = std::sqrt(c.dist2);
-    if (dist > 1e-12 * r) {
-      c.normal = (x - c.cp.point) / dist;
+    if (m.one_sided()) {
+      // (TriangleMesh::one_sided(): a face pushes along its outward normal, also a centre that
+      // has passed behind it; an edge or vertex touches only from the outer side of the plane)
+      const Eigen::Vector3d nt = m.normal(mc.triangle);
+      const double s = (x - c.cp.point).dot(nt);
+      c.behind = s < 0.0;
+      if (c.behind && c.type != TriangleClosestPoint::face) {
+        // behind the plane at an edge or vertex: no contact, unless the centre projects onto it
+        // (the edge between two coplanar triangles, reached from inside): a face contact
+        if (c.dist2 - s * s > 1e-12 * r * r) continue;
+        c.type = TriangleClosestPoint::face;
+        c.feature = mc.triangle;
+      }
+      if (c.type == TriangleClosestPoint::face) {
+        c.normal = nt;
+        c.delta = r - s;
+      } else {
+        c.normal = dist > 1e-12 * r ? ((x - c.cp.point) / dist).eval() : nt;
+        c.delta = r - dist;
+      }
+      any_behind = any_behind || c.behind;
     } else {
-      const auto& tri = m.triangle(mc.triangle);
-      c.normal = (m.position_[tri[1]] - m.position_[tri[0]])
-                     .cross(m.position_[tri[2]] - m.position_[tri[0]])
-                     .normalized();
+      c.behind = false;
+      c.delta = r - dist;
+      if (dist > 1e-12 * r) {
+        c.normal = (x - c.cp.point) / dist;
+      } else {
+        const auto& tri = m.triangle(mc.triangle);
+        c.normal = (m.position_[tri[1]] - m.position_[tri[0]])
+                       .cross(m.position_[tri[2]] - m.position_[tri[0]])
+                       .normalized();
+      }
     }
     if (nc < max_candidates) {
       ++nc;
@@ -94,6 +122,25 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
       for (int w = 1; w < max_candidates; ++w)
         if (before(cand[worst], cand[w])) worst = w;
     }
+  }
+  if (any_behind) {
+    // One-sided meshes: a centre in front of any feature of a mesh within reach is outside its
+    // body, and the faces it is behind are the far side of a thin part (a plate thinner than the
+    // radius): dropped. A centre behind all is inside the body and leaves through the nearest
+    // face (the shallowest: the body's signed distance), not through every face it is behind.
+    bool drop[max_candidates + 1] = {};
+    for (int c = 0; c < nc; ++c) {
+      if (!cand[c].behind) continue;
+      for (int o = 0; o < nc && !drop[c]; ++o) {
+        if (o == c || cand[o].mesh != cand[c].mesh) continue;
+        drop[c] = !cand[o].behind || cand[o].delta < cand[c].delta ||
+                  (cand[o].delta == cand[c].delta && o < c);
+      }
+    }
+    int kept = 0;
+    for (int c = 0; c < nc; ++c)
+      if (!drop[c]) cand[kept++] = cand[c];
+    nc = kept;
   }
   std::sort(cand, cand + nc, before);
   int accepted[max_contacts];
@@ -148,7 +195,7 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     if (from_old[a] >= 0) continue;
     const Candidate& k = cand[accepted[a]];
     const TriangleMesh& m = meshes[k.mesh];
-    double best = r * (r - std::sqrt(k.dist2));  // (contact radius)^2
+    double best = r * k.delta;  // (contact radius)^2
     for (int s = 0; s < n_old; ++s) {
       const MeshContactRecord& rec = records[s];
       if (old_taken[s] || rec.mesh != k.mesh) continue;
@@ -172,7 +219,7 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     const Eigen::Vector3d v_wall = k.cp.barycentric[0] * m.velocity_[tri[0]] +
                                    k.cp.barycentric[1] * m.velocity_[tri[1]] +
                                    k.cp.barycentric[2] * m.velocity_[tri[2]];
-    const double delta = r - std::sqrt(k.dist2);
+    const double delta = k.delta;
     const double cr = r - 0.5 * delta;
     const PairParameters& pp = model.pair(q.material, m.material());
     Eigen::Vector3d fw, ft;

@@ -395,6 +395,12 @@ void System::set_vertex_positions(int mesh, const Eigen::Ref<const Eigen::Matrix
   set_vertex_velocities(mesh, v);
 }
 
+void System::set_mesh_one_sided(int mesh, bool one_sided) {
+  check_mesh(mesh, "set_mesh_one_sided");
+  meshes_[mesh].set_one_sided(one_sided);
+  forces_valid_ = false;
+}
+
 void System::set_triangle_active(int mesh, int triangle, bool active) {
   check_mesh(mesh, "set_triangle_active");
   meshes_[mesh].set_triangle_active(triangle, active);

@@ -166,6 +166,25 @@ TriangleClosestPoint TriangleMesh::closest_point(int t, const Eigen::Vector3d& p
                                              position_[triangles_[t][2]]);
 }
 
+Eigen::Vector3d TriangleMesh::normal(int t) const {
+  const auto& tri = triangles_[t];
+  return (position_[tri[1]] - position_[tri[0]])
+      .cross(position_[tri[2]] - position_[tri[0]])
+      .normalized();
+}
+
+double TriangleMesh::overlap(int t, const Eigen::Vector3d& p, double r, bool* behind) const {
+  const TriangleClosestPoint cp = closest_point(t, p);
+  if (behind) *behind = false;
+  if (!one_sided_) return r - (p - cp.point).norm();
+  const double s = (p - cp.point).dot(normal(t));
+  if (s >= 0.0) return r - (p - cp.point).norm();
+  // behind the plane: a face (or the point projects onto the triangle's edge), < r deep
+  if ((p - cp.point).squaredNorm() - s * s > 1e-12 * r * r || s <= -r) return 0.0;
+  if (behind) *behind = true;
+  return r - s;
+}
+
 void TriangleMesh::write_state(BinaryWriter& out) const {
   out.value(static_cast<std::int64_t>(vertex_count()));
   out.value(static_cast<std::int64_t>(triangle_count()));

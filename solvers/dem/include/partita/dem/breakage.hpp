@@ -110,7 +110,8 @@ class Breakage final : public StepHook {
   std::vector<std::size_t> parents_, added_;            // scratch of crush()
   std::vector<System::Fragment> fragments_;             // (the same)
   std::vector<int> nb_offsets_, nb_items_;              // (the same: listed neighbours)
-  mutable std::vector<double> mesh_d2_;                 // (contact_energy(): per mesh)
+  mutable std::vector<double> mesh_overlap_;  // (contact_energy(): per mesh, from outside)
+  mutable std::vector<double> mesh_inside_;   // (per one-sided mesh: the way out from inside)
 };
 
 }  // namespace partita::dem

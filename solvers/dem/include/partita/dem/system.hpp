@@ -226,6 +226,8 @@ class System {
   void set_vertex_positions(int mesh, const Eigen::Ref<const Eigen::MatrixX3d>& positions,
                             const Eigen::Ref<const Eigen::MatrixX3d>& velocities);
   void set_vertex_velocities(int mesh, const Eigen::Ref<const Eigen::MatrixX3d>& velocities);
+  /// One-sided or two-sided contacts with a mesh: TriangleMesh::one_sided().
+  void set_mesh_one_sided(int mesh, bool one_sided);
   /// Takes a triangle out of (or back into) the contacts: TriangleMesh::triangle_active().
   void set_triangle_active(int mesh, int triangle, bool active);
   int mesh_count() const { return static_cast<int>(meshes_.size()); }

@@ -47,6 +47,25 @@ class TriangleMesh {
   void set_triangle_active(int t, bool active);
   int inactive_triangle_count() const { return inactive_; }
 
+  /// Whether the contacts are one-sided (off: two-sided, the default). Two-sided, a sphere
+  /// touches a triangle from either side and is pushed along centre - closest point. One-sided,
+  /// the mesh is the surface of a body (a closed FE surface: triangles counter-clockwise seen
+  /// from outside, the body behind them): a face contact pushes along the triangle's outward
+  /// normal with overlap r - s (s the centre's signed distance to its plane), so a sphere whose
+  /// centre has passed behind the face (less than its radius deep) is pushed back out instead
+  /// of on through; an edge or vertex touches only a centre on the outer side of the triangle's
+  /// plane (a centre inside the body meets the faces). A thin plate pressed harder than a
+  /// sphere's radius no longer lets it through.
+  bool one_sided() const { return one_sided_; }
+  void set_one_sided(bool on) { one_sided_ = on; }
+  /// Unit normal of triangle t (right-hand rule: outward for a one-sided mesh).
+  Eigen::Vector3d normal(int t) const;
+  /// Overlap of a sphere (centre p, radius r) with triangle t as a contact counts it, <= 0 for
+  /// none (two-sided: r - |p - closest point|; one-sided: see one_sided(), *behind set when the
+  /// centre is behind the face). Ignores whether the closest point is a local closest point of
+  /// the mesh and the choice among several faces a centre is behind (MeshContacts::evaluate()).
+  double overlap(int t, const Eigen::Vector3d& p, double r, bool* behind = nullptr) const;
+
   /// Closest point of triangle t to p (Ericson, Real-Time Collision Detection, 5.1.5).
   TriangleClosestPoint closest_point(int t, const Eigen::Vector3d& p) const;
 
@@ -104,6 +123,7 @@ class TriangleMesh {
   Eigen::MatrixX3d vertex_force_;
   int material_ = 0;
   bool velocity_from_motion_ = false;  // next step derives velocities from the displacement
+  bool one_sided_ = false;             // see one_sided()
 };
 
 }  // namespace partita::dem
