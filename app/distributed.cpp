@@ -12,10 +12,10 @@
 
 #include <fmt/format.h>
 
-#include "partita/run/remote_participant.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/participant_ranks.hpp"
+#include "partita/run/remote_participant.hpp"
 
 #ifdef PARTITA_MPI
 #include "partita/mpi/mpi_channel.hpp"
@@ -37,7 +37,9 @@ bool started_by_mpirun() {
 
 #ifndef PARTITA_MPI
 
-bool distributed_available() { return false; }
+bool distributed_available() {
+  return false;
+}
 
 int run_on_ranks(const coupling::Registries&, RanksOptions) {
   std::cerr << "partita: error: this process was started by mpirun with others, and this partita "
@@ -55,7 +57,9 @@ int run_distributed(const coupling::Registries&, DistributedOptions) {
 
 #else
 
-bool distributed_available() { return true; }
+bool distributed_available() {
+  return true;
+}
 
 int run_on_ranks(const coupling::Registries& registries, RanksOptions o) {
   int provided = 0;
@@ -144,70 +148,140 @@ int run_on_ranks(const coupling::Registries& registries, RanksOptions o) {
   return end(status, false);
 }
 
+// A process of a participant on several ranks other than its leader: builds that participant
+// alone (check-only: it writes nothing) and follows its leader until the leader's solver ends the
+// run. A failure of its own in the middle of the ranks' work together ends every process
+// (MPI_Abort) after its message; anything else is said by the leader or the controller.
+static int follow_leader(const coupling::Registries& registries, DistributedOptions& o,
+                         const mpi::Membership& m, const std::shared_ptr<ParticipantRanks>& ranks) {
+  run::RunOptions& ro = o.run;
+  ro.check_only = true;
+  ro.check_sweep_values = false;
+  ro.ranks = ranks;
+  if (log::get("app")->level() < spdlog::level::warn) log::set_level(spdlog::level::warn);
+  const std::string who = fmt::format("participant '{}' rank {} of {} (rank {} of the run)",
+                                      o.participant, m.local_rank, m.local_size, m.rank);
+  std::unique_ptr<run::CaseRun> c;
+  int status = 1;
+  try {
+    c = std::make_unique<run::CaseRun>(o.case_file, registries, ro);
+    if (o.install_stop_handlers) o.install_stop_handlers();
+    status = ranks->follow();
+  } catch (const std::exception& e) {
+    // the same set-up error as the leader's, which says it: only a failure of this rank's own
+    // while the ranks work together is said here (the leader may wait in vain)
+    if (ranks->broken()) {
+      const std::string what = dynamic_cast<const Error*>(&e) != nullptr
+                                   ? std::string(e.what())
+                                   : "internal error: " + std::string(e.what());
+      const std::string note = ranks->world_note();
+      std::cerr << ("partita: error: " + who + ": " + what +
+                    (what.find(note) == std::string::npos ? note : std::string()) + "\n")
+                << std::flush;
+      MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    status = 1;
+  }
+  c.reset();  // (the solver's transport before MPI_Finalize)
+  return status;
+}
+
 int run_distributed(const coupling::Registries& registries, DistributedOptions o) {
   int provided = 0;
   MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  auto logger = log::get("app");
   auto fail = [&](const std::string& what, bool stuck) {
-    std::cerr << "partita: error: " << what << "\n";
+    std::cerr << ("partita: error: " + what + "\n") << std::flush;
     if (stuck) MPI_Abort(MPI_COMM_WORLD, 1);  // a stuck peer would hold MPI_Finalize forever
     MPI_Finalize();
     return 1;
   };
 
-  // Who runs what (one process per participant: the solvers use threads, not MPI ranks).
+  // Who runs what: one process per participant, or several for a participant whose solver runs
+  // on ranks (its first process leads them; the controller and the others talk to the leader).
   mpi::Membership m;
   try {
-    m = mpi::join(MPI_COMM_WORLD, o.participant);
+    m = mpi::join(MPI_COMM_WORLD, o.participant, /*several=*/true);
   } catch (const Error& e) {
     return fail(e.what(), false);
   }
   const std::vector<std::string>& names = m.participants;
-  MPI_Comm participant_comm = m.participant_comm;
-
-  std::vector<std::unique_ptr<mpi::MpiChannel>> channels;
+  static MPI_Comm participant_comm = MPI_COMM_NULL;  // (ParticipantRanks points to it)
+  participant_comm = m.participant_comm;
+  std::shared_ptr<ParticipantRanks> ranks;
+  if (m.local_size > 1 || o.on_ranks) {
+    // a rank's wait for another is half the controller's for a participant (--peer-timeout), so
+    // that a stalled rank is named by its leader before the controller gives up on the leader
+    ranks = std::make_shared<ParticipantRanks>(m.local_rank, m.local_size, &participant_comm,
+                                               0.5 * o.peer_timeout);
+    ranks->set_world_ranks(m.world_ranks);
+  }
   run::RunOptions& ro = o.run;
   ro.distributed.participant = o.participant;
+  if (ranks && !ranks->leads()) {
+    const int status = follow_leader(registries, o, m, ranks);
+    MPI_Comm_free(&participant_comm);
+    MPI_Finalize();
+    return status;
+  }
+  ro.ranks = ranks;
+
+  std::vector<std::unique_ptr<mpi::MpiChannel> > channels;
   if (rank == 0) {
     for (int r = 1; r < m.size; ++r) {
+      if (!m.leads_other(r)) continue;  // (a follower of its participant's leader)
       channels.push_back(std::make_unique<mpi::MpiChannel>(
-          MPI_COMM_WORLD, r, fmt::format("participant '{}' (rank {})", names[r], r), o.peer_timeout));
+          MPI_COMM_WORLD, r, fmt::format("participant '{}' (rank {})", names[r], r),
+          o.peer_timeout));
       ro.distributed.servers.emplace_back(names[r], channels.back().get());
     }
   } else {
     channels.push_back(std::make_unique<mpi::MpiChannel>(
-        MPI_COMM_WORLD, 0, fmt::format("the controller, participant '{}' (rank 0)", names[0]), o.peer_timeout));
+        MPI_COMM_WORLD, 0, fmt::format("the controller, participant '{}' (rank 0)", names[0]),
+        o.peer_timeout));
     ro.distributed.controller = channels.back().get();
   }
   const std::string who = fmt::format("participant '{}' (rank {})", o.participant, rank);
   int status = 0;
   bool built = false;
+  std::unique_ptr<run::CaseRun> c;
+  // a participant on ranks: its other ranks end with this one (end(): the status; nothing where
+  // its solver has ended them); true when they cannot be told (MPI_Abort then)
+  auto end_ranks = [&](int with) {
+    if (!ranks || ranks->broken()) return ranks != nullptr;
+    try {
+      ranks->end(with);
+    } catch (...) {
+      ranks->set_broken();
+    }
+    return ranks->broken();
+  };
   try {
-    run::CaseRun c(o.case_file, registries, ro);
+    c = std::make_unique<run::CaseRun>(o.case_file, registries, ro);
     built = true;
     if (o.install_stop_handlers) o.install_stop_handlers();
-    c.run();
-    if (const int signal = c.summary().stopped_by_signal; signal != 0) {
+    c->run();
+    if (const int signal = c->summary().stopped_by_signal; signal != 0) {
       std::cout << "partita run: " << who << " stopped by signal " << signal;
-      if (rank == 0) std::cout << " after window " << c.summary().windows;
+      if (rank == 0) std::cout << " after window " << c->summary().windows;
       std::cout << "\n";
       status = 128 + signal;
-    } else if (rank == 0) {
-      if (o.on_finished) o.on_finished(c);
-    } else {
+    }
+    end_ranks(status);
+    if (status == 0 && rank == 0) {
+      if (o.on_finished) o.on_finished(*c);
+    } else if (status == 0) {
       std::cout << "partita run: " << who << " finished\n";
     }
   } catch (const std::exception& e) {
-    const bool stuck = dynamic_cast<const mpi::PeerTimeout*>(&e) != nullptr;
+    bool stuck = dynamic_cast<const mpi::PeerTimeout*>(&e) != nullptr;
     const std::string what = dynamic_cast<const Error*>(&e)
                                  ? std::string(e.what())
                                  : "internal error: " + std::string(e.what());
     if (rank == 0) {
       for (auto& ch : channels) run::abort_server(*ch, who + " stopped the run: " + what);
-    } else if (!built && !stuck &&
-               dynamic_cast<const run::StoppedByController*>(&e) == nullptr) {
+    } else if (!built && !stuck && dynamic_cast<const run::StoppedByController*>(&e) == nullptr) {
       // the controller waits for this process's hello or final meshes: tell it, and wait for its
       // answer so that it can name this failure before every process ends
       run::ParticipantServer(*channels.front()).fail_setup(what);
@@ -216,12 +290,23 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
       } catch (...) {
       }
     }
+    // the participant's other ranks: ended with status 1, or (a rank that failed or stopped
+    // answering in the middle of their work together) with every process
+    stuck = end_ranks(1) || stuck;
     for (auto& ch : channels) ch->drain(2.0);
     channels.clear();
+    std::string note = ranks ? ranks->world_note() : std::string();
+    if (!note.empty() && what.find(note) != std::string::npos) note.clear();  // (said)
+    if (stuck) {
+      std::cerr << ("partita: error: " + who + ": " + what + note + "\n") << std::flush;
+      MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    c.reset();
     MPI_Comm_free(&participant_comm);
-    return fail(who + ": " + what, stuck);
+    return fail(who + ": " + what + note, false);
   }
   channels.clear();
+  c.reset();
   MPI_Comm_free(&participant_comm);
   MPI_Finalize();
   return status;

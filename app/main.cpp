@@ -2,6 +2,8 @@
 //   partita run CASE.yaml [--output DIR] [--threads N] [--log-level L] [--resume DIR] [--no-plots]
 //   mpirun -n 1 partita run CASE --participant A : -n 1 partita run CASE --participant B
 //   mpirun -n N partita run CASE           (a case of one DEM participant, on N ranks)
+//   mpirun -n 1 partita run CASE --participant A : -n N partita run CASE --participant B
+//                                          (B, a DEM, on N ranks beside A)
 //   partita check CASE.yaml
 //   partita list
 //   partita docs [NAME]
@@ -32,15 +34,15 @@
 #include <omp.h>
 #endif
 
+#include "after_run.hpp"
+#include "distributed.hpp"
 #include "partita/adapters/mesh_files.hpp"
 #include "partita/adapters/register_all.hpp"
-#include "partita/run/case_run.hpp"
 #include "partita/coupling/registries.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/version.hpp"
-#include "after_run.hpp"
-#include "distributed.hpp"
+#include "partita/run/case_run.hpp"
 #include "plugin_loader.hpp"
 #include "process.hpp"
 #include "sweep_runner.hpp"
@@ -174,10 +176,15 @@ int main(int argc, char** argv) {
                   "(DIR/restart/w<window>.bin), bit for bit; time.end may be raised with --set");
   std::string participant;
   double peer_timeout = 600.0;
+  bool on_ranks = false;
   run->add_option("--participant", participant,
                   "Run only this participant, in this process, with the others in processes of "
-                  "their own (under mpirun, one process per participant: mpirun -n 1 partita run "
-                  "CASE --participant A : -n 1 partita run CASE --participant B)");
+                  "their own (under mpirun: mpirun -n 1 partita run CASE --participant A : -n 1 "
+                  "partita run CASE --participant B; a DEM participant may have several: -n 3)");
+  run->add_flag("--on-ranks", on_ranks,
+                "With --participant: run the participant on its processes' ranks even where it "
+                "has one (a DEM then steps its split bed, whose results are the same bytes on any "
+                "number of processes; more than one process gives the ranks anyway)");
   run->add_option("--peer-timeout", peer_timeout,
                   "With --participant, or on several ranks: the longest wait for another "
                   "process's message [s] (default 600): a stuck process ends the run after it")
@@ -267,6 +274,7 @@ int main(int argc, char** argv) {
       d.run = options;
       d.participant = participant;
       d.peer_timeout = peer_timeout;
+      d.on_ranks = on_ranks;
       d.stop_signal = &g_stop_signal;
       d.install_stop_handlers = install_stop_handlers;
       d.on_finished = [&](const partita::run::CaseRun& c) {
@@ -281,7 +289,8 @@ int main(int argc, char** argv) {
         (partita::app::distributed_available() || partita::app::started_with_others())) {
       if (!no_sweep && resume_dir.empty() && partita::app::has_sweep(case_file, overrides))
         throw partita::Error(
-            case_file + " has a sweep section, and this process was started by mpirun: a sweep "
+            case_file +
+            " has a sweep section, and this process was started by mpirun: a sweep "
             "runs its variants each in a process of its own (run it without mpirun), or give "
             "--no-sweep to run the case as written on the ranks");
       partita::app::RanksOptions r;

@@ -27,8 +27,9 @@ namespace {
 // What a split over ranks does not handle yet, asked of the solver at run time.
 [[noreturn]] void not_on_ranks(const std::string& participant, const std::string& what) {
   throw Error("dem '" + participant + "': " + what +
-              " is not yet on several ranks (mpirun -n N partita run CASE splits the bed over "
-              "N ranks); run this case in one process, without mpirun");
+              " is not yet on several ranks (the bed split over the processes mpirun gives the "
+              "participant); run it in one process (without mpirun, or -n 1 before its "
+              "--participant, without --on-ranks)");
 }
 
 }  // namespace
@@ -51,37 +52,57 @@ std::size_t DemAdapter::find(std::string_view mesh, bool* centres) const {
 }
 
 void DemAdapter::read(std::string_view mesh, std::string_view data, const Eigen::MatrixXd& values) {
-  if (on_ranks()) not_on_ranks(name_, "reading coupled data ('" + std::string(data) + "')");
   bool centres = false;
-  CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
-  if (centres && data == "attached") {
-    // every window, mostly unchanged: only the triangles whose state changes are set (setting
-    // one to its state is a no-op); a count that does not fit goes through the checked call
-    const dem::TriangleMesh& m = system_.mesh(cm.id);
-    const bool fits = values.rows() == m.triangle_count();
-    for (Eigen::Index t = 0; t < values.rows(); ++t) {
-      const bool active = values(t, 0) >= 0.5;
-      if (!fits || active != m.triangle_active(static_cast<int>(t)))
-        system_.set_triangle_active(cm.id, static_cast<int>(t), active);
-    }
-    return;
-  }
-  if (centres || data != "displacement")
+  const std::size_t k = find(mesh, &centres);
+  CouplingMesh& cm = meshes_dem_[k];
+  const bool attached = centres && data == "attached";
+  if (!attached && (centres || data != "displacement"))
     throw Error("dem '" + name_ + "' reads 'displacement' on mesh '" + cm.name +
                 "' and 'attached' on '" + cm.name + "_centres', not '" + std::string(data) +
                 "' on '" + std::string(mesh) + "'");
+  if (on_ranks()) {  // every rank's copy of the mesh alike (dem_ranks.cpp)
+    lead_read(k, attached ? OnRanks::kAttached : OnRanks::kDisplacement, values);
+    return;
+  }
+  if (attached) {
+    set_attached(cm, values);
+    return;
+  }
   // x = X + d: the vertices follow the other side's displacement (no allocation: same size).
   cm.positions = cm.reference + values;
   system_.set_vertex_positions(cm.id, cm.positions);
 }
 
+void DemAdapter::set_attached(const CouplingMesh& cm, const Eigen::MatrixXd& values) {
+  // every window, mostly unchanged: only the triangles whose state changes are set (setting
+  // one to its state is a no-op); a count that does not fit goes through the checked call
+  const dem::TriangleMesh& m = system_.mesh(cm.id);
+  const bool fits = values.rows() == m.triangle_count();
+  for (Eigen::Index t = 0; t < values.rows(); ++t) {
+    const bool active = values(t, 0) >= 0.5;
+    if (!fits || active != m.triangle_active(static_cast<int>(t)))
+      system_.set_triangle_active(cm.id, static_cast<int>(t), active);
+  }
+}
+
 void DemAdapter::write(std::string_view mesh, std::string_view data, Eigen::MatrixXd& values) {
-  if (on_ranks()) not_on_ranks(name_, "writing coupled data ('" + std::string(data) + "')");
   bool centres = false;
-  const CouplingMesh& cm = meshes_dem_[find(mesh, &centres)];
+  const std::size_t k = find(mesh, &centres);
+  const CouplingMesh& cm = meshes_dem_[k];
+  if (!centres && data != "force")
+    throw Error("dem '" + name_ + "' writes only 'force' on mesh '" + cm.name + "'");
+  if (centres && data != "force" && data != "traction")
+    throw Error("dem '" + name_ + "' writes 'force' and 'traction' on mesh '" + cm.name +
+                "_centres', not '" + std::string(data) + "'");
+  if (on_ranks()) {  // the forces summed over the ranks (dem_ranks.cpp)
+    lead_write(k,
+               !centres          ? OnRanks::kVertexForce
+               : data == "force" ? OnRanks::kTriangleForce
+                                 : OnRanks::kTraction,
+               values);
+    return;
+  }
   if (!centres) {
-    if (data != "force")
-      throw Error("dem '" + name_ + "' writes only 'force' on mesh '" + cm.name + "'");
     values = system_.vertex_forces(cm.id);
     return;
   }
@@ -330,6 +351,11 @@ void DemAdapter::receive_mesh(const std::string& name, const Mesh& mesh) {
                                 e.what());
       }
       if (!lost_margin_given_) lost_margin_ = default_lost_margin();
+      if (on_ranks()) {
+        // (the leader) the others add it alike; every rank cuts the bed once all are in
+        if (ranks_->ranks->leads()) lead_mesh(name, mesh);
+        if (++ranks_->meshes_received == requests_.size()) ranks_split();
+      }
       return;
     }
   throw Error("dem '" + name_ + "' asked for no mesh '" + name + "'");

@@ -20,10 +20,10 @@
 // M_centres (what it reads moves nothing).
 // Monitors: kinetic_energy [J], momentum_x|y|z [kg m/s] (sum m v: with the meshes' and walls'
 // forces and gravity, the impulse balance of a bed that is not at rest), the energy accounting
-// (dem::System::energies(), cumulative since the first step) friction_work, damping_work, breakage_energy, stiffening_work,
-// gravity_work, wall_work (all walls and meshes), M.work and <wall>.work [J], elastic_energy [J]
-// and energy_balance_error [-] (each a pass over the particles: computed when asked for),
-// M.force_x|y|z [N] (force of the particles on mesh M),
+// (dem::System::energies(), cumulative since the first step) friction_work, damping_work,
+// breakage_energy, stiffening_work, gravity_work, wall_work (all walls and meshes), M.work and
+// <wall>.work [J], elastic_energy [J] and energy_balance_error [-] (each a pass over the particles:
+// computed when asked for), M.force_x|y|z [N] (force of the particles on mesh M),
 // particle.<id>.x|y|z [m] and .vx|vy|vz [m/s] for the ids in monitor_particles,
 // <wall>.force_x|y|z [N] (a box wall: all its faces), <wall>.<face>.force_x|y|z [N] (each closed
 // face of a box wall, faces xmin..zmax), particles, contacts_per_particle; with `breakage`:
@@ -36,9 +36,10 @@
 // back bit for bit: <output>/<participant>.data at finalize() (and
 // <output>/particles/<participant>_<frame>.data at each output time).
 //
-// On several ranks (SolverContext::ranks: mpirun -n N partita run CASE, a DEM-only case): the bed
-// split over the ranks, one subdomain each, rank 0 leading the others (dem_ranks.cpp, which says
-// what is handled and what is refused).
+// On several ranks (SolverContext::ranks: mpirun -n N partita run CASE for a DEM-only case, or
+// -n N before --participant in a run of participants as processes): the bed split over the ranks,
+// one subdomain each, rank 0 leading the others (dem_ranks.cpp, which says what is handled and
+// what is refused). The coupled data are the same bits on any N.
 
 #include <array>
 #include <cstdint>
@@ -109,8 +110,8 @@ class DemAdapter : public Solver {
   struct Wall {
     std::string name;
     int id = -1;
-    unsigned faces = 0;  // a box wall: its closed faces (bit k: kFaces[k]); 0: a plane wall
-    bool moving = false;                                 // velocity from a table
+    unsigned faces = 0;   // a box wall: its closed faces (bit k: kFaces[k]); 0: a plane wall
+    bool moving = false;  // velocity from a table
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // times table(t)
     TimeTable table;
     // on several ranks, a servo's law applied by the adapter with the force summed over the
@@ -126,7 +127,8 @@ class DemAdapter : public Solver {
   void write_grading(const OutputFrame& frame) const;
   /// The particles as a LAMMPS data file (dem::LammpsData), written atomically.
   void write_particles_file(const std::filesystem::path& file) const;
-  void write_particles_file(const dem::Particles& particles, const std::filesystem::path& file) const;
+  void write_particles_file(const dem::Particles& particles,
+                            const std::filesystem::path& file) const;
 
   std::string name_;
   std::filesystem::path output_dir_;
@@ -165,8 +167,9 @@ class DemAdapter : public Solver {
   std::vector<MeshRequest> requests_;
   std::vector<int> request_materials_;
   std::vector<char> request_one_sided_;
-  void add_coupling_mesh(const std::string& name, const Mesh& mesh, int material,
-                         bool one_sided);
+  void add_coupling_mesh(const std::string& name, const Mesh& mesh, int material, bool one_sided);
+  /// read() of "attached" on M_centres: a triangle whose value is below 1/2 leaves the contacts.
+  void set_attached(const CouplingMesh& cm, const Eigen::MatrixXd& values);
   int breakage_ = -1;  // hook index of the breakage model, -1: off
   // monitor_particles: the ids whose position and velocity are monitor quantities
   // particle.<id>.x|y|z|vx|vy|vz, the index where each was last found (ids are stable, indices
@@ -176,13 +179,16 @@ class DemAdapter : public Solver {
   mutable std::vector<std::array<double, 6>> tracked_last_;
 
   // ---- on several ranks (dem_ranks.cpp): the bed split over the participant's ranks ----
-  struct OnRanks;  // dem_ranks.hpp
+  struct OnRanks;                   // dem_ranks.hpp
   std::unique_ptr<OnRanks> ranks_;  // null: one process (system_ holds the whole bed)
   bool on_ranks() const { return ranks_ != nullptr; }
   /// At the end of the constructor with SolverContext::ranks: refuses what a split does not
   /// handle yet (naming the key), keeps this rank's particles, sets up the stepper, claims the
   /// ranks.
   void setup_ranks(const SolverContext& context);
+  /// Cuts the bed into the ranks' boxes and sets up the stepper, on every rank alike, once every
+  /// mesh is in (at set-up, or after the last mesh taken from another participant).
+  void ranks_split();
   /// (rank 0) The command `bytes` to every other rank; (the others) the next command.
   void tell_others(const std::vector<std::byte>& bytes) const;
   std::vector<std::byte> next_command() const;
@@ -196,6 +202,15 @@ class DemAdapter : public Solver {
   void lead_particles_file(const std::filesystem::path& file);
   /// The restart stream resumed on every rank; the check of the state (empty: fine).
   std::string lead_resume(const std::string& stream, const std::string& source);
+  /// (the leader) A mesh taken from another participant, passed on to the others.
+  void lead_mesh(const std::string& name, const Mesh& mesh) const;
+  /// Coupled data of meshes_dem_[k]: read (the leader passes the values on ahead of its next
+  /// command; what: displacement 1, attached 2) and written (forces summed over the ranks; what:
+  /// vertex forces 3, triangle forces 4, tractions 5).
+  void lead_read(std::size_t k, std::uint32_t what, const Eigen::MatrixXd& values);
+  void ranks_read(std::size_t k, std::uint32_t what, const Eigen::MatrixXd& values);
+  void lead_write(std::size_t k, std::uint32_t what, Eigen::MatrixXd& values) const;
+  void ranks_write(std::size_t k, std::uint32_t what, Eigen::MatrixXd& values) const;
   /// What every rank does for a command (collective); each starts the stepper first if no
   /// command has (its first force pass, on every rank at the same command).
   void ranks_start() const;

@@ -1,5 +1,7 @@
-// The DEM adapter on several ranks: `mpirun -n N partita run CASE` for a case whose one
-// participant is a DEM (SolverContext::ranks, participant_ranks.hpp).
+// The DEM adapter on several ranks (SolverContext::ranks): `mpirun -n N partita run CASE` for a
+// case whose one participant is a DEM, or the DEM participant of a coupled case on the N processes
+// that follow its --participant (mpirun -n 1 partita run CASE --participant plate : -n N partita
+// run CASE --participant granules).
 //
 // The bed is split into N subdomains, one a rank (dem::SubdomainStepper over
 // dem::MpiSubdomainTransport; subdomain.hpp says why the split steps to the same bits on any N):
@@ -9,10 +11,14 @@
 // The decomposition's bounds are the domain's box (walls, meshes,
 // particles at the start) grown by 2 R_max + skin on every side, the same on every N: the global
 // order's grid, and so every sum, does not depend on N. The skin is the case's, or 10 % of the
-// largest radius (as one System's default).
+// largest radius (as one System's default). The cut waits for the meshes taken from another
+// participant (meshes: [{from: ...}]): they widen the domain (ranks_split()).
 //
-// Rank 0 is the run's: the run drives its adapter through the Solver contract, and the adapter
-// tells the others what to do (a command, through the transport) before doing it with them:
+// Rank 0 leads: the run (in one process, or the server a controller talks to) drives its adapter
+// through the Solver contract, and the adapter tells the others what to do (a command, through
+// the transport) before doing it with them:
+//   mesh             (set-up) a mesh taken from another participant, which the leader received:
+//                    every rank adds it alike (its one_sided flag from the case, as the leader's);
 //   advance dt       every rank steps its subdomain (walls moved by their tables alike);
 //   monitors groups  the sums the quantities asked for need, each an exact sum over the owned
 //                    particles rounded once (SubdomainStepper: kinetic energy, momentum, elastic
@@ -30,6 +36,16 @@
 //   particles file   (output.particles_file, at finalize(); every-output: with each frame) every
 //                    owned particle to rank 0, which writes them in the order of their ids (the
 //                    same file on any N);
+//   read             coupled data read: a mesh's displacement (every rank's System holds every
+//                    mesh whole and moves it alike) or its triangles' `attached` states (sent only
+//                    when they change); no message of its own: the leader applies it at once and
+//                    passes it on ahead of its next command, in the same message;
+//   write            coupled data written: the forces on a mesh's vertices or triangles (or the
+//                    tractions f / A) from SubdomainStepper's exact sums over the owned particles'
+//                    contacts, rounded once: the same bits on any N. After each step the vertex
+//                    forces of a mesh that a displacement moved are summed alike for the
+//                    interface-work audit (kept by the leader), so interface_work() is the same
+//                    bits on any N too;
 //   finish / end     the others' loop ends (finalize(): status 0; a failure on rank 0: the
 //                    status the app gives, end_others()).
 // The others run follow() (the loop the adapter claims the ranks with) until finish or end.
@@ -38,15 +54,14 @@
 // summed over the ranks (the hook on each rank's System would steer by that rank's part).
 //
 // Not handled on a split yet, refused at set-up naming the key: breakage (fragment ids unique over
-// the ranks, new particles' ghosts), the energy accounting, meshes taken from another participant
-// (the coupling); at
-// run time: a monitor quantity not listed above (none of the DEM's today: a guard for new ones),
-// coupled data, checkpoints.
+// the ranks, new particles' ghosts), the energy accounting; at run time: a monitor quantity not
+// listed above (none of the DEM's today: a guard for new ones), checkpoints (an implicit coupling
+// scheme: the split bed's state would have to be saved and restored on every rank).
 //
-// The split path gives the same bytes on every N, N = 1 under mpirun included. It is not the path
-// of one process without mpirun (one dem::System stepped whole): the split numbers the particles
-// by a global grid and sums forces on walls and meshes in exact sums, so the two differ in the
-// last bits, and so do their monitors (README, "A DEM-only case on N ranks").
+// The split path gives the same bytes on every N, N = 1 under mpirun (or --on-ranks) included. It
+// is not the path of one process without mpirun (one dem::System stepped whole): the split numbers
+// the particles by a global grid and sums forces on walls and meshes in exact sums, so the two
+// differ in the last bits, and so do their monitors (README, "A DEM-only case on N ranks").
 //
 // A failure: on rank 0 before a command (a refused quantity, a file it cannot write) the app ends
 // the others with end_others(); during a command on any rank (or a rank that does not answer
@@ -89,7 +104,10 @@ enum class Command : std::uint32_t {
   resume,
   finish,
   end,
-  particles_file
+  particles_file,
+  mesh,  // a mesh taken from another participant: name, points, triangles
+  read,  // coupled data read: mesh index, what (OnRanks::kDisplacement, kAttached), values
+  write  // coupled data written: mesh index, what (OnRanks::kVertexForce, ...)
 };
 
 // the monitor groups (what ranks_monitors() sums)
@@ -119,6 +137,16 @@ class Bytes {
     if (!s.empty()) std::memcpy(b_.data() + at, s.data(), s.size());
     return *this;
   }
+  /// rows (u64), cols (u64), then the values column by column (Eigen's storage)
+  template <class M>
+  Bytes& put_matrix(const M& m) {
+    put(static_cast<std::uint64_t>(m.rows())).put(static_cast<std::uint64_t>(m.cols()));
+    const std::size_t n = static_cast<std::size_t>(m.size()) * sizeof(typename M::Scalar);
+    const std::size_t at = b_.size();
+    b_.resize(at + n);
+    if (n) std::memcpy(b_.data() + at, m.data(), n);
+    return *this;
+  }
   std::vector<std::byte>& bytes() { return b_; }
 
  private:
@@ -143,6 +171,15 @@ class Reader {
     at_ += n;
     return s;
   }
+  template <class M>
+  void matrix(M& m) {
+    const auto rows = get<std::uint64_t>(), cols = get<std::uint64_t>();
+    const std::size_t n = rows * cols * sizeof(typename M::Scalar);
+    need(n);
+    m.resize(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(cols));
+    if (n) std::memcpy(m.data(), b_.data() + at_, n);
+    at_ += n;
+  }
   bool done() const { return at_ == b_.size(); }
 
  private:
@@ -166,49 +203,26 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
   const Node& c = context.config;
   const auto refuse = [&](const Node& key, const std::string& what) {
     key.fail(fmt::format(
-        "{} is not yet on several ranks (mpirun -n {} partita run splits the DEM bed over the "
-        "ranks); run this case in one process, without mpirun",
+        "{} is not yet on several ranks (the DEM's bed split over {} processes of mpirun); run "
+        "this participant in one process (mpirun -n 1, or without mpirun)",
         what, ranks->size()));
   };
   if (c.has("breakage")) refuse(c["breakage"], "breakage (fragments born at run time)");
   if (c.has("energy_accounting") && c.boolean("energy_accounting"))
     refuse(c["energy_accounting"], "the energy accounting");
-  for (const Node& m : c["meshes"].items())
-    if (m.has("from")) refuse(m["from"], "a mesh taken from another participant (coupling)");
 #ifndef PARTITA_DEM_MPI
   throw Error("dem '" + name_ +
               "': this partita was built without the DEM's MPI transport "
               "(partita::dem_mpi): it cannot run on several ranks");
 #else
+  if (system_.particles().size() == 0)
+    c["particles"].fail("a DEM on several ranks needs particles at the start");
   auto o = std::make_unique<OnRanks>();
   o->ranks = ranks;
-  const dem::Particles& p = system_.particles();
-  if (p.size() == 0) c["particles"].fail("a DEM on several ranks needs particles at the start");
-  double r_max = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    r_max = std::max(r_max, p.radius[i]);
-    o->mass += p.mass[i];
-  }
-  o->particles = static_cast<double>(p.size());
-  o->stable = stable_time_step();
-  o->skin = c.has("skin") ? c.real("skin") : 0.1 * r_max;
-  o->wall_force.assign(walls_.size(), Eigen::Vector3d::Zero());
-  std::array<Eigen::Vector3d, 6> none;
-  none.fill(Eigen::Vector3d::Zero());
-  o->face_force.assign(walls_.size(), none);
-  o->mesh_force.assign(meshes_dem_.size(), Eigen::Vector3d::Zero());
+  o->skin = c.has("skin") ? c.real("skin") : 0.0;
   try {
-    const Eigen::Vector3d pad = Eigen::Vector3d::Constant(2.0 * r_max + o->skin);
-    o->decomposition = dem::DomainDecomposition::bisection(p.position, domain_lo_ - pad,
-                                                           domain_hi_ + pad, ranks->size());
-    std::vector<char> elsewhere(p.size(), 0);
-    for (std::size_t i = 0; i < p.size(); ++i)
-      elsewhere[i] = o->decomposition.owner(p.position[i]) != ranks->rank();
-    system_.remove_particles(elsewhere);
     const MPI_Comm comm = *static_cast<const MPI_Comm*>(ranks->communicator());
     o->transport = std::make_unique<dem::MpiSubdomainTransport>(comm, ranks->deadline());
-    o->stepper = std::make_unique<dem::SubdomainStepper>(std::vector<dem::System*>{&system_},
-                                                         *o->transport, o->decomposition, o->skin);
   } catch (const dem::PeerTimeout& e) {
     ranks->set_broken();
     throw Error("dem '" + name_ + "' on rank " + std::to_string(ranks->rank()) + ": " + e.what());
@@ -219,14 +233,58 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
   o->out.assign(1, dem::SubdomainMail(size));
   o->in.assign(1, dem::SubdomainMail(size));
   ranks_ = std::move(o);
-  if (ranks->leads()) {
+  if (ranks->leads())
+    ranks->claim(nullptr, [this](int status) { end_others(status); });
+  else
+    ranks->claim([this] { return follow(); }, nullptr);
+  // the split waits for the meshes taken from other participants (they widen the domain, and
+  // their materials may lower the stable step): the leader receives them at the run's set-up and
+  // passes each on (Command::mesh), every rank adds it alike
+  if (requests_.empty()) ranks_split();
+#endif
+}
+
+// The bed cut into the ranks' boxes, once every mesh is in: the decomposition's bounds are the
+// domain's box grown by 2 R_max + skin, the same on every N. Every rank does it at the same point
+// (its construction, or the last requested mesh's arrival).
+void DemAdapter::ranks_split() {
+#ifdef PARTITA_DEM_MPI
+  OnRanks& o = *ranks_;
+  const ParticipantRanks& ranks = *o.ranks;
+  const dem::Particles& p = system_.particles();
+  double r_max = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    r_max = std::max(r_max, p.radius[i]);
+    o.mass += p.mass[i];
+  }
+  o.particles = static_cast<double>(p.size());
+  // (stable_time_step() in one process, over every particle: the set is fixed on ranks)
+  o.stable = time_step_fraction_ * system_.rayleigh_time_step();
+  if (!(o.skin > 0.0)) o.skin = 0.1 * r_max;  // (the case's, or as one System's default)
+  o.wall_force.assign(walls_.size(), Eigen::Vector3d::Zero());
+  std::array<Eigen::Vector3d, 6> none;
+  none.fill(Eigen::Vector3d::Zero());
+  o.face_force.assign(walls_.size(), none);
+  o.mesh_force.assign(meshes_dem_.size(), Eigen::Vector3d::Zero());
+  o.moved.assign(meshes_dem_.size(), 0);
+  o.attached.assign(meshes_dem_.size(), Eigen::MatrixXd());
+  try {
+    const Eigen::Vector3d pad = Eigen::Vector3d::Constant(2.0 * r_max + o.skin);
+    o.decomposition = dem::DomainDecomposition::bisection(p.position, domain_lo_ - pad,
+                                                          domain_hi_ + pad, ranks.size());
+    std::vector<char> elsewhere(p.size(), 0);
+    for (std::size_t i = 0; i < p.size(); ++i)
+      elsewhere[i] = o.decomposition.owner(p.position[i]) != ranks.rank();
+    system_.remove_particles(elsewhere);
+    o.stepper = std::make_unique<dem::SubdomainStepper>(std::vector<dem::System*>{&system_},
+                                                        *o.transport, o.decomposition, o.skin);
+  } catch (const dem::Error& e) {
+    throw Error(std::string("DEM model of participant '") + name_ + "' on ranks: " + e.what());
+  }
+  if (ranks.leads())
     log::get("adapters")
         ->info("dem '{}': on {} rank(s), {} particles on rank 0, skin {:.3g} m", name_,
-               ranks->size(), system_.particle_count(), ranks_->skin);
-    ranks->claim(nullptr, [this](int status) { end_others(status); });
-  } else {
-    ranks->claim([this] { return follow(); }, nullptr);
-  }
+               ranks.size(), system_.particle_count(), o.skin);
 #endif
 }
 
@@ -240,7 +298,8 @@ static auto together(ParticipantRanks& ranks, F&& f) {
     return f();
   } catch (const dem::Error& e) {
     ranks.set_broken();
-    throw Error("the DEM on rank " + std::to_string(ranks.rank()) + ": " + e.what());
+    throw Error("the DEM on rank " + std::to_string(ranks.rank()) + ": " + e.what() +
+                ranks.world_note());
   } catch (...) {
     ranks.set_broken();
     throw;
@@ -249,12 +308,19 @@ static auto together(ParticipantRanks& ranks, F&& f) {
 
 void DemAdapter::tell_others(const std::vector<std::byte>& bytes) const {
   OnRanks& o = *ranks_;
-  if (o.ranks->size() == 1) return;
-  for (std::size_t d = 0; d < o.out[0].size(); ++d)
-    if (d == 0)
-      o.out[0][d].clear();
-    else
-      o.out[0][d] = bytes;
+  if (o.ranks->size() == 1) {
+    o.pending.clear();
+    return;
+  }
+  // what read() took since the last command goes ahead of this one, in the same message
+  for (std::size_t d = 0; d < o.out[0].size(); ++d) {
+    std::vector<std::byte>& to = o.out[0][d];
+    to.clear();
+    if (d == 0) continue;
+    to.insert(to.end(), o.pending.begin(), o.pending.end());
+    to.insert(to.end(), bytes.begin(), bytes.end());
+  }
+  o.pending.clear();
   together(*o.ranks, [&] { o.transport->exchange(o.out, o.in); });
 }
 
@@ -274,47 +340,68 @@ int DemAdapter::follow() {
     for (;;) {
       const std::vector<std::byte> message = next_command();
       Reader in(message);
-      switch (static_cast<Command>(in.get<std::uint32_t>())) {
-        case Command::advance:
-          ranks_advance(in.get<double>());
-          break;
-        case Command::monitors:
-          ranks_monitors(in.get<std::uint32_t>());
-          break;
-        case Command::check:
-          ranks_check();
-          break;
-        case Command::output: {
-          OutputFrame f;
-          f.vtk_directory = in.string();
-          f.prefix = in.string();
-          f.index = in.get<int>();
-          f.time = in.get<double>();
-          f.vtk.format = in.get<vtk::Format>();
-          f.vtk.precision = in.get<vtk::Precision>();
-          f.vtk.zlib_level = in.get<int>();
-          f.vtk.block_size = in.get<std::size_t>();
-          ranks_output(f);
-          break;
+      while (!in.done()) switch (static_cast<Command>(in.get<std::uint32_t>())) {
+          case Command::advance:
+            ranks_advance(in.get<double>());
+            break;
+          case Command::monitors:
+            ranks_monitors(in.get<std::uint32_t>());
+            break;
+          case Command::check:
+            ranks_check();
+            break;
+          case Command::output: {
+            OutputFrame f;
+            f.vtk_directory = in.string();
+            f.prefix = in.string();
+            f.index = in.get<int>();
+            f.time = in.get<double>();
+            f.vtk.format = in.get<vtk::Format>();
+            f.vtk.precision = in.get<vtk::Precision>();
+            f.vtk.zlib_level = in.get<int>();
+            f.vtk.block_size = in.get<std::size_t>();
+            ranks_output(f);
+            break;
+          }
+          case Command::restart:
+            ranks_restart();
+            break;
+          case Command::resume:
+            ranks_resume(in.string());
+            ranks_check();
+            break;
+          case Command::particles_file:
+            ranks_particles_file(in.string());
+            break;
+          case Command::mesh: {
+            const std::string name = in.string();
+            Mesh::Points points;
+            Mesh::Triangles triangles;
+            in.matrix(points);
+            in.matrix(triangles);
+            receive_mesh(name, Mesh(name, std::move(points), std::move(triangles)));
+            break;
+          }
+          case Command::read: {
+            const auto k = in.get<std::uint64_t>();
+            const auto what = in.get<std::uint32_t>();
+            in.matrix(o.values);
+            ranks_read(k, what, o.values);
+            break;
+          }
+          case Command::write: {
+            const auto k = in.get<std::uint64_t>();
+            ranks_write(k, in.get<std::uint32_t>(), o.values);
+            break;
+          }
+          case Command::finish:
+            return 0;
+          case Command::end:
+            return in.get<int>();
+          default:
+            throw Error("dem '" + name_ + "' on rank " + std::to_string(o.ranks->rank()) +
+                        ": an unknown command from rank 0");
         }
-        case Command::restart:
-          ranks_restart();
-          break;
-        case Command::resume:
-          ranks_resume(in.string());
-          ranks_check();
-          break;
-        case Command::particles_file:
-          ranks_particles_file(in.string());
-          break;
-        case Command::finish:
-          return 0;
-        case Command::end:
-          return in.get<int>();
-        default:
-          throw Error("dem '" + name_ + "' on rank " + std::to_string(o.ranks->rank()) +
-                      ": an unknown command from rank 0");
-      }
     }
   });
 }
@@ -330,6 +417,78 @@ void DemAdapter::end_others(int status) {
   Bytes b(status == 0 ? Command::finish : Command::end);
   b.put(status);
   tell_others(b.bytes());
+}
+
+// ---- coupled data ----------------------------------------------------------------------------
+
+// A mesh handed over by another participant (the leader got it at the run's set-up): passed on
+// to the others, who add it alike (with the one_sided flag of their own, the same, case).
+void DemAdapter::lead_mesh(const std::string& name, const Mesh& mesh) const {
+  Bytes b(Command::mesh);
+  b.put(name).put_matrix(mesh.points()).put_matrix(mesh.triangles());
+  tell_others(b.bytes());
+}
+
+void DemAdapter::lead_read(std::size_t k, std::uint32_t what, const Eigen::MatrixXd& values) {
+  OnRanks& o = *ranks_;
+  if (what == OnRanks::kAttached && o.attached[k].rows() == values.rows() &&
+      o.attached[k].cols() == values.cols() && o.attached[k] == values)
+    return;  // (the same as the last: the triangles' states do not change)
+  if (what == OnRanks::kAttached) o.attached[k] = values;
+  // ahead of the next command (no message of its own)
+  Bytes b(Command::read);
+  b.put(static_cast<std::uint64_t>(k)).put(what).put_matrix(values);
+  o.pending.insert(o.pending.end(), b.bytes().begin(), b.bytes().end());
+  ranks_read(k, what, values);
+}
+
+// Every rank's System holds every mesh whole: each moves it (or sets its triangles' states)
+// alike, as one process does.
+void DemAdapter::ranks_read(std::size_t k, std::uint32_t what, const Eigen::MatrixXd& values) {
+  CouplingMesh& cm = meshes_dem_.at(k);
+  if (what == OnRanks::kAttached) {
+    set_attached(cm, values);
+    return;
+  }
+  if (values.rows() != cm.reference.rows() || values.cols() != 3)
+    throw Error(
+        fmt::format("dem '{}': the displacement of mesh '{}' has {} x {} values, not {} x 3", name_,
+                    cm.name, values.rows(), values.cols(), cm.reference.rows()));
+  cm.positions = cm.reference + values;
+  system_.set_vertex_positions(cm.id, cm.positions);
+  ranks_->moved[k] = 1;
+}
+
+void DemAdapter::lead_write(std::size_t k, std::uint32_t what, Eigen::MatrixXd& values) const {
+  Bytes b(Command::write);
+  b.put(static_cast<std::uint64_t>(k)).put(what);
+  tell_others(b.bytes());
+  ranks_write(k, what, values);
+}
+
+// The forces on a mesh summed over the ranks (SubdomainStepper: each vertex's an exact sum over
+// the owned particles' contacts, rounded once; the same bits on any N); collective. Before the
+// first step after a resume there is no pass whose forces they would be: zero (as the output's).
+void DemAdapter::ranks_write(std::size_t k, std::uint32_t what, Eigen::MatrixXd& values) const {
+  OnRanks& o = *ranks_;
+  ranks_start();
+  const CouplingMesh& cm = meshes_dem_.at(k);
+  const dem::TriangleMesh& tm = system_.mesh(cm.id);
+  together(*o.ranks, [&] {
+    if (what == OnRanks::kVertexForce) {
+      if (o.forces)
+        values = o.stepper->vertex_forces(cm.id);
+      else
+        values.setZero(static_cast<Eigen::Index>(tm.positions().size()), 3);
+      return;
+    }
+    if (o.forces)
+      values = o.stepper->triangle_forces(cm.id);
+    else
+      values.setZero(static_cast<Eigen::Index>(tm.triangle_count()), 3);
+    // t_i = f_i / A_i, as in one process
+    if (what == OnRanks::kTraction) values.array() = values.array().colwise() / cm.areas.array();
+  });
 }
 
 // ---- advance ---------------------------------------------------------------------------------
@@ -363,8 +522,8 @@ void DemAdapter::ranks_advance(double dt) {
     try {
       o.stepper->step(dt);
     } catch (const dem::Error& e) {
-      throw Error(fmt::format("dem '{}' on rank {} at t = {:.6g} s: {}", name_, o.ranks->rank(),
-                              system_.time(), e.what()));
+      throw Error(fmt::format("dem '{}' on rank {} at t = {:.6g} s: {}{}", name_, o.ranks->rank(),
+                              system_.time(), e.what(), o.ranks->world_note()));
     }
   });
   o.forces = true;
@@ -379,7 +538,16 @@ void DemAdapter::ranks_advance(double dt) {
         std::clamp(sp.gain * (sp.force + f.dot(sp.normal)), -sp.max_velocity, sp.max_velocity);
     system_.set_wall_velocity(w.id, v * sp.normal);
   }
-  // (the meshes do not move on ranks: no coupled data is read, so their work stays 0)
+  // the work the moving meshes did on the particles over this step, from their vertex forces
+  // summed over the ranks (collective: every rank asks; the leader keeps the audit). A mesh that
+  // no displacement has moved does no work (and costs no sum).
+  for (std::size_t k = 0; k < meshes_dem_.size(); ++k) {
+    if (!o.moved[k]) continue;
+    CouplingMesh& cm = meshes_dem_[k];
+    const Eigen::MatrixX3d* f = nullptr;
+    together(*o.ranks, [&] { f = &o.stepper->vertex_forces(cm.id); });
+    if (o.ranks->leads()) cm.audit.motion_step(cm.positions, *f);
+  }
   if (o.stepper->steps() % kBalanceEvery == 0) ranks_rebalance();
 }
 

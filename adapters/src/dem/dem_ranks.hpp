@@ -19,6 +19,9 @@
 namespace partita::adapters {
 
 struct DemAdapter::OnRanks {
+  // what a read or write of coupled data carries
+  static constexpr std::uint32_t kDisplacement = 1, kAttached = 2, kVertexForce = 3,
+                                 kTriangleForce = 4, kTraction = 5;
   std::shared_ptr<ParticipantRanks> ranks;
   std::unique_ptr<dem::SubdomainTransport> transport;  // MpiSubdomainTransport
   std::unique_ptr<dem::SubdomainStepper> stepper;      // over the adapter's System
@@ -36,6 +39,15 @@ struct DemAdapter::OnRanks {
   std::vector<Eigen::Vector3d> wall_force;                 // by walls_ index
   std::vector<std::array<Eigen::Vector3d, 6>> face_force;  // by walls_ index, face (a box's)
   std::vector<Eigen::Vector3d> mesh_force;                 // by meshes_dem_ index
+  // the coupled meshes (by meshes_dem_ index): whether a displacement was read (from then on
+  // every step adds the motion's work to the audit, from the forces summed over the ranks), and
+  // (the leader) the last `attached` values passed on (mostly unchanged: not sent again)
+  std::vector<char> moved;
+  std::vector<Eigen::MatrixXd> attached;
+  // (the leader) what read() took since the last command, passed on ahead of the next one
+  std::vector<std::byte> pending;
+  std::size_t meshes_received = 0;  // of the requested ones (the split waits for all)
+  Eigen::MatrixXd values;           // (the others) a read's or write's values
   // the transport's buffers (one local subdomain)
   std::vector<dem::SubdomainMail> out, in;
 };

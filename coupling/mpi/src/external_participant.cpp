@@ -310,6 +310,7 @@ void ExternalParticipant::initialize() {
                             std::to_string(m.rank) + ", an external program): " + e.what();
     if (m.rank == 0) {
       for (int r = 1; r < m.size; ++r) {
+        if (!m.leads_other(r)) continue;  // (the others follow their leader)
         MpiChannel other(b.options_.comm, r, "rank " + std::to_string(r), b.options_.peer_timeout);
         run::abort_server(other, why);
       }

@@ -15,37 +15,62 @@ constexpr int kTag = 7341;
 constexpr int kName = 256;
 }  // namespace
 
-Membership join(MPI_Comm comm, const std::string& participant) {
+Membership join(MPI_Comm comm, const std::string& participant, bool several) {
   Membership m;
   MPI_Comm_rank(comm, &m.rank);
   MPI_Comm_size(comm, &m.size);
-  std::vector<char> mine(kName, '\0'), all(static_cast<std::size_t>(kName) * m.size, '\0');
+  // each process's name, and whether it may share its participant with other processes (the
+  // name's buffer ends in that flag)
+  std::vector<char> mine(kName + 1, '\0'), all(static_cast<std::size_t>(kName + 1) * m.size, '\0');
   std::strncpy(mine.data(), participant.c_str(), kName - 1);
-  MPI_Allgather(mine.data(), kName, MPI_CHAR, all.data(), kName, MPI_CHAR, comm);
+  mine[kName] = several ? 1 : 0;
+  MPI_Allgather(mine.data(), kName + 1, MPI_CHAR, all.data(), kName + 1, MPI_CHAR, comm);
+  std::vector<char> shares(static_cast<std::size_t>(m.size));
+  for (int r = 0; r < m.size; ++r) {
+    const char* at = all.data() + static_cast<std::size_t>(r) * (kName + 1);
+    m.participants.emplace_back(at);
+    shares[static_cast<std::size_t>(r)] = at[kName];
+  }
+  // the first process of each participant leads it
+  for (int r = 0; r < m.size; ++r) {
+    int first = 0;
+    while (m.participants[first] != m.participants[r]) ++first;
+    m.leaders.push_back(first);
+  }
+  if (std::all_of(m.leaders.begin(), m.leaders.end(), [](int l) { return l == 0; }))
+    throw Error(
+        m.size < 2
+            ? "participant '" + participant +
+                  "': this process runs alone; start one process per participant with mpirun, "
+                  "e.g. mpirun -n 1 partita run CASE --participant A : -n 1 partita run CASE "
+                  "--participant B"
+            : fmt::format("all {} processes of the run are participant '{}'; start the other "
+                          "participants beside it, e.g. mpirun -n 1 partita run CASE "
+                          "--participant A : -n {} partita run CASE --participant {}",
+                          m.size, m.participants[0], m.size, m.participants[0]));
   for (int r = 0; r < m.size; ++r)
-    m.participants.emplace_back(all.data() + static_cast<std::size_t>(r) * kName);
-  if (m.size < 2)
-    throw Error("participant '" + participant +
-                "': this process runs alone; start one process per participant with mpirun, "
-                "e.g. mpirun -n 1 partita run CASE --participant A : -n 1 partita run CASE "
-                "--participant B");
+    if (m.leaders[r] != r && (!shares[r] || !shares[m.leaders[r]]))
+      throw Error(fmt::format(
+          "participant '{}' is run by the processes of rank {} and {}, and an external program "
+          "(partita::mpi::ExternalParticipant) runs one participant in one process; a partita "
+          "participant whose solver runs on several ranks (a DEM) may have several: -n K before "
+          "its --participant",
+          m.participants[r], m.leaders[r], r));
+  m.leader = m.leaders[m.rank];
+  MPI_Comm_split(comm, m.leader, m.rank, &m.participant_comm);
+  MPI_Comm_rank(m.participant_comm, &m.local_rank);
+  MPI_Comm_size(m.participant_comm, &m.local_size);
   for (int r = 0; r < m.size; ++r)
-    for (int q = r + 1; q < m.size; ++q)
-      if (m.participants[r] == m.participants[q])
-        throw Error(fmt::format(
-            "participant '{}' is run by the processes of rank {} and {}: each participant runs "
-            "in one process (it uses threads: --threads)",
-            m.participants[r], r, q));
-  int color = 0;
-  while (m.participants[color] != participant) ++color;
-  MPI_Comm_split(comm, color, m.rank, &m.participant_comm);
+    if (m.leaders[r] == m.leader) m.world_ranks.push_back(r);
   return m;
 }
 
 MpiChannel::MpiChannel(MPI_Comm comm, int rank, std::string name, double deadline)
     : comm_(comm), rank_(rank), name_(std::move(name)), deadline_(deadline) {}
 
-MpiChannel::~MpiChannel() { drain(2.0); }
+MpiChannel::~MpiChannel() {
+  drain(2.0);
+}
 
 void MpiChannel::send(std::string& bytes) {
   if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
@@ -102,7 +127,8 @@ void MpiChannel::receive(std::string& bytes, std::string_view what) {
   int count = 0;
   MPI_Get_count(&status, MPI_BYTE, &count);
   // (a buffer of the same size as the last message is not touched: no allocation, no filling)
-  if (bytes.size() != static_cast<std::size_t>(count)) bytes.resize(static_cast<std::size_t>(count));
+  if (bytes.size() != static_cast<std::size_t>(count))
+    bytes.resize(static_cast<std::size_t>(count));
   MPI_Recv(bytes.data(), count, MPI_BYTE, rank_, kTag, comm_, MPI_STATUS_IGNORE);
 }
 

@@ -124,6 +124,7 @@ CaseRun::CaseRun(const fs::path& case_file, const Registries& registries, RunOpt
     }
 
   build_participants(root);
+  if (follows()) return;  // the leader's solver drives this process's
   if (serves()) {  // the controller builds the rest; this process serves its participant
     if (root.has("coupling")) served_coupling_ = root["coupling"];  // (the mappers it runs)
     return;

@@ -106,7 +106,8 @@ void CaseRun::build_participants(const config::Node& root) {
             " participants needs a coupling section (scheme and exchanges); only a case with one "
             "participant runs without one");
 
-  if (options_.ranks && options_.ranks->size() > 1 && names.size() != 1)
+  if (options_.ranks && options_.ranks->size() > 1 && names.size() != 1 &&
+      options_.distributed.participant.empty())
     ps.fail(fmt::format(
         "this case has {} participants ({}) and runs on {} ranks (mpirun -n {}): a case of one "
         "participant runs on several ranks; run each participant in a process of its own, e.g. "
@@ -199,9 +200,21 @@ void CaseRun::build_participants(const config::Node& root) {
       log::get("coupling")
           ->info("set-up of participant '{}' ({}): {:.1f} s", name, entry.name, setup.seconds());
     if (!solver) pn.fail("solver '" + entry.name + "' could not be built");
+    if (ctx.ranks && ctx.ranks->size() > 1 && !ctx.ranks->claimed() &&
+        !options_.distributed.participant.empty())
+      pn["solver"].fail(fmt::format(
+          "participant '{}' runs on {} processes (-n {} before its --participant), and its solver "
+          "'{}' does not run on several ranks (a DEM does); give it one process: -n 1 partita run "
+          "CASE --participant {}",
+          name, ctx.ranks->size(), ctx.ranks->size(), entry.name, name));
     built.push_back(Built{name, pn, entry.name, std::move(solver)});
   }
 
+  if (follows()) {  // (kept alive: its solver follows the leader's, ParticipantRanks::follow())
+    participants_.push_back(std::make_unique<LocalParticipant>(
+        built.front().name, std::move(built.front().solver), Substeps{}));
+    return;
+  }
   if (serves()) {
     serve_handshake(built.front().solver, substeps, coupled);
     return;

@@ -1,14 +1,18 @@
 #pragma once
-// The processes one participant runs on: `mpirun -n N partita run CASE` for a case of one
-// participant gives that participant the N processes of mpirun (its ranks), through
-// SolverContext::ranks. Without it (null) a solver runs in its one process, as always.
+// The processes one participant runs on, through SolverContext::ranks: `mpirun -n N partita run
+// CASE` for a case of one participant gives it the N processes of mpirun (its ranks); in a run of
+// participants as processes, `mpirun -n 1 partita run CASE --participant plate : -n 3 partita run
+// CASE --participant granules` gives granules the three processes of its part of the line (the
+// first, its leader, is rank 0 here; world_ranks() maps them to the run's). Without it (null) a
+// solver runs in its one process, as always.
 //
-// Rank 0 leads: the run (the coupling core, the services, every file the run writes) lives in
-// its process and drives its solver through the Solver contract, as in one process. The solver
-// on rank 0 passes what the others must do on to them (its own messages, over the communicator);
-// every other rank builds the case alike (the same participant, the same solver set up from the
-// same section) and then only follows: the solver hands the app the loop that does so (claim()),
-// and the app runs it (follow()) until rank 0's solver says the run has ended.
+// Rank 0 leads: the run (the coupling core, the services, every file the run writes; or, as a
+// participant among processes, the server of this participant that the controller talks to)
+// lives in its process and drives its solver through the Solver contract, as in one process. The
+// solver on rank 0 passes what the others must do on to them (its own messages, over the
+// communicator); every other rank builds the case alike (the same participant, the same solver set
+// up from the same section) and then only follows: the solver hands the app the loop that does so
+// (claim()), and the app runs it (follow()) until rank 0's solver says the run has ended.
 //
 // A solver that does not run on several ranks leaves the handle alone; the app then refuses a run
 // on more than one rank, naming the participant and its solver.
@@ -16,9 +20,11 @@
 // The communicator is MPI's (an MPI_Comm, passed as a pointer to it so that interface/ does not
 // include mpi.h); only a solver built with MPI reads it.
 
+#include <cstddef>
 #include <functional>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace partita {
 
@@ -36,6 +42,28 @@ class ParticipantRanks {
   /// A pointer to the MPI_Comm of the participant's processes.
   const void* communicator() const { return communicator_; }
   double deadline() const { return deadline_; }
+
+  /// The run's rank (MPI_COMM_WORLD) of each of these ranks, where they are part of a larger run
+  /// (participants as processes); empty: they are the run's ranks.
+  void set_world_ranks(std::vector<int> world) { world_ = std::move(world); }
+  const std::vector<int>& world_ranks() const { return world_; }
+  /// For messages: how this participant's ranks map to the run's ("" where they are the same),
+  /// e.g. " (the participant's ranks 0, 1, 2 are ranks 1, 2, 3 of the run)".
+  std::string world_note() const {
+    bool same = true;
+    for (std::size_t r = 0; r < world_.size(); ++r) same = same && world_[r] == static_cast<int>(r);
+    if (same) return {};
+    std::string local, world;
+    for (std::size_t r = 0; r < world_.size(); ++r) {
+      if (r > 0) {
+        local.append(", ");
+        world.append(", ");
+      }
+      local.append(std::to_string(r));
+      world.append(std::to_string(world_[r]));
+    }
+    return " (the participant's ranks " + local + " are ranks " + world + " of the run)";
+  }
 
   /// The solver runs on these ranks. On a rank other than 0, `follow` is how it follows rank
   /// 0's solver: it returns the exit status when rank 0's solver ends the run (0 after a run
@@ -69,6 +97,7 @@ class ParticipantRanks {
   bool broken_ = false;
   std::function<int()> follow_;
   std::function<void(int)> end_;
+  std::vector<int> world_;
 };
 
 }  // namespace partita

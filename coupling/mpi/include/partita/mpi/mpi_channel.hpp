@@ -4,9 +4,13 @@
 //
 // Every process of the run (partita run --participant, or an external program through
 // ExternalParticipant) calls join() first, with the same communicator (MPI_COMM_WORLD by
-// default): it gathers every process's participant name, checks that each participant has one
-// process, and splits the communicator by participant. The process of rank 0 is the controller;
-// it has a channel to each other process, every other process one to rank 0.
+// default): it gathers every process's participant name and splits the communicator by
+// participant. A participant may run on several processes (mpirun ... : -n 3 partita run CASE
+// --participant granules) where its solver runs on ranks (a DEM; an external program has one
+// process): the first of them, its leader, is the one the others talk to; the rest follow the
+// leader over the participant's communicator (partita/interface/participant_ranks.hpp). The
+// process of rank 0 is the controller (and the leader of its own participant); it has a channel
+// to each other participant's leader, every other leader one to rank 0.
 
 #include <memory>
 #include <string>
@@ -15,8 +19,8 @@
 
 #include <mpi.h>
 
-#include "partita/run/remote_participant.hpp"
 #include "partita/interface/error.hpp"
+#include "partita/run/remote_participant.hpp"
 
 namespace partita::mpi {
 
@@ -31,13 +35,21 @@ struct Membership {
   int rank = 0;
   int size = 1;
   std::vector<std::string> participants;  ///< by rank
-  MPI_Comm participant_comm = MPI_COMM_NULL;  ///< this participant's processes (one today)
+  std::vector<int> leaders;  ///< by rank: the rank of the first process of its participant
+  int leader = 0;            ///< this participant's leader (the lowest rank that runs it)
+  /// This participant's processes, ordered by rank (the leader has rank 0 in it).
+  MPI_Comm participant_comm = MPI_COMM_NULL;
+  int local_rank = 0, local_size = 1;  ///< in participant_comm
+  std::vector<int> world_ranks;        ///< by local rank: the rank in `comm`
+  /// Whether rank r leads a participant other than the controller's (a peer of the controller).
+  bool leads_other(int r) const { return leaders[r] == r && leaders[r] != leaders[0]; }
 };
 
 /// Gather the participants' names over `comm` (collective: every process of the run calls it);
-/// throws partita::Error (on every process alike) where a participant has several processes or
-/// the run has one process only.
-Membership join(MPI_Comm comm, const std::string& participant);
+/// throws partita::Error (on every process alike) where the run has one participant only, or a
+/// participant has several processes and one of them does not allow it (`several`: false for an
+/// external program).
+Membership join(MPI_Comm comm, const std::string& participant, bool several = false);
 
 /// One peer: non-blocking sends (each message's buffer lives until its send completes, then is
 /// handed back to a later send() for the next message: no allocation once the buffers have

@@ -107,7 +107,11 @@ struct RunOptions {
   } distributed;
   /// The processes of `mpirun -n N partita run CASE` (participant_ranks.hpp): a case of one
   /// participant runs it on all of them (its solver gets them in SolverContext::ranks); a case
-  /// of several is refused on more than one. Null: one process.
+  /// of several is refused on more than one. With distributed.participant: that participant's
+  /// processes (a solver that does not take them is refused); on its leader (rank 0) the run
+  /// serves or controls as without ranks, on the others (check_only) it builds only that
+  /// participant, whose solver then follows its leader's (ParticipantRanks::follow()). Null: one
+  /// process.
   std::shared_ptr<ParticipantRanks> ranks = nullptr;
 };
 
@@ -134,6 +138,11 @@ class CaseRun {
   /// This process serves one participant for a controller in another process (run() answers
   /// its requests until the run ends).
   bool serves() const { return options_.distributed.controller != nullptr; }
+  /// This process runs one participant on several ranks and does not lead it: it builds only
+  /// that participant, for the app to follow the leader (ParticipantRanks::follow()).
+  bool follows() const {
+    return options_.ranks && !options_.ranks->leads() && !options_.distributed.participant.empty();
+  }
   const RunSummary& summary() const { return summary_; }
   double window_size() const { return window_size_; }
   std::int64_t window_count() const { return window_count_; }

@@ -1,0 +1,190 @@
+#!/usr/bin/env bash
+# A coupled case with the DEM participant on several ranks beside one FE process, run by ctest
+# (tests/CMakeLists.txt):
+#   coupled_ranks.sh PARTITA SCENARIO
+#
+#   mpirun -n 1 partita run CASE --participant plate : -n N partita run CASE --participant granules
+#
+# The case: cases/uniaxial_compaction/steel.yaml (explicit-serial, the granules subcycling under
+# the plate: displacements to the DEM's mesh, tractions back), shortened with --set.
+# Scenarios:
+#   identical   the granules on 1 (--on-ranks), 2 and 3 ranks: every CSV file (the monitors,
+#               coupling.csv with the interface work) the same bytes; the granules on 2 ranks with
+#               the controller leading them (granules first on the line): the same bytes again;
+#               the plate's reaction at the end pushes it up (granules.plate.force_z and
+#               plate.bottom.force_z > 0) and is of the order of the static load (10 kPa on
+#               4 cm^2 plus the plate's weight: plate.static_reaction_z, 4.06 N): within a factor
+#               of 3 of it; the split run's reaction within 1e-6 of the plain one-process DEM's
+#               (the split sums in another order: the last bits differ, the physics does not)
+#   resume      granules on 2 ranks to 0.6 ms with a restart file, resumed on 3 ranks to 1.2 ms,
+#               against written on 3 and resumed on 1: the same CSV bytes (a split bed's restart
+#               does not depend on the splits that write and read it; an uninterrupted run builds
+#               its neighbour lists on other steps, so it differs in the last bits: subdomain.hpp)
+#   stalled     the granules' rank 1 (rank 2 of the run) stopped (SIGSTOP) mid-run with
+#               --peer-timeout 3: every process ends within 15 s, non-zero, the message naming the
+#               participant's rank 1 and that it is rank 2 of the run
+#   killed      the granules' rank 2 (rank 3 of the run) killed (SIGKILL) mid-run: every process
+#               ends within 10 s, non-zero
+#   refused     the plate (a FE solver, which does not run on ranks) on 2 processes: refused
+#               before any window, naming the participant and its solver; an implicit scheme with
+#               the granules on 2 ranks: refused naming the checkpoint ("not yet on several
+#               ranks"); every process ended within 60 s
+# OpenMPI refuses to run as root unless told (CI runs as root); --oversubscribe: 4 processes on
+# fewer cores. One OpenMP thread a process, passive waits.
+set -uo pipefail
+P=$(realpath "$1")
+SCENARIO=$2
+HERE=$(cd "$(dirname "$0")" && pwd)
+CASE=$HERE/../../cases/uniaxial_compaction/steel.yaml
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 PARTITA_LOG_LEVEL=${PARTITA_LOG_LEVEL:-warn}
+export OMPI_MCA_rmaps_base_oversubscribe=1 PARTITA_NO_PLOTS=1 OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive
+MPIRUN=(mpirun --oversubscribe)
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+cd "$WORK"
+SHORT=(--set time.end=0.0015 --set output.every=5e-4)
+
+fail() { echo "FAILED: $*" >&2; exit 1; }
+
+# coupled N DIR [args...]: the plate in one process, the granules on N (1: --on-ranks), into DIR
+coupled() {
+  local n=$1 dir=$2 on=()
+  shift 2
+  [ "$n" -eq 1 ] && on=(--on-ranks)
+  local start=$(date +%s%N)
+  timeout 120 "${MPIRUN[@]}" -n 1 "$P" run "$CASE" -o "$dir" --threads 1 --participant plate "$@" : \
+    -n "$n" "$P" run "$CASE" -o "$dir" --threads 1 --participant granules "${on[@]}" "$@" > "$dir.log" 2>&1 ||
+    { local s=$?; cat "$dir.log" >&2; fail "the granules on $n rank(s) exited with $s"; }
+  echo "granules on $n rank(s): $((($(date +%s%N) - start) / 1000000)) ms"
+}
+
+# same DIR_A DIR_B: every CSV file of A in B, byte for byte (and as many)
+same() {
+  local a=$1 b=$2 f n=0
+  for f in "$a"/*.csv; do
+    cmp "$f" "$b/$(basename "$f")" || fail "$(basename "$f"): $a and $b differ"
+    n=$((n + 1))
+  done
+  [ "$n" -ge 2 ] || fail "$a holds $n CSV files"
+  [ "$(ls "$b"/*.csv | wc -l)" -eq "$n" ] || fail "$b holds other CSV files than $a"
+}
+
+# find_rank R: the pid of this test's partita process of rank R of the run
+find_rank() {
+  local p
+  for p in $(pgrep -x partita); do
+    [ "$(readlink /proc/"$p"/cwd)" = "$WORK" ] &&
+      tr '\0' '\n' < /proc/"$p"/environ 2> /dev/null | grep -qx "OMPI_COMM_WORLD_RANK=$1" && echo "$p"
+  done
+}
+
+# under_way DIR: wait for the run's second VTK frame
+under_way() {
+  for _ in $(seq 1 600); do
+    compgen -G "$1/vtk/*_000001.vt?" > /dev/null && return
+    sleep 0.05
+  done
+}
+
+case $SCENARIO in
+identical)
+  for n in 1 2 3; do coupled $n r$n "${SHORT[@]}"; done
+  same r1 r2
+  same r1 r3
+  # the controller leading the granules' ranks (the granules first on the line)
+  timeout 120 "${MPIRUN[@]}" -n 2 "$P" run "$CASE" -o c2 --threads 1 --participant granules "${SHORT[@]}" : \
+    -n 1 "$P" run "$CASE" -o c2 --threads 1 --participant plate "${SHORT[@]}" > c2.log 2>&1 ||
+    { cat c2.log >&2; fail "the controller leading the granules on 2 ranks"; }
+  same r1 c2
+  # the plain DEM in one process, for the physics
+  timeout 120 "${MPIRUN[@]}" -n 1 "$P" run "$CASE" -o plain --threads 1 --participant plate "${SHORT[@]}" : \
+    -n 1 "$P" run "$CASE" -o plain --threads 1 --participant granules "${SHORT[@]}" > plain.log 2>&1 ||
+    { cat plain.log >&2; fail "the plain run"; }
+  python3 - r3/reaction.csv plain/reaction.csv r3/coupling.csv << 'EOF' || fail "the reaction"
+import csv, sys
+def table(f):
+    rows = list(csv.reader(open(f)))
+    return {h.split(' [')[0]: k for k, h in enumerate(rows[0])}, [[float(v) for v in r] for r in rows[1:]]
+col, split = table(sys.argv[1])
+_, plain = table(sys.argv[2])
+windows = len(list(csv.reader(open(sys.argv[3])))) - 1
+assert windows == 150 and len(split) == windows + 1, (windows, len(split))
+end = split[-1]
+static = end[col['plate.static_reaction_z']]
+assert abs(static - 4.0616) < 1e-3, static  # 10 kPa x 4 cm^2 + 7850 x 0.8 cm^3 x 9.81
+for q in ('granules.plate.force_z', 'plate.bottom.force_z'):
+    f = end[col[q]]
+    assert 0.0 < f < 3.0 * static, (q, f, static)  # the granules hold the plate up
+    p = plain[-1][col[q]]
+    assert abs(f - p) <= 1e-6 * abs(p), (q, f, p)
+print('reaction at the end: %.4g N (static %.4g N), the plain DEM\'s to %.1e' %
+      (end[col['granules.plate.force_z']], static,
+       abs(end[col['granules.plate.force_z']] / plain[-1][col['granules.plate.force_z']] - 1)))
+EOF
+  echo "the CSV files of the granules on 1, 2 and 3 ranks (and led by the controller) are the same bytes"
+  ;;
+resume)
+  # resume W R DIR: written with the granules on W ranks to 0.6 ms, resumed on R to 1.2 ms
+  resume() {
+    local w=$1 r=$2 dir=$3 on=()
+    coupled "$w" "$dir" --set time.end=0.0006 --set output.every=2e-4 --set output.restart.at_end=true
+    [ "$r" -eq 1 ] && on=(--on-ranks)
+    local start=$(date +%s%N)
+    timeout 120 "${MPIRUN[@]}" -n 1 "$P" run "$CASE" --resume "$dir" --threads 1 --participant plate --set time.end=0.0012 --set output.every=2e-4 : \
+      -n "$r" "$P" run "$CASE" --resume "$dir" --threads 1 --participant granules "${on[@]}" --set time.end=0.0012 --set output.every=2e-4 > "$dir-2.log" 2>&1 ||
+      { cat "$dir-2.log" >&2; fail "resumed with the granules on $r rank(s)"; }
+    echo "resumed on $r rank(s): $((($(date +%s%N) - start) / 1000000)) ms"
+    [ "$(tail -n 1 "$dir/reaction.csv" | cut -d, -f1)" = 0.0012 ] || fail "$dir: the resumed run did not reach 1.2 ms"
+  }
+  resume 2 3 a
+  resume 3 1 b
+  same a b
+  echo "written on 2 ranks and resumed on 3, written on 3 and resumed on 1: the same bytes"
+  ;;
+stalled | killed)
+  if [ "$SCENARIO" = stalled ]; then victim_rank=2 sig=STOP limit=15; else victim_rank=3 sig=KILL limit=10; fi
+  timeout 120 "${MPIRUN[@]}" -n 1 "$P" run "$CASE" -o s --threads 1 --participant plate --peer-timeout 3 --set time.end=1 : \
+    -n 3 "$P" run "$CASE" -o s --threads 1 --participant granules --peer-timeout 3 --set time.end=1 > s.log 2>&1 &
+  run=$!
+  under_way s
+  victim=$(find_rank $victim_rank)
+  [ -n "$victim" ] || { kill $run; fail "no rank $victim_rank found"; }
+  start=$(date +%s)
+  kill -$sig "$victim"
+  wait $run
+  status=$?
+  took=$(($(date +%s) - start))
+  kill -CONT "$victim" 2> /dev/null
+  [ $status -ne 0 ] || fail "the run ended with status 0"
+  [ $took -le $limit ] || fail "the run ended $took s after SIG$sig to rank $victim_rank"
+  if [ "$SCENARIO" = stalled ]; then
+    grep 'partita: error' s.log | grep -q "rank 1 is stuck or gone" || { cat s.log >&2; fail "rank 1 is not named"; }
+    grep 'partita: error' s.log | grep -q "ranks 0, 1, 2 are ranks 1, 2, 3 of the run" ||
+      { cat s.log >&2; fail "the message does not say which of the run's ranks that is"; }
+  fi
+  echo "rank $victim_rank of the run SIG$sig: every process ended after $took s, status $status: $(grep -m1 'partita: error' s.log | cut -c1-200)..."
+  ;;
+refused)
+  start=$(date +%s)
+  timeout 60 "${MPIRUN[@]}" -n 2 "$P" run "$CASE" -o x --threads 1 --participant plate "${SHORT[@]}" : \
+    -n 1 "$P" run "$CASE" -o x --threads 1 --participant granules "${SHORT[@]}" > x.log 2>&1
+  status=$?
+  [ $status -ne 0 ] && [ $status -ne 124 ] || { cat x.log >&2; fail "the plate on 2 processes: exit status $status"; }
+  grep 'partita: error' x.log | grep -q "participant 'plate' runs on 2 processes.*solver 'fem' does not run on several ranks" ||
+    { cat x.log >&2; fail "the plate on 2 processes: not refused naming it and its solver"; }
+  ! grep -q "window 1/" x.log || fail "the plate on 2 processes: a window ran"
+  echo "the plate on 2 processes: refused in $(($(date +%s) - start)) s: $(grep -m1 'partita: error' x.log | cut -c1-160)..."
+  start=$(date +%s)
+  rubber=$HERE/../../cases/uniaxial_compaction/rubber-implicit.yaml
+  timeout 60 "${MPIRUN[@]}" -n 1 "$P" run "$rubber" -o y --threads 1 --participant plate --set time.end=1e-4 : \
+    -n 2 "$P" run "$rubber" -o y --threads 1 --participant granules --set time.end=1e-4 > y.log 2>&1
+  status=$?
+  [ $status -ne 0 ] && [ $status -ne 124 ] || { cat y.log >&2; fail "an implicit scheme on ranks: exit status $status"; }
+  grep 'partita: error' y.log | grep -q "checkpoint.*not yet on several ranks" ||
+    { cat y.log >&2; fail "an implicit scheme on ranks: not refused naming the checkpoint"; }
+  echo "an implicit scheme on ranks: refused in $(($(date +%s) - start)) s: $(grep -m1 'partita: error' y.log | cut -c1-200)..."
+  ;;
+*)
+  fail "unknown scenario $SCENARIO"
+  ;;
+esac
