@@ -15,7 +15,10 @@
 #               plate.bottom.force_z > 0) and is of the order of the static load (10 kPa on
 #               4 cm^2 plus the plate's weight: plate.static_reaction_z, 4.06 N): within a factor
 #               of 3 of it; the split run's reaction within 1e-6 of the plain one-process DEM's
-#               (the split sums in another order: the last bits differ, the physics does not)
+#               (the split sums in another order: the last bits differ, the physics does not);
+#               the plate's lower face handed to the granules as their mesh (from:, one_sided:
+#               true) with the vertices' forces back and the attached states read: the same bytes
+#               on 1, 2 and 3 ranks, the reaction within the same bounds
 #   resume      granules on 2 ranks to 0.6 ms with a restart file, resumed on 3 ranks to 1.2 ms,
 #               against written on 3 and resumed on 1: the same CSV bytes (a split bed's restart
 #               does not depend on the splits that write and read it; an uninterrupted run builds
@@ -43,6 +46,10 @@ WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 cd "$WORK"
 SHORT=(--set time.end=0.0015 --set output.every=5e-4)
+# the plate's lower face as the granules' mesh (instead of the STL), one-sided, with the
+# vertices' forces back (scale.yaml's route) and the faces' attached states read
+HANDED=(--set 'participants.granules.meshes=[{name: plate, from: plate.bottom, material: steel, one_sided: true}]'
+        --set 'coupling.exchanges=[{data: displacement, from: plate.bottom, to: granules.plate, mapper: nearest-neighbor}, {data: force, from: granules.plate, to: plate.bottom, mapper: nearest-neighbor}, {data: attached, from: plate.bottom_centres, to: granules.plate_centres, mapper: nearest-neighbor}]')
 
 fail() { echo "FAILED: $*" >&2; exit 1; }
 
@@ -122,6 +129,22 @@ print('reaction at the end: %.4g N (static %.4g N), the plain DEM\'s to %.1e' %
        abs(end[col['granules.plate.force_z']] / plain[-1][col['granules.plate.force_z']] - 1)))
 EOF
   echo "the CSV files of the granules on 1, 2 and 3 ranks (and led by the controller) are the same bytes"
+  # the plate's lower face handed to the granules as their contact mesh (from:, one-sided), the
+  # vertices' forces back and the faces' attached states read: the same bytes on 1, 2 and 3 ranks
+  for n in 1 2 3; do coupled $n h$n "${SHORT[@]}" "${HANDED[@]}"; done
+  same h1 h2
+  same h1 h3
+  python3 - h3/reaction.csv << 'EOF' || fail "the reaction on the handed-over face"
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+col = {h.split(' [')[0]: k for k, h in enumerate(rows[0])}
+end = [float(v) for v in rows[-1]]
+static = end[col['plate.static_reaction_z']]
+for q in ('granules.plate.force_z', 'plate.bottom.force_z'):
+    assert 0.0 < end[col[q]] < 3.0 * static, (q, end[col[q]], static)
+print('the handed-over face: reaction %.4g N at the end' % end[col['granules.plate.force_z']])
+EOF
+  echo "the handed-over face: the same bytes on 1, 2 and 3 ranks"
   ;;
 resume)
   # resume W R DIR: written with the granules on W ranks to 0.6 ms, resumed on R to 1.2 ms
