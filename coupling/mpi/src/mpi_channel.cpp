@@ -53,7 +53,7 @@ Membership join(MPI_Comm comm, const std::string& participant, bool several) {
       throw Error(fmt::format(
           "participant '{}' is run by the processes of rank {} and {}, and an external program "
           "(partita::mpi::ExternalParticipant) runs one participant in one process; a partita "
-          "participant whose solver runs on several ranks (a DEM) may have several: -n K before "
+          "participant whose solver runs on several ranks may have several: -n K before "
           "its --participant",
           m.participants[r], m.leaders[r], r));
   m.leader = m.leaders[m.rank];

@@ -204,7 +204,7 @@ void CaseRun::build_participants(const config::Node& root) {
         !options_.distributed.participant.empty())
       pn["solver"].fail(fmt::format(
           "participant '{}' runs on {} processes (-n {} before its --participant), and its solver "
-          "'{}' does not run on several ranks (a DEM does); give it one process: -n 1 partita run "
+          "'{}' does not run on several ranks; give it one process: -n 1 partita run "
           "CASE --participant {}",
           name, ctx.ranks->size(), ctx.ranks->size(), entry.name, name));
     built.push_back(Built{name, pn, entry.name, std::move(solver)});

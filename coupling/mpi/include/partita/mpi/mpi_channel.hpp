@@ -6,7 +6,7 @@
 // ExternalParticipant) calls join() first, with the same communicator (MPI_COMM_WORLD by
 // default): it gathers every process's participant name and splits the communicator by
 // participant. A participant may run on several processes (mpirun ... : -n 3 partita run CASE
-// --participant granules) where its solver runs on ranks (a DEM; an external program has one
+// --participant granules) where its solver runs on ranks (an external program has one
 // process): the first of them, its leader, is the one the others talk to; the rest follow the
 // leader over the participant's communicator (partita/interface/participant_ranks.hpp). The
 // process of rank 0 is the controller (and the leader of its own participant); it has a channel
