@@ -263,6 +263,11 @@ int main(int argc, char** argv) {
       else
         partita::log::get("app")->debug("plots: not drawn (--no-plots or PARTITA_NO_PLOTS)");
     };
+    if (on_ranks && participant.empty())
+      throw partita::Error(
+          "--on-ranks gives a participant of a run of participants as processes its ranks "
+          "(with --participant NAME); a case of one participant runs on the ranks of mpirun "
+          "without it: mpirun -n N partita run CASE");
     if (!participant.empty()) {
       if (!no_sweep && resume_dir.empty() && partita::app::has_sweep(case_file, overrides))
         throw partita::Error(
