@@ -25,7 +25,8 @@
 #               its neighbour lists on other steps, so it differs in the last bits: subdomain.hpp)
 #   stalled     the granules' rank 1 (rank 2 of the run) stopped (SIGSTOP) mid-run with
 #               --peer-timeout 3: every process ends within 15 s, non-zero, the message naming the
-#               participant's rank 1 and that it is rank 2 of the run
+#               participant's rank 1 and that it is rank 2 of the run; the same for the granules'
+#               leader (rank 0, rank 1 of the run), named by the others
 #   killed      the granules' rank 2 (rank 3 of the run) killed (SIGKILL) mid-run: every process
 #               ends within 10 s, non-zero
 #   refused     the plate (a FE solver, which does not run on ranks) on 2 processes: refused
@@ -165,27 +166,40 @@ resume)
   echo "written on 2 ranks and resumed on 3, written on 3 and resumed on 1: the same bytes"
   ;;
 stalled | killed)
-  if [ "$SCENARIO" = stalled ]; then victim_rank=2 sig=STOP limit=15; else victim_rank=3 sig=KILL limit=10; fi
-  timeout 120 "${MPIRUN[@]}" -n 1 "$P" run "$CASE" -o s --threads 1 --participant plate --peer-timeout 3 --set time.end=1 : \
-    -n 3 "$P" run "$CASE" -o s --threads 1 --participant granules --peer-timeout 3 --set time.end=1 > s.log 2>&1 &
-  run=$!
-  under_way s
-  victim=$(find_rank $victim_rank)
-  [ -n "$victim" ] || { kill $run; fail "no rank $victim_rank found"; }
-  start=$(date +%s)
-  kill -$sig "$victim"
-  wait $run
-  status=$?
-  took=$(($(date +%s) - start))
-  kill -CONT "$victim" 2> /dev/null
-  [ $status -ne 0 ] || fail "the run ended with status 0"
-  [ $took -le $limit ] || fail "the run ended $took s after SIG$sig to rank $victim_rank"
-  if [ "$SCENARIO" = stalled ]; then
-    grep 'partita: error' s.log | grep -q "rank 1 is stuck or gone" || { cat s.log >&2; fail "rank 1 is not named"; }
+  # stop RANK SIG LIMIT: rank RANK of the run sent SIG mid-run; every process ends within LIMIT s
+  stop() {
+    local victim_rank=$1 sig=$2 limit=$3
+    rm -rf s
+    timeout 120 "${MPIRUN[@]}" -n 1 "$P" run "$CASE" -o s --threads 1 --participant plate --peer-timeout 3 --set time.end=1 : \
+      -n 3 "$P" run "$CASE" -o s --threads 1 --participant granules --peer-timeout 3 --set time.end=1 > s.log 2>&1 &
+    local run=$!
+    under_way s
+    local victim=$(find_rank "$victim_rank")
+    [ -n "$victim" ] || { kill $run; fail "no rank $victim_rank found"; }
+    local start=$(date +%s)
+    kill -"$sig" "$victim"
+    wait $run
+    local status=$?
+    local took=$(($(date +%s) - start))
+    kill -CONT "$victim" 2> /dev/null
+    [ $status -ne 0 ] || fail "the run ended with status 0"
+    [ $took -le "$limit" ] || fail "the run ended $took s after SIG$sig to rank $victim_rank"
+    echo "rank $victim_rank of the run SIG$sig: every process ended after $took s, status $status: $(grep -m1 'partita: error' s.log | cut -c1-200)..."
+  }
+  # named (SIGSTOP): 1 is the participant's rank, "ranks 0, 1, 2 are ranks 1, 2, 3 of the run"
+  named() {
+    grep 'partita: error' s.log | grep -q "rank $1 is stuck or gone" || { cat s.log >&2; fail "rank $1 is not named"; }
     grep 'partita: error' s.log | grep -q "ranks 0, 1, 2 are ranks 1, 2, 3 of the run" ||
       { cat s.log >&2; fail "the message does not say which of the run's ranks that is"; }
+  }
+  if [ "$SCENARIO" = stalled ]; then
+    stop 2 STOP 15  # the granules' rank 1: its leader names it
+    named 1
+    stop 1 STOP 15  # the granules' leader: the others name it
+    named 0
+  else
+    stop 3 KILL 10  # the granules' rank 2
   fi
-  echo "rank $victim_rank of the run SIG$sig: every process ended after $took s, status $status: $(grep -m1 'partita: error' s.log | cut -c1-200)..."
   ;;
 refused)
   start=$(date +%s)
