@@ -22,18 +22,6 @@
 
 namespace partita::adapters {
 
-namespace {
-
-// What a split over ranks does not handle yet, asked of the solver at run time.
-[[noreturn]] void not_on_ranks(const std::string& participant, const std::string& what) {
-  throw Error("dem '" + participant + "': " + what +
-              " is not yet on several ranks (the bed split over the processes mpirun gives the "
-              "participant); run it in one process (without mpirun, or -n 1 before its "
-              "--participant, without --on-ranks)");
-}
-
-}  // namespace
-
 DemAdapter::~DemAdapter() = default;
 
 const dem::Breakage* DemAdapter::breakage() const {
@@ -172,19 +160,24 @@ std::optional<double> DemAdapter::interface_work(std::string_view mesh) const {
 }
 
 void DemAdapter::save_checkpoint() {
-  if (on_ranks()) not_on_ranks(name_, "a checkpoint (an implicit coupling scheme)");
-  checkpoint_ = system_.save_state();
+  if (on_ranks())
+    ranks_->checkpoint = lead_restart();  // the split bed gathered to the leader (dem_ranks.cpp)
+  else
+    checkpoint_ = system_.save_state();
   for (auto& cm : meshes_dem_) cm.audit.save_checkpoint();
   has_checkpoint_ = true;
 }
 
 void DemAdapter::restore_checkpoint() {
-  if (on_ranks()) not_on_ranks(name_, "a checkpoint (an implicit coupling scheme)");
   if (!has_checkpoint_)
     throw Error("dem '" + name_ + "': restore_checkpoint() before save_checkpoint()");
-  system_.restore_state(checkpoint_);
+  if (on_ranks()) {
+    lead_restore(ranks_->checkpoint);
+  } else {
+    system_.restore_state(checkpoint_);
+    stable_for_count_ = kNoCount;
+  }
   for (auto& cm : meshes_dem_) cm.audit.restore_checkpoint();
-  stable_for_count_ = kNoCount;
 }
 
 void DemAdapter::write_output(const OutputFrame& frame) {

@@ -202,6 +202,8 @@ class DemAdapter : public Solver {
   void lead_particles_file(const std::filesystem::path& file);
   /// The restart stream resumed on every rank; the check of the state (empty: fine).
   std::string lead_resume(const std::string& stream, const std::string& source);
+  /// (restore_checkpoint()) The split bed of save_checkpoint() resumed on every rank.
+  void lead_restore(const std::string& stream);
   /// (the leader) A mesh taken from another participant, passed on to the others.
   void lead_mesh(const std::string& name, const Mesh& mesh) const;
   /// Coupled data of meshes_dem_[k]: read (the leader passes the values on ahead of its next

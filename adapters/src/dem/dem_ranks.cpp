@@ -46,6 +46,9 @@
 //                    forces of a mesh that a displacement moved are summed alike for the
 //                    interface-work audit (kept by the leader), so interface_work() is the same
 //                    bits on any N too;
+//   restore stream   (restore_checkpoint(): an implicit scheme's next iteration) the split bed that
+//                    save_checkpoint() gathered (a restart stream, `restart` above) resumed on
+//                    every rank, as a restart file is: the same bits on any N;
 //   finish / end     the others' loop ends (finalize(): status 0; a failure on rank 0: the
 //                    status the app gives, end_others()).
 // The others run follow() (the loop the adapter claims the ranks with) until finish or end.
@@ -55,8 +58,7 @@
 //
 // Not handled on a split yet, refused at set-up naming the key: breakage (fragment ids unique over
 // the ranks, new particles' ghosts), the energy accounting; at run time: a monitor quantity not
-// listed above (none of the DEM's today: a guard for new ones), checkpoints (an implicit coupling
-// scheme: the split bed's state would have to be saved and restored on every rank).
+// listed above (none of the DEM's today: a guard for new ones).
 //
 // The split path gives the same bytes on every N, N = 1 under mpirun (or --on-ranks) included. It
 // is not the path of one process without mpirun (one dem::System stepped whole): the split numbers
@@ -105,9 +107,10 @@ enum class Command : std::uint32_t {
   finish,
   end,
   particles_file,
-  mesh,  // a mesh taken from another participant: name, points, triangles
-  read,  // coupled data read: mesh index, what (OnRanks::kDisplacement, kAttached), values
-  write  // coupled data written: mesh index, what (OnRanks::kVertexForce, ...)
+  restore,  // a checkpoint's split bed resumed (an implicit scheme's next iteration)
+  mesh,     // a mesh taken from another participant: name, points, triangles
+  read,     // coupled data read: mesh index, what (OnRanks::kDisplacement, kAttached), values
+  write     // coupled data written: mesh index, what (OnRanks::kVertexForce, ...)
 };
 
 // the monitor groups (what ranks_monitors() sums)
@@ -369,6 +372,10 @@ int DemAdapter::follow() {
           case Command::resume:
             ranks_resume(in.string());
             ranks_check();
+            break;
+          case Command::restore:
+            ranks_resume(in.string());
+            o.attached.assign(meshes_dem_.size(), Eigen::MatrixXd());
             break;
           case Command::particles_file:
             ranks_particles_file(in.string());
@@ -974,6 +981,18 @@ std::string DemAdapter::lead_resume(const std::string& stream, const std::string
   tell_others(b.bytes());
   ranks_resume(stream);
   return ranks_check();
+}
+
+// A checkpoint (an implicit scheme) is the split bed as a restart stream (save_checkpoint():
+// lead_restart(), gathered to the leader); restoring it resumes it on every rank, as a restart
+// file does: the same bits on any N (SplitRestart). The triangles' states come back with the
+// world, so the next `attached` values are passed on whatever the last ones were.
+void DemAdapter::lead_restore(const std::string& stream) {
+  Bytes b(Command::restore);
+  b.put(stream);
+  tell_others(b.bytes());
+  ranks_resume(stream);
+  ranks_->attached.assign(meshes_dem_.size(), Eigen::MatrixXd());
 }
 
 void DemAdapter::ranks_resume(const std::string& stream) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -48,6 +49,7 @@ struct DemAdapter::OnRanks {
   std::vector<std::byte> pending;
   std::size_t meshes_received = 0;  // of the requested ones (the split waits for all)
   Eigen::MatrixXd values;           // (the others) a read's or write's values
+  std::string checkpoint;           // (the leader) the split bed at save_checkpoint()
   // the transport's buffers (one local subdomain)
   std::vector<dem::SubdomainMail> out, in;
 };
