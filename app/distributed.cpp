@@ -279,7 +279,13 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
     const std::string what = dynamic_cast<const Error*>(&e)
                                  ? std::string(e.what())
                                  : "internal error: " + std::string(e.what());
+    std::string note = ranks ? ranks->world_note() : std::string();
+    if (!note.empty() && what.find(note) != std::string::npos) note.clear();  // (said)
+    bool said = false;
     if (rank == 0) {
+      // said before the others hear of it (one of them may end every process at once)
+      std::cerr << ("partita: error: " + who + ": " + what + note + "\n") << std::flush;
+      said = true;
       for (auto& ch : channels) run::abort_server(*ch, who + " stopped the run: " + what);
     } else if (!built && !stuck && dynamic_cast<const run::StoppedByController*>(&e) == nullptr) {
       // the controller waits for this process's hello or final meshes: tell it, and wait for its
@@ -291,19 +297,18 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
       }
     }
     // the participant's other ranks: ended with status 1, or (a rank that failed or stopped
-    // answering in the middle of their work together) with every process
+    // answering in the middle of their work together) with every process; so too where the
+    // set-up failed after the solver claimed the ranks (the others follow a solver that is gone)
     stuck = end_ranks(1) || stuck;
+    if (!built && ranks && ranks->size() > 1 && ranks->claimed()) stuck = true;
     for (auto& ch : channels) ch->drain(2.0);
     channels.clear();
-    std::string note = ranks ? ranks->world_note() : std::string();
-    if (!note.empty() && what.find(note) != std::string::npos) note.clear();  // (said)
-    if (stuck) {
-      std::cerr << ("partita: error: " + who + ": " + what + note + "\n") << std::flush;
-      MPI_Abort(MPI_COMM_WORLD, 1);
-    }
+    if (!said) std::cerr << ("partita: error: " + who + ": " + what + note + "\n") << std::flush;
+    if (stuck) MPI_Abort(MPI_COMM_WORLD, 1);
     c.reset();
     MPI_Comm_free(&participant_comm);
-    return fail(who + ": " + what + note, false);
+    MPI_Finalize();
+    return 1;
   }
   channels.clear();
   c.reset();

@@ -35,7 +35,10 @@
 #               than one iteration (a checkpoint was restored)
 #   refused     the plate (a FE solver, which does not run on ranks) on 2 processes: refused
 #               before any window, naming the participant and its solver, every process ended
-#               within 60 s
+#               within 60 s; a surface the plate does not have (from: plate.nothere) with the
+#               granules on 3 ranks, refused by the controller in the handshake while the
+#               granules' ranks follow their leader: every process ends within 30 s (not after
+#               --peer-timeout), the controller's message first
 # OpenMPI refuses to run as root unless told (CI runs as root); --oversubscribe: 4 processes on
 # fewer cores. One OpenMP thread a process, passive waits.
 set -uo pipefail
@@ -240,6 +243,21 @@ refused)
     { cat x.log >&2; fail "the plate on 2 processes: not refused naming it and its solver"; }
   ! grep -q "window 1/" x.log || fail "the plate on 2 processes: a window ran"
   echo "the plate on 2 processes: refused in $(($(date +%s) - start)) s: $(grep -m1 'partita: error' x.log | cut -c1-160)..."
+  # a surface the plate does not have (from:) with the granules on 3 ranks: the controller refuses
+  # it in the handshake, when the granules' ranks already follow their leader: every process ends
+  # at once (not after --peer-timeout, 600 s by default), the controller's message first
+  start=$(date +%s)
+  bad=(--set 'participants.granules.meshes=[{name: plate, from: plate.nothere, material: steel}]'
+       --set 'coupling.exchanges=[{data: displacement, from: plate.bottom, to: granules.plate, mapper: nearest-neighbor}, {data: force, from: granules.plate, to: plate.bottom, mapper: nearest-neighbor}]')
+  timeout 60 "${MPIRUN[@]}" -n 1 "$P" run "$CASE" -o w --threads 1 --participant plate "${SHORT[@]}" "${bad[@]}" : \
+    -n 3 "$P" run "$CASE" -o w --threads 1 --participant granules "${SHORT[@]}" "${bad[@]}" > w.log 2>&1
+  status=$?
+  took=$(($(date +%s) - start))
+  [ $status -ne 0 ] && [ $status -ne 124 ] || { cat w.log >&2; fail "a surface the plate does not have: exit status $status"; }
+  [ $took -le 30 ] || fail "a surface the plate does not have: every process ended after $took s"
+  grep -m1 'partita: error' w.log | grep -q "participant 'plate' (rank 0): .*participant 'plate' has no mesh 'nothere'" ||
+    { cat w.log >&2; fail "a surface the plate does not have: the controller's message is not the first"; }
+  echo "a surface the plate does not have, the granules on 3 ranks: refused in $took s: $(grep -m1 'partita: error' w.log | cut -c1-160)..."
   ;;
 *)
   fail "unknown scenario $SCENARIO"

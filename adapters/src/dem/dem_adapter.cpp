@@ -22,7 +22,11 @@
 
 namespace partita::adapters {
 
-DemAdapter::~DemAdapter() = default;
+// On ranks the handle forgets this object's loops (the app may still hold it: a run whose set-up
+// failed after this solver was built; it then ends the ranks itself).
+DemAdapter::~DemAdapter() {
+  if (ranks_) ranks_->ranks->claim(nullptr, nullptr);
+}
 
 const dem::Breakage* DemAdapter::breakage() const {
   return breakage_ < 0 ? nullptr : &static_cast<const dem::Breakage&>(system_.hook(breakage_));

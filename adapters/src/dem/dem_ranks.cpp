@@ -236,14 +236,15 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
   o->out.assign(1, dem::SubdomainMail(size));
   o->in.assign(1, dem::SubdomainMail(size));
   ranks_ = std::move(o);
-  if (ranks->leads())
-    ranks->claim(nullptr, [this](int status) { end_others(status); });
-  else
-    ranks->claim([this] { return follow(); }, nullptr);
   // the split waits for the meshes taken from other participants (they widen the domain, and
   // their materials may lower the stable step): the leader receives them at the run's set-up and
   // passes each on (Command::mesh), every rank adds it alike
   if (requests_.empty()) ranks_split();
+  // (last: a constructor that throws leaves the handle unclaimed; ~DemAdapter() lets it go)
+  if (ranks->leads())
+    ranks->claim(nullptr, [this](int status) { end_others(status); });
+  else
+    ranks->claim([this] { return follow(); }, nullptr);
 #endif
 }
 
