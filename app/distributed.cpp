@@ -204,7 +204,9 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
   try {
     m = mpi::join(MPI_COMM_WORLD, o.participant, /*several=*/true);
   } catch (const Error& e) {
-    return fail(e.what(), false);
+    if (rank == 0) return fail(e.what(), false);  // (every process meets it alike: one says it)
+    MPI_Finalize();
+    return 1;
   }
   const std::vector<std::string>& names = m.participants;
   static MPI_Comm participant_comm = MPI_COMM_NULL;  // (ParticipantRanks points to it)
