@@ -183,8 +183,8 @@ class DemAdapter : public Solver {
   std::unique_ptr<OnRanks> ranks_;  // null: one process (system_ holds the whole bed)
   bool on_ranks() const { return ranks_ != nullptr; }
   /// At the end of the constructor with SolverContext::ranks: refuses what a split does not
-  /// handle yet (naming the key), keeps this rank's particles, sets up the stepper, claims the
-  /// ranks.
+  /// handle yet (naming the key), sets up the transport, cuts the bed (ranks_split()) unless it
+  /// waits for meshes from other participants, claims the ranks.
   void setup_ranks(const SolverContext& context);
   /// Cuts the bed into the ranks' boxes and sets up the stepper, on every rank alike, once every
   /// mesh is in (at set-up, or after the last mesh taken from another participant).
