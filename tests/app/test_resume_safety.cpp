@@ -31,13 +31,17 @@ namespace {
 
 const fs::path kSource = PARTITA_SOURCE_DIR;
 
-fs::path scratch(const std::string& name) { return partita::test::scratch_dir("resume", name); }
+fs::path scratch(const std::string& name) {
+  return partita::test::scratch_dir("resume", name);
+}
 
 partita::test::CommandResult partita_run(const std::string& args) {
   return partita::test::run_partita(args);
 }
 
-std::string read_all(const fs::path& p) { return partita::test::read_file(p); }
+std::string read_all(const fs::path& p) {
+  return partita::test::read_file(p);
+}
 
 void write_all(const fs::path& p, const std::string& bytes) {
   std::ofstream(p, std::ios::binary | std::ios::trunc) << bytes;
@@ -200,5 +204,37 @@ TEST_CASE("resume: one byte flipped in any section of a restart file is refused 
   r = partita_run(resume);
   INFO(r.output);
   CHECK(r.status == 0);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("resume: a run resumed with a finer output.every writes its frames at the new spacing",
+          "[app][restart]") {
+  // Frames every 0.1 s to 0.5 s (restart every 5 windows of 0.01 s), resumed from 0.5 s with
+  // frames every 0.02 s to 0.6 s: the series holds t = 0, 0.1 .. 0.5, then 0.52 .. 0.6 (each
+  // frame once), and the run ends (the next frame time is the next multiple of the new spacing).
+  const fs::path dir = scratch("finer");
+  const std::string c = quote((kSource / "cases/elastic_tube_1d/iqn-ils.yaml").string());
+  auto r = partita_run("run " + c + " --set time.end=0.5 --set output.restart.every_windows=5 " +
+                       "--output " + quote(dir.string()));
+  REQUIRE(r.status == 0);
+  r = partita::test::run_command("timeout 120 " + quote(PARTITA_EXECUTABLE) + " run " + c +
+                                 " --set time.end=0.6 --set output.every=0.02 --resume " +
+                                 quote(dir.string()));
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  std::vector<double> times;
+  for (const auto& e : fs::directory_iterator(dir / "vtk")) {
+    if (e.path().extension() != ".pvd") continue;
+    const std::string pvd = read_all(e.path());
+    times.clear();
+    for (std::size_t at = pvd.find("timestep=\""); at != std::string::npos;
+         at = pvd.find("timestep=\"", at + 1))
+      times.push_back(std::stod(pvd.substr(at + 10)));
+    break;
+  }
+  const std::vector<double> expected = {0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.52, 0.54, 0.56, 0.58, 0.6};
+  REQUIRE(times.size() == expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k)
+    CHECK(times[k] == Approx(expected[k]).margin(1e-9));
   fs::remove_all(dir);
 }

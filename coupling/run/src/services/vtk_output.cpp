@@ -30,10 +30,29 @@ void VtkOutput::observe(FinishedWindow& w) {
     write(frame_++, 0.0);
     return;
   }
+  if (respace_) {
+    // resumed: with another output.every than the run that wrote the restart, the next frame
+    // is the new spacing's first multiple after the restart's time (with the same, the same)
+    respace_ = false;
+    if (every_ > 0.0) {
+      const double resumed_at = w.time - window_size_;
+      double k = std::floor(resumed_at / every_);
+      while (TimeWindow::reached(resumed_at, k * every_, window_size_)) k += 1.0;
+      if (std::abs(k * every_ - next_output_) > 1e-9 * every_) next_output_ = k * every_;
+    }
+  }
   if ((every_ > 0.0 && TimeWindow::reached(w.time, next_output_, window_size_)) || w.last) {
     write(frame_++, w.time);
-    while (every_ > 0.0 && TimeWindow::reached(w.time, next_output_, window_size_))
-      next_output_ = static_cast<double>(frame_) * every_;
+    // the next multiple of `every` after this window (a run resumed with another output.every
+    // takes up the new spacing from here; the frames keep counting)
+    if (every_ > 0.0) {
+      double k = static_cast<double>(frame_);
+      if (TimeWindow::reached(w.time, k * every_, window_size_) ||
+          !TimeWindow::reached(w.time, (k - 1.0) * every_, window_size_))
+        k = std::floor(w.time / every_);
+      while (TimeWindow::reached(w.time, k * every_, window_size_)) k += 1.0;
+      next_output_ = k * every_;
+    }
   }
 }
 
@@ -132,11 +151,14 @@ void VtkOutput::serialize_series(StateArchive& ar) {
 void VtkOutput::restored() {
   frame_ = restored_.frame;
   next_output_ = restored_.next_output;
+  respace_ = true;
   fs::create_directories(vtk_dir_);
   for (auto& [series, entries] : restored_.pvds) pvd(series).restore_entries(std::move(entries));
   restored_ = Restored{};
 }
 
-void VtkOutput::report(RunSummary& summary) const { summary.output_seconds += seconds_; }
+void VtkOutput::report(RunSummary& summary) const {
+  summary.output_seconds += seconds_;
+}
 
 }  // namespace partita::run

@@ -37,15 +37,16 @@ class VtkOutput final : public Service {
   PvdSeries& pvd(const std::string& series);
 
   std::filesystem::path vtk_dir_;
-  double every_;        // 0: first and last frame only
+  double every_;  // 0: first and last frame only
   double window_size_;
   vtk::Options options_;
   std::vector<coupling::Participant*> participants_;
   std::vector<const coupling::Exchange*> exchanges_;
   int frame_ = 0;
   double next_output_ = 0.0;
+  bool respace_ = false;  // resumed: the next frame time follows this run's every_ (observe())
   std::vector<std::pair<std::string, PvdSeries>> pvds_;  // series name -> .pvd
-  double seconds_ = 0.0;  // output time
+  double seconds_ = 0.0;                                 // output time
   struct Restored {
     int frame = 0;
     double next_output = 0.0;
