@@ -1,7 +1,7 @@
 #include "partita/dem/mesh_contacts.hpp"
 
-#include "partita/dem/error.hpp"
 #include "parallel_pass.hpp"
+#include "partita/dem/error.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -174,9 +174,11 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
   std::int64_t old_key[max_contacts];
   Eigen::Vector3d old_shear[max_contacts];
   const int n_old = row.count;
+  float old_pre[max_contacts];
   for (int s = 0; s < n_old; ++s) {
     old_key[s] = slot_key[s];
     old_shear[s] = slot_shear[s];
+    old_pre[s] = records[s].pre_overlap;
   }
   // A contact keeps its history when its feature stays (same key) and also when it passes to
   // a neighbouring feature of the same mesh, rolling or sliding across triangle boundaries: an
@@ -219,8 +221,16 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     const Eigen::Vector3d v_wall = k.cp.barycentric[0] * m.velocity_[tri[0]] +
                                    k.cp.barycentric[1] * m.velocity_[tri[1]] +
                                    k.cp.barycentric[2] * m.velocity_[tri[2]];
-    const double delta = k.delta;
-    const double cr = r - 0.5 * delta;
+    // pre-overlap: a contact made with a triangle that has just entered the contacts keeps its
+    // overlap of now; one carried over keeps the smaller of its own and now's (TriangleMesh::
+    // triangle_fresh()); the force acts on the overlap beyond it
+    float pre = 0.0f;
+    if (from_old[a] >= 0 && old_pre[from_old[a]] > 0.0f)
+      pre = std::min(old_pre[from_old[a]], static_cast<float>(k.delta));
+    else if (from_old[a] < 0 && m.triangle_fresh(k.triangle))
+      pre = static_cast<float>(k.delta);
+    const double delta = pre > 0.0f ? std::max(0.0, k.delta - static_cast<double>(pre)) : k.delta;
+    const double cr = r - 0.5 * k.delta;
     const PairParameters& pp = model.pair(q.material, m.material());
     Eigen::Vector3d fw, ft;
     DissipativeParts parts;
@@ -251,6 +261,7 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     rec.delta = delta;
     rec.r_eff = r;
     rec.material = m.material();
+    rec.pre_overlap = pre;
   }
   row.count = na;
 }
@@ -261,20 +272,20 @@ template void MeshContacts::evaluate<false, false>(int, const Particle&, const N
                                                    Eigen::Vector3d&, Eigen::Vector3d&, double&,
                                                    DissipationSums*, WallDissipation*);
 template void MeshContacts::evaluate<false, true>(int, const Particle&, const NeighborList&,
-                                                   const std::vector<TriangleMesh>&,
-                                                   const ContactModel&, const Row&, double, bool,
-                                                   Eigen::Vector3d&, Eigen::Vector3d&, double&,
-                                                   DissipationSums*, WallDissipation*);
+                                                  const std::vector<TriangleMesh>&,
+                                                  const ContactModel&, const Row&, double, bool,
+                                                  Eigen::Vector3d&, Eigen::Vector3d&, double&,
+                                                  DissipationSums*, WallDissipation*);
 template void MeshContacts::evaluate<true, false>(int, const Particle&, const NeighborList&,
-                                                   const std::vector<TriangleMesh>&,
-                                                   const ContactModel&, const Row&, double, bool,
-                                                   Eigen::Vector3d&, Eigen::Vector3d&, double&,
-                                                   DissipationSums*, WallDissipation*);
+                                                  const std::vector<TriangleMesh>&,
+                                                  const ContactModel&, const Row&, double, bool,
+                                                  Eigen::Vector3d&, Eigen::Vector3d&, double&,
+                                                  DissipationSums*, WallDissipation*);
 template void MeshContacts::evaluate<true, true>(int, const Particle&, const NeighborList&,
-                                                   const std::vector<TriangleMesh>&,
-                                                   const ContactModel&, const Row&, double, bool,
-                                                   Eigen::Vector3d&, Eigen::Vector3d&, double&,
-                                                   DissipationSums*, WallDissipation*);
+                                                 const std::vector<TriangleMesh>&,
+                                                 const ContactModel&, const Row&, double, bool,
+                                                 Eigen::Vector3d&, Eigen::Vector3d&, double&,
+                                                 DissipationSums*, WallDissipation*);
 
 // Each contact's reaction shared among its triangle's vertices with the barycentric weights of
 // the contact point, particles in order (a fixed summation order); then each triangle's force
@@ -465,9 +476,8 @@ std::size_t MeshContacts::check_packed(const std::byte* data, std::size_t bytes,
     std::memcpy(&count, data + at, sizeof count);
     at += sizeof count;
     if (count < 0 || count > max_contacts)
-      throw Error("particle " + std::to_string(p) + " of the message has " +
-                  std::to_string(count) + " mesh contacts; a particle keeps 0 to " +
-                  std::to_string(max_contacts));
+      throw Error("particle " + std::to_string(p) + " of the message has " + std::to_string(count) +
+                  " mesh contacts; a particle keeps 0 to " + std::to_string(max_contacts));
     if ((bytes - at) / packed_contact_bytes < static_cast<std::size_t>(count))
       throw Error("the mesh contacts of particle " + std::to_string(p) +
                   " of the message are cut short");

@@ -620,6 +620,7 @@ void System::reduce_wall_and_mesh_forces(double dt, bool work) {
   // Mesh forces: particles in order (MeshContacts::reduce).
   if (meshes_.empty()) return;
   mesh_contacts_.reduce(meshes_);
+  for (TriangleMesh& m : meshes_) m.clear_fresh();
 }
 
 }  // namespace partita::dem

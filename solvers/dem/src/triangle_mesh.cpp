@@ -113,6 +113,10 @@ void TriangleMesh::set_triangle_active(int t, bool active) {
   }
   if ((active_[t] != 0) == active) return;
   active_[t] = active ? 1 : 0;
+  if (active) {
+    if (fresh_.empty()) fresh_.assign(triangles_.size(), 0);
+    if (fresh_[t] == 0) fresh_[t] = 1, ++fresh_count_;
+  }
   inactive_ += active ? -1 : 1;
   // a vertex's force is shared among the active triangles that have it (a vertex with force
   // has one: the contacts touch active triangles only)
@@ -120,6 +124,12 @@ void TriangleMesh::set_triangle_active(int t, bool active) {
     vertex_triangles_[v] += active ? 1 : -1;
     vertex_share_[v] = vertex_triangles_[v] > 0 ? 1.0 / vertex_triangles_[v] : 0.0;
   }
+}
+
+void TriangleMesh::clear_fresh() {
+  if (fresh_count_ == 0) return;
+  std::fill(fresh_.begin(), fresh_.end(), 0);
+  fresh_count_ = 0;
 }
 
 bool TriangleMesh::feature_is_local_closest(int t, const TriangleClosestPoint& cp,
@@ -161,9 +171,8 @@ bool TriangleMesh::feature_is_local_closest(int t, const TriangleClosestPoint& c
 }
 
 TriangleClosestPoint TriangleMesh::closest_point(int t, const Eigen::Vector3d& p) const {
-  return geometry::closest_point_on_triangle(p, position_[triangles_[t][0]],
-                                             position_[triangles_[t][1]],
-                                             position_[triangles_[t][2]]);
+  return geometry::closest_point_on_triangle(
+      p, position_[triangles_[t][0]], position_[triangles_[t][1]], position_[triangles_[t][2]]);
 }
 
 Eigen::Vector3d TriangleMesh::normal(int t) const {

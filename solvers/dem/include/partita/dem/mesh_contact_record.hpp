@@ -16,12 +16,14 @@ struct MeshContactRecord {
   double delta = 0.0;                               ///< overlap [m]
   double r_eff = 0.0;
   int material = 0;
-  // The 4 bytes after `material`, made a member: the records go into state files as raw bytes,
-  // and padding would carry whatever the heap held there (two identical runs wrote files that
-  // differed in those bytes). A member is copied with the record and stays zero.
-  int reserved = 0;
+  /// The overlap the contact had when its triangle entered the contacts (a face that erosion
+  /// exposed under the particle) [m], followed down as the particle moves out; the force acts on
+  /// the overlap beyond it (`delta` is that part). 0 for a contact made by approach. (Single
+  /// precision: the 4 bytes after `material`, which the records need anyway: they go into state
+  /// files as raw bytes, and padding would carry whatever the heap held there.)
+  float pre_overlap = 0.0f;
 };
-static_assert(sizeof(MeshContactRecord) == 4 * sizeof(int) + 8 * sizeof(double),
+static_assert(sizeof(MeshContactRecord) == 3 * sizeof(int) + sizeof(float) + 8 * sizeof(double),
               "no padding: the records are written as raw bytes");
 
 }  // namespace partita::dem

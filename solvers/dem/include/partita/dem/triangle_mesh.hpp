@@ -45,6 +45,14 @@ class TriangleMesh {
   /// and a particle passes where it was.
   bool triangle_active(int t) const { return inactive_ == 0 || active_[t] != 0; }
   void set_triangle_active(int t, bool active);
+  /// Whether triangle t entered the contacts (set_triangle_active(t, true) after false) since
+  /// the last force pass. A particle that overlaps such a triangle at that pass was there before
+  /// the surface was (a face exposed under it): its contact keeps that overlap as its
+  /// pre-overlap (MeshContactRecord::pre_overlap) and pushes only beyond it, instead of throwing
+  /// the particle out with the energy of the whole overlap at once.
+  bool triangle_fresh(int t) const { return fresh_count_ > 0 && fresh_[t] != 0; }
+  /// Forgets which triangles entered (System, after each force pass).
+  void clear_fresh();
   int inactive_triangle_count() const { return inactive_; }
 
   /// Whether the contacts are one-sided (off: two-sided, the default). Two-sided, a sphere
@@ -115,8 +123,10 @@ class TriangleMesh {
   std::vector<int> vertex_neighbor_offset_, vertex_neighbor_;
   // the triangle of each edge_opposite_ entry, the edge of each vertex_neighbor_ entry
   std::vector<int> edge_opposite_triangle_, vertex_neighbor_edge_;
-  std::vector<char> active_;           // per triangle (see triangle_active())
-  int inactive_ = 0;                   // triangles not active
+  std::vector<char> active_;  // per triangle (see triangle_active())
+  int inactive_ = 0;          // triangles not active
+  std::vector<char> fresh_;   // per triangle (see triangle_fresh()), sized on first use
+  int fresh_count_ = 0;
   std::vector<int> vertex_triangles_;  // the number of active triangles that have the vertex
   std::vector<double> vertex_share_;   // 1 / that number (0 for none)
   Eigen::MatrixX3d triangle_force_;
