@@ -224,11 +224,13 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     // pre-overlap: a contact made with a triangle that has just entered the contacts keeps its
     // overlap of now; one carried over keeps the smaller of its own and now's (TriangleMesh::
     // triangle_fresh()); the force acts on the overlap beyond it
+    // (fresh: also where the contact took over the history of a neighbouring feature's, as a
+    // particle in a hole touching its walls does when the face under it is exposed)
     float pre = 0.0f;
-    if (from_old[a] >= 0 && old_pre[from_old[a]] > 0.0f)
-      pre = std::min(old_pre[from_old[a]], static_cast<float>(k.delta));
-    else if (from_old[a] < 0 && m.triangle_fresh(k.triangle))
+    if (m.triangle_fresh(k.triangle))
       pre = static_cast<float>(k.delta);
+    else if (from_old[a] >= 0 && old_pre[from_old[a]] > 0.0f)
+      pre = std::min(old_pre[from_old[a]], static_cast<float>(k.delta));
     const double delta = pre > 0.0f ? std::max(0.0, k.delta - static_cast<double>(pre)) : k.delta;
     const double cr = r - 0.5 * k.delta;
     const PairParameters& pp = model.pair(q.material, m.material());
