@@ -196,11 +196,11 @@ const MonitorTable<FemAdapter>& FemAdapter::monitor_table() {
             const auto& regions = s.mesh().region_names();
             std::vector<double> count(regions.size(), 0.0), first(regions.size(), -1.0);
             for (std::size_t e = 0; e < s.mesh().num_elements(); ++e) {
-              const double t = s.element_failure_time(e);
-              if (t < 0.0) continue;
+              const double failed_at = s.element_failure_time(e);
+              if (failed_at < 0.0) continue;
               const auto r = static_cast<std::size_t>(s.mesh().elements()[e].region);
               count[r] += 1.0;
-              if (first[r] < 0.0 || t < first[r]) first[r] = t;
+              if (first[r] < 0.0 || failed_at < first[r]) first[r] = failed_at;
             }
             for (std::size_t i = 0; i < regions.size(); ++i) out({regions[i]}, {count[i], first[i]});
           },
