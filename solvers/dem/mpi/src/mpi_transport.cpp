@@ -6,6 +6,7 @@
 #include <climits>
 #include <cmath>
 #include <limits>
+#include <iomanip>
 #include <sstream>
 #include <thread>
 
@@ -80,7 +81,7 @@ void MpiSubdomainTransport::wait_all(const char* what) {
       // which requests are still pending, by rank (MPI_Test completes the others)
       std::ostringstream msg;
       msg << "MpiSubdomainTransport: rank " << rank_ << " of " << size_ << " waited "
-          << static_cast<int>(waited) << " s (deadline " << deadline_ << " s) in call "
+          << std::setprecision(3) << waited << " s (deadline " << deadline_ << " s) in call "
           << calls_ << " for " << what << "; still awaited:";
       std::vector<int> silent;
       for (std::size_t k = 0; k < requests_.size(); ++k) {
