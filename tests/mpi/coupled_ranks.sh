@@ -59,6 +59,7 @@ HANDED=(--set 'participants.granules.meshes=[{name: plate, from: plate.bottom, m
         --set 'coupling.exchanges=[{data: displacement, from: plate.bottom, to: granules.plate, mapper: nearest-neighbor}, {data: force, from: granules.plate, to: plate.bottom, mapper: nearest-neighbor}, {data: attached, from: plate.bottom_centres, to: granules.plate_centres, mapper: nearest-neighbor}]')
 
 fail() { echo "FAILED: $*" >&2; exit 1; }
+. "$HERE/same_csv.sh"
 
 # coupled N DIR [args...]: the plate in one process, the granules on N (1: --on-ranks), into DIR
 coupled() {
@@ -73,15 +74,7 @@ coupled() {
 }
 
 # same DIR_A DIR_B: every CSV file of A in B, byte for byte (and as many)
-same() {
-  local a=$1 b=$2 f n=0
-  for f in "$a"/*.csv; do
-    cmp "$f" "$b/$(basename "$f")" || fail "$(basename "$f"): $a and $b differ"
-    n=$((n + 1))
-  done
-  [ "$n" -ge 2 ] || fail "$a holds $n CSV files"
-  [ "$(ls "$b"/*.csv | wc -l)" -eq "$n" ] || fail "$b holds other CSV files than $a"
-}
+same() { same_csv "$1" "$2"; }
 
 # find_rank R: the pid of this test's partita process of rank R of the run
 find_rank() {

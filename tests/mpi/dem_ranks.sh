@@ -41,6 +41,7 @@ trap 'rm -rf "$WORK"' EXIT
 cd "$WORK"
 
 fail() { echo "FAILED: $*" >&2; exit 1; }
+. "$HERE/same_csv.sh"
 
 # ranks N DIR [args...]: the case on N ranks into DIR
 ranks() {
@@ -52,14 +53,8 @@ ranks() {
 
 # same DIR_A DIR_B: every CSV file of A in B, byte for byte (and as many), and the particles file
 same() {
-  local a=$1 b=$2 f n=0
-  cmp "$a/bed.data" "$b/bed.data" || fail "bed.data (the particles file): $a and $b differ"
-  for f in "$a"/*.csv; do
-    cmp "$f" "$b/$(basename "$f")" || fail "$(basename "$f"): $a and $b differ"
-    n=$((n + 1))
-  done
-  [ "$n" -ge 2 ] || fail "$a holds $n CSV files"
-  [ "$(ls "$b"/*.csv | wc -l)" -eq "$n" ] || fail "$b holds other CSV files than $a"
+  cmp "$1/bed.data" "$2/bed.data" || fail "bed.data (the particles file): $1 and $2 differ"
+  same_csv "$1" "$2"
 }
 
 case $SCENARIO in
