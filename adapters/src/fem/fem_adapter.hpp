@@ -132,6 +132,7 @@ class FemAdapter : public Solver {
     bool has_surface = false;  // offers the mesh <name> (writes "displacement")
   };
   std::vector<Indenter> indenters_;
+  fem::SelfContact* self_contact_ = nullptr;  // self_contact: (the solver owns it)
 };
 
 }  // namespace partita::adapters

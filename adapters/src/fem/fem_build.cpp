@@ -14,6 +14,7 @@
 #include "partita/fem/blas_runtime.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/face_area.hpp"
+#include "partita/fem/self_contact.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
 #include "partita/interface/time_table.hpp"
@@ -431,6 +432,31 @@ FemAdapter::FemAdapter(const SolverContext& context) : name_(context.name) {
       b.contact->set_eroded(
           [s = solver_.get()](std::size_t element) { return s->element_eroded(element); });
       solver_->add_contribution(std::move(b.contact));
+    }
+    if (c.has("self_contact")) {
+      const Node sc = c["self_contact"];
+      if (!transient_ || options.integrator != fem::Integrator::CentralDifference)
+        sc.fail("self contact offers no tangent: it works in central-difference analyses only "
+                "(analysis: {type: transient, integrator: central-difference})");
+      if (!(sc.real("depth") < 1.0))
+        sc["depth"].fail(fmt::format("depth {} is a fraction of the element's thickness under a "
+                                     "face: give 0 < depth < 1",
+                                     sc.real("depth")));
+      const auto contact_faces = sc.strings("faces");
+      if (contact_faces.empty()) sc["faces"].fail("an empty list: name the faces that may touch each other");
+      for (const auto& f : contact_faces) require_name(sc["faces"], f, solver_->mesh().face_names(), "face");
+      fem::SelfContactOptions so;
+      so.penalty_factor = sc.real("penalty_factor");
+      so.depth = sc.real("depth");
+      auto self = std::make_unique<fem::SelfContact>("self_contact", solver_->model(), contact_faces, so);
+      self->set_detached([s = solver_.get()](std::size_t node) { return s->node_detached(node); });
+      self->set_eroded([s = solver_.get()](std::size_t element) { return s->element_eroded(element); });
+      log::get("adapters")
+          ->info("fem '{}': self contact over {}: {} triangles exposed now, {} face nodes",
+                 context.name, join_names(contact_faces), self->triangles_in_contact_surface(),
+                 self->surface_nodes());
+      self_contact_ = self.get();
+      solver_->add_contribution(std::move(self));
     }
     if (!transient_) solver_->solve_static();
   } catch (const fem::Error& e) {

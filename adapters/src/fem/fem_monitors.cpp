@@ -84,6 +84,16 @@ const MonitorTable<FemAdapter>& FemAdapter::monitor_table() {
                return mass > 0.0 ? 100.0 * added / mass : 0.0;
              },
              mass_scaled);
+    const auto self_contact = [](const A& a) { return a.self_contact_ != nullptr; };
+    t.scalar("self_contact_nodes", "",
+             "nodes in contact with a face of the body itself (self_contact:)",
+             [](const A& a) { return static_cast<double>(a.self_contact_->active_nodes()); },
+             self_contact);
+    t.scalar("self_contact_force", "N", "the sum of the self contact's normal forces |p| on its nodes",
+             [](const A& a) { return a.self_contact_->total_normal_force(); }, self_contact);
+    t.scalar("self_contact_energy", "J",
+             "the self contact's penalty energy 1/2 k g^2 (part of strain_energy)",
+             [](const A& a) { return a.self_contact_->stored_energy(); }, self_contact);
     // rigid indenters (indenters:, indenter_config.hpp); before the regions' quantities: where a
     // region and an indenter share a name, the region's kinetic_energy is the one a monitor
     // column takes (the last of that name)

@@ -293,6 +293,28 @@ std::shared_ptr<Spec> make_spec() {
           "displacement and received force are monitor quantities)",
           interface);
   s->section("analysis", "analysis type and time integration", analysis);
+  auto self = std::make_shared<Spec>(
+      "self_contact",
+      "node-to-face penalty contact of the body with itself over the listed faces; with "
+      "erosion, the faces between elements (mesh.interior_faces) join once the element across "
+      "has eroded (eroding single-surface contact: a torn plate folding onto a web, the faces "
+      "around a crushed element closing its gap); central-difference analyses only");
+  self->strings("faces",
+                "the faces that may touch each other (their union), e.g. [outer, inner, cavity, "
+                "exposed]")
+      .required();
+  self->real("penalty_factor",
+             "k = factor E A_node / h per node (as an indenter's penalty); the default 0.1 is "
+             "the scale explicit codes use for contact between deformable parts (LS-DYNA's "
+             "SLSFAC)")
+      .positive()
+      .def(0.1);
+  self->real("depth",
+             "the deepest penetration caught, as a fraction of the element's thickness under "
+             "the face (0 < depth < 1; deeper lies the plate's other side)")
+      .positive()
+      .def(0.5);
+  s->section("self_contact", "contact of the body with itself (optional)", self);
   s->list("indenters",
           "rigid indenters in penalty contact with an FE face (part of this model's operator; a "
           "linear-elastic model keeps its fast K u in central difference, and takes the "

@@ -8,6 +8,7 @@
 #include "partita/fem/gmsh_reader.hpp"
 #include "partita/fem/hardening_curve.hpp"
 #include "partita/fem/indenter_contact.hpp"
+#include "partita/fem/self_contact.hpp"
 #include "partita/fem/j2_plasticity_law.hpp"
 #include "partita/fem/linear_elastic_law.hpp"
 #include "partita/fem/linear_solver.hpp"
