@@ -445,6 +445,7 @@ void DemAdapter::add_breakage(const config::Node& b) {
   p.scatter = b.string("scatter") == "weibull";
   p.comminution_limit = b.real("comminution_limit");
   p.powder = b.string("below_limit") == "powder";
+  p.yield = b.string("below_limit") == "yield";
   p.pattern = dem::FragmentPattern::named(b.string("pattern")).kind();
   p.restore_mass = b.string("mass") == "restored";
   p.seed = static_cast<std::uint64_t>(b.integer("seed"));

@@ -56,8 +56,8 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
              "spring energy the cap released)",
              [](const A& a) { return a.system_.energies().friction; }, energies);
     t.scalar("damping_work", "J",
-             "energy dissipated by viscous contact damping (normal, tangential) and rolling "
-             "resistance since the start",
+             "energy dissipated by viscous contact damping (normal, tangential), rolling "
+             "resistance and yielding mesh contacts (breakage.below_limit: yield) since the start",
              [](const A& a) { return a.system_.energies().damping; }, energies);
     t.scalar("breakage_energy", "J",
              "mechanical energy (kinetic, potential, contact) before minus after the changes of "

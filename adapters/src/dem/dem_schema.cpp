@@ -158,10 +158,15 @@ std::shared_ptr<Spec> make_spec() {
   breakage
       ->choice("below_limit",
                "what a particle smaller than comminution_limit does when a contact reaches its "
-               "strength: unbreakable (nothing: it never breaks) or powder (it is crushed to "
+               "strength: unbreakable (nothing: it never breaks), powder (it is crushed to "
                "powder: removed, its mass and kinetic and contact energy counted in "
-               "breakage.powder_mass and breakage.powder_energy; powder carries no load)",
-               {"unbreakable", "powder"})
+               "breakage.powder_mass and breakage.powder_energy; powder carries no load) or yield "
+               "(it stays, unbreakable, and where it meets the structure's meshes it yields: the "
+               "contact's mean pressure is held at its strength, the overlap beyond becomes "
+               "permanent and its work joins damping_work; a fragment pinched between two closing "
+               "faces is flattened instead of storing the elastic energy of an overlap of its own "
+               "size)",
+               {"unbreakable", "powder", "yield"})
       .def("unbreakable");
   breakage
       ->choice("pattern",

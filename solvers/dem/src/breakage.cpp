@@ -42,6 +42,9 @@ Breakage::Breakage(const BreakageParameters& p) : parameters_(p), pattern_(p.pat
   check_positive(p.reference_size, "the reference size d0 [m]", msg);
   check_positive(p.weibull_modulus, "the Weibull modulus m", msg);
   check_positive(p.comminution_limit, "the comminution limit d_min [m]", msg);
+  if (p.powder && p.yield)
+    msg << "below the comminution limit a particle is either crushed to powder or yields, not "
+           "both; ";
   if (!msg.str().empty()) throw Error(msg.str());
   broken_.reserve(64);
   powder_.reserve(64);

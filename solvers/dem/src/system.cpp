@@ -319,6 +319,13 @@ int System::add_hook(std::unique_ptr<StepHook> hook) {
                   "system)");
     h_load_limit_ = h;
   }
+  if (const StepHook::ContactYield y = hooks_[k].contact_yield(); y.pressure >= 0) {
+    if (yield_.pressure >= 0)
+      throw Error("add_hook: '" + hooks_[k].name() +
+                  "' brings contact yield pressures and another hook has them already (one per "
+                  "system)");
+    yield_ = y;
+  }
   forces_valid_ = false;
   prepared_ = false;  // sizes the load array (the lists stay)
   return k;

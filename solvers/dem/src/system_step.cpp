@@ -330,6 +330,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   const int* const material = p.material.data();
   double* load = Load ? load_.data() : nullptr;
   const double* load_limit = Limit ? store_.array<double>(h_load_limit_).data() : nullptr;
+  const double* yield_pressure_of =
+      yield_.pressure >= 0 ? store_.array<double>(yield_.pressure).data() : nullptr;
   const MeshContacts::Pass mesh = mesh_contacts_.pass();  // rows: particles near a mesh
   const int* const offsets = nl.offsets_.data();
   const int* const neighbors = nl.neighbors_.data();
@@ -558,7 +560,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         if (mesh_row < mesh.rows && mesh.particle[mesh_row] == i) {
           // own accumulators: f and t keep their registers
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
-          const MeshContacts::Particle q{qi.x, qi.r, qi.v, mass[i], qi.w, material[i]};
+          const double yield_pressure =
+              yield_pressure_of != nullptr && 2.0 * qi.r < yield_.below_diameter ? yield_pressure_of[i] : 0.0;
+          const MeshContacts::Particle q{qi.x, qi.r, qi.v, mass[i], qi.w, material[i], yield_pressure};
           MeshContacts::evaluate<Load, Energy>(i, q, nl, meshes_, model_, mesh.row(mesh_row++),
                                                dt, update_history, fm, tm, load_i, &di, &wd);
           f += fm;
@@ -577,7 +581,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           accel2 = std::max(accel2, f.squaredNorm() / (mass[i] * mass[i]));
           extent = std::max(extent, qi.x.cwiseAbs().maxCoeff());
           if constexpr (Energy) {  // powers at the end-of-step velocities (Energies)
-            block_e.damping += (wd.damping - (di.fd.dot(qi.v) + di.td.dot(qi.w))) * dt;
+            block_e.damping += (wd.damping - (di.fd.dot(qi.v) + di.td.dot(qi.w))) * dt + wd.plastic;
             block_e.friction += (wd.friction - (di.ff.dot(qi.v) + di.tf.dot(qi.w))) * dt +
                                 wd.spring;
             block_e.gravity += mass[i] * gravity.dot(qi.v) * dt;

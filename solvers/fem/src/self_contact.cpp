@@ -298,8 +298,9 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
     for (std::size_t i = 0; i < count; ++i) {
       if (!probe_[i].valid || !(probe_[i].gap >= 0.0)) continue;
       const std::size_t owner = face_owner_[triangles_[candidates_[start_[j] + i]].face];
-      for (std::size_t k = 0; k < count; ++k)
-        if (face_owner_[triangles_[candidates_[start_[j] + k]].face] == owner) probe_[k].owner_outside = true;
+      for (std::size_t other = 0; other < count; ++other)
+        if (face_owner_[triangles_[candidates_[start_[j] + other]].face] == owner)
+          probe_[other].owner_outside = true;
     }
     // of the faces it lies behind (within their depth) and projects onto, the nearest plane (the
     // face it has just passed), the first on a tie. "Onto" up to a margin of |g| / size: the

@@ -196,6 +196,78 @@ TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh turns t
   CHECK(breakage_of(keep).counters().powder_events == 0);
 }
 
+TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh yields at the pressure "
+          "of eq. 2", "[dem][breakage][energy]") {
+  // The fragment of the test above, with below_limit yield: the mesh contact holds its mean
+  // pressure at the granule's strength, so its force stays at eq. 2's while the mesh goes on
+  // down by a quarter of a diameter; the overlap beyond becomes permanent and its work is dissipated
+  // (booked with the damping); the granule keeps its mass and stores only the elastic energy at
+  // yield, where the unbreakable one stores the Hertz energy of the whole squeeze.
+  BreakageParameters b = parameters(3.0);
+  const double d = 2.0e-3, speed = 0.005;
+  b.comminution_limit = 2.5e-3;
+  b.yield = true;
+  const double e_eff = 1.0 / ((1.0 - NU * NU) / E + (1.0 - NU_P * NU_P) / E_P);
+  const double f_y = eq2_force(d, b);
+  // the overlap at which a Hertz contact of R = d/2 carries f_y
+  const double delta_y = std::pow(3.0 * f_y / (4.0 * e_eff * std::sqrt(0.5 * d)), 2.0 / 3.0);
+  Eigen::MatrixX3d x(4, 3);  // a square of side 4 d at the granule's top
+  x << -2 * d, -2 * d, d, 2 * d, -2 * d, d, 2 * d, 2 * d, d, -2 * d, 2 * d, d;
+  TriangleMesh::Triangles t(2, 3);
+  t << 0, 1, 2, 0, 2, 3;
+  const Eigen::MatrixX3d x0 = x;
+  struct Squeeze {
+    double max_force = 0.0, force = 0.0, elastic = 0.0, damping = 0.0, balance = 0.0;
+    std::size_t particles = 0;
+    double mass = 0.0;
+  };
+  const auto squeeze = [&](bool yield) {
+    b.yield = yield;
+    System sys;
+    granule_on_floor(sys, d);
+    const int mesh = sys.add_mesh(x0, t, 1);
+    sys.add_hook(std::make_unique<Breakage>(b));
+    sys.set_energy_tracking(true);
+    const double dt = 0.2 * sys.rayleigh_time_step();
+    // down by the two elastic overlaps (the granule's top touches the mesh at the start) plus a
+    // quarter of a diameter (the mesh stays above the granule's centre)
+    const auto steps = static_cast<long>((0.25 * d + 2.0 * delta_y) / (speed * dt));
+    Squeeze r;
+    Eigen::MatrixX3d y = x0;
+    for (long k = 0; k < steps; ++k) {
+      y.col(2) = x0.col(2).array() - speed * dt * static_cast<double>(k + 1);
+      sys.set_vertex_positions(mesh, y);
+      sys.step(dt);
+      r.max_force = std::max(r.max_force, sys.mesh_force(mesh).norm());
+    }
+    r.force = sys.mesh_force(mesh).norm();
+    r.elastic = sys.elastic_energy();
+    r.damping = sys.energies().damping;
+    r.balance = sys.energy_balance_error();
+    r.particles = sys.particle_count();
+    r.mass = sys.particles().mass[0];
+    return r;
+  };
+  const Squeeze yielding = squeeze(true), elastic = squeeze(false);
+  INFO("yield: max force " << yielding.max_force << " N, eq. 2 " << f_y << " N; elastic energy "
+                           << yielding.elastic << " J (unbreakable " << elastic.elastic
+                           << " J), damping " << yielding.damping << " J, balance error "
+                           << yielding.balance);
+  // the force holds at eq. 2's (the floor, a plane, stays elastic and carries the same force)
+  CHECK(yielding.max_force == Approx(f_y).epsilon(0.01));
+  CHECK(yielding.force == Approx(f_y).epsilon(0.01));
+  CHECK(elastic.force > 10.0 * f_y);
+  // the granule stays whole, with its mass
+  CHECK(yielding.particles == 1);
+  CHECK(yielding.mass == Approx(test::sphere_mass(0.5 * d, RHO)).epsilon(1e-12));
+  // stored: the two contacts at yield, 2 x 2/5 f_y delta_y; dissipated: f_y times the permanent
+  // overlap, the mesh's travel beyond the elastic overlaps (0.25 d)
+  CHECK(yielding.elastic == Approx(2.0 * 0.4 * f_y * delta_y).epsilon(0.02));
+  CHECK(yielding.damping == Approx(f_y * 0.25 * d).epsilon(0.02));
+  CHECK(std::abs(yielding.balance) < 2e-3);
+  CHECK(elastic.elastic > 50.0 * yielding.elastic);
+}
+
 TEST_CASE("dem: breakage conserves momentum and does not create kinetic energy",
           "[dem][breakage]") {
   for (const std::string& pattern : FragmentPattern::names())
@@ -447,6 +519,9 @@ TEST_CASE("dem: breakage parameters out of range are refused", "[dem][breakage][
               : b.comminution_limit) = -1.0;
     CHECK_THROWS_AS(Breakage(b), Error);
   }
+  BreakageParameters both = parameters(3.0);
+  both.powder = both.yield = true;
+  CHECK_THROWS_WITH(Breakage(both), Catch::Contains("powder or yields"));
   CHECK_THROWS_WITH(FragmentPattern::named("apolonian-14"), Catch::Contains("apollonian-14"));
   System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
   sys.add_hook(std::make_unique<Breakage>(parameters(3.0)));

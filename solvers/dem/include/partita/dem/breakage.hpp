@@ -62,6 +62,9 @@ class Breakage final : public StepHook {
   void attach(System& system) override;
   bool wants_contact_load() const override { return true; }
   int contact_load_limit() const override { return h_limit_; }
+  ContactYield contact_yield() const override {
+    return parameters_.yield ? ContactYield{h_strength_, parameters_.comminution_limit} : ContactYield{};
+  }
   void end_of_step(System& system, double dt) override;
   void write_state(BinaryWriter& out) const override;
   void read_state(BinaryReader& in) override;

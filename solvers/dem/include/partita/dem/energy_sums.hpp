@@ -29,6 +29,7 @@ struct DissipationSums {
 /// released, and the stiffening terms (DissipativeParts).
 struct WallDissipation {
   double damping = 0.0, friction = 0.0, spring = 0.0, stiffening = 0.0;
+  double plastic = 0.0;  ///< work of yielding mesh contacts (an energy, not a power) [J]
 };
 
 /// A wall or mesh contact's dissipative parts (normal n, arm cr, the wall's velocity at the

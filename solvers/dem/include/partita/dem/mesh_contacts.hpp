@@ -44,6 +44,8 @@ class MeshContacts {
     double m;
     const Eigen::Vector3d& w;
     int material;
+    /// > 0: the particle yields at this mean contact pressure [Pa] (StepHook::contact_yield())
+    double yield_pressure = 0.0;
   };
   /// One particle's row: its contacts of the last pass (count), their feature keys, tangential
   /// histories and records, room for `capacity`.

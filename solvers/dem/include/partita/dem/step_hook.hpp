@@ -45,6 +45,16 @@ class StepHook {
   /// the array's default; one below 0 makes them count as reached (the hook then sets their
   /// limits). One hook per system may have limits.
   virtual int contact_load_limit() const { return -1; }
+  /// Particles that yield against meshes: the handle of a per-particle store array (double,
+  /// width 1) of yield pressures [Pa] (values <= 0: none yet) and the diameter below which they
+  /// apply ({-1, 0}: none). A mesh contact of such a particle holds its mean Hertz pressure
+  /// F/(pi a^2) at the yield pressure, the overlap beyond it becoming permanent
+  /// (MeshContactRecord::pre_overlap). One hook per system may have them.
+  struct ContactYield {
+    int pressure = -1;
+    double below_diameter = 0.0;
+  };
+  virtual ContactYield contact_yield() const { return {}; }
   virtual void post_force(System& /*system*/, double /*dt*/) {}
   virtual void end_of_step(System& /*system*/, double /*dt*/) {}
   virtual void write_state(BinaryWriter& /*out*/) const {}

@@ -361,7 +361,8 @@ class System {
   struct Energies {
     double friction = 0.0;  ///< Coulomb sliding: power of the capped tangential forces on the
                             ///< relative motion + the spring energy the cap released
-    double damping = 0.0;   ///< viscous normal and tangential contact damping, rolling resistance
+    double damping = 0.0;   ///< viscous normal and tangential contact damping, rolling resistance,
+                            ///< yielding mesh contacts (StepHook::contact_yield())
     double breakage = 0.0;  ///< mechanical energy (KE + PE + E_el) before minus after changes of
                             ///< the particle set between steps (breakage, removal, insertion)
     double gravity = 0.0;   ///< work of gravity on the particles
@@ -507,6 +508,7 @@ class System {
   std::uint64_t identity_ = 0;  // shared by copies; a state remembers the system it came from
   std::vector<double> load_;    // largest contact load per particle (track_load_)
   int h_load_limit_ = -1;       // a hook's per-particle load limits (store array) or -1
+  StepHook::ContactYield yield_;  // a hook's yield pressures against meshes (or none)
   std::vector<char> load_reached_;  // per part: a load reached its limit in the last pass
   struct PartMotion {  // per part, maxima after the last pass's kick: |v|^2, |F/m|^2, |x_k|
     double speed2 = 0.0, accel2 = 0.0, extent = 0.0;
