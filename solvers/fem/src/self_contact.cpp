@@ -128,6 +128,9 @@ SelfContact::SelfContact(std::string name, const Model& model, const std::vector
   x_built_.assign(nodes_.size(), Vec3::Zero());
   start_.assign(nodes_.size() + 1, 0);
   boxes_.resize(triangles_.size());
+  pre_.assign(nodes_.size(), 0.0);
+  pre_trial_ = pre_;
+  face_active_committed_.assign(faces_.size(), 0);  // at the start every face is new
   update_active();
 }
 
@@ -249,6 +252,7 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
   if (k != nullptr)
     throw Error("self contact '" + name_ + "' offers no tangent: it works in central-difference "
                 "(explicit) analyses only");
+  const bool refreshed = refresh_;
   if (refresh_) {
     update_active();
     build_list(u);
@@ -264,6 +268,7 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
   }
   energy_ = force_sum_ = 0.0;
   active_ = 0;
+  std::fill(pre_trial_.begin(), pre_trial_.end(), 0.0);
   double round_off2 = 0.0;
   for (std::size_t j = 0; j < nodes_.size(); ++j) {
     if (start_[j] == start_[j + 1]) continue;
@@ -319,23 +324,55 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
     if (best == count) continue;
     const Probe& pr = probe_[best];
     const Triangle& tri = triangles_[candidates_[start_[j] + best]];
+    // pre-penetration: a face that has just joined (erosion exposed it) finds the node where it
+    // is and pushes only beyond that depth; the depth is followed down as the node comes out
+    const double depth = -pr.gap;
+    const bool fresh = refreshed && !face_active_committed_[tri.face];
+    const double pre = fresh ? std::max(pre_[j], depth) : std::min(pre_[j], depth);
+    pre_trial_[j] = pre;
+    const double overlap = depth - pre;
+    if (!(overlap > 0.0)) continue;
     ++active_;
     const double kn = k_node_[j];
-    // p = -k g n on the node, -l_i p on the triangle's corners (the weights clamped to the
-    // triangle where the projection lies within the margin outside); W = 1/2 k g^2
-    const Vec3 p = -kn * pr.gap * pr.normal;
+    // p = k (|g| - pre) n on the node, -l_i p on the triangle's corners (the weights clamped to
+    // the triangle where the projection lies within the margin outside); W = 1/2 k (|g| - pre)^2
+    const Vec3 p = kn * overlap * pr.normal;
     std::array<double, 3> w{std::max(pr.weights[0], 0.0), std::max(pr.weights[1], 0.0),
                             std::max(pr.weights[2], 0.0)};
     const double sum = w[0] + w[1] + w[2];
     f.segment<3>(3 * static_cast<Eigen::Index>(node)) -= p;
     for (std::size_t c = 0; c < 3; ++c)
       f.segment<3>(3 * static_cast<Eigen::Index>(tri.nodes[c])) += (w[c] / sum) * p;
-    energy_ += 0.5 * kn * pr.gap * pr.gap;
+    energy_ += 0.5 * kn * overlap * overlap;
     force_sum_ += p.norm();
-    const double scale = kn * (x.norm() + std::abs(pr.gap)) + p.norm();
+    const double scale = kn * (x.norm() + depth) + p.norm();
     round_off2 += scale * scale;
   }
   round_off_ = std::numeric_limits<double>::epsilon() * std::sqrt(round_off2);
+  if (refreshed) {  // at the committed configuration: its depths and faces are the committed ones
+    pre_ = pre_trial_;
+    face_active_committed_ = face_active_;
+  }
+}
+
+void SelfContact::commit() { pre_.swap(pre_trial_); }
+
+const std::vector<double>& SelfContact::committed_state() const {
+  state_.assign(pre_.begin(), pre_.end());
+  for (const char a : face_active_committed_) state_.push_back(a ? 1.0 : 0.0);
+  return state_;
+}
+
+void SelfContact::set_committed_state(const std::vector<double>& state) {
+  const std::size_t expected = nodes_.size() + faces_.size();
+  if (state.size() != expected)
+    throw Error("self contact '" + name_ + "': a state of " + std::to_string(state.size()) +
+                " values was given, it keeps " + std::to_string(expected));
+  std::copy(state.begin(), state.begin() + static_cast<std::ptrdiff_t>(nodes_.size()), pre_.begin());
+  for (std::size_t f = 0; f < faces_.size(); ++f)
+    face_active_committed_[f] = state[nodes_.size() + f] != 0.0 ? 1 : 0;
+  pre_trial_ = pre_;
+  refresh_ = true;
 }
 
 double SelfContact::max_frequency_squared(const Eigen::VectorXd& nodal_mass) const {

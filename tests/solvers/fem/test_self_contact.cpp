@@ -175,8 +175,9 @@ TEST_CASE("self contact: a plate thinned to 40 % is no contact with its own far 
 
 TEST_CASE("self contact: the faces an eroded element exposes push each other apart",
           "[fem][contact][self][rupture]") {
-  // a column of three 10 mm steel cubes; the middle one erodes, the top one is pushed down until
-  // its bottom face lies 1 mm below the bottom cube's top face
+  // a column of three 10 mm steel cubes; the middle one erodes while the top one has come down
+  // onto the bottom one (the middle crushed flat), then the top one goes on down until its bottom
+  // face lies 1 mm below the bottom cube's top face
   const double e = 210e9, h = 0.01, factor = 0.1, pass = 1e-3;
   BoxSpec b;
   b.size = Vec3(h, h, 3 * h);
@@ -191,19 +192,27 @@ TEST_CASE("self contact: the faces an eroded element exposes push each other apa
     for (auto node : model.mesh().element(el).node_span()) z += model.mesh().node(node).z();
     return std::abs(z / 8.0 - 1.5 * h) < 1e-9;
   };
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
-  for (std::size_t i = 0; i < model.mesh().num_nodes(); ++i)
-    if (model.mesh().node(i).z() > 1.5 * h) u[3 * static_cast<Eigen::Index>(i) + 2] = -(h + pass);
+  const auto top_down = [&](double by) {  // the top cube moved down by `by`
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+    for (std::size_t i = 0; i < model.mesh().num_nodes(); ++i)
+      if (model.mesh().node(i).z() > 1.5 * h) u[3 * static_cast<Eigen::Index>(i) + 2] = -by;
+    return u;
+  };
   SelfContact c("self", model, {"zmin", "zmax", "between"}, {factor, 0.5});
   Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
   c.set_time(0.0, 0.0);
-  c.add(u, f, nullptr, assembler);
+  c.add(top_down(h + pass), f, nullptr, assembler);
   CHECK(c.active_nodes() == 0);  // the middle element is there: its faces are inside the body
+  // it erodes with the faces touching (a refresh at the committed configuration)
   c.set_eroded(middle);
   c.set_time(0.0, 0.0);
+  c.add(top_down(h), f, nullptr, assembler);
+  CHECK(c.active_nodes() == 0);
+  // a step on: each of the 8 nodes of the two faces lies behind the other face by 1 mm
   f.setZero();
-  c.add(u, f, nullptr, assembler);
-  // each of the 8 nodes of the two faces behind the other face by 1 mm (< 0.5 h)
+  c.set_time(1e-6, 1.0);
+  c.add(top_down(h + pass), f, nullptr, assembler);
+  c.commit();
   CHECK(c.active_nodes() == 8);
   // k per node = factor E (A / 4) / h (the node's one exposed face); W = 8 * 1/2 k g^2
   const double k = factor * e * (h * h / 4) / h;
@@ -223,12 +232,66 @@ TEST_CASE("self contact: the faces an eroded element exposes push each other apa
   CHECK(up == Approx(8 * k * pass));
   CHECK(down == Approx(-8 * k * pass));
   // 4.5 mm through: still caught (depth 0.5 h = 5 mm), the springs' energy as g^2
-  for (std::size_t i = 0; i < model.mesh().num_nodes(); ++i)
-    if (model.mesh().node(i).z() > 1.5 * h) u[3 * static_cast<Eigen::Index>(i) + 2] = -(h + 4.5e-3);
   f.setZero();
-  c.add(u, f, nullptr, assembler);
+  c.add(top_down(h + 4.5e-3), f, nullptr, assembler);
   CHECK(c.active_nodes() == 8);
   CHECK(c.stored_energy() == Approx(8 * 0.5 * k * 4.5e-3 * 4.5e-3));
+  // the committed state (1 mm through) restored: the same contact, the same energy
+  const std::vector<double> state = c.committed_state();
+  SelfContact again("self", model, {"zmin", "zmax", "between"}, {factor, 0.5});
+  again.set_eroded(middle);
+  again.set_committed_state(state);
+  f.setZero();
+  again.add(top_down(h + pass), f, nullptr, assembler);
+  CHECK(again.active_nodes() == 8);
+  CHECK(again.stored_energy() == Approx(8 * 0.5 * k * pass * pass));
+}
+
+TEST_CASE("self contact: a face that erosion exposes behind a node pushes only beyond that depth",
+          "[fem][contact][self][rupture]") {
+  // the column above, the middle element eroding when the top cube is already 1 mm through (a
+  // crushed element): the new faces find the nodes 1 mm behind them and store nothing; 0.5 mm
+  // further the springs hold 0.5 mm; back out, the depth follows the nodes down
+  const double e = 210e9, h = 0.01, factor = 0.1, pass = 1e-3;
+  BoxSpec b;
+  b.size = Vec3(h, h, 3 * h);
+  b.cells = {1, 1, 3};
+  Mesh mesh = make_box_mesh(b);
+  mesh.add_interior_faces("between");
+  const Model model(mesh, Material{e, 0.3, 7850});
+  const BlockAssembler assembler(model.mesh());
+  const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
+  const auto top_down = [&](double by) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+    for (std::size_t i = 0; i < model.mesh().num_nodes(); ++i)
+      if (model.mesh().node(i).z() > 1.5 * h) u[3 * static_cast<Eigen::Index>(i) + 2] = -by;
+    return u;
+  };
+  SelfContact c("self", model, {"zmin", "zmax", "between"}, {factor, 0.5});
+  c.set_eroded([&](std::size_t el) {
+    double z = 0.0;
+    for (auto node : model.mesh().element(el).node_span()) z += model.mesh().node(node).z();
+    return std::abs(z / 8.0 - 1.5 * h) < 1e-9;
+  });
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  c.set_time(0.0, 0.0);
+  c.add(top_down(h + pass), f, nullptr, assembler);
+  CHECK(c.stored_energy() == 0.0);
+  CHECK(f.norm() == 0.0);
+  const double k = factor * e * (h * h / 4) / h;
+  c.set_time(1e-6, 1.0);
+  c.add(top_down(h + 1.5 * pass), f, nullptr, assembler);
+  c.commit();
+  CHECK(c.active_nodes() == 8);
+  CHECK(c.stored_energy() == Approx(8 * 0.5 * k * 0.25 * pass * pass));
+  // out to 0.5 mm through: no force (the pre-penetration is 1 mm), and it follows to 0.5 mm
+  c.add(top_down(h + 0.5 * pass), f, nullptr, assembler);
+  c.commit();
+  CHECK(c.active_nodes() == 0);
+  f.setZero();
+  c.add(top_down(h + 0.75 * pass), f, nullptr, assembler);
+  CHECK(c.active_nodes() == 8);
+  CHECK(c.stored_energy() == Approx(8 * 0.5 * k * 0.0625 * pass * pass));
 }
 
 TEST_CASE("self contact: bad options and faces are named", "[fem][contact][self]") {

@@ -56,7 +56,15 @@ struct SelfContactOptions {
 // of the triangles' boxes (skin = half the thinnest face element's h); between builds each step
 // evaluates only those, so a step costs one pass over the contact nodes and one over the pairs.
 // The result does not depend on when the list was built (each node's candidates are kept in
-// triangle order), so a restart gives the same bits. Stateless: no committed state.
+// triangle order), so a restart gives the same bits.
+//
+// Faces that join (erosion exposes them; every face at the start): a node they find already
+// behind them, where the element between was crushed or distorted, would take the spring
+// energy 1/2 k g^2 of that depth from nowhere. Such a contact keeps the depth it was found at
+// as a pre-penetration and pushes only beyond it (p = k (|g| - pre) n, W = 1/2 k (|g| - pre)^2),
+// the pre-penetration followed down as the node comes out (as the DEM's mesh contacts do with a
+// face exposed under a particle). Committed state: the pre-penetration per contact node and
+// which faces took part at the last committed configuration.
 //
 // Explicit (central difference) analyses only: it offers no tangent. Stable step:
 // max_frequency_squared() estimates M^-1 K_c's largest eigenvalue for a node in one pair whose
@@ -77,6 +85,9 @@ class SelfContact final : public OperatorContribution {
   bool has_tangent() const override { return false; }
   double stored_energy() const override { return energy_; }
   double round_off() const override { return round_off_; }
+  void commit() override;
+  const std::vector<double>& committed_state() const override;
+  void set_committed_state(const std::vector<double>& state) override;
   double max_frequency_squared(const Eigen::VectorXd& nodal_mass) const override;
 
   /// Nodes that have left the structure (every element around them eroded) take no part.
@@ -129,6 +140,11 @@ class SelfContact final : public OperatorContribution {
     bool valid, owner_outside;
   };
   std::vector<Probe> probe_;
+  // per contact node the pre-penetration (committed, of the last add()); per face element
+  // whether it took part at the last committed configuration (a face not there then is new)
+  std::vector<double> pre_, pre_trial_;
+  std::vector<char> face_active_committed_;
+  mutable std::vector<double> state_;
   double energy_ = 0.0, round_off_ = 0.0, force_sum_ = 0.0;
   std::size_t active_ = 0;
   std::function<bool(std::size_t)> detached_, eroded_;
