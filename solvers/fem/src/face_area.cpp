@@ -1,5 +1,6 @@
 #include "partita/fem/face_area.hpp"
 
+#include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/quadrature.hpp"
 #include "partita/fem/shape_functions.hpp"
@@ -28,6 +29,25 @@ double face_area(const Mesh& mesh, const std::string& face) {
     }
   }
   return total;
+}
+
+double corner_area(const Mesh& mesh, const SurfaceElement& s) {
+  const auto& x0 = mesh.node(s.nodes[0]);
+  const auto& x1 = mesh.node(s.nodes[1]);
+  const auto& x2 = mesh.node(s.nodes[2]);
+  if (corner_count(s.type) == 3) return 0.5 * (x1 - x0).cross(x2 - x0).norm();
+  const auto& x3 = mesh.node(s.nodes[3]);
+  return 0.5 * (x2 - x0).cross(x3 - x1).norm();
+}
+
+double element_volume(const Mesh& mesh, const Element& e) {
+  const ElementCoordinates x = element_coordinates(mesh, e);
+  ShapeVector n;
+  ShapeGradient g;
+  double v = 0.0;
+  for (const auto& q : volume_rule(e.type, QuadratureUse::Stiffness))
+    v += physical_gradients(e.type, x, q.xi, n, g) * q.weight;
+  return v;
 }
 
 }  // namespace partita::fem

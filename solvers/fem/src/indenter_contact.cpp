@@ -7,32 +7,10 @@
 
 #include "partita/fem/element_integrator.hpp"
 #include "partita/fem/error.hpp"
+#include "partita/fem/face_area.hpp"
 #include "partita/fem/quadrature.hpp"
 
 namespace partita::fem {
-namespace {
-
-// Area of a face element: its corners' polygon (two triangles for a quadrilateral).
-double corner_area(const Mesh& mesh, const SurfaceElement& s) {
-  const auto& x0 = mesh.node(s.nodes[0]);
-  const auto& x1 = mesh.node(s.nodes[1]);
-  const auto& x2 = mesh.node(s.nodes[2]);
-  if (corner_count(s.type) == 3) return 0.5 * (x1 - x0).cross(x2 - x0).norm();
-  const auto& x3 = mesh.node(s.nodes[3]);
-  return 0.5 * (x2 - x0).cross(x3 - x1).norm();
-}
-
-double element_volume(const Mesh& mesh, const Element& e) {
-  const ElementCoordinates x = element_coordinates(mesh, e);
-  ShapeVector n;
-  ShapeGradient g;
-  double v = 0.0;
-  for (const auto& q : volume_rule(e.type, QuadratureUse::Stiffness))
-    v += physical_gradients(e.type, x, q.xi, n, g) * q.weight;
-  return v;
-}
-
-}  // namespace
 
 IndenterContact::IndenterContact(std::string name, const Model& model, const std::string& face,
                                  RigidIndenter indenter, IndenterContactOptions options)

@@ -42,6 +42,34 @@ std::size_t append_box(Mesh& into, const BoxSpec& spec, const std::string& set) 
   return offset;
 }
 
+// A column of three 10 mm steel cubes (1 x 1 x 3 Hex8) with the faces between elements, its
+// middle cube the one that erodes, and u with the top cube moved down by `by`.
+struct Column {
+  static constexpr double h = 0.01;
+  Model model;
+  BlockAssembler assembler;
+  Column() : model(mesh(), Material{210e9, 0.3, 7850}), assembler(model.mesh()) {}
+  static Mesh mesh() {
+    BoxSpec b;
+    b.size = Vec3(h, h, 3 * h);
+    b.cells = {1, 1, 3};
+    Mesh m = make_box_mesh(b);
+    m.add_interior_faces("between");
+    return m;
+  }
+  bool middle(std::size_t el) const {
+    double z = 0.0;
+    for (auto node : model.mesh().element(el).node_span()) z += model.mesh().node(node).z();
+    return std::abs(z / 8.0 - 1.5 * h) < 1e-9;
+  }
+  Eigen::VectorXd top_down(double by) const {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * model.mesh().num_nodes()));
+    for (std::size_t i = 0; i < model.mesh().num_nodes(); ++i)
+      if (model.mesh().node(i).z() > 1.5 * h) u[3 * static_cast<Eigen::Index>(i) + 2] = -by;
+    return u;
+  }
+};
+
 }  // namespace
 
 TEST_CASE("self contact: two blocks of one mesh meet as an elastic impact",
@@ -178,26 +206,13 @@ TEST_CASE("self contact: the faces an eroded element exposes push each other apa
   // a column of three 10 mm steel cubes; the middle one erodes while the top one has come down
   // onto the bottom one (the middle crushed flat), then the top one goes on down until its bottom
   // face lies 1 mm below the bottom cube's top face
-  const double e = 210e9, h = 0.01, factor = 0.1, pass = 1e-3;
-  BoxSpec b;
-  b.size = Vec3(h, h, 3 * h);
-  b.cells = {1, 1, 3};
-  Mesh mesh = make_box_mesh(b);
-  mesh.add_interior_faces("between");
-  const Model model(mesh, Material{e, 0.3, 7850});
-  const BlockAssembler assembler(model.mesh());
+  const double e = 210e9, h = Column::h, factor = 0.1, pass = 1e-3;
+  const Column col;
+  const Model& model = col.model;
+  const BlockAssembler& assembler = col.assembler;
   const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
-  const auto middle = [&](std::size_t el) {
-    double z = 0.0;
-    for (auto node : model.mesh().element(el).node_span()) z += model.mesh().node(node).z();
-    return std::abs(z / 8.0 - 1.5 * h) < 1e-9;
-  };
-  const auto top_down = [&](double by) {  // the top cube moved down by `by`
-    Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
-    for (std::size_t i = 0; i < model.mesh().num_nodes(); ++i)
-      if (model.mesh().node(i).z() > 1.5 * h) u[3 * static_cast<Eigen::Index>(i) + 2] = -by;
-    return u;
-  };
+  const auto middle = [&](std::size_t el) { return col.middle(el); };
+  const auto top_down = [&](double by) { return col.top_down(by); };
   SelfContact c("self", model, {"zmin", "zmax", "between"}, {factor, 0.5});
   Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
   c.set_time(0.0, 0.0);
@@ -252,27 +267,14 @@ TEST_CASE("self contact: a face that erosion exposes behind a node pushes only b
   // the column above, the middle element eroding when the top cube is already 1 mm through (a
   // crushed element): the new faces find the nodes 1 mm behind them and store nothing; 0.5 mm
   // further the springs hold 0.5 mm; back out, the depth follows the nodes down
-  const double e = 210e9, h = 0.01, factor = 0.1, pass = 1e-3;
-  BoxSpec b;
-  b.size = Vec3(h, h, 3 * h);
-  b.cells = {1, 1, 3};
-  Mesh mesh = make_box_mesh(b);
-  mesh.add_interior_faces("between");
-  const Model model(mesh, Material{e, 0.3, 7850});
-  const BlockAssembler assembler(model.mesh());
+  const double e = 210e9, h = Column::h, factor = 0.1, pass = 1e-3;
+  const Column col;
+  const Model& model = col.model;
+  const BlockAssembler& assembler = col.assembler;
   const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
-  const auto top_down = [&](double by) {
-    Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
-    for (std::size_t i = 0; i < model.mesh().num_nodes(); ++i)
-      if (model.mesh().node(i).z() > 1.5 * h) u[3 * static_cast<Eigen::Index>(i) + 2] = -by;
-    return u;
-  };
+  const auto top_down = [&](double by) { return col.top_down(by); };
   SelfContact c("self", model, {"zmin", "zmax", "between"}, {factor, 0.5});
-  c.set_eroded([&](std::size_t el) {
-    double z = 0.0;
-    for (auto node : model.mesh().element(el).node_span()) z += model.mesh().node(node).z();
-    return std::abs(z / 8.0 - 1.5 * h) < 1e-9;
-  });
+  c.set_eroded([&](std::size_t el) { return col.middle(el); });
   Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
   c.set_time(0.0, 0.0);
   c.add(top_down(h + pass), f, nullptr, assembler);

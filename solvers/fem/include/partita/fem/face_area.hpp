@@ -10,4 +10,11 @@ namespace partita::fem {
 // unknown face (listing the known ones) or a degenerate surface element.
 double face_area(const Mesh& mesh, const std::string& face);
 
+// Area [m^2] of one face element's corner polygon (two triangles for a quadrilateral), in the
+// reference configuration: the penalty contacts' share of a face per node.
+double corner_area(const Mesh& mesh, const SurfaceElement& s);
+
+// Volume [m^3] of a volume element in the reference configuration (its stiffness rule).
+double element_volume(const Mesh& mesh, const Element& e);
+
 }  // namespace partita::fem
