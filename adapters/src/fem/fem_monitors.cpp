@@ -92,7 +92,7 @@ const MonitorTable<FemAdapter>& FemAdapter::monitor_table() {
     t.scalar("self_contact_force", "N", "the sum of the self contact's normal forces |p| on its nodes",
              [](const A& a) { return a.self_contact_->total_normal_force(); }, self_contact);
     t.scalar("self_contact_energy", "J",
-             "the self contact's penalty energy 1/2 k g^2 (part of strain_energy)",
+             "the self contact's penalty energy, 1/2 k (depth - pre-penetration)^2 over its nodes (part of strain_energy)",
              [](const A& a) { return a.self_contact_->stored_energy(); }, self_contact);
     // rigid indenters (indenters:, indenter_config.hpp); before the regions' quantities: where a
     // region and an indenter share a name, the region's kinetic_energy is the one a monitor
