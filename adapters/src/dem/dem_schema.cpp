@@ -161,11 +161,11 @@ std::shared_ptr<Spec> make_spec() {
                "strength: unbreakable (nothing: it never breaks), powder (it is crushed to "
                "powder: removed, its mass and kinetic and contact energy counted in "
                "breakage.powder_mass and breakage.powder_energy; powder carries no load) or yield "
-               "(it stays, unbreakable, and where it meets the structure's meshes it yields: the "
-               "contact's mean pressure is held at its strength, the overlap beyond becomes "
-               "permanent and its work joins damping_work; a fragment pinched between two closing "
-               "faces is flattened instead of storing the elastic energy of an overlap of its own "
-               "size)",
+               "(it stays, unbreakable, and yields in its contacts with the structure's meshes and "
+               "with other particles: the contact's mean pressure is held at its strength, the "
+               "overlap beyond becomes permanent and its work joins damping_work; a fragment "
+               "pinched between two closing faces or by its neighbours is flattened instead of "
+               "storing the elastic energy of an overlap of its own size; planes stay elastic)",
                {"unbreakable", "powder", "yield"})
       .def("unbreakable");
   breakage

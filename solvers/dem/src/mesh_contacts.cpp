@@ -232,24 +232,11 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
       pre = static_cast<float>(k.delta);
     else if (from_old[a] >= 0 && old_pre[from_old[a]] > 0.0f)
       pre = std::min(old_pre[from_old[a]], static_cast<float>(k.delta));
-    double delta = pre > 0.0f ? std::max(0.0, k.delta - static_cast<double>(pre)) : k.delta;
-    const double cr = r - 0.5 * k.delta;
     const PairParameters& pp = model.pair(q.material, m.material());
-    // yield: the mean pressure F/(pi a^2) = 4 E* sqrt(delta) / (3 pi sqrt(R)) held at p_y, i.e.
-    // the elastic overlap at most delta_y = R (3 pi p_y / (4 E*))^2; the overlap beyond adds to
-    // the permanent one, the elastic force F_y = 4/3 E* sqrt(R) delta_y^(3/2) doing the work
-    if (q.yield_pressure > 0.0) {
-      const double root = 0.75 * std::numbers::pi * q.yield_pressure / pp.e_star;
-      const double delta_y = r * root * root;
-      if (delta > delta_y) {
-        const float yielded = static_cast<float>(k.delta - delta_y);
-        if constexpr (Energy)
-          wd->plastic += (4.0 / 3.0) * pp.e_star * std::sqrt(r) * delta_y * std::sqrt(delta_y) *
-                         (static_cast<double>(yielded) - static_cast<double>(pre));
-        pre = yielded;
-        delta = std::max(0.0, k.delta - static_cast<double>(pre));
-      }
-    }
+    // yield (yield_overlap()): the overlap beyond the elastic limit adds to the permanent one
+    const double delta = yield_overlap(k.delta, r, pp.e_star, q.yield_pressure, pre,
+                                       Energy ? &wd->plastic : nullptr);
+    const double cr = r - 0.5 * k.delta;
     Eigen::Vector3d fw, ft;
     DissipativeParts parts;
     const double fn = hertz_mindlin(pp, delta, r, q.m, k.normal, q.v - v_wall, cr * q.w, shear, dt,

@@ -4,6 +4,7 @@
 #include "partita/dem/error.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -22,19 +23,42 @@ void PairContacts::follow(const std::vector<NeighborList::SlotSource>& sources) 
       new_shear_[k] = shear_[src.slot];
   }
   shear_.swap(new_shear_);
+  if (keep_plastic_) {
+    new_plastic_.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      new_plastic_[k] = sources[k].slot < 0 || plastic_.empty() ? 0.0f : plastic_[sources[k].slot];
+    plastic_.swap(new_plastic_);
+  }
   touching_.assign(n, 1);  // the next force pass settles forces and histories
+}
+
+void PairContacts::keep_plastic() {
+  keep_plastic_ = true;
+  plastic_.assign(shear_.size(), 0.0f);
 }
 
 void PairContacts::write(BinaryWriter& out) const {
   out.array(shear_);
   out.array(touching_);
+  out.array(plastic_);
 }
 
-void PairContacts::read(BinaryReader& in, std::size_t slots) {
+void PairContacts::read(BinaryReader& in, std::size_t slots, bool with_plastic) {
   in.array(shear_, "pair histories");
   in.array(touching_, "pair contact flags");
-  if (shear_.size() != slots || touching_.size() != slots)
+  if (with_plastic)
+    in.array(plastic_, "pair permanent overlaps");
+  else
+    plastic_.clear();
+  if (shear_.size() != slots || touching_.size() != slots ||
+      !(plastic_.empty() || plastic_.size() == slots))
     throw Error("corrupt state: neighbour list arrays do not agree");
+  // a state of a system without yielding particles, read by one with them: none yet (and the
+  // other way round: the permanent overlaps are dropped, as the contacts are then elastic)
+  if (keep_plastic_ && plastic_.empty())
+    plastic_.assign(slots, 0.0f);
+  else if (!keep_plastic_)
+    plastic_.clear();
 }
 
 // ---- histories that travel with their particles ---------------------------------------------
@@ -46,6 +70,7 @@ void put_record(const PairContacts::Record& r, std::byte* at) {
   std::memcpy(at + 8, &r.id_j, 8);
   std::memcpy(at + 16, r.shear.data(), 24);
   std::memcpy(at + 40, &r.touching, 1);
+  std::memcpy(at + 41, &r.plastic, 4);
 }
 
 PairContacts::Record get_record(const std::byte* at) {
@@ -54,6 +79,7 @@ PairContacts::Record get_record(const std::byte* at) {
   std::memcpy(&r.id_j, at + 8, 8);
   std::memcpy(r.shear.data(), at + 16, 24);
   std::memcpy(&r.touching, at + 40, 1);
+  std::memcpy(&r.plastic, at + 41, 4);
   return r;
 }
 
@@ -76,8 +102,10 @@ std::size_t PairContacts::pack(const NeighborList& nl, const std::vector<std::in
     for (int i = 0; i < rows; ++i) {
       for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
         const int j = nl.neighbors_[s];
-        if (!(chosen[i] || chosen[j]) || shear_[s] == Eigen::Vector3d::Zero()) continue;
-        append(Record{id[i], id[j], shear_[s], touching_[s]});
+        const float plastic = plastic_.empty() ? 0.0f : plastic_[s];
+        if (!(chosen[i] || chosen[j]) || (shear_[s] == Eigen::Vector3d::Zero() && plastic == 0.0f))
+          continue;
+        append(Record{id[i], id[j], shear_[s], touching_[s], plastic});
       }
     }
   }
@@ -91,10 +119,12 @@ std::size_t PairContacts::pack(const NeighborList& nl, const std::vector<std::in
 void PairContacts::check_packed(const std::byte* data, std::size_t count) {
   for (std::size_t k = 0; k < count; ++k) {
     const Record r = get_record(data + k * record_bytes);
-    if (r.id_i < 0 || r.id_j < 0 || r.id_i == r.id_j || !r.shear.allFinite())
+    const bool plastic_ok = std::isfinite(r.plastic) && r.plastic >= 0.0f;
+    if (r.id_i < 0 || r.id_j < 0 || r.id_i == r.id_j || !r.shear.allFinite() || !plastic_ok)
       throw Error("pair history " + std::to_string(k) + " of the message names particles " +
                   std::to_string(r.id_i) + " and " + std::to_string(r.id_j) +
                   (r.shear.allFinite() ? "" : " with a spring that is not finite") +
+                  (plastic_ok ? "" : " with a permanent overlap that is not a finite value >= 0") +
                   " (a pair needs two distinct ids >= 0: corrupt or foreign bytes?)");
   }
 }
@@ -131,6 +161,7 @@ void PairContacts::place_waiting(const NeighborList& nl, const std::vector<std::
     if (s < sources.size() && sources[s].slot >= 0) continue;  // carried over by the build
     // (the slot keeps follow()'s touching mark: the next force pass settles the pair)
     shear_[s] = a < b ? r.shear : Eigen::Vector3d(-r.shear);
+    if (!plastic_.empty()) plastic_[s] = r.plastic;
   }
   waiting_.clear();
 }

@@ -19,7 +19,7 @@ namespace {
 
 constexpr std::uint32_t moves_magic = 0x4d445350u;    // "PSDM"
 constexpr std::uint32_t refresh_magic = 0x52484750u;  // "PGHR"
-constexpr std::uint32_t format_version = 1;
+constexpr std::uint32_t format_version = 2;  // 2: pair records carry the permanent overlap
 constexpr std::size_t moves_header = 4 + 4 + 8 + 8;
 constexpr std::size_t refresh_header = 4 + 4 + 8;
 constexpr std::size_t refresh_row = 8 + 9 * 8;

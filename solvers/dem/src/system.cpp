@@ -325,6 +325,7 @@ int System::add_hook(std::unique_ptr<StepHook> hook) {
                   "' brings contact yield pressures and another hook has them already (one per "
                   "system)");
     yield_ = y;
+    pairs_.keep_plastic();  // pairs with a yielding particle keep their permanent overlaps
   }
   forces_valid_ = false;
   prepared_ = false;  // sizes the load array (the lists stay)
@@ -630,7 +631,8 @@ double System::set_energy(const std::vector<std::size_t>& which, const std::vect
     const double rsum = p.radius[i] + p.radius[j];
     const double delta = rsum - (p.position[i] - p.position[j]).norm();
     if (delta <= 0.0) continue;
-    e += hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
+    e += hertz_elastic_energy(model_.pair(p.material[i], p.material[j]),
+                              elastic_overlap(delta, pairs_.plastic(s)),
                               p.radius[i] * p.radius[j] / rsum, pairs_.shear(s));
   }
   mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec, const Eigen::Vector3d& shear) {

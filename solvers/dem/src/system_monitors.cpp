@@ -113,12 +113,13 @@ double System::elastic_energy() const {
   double e = 0.0;
   const int n = static_cast<int>(p.size());
   const Eigen::Vector3d no_shear = Eigen::Vector3d::Zero();
-  auto pair_energy = [&](int i, int j, const Eigen::Vector3d& shear) {
+  auto pair_energy = [&](int i, int j, const Eigen::Vector3d& shear, double plastic) {
     const double rsum = p.radius[i] + p.radius[j];
     const double delta = rsum - (p.position[i] - p.position[j]).norm();
     if (delta <= 0.0) return 0.0;
-    return hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
-                                p.radius[i] * p.radius[j] / rsum, shear);
+    return hertz_elastic_energy(model_.pair(p.material[i], p.material[j]),
+                                elastic_overlap(delta, plastic), p.radius[i] * p.radius[j] / rsum,
+                                shear);
   };
   // The contacts of the last force pass, with their histories. Without lists for the present
   // particles (before the first step, or after a change of the particle set until the next step)
@@ -137,18 +138,26 @@ double System::elastic_energy() const {
   const int kept_rows = current || pairs_.slot_count() != lists.neighbors_.size()
                             ? 0
                             : static_cast<int>(lists.offsets_.size()) - 1;
-  auto kept_shear = [&](int i, int j) -> const Eigen::Vector3d& {
-    if (i >= kept_rows) return no_shear;
+  // the slot of the kept pair (i, j), or -1
+  auto kept_slot = [&](int i, int j) -> std::ptrdiff_t {
+    if (i >= kept_rows) return -1;
     const auto first = lists.neighbors_.begin() + lists.offsets_[i];
     const auto last = lists.neighbors_.begin() + lists.offsets_[i + 1];
     const auto at = std::lower_bound(first, last, j);
-    if (at == last || *at != j) return no_shear;
-    return pairs_.shear(static_cast<std::size_t>(at - lists.neighbors_.begin()));
+    if (at == last || *at != j) return -1;
+    return at - lists.neighbors_.begin();
   };
   for (int i = 0; i < n; ++i)
     for (int s = nl.offsets_[i]; s < nl.offsets_[i + 1]; ++s) {
       const int j = nl.neighbors_[s];
-      e += pair_energy(i, j, current ? pairs_.shear(s) : kept_shear(i, j));
+      if (current) {
+        e += pair_energy(i, j, pairs_.shear(s), pairs_.plastic(s));
+      } else {
+        const std::ptrdiff_t k = kept_slot(i, j);
+        e += k < 0 ? pair_energy(i, j, no_shear, 0.0)
+                   : pair_energy(i, j, pairs_.shear(static_cast<std::size_t>(k)),
+                                 pairs_.plastic(static_cast<std::size_t>(k)));
+      }
     }
   const std::size_t np = planes.size();
   const bool have_shear = plane_shear.size() == p.size() * np;

@@ -162,7 +162,8 @@ void System::add_elastic_energy(const std::vector<char>& skip, ExactSum& sum) co
       const double rsum = p.radius[i] + p.radius[j];
       const double delta = rsum - (p.position[i] - p.position[j]).norm();
       if (delta <= 0.0) continue;
-      sum.add(hertz_elastic_energy(model_.pair(p.material[i], p.material[j]), delta,
+      sum.add(hertz_elastic_energy(model_.pair(p.material[i], p.material[j]),
+                                   elastic_overlap(delta, pairs_.plastic(s)),
                                    p.radius[i] * p.radius[j] / rsum, pairs_.shear(s)));
     }
   }

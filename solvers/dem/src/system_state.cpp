@@ -42,10 +42,10 @@ SystemState SystemState::read(std::istream& in) {
         "'PTDEMST1'); give a file written by System::write_state");
   BinaryReader r(in);
   const auto version = r.value<std::uint32_t>("the format version");
-  if (version != format_version)
+  if (version < oldest_version || version > format_version)
     throw Error("read_state: the state has format version " + std::to_string(version) +
-                "; this build reads version " + std::to_string(format_version) +
-                " only (write it again with a matching build)");
+                "; this build reads versions " + std::to_string(oldest_version) + " to " +
+                std::to_string(format_version) + " only (write it again with a matching build)");
   const auto bom = r.value<std::uint32_t>("the byte-order mark");
   if (bom != byte_order_mark)
     throw Error(
@@ -57,6 +57,7 @@ SystemState SystemState::read(std::istream& in) {
   s.particles_ = static_cast<std::size_t>(r.value<std::uint64_t>("the particle count"));
   s.body_ = r.string("the state body");
   s.origin_ = 0;
+  s.version_ = version;
   return s;
 }
 
@@ -85,7 +86,7 @@ void System::restore_state(const SystemState& s) {
   }
   std::istringstream in(s.body_, std::ios::binary);
   BinaryReader r(in);
-  read_body(r);
+  read_body(r, s.version_);
   pairs_.clear_waiting();  // (received histories belong to the state that was replaced)
   verlet_.store_replaced();
   partition_.invalidate();
@@ -146,7 +147,7 @@ void System::write_body(BinaryWriter& w) const {
 
 // The set-up is checked first (nothing is changed when the state does not fit); a body that is
 // inconsistent further on (corrupt data) throws with the system partly overwritten.
-void System::read_body(BinaryReader& r) {
+void System::read_body(BinaryReader& r, std::uint32_t version) {
   r.expect(body_tag, "the body tag");
   r.expect(static_cast<std::int32_t>(model_.material_count()), "the number of materials");
   r.expect(static_cast<std::int32_t>(walls_.wall_count()), "the number of walls");
@@ -168,7 +169,7 @@ void System::read_body(BinaryReader& r) {
   walls_.read(r);
   for (TriangleMesh& m : meshes_) m.read_state(r);
   neighbors_.read_rows(r);
-  pairs_.read(r, neighbors_.pair_count());
+  pairs_.read(r, neighbors_.pair_count(), version >= 5);
   neighbors_.read_build_references(r);
   walls_.read_forces(r);
   r.value(time_, "the time");

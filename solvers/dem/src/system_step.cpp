@@ -332,6 +332,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   const double* load_limit = Limit ? store_.array<double>(h_load_limit_).data() : nullptr;
   const double* yield_pressure_of =
       yield_.pressure >= 0 ? store_.array<double>(yield_.pressure).data() : nullptr;
+  // pairs with a yielding particle (nullptr: none)
+  const PairYield pair_yield{yield_pressure_of, yield_.below_diameter, pairs.plastic};
+  const PairYield* const yield = pairs.plastic != nullptr && yield_pressure_of != nullptr ? &pair_yield : nullptr;
   const MeshContacts::Pass mesh = mesh_contacts_.pass();  // rows: particles near a mesh
   const int* const offsets = nl.offsets_.data();
   const int* const neighbors = nl.neighbors_.data();
@@ -395,14 +398,17 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         const bool touch = !(d.squaredNorm() >= rsum * rsum);  // (as the scalar kernel)
         if (static_cast<char>(touch) != pairs.touching[c.slot]) {
           pairs.touching[c.slot] = static_cast<char>(touch);
-          if (!touch) pairs.shear[c.slot].setZero();  // parted: the history is settled
+          if (!touch) {  // parted: the history is settled
+            pairs.shear[c.slot].setZero();
+            if (pairs.plastic != nullptr) pairs.plastic[c.slot] = 0.0f;
+          }
         }
         tp.cross_force[k].touching = touch;
         chunk_tasks[n_touch] = PairTask{c.slot, c.i, c.j};
         n_touch += touch ? 1 : 0;
       }
       batch(chunk_tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
-            chunk_forces, chunk_energy);
+            chunk_forces, chunk_energy, yield);
       const PairForce* o = chunk_forces;
       for (int k = k0; k < k1; ++k) {
         ThreadPartition::CrossForce& cf = tp.cross_force[k];
@@ -489,7 +495,10 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           // unlike one on the flag or on the test themselves)
           if (static_cast<char>(touch) != pairs.touching[s]) {
             pairs.touching[s] = static_cast<char>(touch);
-            if (!touch) pairs.shear[s].setZero();  // parted: the history is settled
+            if (!touch) {  // parted: the history is settled
+              pairs.shear[s].setZero();
+              if (pairs.plastic != nullptr) pairs.plastic[s] = 0.0f;
+            }
           }
           tasks[n_touch] = PairTask{s, i, j};
           n_touch += touch ? 1 : 0;
@@ -498,7 +507,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
       }
       row_first[i_end - i_begin] = n_touch;
       batch(tasks, n_touch, packed, mass, material, model_, pairs.shear, dt, update_history,
-            forces, energies);
+            forces, energies, yield);
       BlockEnergy block_e;  // (Energy) this block's energies: powers x dt, spring energies
       for (int i = i_begin; i < i_end; ++i) {
         PackedParticle& qi = packed[i];
@@ -534,6 +543,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
             dj.tf += Eigen::Map<const Eigen::Vector3d>(e.tfj);
             block_e.friction += e.spring;
             block_e.stiffening += e.stiffening;
+            block_e.damping += e.plastic;
           }
         }
         for (int s = row_cross[i - i_begin]; s < offsets[i + 1]; ++s) {  // already evaluated
@@ -550,6 +560,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
               di.tf += Eigen::Map<const Eigen::Vector3d>(e.tfi);
               block_e.friction += e.spring;
               block_e.stiffening += e.stiffening;
+              block_e.damping += e.plastic;
             }
           }
         }

@@ -268,6 +268,84 @@ TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh yields 
   CHECK(elastic.elastic > 50.0 * yielding.elastic);
 }
 
+TEST_CASE("dem: below the comminution limit two granules that collide yield and rebound at the "
+          "yield velocity", "[dem][breakage][energy]") {
+  // Two equal granules below the comminution limit (below_limit yield), no damping (restitution
+  // 1), head on at v. Their contact's mean pressure is held at their strength sigma: elastic up
+  // to delta_y = R* (3 pi sigma / (4 E*))^2, where it carries F_y = 4/3 E* sqrt(R*) delta_y^1.5
+  // and stores W_y = 2/5 F_y delta_y; beyond, the overlap becomes permanent and F_y's work is
+  // dissipated. Unloading gives back W_y only, so the granules part at the yield velocity
+  // v_y = sqrt(2 W_y / m*): restitution v_y / v, the rest of the kinetic energy dissipated.
+  // The state written mid-contact (the permanent overlap with it) resumes to the same bits.
+  const double d = 2.0e-3, v = 3.5;
+  BreakageParameters b = parameters(3.0);
+  b.comminution_limit = 2.5e-3;
+  b.yield = true;
+  const double sigma = b.limit_strength;  // d = d0
+  const double e_star = E / (2.0 * (1.0 - NU * NU)), r_star = 0.25 * d;
+  const double root = 0.75 * std::numbers::pi * sigma / e_star;
+  const double delta_y = r_star * root * root;
+  const double f_y = 4.0 / 3.0 * e_star * std::sqrt(r_star) * std::pow(delta_y, 1.5);
+  const double mass = test::sphere_mass(0.5 * d, RHO), m_star = 0.5 * mass;
+  const double v_y = std::sqrt(2.0 * 0.4 * f_y * delta_y / m_star);
+  REQUIRE(v_y < 0.5 * v);
+  const auto setup = [&](System& sys, bool yield) {
+    b.yield = yield;
+    const int g = sys.add_material({E, NU, RHO});
+    sys.add_interaction(g, g, {0.0, 1.0, 0.0});
+    sys.add_particle({-0.5 * d - 1e-6, 0, 0}, 0.5 * d, g);
+    sys.add_particle({0.5 * d + 1e-6, 0, 0}, 0.5 * d, g);
+    sys.set_particle_velocity(0, {0.5 * v, 0, 0});
+    sys.set_particle_velocity(1, {-0.5 * v, 0, 0});
+    sys.add_hook(std::make_unique<Breakage>(b));
+    sys.set_energy_tracking(true);
+  };
+  System sys;
+  setup(sys, true);
+  const double dt = 0.05 * sys.rayleigh_time_step();
+  const long steps = static_cast<long>(4.0 * 0.5 * d / v / dt);  // long after they part
+  std::stringstream mid;
+  double deepest = 0.0;
+  long written = -1;  // the step after which the state was written (yielding)
+  for (long k = 0; k < steps; ++k) {
+    sys.step(dt);
+    const Particles& p = sys.particles();
+    deepest = std::max(deepest, d - (p.position[1] - p.position[0]).norm());
+    if (written < 0 && deepest > 2.0 * delta_y) {
+      sys.write_state(mid);
+      written = k;
+    }
+  }
+  REQUIRE(written > 0);
+  const Particles& p = sys.particles();
+  const double rebound = p.velocity[1].x() - p.velocity[0].x();
+  const double ke_in = 0.5 * m_star * v * v;
+  INFO("v_y " << v_y << " m/s, rebound " << rebound << " m/s; deepest overlap " << deepest
+              << " m, delta_y " << delta_y << " m; dissipated " << sys.energies().damping
+              << " J of " << ke_in << " J; balance error " << sys.energy_balance_error());
+  REQUIRE(sys.particle_count() == 2);
+  CHECK(breakage_of(sys).counters().events == 0);
+  CHECK(p.mass[0] == Approx(mass).epsilon(1e-12));
+  CHECK(rebound == Approx(v_y).epsilon(0.01));
+  // the deepest overlap: F_y (deepest - delta_y) + W_y = the kinetic energy of the approach
+  CHECK(deepest == Approx(delta_y + (ke_in - 0.4 * f_y * delta_y) / f_y).epsilon(0.01));
+  CHECK(sys.energies().damping == Approx(ke_in - 0.5 * m_star * v_y * v_y).epsilon(0.01));
+  CHECK(std::abs(sys.energy_balance_error()) < 1e-3);
+  // resumed from the state written mid-contact: the same bits
+  System resumed;
+  setup(resumed, true);
+  resumed.read_state(mid);
+  for (long k = written + 1; k < steps; ++k) resumed.step(dt);
+  CHECK(resumed.particles().velocity[1].x() == p.velocity[1].x());
+  CHECK(resumed.particles().position[1].x() == p.position[1].x());
+  // elastic granules (below_limit unbreakable) rebound at the speed they came
+  System elastic;
+  setup(elastic, false);
+  for (long k = 0; k < steps; ++k) elastic.step(dt);
+  const Particles& q = elastic.particles();
+  CHECK(q.velocity[1].x() - q.velocity[0].x() == Approx(v).epsilon(0.01));
+}
+
 TEST_CASE("dem: breakage conserves momentum and does not create kinetic energy",
           "[dem][breakage]") {
   for (const std::string& pattern : FragmentPattern::names())

@@ -70,14 +70,14 @@ bool same_by_id(const System& a, const System& b) {
 }
 
 // A message of System::pack_particles() without its pair records (header: 41 bytes; the
-// particle count at byte 16, the record count at 24; records of 41 bytes after the particles).
+// particle count at byte 16, the record count at 24; records of PairContacts::record_bytes after the particles).
 std::vector<std::byte> without_pair_records(const std::vector<std::byte>& m, std::size_t row) {
   std::uint64_t n = 0, records = 0;
   std::memcpy(&n, m.data() + 16, 8);
   std::memcpy(&records, m.data() + 24, 8);
   const std::size_t pairs_at = 41 + n * row;
   std::vector<std::byte> out(m.begin(), m.begin() + static_cast<std::ptrdiff_t>(pairs_at));
-  out.insert(out.end(), m.begin() + static_cast<std::ptrdiff_t>(pairs_at + records * 41), m.end());
+  out.insert(out.end(), m.begin() + static_cast<std::ptrdiff_t>(pairs_at + records * PairContacts::record_bytes), m.end());
   const std::uint64_t none = 0;
   std::memcpy(out.data() + 24, &none, 8);
   return out;
@@ -308,7 +308,7 @@ TEST_CASE("dem: malformed particle messages are refused with the system unchange
   std::memcpy(&records, good.data() + 24, 8);
   REQUIRE(records > 0);
   const std::size_t pairs_at = header + which.size() * row;
-  const std::size_t mesh_at = pairs_at + records * 41;
+  const std::size_t mesh_at = pairs_at + records * PairContacts::record_bytes;
 
   refused({good.begin(), good.end() - 1}, "cut short by a byte");
   refused({good.begin(), good.begin() + 20}, "shorter than the header");

@@ -2,7 +2,8 @@
 // on random touching pairs of every branch of the law (both damping models, so both tangential
 // caps and the tension clamp; friction off and on, sticking and sliding, a zero history;
 // rolling resistance off and on; restitution 1, no damping; coincident centres), every kernel
-// set this CPU runs gives the scalar kernel's bits: forces, torques, load and history.
+// set this CPU runs gives the scalar kernel's bits: forces, torques, load and history; with
+// yielding particles also the permanent overlaps and the work of their growth.
 
 #include "partita/dem/pair_batch.hpp"
 #include "partita/dem/contact_model.hpp"
@@ -31,7 +32,25 @@ struct Contacts {
   std::vector<int> material;
   std::vector<PairTask> tasks;
   std::vector<Eigen::Vector3d> shear;
+  // yield (empty: none): per particle the yield pressure, per slot the permanent overlap
+  std::vector<double> pressure;
+  std::vector<float> plastic;
+  double below_diameter = 0.0;
 };
+
+// Yielding particles for c: a third below the diameter limit with a yield pressure, some
+// pairs with a permanent overlap (below, near and above the present overlap)
+void add_yield(Contacts& c, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  c.below_diameter = 2.0e-3;  // radii 0.5..1.5 mm: about half the particles
+  for (std::size_t i = 0; i < c.packed.size(); ++i)
+    c.pressure.push_back(i % 3 == 2 ? 0.0 : 1.0e6 * (1.0 + 20.0 * unit(rng)));
+  for (const PairTask& t : c.tasks) {
+    const double overlap = c.packed[t.i].r + c.packed[t.j].r - (c.packed[t.i].x - c.packed[t.j].x).norm();
+    const int kind = t.s % 4;
+    c.plastic.push_back(kind == 0 ? 0.0f : static_cast<float>(overlap * (kind == 1 ? 0.3 : kind == 2 ? 0.999 : 1.5)));
+  }
+}
 
 // n pairs (2k, 2k + 1), each overlapping, in slot k; materials drawn from 0..materials-1
 Contacts random_contacts(int n, int materials, std::mt19937_64& rng) {
@@ -89,24 +108,37 @@ void check_against_scalar(const ContactModel& model, const Contacts& c, bool upd
   const double dt = 1e-6;
   // the scalar kernel
   std::vector<Eigen::Vector3d> shear_scalar = c.shear;
+  std::vector<float> plastic_scalar = c.plastic;
+  const bool yields = !c.pressure.empty();
   std::vector<PairForce> expected(static_cast<std::size_t>(n));
+  std::vector<double> work_scalar(static_cast<std::size_t>(n), 0.0);
+  int yielded = 0;
   for (int k = 0; k < n; ++k) {
     const PairTask& t = c.tasks[k];
     char touching = 0;
     Eigen::Vector3d f = Eigen::Vector3d::Zero(), ti = f, tj = f;
     double load = 0.0;
+    double p_y = 0.0;
+    if (yields)
+      p_y = pair_yield_pressure(2.0 * c.packed[t.i].r < c.below_diameter ? c.pressure[t.i] : 0.0,
+                                2.0 * c.packed[t.j].r < c.below_diameter ? c.pressure[t.j] : 0.0);
     const bool touch = PairContacts::force<Load>(
         model, c.packed[t.i], c.packed[t.j], c.mass[t.i], c.mass[t.j], c.material[t.i],
-        c.material[t.j], shear_scalar[t.s], touching, dt, update_history, f, ti, tj, load);
+        c.material[t.j], shear_scalar[t.s], touching, dt, update_history, f, ti, tj, load,
+        yields ? &plastic_scalar[t.s] : nullptr, p_y, &work_scalar[k]);
     REQUIRE(touch);
+    yielded += work_scalar[k] > 0.0 ? 1 : 0;
     PairForce& e = expected[k];
     for (int a = 0; a < 3; ++a) e.f[a] = f[a], e.ti[a] = ti[a], e.tj[a] = tj[a];
     e.load = load;
   }
+  if (yields && update_history) CHECK(yielded > n / 10);  // the yield branch is exercised
   // the batch, in pieces of every length up to 2 x lanes + 1 (partly filled vectors); the
   // kernels with the energy parts give the same forces
   for (const bool with_energy : {false, true}) {
   std::vector<Eigen::Vector3d> shear_batch = c.shear;
+  std::vector<float> plastic_batch = c.plastic;
+  const PairYield yield{c.pressure.data(), c.below_diameter, plastic_batch.data()};
   std::vector<PairForce> got(static_cast<std::size_t>(n));
   std::vector<PairEnergy> energy(static_cast<std::size_t>(n));
   const PairBatchKernel kernel = with_energy ? (Load ? set.with_load_energy : set.plain_energy)
@@ -114,7 +146,8 @@ void check_against_scalar(const ContactModel& model, const Contacts& c, bool upd
   for (int k = 0, piece = 1; k < n; k += piece, piece = piece % (2 * set.lanes + 1) + 1) {
     const int m = std::min(piece, n - k);
     kernel(c.tasks.data() + k, m, c.packed.data(), c.mass.data(), c.material.data(), model,
-           shear_batch.data(), dt, update_history, got.data() + k, energy.data() + k);
+           shear_batch.data(), dt, update_history, got.data() + k, energy.data() + k,
+           yields ? &yield : nullptr);
   }
   int differ = 0;
   for (int k = 0; k < n; ++k) {
@@ -122,7 +155,9 @@ void check_against_scalar(const ContactModel& model, const Contacts& c, bool upd
                       same_bits(expected[k].ti, got[k].ti, 3) &&
                       same_bits(expected[k].tj, got[k].tj, 3) &&
                       (!Load || same_bits(&expected[k].load, &got[k].load, 1)) &&
-                      same_bits(shear_scalar[k].data(), shear_batch[k].data(), 3);
+                      same_bits(shear_scalar[k].data(), shear_batch[k].data(), 3) &&
+                      plastic_scalar == plastic_batch &&
+                      (!with_energy || !yields || same_bits(&work_scalar[k], &energy[k].plastic, 1));
     if (!same && ++differ <= 3)
       UNSCOPED_INFO("pair " << k << " differs: f " << expected[k].f[0] << " / " << got[k].f[0]);
   }
@@ -148,6 +183,13 @@ TEST_CASE("dem: the batched pair kernels give the scalar kernel's bits", "[dem][
         for (bool update : {true, false}) {
           check_against_scalar<false>(model, c, update, *sets[s]);
           check_against_scalar<true>(model, c, update, *sets[s]);
+        }
+        Contacts yielding = c;
+        add_yield(yielding, rng);
+        for (bool update : {true, false}) {
+          INFO("with yielding particles");
+          check_against_scalar<false>(model, yielding, update, *sets[s]);
+          check_against_scalar<true>(model, yielding, update, *sets[s]);
         }
       }
     }

@@ -80,7 +80,7 @@ double time_step() {
 }
 
 // One System::pack_particles() message (header 41 bytes: n at 16, pair records at 24, the mesh
-// bytes at 32; the particles, the records of 41 bytes, then per particle a count (int32) and its
+// bytes at 32; the particles, the records of PairContacts::record_bytes, then per particle a count (int32) and its
 // contacts) with every particle's count 0: a particle arrives without its tangential springs on
 // the plate. Adds the contacts taken out to `stripped`.
 std::vector<std::byte> without_mesh_contacts(System& any, const std::byte* m, std::size_t bytes,
@@ -88,7 +88,7 @@ std::vector<std::byte> without_mesh_contacts(System& any, const std::byte* m, st
   using test::read_at;
   const auto n = read_at<std::uint64_t>(m + 16), records = read_at<std::uint64_t>(m + 24);
   const std::size_t mesh_at =
-      41 + n * any.store_unsynced().packed_bytes_per_particle() + records * 41;
+      41 + n * any.store_unsynced().packed_bytes_per_particle() + records * PairContacts::record_bytes;
   stripped += static_cast<long>((bytes - mesh_at - 4 * n) / MeshContacts::packed_contact_bytes);
   std::vector<std::byte> out(m, m + mesh_at);
   out.resize(mesh_at + 4 * n, std::byte{0});

@@ -57,13 +57,13 @@ std::unique_ptr<System> subdomain_system(const std::vector<int>& keep) {
 }
 
 // One System::pack_particles() message without its pair records (header 41 bytes: n at 16, the
-// record count at 24; records of 41 bytes after the particles): the histories do not travel.
+// record count at 24; records of PairContacts::record_bytes after the particles): the histories do not travel.
 std::vector<std::byte> without_records(System& any, const std::byte* m, std::size_t bytes) {
   using test::read_at;
   const auto n = read_at<std::uint64_t>(m + 16), records = read_at<std::uint64_t>(m + 24);
   const std::size_t pairs_at = 41 + n * any.store_unsynced().packed_bytes_per_particle();
   std::vector<std::byte> out(m, m + pairs_at);
-  out.insert(out.end(), m + pairs_at + records * 41, m + bytes);
+  out.insert(out.end(), m + pairs_at + records * PairContacts::record_bytes, m + bytes);
   const std::uint64_t none = 0;
   std::memcpy(out.data() + 24, &none, 8);
   return out;

@@ -22,13 +22,14 @@ struct BreakageParameters {
   /// (BreakageCounters::powder_*). Powder carries no load: use it where the fines are few or
   /// where an unbreakable sphere would be squeezed through a gap narrower than itself.
   bool powder = false;
-  /// (Exclusive with powder.) true: a particle with d < d_min yields where it meets the
-  /// structure (mesh contacts): the contact's mean pressure F/(pi a^2) is held at the particle's
-  /// strength sigma (the same value that would break it above d_min), the overlap beyond becomes
-  /// permanent (an elastic-perfectly plastic contact, Thornton 1997 with the yield pressure
-  /// p_y = sigma) and its work is dissipated (booked with the damping). A fragment that two
-  /// closing faces pinch is flattened instead of storing the Hertz energy of an overlap of its
-  /// own size; its mass stays in the bed. Between particles the contact stays elastic.
+  /// (Exclusive with powder.) true: a particle with d < d_min yields in its contacts with the
+  /// structure (meshes) and with other particles: the contact's mean pressure F/(pi a^2) is held
+  /// at the particle's strength sigma (the same value that would break it above d_min; between
+  /// two such particles the weaker one's), the overlap beyond becomes permanent (an
+  /// elastic-perfectly plastic contact, Thornton 1997 with the yield pressure p_y = sigma;
+  /// yield_overlap()) and its work is dissipated (booked with the damping). A fragment that two
+  /// closing faces or its neighbours pinch is flattened instead of storing the Hertz energy of an
+  /// overlap of its own size; its mass stays in the bed. Planes stay elastic.
   bool yield = false;
   FragmentPattern::Kind pattern = FragmentPattern::Kind::apollonian_14;
   /// false: the mass the inscribed fragments cannot hold is lost (counted); true: it is restored

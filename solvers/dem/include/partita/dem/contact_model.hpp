@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -206,6 +207,57 @@ PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, d
   if (parts) parts->stiffening = stiffening;
   force += f_tangential;
   return f_n;
+}
+
+/// Particles that yield in their contacts with each other (StepHook::contact_yield()): a pair
+/// with a yielding particle holds its mean Hertz pressure F/(pi a^2) at the yield pressure, the
+/// overlap beyond becoming the pair's permanent overlap (PairContacts). The force pass hands the
+/// pair kernels this (nullptr: no particle yields).
+struct PairYield {
+  const double* pressure;  ///< per particle: the yield pressure [Pa] (<= 0: none)
+  double below_diameter;   ///< it applies to particles with 2 r below this [m]
+  float* plastic;          ///< per pair slot: the permanent overlap [m]
+};
+
+/// The yield pressure of a pair whose particles yield at pi and pj (<= 0: that one does not):
+/// the weaker of the two that yield, 0 when neither does.
+inline double pair_yield_pressure(double pi, double pj) {
+  return pi > 0.0 && pj > 0.0 ? std::min(pi, pj) : std::max(pi, std::max(pj, 0.0));
+}
+
+/// An elastic-perfectly plastic contact (Thornton 1997 with the mean contact pressure limited to
+/// p_y): the overlap delta of a contact of effective radius r_eff whose permanent part is
+/// `plastic` (followed down where delta is smaller: the surfaces have parted that far) is
+/// elastic up to delta_y = r_eff (3 pi p_y / (4 E*))^2 (the overlap at which the mean Hertz
+/// pressure 4 E* sqrt(delta) / (3 pi sqrt(r_eff)) reaches p_y); beyond it the permanent overlap
+/// grows to delta - delta_y and the elastic force F_y = 4/3 E* sqrt(r_eff) delta_y^(3/2) does the
+/// work F_y x its growth (added to *work). Returns the elastic overlap (>= 0); p_y <= 0: no
+/// yield (the permanent overlap only followed down). The permanent overlap is a float (a pair's
+/// or a mesh contact's 4 bytes); the work is taken on the stored values.
+inline double yield_overlap(double delta, double r_eff, double e_star, double p_y, float& plastic,
+                            double* work) {
+  float pl = std::min(plastic, static_cast<float>(delta));
+  double elastic = pl > 0.0f ? std::max(0.0, delta - static_cast<double>(pl)) : delta;
+  if (p_y > 0.0) {
+    const double root = 0.75 * std::numbers::pi * p_y / e_star;
+    const double delta_y = r_eff * root * root;
+    if (elastic > delta_y) {
+      const float yielded = static_cast<float>(delta - delta_y);
+      if (work != nullptr)
+        *work += (4.0 / 3.0) * e_star * std::sqrt(r_eff) * delta_y * std::sqrt(delta_y) *
+                 (static_cast<double>(yielded) - static_cast<double>(pl));
+      pl = yielded;
+      elastic = std::max(0.0, delta - static_cast<double>(pl));
+    }
+  }
+  plastic = pl;
+  return elastic;
+}
+
+/// The elastic part of a contact's overlap delta whose permanent part is `plastic` (followed
+/// down where delta is smaller, as yield_overlap() does).
+inline double elastic_overlap(double delta, double plastic) {
+  return plastic > 0.0 ? std::max(0.0, delta - std::min(plastic, delta)) : delta;
 }
 
 /// Elastic energy stored in a Hertz contact: integral of 4/3 E* sqrt(R*) d^(3/2) from 0 to delta

@@ -54,16 +54,18 @@ struct PairEnergy {
   double tfj[3];
   double spring;
   double stiffening;
+  double plastic;  ///< work of the pair's yield in this pass (an energy) [J]
 };
 
 /// Evaluates the touching pairs tasks[0, n) into out[0, n) and updates their histories
 /// shear[tasks[k].s] as PairContacts::force() does for a pair known to overlap (the caller marks
 /// their slots touching). mass and material: the store's arrays. energy: the dissipative parts
-/// into energy[0, n) (the energy kernels; ignored by the others).
+/// into energy[0, n) (the energy kernels; ignored by the others). yield: the particles that
+/// yield and the pairs' permanent overlaps (nullptr: none; PairContacts::force()'s plastic).
 using PairBatchKernel = void (*)(const PairTask* tasks, int n, const PackedParticle* packed,
                                  const double* mass, const int* material, const ContactModel& model,
                                  Eigen::Vector3d* shear, double dt, bool update_history,
-                                 PairForce* out, PairEnergy* energy);
+                                 PairForce* out, PairEnergy* energy, const PairYield* yield);
 
 struct PairBatchKernels {
   const char* name;  ///< "avx512", "avx2" or "sse2"

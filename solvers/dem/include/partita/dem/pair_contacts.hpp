@@ -22,6 +22,11 @@
 // whose pair the build carried over from the receiver's own previous build keeps that history.
 // The contact law keeps no other per-pair state (rolling resistance is a torque of the moment,
 // mu_r F_n R* w/|w|, without a spring), so the record is all a pair carries.
+//
+// Pairs that yield (particles below the comminution limit with breakage's below_limit: yield,
+// StepHook::contact_yield()): each slot also holds the pair's permanent overlap (a float,
+// yield_overlap()); it follows the slots, travels in the records and is written with the
+// histories. Without yielding particles that array is empty (no memory, no work).
 
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
@@ -49,6 +54,11 @@ class PairContacts {
   std::size_t slot_count() const { return shear_.size(); }
   /// The tangential history of the pair in slot s.
   const Eigen::Vector3d& shear(std::size_t s) const { return shear_[s]; }
+  /// Keeps a permanent overlap per slot from now on (zero for every slot; follow() sizes it).
+  void keep_plastic();
+  bool keeps_plastic() const { return keep_plastic_; }
+  /// The permanent overlap of the pair in slot s [m] (0 without yielding particles).
+  double plastic(std::size_t s) const { return plastic_.empty() ? 0.0 : plastic_[s]; }
 
   /// What one force pass reads and writes, taken once per pass (raw pointers the loops keep in
   /// registers: a member vector's data pointer would be reloaded after every store through the
@@ -56,6 +66,7 @@ class PairContacts {
   struct Pass {
     Eigen::Vector3d* shear;
     char* touching;
+    float* plastic;       // per slot: the permanent overlap, or nullptr (no particle yields)
     const double* mass;   // the store's masses
     const int* material;  // the store's material ids
 
@@ -71,26 +82,30 @@ class PairContacts {
     }
   };
   Pass pass(const Particles& p) {
-    return Pass{shear_.data(), touching_.data(), p.mass.data(), p.material.data()};
+    return Pass{shear_.data(), touching_.data(), plastic_.empty() ? nullptr : plastic_.data(),
+                p.mass.data(), p.material.data()};
   }
 
   /// A pair's history keyed by particle ids: the tangential spring of particle id_i relative to
-  /// id_j and the touching flag; packed as 41 bytes (two int64, three doubles, one byte).
+  /// id_j, the touching flag and the permanent overlap; packed as 45 bytes (two int64, three
+  /// doubles, one byte, one float).
   struct Record {
     std::int64_t id_i = -1, id_j = -1;
     Eigen::Vector3d shear = Eigen::Vector3d::Zero();
     char touching = 0;
+    float plastic = 0.0f;
   };
-  static constexpr std::size_t record_bytes = 2 * sizeof(std::int64_t) + 3 * sizeof(double) + 1;
+  static constexpr std::size_t record_bytes =
+      2 * sizeof(std::int64_t) + 3 * sizeof(double) + 1 + sizeof(float);
   /// Appends to `out` the records of the listed pairs (lists `nl`, the slots this object
-  /// follows) that have a history (a nonzero spring: a pair without one is what the receiver's
-  /// build starts a new pair with) and a chosen particle (chosen[i] != 0), then the waiting
+  /// follows) that have a history (a nonzero spring or permanent overlap: a pair without one is
+  /// what the receiver's build starts a new pair with) and a chosen particle (chosen[i] != 0), then the waiting
   /// records that name an id in `chosen_ids` (sorted); returns how many it appended.
   std::size_t pack(const NeighborList& nl, const std::vector<std::int64_t>& id,
                    const std::vector<char>& chosen, const std::vector<std::int64_t>& chosen_ids,
                    std::vector<std::byte>& out) const;
   /// Reads `count` packed records at `data`; throws Error (nothing changed) when one has a
-  /// negative id, two equal ids or a spring that is not finite.
+  /// negative id, two equal ids, a spring that is not finite or a negative permanent overlap.
   static void check_packed(const std::byte* data, std::size_t count);
   /// Adds `count` packed records (checked) to the waiting ones.
   void add_waiting(const std::byte* data, std::size_t count);
@@ -102,11 +117,12 @@ class PairContacts {
   /// allocation once the scratch has had the particle count.
   void place_waiting(const NeighborList& nl, const std::vector<std::int64_t>& id);
 
-  /// Writes / reads the histories and flags (in the state format, between the neighbour list's
-  /// rows and its build references: see System::write_body()). read() throws Error when their
-  /// number is not `slots` (the neighbour list's pair count).
+  /// Writes / reads the histories, flags and permanent overlaps (in the state format, between the
+  /// neighbour list's rows and its build references: see System::write_body()). read() throws
+  /// Error when their number is not `slots` (the neighbour list's pair count); with_plastic
+  /// false: a state without permanent overlaps (format version 4), read as none.
   void write(BinaryWriter& out) const;
-  void read(BinaryReader& in, std::size_t slots);
+  void read(BinaryReader& in, std::size_t slots, bool with_plastic = true);
 
   /// Force of the pair (i, j) on i and the torques on i and j (masses mi, mj and materials of the
   /// two, read only when they overlap); false (and the history settled:
@@ -114,13 +130,18 @@ class PairContacts {
   /// T_j = -cr_j n x F_t (cr = R - delta/2, LIGGGHTS convention), rolling resistance
   /// T_i = -mu_r F_n R* w_rel/|w_rel| = -T_j (w_rel = omega_i - omega_j).
   /// Load: also the contact load F_n (E*/R*)^2 (breakage criterion, System::contact_load()).
+  /// plastic: the pair's permanent overlap (nullptr: none), the contact yielding at the pair's
+  /// yield pressure p_y > 0 (yield_overlap(); its growth kept when update_history, its work added
+  /// to *plastic_work). The geometric overlap gives the arms cr, the elastic one the force.
   template <bool Load>
   static PARTITA_DEM_INLINE bool force(const ContactModel& model, const PackedParticle& qi,
                                        const PackedParticle& qj, const double& mi, const double& mj,
                                        const int& material_i, const int& material_j,
                                        Eigen::Vector3d& shear, char& touching, double dt,
                                        bool update_history, Eigen::Vector3d& fij,
-                                       Eigen::Vector3d& ti, Eigen::Vector3d& tj, double& load) {
+                                       Eigen::Vector3d& ti, Eigen::Vector3d& tj, double& load,
+                                       float* plastic = nullptr, double p_y = 0.0,
+                                       double* plastic_work = nullptr) {
     const Eigen::Vector3d d = qi.x - qj.x;
     const double ri = qi.r, rj = qj.r;
     const double rsum = ri + rj;
@@ -129,6 +150,7 @@ class PairContacts {
       if (touching) {
         touching = 0;
         shear.setZero();
+        if (plastic != nullptr) *plastic = 0.0f;
       }
       return false;
     }
@@ -136,12 +158,19 @@ class PairContacts {
     const double r = std::sqrt(r2);
     const Eigen::Vector3d nrm =
         r > 0.0 ? Eigen::Vector3d(d * (1.0 / r)) : Eigen::Vector3d::UnitZ();
-    const double delta = rsum - r;
+    const double delta_geometric = rsum - r;
     const PairParameters& pp = model.pair(material_i, material_j);
     const double r_eff = ri * rj / rsum;
     const double m_eff = mi * mj / (mi + mj);
-    const double cri = ri - 0.5 * delta, crj = rj - 0.5 * delta;
+    const double cri = ri - 0.5 * delta_geometric, crj = rj - 0.5 * delta_geometric;
     const Eigen::Vector3d w_arm = cri * qi.w + crj * qj.w;
+    double delta = delta_geometric;
+    if (plastic != nullptr) {
+      float kept = *plastic;
+      delta = yield_overlap(delta_geometric, r_eff, pp.e_star, p_y, kept,
+                            update_history ? plastic_work : nullptr);
+      if (update_history) *plastic = kept;
+    }
     Eigen::Vector3d ft;
     const double fn = hertz_mindlin(pp, delta, r_eff, m_eff, nrm, qi.v - qj.v, w_arm, shear, dt,
                                     update_history, fij, ft);
@@ -167,6 +196,9 @@ class PairContacts {
  private:
   std::vector<Eigen::Vector3d> shear_;  // per slot: tangential spring
   std::vector<char> touching_;          // per slot: overlap > 0 in the last force pass
+  std::vector<float> plastic_;          // per slot: permanent overlap (keep_plastic_) or empty
+  bool keep_plastic_ = false;
+  std::vector<float> new_plastic_;      // scratch of follow()
   std::vector<Eigen::Vector3d> new_shear_;  // scratch of follow()
   std::vector<Record> waiting_;             // records received, until the next build
   std::vector<std::pair<std::int64_t, int>> index_of_id_;  // scratch of place_waiting()

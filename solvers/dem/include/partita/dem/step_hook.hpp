@@ -45,11 +45,12 @@ class StepHook {
   /// the array's default; one below 0 makes them count as reached (the hook then sets their
   /// limits). One hook per system may have limits.
   virtual int contact_load_limit() const { return -1; }
-  /// Particles that yield against meshes: the handle of a per-particle store array (double,
+  /// Particles that yield in their contacts: the handle of a per-particle store array (double,
   /// width 1) of yield pressures [Pa] (values <= 0: none yet) and the diameter below which they
-  /// apply ({-1, 0}: none). A mesh contact of such a particle holds its mean Hertz pressure
-  /// F/(pi a^2) at the yield pressure, the overlap beyond it becoming permanent
-  /// (MeshContactRecord::pre_overlap). One hook per system may have them.
+  /// apply ({-1, 0}: none). A mesh or pair contact of such a particle holds its mean Hertz
+  /// pressure F/(pi a^2) at the yield pressure (a pair of two: the smaller), the overlap beyond
+  /// it becoming permanent (MeshContactRecord::pre_overlap; PairContacts' per-slot permanent
+  /// overlap). One hook per system may have them.
   struct ContactYield {
     int pressure = -1;
     double below_diameter = 0.0;

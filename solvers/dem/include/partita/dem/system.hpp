@@ -362,7 +362,7 @@ class System {
     double friction = 0.0;  ///< Coulomb sliding: power of the capped tangential forces on the
                             ///< relative motion + the spring energy the cap released
     double damping = 0.0;   ///< viscous normal and tangential contact damping, rolling resistance,
-                            ///< yielding mesh contacts (StepHook::contact_yield())
+                            ///< yielding contacts (StepHook::contact_yield())
     double breakage = 0.0;  ///< mechanical energy (KE + PE + E_el) before minus after changes of
                             ///< the particle set between steps (breakage, removal, insertion)
     double gravity = 0.0;   ///< work of gravity on the particles
@@ -481,7 +481,7 @@ class System {
   void settle_set_change(bool provisional = false);
   void start_load_pass(int parts);
   void write_body(BinaryWriter& out) const;
-  void read_body(BinaryReader& in);
+  void read_body(BinaryReader& in, std::uint32_t version);
 
   ContactModel model_;
   // every per-particle array; position, velocity and angular velocity: verlet_ holds them while

@@ -34,7 +34,10 @@ class SystemState {
   // particle store, which no longer has the four mesh arrays of version 1
   // 3: the cumulative energies (System::energies()) after the hooks' state
   // 4: the breakage counters' powder fields
-  static constexpr std::uint32_t format_version = 4;
+  // 5: the pairs' permanent overlaps (PairContacts) after their histories; version 4 is read
+  // as a state without them
+  static constexpr std::uint32_t format_version = 5;
+  static constexpr std::uint32_t oldest_version = 4;
 
   double time() const { return time_; }
   long step_count() const { return steps_; }
@@ -55,6 +58,7 @@ class SystemState {
   long steps_ = 0;
   std::size_t particles_ = 0;
   std::uint64_t origin_ = 0;  // System::identity_ of the saving system; 0: read from a stream
+  std::uint32_t version_ = format_version;  // the format of body_
 };
 
 }  // namespace partita::dem
