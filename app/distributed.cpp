@@ -69,6 +69,7 @@ int run_on_ranks(const coupling::Registries& registries, RanksOptions o) {
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   static MPI_Comm world = MPI_COMM_WORLD;  // (the handle points to it)
   auto ranks = std::make_shared<ParticipantRanks>(rank, size, &world, o.peer_timeout);
+  ranks->set_stop_flag(o.stop_signal);
   run::RunOptions& ro = o.run;
   ro.ranks = ranks;
   if (rank != 0) {
@@ -218,6 +219,7 @@ int run_distributed(const coupling::Registries& registries, DistributedOptions o
     ranks = std::make_shared<ParticipantRanks>(m.local_rank, m.local_size, &participant_comm,
                                                0.5 * o.peer_timeout);
     ranks->set_world_ranks(m.world_ranks);
+    ranks->set_stop_flag(o.stop_signal);
   }
   run::RunOptions& ro = o.run;
   ro.distributed.participant = o.participant;

@@ -70,6 +70,7 @@ struct RanksOptions {
   run::RunOptions run;
   double peer_timeout = 600.0;  ///< [s] the longest wait for another rank
   std::function<void()> install_stop_handlers;
+  std::atomic<int>* stop_signal = nullptr;  ///< what the handlers set (the ranks pass it on)
   /// Called on rank 0 after a run that finished (plots, scripts, the last line).
   std::function<void(const run::CaseRun&)> on_finished;
 };

@@ -304,6 +304,7 @@ int main(int argc, char** argv) {
       r.run = options;
       r.peer_timeout = peer_timeout;
       r.install_stop_handlers = install_stop_handlers;
+      r.stop_signal = &g_stop_signal;
       r.on_finished = [&](const partita::run::CaseRun& c) {
         finish(c.output_dir());
         partita::app::run_scripts(c.scripts(), c.output_dir());

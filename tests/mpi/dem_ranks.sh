@@ -22,6 +22,7 @@
 #               within 2 % of its target at the end
 #   signal      SIGINT to mpirun mid-run on 2 ranks: every process ends within 10 s after the
 #               window, with a restart file, which resumes on 3 ranks to the end
+#   signal-rank SIGINT to rank 1's process alone: the same stop (status 130, a restart file)
 #   refused     on 2 ranks, what a split does not handle yet (breakage, the energy accounting):
 #               exit status 1, one message naming the key and saying "not yet on several ranks",
 #               every process ended within 60 s;
@@ -262,6 +263,34 @@ signal)
   python3 -c "import sys; t = float(open('g/bed.csv').read().split()[-1].split(',')[0]); sys.exit(abs(t - $end) > 1e-9)" ||
     fail "the resumed run did not reach $end s"
   echo "SIGINT: every process ended after $took s with a restart file ($(ls g/restart)) at $stopped s, resumed on 3 ranks to $end s"
+  ;;
+signal-rank)
+  # SIGINT to rank 1's process alone (a batch system's signal to one process, or kill): rank 1
+  # passes it on to rank 0 with the window's check, and the run stops after the window as for a
+  # signal to mpirun: every process ends within 10 s, status 130, with a restart file
+  still=(--set 'participants.bed.walls[1].velocity=[0, 0, 0]')
+  "${MPIRUN[@]}" -n 2 "$P" run "$CASE" -o h --threads 1 --set time.end=1 "${still[@]}" > h.log 2>&1 &
+  run=$!
+  for _ in $(seq 1 600); do
+    compgen -G "h/vtk/*_000001.pvtp" > /dev/null && break
+    sleep 0.05
+  done
+  victim=
+  for p in $(pgrep -x partita); do  # (this test's: started in its folder)
+    [ "$(readlink /proc/"$p"/cwd)" = "$WORK" ] &&
+      tr '\0' '\n' < /proc/"$p"/environ 2> /dev/null | grep -qx "OMPI_COMM_WORLD_RANK=1" && victim=$p
+  done
+  [ -n "$victim" ] || { kill $run; fail "no rank 1 found"; }
+  start=$(date +%s)
+  kill -INT "$victim"
+  wait $run
+  status=$?
+  took=$(($(date +%s) - start))
+  [ $took -le 10 ] || { kill -TERM $run 2> /dev/null; fail "the run ended $took s after SIGINT to rank 1"; }
+  [ "$status" -eq 130 ] || { cat h.log >&2; fail "exit status $status after SIGINT to rank 1 (expected 130)"; }
+  grep -q "stopped by signal 2" h.log || { cat h.log >&2; fail "no stop by signal"; }
+  compgen -G "h/restart/w*.bin" > /dev/null || { cat h.log >&2; fail "no restart file"; }
+  echo "SIGINT to rank 1 alone: every process ended after $took s, status $status, with a restart file ($(ls h/restart))"
   ;;
 servo)
   # the lid as a servo wall to 1 N (the law applied with the force summed over the ranks): the

@@ -24,7 +24,9 @@
 //                    particles rounded once (SubdomainStepper: kinetic energy, momentum, elastic
 //                    energy, each wall's, box face's and mesh's force, the contacts), the monitor
 //                    particles' states gathered from their owners: the same bits on any N;
-//   check            every rank's astray owned particle of lowest id to rank 0;
+//   check            every rank's astray owned particle of lowest id to rank 0, and a stop
+//                    signal that reached another rank's process alone (rank 0 then stops the
+//                    run after the window, as for its own: ParticipantRanks::raise_stop());
 //   output frame     every rank writes its owned particles as one piece
 //                    (<prefix>_particles_<frame>_<rank>.vtp), rank 0 the .pvtp that joins them
 //                    (the series' file: ParaView opens the pieces as one) and the meshes with the
@@ -781,10 +783,14 @@ std::string DemAdapter::ranks_check() const {
       message = astray_message(i, false);
     }
   }
+  // (with it, a stop signal that reached this rank's process alone: rank 0 stops the run after
+  // the window, as for a signal to its own; ParticipantRanks)
   return together(*o.ranks, [&]() -> std::string {
     for (auto& b : o.out[0]) b.clear();
     if (!o.ranks->leads()) {
-      if (!message.empty()) o.out[0][0] = Bytes().put(id).put(message).bytes();
+      const int signal = o.ranks->stop_signal();
+      if (!message.empty() || signal != 0)
+        o.out[0][0] = Bytes().put(static_cast<std::int32_t>(signal)).put(id).put(message).bytes();
       o.transport->exchange(o.out, o.in);
       return {};
     }
@@ -793,9 +799,10 @@ std::string DemAdapter::ranks_check() const {
       for (std::size_t r = 1; r < o.in[0].size(); ++r) {
         if (o.in[0][r].empty()) continue;
         Reader in(o.in[0][r]);
+        o.ranks->raise_stop(in.get<std::int32_t>());
         const auto other = in.get<std::int64_t>();
         std::string text = in.string();
-        if (other < id) id = other, message = std::move(text);
+        if (!text.empty() && other < id) id = other, message = std::move(text);
       }
     }
     return message;

@@ -19,7 +19,13 @@
 //
 // The communicator is MPI's (an MPI_Comm, passed as a pointer to it so that interface/ does not
 // include mpi.h); only a solver built with MPI reads it.
+//
+// Stop signals: SIGINT/SIGTERM to a process of the run ends it after the window with a restart
+// file. The run reads the signal of rank 0's process; a solver on ranks passes a signal that
+// reached another of its ranks alone on to rank 0 (stop_signal() there, raise_stop() on rank 0),
+// so that a signal to any one process stops the run.
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <string>
@@ -83,6 +89,18 @@ class ParticipantRanks {
     if (end_) end_(status);
   }
 
+  /// The process's stop flag (the signal number that asked the run to stop, 0: none), which the
+  /// app's signal handlers set; null: none.
+  void set_stop_flag(std::atomic<int>* flag) { stop_flag_ = flag; }
+  /// The signal that reached this process (0: none).
+  int stop_signal() const { return stop_flag_ != nullptr ? stop_flag_->load() : 0; }
+  /// (rank 0) Another rank's signal: the run stops after the window, as for one to this process
+  /// (a signal of this process's own is kept).
+  void raise_stop(int signal) const {
+    int none = 0;
+    if (stop_flag_ != nullptr && signal != 0) stop_flag_->compare_exchange_strong(none, signal);
+  }
+
   /// Set by the solver when a rank failed or stopped answering in the middle of what all ranks
   /// do together: the others cannot finish with it, and the app must end them all (MPI_Abort)
   /// after printing the message.
@@ -93,6 +111,7 @@ class ParticipantRanks {
   int rank_ = 0, size_ = 1;
   const void* communicator_ = nullptr;
   double deadline_ = 600.0;
+  std::atomic<int>* stop_flag_ = nullptr;
   bool claimed_ = false;
   bool broken_ = false;
   std::function<int()> follow_;
