@@ -52,6 +52,19 @@ ranks() {
     { local s=$?; cat "$dir.log" >&2; fail "the case on $n rank(s) exited with $s"; }
 }
 
+# rank1_of_run DIR: after the run into DIR (started in the background) wrote its first frame,
+# the process id of its rank 1 (this test's: started in its folder)
+rank1_of_run() {
+  for _ in $(seq 1 600); do
+    compgen -G "$1/vtk/*_000001.pvtp" > /dev/null && break
+    sleep 0.05
+  done
+  for p in $(pgrep -x partita); do
+    [ "$(readlink /proc/"$p"/cwd)" = "$WORK" ] &&
+      tr '\0' '\n' < /proc/"$p"/environ 2> /dev/null | grep -qx "OMPI_COMM_WORLD_RANK=1" && echo "$p"
+  done
+}
+
 # same DIR_A DIR_B: every CSV file of A in B, byte for byte (and as many), and the particles file
 same() {
   cmp "$1/bed.data" "$2/bed.data" || fail "bed.data (the particles file): $1 and $2 differ"
@@ -214,15 +227,7 @@ stalled)
   # message naming rank 1
   timeout 120 "${MPIRUN[@]}" -n 2 "$P" run "$CASE" -o s --threads 1 --peer-timeout 3 --set time.end=1 > s.log 2>&1 &
   run=$!
-  for _ in $(seq 1 600); do
-    compgen -G "s/vtk/*_000001.pvtp" > /dev/null && break
-    sleep 0.05
-  done
-  victim=
-  for p in $(pgrep -x partita); do  # (this test's: started in its folder)
-    [ "$(readlink /proc/"$p"/cwd)" = "$WORK" ] &&
-      tr '\0' '\n' < /proc/"$p"/environ 2> /dev/null | grep -qx "OMPI_COMM_WORLD_RANK=1" && victim=$p
-  done
+  victim=$(rank1_of_run s | head -n 1)
   [ -n "$victim" ] || { kill $run; fail "no rank 1 found"; }
   start=$(date +%s)
   kill -STOP "$victim"
@@ -271,15 +276,7 @@ signal-rank)
   still=(--set 'participants.bed.walls[1].velocity=[0, 0, 0]')
   "${MPIRUN[@]}" -n 2 "$P" run "$CASE" -o h --threads 1 --set time.end=1 "${still[@]}" > h.log 2>&1 &
   run=$!
-  for _ in $(seq 1 600); do
-    compgen -G "h/vtk/*_000001.pvtp" > /dev/null && break
-    sleep 0.05
-  done
-  victim=
-  for p in $(pgrep -x partita); do  # (this test's: started in its folder)
-    [ "$(readlink /proc/"$p"/cwd)" = "$WORK" ] &&
-      tr '\0' '\n' < /proc/"$p"/environ 2> /dev/null | grep -qx "OMPI_COMM_WORLD_RANK=1" && victim=$p
-  done
+  victim=$(rank1_of_run h | head -n 1)
   [ -n "$victim" ] || { kill $run; fail "no rank 1 found"; }
   start=$(date +%s)
   kill -INT "$victim"
