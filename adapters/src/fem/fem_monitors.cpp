@@ -62,6 +62,12 @@ const MonitorTable<FemAdapter>& FemAdapter::monitor_table() {
           });
     t.scalar("max_displacement", "m", "largest nodal displacement magnitude",
              [](const A& a) { return a.solver_->max_displacement(); });
+    t.scalar("min_element_step", "s",
+             "the smallest stable step of the elements not eroded at their present shape: each "
+             "element's bound at rest times its length V / A_max now over the one at rest (an "
+             "explicit step above it integrates that element unstably; 0: an element turned "
+             "inside out)",
+             [](const A& a) { return a.solver_->min_element_time_step(); });
     t.scalar("kinetic_energy", "J", "1/2 v^T M v",
              [](const A& a) { return a.solver_->kinetic_energy(); });
     t.scalar("strain_energy", "J", "stored elastic energy (1/2 u^T K u when linear)",

@@ -8,6 +8,8 @@
 #include "partita/fem/error.hpp"
 #include "partita/fem/structural_solver.hpp"
 
+#include "partita/fem/element_size.hpp"
+
 namespace partita::fem {
 
 const std::vector<double>& StructuralSolver::element_frequencies_squared() const {
@@ -157,6 +159,34 @@ double StructuralSolver::stable_time_step() const {
     stable_step_ *= std::sqrt(1.0 + xi * xi) - xi;
   }
   return stable_step_;
+}
+
+double StructuralSolver::element_time_step(std::size_t ei) const {
+  const auto& omega2 = element_frequencies_squared();
+  const std::size_t ne = mesh().num_elements();
+  if (element_length0_.size() != ne) {
+    element_length0_.resize(ne);
+    for (std::size_t k = 0; k < ne; ++k) {
+      const Element& e = mesh().elements()[k];
+      element_length0_[k] = element_length(e.type, element_coordinates(mesh(), e));
+    }
+  }
+  if (!(omega2[ei] > 0.0) || !(element_length0_[ei] > 0.0))
+    return std::numeric_limits<double>::infinity();
+  const Element& e = mesh().elements()[ei];
+  ElementCoordinates x = element_coordinates(mesh(), e);
+  if (kin_.u.size() == static_cast<Eigen::Index>(ndof_))  // (before the first solve: at rest)
+    for (int a = 0; a < node_count(e.type); ++a)
+      x.row(a) += kin_.u.segment<3>(3 * static_cast<Eigen::Index>(e.nodes[a])).transpose();
+  const double at_rest = 2.0 / std::sqrt(omega2[ei] / mass_scale_factor(ei));
+  return at_rest * element_length(e.type, x) / element_length0_[ei];
+}
+
+double StructuralSolver::min_element_time_step() const {
+  double smallest = std::numeric_limits<double>::infinity();
+  for (std::size_t ei = 0; ei < mesh().num_elements(); ++ei)
+    if (!element_eroded(ei)) smallest = std::min(smallest, element_time_step(ei));
+  return smallest;
 }
 
 }  // namespace partita::fem

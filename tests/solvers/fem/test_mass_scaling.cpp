@@ -7,6 +7,7 @@
 
 #include "fem_test_helpers.hpp"
 #include "partita/fem/box_mesher.hpp"
+#include "partita/fem/element_size.hpp"
 #include "partita/fem/error.hpp"
 #include "partita/fem/j2_plasticity_law.hpp"
 #include "partita/fem/structural_solver.hpp"
@@ -170,4 +171,37 @@ TEST_CASE("mass scaling: refused outside central difference", "[fem][explicit][m
   o.mass_scaling_time_step = 1e-6;
   CHECK_THROWS_WITH(StructuralSolver(rod(1.0, 2), o), Catch::Contains("central-difference"));
   CHECK_THROWS_WITH(StructuralSolver(rod(1.0, 2), scaled(-1.0)), Catch::Contains(">= 0"));
+}
+
+TEST_CASE("element length V / A_max: a box's thinnest side, a tetrahedron's, 0 inside out",
+          "[fem][explicit][element-step]") {
+  const Model box(make_box_mesh({Vec3::Zero(), Vec3(0.3, 0.2, 0.05), {1, 1, 1}, ElementType::Hex8}),
+                  Material{kE, kNu, kRho});
+  const Element& e = box.mesh().elements()[0];
+  ElementCoordinates x = element_coordinates(box.mesh(), e);
+  CHECK(element_length(e.type, x) == Approx(0.05).epsilon(1e-12));
+  x.col(2) *= -1.0;  // mirrored: turned inside out
+  CHECK(element_length(e.type, x) == 0.0);
+  ElementCoordinates t(4, 3);
+  t << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  // V = 1/6, the largest face the slanted one, sqrt(3)/2
+  CHECK(element_length(ElementType::Tet4, t) == Approx((1.0 / 6.0) / (std::sqrt(3.0) / 2.0)).epsilon(1e-12));
+}
+
+TEST_CASE("the elements' stable step at their present shape: the step at rest, shrinking with "
+          "a squeezed element", "[fem][explicit][element-step]") {
+  // cube elements of the rod (y, z fixed): at rest each element's step is h / c_d (with the
+  // scaled mass 3 h / c_d), the stable step; the rod shortened by 20 % (a static solve with its
+  // end displaced) makes every element 0.8 h long, so its step 0.8 times that
+  const double length = 1.0, a = 0.02;
+  const int n = 50;
+  const double dt_e = (length / n) / dilatational_speed();
+  Model m = rod(length, n, a);
+  m.fix("xmin", {0});
+  m.prescribe("xmax", 0, [](double t) { return -0.2 * t; });  // (at rest at t = 0)
+  StructuralSolver s(std::move(m), scaled(3.0 * dt_e));
+  CHECK(s.min_element_time_step() == Approx(s.stable_time_step()).epsilon(1e-12));
+  CHECK(s.min_element_time_step() == Approx(3.0 * dt_e).epsilon(1e-12));
+  s.step_static(1.0);
+  CHECK(s.min_element_time_step() == Approx(0.8 * 3.0 * dt_e).epsilon(1e-9));
 }

@@ -192,6 +192,13 @@ class StructuralSolver final : private StructuralSystem {
     return mass_scale_.empty() ? 1.0 : mass_scale_[element];
   }
   std::size_t mass_scaled_elements() const;  // elements with s_e > 1
+  // The smallest stable step of the elements not eroded at their present shape [s]: each
+  // element's own bound at rest, 2 / omega_e (its scaled mass), times its characteristic length
+  // now over the one at rest (element_length(): V / A_max; a squeezed element's step shrinks
+  // with it, one turned inside out gives 0). The stable step (stable_time_step()) is the bound
+  // at rest; an explicit step above this one integrates that element unstably. infinity
+  // without elements.
+  double min_element_time_step() const;
   double physical_mass() const;  // sum of rho V over the elements not eroded [kg]
   double added_mass() const;     // sum of (s_e - 1) rho V over the elements not eroded [kg]
   // Newton reports of the last nonlinear static solve / Newmark step.
@@ -276,6 +283,8 @@ class StructuralSolver final : private StructuralSystem {
   mutable double stable_step_ = -1.0;           // cached stable_time_step()
   mutable std::vector<double> element_omega2_;  // element_frequencies_squared()
   std::vector<double> mass_scale_;              // per element s_e (empty: no mass scaling)
+  mutable std::vector<double> element_length0_;  // element_time_step(): lengths at rest
+  double element_time_step(std::size_t element) const;  // at its present shape
   std::vector<double> element_mass_;            // per element rho V (with mass scaling)
   // lumped mass: each element's nodal masses as assembled (element e's from
   // element_lumped_[element_lumped_start_[e]]; an eroded element's are stale and not read)
