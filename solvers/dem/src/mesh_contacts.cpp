@@ -234,13 +234,15 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
       pre = std::min(old_pre[from_old[a]], static_cast<float>(k.delta));
     const PairParameters& pp = model.pair(q.material, m.material());
     // yield (yield_overlap()): the overlap beyond the elastic limit adds to the permanent one
+    const float pre_before = pre;
     const double delta = yield_overlap(k.delta, r, pp.e_star, q.yield_pressure, pre,
                                        Energy ? &wd->plastic : nullptr);
     const double cr = r - 0.5 * k.delta;
     Eigen::Vector3d fw, ft;
     DissipativeParts parts;
     const double fn = hertz_mindlin(pp, delta, r, q.m, k.normal, q.v - v_wall, cr * q.w, shear, dt,
-                                    update_history, fw, ft, Energy ? &parts : nullptr);
+                                    update_history, fw, ft, Energy ? &parts : nullptr,
+                                    static_cast<double>(pre) - static_cast<double>(pre_before));
     f += fw;
     t -= cr * k.normal.cross(ft);
     if constexpr (Energy) add_wall_parts(parts, k.normal, cr, v_wall, *sums, *wd);

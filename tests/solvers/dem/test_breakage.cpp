@@ -346,6 +346,50 @@ TEST_CASE("dem: below the comminution limit two granules that collide yield and 
   CHECK(q.velocity[1].x() - q.velocity[0].x() == Approx(v).epsilon(0.01));
 }
 
+TEST_CASE("dem: a bed of fragments that yield against each other keeps its energy books",
+          "[dem][breakage][energy]") {
+  // ~400 granules below the comminution limit (below_limit yield) in a box, pressed by a lid
+  // to a fifth of their size of overlap, on 1 and 2 threads (the cross pairs of two parts): the
+  // lid's work goes into the contacts' elastic energy, damping and the pairs' yield (booked with
+  // the damping); the books close as they do for the elastic bed (|error| < 1e-3), and the yield
+  // work is a real part of them.
+  const double d1 = 1.0e-3, d2 = 1.5e-3, side = 8.0e-3, speed = 0.2;
+  for (int threads : {1, 2})
+    for (bool yield : {true, false}) {
+      set_num_threads(threads);
+      BreakageParameters b = parameters(3.0);
+      b.comminution_limit = 2.0e-3;
+      b.yield = yield;
+      System sys = test::single_material(E, NU, RHO, 0.5, 0.3);
+      const Packing pk = test::two_size_packing({0, 0, 0}, {side, side, side}, d1, d2, 0.5, 7);
+      sys.add_particles(pk.positions, pk.radii, 0);
+      sys.add_plane({0, 0, 0}, {0, 0, 1}, 0);
+      sys.add_plane({0, 0, 0}, {1, 0, 0}, 0);
+      sys.add_plane({0, 0, 0}, {0, 1, 0}, 0);
+      sys.add_plane({side, 0, 0}, {-1, 0, 0}, 0);
+      sys.add_plane({0, side, 0}, {0, -1, 0}, 0);
+      const int lid = sys.add_plane({0, 0, side}, {0, 0, -1}, 0, {0, 0, -speed});
+      sys.add_hook(std::make_unique<Breakage>(b));
+      sys.set_energy_tracking(true);
+      const double dt = 0.2 * sys.rayleigh_time_step();
+      const long steps = static_cast<long>(0.25 * side / speed / dt);  // the lid down by a quarter
+      double worst = 0.0;  // over the second half (the error is relative to the work done)
+      for (long k = 0; k < steps; ++k) {
+        sys.step(dt);
+        if (2 * k > steps) worst = std::max(worst, std::abs(sys.energy_balance_error()));
+      }
+      const System::Energies& e = sys.energies();
+      INFO(threads << " thread(s), yield " << yield << ": " << sys.particle_count()
+                   << " particles, lid work " << e.wall_work[static_cast<std::size_t>(lid)]
+                   << " J, damping " << e.damping << " J, friction " << e.friction
+                   << " J, elastic " << sys.elastic_energy() << " J, worst balance error " << worst);
+      CHECK(sys.particle_count() == static_cast<std::size_t>(pk.radii.size()));
+      CHECK(worst < 1e-3);
+      if (yield) CHECK(e.damping > 0.2 * e.wall_work[static_cast<std::size_t>(lid)]);
+    }
+  set_num_threads(1);
+}
+
 TEST_CASE("dem: breakage conserves momentum and does not create kinetic energy",
           "[dem][breakage]") {
   for (const std::string& pattern : FragmentPattern::names())

@@ -110,12 +110,16 @@ struct DissipativeParts {
 ///   shear  tangential displacement history, updated in place when update_history
 /// Returns the normal force magnitude F_n; writes the total force on i and its tangential part.
 /// parts (not null): also the dissipative parts (DissipativeParts); the force is the same bits.
+/// plastic_growth: how much the contact's permanent overlap grew in this step (yield_overlap();
+/// delta is then the elastic overlap): the elastic overlap before the step, from which the
+/// stiffening term takes the tangential stiffness, is delta + v_n dt + that growth.
 PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, double r_eff,
                                         double m_eff, const Eigen::Vector3d& n,
                                         const Eigen::Vector3d& v_rel, const Eigen::Vector3d& w_arm,
                                         Eigen::Vector3d& shear, double dt, bool update_history,
                                         Eigen::Vector3d& force, Eigen::Vector3d& f_tangential,
-                                        DissipativeParts* parts = nullptr) {
+                                        DissipativeParts* parts = nullptr,
+                                        double plastic_growth = 0.0) {
   // Normal: F_n = 4/3 E* sqrt(R*) delta^(3/2) - gamma_n v_n, S_n = 2 E* sqrt(R* delta),
   // gamma_n = 2 zeta sqrt(S_n m*) (v_n < 0 while approaching).
   const double a = std::sqrt(r_eff * delta);  // contact radius
@@ -159,7 +163,9 @@ PARTITA_DEM_INLINE double hertz_mindlin(const PairParameters& p, double delta, d
   // the history lost its part along the new normal
   double stiffening = 0.0;
   if (parts) {
-    const double delta_before = std::max(0.0, delta + v_n * dt);
+    double before = delta + v_n * dt;
+    if (plastic_growth != 0.0) before += plastic_growth;
+    const double delta_before = std::max(0.0, before);
     const double k_before = 8.0 * p.g_star * std::sqrt(r_eff * delta_before);
     stiffening = 0.5 * (k_before - k_t) * before2 + 0.5 * k_t * xn_before * xn_before;
   }
