@@ -182,9 +182,13 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     old_pre[s] = records[s].pre_overlap;
   }
   // A contact keeps its history when its feature stays (same key) and also when it passes to
-  // a neighbouring feature of the same mesh, rolling or sliding across triangle boundaries: an
-  // unmatched old contact whose point (the same material point of the wall, at the current
-  // vertex positions) lies within the new contact radius sqrt(R delta) hands its history on.
+  // a neighbouring feature, rolling or sliding across triangle boundaries, or to another mesh
+  // that meets this one there (two interfaces of one body sharing an edge or a face: the twin
+  // features have the same normal and one of them holds the contact, whichever is nearer by a
+  // rounding): an unmatched old contact whose point (the same material point of its wall, at the
+  // current vertex positions) lies within the new contact radius sqrt(R delta) hands its
+  // history on - the shear spring and the permanent overlap, which a contact started afresh
+  // would lose (its elastic energy made anew, and yielded again).
   int from_old[max_contacts];
   bool old_taken[max_contacts] = {};
   for (int a = 0; a < na; ++a) {
@@ -197,11 +201,11 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
   for (int a = 0; a < na; ++a) {
     if (from_old[a] >= 0) continue;
     const Candidate& k = cand[accepted[a]];
-    const TriangleMesh& m = meshes[k.mesh];
     double best = r * k.delta;  // (contact radius)^2
     for (int s = 0; s < n_old; ++s) {
       const MeshContactRecord& rec = records[s];
-      if (old_taken[s] || rec.mesh != k.mesh) continue;
+      if (old_taken[s]) continue;
+      const TriangleMesh& m = meshes[rec.mesh];
       const auto& tri = m.triangle(rec.triangle);
       const Eigen::Vector3d p = rec.barycentric[0] * m.position_[tri[0]] +
                                 rec.barycentric[1] * m.position_[tri[1]] +

@@ -268,6 +268,94 @@ TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh yields 
   CHECK(elastic.elastic > 50.0 * yielding.elastic);
 }
 
+TEST_CASE("dem: a yielding granule under two meshes that coincide keeps its permanent overlap as "
+          "its contact passes between them", "[dem][breakage][energy]") {
+  // Two meshes over the same square (the second triangulated along the other diagonal and tilted
+  // by 1e-5 rad), as two interfaces of one body meet along a shared edge or face: a sphere
+  // touches them as one wall (one contact: the twin's normal is the same within the tolerance),
+  // held by the nearer mesh, which changes where the tilted one crosses the other. The granule, below the
+  // comminution limit, is squeezed by a tenth of its diameter beyond the elastic overlaps and the
+  // meshes then slide two diameters over it without friction: its permanent overlap must follow
+  // the contact from one mesh to the other, so that the yield work stays f_y times the squeeze's
+  // travel and the books close. (A contact that restarted without it would yield again: each
+  // change of mesh would book f_y times the permanent overlap once more.)
+  BreakageParameters b = parameters(3.0);
+  const double d = 2.0e-3, speed = 0.005, slide_speed = 0.05;
+  b.comminution_limit = 2.5e-3;
+  b.yield = true;
+  const double e_eff = 1.0 / ((1.0 - NU * NU) / E + (1.0 - NU_P * NU_P) / E_P);
+  const double f_y = eq2_force(d, b);
+  const double delta_y = std::pow(3.0 * f_y / (4.0 * e_eff * std::sqrt(0.5 * d)), 2.0 / 3.0);
+  const double squeeze = 0.1 * d;
+  Eigen::MatrixX3d x0(4, 3);  // a square of side 8 d at the granule's top
+  x0 << -4 * d, -4 * d, d, 4 * d, -4 * d, d, 4 * d, 4 * d, d, -4 * d, 4 * d, d;
+  TriangleMesh::Triangles ta(2, 3), tb(2, 3);
+  ta << 0, 1, 2, 0, 2, 3;
+  tb << 1, 2, 3, 1, 3, 0;
+  System sys;
+  const int g = sys.add_material({E, NU, RHO});
+  const int s = sys.add_material({E_P, NU_P, 7850.0});
+  const int w = sys.add_material({E_P, NU_P, 7850.0});  // the meshes: frictionless
+  sys.add_interaction(g, g, {0.3, 0.5, 0.0});
+  sys.add_interaction(g, s, {0.3, 0.5, 0.0});
+  sys.add_interaction(g, w, {0.0, 0.5, 0.0});
+  sys.add_interaction(s, w, {0.0, 0.5, 0.0});
+  sys.add_interaction(s, s, {0.0, 0.5, 0.0});
+  sys.add_interaction(w, w, {0.0, 0.5, 0.0});
+  sys.add_particle({0.3 * d, 0.1 * d, 0.5 * d}, 0.5 * d, g);
+  sys.add_plane({0, 0, 0}, {0, 0, 1}, s);
+  Eigen::MatrixX3d xb0 = x0;  // crossing the first mesh where the granule is 1 d into the slide
+  xb0.col(2).array() += 1.0e-5 * (x0.col(0).array() - 1.3 * d);
+  const int ma = sys.add_mesh(x0, ta, w);
+  const int mb = sys.add_mesh(xb0, tb, w);
+  sys.add_hook(std::make_unique<Breakage>(b));
+  sys.set_energy_tracking(true);
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  const auto move = [&](const Eigen::Vector3d& shift) {
+    const Eigen::MatrixX3d ya = x0.rowwise() + shift.transpose();
+    const Eigen::MatrixX3d yb = xb0.rowwise() + shift.transpose();
+    sys.set_vertex_positions(ma, ya);
+    sys.set_vertex_positions(mb, yb);
+    sys.step(dt);
+  };
+  const auto down = static_cast<long>((squeeze + 2.0 * delta_y) / (speed * dt));
+  for (long k = 0; k < down; ++k)
+    move({0.0, 0.0, -speed * dt * static_cast<double>(k + 1)});
+  const double z = -speed * dt * static_cast<double>(down);
+  const double damping_squeezed = sys.energies().damping;
+  const auto across = static_cast<long>(2.0 * d / (slide_speed * dt));
+  double f_min = 1e300, f_max = 0.0;
+  int switches = 0, holder = -1;
+  for (long k = 0; k < across; ++k) {
+    const double s_k = slide_speed * dt * static_cast<double>(k + 1);
+    move({-s_k, 0.35 * s_k, z});
+    const double fa = sys.mesh_force(ma).norm(), fb = sys.mesh_force(mb).norm();
+    const double f = sys.mesh_force(ma).z() + sys.mesh_force(mb).z();
+    f_min = std::min(f_min, f);
+    f_max = std::max(f_max, f);
+    const int now = fa > fb ? ma : mb;
+    if (holder >= 0 && now != holder) ++switches;
+    holder = now;
+  }
+  const double damping = sys.energies().damping;
+  INFO("f_y " << f_y << " N; mesh force during the slide " << f_min << " to " << f_max
+              << " N; the contact changed mesh " << switches << " times; yield and damping work "
+              << damping_squeezed << " J after the squeeze, " << damping
+              << " J after the slide (f_y x squeeze " << f_y * squeeze
+              << " J); balance error " << sys.energy_balance_error());
+  // the granule keeps its mass and stays below the meshes
+  CHECK(sys.particle_count() == 1);
+  // the contact did pass between the meshes (else this tests nothing)
+  CHECK(switches > 0);
+  // the squeeze: f_y times the travel beyond the elastic overlaps
+  CHECK(damping_squeezed == Approx(f_y * squeeze).epsilon(0.03));
+  // the slide (along the meshes) yields no more: the pressure stays at the strength
+  CHECK(damping == Approx(damping_squeezed).epsilon(0.02));
+  CHECK(f_min == Approx(f_y).epsilon(0.02));
+  CHECK(f_max == Approx(f_y).epsilon(0.02));
+  CHECK(std::abs(sys.energy_balance_error()) < 2e-3);
+}
+
 TEST_CASE("dem: below the comminution limit two granules that collide yield and rebound at the "
           "yield velocity", "[dem][breakage][energy]") {
   // Two equal granules below the comminution limit (below_limit yield), no damping (restitution
