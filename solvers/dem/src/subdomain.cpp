@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <istream>
@@ -479,6 +480,41 @@ void Subdomain::add_mesh_forces(int mesh, MeshForceSums& sums) const {
       });
 }
 
+void Subdomain::add_step_energies(double dt, ExactSum* sums) const {
+  const std::size_t n = sys_->particle_count();
+  if (n == 0) return;
+  const std::vector<System::ParticleEnergy>& e = sys_->particle_energies();
+  const std::vector<Eigen::Vector3d>& reaction = sys_->wall_reactions();
+  const std::vector<PlaneWall>& planes = sys_->planes();
+  const std::size_t np = planes.size();
+  if (e.size() != n || reaction.size() != n * np)
+    throw Error("subdomain " + std::to_string(rank_) +
+                ": the particles' energies or the planes' reactions are not recorded "
+                "(System::set_energy_terms(true) and set_wall_reactions(true) before the step)");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (is_ghost(i)) continue;
+    sums[0].add(e[i].damping);
+    sums[1].add(e[i].friction);
+    sums[2].add(e[i].gravity);
+    sums[3].add(e[i].stiffening);
+    for (std::size_t k = 0; k < np; ++k)
+      if (planes[k].velocity != Eigen::Vector3d::Zero())
+        sums[4 + planes[k].wall].add(-reaction[i * np + k].dot(planes[k].velocity) * dt);
+  }
+  const std::size_t walls = static_cast<std::size_t>(sys_->wall_count());
+  sys_->mesh_contacts().for_each_contact(
+      [&](int i, const MeshContactRecord& rec, const Eigen::Vector3d&) {
+        if (is_ghost(static_cast<std::size_t>(i))) return;
+        const TriangleMesh& m = sys_->mesh(rec.mesh);
+        const auto& tri = m.triangle(rec.triangle);
+        const std::vector<Eigen::Vector3d>& v = m.velocities();
+        const Eigen::Vector3d v_wall = rec.barycentric[0] * v[tri[0]] +
+                                       rec.barycentric[1] * v[tri[1]] +
+                                       rec.barycentric[2] * v[tri[2]];
+        sums[4 + walls + static_cast<std::size_t>(rec.mesh)].add(rec.force.dot(v_wall) * dt);
+      });
+}
+
 void Subdomain::forces(double dt, bool step) {
   if (sys_->particle_count() > 0) sys_->phase_forces(dt, step);
 }
@@ -563,8 +599,40 @@ void SubdomainStepper::resume() {
   started_ = true;
 }
 
+void SubdomainStepper::set_energy_accounting(bool on) {
+  if (started_)
+    throw Error("SubdomainStepper::set_energy_accounting: turn it on or off before start() or "
+                "resume()");
+  energy_ = on;
+  for (Subdomain& sd : subdomains_) sd.system().set_energy_terms(on);
+}
+
+std::size_t SubdomainStepper::book_count() const {
+  const System& sys = subdomains_[0].system();
+  return 4 + static_cast<std::size_t>(sys.wall_count()) + static_cast<std::size_t>(sys.mesh_count());
+}
+
+double SubdomainStepper::half_step_term(double dt) {
+  sum_dt_ = dt;
+  global_sums(Sums::half_step);
+  return totals_[0].value();
+}
+
 void SubdomainStepper::step(double dt) {
   if (!started_) start(dt);
+  if (energy_) {  // the books' start (collective: every process steps alike)
+    if (books_.size() != subdomains_.size())
+      books_.assign(subdomains_.size(), std::vector<ExactSum>(book_count()));
+    if (!books_started_) {
+      books_started_ = true;
+      books_dt_ = dt;
+      kinetic_start_ = kinetic_energy() + half_step_term(dt);
+      elastic_start_ = elastic_energy();
+    } else if (dt != books_dt_) {  // the half-step term of the state now, at the new step
+      kinetic_start_ += half_step_term(dt) - half_step_term(books_dt_);
+      books_dt_ = dt;
+    }
+  }
   for (std::size_t k = 0; k < subdomains_.size(); ++k) values_[k] = subdomains_[k].drift(dt);
   const bool rebuild = transport_->max(values_) > 0.0;
   if (rebuild) {
@@ -575,8 +643,102 @@ void SubdomainStepper::step(double dt) {
     for (std::size_t k = 0; k < subdomains_.size(); ++k) subdomains_[k].unpack_refresh(in_[k]);
   }
   for (Subdomain& s : subdomains_) s.forces(dt, true);
+  if (energy_)
+    for (std::size_t k = 0; k < subdomains_.size(); ++k)
+      subdomains_[k].add_step_energies(dt, books_[k].data());
   for (Subdomain& s : subdomains_) s.finish(dt);
   ++steps_;
+}
+
+System::Energies SubdomainStepper::energies() {
+  System::Energies e;
+  if (!energy_ || !books_started_) return e;
+  global_sums(Sums::books);
+  e.started = true;
+  e.damping = totals_[0].value();
+  e.friction = totals_[1].value();
+  e.gravity = totals_[2].value();
+  e.stiffening = totals_[3].value();
+  const System& sys = subdomains_[0].system();
+  const auto walls = static_cast<std::size_t>(sys.wall_count());
+  e.wall_work.resize(walls);
+  for (std::size_t w = 0; w < walls; ++w) e.wall_work[w] = totals_[4 + w].value();
+  e.mesh_work.resize(static_cast<std::size_t>(sys.mesh_count()));
+  for (std::size_t m = 0; m < e.mesh_work.size(); ++m) e.mesh_work[m] = totals_[4 + walls + m].value();
+  e.kinetic_start = kinetic_start_;
+  e.elastic_start = elastic_start_;
+  return e;
+}
+
+double SubdomainStepper::energy_balance_error() {
+  const System::Energies e = energies();
+  if (!e.started) return 0.0;
+  double in = e.gravity, scale = e.kinetic_start + e.elastic_start + std::abs(e.gravity);
+  for (const double w : e.wall_work) in += w, scale += std::abs(w);
+  for (const double w : e.mesh_work) in += w, scale += std::abs(w);
+  const double stored = (kinetic_energy() + half_step_term(books_dt_) - e.kinetic_start) +
+                        (elastic_energy() - e.elastic_start);
+  const double residual = in - stored - e.friction - e.damping - e.breakage - e.stiffening;
+  return scale > 0.0 ? residual / scale : 0.0;
+}
+
+// books(): "PSBK" (u32), started (u8), kinetic_start, elastic_start, the step (3 f64), the count
+// of sums (u64), the sums (ExactSum::write(), each over every subdomain)
+namespace {
+constexpr std::uint32_t books_magic = 0x4b425350u;  // "PSBK"
+constexpr std::size_t books_head = 4 + 1 + 3 * 8 + 8;
+}  // namespace
+
+std::vector<std::byte> SubdomainStepper::books() {
+  std::vector<std::byte> out;
+  if (!energy_) return out;
+  const std::size_t m = book_count();
+  if (books_.size() != subdomains_.size())
+    books_.assign(subdomains_.size(), std::vector<ExactSum>(m));
+  global_sums(Sums::books);
+  out.resize(books_head + m * ExactSum::byte_size);
+  std::byte* at = out.data();
+  const auto put = [&](const auto& v) {
+    std::memcpy(at, &v, sizeof v);
+    at += sizeof v;
+  };
+  put(books_magic);
+  put(static_cast<std::uint8_t>(books_started_ ? 1 : 0));
+  put(kinetic_start_);
+  put(elastic_start_);
+  put(books_dt_);
+  put(static_cast<std::uint64_t>(m));
+  for (std::size_t q = 0; q < m; ++q, at += ExactSum::byte_size) totals_[q].write(at);
+  return out;
+}
+
+void SubdomainStepper::restore_books(const std::vector<std::byte>& bytes) {
+  if (!energy_)
+    throw Error("SubdomainStepper::restore_books: the energy accounting is off "
+                "(set_energy_accounting(true) before resume())");
+  const std::size_t m = book_count();
+  std::uint32_t magic = 0;
+  std::uint64_t count = 0;
+  if (bytes.size() >= books_head) {
+    std::memcpy(&magic, bytes.data(), 4);
+    std::memcpy(&count, bytes.data() + books_head - 8, 8);
+  }
+  if (magic != books_magic || count != m || bytes.size() != books_head + m * ExactSum::byte_size)
+    throw Error("SubdomainStepper::restore_books: the restart's energy books do not fit this "
+                "split (" + std::to_string(count) + " sums for " + std::to_string(m) +
+                " = 4 + walls + meshes, or not books at all)");
+  books_started_ = std::to_integer<std::uint8_t>(bytes[4]) != 0;
+  std::memcpy(&kinetic_start_, bytes.data() + 5, 8);
+  std::memcpy(&elastic_start_, bytes.data() + 13, 8);
+  std::memcpy(&books_dt_, bytes.data() + 21, 8);
+  books_.assign(subdomains_.size(), std::vector<ExactSum>(m));
+  // the sums over every subdomain go to subdomain 0's (exact: where they are added up does not
+  // matter), on its process only
+  const std::vector<int>& local = transport_->local();
+  const auto first = std::find(local.begin(), local.end(), 0);
+  if (first == local.end()) return;
+  std::vector<ExactSum>& b = books_[static_cast<std::size_t>(first - local.begin())];
+  for (std::size_t q = 0; q < m; ++q) b[q].read(bytes.data() + books_head + q * ExactSum::byte_size);
 }
 
 // Every subdomain sends its partial sums to every subdomain (itself included); each adds them up
@@ -585,18 +747,24 @@ void SubdomainStepper::global_sums(Sums what) {
   const std::size_t local = subdomains_.size();
   const auto walls = static_cast<std::size_t>(subdomains_[0].system().wall_count());
   const std::size_t planes = subdomains_[0].system().planes().size();
-  const std::size_t m = what == Sums::kinetic                              ? 4
-                        : what == Sums::elastic || what == Sums::contacts ? 1
-                        : what == Sums::walls                              ? 3 * walls
-                                                                           : 3 * planes;
+  const std::size_t m = what == Sums::kinetic ? 4
+                        : what == Sums::elastic || what == Sums::contacts || what == Sums::half_step
+                            ? 1
+                        : what == Sums::walls ? 3 * walls
+                        : what == Sums::books ? book_count()
+                                              : 3 * planes;
   sums_.resize(m * local);
   totals_.resize(m);
   for (std::size_t k = 0; k < local; ++k) {
     ExactSum* sums = sums_.data() + m * k;
     for (std::size_t q = 0; q < m; ++q) sums[q].clear();
     const Subdomain& sd = subdomains_[k];
-    if (sd.system().particle_count() == 0)
+    if (what == Sums::books)  // (cumulative, also where the subdomain is empty now)
+      for (std::size_t q = 0; q < m; ++q) sums[q] = books_[k][q];
+    else if (sd.system().particle_count() == 0)
       ;  // (nothing to add)
+    else if (what == Sums::half_step)
+      sd.add_half_step(sum_dt_, sums[0]);
     else if (what == Sums::kinetic)
       subdomains_[k].add_kinetic(sums);
     else if (what == Sums::elastic)
@@ -739,7 +907,7 @@ void SubdomainStepper::run(long steps, double dt) {
 
 namespace {
 constexpr std::uint32_t restart_magic = 0x53525350u;  // "PSRS"
-constexpr std::uint32_t restart_version = 1;
+constexpr std::uint32_t restart_version = 2;  // (1: without the energy books, still read)
 
 template <class T>
 void put_value(std::ostream& out, const T& v) {
@@ -765,12 +933,14 @@ SplitRestart SplitRestart::gather(SubdomainStepper& stepper) {
   const auto local = static_cast<std::size_t>(stepper.local_count());
   std::vector<SubdomainMail> out(local, SubdomainMail(static_cast<std::size_t>(transport.parts())));
   std::vector<SubdomainMail> in;
+  std::vector<std::byte> books = stepper.books();  // (collective)
   for (std::size_t k = 0; k < local; ++k)
     if (stepper.subdomain(static_cast<int>(k)).owned_count() > 0)
       stepper.subdomain(static_cast<int>(k)).pack_owned(out[k][0]);
   transport.exchange(out, in);
   SplitRestart r;
   if (transport.local()[0] != 0) return r;  // (held by subdomain 0's process)
+  r.books_ = std::move(books);
   std::ostringstream world(std::ios::binary);
   stepper.subdomain(0).system().write_state(world);
   r.world_ = std::move(world).str();
@@ -791,14 +961,17 @@ void SplitRestart::write(std::ostream& out) const {
     put_value(out, static_cast<std::uint64_t>(m.size()));
     out.write(reinterpret_cast<const char*>(m.data()), static_cast<std::streamsize>(m.size()));
   }
+  put_value(out, static_cast<std::uint64_t>(books_.size()));
+  out.write(reinterpret_cast<const char*>(books_.data()), static_cast<std::streamsize>(books_.size()));
 }
 
 SplitRestart SplitRestart::read(std::istream& in) {
   if (get_value<std::uint32_t>(in, "its magic") != restart_magic)
     throw Error("SplitRestart::read: not a split bed's restart (no \"PSRS\" at the start)");
-  if (const auto v = get_value<std::uint32_t>(in, "its version"); v != restart_version)
-    throw Error("SplitRestart::read: format version " + std::to_string(v) + "; this build reads " +
-                std::to_string(restart_version));
+  const auto version = get_value<std::uint32_t>(in, "its version");
+  if (version < 1 || version > restart_version)
+    throw Error("SplitRestart::read: format version " + std::to_string(version) +
+                "; this build reads 1 to " + std::to_string(restart_version));
   SplitRestart r;
   r.world_.resize(get_value<std::uint64_t>(in, "the world's size"));
   get_bytes(in, r.world_.data(), r.world_.size(), "the world's state");
@@ -806,6 +979,10 @@ SplitRestart SplitRestart::read(std::istream& in) {
   for (std::vector<std::byte>& m : r.owned_) {
     m.resize(get_value<std::uint64_t>(in, "a part's size"));
     get_bytes(in, reinterpret_cast<char*>(m.data()), m.size(), "a part's particles");
+  }
+  if (version >= 2) {
+    r.books_.resize(get_value<std::uint64_t>(in, "the energy books' size"));
+    get_bytes(in, reinterpret_cast<char*>(r.books_.data()), r.books_.size(), "the energy books");
   }
   return r;
 }

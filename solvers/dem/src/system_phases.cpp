@@ -74,6 +74,8 @@ double System::phase_drift(double dt, const std::vector<char>& skip) {
   if (!verlet_.loaded()) verlet_.load(store_.core());
   verlet_.moved();
   move_walls_and_meshes();
+  // (the sums start below; a System resumed from a restart has had no force pass to size them)
+  if (energy_pass() && dissipation_.size() != n) dissipation_.resize(n);
   const VelocityVerlet::Pass verlet = verlet_.pass(store_.core());
   const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
   const bool have_build = x_build.size() == n;
@@ -187,6 +189,40 @@ void System::add_elastic_energy(const std::vector<char>& skip, ExactSum& sum) co
         sum.add(hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta,
                                      rec.r_eff, shear));
       });
+}
+
+void System::add_half_step_term(const std::vector<char>& skip, double dt, ExactSum& sum) const {
+  sync_particles();
+  const Particles& p = store_.core();
+  const std::size_t n = p.size();
+  const std::vector<PlaneWall>& planes = walls_.planes();
+  const std::size_t np = planes.size();
+  const std::vector<Eigen::Vector3d>& reaction = walls_.reactions();
+  if (skip.size() != n)
+    throw Error("add_half_step_term: needs one flag per particle (" + std::to_string(n) +
+                "), got " + std::to_string(skip.size()));
+  if (n > 0 && np > 0 && reaction.size() != n * np)
+    throw Error(
+        "add_half_step_term: the planes' reactions are not recorded (set_wall_reactions(true) "
+        "before the force pass)");
+  const double h = 0.5 * dt, h2 = 0.125 * dt * dt;
+  for (std::size_t i = 0; i < n; ++i) {  // (the terms as half_step_term() takes them)
+    if (skip[i]) continue;
+    const Eigen::Vector3d &f = p.force[i], &t = p.torque[i];
+    sum.add(h * (f.dot(p.velocity[i]) + t.dot(p.angular_velocity[i])) +
+            h2 * (f.squaredNorm() / p.mass[i] + t.squaredNorm() / p.inertia[i]));
+    for (std::size_t k = 0; k < np; ++k)  // the planes' motion: -F_plane . v_plane over dt/2
+      if (planes[k].velocity != Eigen::Vector3d::Zero())
+        sum.add(-h * reaction[i * np + k].dot(planes[k].velocity));
+  }
+  mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec, const Eigen::Vector3d&) {
+    if (skip[i]) return;
+    const TriangleMesh& m = meshes_[rec.mesh];
+    const auto& tri = m.triangle(rec.triangle);
+    sum.add(h * rec.force.dot(rec.barycentric[0] * m.velocity_[tri[0]] +
+                              rec.barycentric[1] * m.velocity_[tri[1]] +
+                              rec.barycentric[2] * m.velocity_[tri[2]]));
+  });
 }
 
 }  // namespace partita::dem

@@ -215,7 +215,7 @@ void System::start_sums(int i) {
   q.f = store_.core().mass[i] * gravity_;
   q.t.setZero();
   if (track_load_) load_[i] = 0.0;
-  if (energy_tracking_) dissipation_[i].clear();
+  if (energy_pass()) dissipation_[i].clear();
 }
 
 // Clears the per-part flags of the load limits, sizes the per-part motion maxima (no allocation
@@ -237,9 +237,10 @@ void System::start_load_pass(int parts) {
     if (sc.tasks.size() >= size) continue;
     sc.tasks.resize(size + size / 4);  // (headroom: lists grow a little between builds)
     sc.forces.resize(size + size / 4);
-    if (energy_tracking_) sc.energy.resize(size + size / 4);
+    if (energy_pass()) sc.energy.resize(size + size / 4);
   }
-  if (energy_tracking_) {  // (no allocation while the sizes hold)
+  if (energy_terms_) particle_energy_.resize(store_.size());
+  if (energy_pass()) {  // (no allocation while the sizes hold)
     for (PairScratch& sc : pair_scratch_)
       if (sc.energy.size() < sc.tasks.size()) sc.energy.resize(sc.tasks.size());
     dissipation_.resize(store_.size());
@@ -293,7 +294,9 @@ void System::compute_forces(double dt, bool update_history, double kick, bool st
 // each once, into its cross_force, then added by both owners in the same place of their sums.
 void System::evaluate_forces(double dt, bool update_history, double kick, bool drift) {
   // the energies are those of a step (a kick and the histories' update)
-  const bool energy = energy_tracking_ && kick > 0.0 && update_history;
+  const bool energy = energy_pass() && kick > 0.0 && update_history;
+  if (energy_terms_ && !energy)  // (a pass without a kick books nothing)
+    std::fill(particle_energy_.begin(), particle_energy_.end(), ParticleEnergy{});
   auto run = [&]<bool Drift, bool Energy>() {
     if (track_load_)
       if (h_load_limit_ >= 0)
@@ -344,6 +347,7 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
                                        : (Load ? kernels.with_load : kernels.plain);
   DissipationSums* const diss = Energy ? dissipation_.data() : nullptr;
   PairEnergy* const cross_energy = Energy ? cross_energy_.data() : nullptr;
+  ParticleEnergy* const particle_energy = Energy && energy_terms_ ? particle_energy_.data() : nullptr;
   // Drift: the integrator's first half of particle i (with kick = dt/2) and the start of its
   // force sums, as the loop before the pass does it (step(), which knows that no particle can
   // have moved beyond the skin)
@@ -517,6 +521,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
         // (Energy) i's dissipative sums, held here for its row (the pairs (k, i), k < i, are in)
         DissipationSums di;
         if constexpr (Energy) di = diss[i];
+        // (Energy) the per-contact terms of i's pairs (i, j): i's ParticleEnergy
+        [[maybe_unused]] double row_spring = 0.0, row_stiffening = 0.0, row_plastic = 0.0;
         for (int k = row_first[i - i_begin]; k < row_first[i - i_begin + 1]; ++k) {
           const PairForce& o = forces[k];
           const Eigen::Map<const Eigen::Vector3d> fij(o.f), ti(o.ti), tj(o.tj);
@@ -544,6 +550,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
             block_e.friction += e.spring;
             block_e.stiffening += e.stiffening;
             block_e.damping += e.plastic;
+            row_spring += e.spring;
+            row_stiffening += e.stiffening;
+            row_plastic += e.plastic;
           }
         }
         for (int s = row_cross[i - i_begin]; s < offsets[i + 1]; ++s) {  // already evaluated
@@ -561,6 +570,9 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
               block_e.friction += e.spring;
               block_e.stiffening += e.stiffening;
               block_e.damping += e.plastic;
+              row_spring += e.spring;
+              row_stiffening += e.stiffening;
+              row_plastic += e.plastic;
             }
           }
         }
@@ -592,11 +604,18 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           accel2 = std::max(accel2, f.squaredNorm() / (mass[i] * mass[i]));
           extent = std::max(extent, qi.x.cwiseAbs().maxCoeff());
           if constexpr (Energy) {  // powers at the end-of-step velocities (Energies)
-            block_e.damping += (wd.damping - (di.fd.dot(qi.v) + di.td.dot(qi.w))) * dt + wd.plastic;
-            block_e.friction += (wd.friction - (di.ff.dot(qi.v) + di.tf.dot(qi.w))) * dt +
-                                wd.spring;
-            block_e.gravity += mass[i] * gravity.dot(qi.v) * dt;
+            const double damping =
+                (wd.damping - (di.fd.dot(qi.v) + di.td.dot(qi.w))) * dt + wd.plastic;
+            const double friction =
+                (wd.friction - (di.ff.dot(qi.v) + di.tf.dot(qi.w))) * dt + wd.spring;
+            const double gravity_work = mass[i] * gravity.dot(qi.v) * dt;
+            block_e.damping += damping;
+            block_e.friction += friction;
+            block_e.gravity += gravity_work;
             block_e.stiffening += wd.stiffening;
+            if (particle_energy != nullptr)
+              particle_energy[i] = ParticleEnergy{row_plastic + damping, row_spring + friction,
+                                                  gravity_work, row_stiffening + wd.stiffening};
           }
         }
       }

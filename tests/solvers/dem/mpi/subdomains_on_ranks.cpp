@@ -9,7 +9,8 @@
 // Every rank builds the same bed, keeps the particles its box of a bisection into N owns and
 // steps them with SubdomainStepper; every particle's id, x, v, omega and every rank's collective
 // sums (kinetic and elastic energy, the contacts, momentum, the walls' forces, each at once and
-// all in one round, the planes' forces, the mesh's force, per triangle and per vertex) go to
+// all in one round, the planes' forces, the mesh's force, per triangle and per vertex, the energy
+// books and their balance) go to
 // rank 0 (through the transport), which steps the bed in one subdomain
 // (InProcessTransport) and compares them bit for bit: exit status 1 and a message on the first
 // difference. --piece: the largest MPI message of the transport (cut and joined). --stall: rank
@@ -275,6 +276,13 @@ Result result(const Bed& bed, SubdomainStepper& stepper, System& sys, double dt)
     add(Eigen::VectorXd(stepper.triangle_forces(m).reshaped()));
     add(Eigen::VectorXd(stepper.vertex_forces(m).reshaped()));
   }
+  const System::Energies e = stepper.energies();  // the energy books
+  for (const double v : {e.damping, e.friction, e.gravity, e.stiffening, e.kinetic_start,
+                         e.elastic_start})
+    r.sums.push_back(v);
+  r.sums.insert(r.sums.end(), e.wall_work.begin(), e.wall_work.end());
+  r.sums.insert(r.sums.end(), e.mesh_work.begin(), e.mesh_work.end());
+  r.sums.push_back(stepper.energy_balance_error());
   r.builds = stepper.builds();
   r.time = static_cast<double>(bed.steps) * dt;
   r.migrated = sd.migrated_in();
@@ -293,6 +301,7 @@ Result run(const Bed& bed, SubdomainTransport& transport, const Knobs& knobs) {
   const double dt = time_step(bed);
   std::unique_ptr<System> sys = bed.system(keep);
   SubdomainStepper stepper({sys.get()}, transport, d, bed.skin, knobs.options);
+  stepper.set_energy_accounting(true);
   step_range(bed, stepper, *sys, 0, bed.steps, dt, knobs);
   return result(bed, stepper, *sys, dt);
 }
@@ -307,6 +316,7 @@ std::string write_restart(const Bed& bed, SubdomainTransport& writers, long at) 
     if (d.owner(x0[i]) == writers.local()[0]) keep.push_back(static_cast<int>(i));
   std::unique_ptr<System> sys = bed.system(keep);
   SubdomainStepper stepper({sys.get()}, writers, d, bed.skin);
+  stepper.set_energy_accounting(true);
   step_range(bed, stepper, *sys, 0, at, time_step(bed), {});
   const SplitRestart restart = SplitRestart::gather(stepper);
   if (!restart.holds()) return {};
@@ -322,7 +332,9 @@ Result resume(const Bed& bed, SubdomainTransport& readers, const std::string& st
   std::unique_ptr<System> sys = bed.system({});
   restart.restore({sys.get()}, readers);
   SubdomainStepper stepper({sys.get()}, readers, cut(bed, readers.parts()), bed.skin);
+  stepper.set_energy_accounting(true);
   stepper.resume();
+  stepper.restore_books(restart.books());
   const double dt = time_step(bed);
   step_range(bed, stepper, *sys, at, bed.steps, dt, {});
   return result(bed, stepper, *sys, dt);

@@ -60,8 +60,8 @@
 //    System's sums added up: they count the ghosts' contacts twice, and a sum of per-subdomain
 //    rounded sums depends on the split. They may differ from one System's triangle_forces()
 //    (vertex sums rounded contact by contact) in the last bits. The messages carry only the
-//    vertices the contacts touched. The energy accounting's mesh work is not summed (the
-//    accounting is refused in phases).
+//    vertices the contacts touched. The energy accounting's mesh work is each owned contact's
+//    (SubdomainStepper::set_energy_accounting()).
 //  - An empty subdomain (no particle, not even a ghost) still moves its walls and meshes and
 //    advances its time (phase_drift() and phase_finish() without particles): a moving wall or
 //    mesh is where it should be when particles reach it. It asks for no list build.
@@ -81,7 +81,8 @@
 //    System::kinetic_energy()'s ordered sum in the last bits), and so is elastic_energy() (each
 //    pair counted where the first of its two in the global order is owned, planes and meshes
 //    where the particle is owned). The energy accounting (System::energies()) is refused in
-//    phases (System::phase_drift()).
+//    phases (System::phase_drift()); the split's own books are SubdomainStepper::
+//    set_energy_accounting()'s: each step's terms of the owned particles in exact sums.
 //  - Hooks that change the particle set (breakage's fragments) are not handled: fragment ids
 //    must be unique over the subdomains and the new particles need ghosts.
 //  - Wall servos and other hooks that read a wall's force read their own System's (partial, with
@@ -214,6 +215,15 @@ class Subdomain {
   void add_wall_forces(ExactSum* sums) const;
   /// The same per plane: sums[3 k + c] (plane k of System::planes(), component c).
   void add_plane_forces(ExactSum* sums) const;
+  /// Adds the owned particles' energies of the last step (System::particle_energies(): the
+  /// System records them with set_energy_terms()) to sums[0..3] (damping, friction, gravity,
+  /// stiffening), the work of each wall's motion on them (-their reaction . v_plane dt, as
+  /// System::energies() books it per plane) to sums[4 + wall] and of each mesh's motion (the
+  /// contact's force on the particle . the mesh's velocity at the contact point dt) to
+  /// sums[4 + walls + mesh].
+  void add_step_energies(double dt, ExactSum* sums) const;
+  /// Adds the owned particles' half-step term (System::add_half_step_term()).
+  void add_half_step(double dt, ExactSum& sum) const { sys_->add_half_step_term(ghost_, dt, sum); }
   /// Adds the owned particles' contacts with mesh `mesh` in the last pass to `sums` (each
   /// contact's reaction to its triangle's vertices with the contact point's barycentric weights,
   /// as MeshContacts::reduce() shares it, and to the total); the ghosts' contacts are left out.
@@ -313,6 +323,30 @@ class SubdomainStepper {
   /// same bits on any split; System::mesh_force() adds the rounded triangle forces); collective.
   Eigen::Vector3d mesh_force(int mesh);
 
+  /// The energy accounting over the split: the books of System::energies(), each step's terms of
+  /// the owned particles (System::set_energy_terms(): their contacts' dissipation, gravity's
+  /// work, the stiffening term, the walls' and meshes' work on them) added to exact sums that are
+  /// never rounded until read, so that energies() and energy_balance_error() are the same bits on
+  /// any split (and differ from one System's energies(), summed per block, in the last bits).
+  /// Turn it on before start() or resume(). A change of the particle set between steps
+  /// (breakage, removal) is not booked on a split (energies().breakage stays 0).
+  void set_energy_accounting(bool on);
+  bool energy_accounting() const { return energy_; }
+  /// The books since the first step (collective): damping, friction, gravity, stiffening, each
+  /// wall's and mesh's work, the kinetic energy with its half-step term and the elastic energy at
+  /// the first step; unstarted (all zero) before it or without the accounting.
+  System::Energies energies();
+  /// As System::energy_balance_error(), from energies(), kinetic_energy(), elastic_energy() and
+  /// the half-step term of the owned particles (collective). 0 before the first step.
+  double energy_balance_error();
+  /// The books as bytes for a restart (SplitRestart::gather()): the start values and the exact
+  /// sums over every subdomain, the same on every process (collective); empty without the
+  /// accounting.
+  std::vector<std::byte> books();
+  /// Continues the books of a restart (books()' bytes) after resume(), before the next step;
+  /// throws Error when they do not fit this split's walls and meshes, or the accounting is off.
+  void restore_books(const std::vector<std::byte>& bytes);
+
  private:
   // the owned contacts with `mesh` summed over every subdomain into mesh_vertex_, mesh_triangle_
   // and mesh_total_
@@ -327,11 +361,21 @@ class SubdomainStepper {
   // what global_sums() adds up: per local subdomain, kinetic energy and momentum (4 sums), the
   // elastic energy (1), the walls' forces (3 per wall), the planes' forces (3 per plane) or the
   // contacts (1)
-  enum class Sums { kinetic, elastic, walls, planes, contacts };
+  enum class Sums { kinetic, elastic, walls, planes, contacts, books, half_step };
   std::vector<Eigen::Vector3d> forces_;  // wall_forces(), plane_forces()
   // sums_[m k + q]: local subdomain k's sum q, then summed over every subdomain into totals_
   void global_sums(Sums what);
   std::vector<ExactSum> sums_, totals_;
+  // the energy accounting: per local subdomain its owned particles' books (4 + walls + meshes
+  // exact sums, Subdomain::add_step_energies()); the start values (as System::Energies'), the
+  // step the half-step term is taken for
+  bool energy_ = false;
+  std::vector<std::vector<ExactSum>> books_;
+  bool books_started_ = false;
+  double kinetic_start_ = 0.0, elastic_start_ = 0.0, books_dt_ = 0.0;
+  double sum_dt_ = 0.0;  // (global_sums(Sums::half_step)'s step)
+  std::size_t book_count() const;
+  double half_step_term(double dt);
 
   std::vector<Subdomain> subdomains_;
   SubdomainTransport* transport_;
@@ -353,7 +397,9 @@ class SubdomainStepper {
 /// over them and resume()), with the same bits whatever the split that wrote it, in one process
 /// or over processes (each reads the stream and restores it with its transport).
 /// Stream: "PSRS" (u32), version (u32), the world's size (u64) and its SystemState::write()
-/// bytes, the number of parts (u64), then per part its size (u64) and its message.
+/// bytes, the number of parts (u64), then per part its size (u64) and its message; then the
+/// energy books' size (u64) and bytes (SubdomainStepper::books(); version 2 on, 0 without the
+/// accounting; version 1 is read as a restart without books).
 class SplitRestart {
  public:
   /// Every subdomain's owned particles, gathered through the stepper's transport to the process
@@ -375,9 +421,13 @@ class SplitRestart {
   /// subdomain 0, on its process only (resume() sends each to its owner).
   void restore(const std::vector<System*>& systems, const SubdomainTransport& transport) const;
   std::size_t parts() const { return owned_.size(); }
+  /// The stepper's energy books at the restart (SubdomainStepper::books(); empty without the
+  /// energy accounting): SubdomainStepper::restore_books() continues them.
+  const std::vector<std::byte>& books() const { return books_; }
 
  private:
   void restore(const std::vector<System*>& systems, int particles_to) const;
+  std::vector<std::byte> books_;
   std::string world_;
   std::vector<std::vector<std::byte>> owned_;
 };

@@ -381,6 +381,34 @@ class System {
   /// before the first step: the energies count from the first step taken with it on.
   void set_energy_tracking(bool on) { energy_tracking_ = on; }
   bool energy_tracking() const { return energy_tracking_; }
+  /// What one step books for one particle (set_energy_terms()): the dissipation of its contacts
+  /// (its share of each contact's dissipative power at the end-of-step velocities, its wall and
+  /// mesh contacts' yield work and released spring energy, and the per-contact terms of its pairs
+  /// (i, j) with j after it in the numbering), the work of gravity on it and the stiffening term
+  /// [J]. Summed over the particles these are the step's increments of energies()' damping,
+  /// friction, gravity and stiffening (in another order: energies() sums per block).
+  struct ParticleEnergy {
+    double damping = 0.0, friction = 0.0, gravity = 0.0, stiffening = 0.0;
+  };
+  /// Records each particle's ParticleEnergy in every step's force pass (particle_energies()),
+  /// for sums in an order of the caller's (a split bed's energy accounting, SubdomainStepper::
+  /// set_energy_accounting(): each subdomain adds its owned particles' terms). Unlike
+  /// set_energy_tracking() it keeps no books of its own (energies() stays unstarted) and is
+  /// allowed in a step taken in phases. Off by default.
+  void set_energy_terms(bool on) {
+    energy_terms_ = on;
+    prepared_ = false;  // (sizes the sums)
+  }
+  bool energy_terms() const { return energy_terms_; }
+  /// Per particle (current numbering), the terms of the last step's force pass; zero for a pass
+  /// without a kick.
+  const std::vector<ParticleEnergy>& particle_energies() const { return particle_energy_; }
+  /// Adds to `sum` the half-step term of energies() (KE's dt/2 (F.v + T.omega) + dt^2/8 (|F|^2/m
+  /// + |T|^2/I) and the walls' and meshes' dt/2 F_c . v_wall) of the particles with skip[i] == 0
+  /// and their plane and mesh contacts (the planes' reactions need set_wall_reactions()), term by
+  /// term. Throws Error without recorded reactions while planes exist, or with another number of
+  /// flags.
+  void add_half_step_term(const std::vector<char>& skip, double dt, ExactSum& sum) const;
   const Energies& energies() const { return energies_; }
   /// (sum(wall_work) + sum(mesh_work) + gravity - dKE - dE_el - friction - damping - breakage
   /// - stiffening)
@@ -517,6 +545,10 @@ class System {
   // energy accounting (energies()): per particle the dissipative force sums of the pass, per
   // block of particles the pass's energies, per cross pair its dissipative parts
   bool energy_tracking_ = false;
+  bool energy_terms_ = false;                      // (set_energy_terms())
+  std::vector<ParticleEnergy> particle_energy_;    // (the same)
+  // the force pass gathers the dissipative sums (energy accounting, or its terms per particle)
+  bool energy_pass() const { return energy_tracking_ || energy_terms_; }
   Energies energies_;
   std::vector<DissipationSums> dissipation_;
   std::vector<BlockEnergy> block_energy_;
