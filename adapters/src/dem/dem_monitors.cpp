@@ -21,7 +21,13 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
   static const MonitorTable<DemAdapter> table = [] {
     using A = DemAdapter;
     // the DEM's energy accounting (dem::System::energies(), cumulative since the first step)
-    const auto energies = [](const A& a) { return a.system_.energy_tracking(); };
+    // (on several ranks the split's books, summed over the ranks at the last monitors pass)
+    const auto energies = [](const A& a) {
+      return a.on_ranks() ? a.ranks_->books : a.system_.energy_tracking();
+    };
+    static constexpr auto books = [](const A& a) -> const dem::System::Energies& {
+      return a.on_ranks() ? a.ranks_->energies : a.system_.energies();
+    };
     const auto broken = [](const A& a) { return a.breakage() != nullptr; };
     MonitorTable<A> t;
     t.scalar("kinetic_energy", "J", "translational plus rotational kinetic energy of the particles",
@@ -54,26 +60,26 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
              "<mesh>.work, <wall>.work) energy dissipated by Coulomb sliding in all contacts since "
              "the start (the capped tangential force's work on the relative motion plus the "
              "spring energy the cap released)",
-             [](const A& a) { return a.system_.energies().friction; }, energies);
+             [](const A& a) { return books(a).friction; }, energies);
     t.scalar("damping_work", "J",
              "energy dissipated by viscous contact damping (normal, tangential), rolling "
              "resistance and yielding mesh contacts (breakage.below_limit: yield) since the start",
-             [](const A& a) { return a.system_.energies().damping; }, energies);
+             [](const A& a) { return books(a).damping; }, energies);
     t.scalar("breakage_energy", "J",
              "mechanical energy (kinetic, potential, contact) before minus after the changes of "
              "the particle set (breakage) since the start",
-             [](const A& a) { return a.system_.energies().breakage; }, energies);
+             [](const A& a) { return books(a).breakage; }, energies);
     t.scalar("stiffening_work", "J",
              "energy the tangential springs lost without work (Mindlin's stiffness changing with "
              "the overlap, the history turned with the contact); negative: energy the law created",
-             [](const A& a) { return a.system_.energies().stiffening; }, energies);
+             [](const A& a) { return books(a).stiffening; }, energies);
     t.scalar("gravity_work", "J", "work of gravity on the particles since the start",
-             [](const A& a) { return a.system_.energies().gravity; }, energies);
+             [](const A& a) { return books(a).gravity; }, energies);
     t.scalar("wall_work", "J", "work of all walls and meshes on the particles since the start",
              [](const A& a) {
                double walls_work = 0.0;
-               for (const double w : a.system_.energies().wall_work) walls_work += w;
-               for (const double w : a.system_.energies().mesh_work) walls_work += w;
+               for (const double w : books(a).wall_work) walls_work += w;
+               for (const double w : books(a).mesh_work) walls_work += w;
                return walls_work;
              },
              energies);
@@ -86,7 +92,10 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
              "(wall_work + gravity_work - dKE - d elastic_energy - friction_work - damping_work - "
              "breakage_energy - stiffening_work) / (initial KE + initial elastic energy + the "
              "works' magnitudes); KE with velocity Verlet's half-step term",
-             [](const A& a) { return a.system_.energy_balance_error(); }, energies);
+             [](const A& a) {
+               return a.on_ranks() ? a.ranks_->balance : a.system_.energy_balance_error();
+             },
+             energies);
     // meshes before walls: where a wall and a mesh share a name, the wall's value is the one a
     // monitor column takes (the last of that name)
     t.add(xyz_rows("<mesh>.force", "N", "total contact force of the particles on a mesh, x"),
@@ -100,7 +109,7 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
             "work of one mesh's motion on the particles since the start (a coupled FE surface: "
             "what the structure did on the granules)"}},
           [](const A& a, const Out& out) {
-            const std::vector<double>& work = a.system_.energies().mesh_work;
+            const std::vector<double>& work = books(a).mesh_work;
             for (const auto& m : a.meshes_dem_) {
               const auto id = static_cast<std::size_t>(m.id);
               out({m.name}, {id < work.size() ? work[id] : 0.0});
@@ -117,7 +126,7 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
           });
     t.add({{"<wall>.work", "J", "work of one wall's motion on the particles since the start"}},
           [](const A& a, const Out& out) {
-            const std::vector<double>& work = a.system_.energies().wall_work;
+            const std::vector<double>& work = books(a).wall_work;
             for (const auto& w : a.walls_) {
               const auto id = static_cast<std::size_t>(w.id);
               out({w.name}, {id < work.size() ? work[id] : 0.0});

@@ -22,7 +22,8 @@
 //   advance dt       every rank steps its subdomain (walls moved by their tables alike);
 //   monitors groups  the sums the quantities asked for need, each an exact sum over the owned
 //                    particles rounded once (SubdomainStepper: kinetic energy, momentum, elastic
-//                    energy, each wall's, box face's and mesh's force, the contacts), the monitor
+//                    energy, each wall's, box face's and mesh's force, the contacts, the energy
+//                    books and their balance), the monitor
 //                    particles' states gathered from their owners: the same bits on any N;
 //   check            every rank's astray owned particle of lowest id to rank 0, and a stop
 //                    signal that reached another rank's process alone (rank 0 then stops the
@@ -58,9 +59,13 @@
 // Wall servos: the adapter applies dem::WallServo's law after each step with the wall's force
 // summed over the ranks (the hook on each rank's System would steer by that rank's part).
 //
+// The energy accounting (energy_accounting: true) keeps the split's books (SubdomainStepper::
+// set_energy_accounting(): each step's terms of the owned particles in exact sums, the same bits
+// on any N; they travel in the restart stream); its monitors come with `monitors groups`.
+//
 // Not handled on a split yet, refused at set-up naming the key: breakage (fragment ids unique over
-// the ranks, new particles' ghosts), the energy accounting; at run time: a monitor quantity not
-// listed above (none of the DEM's today: a guard for new ones).
+// the ranks, new particles' ghosts); at run time: a monitor quantity not listed above (none of the
+// DEM's today: a guard for new ones).
 //
 // The split path gives the same bytes on every N, N = 1 under mpirun (or --on-ranks) included. It
 // is not the path of one process without mpirun (one dem::System stepped whole): the split numbers
@@ -121,7 +126,12 @@ constexpr long kBalanceEvery = 200;
 constexpr double kImbalance = 1.25;
 
 constexpr std::uint32_t kKinetic = 1, kElastic = 2, kWalls = 4, kMeshes = 8, kTracked = 16,
-                        kFaceGroup = 32, kContacts = 64;
+                        kFaceGroup = 32, kContacts = 64, kEnergy = 128;
+
+// the energy accounting's monitor quantities (besides <wall>.work and <mesh>.work)
+const char* const kEnergyNames[] = {"friction_work",   "damping_work", "breakage_energy",
+                                    "stiffening_work", "gravity_work", "wall_work",
+                                    "energy_balance_error"};
 
 // A message's bytes.
 class Bytes {
@@ -213,8 +223,10 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
         what, ranks->size()));
   };
   if (c.has("breakage")) refuse(c["breakage"], "breakage (fragments born at run time)");
-  if (c.has("energy_accounting") && c.boolean("energy_accounting"))
-    refuse(c["energy_accounting"], "the energy accounting");
+  // the energy accounting: the split's books (SubdomainStepper), not the System's own (it keeps
+  // them per System, and refuses a step taken in phases)
+  const bool books = system_.energy_tracking();
+  system_.set_energy_tracking(false);
 #ifndef PARTITA_DEM_MPI
   throw Error("dem '" + name_ +
               "': this partita was built without the DEM's MPI transport "
@@ -224,6 +236,7 @@ void DemAdapter::setup_ranks(const SolverContext& context) {
     c["particles"].fail("a DEM on several ranks needs particles at the start");
   auto o = std::make_unique<OnRanks>();
   o->ranks = ranks;
+  o->books = books;
   o->skin = c.has("skin") ? c.real("skin") : 0.0;
   try {
     const MPI_Comm comm = *static_cast<const MPI_Comm*>(ranks->communicator());
@@ -284,6 +297,7 @@ void DemAdapter::ranks_split() {
     system_.remove_particles(elsewhere);
     o.stepper = std::make_unique<dem::SubdomainStepper>(std::vector<dem::System*>{&system_},
                                                         *o.transport, o.decomposition, o.skin);
+    o.stepper->set_energy_accounting(o.books);
   } catch (const dem::Error& e) {
     throw Error(std::string("DEM model of participant '") + name_ + "' on ranks: " + e.what());
   }
@@ -624,6 +638,11 @@ std::vector<std::string> DemAdapter::ranks_monitor_names() const {
     for (const char* c : {"x", "y", "z"}) n.push_back(m.name + ".force_" + c);
   for (const auto& w : walls_)
     for (const char* c : {"x", "y", "z"}) n.push_back(w.name + ".force_" + c);
+  if (ranks_->books) {
+    n.insert(n.end(), std::begin(kEnergyNames), std::end(kEnergyNames));
+    for (const auto& m : meshes_dem_) n.push_back(m.name + ".work");
+    for (const auto& w : walls_) n.push_back(w.name + ".work");
+  }
   for (const auto& w : walls_)
     for (int face = 0; face < 6; ++face)
       if (w.faces & (1u << face))
@@ -648,6 +667,14 @@ std::uint32_t DemAdapter::ranks_monitor_groups(const std::vector<std::string>& n
     if (q == "particles" || q == "mass") known = true;
     if (q == "elastic_energy") groups |= kElastic, known = true;
     if (q == "contacts_per_particle") groups |= kContacts, known = true;
+    if (ranks_->books) {
+      for (const char* e : kEnergyNames)
+        if (q == e) groups |= kEnergy, known = true;
+      for (const auto& m : meshes_dem_)
+        if (q == m.name + ".work") groups |= kEnergy, known = true;
+      for (const auto& w : walls_)
+        if (q == w.name + ".work") groups |= kEnergy, known = true;
+    }
     for (const auto& m : meshes_dem_)
       if (is(m.name + ".force_", {"x", "y", "z"})) groups |= kMeshes, known = true;
     for (const auto& w : walls_) {
@@ -694,6 +721,10 @@ void DemAdapter::ranks_monitors(std::uint32_t groups) const {
     }
     // the forces of a pass: none after a resume before its first step
     if (groups & kElastic) o.elastic = o.forces ? s.elastic_energy() : 0.0;
+    if (groups & kEnergy) {  // the books go on through a resume; their balance needs the forces
+      o.energies = s.energies();
+      o.balance = o.forces ? s.energy_balance_error() : 0.0;
+    }
     // 2 contacts / N, as System::mean_contacts_per_particle() (N fixed: the particle count)
     if (groups & kContacts)
       o.contacts_per_particle = 2.0 * static_cast<double>(s.contact_count()) / o.particles;
@@ -1016,7 +1047,9 @@ void DemAdapter::ranks_resume(const std::string& stream) {
       r.restore({&system_}, *o.transport);
       o.stepper = std::make_unique<dem::SubdomainStepper>(std::vector<dem::System*>{&system_},
                                                           *o.transport, o.decomposition, o.skin);
+      o.stepper->set_energy_accounting(o.books);
       o.stepper->resume();
+      if (o.books) o.stepper->restore_books(r.books());
       o.started = true;
       o.forces = false;
     } catch (const dem::Error& e) {

@@ -34,8 +34,13 @@ struct DemAdapter::OnRanks {
   long rebalances = 0;   // cuts made again as the load drifted (DemAdapter::ranks_rebalance())
   // fixed for the run (no particle is born or removed on a split): over every particle
   double particles = 0.0, mass = 0.0, stable = 0.0;
+  // the energy accounting (energy_accounting: true): the split's books (SubdomainStepper::
+  // set_energy_accounting(); the System keeps none of its own on a split)
+  bool books = false;
   // the monitors' values of the last collective pass (rank 0)
   double kinetic = 0.0, elastic = 0.0, contacts_per_particle = 0.0;
+  dem::System::Energies energies;  // (books) and their balance
+  double balance = 0.0;
   Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> wall_force;                 // by walls_ index
   std::vector<std::array<Eigen::Vector3d, 6>> face_force;  // by walls_ index, face (a box's)

@@ -673,13 +673,7 @@ System::Energies SubdomainStepper::energies() {
 double SubdomainStepper::energy_balance_error() {
   const System::Energies e = energies();
   if (!e.started) return 0.0;
-  double in = e.gravity, scale = e.kinetic_start + e.elastic_start + std::abs(e.gravity);
-  for (const double w : e.wall_work) in += w, scale += std::abs(w);
-  for (const double w : e.mesh_work) in += w, scale += std::abs(w);
-  const double stored = (kinetic_energy() + half_step_term(books_dt_) - e.kinetic_start) +
-                        (elastic_energy() - e.elastic_start);
-  const double residual = in - stored - e.friction - e.damping - e.breakage - e.stiffening;
-  return scale > 0.0 ? residual / scale : 0.0;
+  return System::balance_error(e, kinetic_energy() + half_step_term(books_dt_), elastic_energy());
 }
 
 // books(): "PSBK" (u32), started (u8), kinetic_start, elastic_start, the step (3 f64), the count

@@ -648,13 +648,16 @@ double System::set_energy(const std::vector<std::size_t>& which, const std::vect
 }
 
 double System::energy_balance_error() const {
-  const Energies& e = energies_;
+  if (!energies_.started) return 0.0;
+  return balance_error(energies_, kinetic_energy() + half_step_term(energy_dt_), elastic_energy());
+}
+
+double System::balance_error(const Energies& e, double kinetic, double elastic) {
   if (!e.started) return 0.0;
   double in = e.gravity, scale = e.kinetic_start + e.elastic_start + std::abs(e.gravity);
   for (const double w : e.wall_work) in += w, scale += std::abs(w);
   for (const double w : e.mesh_work) in += w, scale += std::abs(w);
-  const double stored = (kinetic_energy() + half_step_term(energy_dt_) - e.kinetic_start) +
-                        (elastic_energy() - e.elastic_start);
+  const double stored = (kinetic - e.kinetic_start) + (elastic - e.elastic_start);
   const double residual = in - stored - e.friction - e.damping - e.breakage - e.stiffening;
   return scale > 0.0 ? residual / scale : 0.0;
 }

@@ -415,6 +415,9 @@ class System {
   /// / (kinetic_start + elastic_start + |gravity| + sum |wall_work| + sum |mesh_work|); 0 before
   /// the first step. Takes a pass over the particles and contacts (kinetic and elastic energy).
   double energy_balance_error() const;
+  /// The same for books `e` with the kinetic energy now (with its half-step term) and the elastic
+  /// energy now (a split bed's: SubdomainStepper::energy_balance_error()).
+  static double balance_error(const Energies& e, double kinetic, double elastic);
 
   /// Force the particles exerted on a wall (all its planes) in the last step [N].
   Eigen::Vector3d wall_force(int wall) const;
