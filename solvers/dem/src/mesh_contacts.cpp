@@ -27,7 +27,9 @@ std::int64_t feature_key(int mesh, int type, int index) {
 //  - accepted in the order faces, edges, vertices (then by distance): a face always; an edge
 //    only if no accepted face has it as an edge; a vertex only if no accepted face or edge has
 //    it; and any contact only if its normal differs from all accepted ones (a sphere cannot
-//    touch two surfaces with the same normal: coplanar neighbours sharing the point).
+//    touch two surfaces with the same normal: coplanar neighbours sharing the point), and, of
+//    another mesh, only if its point is not on an accepted contact's patch, flush with it (two
+//    meshes meeting there describe one surface: it touches once).
 template <bool Load, bool Energy>
 void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
                             const std::vector<TriangleMesh>& meshes, const ContactModel& model,
@@ -147,13 +149,25 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
   int accepted[max_contacts];
   int na = 0;
   constexpr double same_normal = 1.0 - 5.0e-5;  // about 0.6 degrees
+  constexpr double flush = 0.17;                 // sin(10 degrees)
   for (int c = 0; c < nc; ++c) {
     const Candidate& k = cand[c];
     bool keep = true;
     for (int a = 0; a < na && keep; ++a) {
       const Candidate& acc = cand[accepted[a]];
       if (acc.normal.dot(k.normal) > same_normal) keep = false;
-      if (acc.mesh != k.mesh) continue;
+      if (acc.mesh != k.mesh) {
+        // another mesh's feature whose point lies on this contact's patch (within its contact
+        // radius sqrt(R delta)) and flush with the sphere's tangent plane there: the same
+        // surface twice (two interfaces of one body meeting there, their normals apart by more
+        // than same_normal: a face of one and the rim edge of the other, or two faces of a
+        // deformed surface), which touches the sphere once
+        const Eigen::Vector3d d = k.cp.point - acc.cp.point;
+        const double d2 = d.squaredNorm();
+        if (d2 <= r * acc.delta && std::abs(d.dot(acc.normal)) <= flush * std::sqrt(d2))
+          keep = false;
+        continue;
+      }
       if (acc.type == k.type && acc.feature == k.feature) keep = false;
       const TriangleMesh& m = meshes[k.mesh];
       if (k.type == TriangleClosestPoint::edge && acc.type == TriangleClosestPoint::face) {

@@ -11,6 +11,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -268,26 +269,32 @@ TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh yields 
   CHECK(elastic.elastic > 50.0 * yielding.elastic);
 }
 
-TEST_CASE("dem: a yielding granule under two meshes that coincide keeps its permanent overlap as "
-          "its contact passes between them", "[dem][breakage][energy]") {
-  // Two meshes over the same square (the second triangulated along the other diagonal and tilted
-  // by 1e-5 rad), as two interfaces of one body meet along a shared edge or face: a sphere
-  // touches them as one wall (one contact: the twin's normal is the same within the tolerance),
-  // held by the nearer mesh, which changes where the tilted one crosses the other. The granule, below the
-  // comminution limit, is squeezed by a tenth of its diameter beyond the elastic overlaps and the
-  // meshes then slide two diameters over it without friction: its permanent overlap must follow
-  // the contact from one mesh to the other, so that the yield work stays f_y times the squeeze's
-  // travel and the books close. (A contact that restarted without it would yield again: each
-  // change of mesh would book f_y times the permanent overlap once more.)
+namespace {
+
+// A yielding granule (below the comminution limit) on a floor, squeezed by a tenth of its
+// diameter beyond the elastic overlaps under two meshes that describe one surface (a square of
+// side 8 d at its top; the second triangulated along the other diagonal, then turned by `turn`),
+// which then slide without friction by `slide` over it; `guides`: two frictionless planes at the
+// granule's sides in x.
+struct TwinMeshes {
+  double f_y = 0.0, squeeze = 0.0;
+  double damping_squeezed = 0.0, damping = 0.0, balance = 0.0;
+  double f_min = 1e300, f_max = 0.0;  // the meshes' force (z) during the slide
+  int switches = 0;                   // steps where the mesh that carried the larger force changed
+  std::size_t particles = 0;
+};
+TwinMeshes twin_meshes(const std::function<void(Eigen::MatrixX3d&, double d)>& turn,
+                       const Eigen::Vector3d& slide, bool guides = false) {
   BreakageParameters b = parameters(3.0);
   const double d = 2.0e-3, speed = 0.005, slide_speed = 0.05;
   b.comminution_limit = 2.5e-3;
   b.yield = true;
   const double e_eff = 1.0 / ((1.0 - NU * NU) / E + (1.0 - NU_P * NU_P) / E_P);
-  const double f_y = eq2_force(d, b);
-  const double delta_y = std::pow(3.0 * f_y / (4.0 * e_eff * std::sqrt(0.5 * d)), 2.0 / 3.0);
-  const double squeeze = 0.1 * d;
-  Eigen::MatrixX3d x0(4, 3);  // a square of side 8 d at the granule's top
+  TwinMeshes out;
+  out.f_y = eq2_force(d, b);
+  const double delta_y = std::pow(3.0 * out.f_y / (4.0 * e_eff * std::sqrt(0.5 * d)), 2.0 / 3.0);
+  out.squeeze = 0.1 * d;
+  Eigen::MatrixX3d x0(4, 3);
   x0 << -4 * d, -4 * d, d, 4 * d, -4 * d, d, 4 * d, 4 * d, d, -4 * d, 4 * d, d;
   TriangleMesh::Triangles ta(2, 3), tb(2, 3);
   ta << 0, 1, 2, 0, 2, 3;
@@ -304,8 +311,12 @@ TEST_CASE("dem: a yielding granule under two meshes that coincide keeps its perm
   sys.add_interaction(w, w, {0.0, 0.5, 0.0});
   sys.add_particle({0.3 * d, 0.1 * d, 0.5 * d}, 0.5 * d, g);
   sys.add_plane({0, 0, 0}, {0, 0, 1}, s);
-  Eigen::MatrixX3d xb0 = x0;  // crossing the first mesh where the granule is 1 d into the slide
-  xb0.col(2).array() += 1.0e-5 * (x0.col(0).array() - 1.3 * d);
+  if (guides) {  // frictionless planes touching the granule's sides at x (it cannot roll along x)
+    sys.add_plane({-0.2 * d, 0, 0}, {1, 0, 0}, w);
+    sys.add_plane({0.8 * d, 0, 0}, {-1, 0, 0}, w);
+  }
+  Eigen::MatrixX3d xb0 = x0;
+  turn(xb0, d);
   const int ma = sys.add_mesh(x0, ta, w);
   const int mb = sys.add_mesh(xb0, tb, w);
   sys.add_hook(std::make_unique<Breakage>(b));
@@ -318,42 +329,89 @@ TEST_CASE("dem: a yielding granule under two meshes that coincide keeps its perm
     sys.set_vertex_positions(mb, yb);
     sys.step(dt);
   };
-  const auto down = static_cast<long>((squeeze + 2.0 * delta_y) / (speed * dt));
+  const auto down = static_cast<long>((out.squeeze + 2.0 * delta_y) / (speed * dt));
   for (long k = 0; k < down; ++k)
     move({0.0, 0.0, -speed * dt * static_cast<double>(k + 1)});
   const double z = -speed * dt * static_cast<double>(down);
-  const double damping_squeezed = sys.energies().damping;
-  const auto across = static_cast<long>(2.0 * d / (slide_speed * dt));
-  double f_min = 1e300, f_max = 0.0;
-  int switches = 0, holder = -1;
+  out.damping_squeezed = sys.energies().damping;
+  const auto across = static_cast<long>(slide.norm() * d / (slide_speed * dt));
+  int holder = -1;
   for (long k = 0; k < across; ++k) {
-    const double s_k = slide_speed * dt * static_cast<double>(k + 1);
-    move({-s_k, 0.35 * s_k, z});
+    const Eigen::Vector3d shift =
+        (slide_speed * dt * static_cast<double>(k + 1)) * slide.normalized();
+    move({shift.x(), shift.y(), z});
     const double fa = sys.mesh_force(ma).norm(), fb = sys.mesh_force(mb).norm();
     const double f = sys.mesh_force(ma).z() + sys.mesh_force(mb).z();
-    f_min = std::min(f_min, f);
-    f_max = std::max(f_max, f);
+    out.f_min = std::min(out.f_min, f);
+    out.f_max = std::max(out.f_max, f);
     const int now = fa > fb ? ma : mb;
-    if (holder >= 0 && now != holder) ++switches;
+    if (holder >= 0 && now != holder) ++out.switches;
     holder = now;
   }
-  const double damping = sys.energies().damping;
-  INFO("f_y " << f_y << " N; mesh force during the slide " << f_min << " to " << f_max
-              << " N; the contact changed mesh " << switches << " times; yield and damping work "
-              << damping_squeezed << " J after the squeeze, " << damping
-              << " J after the slide (f_y x squeeze " << f_y * squeeze
-              << " J); balance error " << sys.energy_balance_error());
-  // the granule keeps its mass and stays below the meshes
-  CHECK(sys.particle_count() == 1);
-  // the contact did pass between the meshes (else this tests nothing)
-  CHECK(switches > 0);
+  out.damping = sys.energies().damping;
+  out.balance = sys.energy_balance_error();
+  out.particles = sys.particle_count();
+  return out;
+}
+
+// What both variants must give: one contact that keeps its permanent overlap through the slide
+void check_twin(const TwinMeshes& r) {
+  INFO("f_y " << r.f_y << " N; mesh force during the slide " << r.f_min << " to " << r.f_max
+              << " N; the larger force changed mesh " << r.switches
+              << " times; yield and damping work " << r.damping_squeezed << " J after the squeeze, "
+              << r.damping << " J after the slide (f_y x squeeze " << r.f_y * r.squeeze
+              << " J); balance error " << r.balance);
+  CHECK(r.particles == 1);
   // the squeeze: f_y times the travel beyond the elastic overlaps
-  CHECK(damping_squeezed == Approx(f_y * squeeze).epsilon(0.03));
-  // the slide (along the meshes) yields no more: the pressure stays at the strength
-  CHECK(damping == Approx(damping_squeezed).epsilon(0.02));
-  CHECK(f_min == Approx(f_y).epsilon(0.02));
-  CHECK(f_max == Approx(f_y).epsilon(0.02));
-  CHECK(std::abs(sys.energy_balance_error()) < 2e-3);
+  CHECK(r.damping_squeezed == Approx(r.f_y * r.squeeze).epsilon(0.03));
+  // the slide (along the surface) yields no more, and the force stays at the strength's: one
+  // contact, not one a mesh
+  CHECK(r.damping == Approx(r.damping_squeezed).epsilon(0.02));
+  CHECK(r.f_min == Approx(r.f_y).epsilon(0.02));
+  CHECK(r.f_max == Approx(r.f_y).epsilon(0.02));
+  CHECK(std::abs(r.balance) < 2e-3);
+}
+
+}  // namespace
+
+TEST_CASE("dem: a yielding granule under two meshes that coincide keeps its permanent overlap as "
+          "its contact passes between them", "[dem][breakage][energy]") {
+  // Two meshes of one surface, as two interfaces of one body meet along a shared edge or face
+  // (the torn outer plate's surface and its exposed faces): a sphere touches them as one wall.
+  // The second mesh tilted by 1e-5 rad about the line x = 1.3 d: one contact (the twin's normal
+  // is the same within the tolerance), held by the nearer mesh, which changes where the tilted
+  // one crosses the other, 1 d into a slide along x. Its permanent overlap must follow the
+  // contact from one mesh to the other, so that the yield work stays f_y times the squeeze's
+  // travel and the books close. (A contact that restarted without it would yield again: each
+  // change of mesh would book f_y times the permanent overlap once more.)
+  const TwinMeshes r = twin_meshes(
+      [](Eigen::MatrixX3d& x, double d) {
+        x.col(2) = x.col(2).array() + 1.0e-5 * (x.col(0).array() - 1.3 * d);
+      },
+      {-2.0, 0.7, 0.0});
+  CHECK(r.switches > 0);  // the contact did pass between the meshes (else this tests nothing)
+  check_twin(r);
+}
+
+TEST_CASE("dem: a yielding granule under two meshes of one surface whose normals differ by 2 "
+          "degrees touches it once", "[dem][breakage][energy]") {
+  // The second mesh turned by 2 degrees about the line over the granule's top along y (a face
+  // of one interface and its twin on another, apart by more than the tolerance of equal
+  // normals), the slide along that line: both meshes have their point where the granule touches,
+  // flush with each other. One contact, as on one mesh: the force stays at f_y (two contacts
+  // would carry it twice, each yielding) and the yield work the squeeze's. (Frictionless guides
+  // at the granule's sides: the turned face pushes it along x, and it would roll away.)
+  const TwinMeshes r = twin_meshes(
+      [](Eigen::MatrixX3d& x, double d) {
+        const double a = 2.0 * std::numbers::pi / 180.0, x_c = 0.3 * d, z_c = d;
+        for (Eigen::Index v = 0; v < x.rows(); ++v) {
+          const double u = x(v, 0) - x_c, h = x(v, 2) - z_c;
+          x(v, 0) = x_c + std::cos(a) * u - std::sin(a) * h;
+          x(v, 2) = z_c + std::sin(a) * u + std::cos(a) * h;
+        }
+      },
+      {0.0, 2.0, 0.0}, true);
+  check_twin(r);
 }
 
 TEST_CASE("dem: below the comminution limit two granules that collide yield and rebound at the "
