@@ -251,10 +251,17 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     else if (from_old[a] >= 0 && old_pre[from_old[a]] > 0.0f)
       pre = std::min(old_pre[from_old[a]], static_cast<float>(k.delta));
     const PairParameters& pp = model.pair(q.material, m.material());
-    // yield (yield_overlap()): the overlap beyond the elastic limit adds to the permanent one
+    // yield (yield_overlap()): the overlap beyond the elastic limit adds to the permanent one.
+    // Its work is booked where the overlap grows; a contact found without history deeper than
+    // one step's relative motion makes (the particle was inside before this feature held the
+    // contact: another mesh's face behind it, or the nearest face of a body it is inside) has
+    // its permanent overlap from before, not from work done now: not booked again.
     const float pre_before = pre;
+    const bool found_deep =
+        Energy && from_old[a] < 0 && !m.triangle_fresh(k.triangle) &&
+        k.delta > 2.0 * std::abs((q.v - v_wall).dot(k.normal)) * dt + 1e-9 * r;
     const double delta = yield_overlap(k.delta, r, pp.e_star, q.yield_pressure, pre,
-                                       Energy ? &wd->plastic : nullptr);
+                                       Energy && !found_deep ? &wd->plastic : nullptr);
     const double cr = r - 0.5 * k.delta;
     Eigen::Vector3d fw, ft;
     DissipativeParts parts;

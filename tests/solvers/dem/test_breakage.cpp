@@ -414,6 +414,57 @@ TEST_CASE("dem: a yielding granule under two meshes of one surface whose normals
   check_twin(r);
 }
 
+TEST_CASE("dem: a yielding granule that a mesh is placed into dissipates nothing the mesh did "
+          "not work for", "[dem][breakage][energy]") {
+  // A granule below the comminution limit at rest on a floor; a mesh placed (at rest, velocities
+  // zero) into it by 0.15 d at once, as a contact found deep inside another body's surface is:
+  // no force has worked on the granule, so its contact's permanent overlap, which yields at the
+  // first pass, dissipates nothing (work booked: at most the elastic energy at yield, a small
+  // fraction of f_y times the overlap that a yield counted then would book). Its force is then
+  // f_y, and pressing on, the yield books f_y times the further travel.
+  BreakageParameters b = parameters(3.0);
+  const double d = 2.0e-3;
+  b.comminution_limit = 2.5e-3;
+  b.yield = true;
+  const double f_y = eq2_force(d, b);
+  System sys;
+  granule_on_floor(sys, d);
+  Eigen::MatrixX3d x0(4, 3);  // a square of side 4 d far above the granule
+  x0 << -2 * d, -2 * d, 3 * d, 2 * d, -2 * d, 3 * d, 2 * d, 2 * d, 3 * d, -2 * d, 2 * d, 3 * d;
+  TriangleMesh::Triangles t(2, 3);
+  t << 0, 1, 2, 0, 2, 3;
+  const int mesh = sys.add_mesh(x0, t, 1);
+  sys.add_hook(std::make_unique<Breakage>(b));
+  sys.set_energy_tracking(true);
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  for (int k = 0; k < 10; ++k) sys.step(dt);
+  const double before = sys.energies().damping;
+  Eigen::MatrixX3d y = x0;
+  y.col(2).array() -= 2.0 * d + 0.15 * d;  // its face 0.15 d into the granule's top
+  const Eigen::MatrixX3d still = Eigen::MatrixX3d::Zero(4, 3);
+  sys.set_vertex_positions(mesh, y, still);
+  sys.step(dt);
+  const double found = sys.energies().damping - before;
+  const double force = sys.mesh_force(mesh).norm();
+  // pressing on by 0.05 d at 0.005 m/s: the yield books f_y per unit travel
+  const double speed = 0.005;
+  const auto steps = static_cast<long>(0.05 * d / (speed * dt));
+  for (long k = 0; k < steps; ++k) {
+    y.col(2).array() -= speed * dt;
+    sys.set_vertex_positions(mesh, y, Eigen::MatrixX3d((Eigen::MatrixX3d(4, 3) << 0, 0, -speed, 0, 0, -speed, 0, 0, -speed, 0, 0, -speed).finished()));
+    sys.step(dt);
+  }
+  const double pressed = sys.energies().damping - before - found;
+  INFO("f_y " << f_y << " N; force after the placing " << force << " N; yield and damping work at "
+              << "the placing " << found << " J (f_y x 0.15 d = " << f_y * 0.15 * d
+              << " J), pressing on by 0.05 d " << pressed << " J (f_y x 0.05 d = "
+              << f_y * 0.05 * d << " J)");
+  CHECK(sys.particle_count() == 1);
+  CHECK(force == Approx(f_y).epsilon(0.02));
+  CHECK(found < 0.05 * f_y * 0.15 * d);
+  CHECK(pressed == Approx(f_y * 0.05 * d).epsilon(0.1));
+}
+
 TEST_CASE("dem: below the comminution limit two granules that collide yield and rebound at the "
           "yield velocity", "[dem][breakage][energy]") {
   // Two equal granules below the comminution limit (below_limit yield), no damping (restitution
