@@ -174,7 +174,8 @@ int main(int argc, char** argv) {
   run->add_option("--resume", resume_dir,
                   "Continue the run whose output folder this is from its newest restart file "
                   "(DIR/restart/w<window>.bin), bit for bit; time and output may change with --set "
-                  "(time.end raised, output.every), the participants and the coupling may not");
+                  "(time.end raised, output.every), the participants, the coupling and the monitors may "
+                  "not");
   std::string participant;
   double peer_timeout = 600.0;
   bool on_ranks = false;

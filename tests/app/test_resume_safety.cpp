@@ -1,7 +1,8 @@
 // A refused resume changes nothing, and a damaged restart file is always refused:
 //  - `partita run CASE --resume DIR` with a restart file that is empty, from another case, from
 //    the same case with other participants (another particle count), of a run that has ended,
-//    truncated, or with one byte flipped in any of its sections exits 1 with a message, and every
+//    truncated, or with one byte flipped in any of its sections, or with other monitors (another
+//    quantity, a monitor added) exits 1 with a message, and every
 //    file in DIR is byte for byte what it was (no CSV rewritten with its header only, no file
 //    added or removed);
 //  - the checksum table at the end of a restart file (interface/binary_io.hpp documents the
@@ -142,6 +143,15 @@ TEST_CASE("resume: a refused restart file leaves every file of the run as it was
       {"truncated", good.substr(0, good.size() / 2), resume, "truncated"},
       {"cut before its checksum table", good.substr(0, good.size() - 3), resume,
        "no checksum table"},
+      // the monitors are the run's: their rows so far are in the restart file
+      {"a monitor with another quantity", good,
+       resume + " --set \"monitors[0].quantities=[fluid.inlet_pressure, solid.mid_area]\"",
+       "the monitor 'tube' asks for other quantities than in the run being resumed"},
+      {"a monitor added", good,
+       resume + " --set \"monitors=[{name: tube, quantities: [fluid.inlet_pressure, " +
+           "fluid.outlet_pressure, fluid.inlet_velocity, solid.mid_area]}, {name: more, " +
+           "quantities: [solid.mid_area]}]\"",
+       "the case has 2 monitors (tube, more), the run being resumed had 1 (tube)"},
   };
   for (const Bad& b : bad) {
     SECTION(b.what) {

@@ -98,17 +98,39 @@ void Monitors::serialize(StateArchive& ar) {
     }
     return;
   }
-  if (count > monitors_.size())
+  if (count > monitors_.size() + 1000)  // (a count no case has: damaged bytes)
     ar.fail(fmt::format("{} monitors (found {})", monitors_.size(), count));
   restored_.resize(count);
   for (auto& [monitor, text] : restored_) {
     ar.io(monitor);
     ar.io(text);
   }
+  // A resumed run goes on writing the rows of the monitors it had (their rows so far are in the
+  // restart): other monitors, or other columns of one, would join rows of another width to its
+  // header. Refused, saying what changed.
+  const auto names = [](const auto& list, auto name_of) {
+    std::string n;
+    for (const auto& m : list) n += (n.empty() ? "" : ", ") + name_of(m);
+    return n;
+  };
   if (restored_.size() != monitors_.size())
-    ar.fail(fmt::format("{} monitors (found {})", monitors_.size(), restored_.size()));
-  for (std::size_t i = 0; i < monitors_.size(); ++i)
+    throw Error(fmt::format(
+        "the case has {} monitors ({}), the run being resumed had {} ({}): a resumed run keeps "
+        "its monitors as they were (time and output may change, the monitors' list not); start "
+        "a new run for other monitors",
+        monitors_.size(), names(monitors_, [](const Monitor& m) { return m.name; }),
+        restored_.size(), names(restored_, [](const auto& r) { return r.first; })));
+  for (std::size_t i = 0; i < monitors_.size(); ++i) {
     if (restored_[i].first != monitors_[i].name) ar.fail("the monitor '" + monitors_[i].name + "'");
+    const auto header = [](const std::string& text) { return text.substr(0, text.find('\n')); };
+    const std::string now = header(csv_[i].text()), then = header(restored_[i].second);
+    if (now != then)
+      throw Error(fmt::format(
+          "the monitor '{}' asks for other quantities than in the run being resumed (its columns "
+          "then: {}; now: {}): a resumed run keeps its monitors' columns; start a new run for "
+          "other quantities",
+          monitors_[i].name, then, now));
+  }
 }
 
 void Monitors::restored() {
