@@ -235,11 +235,8 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     const std::int64_t key = feature_key(k.mesh, k.type, k.feature);
     Eigen::Vector3d shear =
         from_old[a] >= 0 ? old_shear[from_old[a]] : Eigen::Vector3d::Zero().eval();
-    const auto& tri = m.triangle(k.triangle);
     // wall velocity at the contact point: barycentric interpolation of the vertex velocities
-    const Eigen::Vector3d v_wall = k.cp.barycentric[0] * m.velocity_[tri[0]] +
-                                   k.cp.barycentric[1] * m.velocity_[tri[1]] +
-                                   k.cp.barycentric[2] * m.velocity_[tri[2]];
+    const Eigen::Vector3d v_wall = m.velocity_at(k.triangle, k.cp.barycentric);
     // pre-overlap: a contact made with a triangle that has just entered the contacts keeps its
     // overlap of now; one carried over keeps the smaller of its own and now's (TriangleMesh::
     // triangle_fresh()); the force acts on the overlap beyond it

@@ -505,12 +505,8 @@ void Subdomain::add_step_energies(double dt, ExactSum* sums) const {
   sys_->mesh_contacts().for_each_contact(
       [&](int i, const MeshContactRecord& rec, const Eigen::Vector3d&) {
         if (is_ghost(static_cast<std::size_t>(i))) return;
-        const TriangleMesh& m = sys_->mesh(rec.mesh);
-        const auto& tri = m.triangle(rec.triangle);
-        const std::vector<Eigen::Vector3d>& v = m.velocities();
-        const Eigen::Vector3d v_wall = rec.barycentric[0] * v[tri[0]] +
-                                       rec.barycentric[1] * v[tri[1]] +
-                                       rec.barycentric[2] * v[tri[2]];
+        const Eigen::Vector3d v_wall =
+            sys_->mesh(rec.mesh).velocity_at(rec.triangle, rec.barycentric);
         sums[4 + walls + static_cast<std::size_t>(rec.mesh)].add(rec.force.dot(v_wall) * dt);
       });
 }

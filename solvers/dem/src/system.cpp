@@ -638,11 +638,7 @@ double System::set_energy(const std::vector<std::size_t>& which, const std::vect
   mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec, const Eigen::Vector3d& shear) {
     if (!in[i]) return;
     e += hertz_elastic_energy(model_.pair(p.material[i], rec.material), rec.delta, rec.r_eff, shear);
-    const TriangleMesh& m = meshes_[rec.mesh];
-    const auto& tri = m.triangle(rec.triangle);
-    e += h * rec.force.dot(rec.barycentric[0] * m.velocity_[tri[0]] +
-                           rec.barycentric[1] * m.velocity_[tri[1]] +
-                           rec.barycentric[2] * m.velocity_[tri[2]]);
+    e += h * rec.force.dot(meshes_[rec.mesh].velocity_at(rec.triangle, rec.barycentric));
   });
   return e;
 }

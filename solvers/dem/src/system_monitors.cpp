@@ -80,11 +80,7 @@ double System::half_step_term(double dt) const {
   // the walls' motion, which the steps' sum F_k . v_wall dt counts beyond the trapezoidal rule
   double walls = walls_.power();
   mesh_contacts_.for_each_contact([&](int, const MeshContactRecord& rec, const Eigen::Vector3d&) {
-    const TriangleMesh& m = meshes_[rec.mesh];
-    const auto& tri = m.triangle(rec.triangle);
-    walls += rec.force.dot(rec.barycentric[0] * m.velocity_[tri[0]] +
-                           rec.barycentric[1] * m.velocity_[tri[1]] +
-                           rec.barycentric[2] * m.velocity_[tri[2]]);
+    walls += rec.force.dot(meshes_[rec.mesh].velocity_at(rec.triangle, rec.barycentric));
   });
   walls *= h;
   if (const PackedParticle* q = verlet_.ahead())

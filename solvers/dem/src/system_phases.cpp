@@ -217,11 +217,7 @@ void System::add_half_step_term(const std::vector<char>& skip, double dt, ExactS
   }
   mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec, const Eigen::Vector3d&) {
     if (skip[i]) return;
-    const TriangleMesh& m = meshes_[rec.mesh];
-    const auto& tri = m.triangle(rec.triangle);
-    sum.add(h * rec.force.dot(rec.barycentric[0] * m.velocity_[tri[0]] +
-                              rec.barycentric[1] * m.velocity_[tri[1]] +
-                              rec.barycentric[2] * m.velocity_[tri[2]]));
+    sum.add(h * rec.force.dot(meshes_[rec.mesh].velocity_at(rec.triangle, rec.barycentric)));
   });
 }
 

@@ -643,11 +643,8 @@ void System::reduce_wall_and_mesh_forces(double dt, bool work) {
     // each contact's force on its particle times the mesh's velocity at the contact point
     // (barycentric), particles in order
     mesh_contacts_.for_each_contact([&](int, const MeshContactRecord& rec, const Eigen::Vector3d&) {
-      const TriangleMesh& m = meshes_[rec.mesh];
-      const auto& tri = m.triangle(rec.triangle);
-      const Eigen::Vector3d v_wall = rec.barycentric[0] * m.velocity_[tri[0]] +
-                                     rec.barycentric[1] * m.velocity_[tri[1]] +
-                                     rec.barycentric[2] * m.velocity_[tri[2]];
+      const Eigen::Vector3d v_wall =
+          meshes_[rec.mesh].velocity_at(rec.triangle, rec.barycentric);
       e.mesh_work[static_cast<std::size_t>(rec.mesh)] += rec.force.dot(v_wall) * dt;
     });
   }

@@ -33,6 +33,12 @@ class TriangleMesh {
   int material() const { return material_; }
   const std::vector<Eigen::Vector3d>& positions() const { return position_; }
   const std::vector<Eigen::Vector3d>& velocities() const { return velocity_; }
+  /// The velocity of triangle t's point of barycentric weights b (a contact point):
+  /// b0 v0 + b1 v1 + b2 v2.
+  Eigen::Vector3d velocity_at(int t, const std::array<double, 3>& b) const {
+    const auto& tri = triangles_[t];
+    return b[0] * velocity_[tri[0]] + b[1] * velocity_[tri[1]] + b[2] * velocity_[tri[2]];
+  }
   const std::array<int, 3>& triangle(int t) const { return triangles_[t]; }
   const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
   /// Edge ids of triangle t: edges (v0,v1), (v1,v2), (v2,v0).
