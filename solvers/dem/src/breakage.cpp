@@ -3,6 +3,7 @@
 #include "partita/dem/error.hpp"
 #include "partita/dem/system.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -206,7 +207,16 @@ void Breakage::break_particles(System& system, const std::vector<std::size_t>& i
 
 void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
                      const std::vector<std::size_t>& powder) {
+  crush(system, fragment, powder, nullptr);
+}
+
+void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
+                     const std::vector<std::size_t>& powder,
+                     const std::vector<std::int64_t>* first_id) {
   if (fragment.empty() && powder.empty()) return;
+  if (first_id != nullptr && first_id->size() != fragment.size())
+    throw Error("breakage: " + std::to_string(first_id->size()) + " first ids for " +
+                std::to_string(fragment.size()) + " broken particles");
   parents_ = fragment;  // (fragment may be broken_)
   const Particles& p = system.particles();
   const std::size_t n = p.size();
@@ -241,7 +251,9 @@ void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
   };
   for (std::size_t k = 0; k < parents_.size(); ++k) {
     const std::size_t i = parents_[k];
-    released += energy_of(k);
+    const double e_parent = energy_of(k);
+    released += e_parent;
+    count(5, e_parent);
     const double r = p.radius[i], mass = p.mass[i], ip = p.inertia[i];
     const Eigen::Vector3d x = p.position[i], v = p.velocity[i], w = p.angular_velocity[i];
     const double rho = system.contact_model().material(p.material[i]).density;
@@ -267,6 +279,7 @@ void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
       f.mass = rho * 4.0 / 3.0 * std::numbers::pi * f.radius * f.radius * f.radius;
       f.inertia = 0.4 * f.mass * f.radius * f.radius;
       f.material = p.material[i];
+      if (first_id != nullptr) f.id = (*first_id)[k] + k2;
       m_f += f.mass;
       j_f += f.mass * 2.0 / 3.0 * c.squaredNorm();  // isotropic second moment: sum m (|c|^2 I - c c^T)
       i_s += f.inertia;
@@ -283,13 +296,20 @@ void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
       }
       counters_.mass_restored += missing;
       counters_.fragment_mass += mass;
+      count(4, missing);
+      count(2, mass);
     } else {
       for (std::size_t k2 = first; k2 < fragments_.size(); ++k2) fragments_[k2].mass = 0.0;  // (the material's)
       counters_.mass_lost += missing;
       counters_.fragment_mass += m_f;
-      released += 0.5 * missing * v.squaredNorm() + 0.5 * i_missing * w.squaredNorm();
+      const double carried = 0.5 * missing * v.squaredNorm() + 0.5 * i_missing * w.squaredNorm();
+      released += carried;
+      count(3, missing);
+      count(2, m_f);
+      count(5, carried);
     }
     ++counters_.events;
+    count(0, 1.0);
   }
   for (std::size_t k = 0; k < powder.size(); ++k) {  // removed whole: their motion and contacts leave with them
     const std::size_t i = powder[k];
@@ -299,6 +319,10 @@ void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
     counters_.powder_mass += p.mass[i];
     counters_.powder_energy += e;
     released += e;
+    count(6, 1.0);
+    count(7, p.mass[i]);
+    count(8, e);
+    count(5, e);
   }
   const std::size_t first = system.replace_particles(remove, fragments_);
   added_.clear();
@@ -314,16 +338,104 @@ void Breakage::crush(System& system, const std::vector<std::size_t>& fragment,
     strength[k] = draw_strength(store.core().id[k], 2.0 * store.core().radius[k]);
     set_limit(system, k, strength[k]);
   }
+  counters_.fragments += static_cast<std::int64_t>(added_.size());
+  count(1, static_cast<double>(added_.size()));
+  if (first_id != nullptr) {  // (their contact energy once the ghosts are new: settled())
+    counters_.energy_released += released;
+    return;
+  }
   if (!added_.empty() && system.lists_current()) {
     system.neighbor_list().listed_neighbours(added_, nb_offsets_, nb_items_);
-    for (std::size_t k = 0; k < added_.size(); ++k)
-      released -= contact_energy(system, added_[k], nb_items_.data() + nb_offsets_[k],
-                                 nb_items_.data() + nb_offsets_[k + 1]);
+    for (std::size_t k = 0; k < added_.size(); ++k) {
+      const double e = contact_energy(system, added_[k], nb_items_.data() + nb_offsets_[k],
+                                      nb_items_.data() + nb_offsets_[k + 1]);
+      released -= e;
+      count(5, -e);
+    }
   } else {
-    for (std::size_t k : added_) released -= contact_energy(system, k);
+    for (std::size_t k : added_) {
+      const double e = contact_energy(system, k);
+      released -= e;
+      count(5, -e);
+    }
   }
-  counters_.fragments += static_cast<std::int64_t>(added_.size());
   counters_.energy_released += released;
+}
+
+void Breakage::choose(System& system, const std::vector<char>& skip,
+                      std::vector<std::size_t>& replaced, std::vector<std::size_t>& removed) {
+  ParticleStore& store = system.store_unsynced();
+  const Particles& p = store.core();
+  const std::vector<double>& load = system.contact_load();
+  const std::size_t n = p.size();
+  if (load.size() != n || !system.contact_load_reached()) return;  // (as end_of_step())
+  if (skip.size() != n)
+    throw Error("breakage: choose() needs one flag per particle (" + std::to_string(n) +
+                "), got " + std::to_string(skip.size()));
+  std::vector<double>& strength = store.array<double>(h_strength_);
+  const std::vector<double>& limit = store.array<double>(h_limit_);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (strength[i] < 0.0) {  // (a ghost's too: the same draw as its owner's)
+      strength[i] = draw_strength(p.id[i], 2.0 * p.radius[i]);
+      set_limit(system, i, strength[i]);
+    }
+    if (!skip[i] && load[i] >= limit[i])
+      (2.0 * p.radius[i] >= parameters_.comminution_limit ? replaced : removed).push_back(i);
+  }
+}
+
+void Breakage::replace(System& system, const std::vector<std::size_t>& replaced,
+                       const std::vector<std::size_t>& removed,
+                       const std::vector<std::int64_t>& first_id) {
+  crush(system, replaced, removed, &first_id);
+}
+
+void Breakage::settled(System& system, const std::vector<char>& skip, std::int64_t first_id,
+                       std::int64_t end_id) {
+  const Particles& p = system.particles();
+  if (skip.size() != p.size())
+    throw Error("breakage: settled() needs one flag per particle (" + std::to_string(p.size()) +
+                "), got " + std::to_string(skip.size()));
+  added_.clear();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (!skip[i] && p.id[i] >= first_id && p.id[i] < end_id) added_.push_back(i);
+  if (added_.empty()) return;
+  const bool listed = system.lists_current();
+  if (listed) system.neighbor_list().listed_neighbours(added_, nb_offsets_, nb_items_);
+  double released = 0.0;
+  for (std::size_t k = 0; k < added_.size(); ++k) {
+    const double e =
+        listed ? contact_energy(system, added_[k], nb_items_.data() + nb_offsets_[k],
+                                nb_items_.data() + nb_offsets_[k + 1])
+               : contact_energy(system, added_[k]);
+    released -= e;
+    count(5, -e);
+  }
+  counters_.energy_released += released;
+}
+
+void Breakage::set_sums(const std::vector<ExactSum>& sums) {
+  if (sums.size() != sum_count)
+    throw Error("breakage: " + std::to_string(sums.size()) + " counter sums, not " +
+                std::to_string(sum_count));
+  sums_ = sums;
+}
+
+BreakageCounters Breakage::counters_from(const std::vector<double>& t) {
+  BreakageCounters c;
+  if (t.size() != sum_count)
+    throw Error("breakage: " + std::to_string(t.size()) + " counter totals, not " +
+                std::to_string(sum_count));
+  c.events = static_cast<std::int64_t>(t[0]);
+  c.fragments = static_cast<std::int64_t>(t[1]);
+  c.fragment_mass = t[2];
+  c.mass_lost = t[3];
+  c.mass_restored = t[4];
+  c.energy_released = t[5];
+  c.powder_events = static_cast<std::int64_t>(t[6]);
+  c.powder_mass = t[7];
+  c.powder_energy = t[8];
+  return c;
 }
 
 void Breakage::write_state(BinaryWriter& out) const {
@@ -336,6 +448,20 @@ void Breakage::write_state(BinaryWriter& out) const {
 void Breakage::read_state(BinaryReader& in) {
   in.expect(parameters_.seed, "the breakage seed");
   in.value(counters_, "the breakage counters");
+  // (the sums restart from the counters; a split bed's restart puts its totals back: set_sums())
+  const double c[sum_count] = {static_cast<double>(counters_.events),
+                               static_cast<double>(counters_.fragments),
+                               counters_.fragment_mass,
+                               counters_.mass_lost,
+                               counters_.mass_restored,
+                               counters_.energy_released,
+                               static_cast<double>(counters_.powder_events),
+                               counters_.powder_mass,
+                               counters_.powder_energy};
+  for (std::size_t q = 0; q < sum_count; ++q) {
+    sums_[q].clear();
+    sums_[q].add(c[q]);
+  }
 }
 
 }  // namespace partita::dem

@@ -426,6 +426,19 @@ void Subdomain::add_kinetic(ExactSum* sums) {
   }
 }
 
+void Subdomain::add_potential(ExactSum& sum) const {
+  const Particles& p = sys_->particles();
+  const Eigen::Vector3d& g = sys_->gravity();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (!is_ghost(i)) sum.add(-p.mass[i] * g.dot(p.position[i]));
+}
+
+void Subdomain::set_changed() {
+  const std::vector<int>& owner = owner_array();
+  ghost_.assign(owner.size(), 0);
+  for (std::size_t i = 0; i < owner.size(); ++i) ghost_[i] = owner[i] >= 0 ? 1 : 0;
+}
+
 void Subdomain::add_wall_forces(ExactSum* sums) const {
   const std::vector<Eigen::Vector3d>& reaction = sys_->wall_reactions();
   const std::vector<PlaneWall>& planes = sys_->planes();
@@ -542,8 +555,14 @@ SubdomainStepper::SubdomainStepper(std::vector<System*> systems, SubdomainTransp
     systems[k]->set_skin(skin);
     systems[k]->set_sort_interval(0);
     systems[k]->set_wall_reactions(true);
+    systems[k]->set_local_fragment_insertion(false);  // (the split builds its lists again)
     subdomains_.emplace_back(*systems[k], local[k], parts);
   }
+  for (int h = 0; h < systems[0]->hook_count(); ++h)
+    if (systems[0]->hook(h).replaces_particles()) replacing_.push_back(h);
+  replaced_.resize(systems.size());
+  removed_.resize(systems.size());
+  first_id_.resize(systems.size());
   out_.assign(systems.size(), SubdomainMail(static_cast<std::size_t>(parts)));
   in_.assign(systems.size(), SubdomainMail(static_cast<std::size_t>(parts)));
   values_.assign(systems.size(), 0.0);
@@ -585,6 +604,16 @@ void SubdomainStepper::start(double dt) {
   redistribute();
   started_ = true;
   for (Subdomain& s : subdomains_) s.forces(dt, false);
+  update_rayleigh();
+}
+
+void SubdomainStepper::update_rayleigh() {
+  for (std::size_t k = 0; k < subdomains_.size(); ++k) {
+    const System& sys = subdomains_[k].system();
+    values_[k] = sys.particle_count() > 0 ? -sys.rayleigh_time_step()
+                                          : -std::numeric_limits<double>::max();
+  }
+  rayleigh_ = -transport_->max(values_);
 }
 
 void SubdomainStepper::resume() {
@@ -593,6 +622,7 @@ void SubdomainStepper::resume() {
                 "start() for the particles of a restart");
   redistribute();
   started_ = true;
+  update_rayleigh();
 }
 
 void SubdomainStepper::set_energy_accounting(bool on) {
@@ -605,7 +635,8 @@ void SubdomainStepper::set_energy_accounting(bool on) {
 
 std::size_t SubdomainStepper::book_count() const {
   const System& sys = subdomains_[0].system();
-  return 4 + static_cast<std::size_t>(sys.wall_count()) + static_cast<std::size_t>(sys.mesh_count());
+  // damping, friction, gravity, stiffening, the walls', the meshes', breakage
+  return 5 + static_cast<std::size_t>(sys.wall_count()) + static_cast<std::size_t>(sys.mesh_count());
 }
 
 double SubdomainStepper::half_step_term(double dt) {
@@ -644,6 +675,103 @@ void SubdomainStepper::step(double dt) {
       subdomains_[k].add_step_energies(dt, books_[k].data());
   for (Subdomain& s : subdomains_) s.finish(dt);
   ++steps_;
+  if (!replacing_.empty()) replace_particles(dt);
+}
+
+double SubdomainStepper::mechanical_energy(double dt) {
+  double e = kinetic_energy() + half_step_term(dt) + elastic_energy();
+  global_sums(Sums::potential);
+  return e + totals_[0].value();
+}
+
+void SubdomainStepper::replace_particles(double dt) {
+  for (const int h : replacing_) {
+    // what each subdomain replaces among the particles it owns, and whether any does
+    for (std::size_t k = 0; k < subdomains_.size(); ++k) {
+      Subdomain& sd = subdomains_[k];
+      replaced_[k].clear();
+      removed_[k].clear();
+      if (sd.system().particle_count() > 0)
+        sd.system().hook(h).choose(sd.system(), sd.ghost_flags(), replaced_[k], removed_[k]);
+      values_[k] = static_cast<double>(replaced_[k].size() + removed_[k].size());
+    }
+    if (!(transport_->max(values_) > 0.0)) continue;
+    // the replaced particles' ids to every subdomain: the new ids follow their order
+    for (std::size_t k = 0; k < subdomains_.size(); ++k) {
+      const std::vector<std::int64_t>& id = subdomains_[k].system().particles().id;
+      for (std::vector<std::byte>& o : out_[k]) {
+        o.resize(replaced_[k].size() * sizeof(std::int64_t));
+        std::byte* at = o.data();
+        for (const std::size_t i : replaced_[k]) {
+          std::memcpy(at, &id[i], sizeof(std::int64_t));
+          at += sizeof(std::int64_t);
+        }
+      }
+    }
+    transport_->exchange(out_, in_);
+    all_ids_.clear();
+    for (const std::vector<std::byte>& m : in_[0])
+      for (std::size_t at = 0; at + sizeof(std::int64_t) <= m.size(); at += sizeof(std::int64_t)) {
+        std::int64_t v;
+        std::memcpy(&v, m.data() + at, sizeof v);
+        all_ids_.push_back(v);
+      }
+    std::sort(all_ids_.begin(), all_ids_.end());
+    for (std::size_t k = 0; k < subdomains_.size(); ++k)
+      values_[k] = static_cast<double>(subdomains_[k].system().store().next_id());
+    const auto next = static_cast<std::int64_t>(transport_->max(values_));
+    const std::int64_t successors = subdomains_[0].system().hook(h).successors();
+    const double before = energy_ && books_started_ ? mechanical_energy(dt) : 0.0;
+    for (std::size_t k = 0; k < subdomains_.size(); ++k) {
+      Subdomain& sd = subdomains_[k];
+      if (replaced_[k].empty() && removed_[k].empty()) continue;
+      const std::vector<std::int64_t>& id = sd.system().particles().id;
+      first_id_[k].clear();
+      for (const std::size_t i : replaced_[k]) {
+        const auto rank = std::lower_bound(all_ids_.begin(), all_ids_.end(), id[i]) - all_ids_.begin();
+        first_id_[k].push_back(next + successors * static_cast<std::int64_t>(rank));
+      }
+      sd.system().hook(h).replace(sd.system(), replaced_[k], removed_[k], first_id_[k]);
+      sd.set_changed();
+    }
+    const std::int64_t next_after = next + successors * static_cast<std::int64_t>(all_ids_.size());
+    for (Subdomain& sd : subdomains_) sd.system().store().reserve_ids(next_after);
+    // the new set's ghosts, lists and forces (a particle's force and contacts from this pass)
+    redistribute();
+    for (Subdomain& sd : subdomains_) sd.forces(dt, false);
+    for (Subdomain& sd : subdomains_)
+      if (sd.system().particle_count() > 0)
+        sd.system().hook(h).settled(sd.system(), sd.ghost_flags(), next, next_after);
+    if (energy_ && books_started_) {
+      const double after = mechanical_energy(dt);
+      const std::vector<int>& local = transport_->local();
+      const auto first = std::find(local.begin(), local.end(), 0);
+      if (first != local.end())  // (booked once: on subdomain 0)
+        books_[static_cast<std::size_t>(first - local.begin())][breakage_book()].add(before - after);
+    }
+    update_rayleigh();
+    ++replacement_steps_;
+  }
+}
+
+std::vector<double> SubdomainStepper::hook_sums(int hook) {
+  sum_hook_ = hook;
+  global_sums(Sums::hook);
+  std::vector<double> v(totals_.size());
+  for (std::size_t q = 0; q < v.size(); ++q) v[q] = totals_[q].value();
+  return v;
+}
+
+std::vector<std::vector<ExactSum>> SubdomainStepper::hook_totals() {
+  const System& sys = subdomains_[0].system();
+  std::vector<std::vector<ExactSum>> t(static_cast<std::size_t>(sys.hook_count()));
+  for (int h = 0; h < sys.hook_count(); ++h) {
+    if (sys.hook(h).sums().empty()) continue;
+    sum_hook_ = h;
+    global_sums(Sums::hook);
+    t[static_cast<std::size_t>(h)] = totals_;
+  }
+  return t;
 }
 
 System::Energies SubdomainStepper::energies() {
@@ -661,6 +789,7 @@ System::Energies SubdomainStepper::energies() {
   for (std::size_t w = 0; w < walls; ++w) e.wall_work[w] = totals_[4 + w].value();
   e.mesh_work.resize(static_cast<std::size_t>(sys.mesh_count()));
   for (std::size_t m = 0; m < e.mesh_work.size(); ++m) e.mesh_work[m] = totals_[4 + walls + m].value();
+  e.breakage = totals_[breakage_book()].value();
   e.kinetic_start = kinetic_start_;
   e.elastic_start = elastic_start_;
   return e;
@@ -713,10 +842,12 @@ void SubdomainStepper::restore_books(const std::vector<std::byte>& bytes) {
     std::memcpy(&magic, bytes.data(), 4);
     std::memcpy(&count, bytes.data() + books_head - 8, 8);
   }
-  if (magic != books_magic || count != m || bytes.size() != books_head + m * ExactSum::byte_size)
+  // (books written before the breakage's book have one sum less: no breakage booked)
+  if (magic != books_magic || (count != m && count + 1 != m) ||
+      bytes.size() != books_head + count * ExactSum::byte_size)
     throw Error("SubdomainStepper::restore_books: the restart's energy books do not fit this "
                 "split (" + std::to_string(count) + " sums for " + std::to_string(m) +
-                " = 4 + walls + meshes, or not books at all)");
+                " = 5 + walls + meshes, or not books at all)");
   books_started_ = std::to_integer<std::uint8_t>(bytes[4]) != 0;
   std::memcpy(&kinetic_start_, bytes.data() + 5, 8);
   std::memcpy(&elastic_start_, bytes.data() + 13, 8);
@@ -728,7 +859,8 @@ void SubdomainStepper::restore_books(const std::vector<std::byte>& bytes) {
   const auto first = std::find(local.begin(), local.end(), 0);
   if (first == local.end()) return;
   std::vector<ExactSum>& b = books_[static_cast<std::size_t>(first - local.begin())];
-  for (std::size_t q = 0; q < m; ++q) b[q].read(bytes.data() + books_head + q * ExactSum::byte_size);
+  for (std::size_t q = 0; q < count; ++q)
+    b[q].read(bytes.data() + books_head + q * ExactSum::byte_size);
 }
 
 // Every subdomain sends its partial sums to every subdomain (itself included); each adds them up
@@ -738,8 +870,11 @@ void SubdomainStepper::global_sums(Sums what) {
   const auto walls = static_cast<std::size_t>(subdomains_[0].system().wall_count());
   const std::size_t planes = subdomains_[0].system().planes().size();
   const std::size_t m = what == Sums::kinetic ? 4
-                        : what == Sums::elastic || what == Sums::contacts || what == Sums::half_step
+                        : what == Sums::elastic || what == Sums::contacts ||
+                                  what == Sums::half_step || what == Sums::potential
                             ? 1
+                        : what == Sums::hook
+                            ? subdomains_[0].system().hook(sum_hook_).sums().size()
                         : what == Sums::walls ? 3 * walls
                         : what == Sums::books ? book_count()
                                               : 3 * planes;
@@ -751,10 +886,16 @@ void SubdomainStepper::global_sums(Sums what) {
     const Subdomain& sd = subdomains_[k];
     if (what == Sums::books)  // (cumulative, also where the subdomain is empty now)
       for (std::size_t q = 0; q < m; ++q) sums[q] = books_[k][q];
+    else if (what == Sums::hook) {  // (the same)
+      const std::vector<ExactSum> h = sd.system().hook(sum_hook_).sums();
+      for (std::size_t q = 0; q < m && q < h.size(); ++q) sums[q] = h[q];
+    }
     else if (sd.system().particle_count() == 0)
       ;  // (nothing to add)
     else if (what == Sums::half_step)
       sd.add_half_step(sum_dt_, sums[0]);
+    else if (what == Sums::potential)
+      sd.add_potential(sums[0]);
     else if (what == Sums::kinetic)
       subdomains_[k].add_kinetic(sums);
     else if (what == Sums::elastic)
@@ -897,7 +1038,8 @@ void SubdomainStepper::run(long steps, double dt) {
 
 namespace {
 constexpr std::uint32_t restart_magic = 0x53525350u;  // "PSRS"
-constexpr std::uint32_t restart_version = 2;  // (1: without the energy books, still read)
+// (1: without the energy books, 2: without the hooks' sums; both still read)
+constexpr std::uint32_t restart_version = 3;
 
 template <class T>
 void put_value(std::ostream& out, const T& v) {
@@ -924,6 +1066,7 @@ SplitRestart SplitRestart::gather(SubdomainStepper& stepper) {
   std::vector<SubdomainMail> out(local, SubdomainMail(static_cast<std::size_t>(transport.parts())));
   std::vector<SubdomainMail> in;
   std::vector<std::byte> books = stepper.books();  // (collective)
+  std::vector<std::vector<ExactSum>> hooks = stepper.hook_totals();  // (the same)
   for (std::size_t k = 0; k < local; ++k)
     if (stepper.subdomain(static_cast<int>(k)).owned_count() > 0)
       stepper.subdomain(static_cast<int>(k)).pack_owned(out[k][0]);
@@ -931,6 +1074,7 @@ SplitRestart SplitRestart::gather(SubdomainStepper& stepper) {
   SplitRestart r;
   if (transport.local()[0] != 0) return r;  // (held by subdomain 0's process)
   r.books_ = std::move(books);
+  r.hooks_ = std::move(hooks);
   std::ostringstream world(std::ios::binary);
   stepper.subdomain(0).system().write_state(world);
   r.world_ = std::move(world).str();
@@ -953,6 +1097,15 @@ void SplitRestart::write(std::ostream& out) const {
   }
   put_value(out, static_cast<std::uint64_t>(books_.size()));
   out.write(reinterpret_cast<const char*>(books_.data()), static_cast<std::streamsize>(books_.size()));
+  put_value(out, static_cast<std::uint64_t>(hooks_.size()));
+  std::vector<std::byte> b(ExactSum::byte_size);
+  for (const std::vector<ExactSum>& h : hooks_) {
+    put_value(out, static_cast<std::uint64_t>(h.size()));
+    for (const ExactSum& x : h) {
+      x.write(b.data());
+      out.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+    }
+  }
 }
 
 SplitRestart SplitRestart::read(std::istream& in) {
@@ -973,6 +1126,19 @@ SplitRestart SplitRestart::read(std::istream& in) {
   if (version >= 2) {
     r.books_.resize(get_value<std::uint64_t>(in, "the energy books' size"));
     get_bytes(in, reinterpret_cast<char*>(r.books_.data()), r.books_.size(), "the energy books");
+  }
+  if (version >= 3) {
+    r.hooks_.resize(get_value<std::uint64_t>(in, "the number of hooks"));
+    std::vector<std::byte> b(ExactSum::byte_size);
+    for (std::vector<ExactSum>& h : r.hooks_) {
+      const auto n = get_value<std::uint64_t>(in, "a hook's number of sums");
+      if (n > 4096) throw Error("SplitRestart::read: a hook with " + std::to_string(n) + " sums");
+      h.resize(n);
+      for (ExactSum& x : h) {
+        get_bytes(in, reinterpret_cast<char*>(b.data()), b.size(), "a hook's sums");
+        x.read(b.data());
+      }
+    }
   }
   return r;
 }
@@ -1009,6 +1175,14 @@ void SplitRestart::restore(const std::vector<System*>& systems, int particles_to
     if (static_cast<int>(j) == particles_to)
       for (const std::vector<std::byte>& m : owned_)
         if (!m.empty()) sys.unpack_particles(m.data(), m.size());
+    // the hooks' counters over the split: on the System that takes the particles (subdomain
+    // 0's), none on the others
+    for (std::size_t h = 0; h < hooks_.size() && h < static_cast<std::size_t>(sys.hook_count()); ++h)
+      if (!hooks_[h].empty())
+        sys.hook(static_cast<int>(h))
+            .set_sums(static_cast<int>(j) == particles_to
+                          ? hooks_[h]
+                          : std::vector<ExactSum>(hooks_[h].size()));
   }
 }
 

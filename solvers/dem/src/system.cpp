@@ -198,7 +198,7 @@ std::size_t System::replace_particles(const std::vector<char>& remove,
     for (std::size_t k = 0; k < fragments.size(); ++k) {
       const Fragment& f = fragments[k];
       const std::size_t i =
-          add_particle(f.position, f.radius, f.material, f.velocity, f.angular_velocity);
+          add_particle(f.position, f.radius, f.material, f.velocity, f.angular_velocity, f.id);
       if (k == 0) first = i;
       if (f.mass > 0.0) set_particle_mass(i, f.mass, f.inertia);
     }
@@ -246,7 +246,7 @@ std::size_t System::replace_particles(const std::vector<char>& remove,
   const int kept = static_cast<int>(store_.size());
   for (std::size_t k = 0; k < fragments.size(); ++k) {
     const Fragment& f = fragments[k];
-    const std::size_t i = store_.add(-1);
+    const std::size_t i = store_.add(f.id);
     Particles& c = store_.core();
     const double rho = model_.material(f.material).density;
     const double m = f.mass > 0.0 ? f.mass : rho * 4.0 / 3.0 * std::numbers::pi * f.radius * f.radius * f.radius;

@@ -142,7 +142,9 @@ void System::phase_finish(double dt) {
   for (int k = 0; k < hooks_.size(); ++k) hooks_[k].post_force(*this, dt);
   time_ += dt;
   ++steps_;
-  for (int k = 0; k < hooks_.size(); ++k) hooks_[k].end_of_step(*this, dt);
+  // (a hook that replaces particles is driven by the split's stepper: step_hook.hpp)
+  for (int k = 0; k < hooks_.size(); ++k)
+    if (!hooks_[k].replaces_particles()) hooks_[k].end_of_step(*this, dt);
 }
 
 void System::add_elastic_energy(const std::vector<char>& skip, ExactSum& sum) const {

@@ -69,6 +69,27 @@ class Breakage final : public StepHook {
   void write_state(BinaryWriter& out) const override;
   void read_state(BinaryReader& in) override;
 
+  // on a split bed (StepHook's protocol): the particles a subdomain owns break there, their
+  // fragments numbered by the stepper; the fragments' contact energy (energy_released) is taken
+  // in settled(), where each fragment is owned once the ghosts hold those born elsewhere
+  bool replaces_particles() const override { return true; }
+  int successors() const override { return pattern_.size(); }
+  void choose(System& system, const std::vector<char>& skip, std::vector<std::size_t>& replaced,
+              std::vector<std::size_t>& removed) override;
+  void replace(System& system, const std::vector<std::size_t>& replaced,
+               const std::vector<std::size_t>& removed,
+               const std::vector<std::int64_t>& first_id) override;
+  void settled(System& system, const std::vector<char>& skip, std::int64_t first_id,
+               std::int64_t end_id) override;
+  /// The counters' totals (besides smallest_fragment) as exact sums, in the order of
+  /// counters_from(); kept beside counters() by every change, saved only in a split bed's restart.
+  std::vector<ExactSum> sums() const override { return sums_; }
+  void set_sums(const std::vector<ExactSum>& sums) override;
+  /// Counters from sums()' totals (events, fragments, fragment_mass, mass_lost, mass_restored,
+  /// energy_released, powder_events, powder_mass, powder_energy); smallest_fragment 0.
+  static BreakageCounters counters_from(const std::vector<double>& totals);
+  static constexpr std::size_t sum_count = 9;
+
   const BreakageParameters& parameters() const { return parameters_; }
   const FragmentPattern& pattern() const { return pattern_; }
   const BreakageCounters& counters() const { return counters_; }
@@ -99,6 +120,14 @@ class Breakage final : public StepHook {
   // current
   double contact_energies(const System& system, const std::vector<std::size_t>& which);
 
+  // crush() with the fragments' ids (first_id[k]: parent k's first; null: the next free ids);
+  // with ids the fragments' contact energy waits for settled()
+  void crush(System& system, const std::vector<std::size_t>& fragment,
+             const std::vector<std::size_t>& powder, const std::vector<std::int64_t>* first_id);
+  void count(std::size_t which, double value) {
+    sums_[which].add(value);
+  }
+  std::vector<ExactSum> sums_ = std::vector<ExactSum>(sum_count);
   BreakageParameters parameters_;
   FragmentPattern pattern_;
   BreakageCounters counters_;

@@ -78,6 +78,8 @@ class ParticleStore {
   void permute(const std::vector<int>& order);
   /// The id the next add() without an id gets.
   std::int64_t next_id() const { return next_id_; }
+  /// Raises next_id() to at least `next` (ids given out elsewhere: a split bed's subdomains).
+  void reserve_ids(std::int64_t next) { next_id_ = next > next_id_ ? next : next_id_; }
 
   /// Writes / reads every array (names, widths and contents) and the id counter. read() requires
   /// the same arrays (names, element sizes) in the same order; it throws Error otherwise.

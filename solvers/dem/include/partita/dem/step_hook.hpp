@@ -19,8 +19,13 @@
 #include "partita/dem/binary_reader.hpp"
 #include "partita/dem/binary_writer.hpp"
 
+#include "partita/dem/exact_sum.hpp"
+
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace partita::dem {
 
@@ -60,6 +65,39 @@ class StepHook {
   virtual void end_of_step(System& /*system*/, double /*dt*/) {}
   virtual void write_state(BinaryWriter& /*out*/) const {}
   virtual void read_state(BinaryReader& /*in*/) {}
+
+  // ---- a hook that replaces particles, on a bed split into subdomains ------------------------
+  // On a split bed (SubdomainStepper, subdomain.hpp) the subdomains must agree on every change of
+  // the particle set: System::phase_finish() does not call end_of_step() of a hook whose
+  // replaces_particles() is true. The stepper instead calls, after each step, choose() on every
+  // subdomain for the particles it owns, gives the new particles ids that do not depend on the
+  // split (from the replaced particles' ids in ascending order), calls replace(), builds the
+  // split's ghosts and lists again, takes a force pass, and calls settled(). Counters that the
+  // monitors add over the subdomains are exact sums (sums()), so that their totals do not depend
+  // on the split either (SubdomainStepper::hook_sums()).
+  virtual bool replaces_particles() const { return false; }
+  /// How many new particles each replaced particle gets.
+  virtual int successors() const { return 0; }
+  /// Appends, ascending, the particles with skip[i] == 0 that it replaces after this step by
+  /// successors() new ones (`replaced`) or removes without successor (`removed`).
+  virtual void choose(System& /*system*/, const std::vector<char>& /*skip*/,
+                      std::vector<std::size_t>& /*replaced*/,
+                      std::vector<std::size_t>& /*removed*/) {}
+  /// Replaces and removes the particles choose() gave; the new particles of replaced[k] take the
+  /// ids first_id[k], first_id[k] + 1, ...
+  virtual void replace(System& /*system*/, const std::vector<std::size_t>& /*replaced*/,
+                       const std::vector<std::size_t>& /*removed*/,
+                       const std::vector<std::int64_t>& /*first_id*/) {}
+  /// After replace() on every subdomain, once the lists hold the new set (ghosts included) and a
+  /// force pass is done: what is left to count for the new particles this subdomain owns now
+  /// (skip: the ghosts), those with ids in [first_id, end_id) (a new particle may have moved to
+  /// another subdomain at the build).
+  virtual void settled(System& /*system*/, const std::vector<char>& /*skip*/,
+                       std::int64_t /*first_id*/, std::int64_t /*end_id*/) {}
+  /// The counters as exact sums, in a fixed order; set_sums() puts such sums back (a split bed's
+  /// restart: the totals on one subdomain, none on the others).
+  virtual std::vector<ExactSum> sums() const { return {}; }
+  virtual void set_sums(const std::vector<ExactSum>& /*sums*/) {}
 };
 
 }  // namespace partita::dem

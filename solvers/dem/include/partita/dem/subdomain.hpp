@@ -83,8 +83,18 @@
 //    where the particle is owned). The energy accounting (System::energies()) is refused in
 //    phases (System::phase_drift()); the split's own books are SubdomainStepper::
 //    set_energy_accounting()'s: each step's terms of the owned particles in exact sums.
-//  - Hooks that change the particle set (breakage's fragments) are not handled: fragment ids
-//    must be unique over the subdomains and the new particles need ghosts.
+//  - Hooks that replace particles (breakage's fragments, powder removed: StepHook::
+//    replaces_particles()): after a step each subdomain's hook chooses among the particles it
+//    owns (their loads are complete there), the stepper gathers the chosen ids to every
+//    subdomain and numbers the new particles from the next free id over the split in the
+//    order of their parents' ids (so the ids do not depend on the split), each subdomain
+//    replaces its own, then every subdomain drops its ghosts and receives them again (a list
+//    build: the fragments reach the subdomains where they are ghosts, and a ghost whose owner
+//    broke it goes) and a force pass without a kick gives the new set its forces, as one
+//    System's step does after a change of the set. A fragment's strength and orientation are
+//    drawn from (seed, id), so they too are the same on any split. The counters are exact sums
+//    (hook_sums()), the breakage's energy booked over the split (set_energy_accounting()).
+//    Cost: a list build and a force pass after every step in which anything broke anywhere.
 //  - Wall servos and other hooks that read a wall's force read their own System's (partial, with
 //    ghosts): they would steer each subdomain's wall apart; not handled.
 //
@@ -178,6 +188,11 @@ class Subdomain {
   int rank() const { return rank_; }
   /// Whether particle i is a ghost (since the last build).
   bool is_ghost(std::size_t i) const { return i < ghost_.size() && ghost_[i] != 0; }
+  /// One flag per particle: 1 for a ghost (since the last build).
+  const std::vector<char>& ghost_flags() const { return ghost_; }
+  /// After a change of the set between builds (particles replaced where they are owned: new
+  /// ones are owned here): the ghost flags again from the owners noted at the build.
+  void set_changed();
   std::size_t owned_count() const;
   std::size_t ghost_count() const { return sys_->particle_count() - owned_count(); }
   /// Particles received as owned (migrated here) since the start.
@@ -202,6 +217,9 @@ class Subdomain {
   /// kinetic_energy()'s terms) to sums[0] and their linear momentum m v to sums[1..3].
   void add_kinetic(ExactSum* sums);
   void add_elastic(ExactSum& sum) const { sys_->add_elastic_energy(ghost_, sum); }
+  /// Adds the owned particles' potential energy in gravity, -m g . x (System::
+  /// potential_energy()'s terms).
+  void add_potential(ExactSum& sum) const;
   /// Adds the particle-particle contacts (listed pairs that overlap, System::contact_count()'s
   /// terms) whose first particle in the global order is owned here: each contact once over the
   /// subdomains (its pair is listed in that particle's row, where it is owned).
@@ -328,8 +346,10 @@ class SubdomainStepper {
   /// work, the stiffening term, the walls' and meshes' work on them) added to exact sums that are
   /// never rounded until read, so that energies() and energy_balance_error() are the same bits on
   /// any split (and differ from one System's energies(), summed per block, in the last bits).
-  /// Turn it on before start() or resume(). A change of the particle set between steps
-  /// (breakage, removal) is not booked on a split (energies().breakage stays 0).
+  /// Turn it on before start() or resume(). A change of the particle set by a hook (breakage's
+  /// fragments) is booked as energies().breakage: the kinetic (with the half-step term),
+  /// potential and elastic energy over the split just before the change less the same once
+  /// the lists and forces are those of the new set (as System::energies() books it).
   void set_energy_accounting(bool on);
   bool energy_accounting() const { return energy_; }
   /// The books since the first step (collective): damping, friction, gravity, stiffening, each
@@ -347,6 +367,18 @@ class SubdomainStepper {
   /// throws Error when they do not fit this split's walls and meshes, or the accounting is off.
   void restore_books(const std::vector<std::byte>& bytes);
 
+  /// Hook `hook`'s counters (StepHook::sums(), the hook of that index on every subdomain's
+  /// System) added over every subdomain, each an exact sum rounded once: the same bits on any
+  /// split (collective).
+  std::vector<double> hook_sums(int hook);
+  /// Every hook's sums over every subdomain, as exact sums (collective): what a restart keeps.
+  std::vector<std::vector<ExactSum>> hook_totals();
+  /// The Rayleigh time step of the smallest particle over every subdomain
+  /// (System::rayleigh_time_step()), as of start(), resume() or the last change of the set.
+  double rayleigh_time_step() const { return rayleigh_; }
+  /// Steps after which a hook replaced particles (StepHook::replaces_particles()).
+  long replacement_steps() const { return replacement_steps_; }
+
  private:
   // the owned contacts with `mesh` summed over every subdomain into mesh_vertex_, mesh_triangle_
   // and mesh_total_
@@ -361,7 +393,8 @@ class SubdomainStepper {
   // what global_sums() adds up: per local subdomain, kinetic energy and momentum (4 sums), the
   // elastic energy (1), the walls' forces (3 per wall), the planes' forces (3 per plane) or the
   // contacts (1)
-  enum class Sums { kinetic, elastic, walls, planes, contacts, books, half_step };
+  enum class Sums { kinetic, elastic, walls, planes, contacts, books, half_step, potential, hook };
+  int sum_hook_ = -1;  // (global_sums(Sums::hook)'s hook)
   std::vector<Eigen::Vector3d> forces_;  // wall_forces(), plane_forces()
   // sums_[m k + q]: local subdomain k's sum q, then summed over every subdomain into totals_
   void global_sums(Sums what);
@@ -375,7 +408,20 @@ class SubdomainStepper {
   double kinetic_start_ = 0.0, elastic_start_ = 0.0, books_dt_ = 0.0;
   double sum_dt_ = 0.0;  // (global_sums(Sums::half_step)'s step)
   std::size_t book_count() const;
+  std::size_t breakage_book() const { return book_count() - 1; }  // (the last)
   double half_step_term(double dt);
+  // the hooks that replace particles: after a step each chooses where its particles are owned,
+  // the new ones are numbered over the split (their parents' ids ascending, from the next free id
+  // over every subdomain), the lists and ghosts built again and a force pass taken
+  void replace_particles(double dt);
+  double mechanical_energy(double dt);  // (collective: kinetic + half-step + potential + elastic)
+  void update_rayleigh();
+  std::vector<int> replacing_;
+  std::vector<std::vector<std::size_t>> replaced_, removed_;
+  std::vector<std::vector<std::int64_t>> first_id_;
+  std::vector<std::int64_t> all_ids_;
+  double rayleigh_ = 0.0;
+  long replacement_steps_ = 0;
 
   std::vector<Subdomain> subdomains_;
   SubdomainTransport* transport_;
@@ -399,7 +445,9 @@ class SubdomainStepper {
 /// Stream: "PSRS" (u32), version (u32), the world's size (u64) and its SystemState::write()
 /// bytes, the number of parts (u64), then per part its size (u64) and its message; then the
 /// energy books' size (u64) and bytes (SubdomainStepper::books(); version 2 on, 0 without the
-/// accounting; version 1 is read as a restart without books).
+/// accounting; version 1 is read as a restart without books); then (version 3 on) the number of
+/// the System's hooks (u64) and per hook its counters' count (u64) and exact sums over the split
+/// (SubdomainStepper::hook_totals(), ExactSum::write(); version 2 is read without them).
 class SplitRestart {
  public:
   /// Every subdomain's owned particles, gathered through the stepper's transport to the process
@@ -428,6 +476,7 @@ class SplitRestart {
  private:
   void restore(const std::vector<System*>& systems, int particles_to) const;
   std::vector<std::byte> books_;
+  std::vector<std::vector<ExactSum>> hooks_;  // per hook of the System: its sums (or none)
   std::string world_;
   std::vector<std::vector<std::byte>> owned_;
 };

@@ -132,6 +132,7 @@ class System {
     double mass = 0.0;     ///< [kg]; <= 0: from the material's density
     double inertia = 0.0;  ///< [kg m^2] (with mass > 0)
     int material = 0;
+    std::int64_t id = -1;  ///< < 0: the next free id (ParticleStore::next_id())
   };
   /// Removes the particles flagged in `remove` and appends `fragments` in their order, in one
   /// change of the set; returns the index of the first fragment. Each fragment's parent must be
@@ -275,7 +276,9 @@ class System {
   /// 2. a ghost's values from its owner: set_phase_motion(); or, at a list build, particles
   ///    removed, added, renumbered, then phase_build().
   /// 3. phase_forces(dt, true): forces at the new positions, histories updated, the closing kick.
-  /// 4. phase_finish(dt): the meshes' positions of the step, the hooks, time and step count.
+  /// 4. phase_finish(dt): the meshes' positions of the step, the hooks, time and step count
+  ///    (not the end_of_step() of a hook that replaces particles: the split's stepper drives it,
+  ///    StepHook::replaces_particles()).
   /// Before the first phase_drift() the forces of a pass must be there: phase_forces(dt, false)
   /// (no kick, no history update: what step() does before its first step). Throws Error with the
   /// energy accounting on (its sums are per System; not available in phases yet), on a bad dt
