@@ -200,7 +200,7 @@ void DemAdapter::write_output(const OutputFrame& frame) {
     write_mesh_vtp(system_, m.id, frame.vtk_directory / mfile, frame.vtk);
     files_.emplace_back(m.name, mfile);
   }
-  if (breakage_ >= 0) write_grading(frame);
+  if (breakage_ >= 0) write_grading(frame, system_.particles());
   if (particles_file_ == "every-output") {
     const std::filesystem::path dir = frame.vtk_directory.parent_path() / "particles";
     std::filesystem::create_directories(dir);
@@ -237,14 +237,14 @@ void DemAdapter::write_particles_file(const dem::Particles& particles,
 
 // Grading at each output time: rows time, diameter, mass fraction passing, appended to
 // DIR/<participant>_grading.csv (DIR the run's output folder, the parent of vtk/).
-void DemAdapter::write_grading(const OutputFrame& frame) const {
+void DemAdapter::write_grading(const OutputFrame& frame, const dem::Particles& particles) const {
   const std::filesystem::path file =
       frame.vtk_directory.parent_path() / (frame.prefix + "_grading.csv");
   const bool header = frame.index == 0 || !std::filesystem::exists(file);
   std::ofstream out(file, header ? std::ios::trunc : std::ios::app);
   if (!out) throw Error("dem '" + name_ + "': cannot write the grading to " + file.string());
   if (header) out << "time_s,diameter_m,passing\n";
-  for (const dem::Grading::Point& g : dem::Grading::cumulative(system_.particles()))
+  for (const dem::Grading::Point& g : dem::Grading::cumulative(particles))
     out << fmt::format("{:.9g},{:.9g},{:.9g}\n", frame.time, g.size, g.passing);
 }
 

@@ -124,7 +124,7 @@ class DemAdapter : public Solver {
   std::size_t find(std::string_view mesh, bool* centres) const;
   void add_breakage(const config::Node& breakage);
   const dem::Breakage* breakage() const;  ///< nullptr when off
-  void write_grading(const OutputFrame& frame) const;
+  void write_grading(const OutputFrame& frame, const dem::Particles& particles) const;
   /// The particles as a LAMMPS data file (dem::LammpsData), written atomically.
   void write_particles_file(const std::filesystem::path& file) const;
   void write_particles_file(const dem::Particles& particles,
@@ -218,6 +218,7 @@ class DemAdapter : public Solver {
   void ranks_start() const;
   void ranks_advance(double dt);
   void ranks_rebalance();
+  void ranks_set_changed() const;
   void ranks_monitors(std::uint32_t groups) const;
   std::string ranks_check() const;
   void ranks_output(const OutputFrame& frame);

@@ -29,6 +29,10 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
       return a.on_ranks() ? a.ranks_->energies : a.system_.energies();
     };
     const auto broken = [](const A& a) { return a.breakage() != nullptr; };
+    // (on several ranks summed over the ranks at the last monitors pass)
+    static constexpr auto breakage_counters = [](const A& a) -> const dem::BreakageCounters& {
+      return a.on_ranks() ? a.ranks_->breakage : a.breakage()->counters();
+    };
     MonitorTable<A> t;
     t.scalar("kinetic_energy", "J", "translational plus rotational kinetic energy of the particles",
              [](const A& a) {
@@ -178,29 +182,29 @@ const MonitorTable<DemAdapter>& DemAdapter::monitor_table() {
       }
     });
     t.scalar("breakage.events", "", "particles broken so far (with breakage on)",
-             [](const A& a) { return static_cast<double>(a.breakage()->counters().events); }, broken);
+             [](const A& a) { return static_cast<double>(breakage_counters(a).events); }, broken);
     t.scalar("breakage.fragments", "", "fragments created so far",
-             [](const A& a) { return static_cast<double>(a.breakage()->counters().fragments); },
+             [](const A& a) { return static_cast<double>(breakage_counters(a).fragments); },
              broken);
     t.scalar("breakage.fragment_mass", "kg", "mass of the fragments created so far",
-             [](const A& a) { return a.breakage()->counters().fragment_mass; }, broken);
+             [](const A& a) { return breakage_counters(a).fragment_mass; }, broken);
     t.scalar("breakage.mass_lost", "kg", "parent mass the inscribed fragments do not hold, lost",
-             [](const A& a) { return a.breakage()->counters().mass_lost; }, broken);
+             [](const A& a) { return breakage_counters(a).mass_lost; }, broken);
     t.scalar("breakage.mass_restored", "kg", "the same, given back to the fragments (mass option)",
-             [](const A& a) { return a.breakage()->counters().mass_restored; }, broken);
+             [](const A& a) { return breakage_counters(a).mass_restored; }, broken);
     t.scalar("breakage.energy_released", "J",
              "elastic contact energy released at breakage (with the powder's energy)",
-             [](const A& a) { return a.breakage()->counters().energy_released; }, broken);
+             [](const A& a) { return breakage_counters(a).energy_released; }, broken);
     t.scalar("breakage.powder_events", "",
              "particles below the comminution limit crushed to powder (removed; below_limit: "
              "powder)",
-             [](const A& a) { return static_cast<double>(a.breakage()->counters().powder_events); },
+             [](const A& a) { return static_cast<double>(breakage_counters(a).powder_events); },
              broken);
     t.scalar("breakage.powder_mass", "kg", "their mass, gone from the system",
-             [](const A& a) { return a.breakage()->counters().powder_mass; }, broken);
+             [](const A& a) { return breakage_counters(a).powder_mass; }, broken);
     t.scalar("breakage.powder_energy", "J",
              "their kinetic energy and contact (normal Hertz) energy when removed",
-             [](const A& a) { return a.breakage()->counters().powder_energy; }, broken);
+             [](const A& a) { return breakage_counters(a).powder_energy; }, broken);
     t.scalar("stable_time_step", "s", "the DEM's stable step now (falls as fragments appear)",
              [](const A& a) { return a.stable_time_step(); }, broken);
     return t;

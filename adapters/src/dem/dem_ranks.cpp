@@ -63,9 +63,16 @@
 // set_energy_accounting(): each step's terms of the owned particles in exact sums, the same bits
 // on any N; they travel in the restart stream); its monitors come with `monitors groups`.
 //
-// Not handled on a split yet, refused at set-up naming the key: breakage (fragment ids unique over
-// the ranks, new particles' ghosts); at run time: a monitor quantity not listed above (none of the
-// DEM's today: a guard for new ones).
+// Breakage: each rank breaks the particles it owns, the stepper numbers the fragments over the
+// ranks and builds the ghosts and lists again (subdomain.hpp), so the set and every sum are the
+// same on any N; the counters are exact sums over the ranks (monitors group kBreakage), the
+// stable step the smallest over the ranks (a step that fragments made too long is split, as in
+// one process), the particle count and mass summed again after each change, the grading of an
+// output frame from every rank's particles (gathered to rank 0 in the order of their ids).
+// `breakage.lists: local` has no effect on ranks (the split builds its lists after a change).
+//
+// Not handled on a split yet: at run time a monitor quantity not listed above (none of the DEM's
+// today: a guard for new ones).
 //
 // The split path gives the same bytes on every N, N = 1 under mpirun (or --on-ranks) included. It
 // is not the path of one process without mpirun (one dem::System stepped whole): the split numbers
@@ -87,6 +94,8 @@
 #include <sstream>
 
 #include "partita/adapters/dem_output.hpp"
+#include "partita/coupling/time_window.hpp"
+#include "partita/dem/breakage.hpp"
 #include "partita/dem/error.hpp"
 #include "partita/interface/error.hpp"
 #include "partita/interface/log.hpp"
@@ -126,7 +135,13 @@ constexpr long kBalanceEvery = 200;
 constexpr double kImbalance = 1.25;
 
 constexpr std::uint32_t kKinetic = 1, kElastic = 2, kWalls = 4, kMeshes = 8, kTracked = 16,
-                        kFaceGroup = 32, kContacts = 64, kEnergy = 128;
+                        kFaceGroup = 32, kContacts = 64, kEnergy = 128, kBreakage = 256;
+
+// the breakage counters' monitor quantities
+const char* const kBreakageNames[] = {
+    "breakage.events",          "breakage.fragments",     "breakage.fragment_mass",
+    "breakage.mass_lost",       "breakage.mass_restored", "breakage.energy_released",
+    "breakage.powder_events",   "breakage.powder_mass",   "breakage.powder_energy"};
 
 // the energy accounting's monitor quantities (besides <wall>.work and <mesh>.work)
 const char* const kEnergyNames[] = {"friction_work",   "damping_work", "breakage_energy",
@@ -216,13 +231,6 @@ const char* const kComponents[] = {"x", "y", "z", "vx", "vy", "vz"};
 void DemAdapter::setup_ranks(const SolverContext& context) {
   const std::shared_ptr<ParticipantRanks>& ranks = context.ranks;
   const Node& c = context.config;
-  const auto refuse = [&](const Node& key, const std::string& what) {
-    key.fail(fmt::format(
-        "{} is not yet on several ranks (the DEM's bed split over {} processes of mpirun); run "
-        "this participant in one process (mpirun -n 1, or without mpirun)",
-        what, ranks->size()));
-  };
-  if (c.has("breakage")) refuse(c["breakage"], "breakage (fragments born at run time)");
   // the energy accounting: the split's books (SubdomainStepper), not the System's own (it keeps
   // them per System, and refuses a step taken in phases)
   const bool books = system_.energy_tracking();
@@ -542,9 +550,17 @@ void DemAdapter::ranks_advance(double dt) {
   for (const auto& w : walls_)
     if (w.moving) system_.set_wall_velocity(w.id, w.velocity * w.table(system_.time() + 0.5 * dt));
   ranks_start();
+  // a step that fragments made too long for the stable step (the smallest over the ranks) is
+  // split into as many equal steps as the new one needs, alike on every rank (as in one process)
+  int parts = 1;
+  if (breakage_ >= 0 && coupling::TimeWindow::longer_than(dt, o.stable))
+    parts = coupling::TimeWindow::substeps_for(dt, o.stable);
   together(*o.ranks, [&] {
     try {
-      o.stepper->step(dt);
+      for (int k = 0; k < parts; ++k) {
+        o.stepper->step(dt / parts);
+        if (o.stepper->replacement_steps() != o.replacements) ranks_set_changed();
+      }
     } catch (const dem::Error& e) {
       throw Error(fmt::format("dem '{}' on rank {} at t = {:.6g} s: {}{}", name_, o.ranks->rank(),
                               system_.time(), e.what(), o.ranks->world_note()));
@@ -573,6 +589,17 @@ void DemAdapter::ranks_advance(double dt) {
     if (o.ranks->leads()) cm.audit.motion_step(cm.positions, *f);
   }
   if (o.stepper->steps() % kBalanceEvery == 0) ranks_rebalance();
+}
+
+// After a change of the particle set (breakage) or a resume: the particle count and mass over
+// the ranks (exact sums), the stable step (the smallest over the ranks); collective.
+void DemAdapter::ranks_set_changed() const {
+  OnRanks& o = *ranks_;
+  const auto [count, mass] = o.stepper->particle_totals();
+  o.particles = static_cast<double>(count);
+  o.mass = mass;
+  o.stable = time_step_fraction_ * o.stepper->rayleigh_time_step();
+  o.replacements = o.stepper->replacement_steps();
 }
 
 // The load drifts as the bed moves (a bed settling empties the upper boxes, a bed flowing down a
@@ -638,6 +665,7 @@ std::vector<std::string> DemAdapter::ranks_monitor_names() const {
     for (const char* c : {"x", "y", "z"}) n.push_back(m.name + ".force_" + c);
   for (const auto& w : walls_)
     for (const char* c : {"x", "y", "z"}) n.push_back(w.name + ".force_" + c);
+  if (breakage_ >= 0) n.insert(n.end(), std::begin(kBreakageNames), std::end(kBreakageNames));
   if (ranks_->books) {
     n.insert(n.end(), std::begin(kEnergyNames), std::end(kEnergyNames));
     for (const auto& m : meshes_dem_) n.push_back(m.name + ".work");
@@ -667,6 +695,9 @@ std::uint32_t DemAdapter::ranks_monitor_groups(const std::vector<std::string>& n
     if (q == "particles" || q == "mass") known = true;
     if (q == "elastic_energy") groups |= kElastic, known = true;
     if (q == "contacts_per_particle") groups |= kContacts, known = true;
+    if (breakage_ >= 0)
+      for (const char* e : kBreakageNames)
+        if (q == e) groups |= kBreakage, known = true;
     if (ranks_->books) {
       for (const char* e : kEnergyNames)
         if (q == e) groups |= kEnergy, known = true;
@@ -725,7 +756,9 @@ void DemAdapter::ranks_monitors(std::uint32_t groups) const {
       o.energies = s.energies();
       o.balance = o.forces ? s.energy_balance_error() : 0.0;
     }
-    // 2 contacts / N, as System::mean_contacts_per_particle() (N fixed: the particle count)
+    if (groups & kBreakage)
+      o.breakage = dem::Breakage::counters_from(s.hook_sums(breakage_));
+    // 2 contacts / N, as System::mean_contacts_per_particle()
     if (groups & kContacts)
       o.contacts_per_particle = 2.0 * static_cast<double>(s.contact_count()) / o.particles;
     if (groups & kWalls) {
@@ -897,6 +930,11 @@ void DemAdapter::ranks_output(const OutputFrame& frame) {
     if (o.ranks->leads()) std::filesystem::create_directories(dir);
     ranks_particles_file(dir / fmt::format("{}_{:06d}.data", frame.prefix, frame.index));
   }
+  // the grading from every rank's particles, in the order of their ids (the same on any N)
+  if (breakage_ >= 0) {
+    const dem::Particles all = ranks_particles();  // (collective)
+    if (o.ranks->leads()) write_grading(frame, all);
+  }
   if (!o.ranks->leads()) return;
   files_.clear();
   std::vector<std::string> pieces;
@@ -1052,6 +1090,7 @@ void DemAdapter::ranks_resume(const std::string& stream) {
       if (o.books) o.stepper->restore_books(r.books());
       o.started = true;
       o.forces = false;
+      ranks_set_changed();
     } catch (const dem::Error& e) {
       throw Error(fmt::format("dem '{}' on rank {}: resuming the restart: {}", name_,
                               o.ranks->rank(), e.what()));

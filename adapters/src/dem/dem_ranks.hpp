@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "dem_adapter.hpp"
+#include "partita/dem/breakage_counters.hpp"
 #include "partita/dem/domain_decomposition.hpp"
 #include "partita/dem/subdomain.hpp"
 #include "partita/dem/subdomain_transport.hpp"
@@ -32,8 +33,12 @@ struct DemAdapter::OnRanks {
   bool forces = false;   // a force pass since the start or the resume (forces to report)
   bool ended = false;    // (rank 0) the others were told the run has ended
   long rebalances = 0;   // cuts made again as the load drifted (DemAdapter::ranks_rebalance())
-  // fixed for the run (no particle is born or removed on a split): over every particle
+  // over every particle: at the start, and again after a step in which breakage changed the set
+  // (the stepper's replacement_steps() moved on from `replacements`)
   double particles = 0.0, mass = 0.0, stable = 0.0;
+  long replacements = 0;
+  // (breakage) its counters summed over the ranks at the last monitors pass
+  dem::BreakageCounters breakage;
   // the energy accounting (energy_accounting: true): the split's books (SubdomainStepper::
   // set_energy_accounting(); the System keeps none of its own on a split)
   bool books = false;

@@ -426,13 +426,6 @@ void Subdomain::add_kinetic(ExactSum* sums) {
   }
 }
 
-void Subdomain::add_potential(ExactSum& sum) const {
-  const Particles& p = sys_->particles();
-  const Eigen::Vector3d& g = sys_->gravity();
-  for (std::size_t i = 0; i < p.size(); ++i)
-    if (!is_ghost(i)) sum.add(-p.mass[i] * g.dot(p.position[i]));
-}
-
 void Subdomain::set_changed() {
   const std::vector<int>& owner = owner_array();
   ghost_.assign(owner.size(), 0);
@@ -679,9 +672,7 @@ void SubdomainStepper::step(double dt) {
 }
 
 double SubdomainStepper::mechanical_energy(double dt) {
-  double e = kinetic_energy() + half_step_term(dt) + elastic_energy();
-  global_sums(Sums::potential);
-  return e + totals_[0].value();
+  return kinetic_energy() + half_step_term(dt) + elastic_energy();
 }
 
 void SubdomainStepper::replace_particles(double dt) {
@@ -752,6 +743,11 @@ void SubdomainStepper::replace_particles(double dt) {
     update_rayleigh();
     ++replacement_steps_;
   }
+}
+
+std::pair<std::size_t, double> SubdomainStepper::particle_totals() {
+  global_sums(Sums::totals);
+  return {static_cast<std::size_t>(totals_[0].value()), totals_[1].value()};
 }
 
 std::vector<double> SubdomainStepper::hook_sums(int hook) {
@@ -871,8 +867,9 @@ void SubdomainStepper::global_sums(Sums what) {
   const std::size_t planes = subdomains_[0].system().planes().size();
   const std::size_t m = what == Sums::kinetic ? 4
                         : what == Sums::elastic || what == Sums::contacts ||
-                                  what == Sums::half_step || what == Sums::potential
+                                  what == Sums::half_step
                             ? 1
+                        : what == Sums::totals ? 2
                         : what == Sums::hook
                             ? subdomains_[0].system().hook(sum_hook_).sums().size()
                         : what == Sums::walls ? 3 * walls
@@ -894,8 +891,12 @@ void SubdomainStepper::global_sums(Sums what) {
       ;  // (nothing to add)
     else if (what == Sums::half_step)
       sd.add_half_step(sum_dt_, sums[0]);
-    else if (what == Sums::potential)
-      sd.add_potential(sums[0]);
+    else if (what == Sums::totals) {
+      sums[0].add(static_cast<double>(sd.owned_count()));
+      const Particles& p = sd.system().particles();
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (!sd.is_ghost(i)) sums[1].add(p.mass[i]);
+    }
     else if (what == Sums::kinetic)
       subdomains_[k].add_kinetic(sums);
     else if (what == Sums::elastic)

@@ -218,7 +218,7 @@ std::size_t System::replace_particles(const std::vector<char>& remove,
     }
     model_.check_material(f.material, what);
   }
-  // The energy the change takes out of KE + PE + E_el is booked here from the particles it
+  // The energy the change takes out of KE + E_el is booked here from the particles it
   // touches (the whole bed's sums before and after differ by just that), unless an earlier change
   // since the last step is pending (then the step's end books both over the whole bed).
   const bool book = energy_tracking_ && energies_.started && !set_change_pending_;
@@ -565,12 +565,13 @@ int System::set_partition() {
 namespace partita::dem {
 
 // Energy accounting across a change of the particle set between steps (energies().breakage):
-// the mechanical energy KE + PE + E_el just before the first change after a step (the lists are
-// still those of the last pass) ...
+// the stored energy KE + E_el (with the half-step term) just before the first change after a step
+// (the lists are still those of the last pass) ... No potential energy: gravity's work is booked
+// step by step from the particles' motion (m g . v dt), so where a particle is born or removed
+// does not enter the books (a removed particle's m g . x, measured from an arbitrary origin, would).
 void System::note_set_change() {
   if (!energy_tracking_ || !energies_.started || set_change_pending_) return;
-  set_change_before_ =
-      kinetic_energy() + half_step_term(energy_dt_) + potential_energy() + elastic_energy();
+  set_change_before_ = kinetic_energy() + half_step_term(energy_dt_) + elastic_energy();
   set_change_pending_ = true;
 }
 
@@ -585,8 +586,7 @@ void System::note_set_change() {
 // fragments' mesh contacts, the new forces' half-step term) is booked with it.
 void System::settle_set_change(bool provisional) {
   if (!set_change_pending_) return;
-  const double after =
-      kinetic_energy() + half_step_term(energy_dt_) + potential_energy() + elastic_energy();
+  const double after = kinetic_energy() + half_step_term(energy_dt_) + elastic_energy();
   energies_.breakage += set_change_before_ - after;
   // (the next step's start books its own change from here; with the lists current and the
   // forces valid it changes nothing: no search, no force pass, and the change is settled)
@@ -596,8 +596,8 @@ void System::settle_set_change(bool provisional) {
     set_change_pending_ = false;
 }
 
-// The part of KE + PE + E_el (and the half-step term) that a change of the particles flagged in
-// `in` (listed in `which`) can alter: their own kinetic, potential and half-step terms, and every
+// The part of KE + E_el (and the half-step term) that a change of the particles flagged in
+// `in` (listed in `which`) can alter: their own kinetic and half-step terms, and every
 // contact one of them is in (pairs with their histories, planes, the last pass's mesh contacts
 // with the meshes' half-step power). The difference of this before and after a local change
 // (System::replace_particles()) is the difference of the whole bed's sums, term by term.
@@ -616,7 +616,6 @@ double System::set_energy(const std::vector<std::size_t>& which, const std::vect
                           &t = p.torque[i];
     e += 0.5 * p.mass[i] * v.squaredNorm() + 0.5 * p.inertia[i] * w.squaredNorm();
     e += h * (f.dot(v) + t.dot(w)) + h2 * (f.squaredNorm() / p.mass[i] + t.squaredNorm() / p.inertia[i]);
-    e -= p.mass[i] * gravity_.dot(p.position[i]);
     for (std::size_t k = 0; k < np; ++k) {
       const double delta = p.radius[i] - (p.position[i] - planes[k].point).dot(planes[k].normal);
       if (delta <= 0.0) continue;

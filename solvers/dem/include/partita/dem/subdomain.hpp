@@ -217,9 +217,6 @@ class Subdomain {
   /// kinetic_energy()'s terms) to sums[0] and their linear momentum m v to sums[1..3].
   void add_kinetic(ExactSum* sums);
   void add_elastic(ExactSum& sum) const { sys_->add_elastic_energy(ghost_, sum); }
-  /// Adds the owned particles' potential energy in gravity, -m g . x (System::
-  /// potential_energy()'s terms).
-  void add_potential(ExactSum& sum) const;
   /// Adds the particle-particle contacts (listed pairs that overlap, System::contact_count()'s
   /// terms) whose first particle in the global order is owned here: each contact once over the
   /// subdomains (its pair is listed in that particle's row, where it is owned).
@@ -347,9 +344,9 @@ class SubdomainStepper {
   /// never rounded until read, so that energies() and energy_balance_error() are the same bits on
   /// any split (and differ from one System's energies(), summed per block, in the last bits).
   /// Turn it on before start() or resume(). A change of the particle set by a hook (breakage's
-  /// fragments) is booked as energies().breakage: the kinetic (with the half-step term),
-  /// potential and elastic energy over the split just before the change less the same once
-  /// the lists and forces are those of the new set (as System::energies() books it).
+  /// fragments) is booked as energies().breakage: the kinetic (with the half-step term) and
+  /// elastic energy over the split just before the change less the same once the lists and
+  /// forces are those of the new set (as System::energies() books it).
   void set_energy_accounting(bool on);
   bool energy_accounting() const { return energy_; }
   /// The books since the first step (collective): damping, friction, gravity, stiffening, each
@@ -376,6 +373,8 @@ class SubdomainStepper {
   /// The Rayleigh time step of the smallest particle over every subdomain
   /// (System::rayleigh_time_step()), as of start(), resume() or the last change of the set.
   double rayleigh_time_step() const { return rayleigh_; }
+  /// The particles over every subdomain and their mass [kg] (an exact sum): collective.
+  std::pair<std::size_t, double> particle_totals();
   /// Steps after which a hook replaced particles (StepHook::replaces_particles()).
   long replacement_steps() const { return replacement_steps_; }
 
@@ -393,7 +392,9 @@ class SubdomainStepper {
   // what global_sums() adds up: per local subdomain, kinetic energy and momentum (4 sums), the
   // elastic energy (1), the walls' forces (3 per wall), the planes' forces (3 per plane) or the
   // contacts (1)
-  enum class Sums { kinetic, elastic, walls, planes, contacts, books, half_step, potential, hook };
+  enum class Sums {
+    kinetic, elastic, walls, planes, contacts, books, half_step, hook, totals
+  };
   int sum_hook_ = -1;  // (global_sums(Sums::hook)'s hook)
   std::vector<Eigen::Vector3d> forces_;  // wall_forces(), plane_forces()
   // sums_[m k + q]: local subdomain k's sum q, then summed over every subdomain into totals_
@@ -414,7 +415,7 @@ class SubdomainStepper {
   // the new ones are numbered over the split (their parents' ids ascending, from the next free id
   // over every subdomain), the lists and ghosts built again and a force pass taken
   void replace_particles(double dt);
-  double mechanical_energy(double dt);  // (collective: kinetic + half-step + potential + elastic)
+  double mechanical_energy(double dt);  // (collective: kinetic + half-step + elastic)
   void update_rayleigh();
   std::vector<int> replacing_;
   std::vector<std::vector<std::size_t>> replaced_, removed_;

@@ -366,8 +366,9 @@ class System {
                             ///< relative motion + the spring energy the cap released
     double damping = 0.0;   ///< viscous normal and tangential contact damping, rolling resistance,
                             ///< yielding contacts (StepHook::contact_yield())
-    double breakage = 0.0;  ///< mechanical energy (KE + PE + E_el) before minus after changes of
-                            ///< the particle set between steps (breakage, removal, insertion)
+    double breakage = 0.0;  ///< stored energy (KE + E_el) before minus after changes of the
+                            ///< particle set between steps (breakage, removal, insertion); no
+                            ///< PE: gravity's work is booked from the motion, step by step
     double gravity = 0.0;   ///< work of gravity on the particles
     /// Mindlin's tangential springs: minus the energy they gained as their stiffness grew with
     /// the overlap at a fixed history (DissipativeParts::stiffening; mostly negative while a bed
@@ -565,7 +566,7 @@ class System {
   // what velocity Verlet's kinetic energy still owes the forces' trapezoidal work, + dt/2 sum
   // F_c . v_wall over the wall and mesh contacts (Energies)
   double half_step_term(double dt) const;
-  double set_change_before_ = 0.0;  // KE + PE + E_el before the pending change
+  double set_change_before_ = 0.0;  // KE + E_el before the pending change
   // per part, the force pass's lists of a block of rows (pair_batch.hpp): its touching pairs,
   // their forces, where each row's pairs start and where its cross pairs start; sized by
   // start_load_pass() for the largest block (no allocation while the lists keep their size)
