@@ -303,6 +303,7 @@ void DemAdapter::ranks_split() {
     for (std::size_t i = 0; i < p.size(); ++i)
       elsewhere[i] = o.decomposition.owner(p.position[i]) != ranks.rank();
     system_.remove_particles(elsewhere);
+    system_.shrink_to_fit();  // (the rank steps its share: the whole bed's arrays go)
     o.stepper = std::make_unique<dem::SubdomainStepper>(std::vector<dem::System*>{&system_},
                                                         *o.transport, o.decomposition, o.skin);
     o.stepper->set_energy_accounting(o.books);

@@ -44,6 +44,12 @@ void ParticleStore::reserve(std::size_t n) {
   for (auto& c : columns_) c->reserve(core_, n);
 }
 
+void ParticleStore::shrink_to_fit() {
+  for (auto& c : columns_) c->shrink(core_);
+  scratch_.clear();
+  scratch_.shrink_to_fit();
+}
+
 std::size_t ParticleStore::add(std::int64_t id) {
   const std::size_t index = size();
   for (auto& c : columns_) c->resize(core_, index + 1);

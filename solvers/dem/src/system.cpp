@@ -169,6 +169,13 @@ void System::remove_particles(const std::vector<char>& remove) {
   particles_changed();
 }
 
+void System::shrink_to_fit() {
+  sync_particles();
+  store_.shrink_to_fit();
+  new_of_old_.clear();
+  new_of_old_.shrink_to_fit();
+}
+
 std::size_t System::replace_particles(const std::vector<char>& remove,
                                       const std::vector<Fragment>& fragments) {
   sync_particles();

@@ -67,6 +67,9 @@ class ParticleStore {
   const Particles& core() const { return core_; }
   std::size_t size() const { return core_.size(); }
   void reserve(std::size_t n);
+  /// Gives back the memory the arrays hold beyond their particles (after a large removal: a
+  /// split bed's rank keeping its share of the bed it was built with).
+  void shrink_to_fit();
 
   /// Appends one particle: every array grows by its fill values; the id is `id`, or the next free
   /// id when id < 0. Returns the new index; the caller sets the core values.
@@ -122,6 +125,7 @@ class ParticleStore {
     virtual std::size_t length(const Particles& core) const = 0;
     virtual void resize(Particles& core, std::size_t n) = 0;
     virtual void reserve(Particles& core, std::size_t n) = 0;
+    virtual void shrink(Particles& core) = 0;
     virtual void compact(Particles& core, const std::vector<int>& new_of_old, std::size_t n) = 0;
     // scratch: room for one entry per particle (element_size() bytes each, max_align_t aligned)
     virtual void permute(Particles& core, const std::vector<int>& order,
@@ -168,6 +172,7 @@ struct ParticleStore::TypedColumn final : Column {
   std::size_t length(const Particles& core) const override { return data(core).size(); }
   void resize(Particles& core, std::size_t n) override { data(core).resize(n * width, fill); }
   void reserve(Particles& core, std::size_t n) override { data(core).reserve(n * width); }
+  void shrink(Particles& core) override { data(core).shrink_to_fit(); }
   void compact(Particles& core, const std::vector<int>& new_of_old, std::size_t n) override {
     std::vector<T>& v = data(core);
     for (std::size_t i = 0; i < new_of_old.size(); ++i) {

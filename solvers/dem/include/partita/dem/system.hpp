@@ -122,6 +122,9 @@ class System {
   /// Removes the particles with remove[i] != 0 (one flag per particle); the others keep their
   /// order, ids and contact histories. The next step rebuilds the lists and recomputes forces.
   void remove_particles(const std::vector<char>& remove);
+  /// Gives back the memory of the per-particle arrays beyond the particles held (after a large
+  /// removal: a split bed's rank keeping its share of the bed it was built with).
+  void shrink_to_fit();
   /// A particle that takes the place of part of another at run time (a fragment).
   struct Fragment {
     std::size_t parent = 0;  ///< index of the particle it replaces (removed in the same change)
