@@ -192,6 +192,7 @@ template <class Visit>
 void NeighborList::visit_pairs(const Particles& p, int i, Visit&& visit) const {
   const Eigen::Vector3d& xi = p.position[i];
   const double ri = p.radius[i] + skin_;
+  const char* const passive = passive_ && (*passive_)[i] ? passive_->data() : nullptr;
   const auto c = grid_.coords(xi);
   const int z0 = std::max(c[2] - 1, 0), z1 = std::min(c[2] + 1, grid_.nz - 1);
   const int y0 = std::max(c[1] - 1, 0), y1 = std::min(c[1] + 1, grid_.ny - 1);
@@ -202,7 +203,7 @@ void NeighborList::visit_pairs(const Particles& p, int i, Visit&& visit) const {
       const int last = cell_start_[grid_.index(x1, iy, iz) + 1];
       for (int k = first; k < last; ++k) {
         const int j = cell_items_[k];
-        if (j <= i) continue;
+        if (j <= i || (passive && passive[j])) continue;
         const double cut = ri + p.radius[j];
         if ((p.position[j] - xi).squaredNorm() < cut * cut) visit(j);
       }
@@ -219,6 +220,9 @@ void NeighborList::search(const Particles& p, const std::vector<PlaneWall>& plan
                           const std::vector<TriangleMesh>& meshes) {
   ++builds_;
   const int n = static_cast<int>(p.size());
+  if (passive_ && passive_->size() != p.size())
+    throw Error("neighbor list: " + std::to_string(passive_->size()) +
+                " passive flags for " + std::to_string(n) + " particles");
   // Grid over the particles' bounding box, cells 2 R_max + skin wide (at most ~4 N cells).
   // (the passes over every particle below run on the threads for large beds; minima, maxima and
   // per-particle results are the same in any order)
@@ -320,7 +324,9 @@ void NeighborList::search(const Particles& p, const std::vector<PlaneWall>& plan
   const int np = static_cast<int>(planes.size());
   detail::parallel_pass(n, [&](int i) {
     std::uint64_t mask = 0;
-    if (np > 64) {
+    if (passive_ && (*passive_)[i]) {
+      // (none)
+    } else if (np > 64) {
       mask = ~std::uint64_t{0};
     } else {
       for (int k = 0; k < np; ++k)
@@ -382,6 +388,7 @@ void NeighborList::build_mesh_candidates(const Particles& p,
   }
   // Each particle keeps the triangles of its own cell within R + skin (two passes).
   auto visit = [&](int i, auto&& keep) {
+    if (passive_ && (*passive_)[i]) return;
     const int c = particle_cell_[i];
     const double cut = p.radius[i] + skin_;
     for (int k = tri_cell_start_[c]; k < tri_cell_start_[c + 1]; ++k) {

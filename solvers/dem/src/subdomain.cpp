@@ -393,14 +393,15 @@ void Subdomain::unpack_moves(const SubdomainMail& in, GlobalOrder& order,
   ghost_.clear();
   if (sys_->particle_count() == 0) return;
   if (order.compute(sys_->particles(), order_)) sys_->renumber_particles(order_);
-  sys_->phase_build();
   const std::vector<int>& owner = owner_array();
-  const Particles& p = sys_->particles();
-  const std::size_t n = p.size();
+  const std::size_t n = sys_->particle_count();
   ghost_.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) ghost_[i] = owner[i] >= 0 ? 1 : 0;
+  // (a ghost's own force is not used: no pair of two ghosts, no plane or mesh contacts)
+  sys_->phase_build(&ghost_);
+  const Particles& p = sys_->particles();
   for (std::size_t i = 0; i < n; ++i) {
     if (owner[i] >= 0) {
-      ghost_[i] = 1;
       recv_[static_cast<std::size_t>(owner[i])].push_back(static_cast<int>(i));
       continue;
     }

@@ -118,14 +118,21 @@ void System::set_phase_motion(std::size_t i, const Eigen::Vector3d& x, const Eig
   q.x = x, q.v = v, q.w = w;
 }
 
-void System::phase_build() {
+void System::phase_build(const std::vector<char>* passive) {
   if (sort_interval_ > 0)
     throw Error(
         "phase_build: the particles of a step taken in phases are numbered by the caller; set "
         "set_sort_interval(0)");
   prepared_ = false;
   lists_current_ = false;
-  prepare();  // (rayleigh_dt_, history sizes, the lists)
+  neighbors_.set_passive(passive);
+  try {
+    prepare();  // (rayleigh_dt_, history sizes, the lists)
+  } catch (...) {
+    neighbors_.set_passive(nullptr);
+    throw;
+  }
+  neighbors_.set_passive(nullptr);  // (a later build of its own lists every pair)
 }
 
 void System::phase_forces(double dt, bool step) {

@@ -50,6 +50,11 @@ class NeighborList {
 
   void set_skin(double skin) { skin_ = skin; }
   double skin() const { return skin_; }
+  /// Passive particles for the builds that follow (null: none): no pair between two passive
+  /// particles is listed, and a passive particle gets no plane and no mesh candidates. A split
+  /// bed's ghosts (System::phase_build()): their own forces are not used, only their pairs with
+  /// the particles the subdomain owns. The flags (one per particle) must live through the build.
+  void set_passive(const std::vector<char>* passive) { passive_ = passive; }
   /// Forgets the lists (next needs_rebuild() is true); slot_sources() becomes empty (per-pair
   /// state is dropped by the owner's follow()).
   void clear();
@@ -173,6 +178,7 @@ class NeighborList {
                              double r_max);
 
   double skin_ = 0.0;
+  const std::vector<char>* passive_ = nullptr;  // (set_passive())
   long builds_ = 0;
   bool valid_ = false;
   Grid grid_;

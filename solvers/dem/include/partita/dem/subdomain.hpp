@@ -17,9 +17,11 @@
 //      carries (System::pack_particles()); a listed pair has its particles within
 //      R_i + R_j + skin at the build, so an owned particle's every listed pair is listed where
 //      it is owned. Between builds each step sends the ghosts' position, velocity and angular
-//      velocity after the integrator's first half (the values the force pass reads); the forces
-//      a subdomain computes on its ghosts are discarded (the ghost's kick is overwritten at the
-//      next refresh, and the ghost itself replaced at the next build).
+//      velocity after the integrator's first half (the values the force pass reads). A ghost's
+//      own force is not used (its kick is overwritten at the next refresh, the ghost replaced at
+//      the next build), so the lists leave out what only it would need: no pair of two ghosts,
+//      no plane or mesh contacts of a ghost (System::phase_build() with the ghosts passive); its
+//      pairs with the owned particles are listed as any.
 //  (2) Histories: a pair between an owned particle and a ghost is listed and evaluated on both
 //      sides with the same inputs in the same order, so both keep the same history. At a build
 //      every subdomain drops its ghosts and receives them again, each with the histories of its
@@ -46,19 +48,18 @@
 //  - Wall forces: SubdomainStepper::wall_force() is the same on any split (each owned particle's
 //    reaction on each plane, System::set_wall_reactions(), in an exact sum); it may differ from
 //    System::wall_force()'s block sums in the last bits; plane_forces() gives each plane's (a box
-//    wall's faces) the same way. Each System's own wall_force(),
-//    mesh_force() and triangle_forces() include its ghosts' contacts.
+//    wall's faces) the same way. (A ghost has no plane or mesh contacts: each System's own
+//    wall_force(), mesh_force() and triangle_forces() are its owned particles', rounded in
+//    another order.)
 //  - Triangle meshes (STL walls, the coupling's FE surfaces): every subdomain holds every mesh
 //    whole, moved alike (set_vertex_positions() on each System before the step), as the coupling
 //    hands over the whole surface. A particle's contacts with the meshes are evaluated where it
-//    is owned and, as a ghost, where its copies are (the same inputs: the same records and
-//    histories); its mesh histories travel with it at a migration and come with each ghost copy
-//    (MeshContacts::pack()). SubdomainStepper::triangle_forces(), vertex_forces() and
+//    is owned; its mesh histories travel with it at a migration (MeshContacts::pack(); a ghost
+//    copy carries them too, unused). SubdomainStepper::triangle_forces(), vertex_forces() and
 //    mesh_force() are the same on any split: each vertex's force an exact sum over the OWNED
-//    particles' contact records (a ghost's are its owner's, counted there), rounded once, and
-//    the triangles' shares taken from those as MeshContacts::reduce() takes them. Why not each
-//    System's sums added up: they count the ghosts' contacts twice, and a sum of per-subdomain
-//    rounded sums depends on the split. They may differ from one System's triangle_forces()
+//    particles' contact records, rounded once, and the triangles' shares taken from those as
+//    MeshContacts::reduce() takes them. Why not each System's sums added up: a sum of
+//    per-subdomain rounded sums depends on the split. They may differ from one System's triangle_forces()
 //    (vertex sums rounded contact by contact) in the last bits. The messages carry only the
 //    vertices the contacts touched. The energy accounting's mesh work is each owned contact's
 //    (SubdomainStepper::set_energy_accounting()).

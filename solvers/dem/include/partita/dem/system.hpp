@@ -296,8 +296,10 @@ class System {
   void set_phase_motion(std::size_t i, const Eigen::Vector3d& x, const Eigen::Vector3d& v,
                         const Eigen::Vector3d& w);
   /// New lists for the current particles and positions (always built; no renumbering: throws
-  /// Error when set_sort_interval() is not 0).
-  void phase_build();
+  /// Error when set_sort_interval() is not 0). passive (one flag per particle, or null): the
+  /// particles whose own forces are not used (a split bed's ghosts): no pair of two of them is
+  /// listed and they get no plane or mesh contacts (NeighborList::set_passive()).
+  void phase_build(const std::vector<char>* passive = nullptr);
   void phase_forces(double dt, bool step);
   void phase_finish(double dt);
   /// Adds to `sum` the elastic energy (as elastic_energy()) of the contacts of the last force
