@@ -3,12 +3,16 @@
 // steps them on MPI ranks, tests/solvers/dem/mpi/, share them): a polydisperse packing thrown
 // about, and a plate mesh that goes down and sags (as the coupling moves an FE surface).
 
+#include "partita/dem/domain_decomposition.hpp"
 #include "partita/dem/packing_generator.hpp"
+#include "partita/dem/system.hpp"
 #include "partita/dem/triangle_mesh.hpp"
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <numbers>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -73,5 +77,41 @@ struct SaggingPlate {
     return t;
   }
 };
+
+/// The bed's positions (one a particle, in the order of the packing).
+inline std::vector<Eigen::Vector3d> positions(const ThrownBed& b) {
+  std::vector<Eigen::Vector3d> x;
+  for (Eigen::Index i = 0; i < b.x.rows(); ++i) x.push_back(b.x.row(i).transpose());
+  return x;
+}
+
+/// The particles (their indices) each box of `d` holds at `x`, one list a box.
+inline std::vector<std::vector<int>> owned_at(const DomainDecomposition& d,
+                                              const std::vector<Eigen::Vector3d>& x) {
+  std::vector<std::vector<int>> keep(static_cast<std::size_t>(d.parts()));
+  for (std::size_t i = 0; i < x.size(); ++i)
+    keep[static_cast<std::size_t>(d.owner(x[i]))].push_back(static_cast<int>(i));
+  return keep;
+}
+
+/// Adds the particles `keep` of the bed (material m, their index as id, at rest in rotation).
+inline void add_bed_particles(System& sys, const ThrownBed& b, const std::vector<int>& keep,
+                              int m) {
+  for (const int i : keep)
+    sys.add_particle(b.x.row(i).transpose(), b.r[i], m, b.v.row(i).transpose(),
+                     Eigen::Vector3d::Zero(), i);
+}
+
+/// One subdomain's System as the split tests set it up alike on every subdomain: one material
+/// (E = 10 MPa, nu = 0.3, 2500 kg/m^3; index 0) with friction 0.5, restitution 0.5 and rolling
+/// friction 0.05 against itself, gravity -9.81 m/s^2 along z, the particles `keep` of the bed.
+inline std::unique_ptr<System> bed_system(const ThrownBed& b, const std::vector<int>& keep) {
+  auto sys = std::make_unique<System>();
+  const int m = sys->add_material({1.0e7, 0.3, 2500.0});
+  sys->add_interaction(m, m, {0.5, 0.5, 0.05});
+  sys->set_gravity({0, 0, -9.81});
+  add_bed_particles(*sys, b, keep, m);
+  return sys;
+}
 
 }  // namespace partita::dem::test

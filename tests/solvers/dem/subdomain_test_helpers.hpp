@@ -16,6 +16,7 @@
 #include <cstring>
 #include <functional>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -65,6 +66,21 @@ class RewritingTransport final : public SubdomainTransport {
   SubdomainTransport& inner_;
   Rewrite rewrite_;
 };
+
+/// One System a subdomain (make(k) for subdomain k) and the pointers a SubdomainStepper takes.
+struct SplitSystems {
+  std::vector<std::unique_ptr<System>> systems;
+  std::vector<System*> raw;
+};
+template <class Make>
+SplitSystems make_systems(int parts, Make&& make) {
+  SplitSystems s;
+  for (int k = 0; k < parts; ++k) {
+    s.systems.push_back(make(k));
+    s.raw.push_back(s.systems.back().get());
+  }
+  return s;
+}
 
 /// The positions of the particles the local subdomains own (for a re-cut by bisection).
 inline std::vector<Eigen::Vector3d> owned_positions(const SubdomainStepper& stepper) {

@@ -56,25 +56,15 @@ BreakageParameters weak() {
 // One subdomain's System, alike on every subdomain: materials, gravity, the box without its
 // top, the plate, the breakage model, the particles of `keep` (id = index).
 std::unique_ptr<System> subdomain_system(const std::vector<int>& keep) {
-  auto sys = std::make_unique<System>();
-  const int m = sys->add_material({1.0e7, 0.3, 2500.0});
-  sys->add_interaction(m, m, {0.5, 0.5, 0.05});
-  sys->set_gravity({0, 0, -9.81});
-  const test::ThrownBed& b = bed();
-  for (const int i : keep)
-    sys->add_particle(b.x.row(i).transpose(), b.r[i], m, b.v.row(i).transpose(),
-                      Eigen::Vector3d::Zero(), i);
+  auto sys = test::bed_system(bed(), keep);
+  const int m = 0;  // (its material)
   sys->add_box(kLo, kHi, m, 0b011111);
   sys->add_mesh(kPlate.vertices(0.0, 1.0), kPlate.triangles(), m);
   sys->add_hook(std::make_unique<Breakage>(weak()));
   return sys;
 }
 
-std::vector<Eigen::Vector3d> start_positions() {
-  std::vector<Eigen::Vector3d> x0;
-  for (Eigen::Index i = 0; i < bed().x.rows(); ++i) x0.push_back(bed().x.row(i).transpose());
-  return x0;
-}
+std::vector<Eigen::Vector3d> start_positions() { return test::positions(bed()); }
 
 double start_mass() {
   double m = 0.0;
@@ -102,15 +92,8 @@ struct Plan {
 
 Run run_split(int parts, const Plan& plan = {}) {
   DomainDecomposition d = DomainDecomposition::bisection(start_positions(), kLo, kCutHi, parts);
-  std::vector<std::vector<int>> keep(static_cast<std::size_t>(parts));
-  const std::vector<Eigen::Vector3d> x0 = start_positions();
-  for (std::size_t i = 0; i < x0.size(); ++i) keep[d.owner(x0[i])].push_back(static_cast<int>(i));
-  std::vector<std::unique_ptr<System>> systems;
-  std::vector<System*> raw;
-  for (int k = 0; k < parts; ++k) {
-    systems.push_back(subdomain_system(keep[k]));
-    raw.push_back(systems.back().get());
-  }
+  const std::vector<std::vector<int>> keep = test::owned_at(d, start_positions());
+  auto [systems, raw] = test::make_systems(parts, [&](int k) { return subdomain_system(keep[k]); });
   auto transport = std::make_unique<InProcessTransport>(parts);
   auto stepper = std::make_unique<SubdomainStepper>(raw, *transport, d, kSkin);
   stepper->set_energy_accounting(plan.energy);
@@ -123,19 +106,15 @@ Run run_split(int parts, const Plan& plan = {}) {
       SplitRestart::gather(*stepper).write(file);
       const SplitRestart restart = SplitRestart::read(file);
       parts = plan.restart_parts;
-      std::vector<std::unique_ptr<System>> next;
-      raw.clear();
-      for (int k = 0; k < parts; ++k) {
-        next.push_back(subdomain_system({}));
-        raw.push_back(next.back().get());
-      }
+      test::SplitSystems next = test::make_systems(parts, [](int) { return subdomain_system({}); });
+      raw = next.raw;
       restart.restore(raw);
-      const Particles& p = next[0]->particles();
+      const Particles& p = raw[0]->particles();
       const std::vector<Eigen::Vector3d> x(p.position.begin(), p.position.end());
       auto next_transport = std::make_unique<InProcessTransport>(parts);
       stepper = std::make_unique<SubdomainStepper>(
           raw, *next_transport, DomainDecomposition::bisection(x, kLo, kCutHi, parts), kSkin);
-      systems = std::move(next);
+      systems = std::move(next.systems);
       transport = std::move(next_transport);
       stepper->set_energy_accounting(plan.energy);
       stepper->resume();

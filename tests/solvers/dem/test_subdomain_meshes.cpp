@@ -62,14 +62,8 @@ TriangleMesh::Triangles plate_triangles() { return kPlate.triangles(); }
 // One subdomain's System, alike on every subdomain: the box without its +x face (wall 0), the
 // +x plane moving inwards (wall 1), the plate (mesh 0), the particles of `keep` (id = index).
 std::unique_ptr<System> subdomain_system(const std::vector<int>& keep) {
-  auto sys = std::make_unique<System>();
-  const int m = sys->add_material({1.0e7, 0.3, 2500.0});
-  sys->add_interaction(m, m, {0.5, 0.5, 0.05});
-  sys->set_gravity({0, 0, -9.81});
-  const Bed& b = bed();
-  for (const int i : keep)
-    sys->add_particle(b.x.row(i).transpose(), b.r[i], m, b.v.row(i).transpose(),
-                      Eigen::Vector3d::Zero(), i);
+  auto sys = test::bed_system(bed(), keep);
+  const int m = 0;  // (its material)
   sys->add_box(kLo, kHi, m, 0b111101);
   sys->add_plane({kWidth, 0, 0}, {-1, 0, 0}, m, {-kSideSpeed, 0, 0});
   sys->add_mesh(plate(0.0, 1.0), plate_triangles(), m);
@@ -117,12 +111,7 @@ struct Run {
   double kinetic = 0.0, elastic = 0.0;
 };
 
-std::vector<Eigen::Vector3d> start_positions() {
-  const Bed& b = bed();
-  std::vector<Eigen::Vector3d> x0;
-  for (Eigen::Index i = 0; i < b.x.rows(); ++i) x0.push_back(b.x.row(i).transpose());
-  return x0;
-}
+std::vector<Eigen::Vector3d> start_positions() { return test::positions(bed()); }
 
 // What a run does besides stepping: a re-cut (a bisection of the positions of step recut_at
 // from then on), the mesh contacts taken out of the build messages, a restart at step
@@ -144,28 +133,16 @@ std::vector<std::unique_ptr<System>> restart_systems(SubdomainStepper& old, int 
   SplitRestart::gather(old).write(file);
   const SplitRestart restart = SplitRestart::read(file);
   books = restart.books();
-  std::vector<std::unique_ptr<System>> systems;
-  std::vector<System*> raw;
-  for (int j = 0; j < parts; ++j) {
-    systems.push_back(subdomain_system({}));
-    raw.push_back(systems.back().get());
-  }
-  restart.restore(raw);
-  return systems;
+  test::SplitSystems s = test::make_systems(parts, [](int) { return subdomain_system({}); });
+  restart.restore(s.raw);
+  return std::move(s.systems);
 }
 
 // The bed split by `d` (parts = its boxes), kSteps steps.
 Run run_split(const DomainDecomposition& d, const Plan& plan = {}) {
   int parts = d.parts();
-  const std::vector<Eigen::Vector3d> x0 = start_positions();
-  std::vector<std::vector<int>> keep(static_cast<std::size_t>(parts));
-  for (std::size_t i = 0; i < x0.size(); ++i) keep[d.owner(x0[i])].push_back(static_cast<int>(i));
-  std::vector<std::unique_ptr<System>> systems;
-  std::vector<System*> raw;
-  for (int k = 0; k < parts; ++k) {
-    systems.push_back(subdomain_system(keep[k]));
-    raw.push_back(systems.back().get());
-  }
+  const std::vector<std::vector<int>> keep = test::owned_at(d, start_positions());
+  auto [systems, raw] = test::make_systems(parts, [&](int k) { return subdomain_system(keep[k]); });
   auto in_process = std::make_unique<InProcessTransport>(parts);
   long stripped = 0;
   test::RewritingTransport stripping(*in_process, [&](const std::byte* m, std::size_t bytes) {

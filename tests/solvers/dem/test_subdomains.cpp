@@ -44,14 +44,8 @@ const Bed& bed() {
 // One subdomain's System: the same set-up on every subdomain, the particles of `keep` (their
 // index is their id).
 std::unique_ptr<System> subdomain_system(const std::vector<int>& keep) {
-  auto sys = std::make_unique<System>();
-  const int m = sys->add_material({1.0e7, 0.3, 2500.0});
-  sys->add_interaction(m, m, {0.5, 0.5, 0.05});
-  sys->set_gravity({0, 0, -9.81});
-  const Bed& b = bed();
-  for (const int i : keep)
-    sys->add_particle(b.x.row(i).transpose(), b.r[i], m, b.v.row(i).transpose(),
-                      Eigen::Vector3d::Zero(), i);
+  auto sys = test::bed_system(bed(), keep);
+  const int m = 0;  // (its material)
   sys->add_box(kLo, kHi, m);
   return sys;
 }
@@ -89,18 +83,10 @@ struct Run {
 // positions of that step from then on.
 Run run_split(int parts, long steps, SubdomainStepper::Options options = {}, long recut_at = 0,
               bool without_histories = false) {
-  const Bed& b = bed();
-  std::vector<Eigen::Vector3d> x0;
-  for (Eigen::Index i = 0; i < b.x.rows(); ++i) x0.push_back(b.x.row(i).transpose());
+  const std::vector<Eigen::Vector3d> x0 = test::positions(bed());
   const DomainDecomposition d = DomainDecomposition::bisection(x0, kLo, kHi, parts);
-  std::vector<std::vector<int>> keep(static_cast<std::size_t>(parts));
-  for (std::size_t i = 0; i < x0.size(); ++i) keep[d.owner(x0[i])].push_back(static_cast<int>(i));
-  std::vector<std::unique_ptr<System>> systems;
-  std::vector<System*> raw;
-  for (int k = 0; k < parts; ++k) {
-    systems.push_back(subdomain_system(keep[k]));
-    raw.push_back(systems.back().get());
-  }
+  const std::vector<std::vector<int>> keep = test::owned_at(d, x0);
+  auto [systems, raw] = test::make_systems(parts, [&](int k) { return subdomain_system(keep[k]); });
   InProcessTransport in_process(parts);
   test::RewritingTransport stripped(in_process, [&](const std::byte* m, std::size_t bytes) {
     return without_records(*systems[0], m, bytes);

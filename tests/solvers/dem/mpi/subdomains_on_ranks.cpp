@@ -62,11 +62,6 @@ struct Bed {
   long min_migrated = 1;  // on several ranks, at least this many particles change rank
 };
 
-void add_particles(System& sys, const test::ThrownBed& b, const std::vector<int>& keep, int m) {
-  for (const int i : keep)
-    sys.add_particle(b.x.row(i).transpose(), b.r[i], m, b.v.row(i).transpose(),
-                     Eigen::Vector3d::Zero(), i);
-}
 
 // The set-up of a bed in a closed box of planes with friction under gravity.
 std::function<std::unique_ptr<System>(const std::vector<int>&)> closed_box(const Bed& bed) {
@@ -75,7 +70,7 @@ std::function<std::unique_ptr<System>(const std::vector<int>&)> closed_box(const
     const int m = sys->add_material({1.0e7, 0.3, 2500.0});
     sys->add_interaction(m, m, {0.5, 0.5, 0.05});
     sys->set_gravity({0, 0, -9.81});
-    add_particles(*sys, *b, keep, m);
+    test::add_bed_particles(*sys, *b, keep, m);
     sys->add_box(lo, hi, m);
     return sys;
   };
@@ -131,7 +126,7 @@ Bed pressed_bed() {
     const int m = sys->add_material({1.0e7, 0.3, 2500.0});
     sys->add_interaction(m, m, {0.5, 0.5, 0.05});
     sys->set_gravity({0, 0, -9.81});
-    add_particles(*sys, *b, keep, m);
+    test::add_bed_particles(*sys, *b, keep, m);
     sys->add_box(lo, hi, m, 0b111101);
     sys->add_plane({hi.x(), 0, 0}, {-1, 0, 0}, m, {-0.5, 0, 0});
     sys->add_mesh(plate.vertices(0.0, 1.0), plate.triangles(), m);
