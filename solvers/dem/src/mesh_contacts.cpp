@@ -249,16 +249,25 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
       pre = std::min(old_pre[from_old[a]], static_cast<float>(k.delta));
     const PairParameters& pp = model.pair(q.material, m.material());
     // yield (yield_overlap()): the overlap beyond the elastic limit adds to the permanent one.
-    // Its work is booked where the overlap grows; a contact found without history deeper than
-    // one step's relative motion makes (the particle was inside before this feature held the
-    // contact: another mesh's face behind it, or the nearest face of a body it is inside) has
-    // its permanent overlap from before, not from work done now: not booked again.
+    // Its work is booked where the overlap grows by the contact's own motion, at most twice
+    // this step's relative normal approach (reach): a contact found without history deeper
+    // than that (the particle was inside before this feature held the contact: another mesh's
+    // face behind it, or the nearest face of a body it is inside) has its permanent overlap
+    // from before, not from work done now: not booked again; and where a carried contact's
+    // overlap grows by more than that, the rest is a jump of the geometry, not worked for (a
+    // particle inside a thin part whose way out passes from a shallow face to a deep one and
+    // back, or a surface moved without a velocity): only the reach's share is booked.
     const float pre_before = pre;
+    const double reach = 2.0 * std::abs((q.v - v_wall).dot(k.normal)) * dt + 1e-9 * r;
     const bool found_deep =
-        Energy && from_old[a] < 0 && !m.triangle_fresh(k.triangle) &&
-        k.delta > 2.0 * std::abs((q.v - v_wall).dot(k.normal)) * dt + 1e-9 * r;
+        Energy && from_old[a] < 0 && !m.triangle_fresh(k.triangle) && k.delta > reach;
+    double work = 0.0;
     const double delta = yield_overlap(k.delta, r, pp.e_star, q.yield_pressure, pre,
-                                       Energy && !found_deep ? &wd->plastic : nullptr);
+                                       Energy && !found_deep ? &work : nullptr);
+    if constexpr (Energy) {
+      const double growth = static_cast<double>(pre) - static_cast<double>(pre_before);
+      wd->plastic += growth > reach ? work * (reach / growth) : work;
+    }
     const double cr = r - 0.5 * k.delta;
     Eigen::Vector3d fw, ft;
     DissipativeParts parts;
