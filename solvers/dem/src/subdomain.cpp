@@ -241,10 +241,25 @@ double Subdomain::max_radius() {
 // An empty subdomain moves its walls and meshes (phase_drift() without particles) and asks for
 // no build: the others' lists decide, and its walls' and meshes' positions at its last build may
 // be old.
+void Subdomain::begin(double dt) { sys_->phase_begin(dt); }
+
 double Subdomain::drift(double dt) {
   const double moved2 = sys_->phase_drift(dt, ghost_);
   if (sys_->particle_count() == 0) return 0.0;
-  return sys_->phase_needs_rebuild(moved2) ? 1.0 : 0.0;
+  return sys_->phase_needs_rebuild(moved2) ? std::numeric_limits<double>::infinity() : moved2;
+}
+
+bool Subdomain::fusable(double dt, double& bound) const {
+  bound = 0.0;
+  if (sys_->particle_count() == 0) return true;
+  if (drifted_.size() != sys_->particle_count()) return false;  // (a change since the build)
+  return sys_->phase_fusable(dt, bound);
+}
+
+void Subdomain::drift_sent(double dt) { sys_->phase_drift_some(dt, sent_); }
+
+void Subdomain::forces_fused(double dt) {
+  if (sys_->particle_count() > 0) sys_->phase_forces_fused(dt, drifted_);
 }
 
 void Subdomain::pack_refresh(SubdomainMail& out) {
@@ -391,6 +406,8 @@ void Subdomain::unpack_moves(const SubdomainMail& in, GlobalOrder& order,
   for (auto& l : send_) l.clear();
   for (auto& l : recv_) l.clear();
   ghost_.clear();
+  sent_.clear();
+  drifted_.clear();
   if (sys_->particle_count() == 0) return;
   if (order.compute(sys_->particles(), order_)) sys_->renumber_particles(order_);
   const std::vector<int>& owner = owner_array();
@@ -408,6 +425,13 @@ void Subdomain::unpack_moves(const SubdomainMail& in, GlobalOrder& order,
     d.near(p.position[i], ghost_distance, near_);
     for (const int r : near_) send_[static_cast<std::size_t>(r)].push_back(static_cast<int>(i));
   }
+  // the fused path's flags: ghosts take their values from their owners, and the owned particles
+  // others read as ghosts take their first half before the refresh
+  drifted_ = ghost_;
+  for (const std::vector<int>& l : send_)
+    for (const int i : l) drifted_[static_cast<std::size_t>(i)] = 1;
+  for (std::size_t i = 0; i < n; ++i)
+    if (drifted_[i] && !ghost_[i]) sent_.push_back(static_cast<int>(i));
 }
 
 void Subdomain::pack_owned(std::vector<std::byte>& out) {
@@ -428,6 +452,8 @@ void Subdomain::add_kinetic(ExactSum* sums) {
 }
 
 void Subdomain::set_changed() {
+  sent_.clear();  // (until the next build: the exact path)
+  drifted_.clear();
   const std::vector<int>& owner = owner_array();
   ghost_.assign(owner.size(), 0);
   for (std::size_t i = 0; i < owner.size(); ++i) ghost_[i] = owner[i] >= 0 ? 1 : 0;
@@ -522,7 +548,7 @@ void Subdomain::forces(double dt, bool step) {
   if (sys_->particle_count() > 0) sys_->phase_forces(dt, step);
 }
 
-void Subdomain::finish(double dt) { sys_->phase_finish(dt); }
+void Subdomain::finish(double dt, double moved) { sys_->phase_finish(dt, moved); }
 
 // ---- SubdomainStepper -----------------------------------------------------------------------
 
@@ -573,6 +599,7 @@ void SubdomainStepper::set_decomposition(const DomainDecomposition& d) {
 }
 
 void SubdomainStepper::redistribute() {
+  motion_known_ = false;  // (a build: the next motion bound comes from a pass with a kick)
   for (std::size_t k = 0; k < subdomains_.size(); ++k) values_[k] = subdomains_[k].max_radius();
   const double r_max = transport_->max(values_);
   if (!(r_max > 0.0))
@@ -654,22 +681,50 @@ void SubdomainStepper::step(double dt) {
       books_dt_ = dt;
     }
   }
-  for (std::size_t k = 0; k < subdomains_.size(); ++k) values_[k] = subdomains_[k].drift(dt);
-  const bool rebuild = transport_->max(values_) > 0.0;
-  if (rebuild) {
-    redistribute();
-  } else {
-    for (std::size_t k = 0; k < subdomains_.size(); ++k) subdomains_[k].pack_refresh(out_[k]);
-    transport_->exchange(out_, in_);
-    for (std::size_t k = 0; k < subdomains_.size(); ++k) subdomains_[k].unpack_refresh(in_[k]);
+  for (Subdomain& s : subdomains_) s.begin(dt);
+  // The fused path where every subdomain's motion bound rules out a build (one max), as
+  // System::step() takes it: the particles others read as ghosts take their first half, their
+  // values go out, then each pass takes the other particles' first half inside it. Else the
+  // exact path: every first half, the rebuild decision over the split (the largest displacement
+  // since the build, +infinity where a subdomain needs a build), the ghosts' values or a build.
+  bool fused = false;
+  if (motion_known_ && options_.fused) {
+    bounds_.resize(subdomains_.size());
+    for (std::size_t k = 0; k < subdomains_.size(); ++k)
+      values_[k] = subdomains_[k].fusable(dt, bounds_[k]) ? 0.0 : 1.0;
+    fused = !(transport_->max(values_) > 0.0);
   }
-  for (Subdomain& s : subdomains_) s.forces(dt, true);
+  double moved = 0.0;  // (the exact path: over the split, from the build positions)
+  if (fused) {
+    for (Subdomain& s : subdomains_) s.drift_sent(dt);
+    refresh();
+    for (Subdomain& s : subdomains_) s.forces_fused(dt);
+    ++fused_steps_;
+  } else {
+    for (std::size_t k = 0; k < subdomains_.size(); ++k) values_[k] = subdomains_[k].drift(dt);
+    const double moved2 = transport_->max(values_);
+    const bool rebuild = !(moved2 < std::numeric_limits<double>::infinity());
+    if (rebuild)
+      redistribute();
+    else
+      refresh();
+    moved = rebuild ? 0.0 : std::sqrt(moved2);
+    for (Subdomain& s : subdomains_) s.forces(dt, true);
+  }
   if (energy_)
     for (std::size_t k = 0; k < subdomains_.size(); ++k)
       subdomains_[k].add_step_energies(dt, books_[k].data());
-  for (Subdomain& s : subdomains_) s.finish(dt);
+  for (std::size_t k = 0; k < subdomains_.size(); ++k)
+    subdomains_[k].finish(dt, fused ? bounds_[k] : moved);
+  motion_known_ = true;
   ++steps_;
   if (!replacing_.empty()) replace_particles(dt);
+}
+
+void SubdomainStepper::refresh() {
+  for (std::size_t k = 0; k < subdomains_.size(); ++k) subdomains_[k].pack_refresh(out_[k]);
+  transport_->exchange(out_, in_);
+  for (std::size_t k = 0; k < subdomains_.size(); ++k) subdomains_[k].unpack_refresh(in_[k]);
 }
 
 double SubdomainStepper::mechanical_energy(double dt) {

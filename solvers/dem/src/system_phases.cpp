@@ -1,21 +1,25 @@
 // System: a step cut into phases, for a bed split into subdomains (subdomain.hpp drives them).
 //
-// The phases are step()'s operations on the path without the fused pass (the first half in a loop
-// of its own, then the rebuild decision, then the forces and the kick), in the same order:
-//   phase_drift     walls_.advance(), the meshes' velocities from their motion, the first half
-//                   and the start of the force sums, particle by particle
-//   (the caller)    the rebuild decision, made for all subdomains at once; ghosts' values from
-//                   their owners, or at a build the particles that move between subdomains
+// The phases are step()'s operations in the same order, where the subdomains of a split bed
+// exchange data between them (system.hpp's "a step in phases" lists them):
+//   phase_begin     walls_.advance(), the meshes' velocities from their motion, the checks
+//   phase_drift     (the exact path) the first half and the start of the force sums, particle
+//                   by particle; the caller makes the rebuild decision for all subdomains at
+//                   once and sends ghosts' values from their owners, or at a build the particles
+//                   that move between subdomains
 //   phase_build     the lists (rebuild_lists(), with the pair histories received placed)
 //   phase_forces    compute_forces() with the kick
+//   phase_fusable, phase_drift_some, phase_forces_fused
+//                   (the fused path, where the motion bound of the last step rules out a build on
+//                   every subdomain) the first half of the particles others read as ghosts, then
+//                   the force pass with every other particle's first half inside it, as step()
 //   phase_finish    what step() does after its force pass
-// A System without particles (a split bed's empty subdomain) takes phase_drift() (the walls' and
+// A System without particles (a split bed's empty subdomain) takes phase_begin() (the walls' and
 // meshes' motion only) and phase_finish(): its walls and meshes are where every other
 // subdomain's are when particles arrive.
-// What differs from step(): the fused pass is never taken (it gives the same bits as the loop of
-// its own, and needs the motion bound of the last step that a ghost's values would not update),
-// the rebuild decision is the caller's, and the lists are renumbered by the caller (its global
-// order) instead of by set_sort_interval().
+// What differs from step(): the rebuild decision and the choice of the fused path are the
+// caller's (over the split), and the lists are renumbered by the caller (its global order)
+// instead of by set_sort_interval().
 #include "partita/dem/system.hpp"
 
 #include "partita/dem/error.hpp"
@@ -29,14 +33,14 @@
 
 namespace partita::dem {
 
-double System::phase_drift(double dt, const std::vector<char>& skip) {
+void System::phase_begin(double dt) {
   if (energy_tracking_)
     throw Error(
-        "phase_drift: the energy accounting is not available in a step taken in phases (a split "
+        "phase_begin: the energy accounting is not available in a step taken in phases (a split "
         "bed); turn it off (set_energy_tracking(false))");
   if (!(dt > 0.0) || !std::isfinite(dt)) {
     std::ostringstream msg;
-    msg << "phase_drift: the time step must be > 0 s, got " << dt;
+    msg << "phase_begin: the time step must be > 0 s, got " << dt;
     throw Error(msg.str());
   }
   // the meshes' velocities from their motion since the last step (where the caller gave none)
@@ -52,30 +56,39 @@ double System::phase_drift(double dt, const std::vector<char>& skip) {
   };
   if (store_.size() == 0) {  // an empty subdomain: its walls and meshes move all the same
     move_walls_and_meshes();
-    return 0.0;
+    phase_begun_ = true;
+    return;
   }
   prepare();
   constexpr double kStepTolerance = 1e-9;  // (as step())
   if (dt > rayleigh_dt_ * (1.0 + kStepTolerance)) {
     std::ostringstream msg;
     msg.precision(6);
-    msg << "phase_drift: time step " << dt << " s is above the Rayleigh time step " << rayleigh_dt_
+    msg << "phase_begin: time step " << dt << " s is above the Rayleigh time step " << rayleigh_dt_
         << " s of the smallest particle; use a fraction of it (rayleigh_time_step())";
     throw Error(msg.str());
   }
   if (!forces_valid_)
     throw Error(
-        "phase_drift: the particles have no forces of a force pass yet; call "
+        "phase_begin: the particles have no forces of a force pass yet; call "
         "phase_forces(dt, false) after the first phase_build()");
+  if (!verlet_.loaded()) verlet_.load(store_.core());
+  verlet_.moved();
+  move_walls_and_meshes();
+  // (the sums start in the first half; a System resumed from a restart has had no force pass to
+  // size them)
+  if (energy_pass() && dissipation_.size() != store_.size()) dissipation_.resize(store_.size());
+  phase_begun_ = true;
+}
+
+double System::phase_drift(double dt, const std::vector<char>& skip) {
+  if (!phase_begun_) throw Error("phase_drift: take phase_begin(dt) first");
+  phase_begun_ = false;
+  if (store_.size() == 0) return 0.0;
   const std::size_t n = store_.size();
   if (!skip.empty() && skip.size() != n)
     throw Error("phase_drift: need one skip flag per particle (" + std::to_string(n) + "), got " +
                 std::to_string(skip.size()));
-  if (!verlet_.loaded()) verlet_.load(store_.core());
-  verlet_.moved();
-  move_walls_and_meshes();
-  // (the sums start below; a System resumed from a restart has had no force pass to size them)
-  if (energy_pass() && dissipation_.size() != n) dissipation_.resize(n);
   const VelocityVerlet::Pass verlet = verlet_.pass(store_.core());
   const std::vector<Eigen::Vector3d>& x_build = neighbors_.position_at_build_;
   const bool have_build = x_build.size() == n;
@@ -90,7 +103,39 @@ double System::phase_drift(double dt, const std::vector<char>& skip) {
       moved2 = std::max(moved2, (x - x_build[k]).squaredNorm());
     start_sums(i);
   }
+  phase_sums_started_ = true;  // (phase_forces() need not start them again)
   return moved2;
+}
+
+bool System::phase_fusable(double dt, double& bound) const {
+  bound = 0.0;
+  if (store_.size() == 0) return true;  // (nothing to bound: the other subdomains decide)
+  if (!verlet_.has_motion() || !verlet_.loaded() ||
+      neighbors_.position_at_build_.size() != store_.size())
+    return false;
+  // (as step(): the first half moves a particle by at most dt (speed + dt/2 accel); rounding
+  // relative in the sums, absolute in x += dt v and x - x_build)
+  const VelocityVerlet::Motion& mo = verlet_.motion();
+  const double drift = dt * (mo.speed + 0.5 * dt * mo.accel);
+  const double eps = std::numeric_limits<double>::epsilon();
+  bound = (mo.moved + drift) * (1.0 + 1e-12) + 8.0 * eps * (mo.extent + drift);
+  return !neighbors_.needs_rebuild(bound * bound, walls_.planes(), meshes_);
+}
+
+void System::phase_drift_some(double dt, const std::vector<int>& particles) {
+  if (!phase_begun_) throw Error("phase_drift_some: take phase_begin(dt) first");
+  phase_begun_ = false;
+  if (store_.size() == 0) return;
+  const VelocityVerlet::Pass verlet = verlet_.pass(store_.core());
+  const double half = 0.5 * dt;
+  const long count = static_cast<long>(particles.size());
+  const long n = static_cast<long>(store_.size());
+  for (const int i : particles)
+    if (i < 0 || i >= n)
+      throw Error("phase_drift_some: particle " + std::to_string(i) + " of " +
+                  std::to_string(n));
+#pragma omp parallel for schedule(static) if (count >= 1024)
+  for (long k = 0; k < count; ++k) verlet.first_half(particles[static_cast<std::size_t>(k)], dt, half);
 }
 
 bool System::phase_needs_rebuild(double moved2) const {
@@ -125,6 +170,7 @@ void System::phase_build(const std::vector<char>* passive) {
         "set_sort_interval(0)");
   prepared_ = false;
   lists_current_ = false;
+  phase_sums_started_ = false;
   neighbors_.set_passive(passive);
   try {
     prepare();  // (rayleigh_dt_, history sizes, the lists)
@@ -136,13 +182,49 @@ void System::phase_build(const std::vector<char>* passive) {
 }
 
 void System::phase_forces(double dt, bool step) {
+  // The sums started by this step's phase_drift() hold where nothing changed since (no build, no
+  // change of the particles: prepared, the packed state still loaded): a refresh of the ghosts'
+  // values sets their motion only. Not starting them again saves a pass over the particles and
+  // gives the same bits (start_sums() writes the same values).
+  const bool started = phase_sums_started_ && prepared_ && verlet_.loaded();
+  phase_sums_started_ = false;
   prepare();
-  compute_forces(dt, step, step ? 0.5 * dt : 0.0, false);
+  compute_forces(dt, step, step ? 0.5 * dt : 0.0, started);
   forces_valid_ = true;
 }
 
-void System::phase_finish(double dt) {
-  verlet_.forget_motion();  // (a later step() takes the exact path)
+void System::phase_forces_fused(double dt, const std::vector<char>& drifted) {
+  if (drifted.size() != store_.size())
+    throw Error("phase_forces_fused: need one flag per particle (" +
+                std::to_string(store_.size()) + "), got " + std::to_string(drifted.size()));
+  if (store_.size() == 0) return;
+  phase_sums_started_ = false;
+  prepare();  // (the lists are current: nothing to do)
+  const int parts = set_partition();
+  partition_.prepare_cross_pairs(neighbors_);
+  start_load_pass(parts);
+  const double half = 0.5 * dt;
+  drift_skip_ = drifted.data();
+  try {
+#pragma omp parallel if (parts > 1) num_threads(parts)
+    evaluate_forces(dt, true, half, true);
+  } catch (...) {
+    drift_skip_ = nullptr;
+    throw;
+  }
+  drift_skip_ = nullptr;
+  reduce_wall_and_mesh_forces(dt, true);
+  forces_valid_ = true;
+}
+
+void System::phase_finish(double dt, double moved) {
+  phase_begun_ = false;
+  // the bound of the next step's motion where the caller keeps it (phase_fusable()), else a
+  // later step takes the exact path
+  if (moved >= 0.0 && store_.size() > 0 && verlet_.loaded())
+    set_motion(moved);
+  else
+    verlet_.forget_motion();
   for (TriangleMesh& m : meshes_)
     detail::parallel_pass(m.vertex_count(),
                           [&](int v) { m.position_last_step_[v] = m.position_[v]; });

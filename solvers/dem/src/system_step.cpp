@@ -352,8 +352,11 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
   // force sums, as the loop before the pass does it (step(), which knows that no particle can
   // have moved beyond the skin)
   const Eigen::Vector3d gravity = gravity_;
+  // (a split bed's fused pass: particles whose first half was taken before it, or ghosts whose
+  // values came from their owners, only start their sums)
+  const char* const drifted = drift_skip_;
   auto drift = [&](int i) {
-    verlet.first_half(i, dt, kick);
+    if (drifted == nullptr || !drifted[i]) verlet.first_half(i, dt, kick);
     PackedParticle& q = packed[i];
     q.f = mass[i] * gravity;
     q.t.setZero();

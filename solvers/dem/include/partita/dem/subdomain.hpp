@@ -200,8 +200,19 @@ class Subdomain {
   long migrated_in() const { return migrated_in_; }
 
   // ---- phases ----
-  /// The first half of the step; returns 1 when this subdomain's lists need a rebuild, else 0.
+  /// The walls' and meshes' motion of the step and its checks (System::phase_begin()).
+  void begin(double dt);
+  /// The exact path's first half (after begin()): the largest squared displacement of an owned
+  /// particle since the last build, or +infinity where this subdomain's lists need a build.
   double drift(double dt);
+  /// Whether the last step's motion bound rules out a build in this step (after begin();
+  /// System::phase_fusable()); bound: the bound to keep after it (finish()).
+  bool fusable(double dt, double& bound) const;
+  /// The fused path: the first half of the owned particles that are ghosts elsewhere (their
+  /// values are sent before the pass); after the ghosts' refresh, forces_fused(): the pass with
+  /// every other particle's first half inside it (System::phase_forces_fused()).
+  void drift_sent(double dt);
+  void forces_fused(double dt);
   void pack_refresh(SubdomainMail& out);
   void unpack_refresh(const SubdomainMail& in);
   /// At a build: the particles that change owner and the ghost copies for every other subdomain
@@ -212,7 +223,8 @@ class Subdomain {
   void unpack_moves(const SubdomainMail& in, GlobalOrder& order, const DomainDecomposition& d,
                     double ghost_distance);
   void forces(double dt, bool step);
-  void finish(double dt);
+  /// moved >= 0: the motion bound kept for fusable() (System::phase_finish()).
+  void finish(double dt, double moved = -1.0);
   double max_radius();
   /// Adds the owned particles' kinetic energy (translational + rotational, System::
   /// kinetic_energy()'s terms) to sums[0] and their linear momentum m v to sums[1..3].
@@ -255,6 +267,8 @@ class Subdomain {
   std::vector<char> ghost_;               // per particle, since the last build
   std::vector<std::vector<int>> send_;    // per rank: owned particles that are ghosts there
   std::vector<std::vector<int>> recv_;    // per rank: the ghosts it owns
+  std::vector<int> sent_;                 // owned particles in any send_ list, once each
+  std::vector<char> drifted_;             // per particle: a ghost or in sent_ (fused pass)
   // pack_moves() -> unpack_moves()
   std::vector<char> remove_;
   std::vector<std::pair<int, int>> become_ghost_;  // (index, new owner)
@@ -271,6 +285,8 @@ class SubdomainStepper {
     /// How far from a box a particle is a ghost there; < 0: 2 R_max + skin (what the lists
     /// need; less breaks the split's bits: a test's knob).
     double ghost_distance = -1.0;
+    /// false: every step on the exact path (the fused path gives the same bits: a test's knob).
+    bool fused = true;
   };
   /// systems[k]: local subdomain transport.local()[k]'s System. Sets the skin of every System
   /// (all must be alike) and the sort interval to 0. Throws Error when the counts do not match
@@ -305,6 +321,10 @@ class SubdomainStepper {
   /// List builds since start() (start()'s included), the same on every subdomain.
   long builds() const { return builds_; }
   long steps() const { return steps_; }
+  /// Steps taken on the fused path (the first half inside the force pass, where the motion
+  /// bound of the last step rules out a build on every subdomain; the same bits as the exact
+  /// path), the same on every subdomain.
+  long fused_steps() const { return fused_steps_; }
   /// Kinetic energy [J] and linear momentum [kg m/s] of the owned particles of every subdomain:
   /// exact sums rounded once, the same bits on any split (collective: every process calls it).
   double kinetic_energy();
@@ -436,7 +456,11 @@ class SubdomainStepper {
   GlobalOrder order_;
   long builds_ = 0, steps_ = 0;
   std::vector<SubdomainMail> out_, in_;
-  std::vector<double> values_;
+  std::vector<double> values_, bounds_;
+  // every subdomain kept its motion bound at the last step's end (the fused path may be tried)
+  bool motion_known_ = false;
+  long fused_steps_ = 0;
+  void refresh();
 };
 
 /// A split bed's restart: the world (one subdomain's System state: walls, meshes, time; alike on

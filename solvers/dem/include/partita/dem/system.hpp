@@ -271,22 +271,40 @@ class System {
 
   // ---- a step in phases (a bed split into subdomains: SubdomainStepper drives them) ---------
   /// step() cut where the subdomains of a split bed exchange data (subdomain.hpp): the same
-  /// operations as step()'s path without the fused pass, in the same order, for one System.
-  /// 1. phase_drift(dt): the walls' and meshes' motion of the step, the integrator's first half
-  ///    (v += dt/2 F/m, x += dt v, omega += dt/2 T/I) and the start of the force sums; returns the
-  ///    largest squared displacement since the last list build of the particles with
-  ///    skip[i] == 0 (skip: empty, or one flag per particle).
-  /// 2. a ghost's values from its owner: set_phase_motion(); or, at a list build, particles
-  ///    removed, added, renumbered, then phase_build().
-  /// 3. phase_forces(dt, true): forces at the new positions, histories updated, the closing kick.
-  /// 4. phase_finish(dt): the meshes' positions of the step, the hooks, time and step count
-  ///    (not the end_of_step() of a hook that replaces particles: the split's stepper drives it,
-  ///    StepHook::replaces_particles()).
-  /// Before the first phase_drift() the forces of a pass must be there: phase_forces(dt, false)
+  /// operations as step() in the same order, for one System. Each step:
+  /// 1. phase_begin(dt): the walls' and meshes' motion of the step and the step's checks.
+  /// 2. Either the exact path, as step() takes it where it cannot rule out a list build:
+  ///    a. phase_drift(dt, skip): the integrator's first half (v += dt/2 F/m, x += dt v,
+  ///       omega += dt/2 T/I) and the start of the force sums of every particle; returns the
+  ///       largest squared displacement since the last list build of the particles with
+  ///       skip[i] == 0 (skip: empty, or one flag per particle).
+  ///    b. a ghost's values from its owner: set_phase_motion(); or, at a list build, particles
+  ///       removed, added, renumbered, then phase_build().
+  ///    c. phase_forces(dt, true): forces at the new positions, histories updated, the kick.
+  ///    Or the fused path, as step() takes it where the last step's motion bound shows that no
+  ///    build can be due (phase_fusable(), true on every subdomain):
+  ///    a. phase_drift_some(dt, particles): the first half of the particles whose values go to
+  ///       other subdomains before the pass;
+  ///    b. the ghosts' values from their owners: set_phase_motion();
+  ///    c. phase_forces_fused(dt, drifted): the force pass with the first half of every other
+  ///       particle inside it, each just before the first row that reads it (its data read once
+  ///       a step instead of twice), and the kick. Both paths give the same bits.
+  /// 3. phase_finish(dt, moved): the meshes' positions of the step, the hooks, time and step
+  ///    count (not the end_of_step() of a hook that replaces particles: the split's stepper
+  ///    drives it, StepHook::replaces_particles()); moved >= 0 keeps the motion bound of the
+  ///    step for the next phase_fusable() (the largest distance of a particle from its position
+  ///    at the last build, over the split), moved < 0 forgets it.
+  /// Before the first phase_begin() the forces of a pass must be there: phase_forces(dt, false)
   /// (no kick, no history update: what step() does before its first step). Throws Error with the
   /// energy accounting on (its sums are per System; not available in phases yet), on a bad dt
-  /// (as step()), or when phase_drift() finds no forces.
+  /// (as step()), when phase_begin() finds no forces, or when a phase comes out of turn.
+  void phase_begin(double dt);
   double phase_drift(double dt, const std::vector<char>& skip);
+  /// Whether this step's first half moves no particle far enough for a list build (the motion
+  /// bound of the last step, kept by phase_finish(dt, moved)); bound: the largest distance from
+  /// the build positions after it, to keep. True for a System without particles (bound 0).
+  bool phase_fusable(double dt, double& bound) const;
+  void phase_drift_some(double dt, const std::vector<int>& particles);
   /// Whether a step whose largest squared particle displacement since the build is `moved2`
   /// needs new lists (a plane or mesh vertex that moved more than skin/2 also makes it).
   bool phase_needs_rebuild(double moved2) const;
@@ -301,7 +319,10 @@ class System {
   /// listed and they get no plane or mesh contacts (NeighborList::set_passive()).
   void phase_build(const std::vector<char>* passive = nullptr);
   void phase_forces(double dt, bool step);
-  void phase_finish(double dt);
+  /// drifted: one flag per particle, 1 where the first half is not taken in the pass (taken by
+  /// phase_drift_some(), or a ghost whose values came from its owner).
+  void phase_forces_fused(double dt, const std::vector<char>& drifted);
+  void phase_finish(double dt, double moved = -1.0);
   /// Adds to `sum` the elastic energy (as elastic_energy()) of the contacts of the last force
   /// pass that belong to the particles with skip[i] == 0 (one flag per particle): the pairs
   /// (i, j), i < j, their plane and mesh contacts. With skip = a split bed's ghosts, every
@@ -543,6 +564,12 @@ class System {
   bool prepared_ = false;
   bool lists_current_ = false;  // the neighbour lists were built for the current particle set
   bool forces_valid_ = false;
+  // phase_drift() started the force sums of the current particles (phase_forces())
+  bool phase_sums_started_ = false;
+  // phase_begin() was taken for this step (the first half may follow)
+  bool phase_begun_ = false;
+  // phase_forces_fused(): the particles whose first half is not taken in the pass (else null)
+  const char* drift_skip_ = nullptr;
   bool track_load_ = false;
   double rayleigh_dt_ = 0.0;
   std::uint64_t identity_ = 0;  // shared by copies; a state remembers the system it came from
