@@ -238,7 +238,7 @@ double Subdomain::max_radius() {
   return r;
 }
 
-// An empty subdomain moves its walls and meshes (phase_drift() without particles) and asks for
+// An empty subdomain moves its walls and meshes (phase_begin() without particles) and asks for
 // no build: the others' lists decide, and its walls' and meshes' positions at its last build may
 // be old.
 void Subdomain::begin(double dt) { sys_->phase_begin(dt); }
@@ -459,19 +459,21 @@ void Subdomain::set_changed() {
   for (std::size_t i = 0; i < owner.size(); ++i) ghost_[i] = owner[i] >= 0 ? 1 : 0;
 }
 
-void Subdomain::add_wall_forces(ExactSum* sums) const {
-  const std::vector<Eigen::Vector3d>& reaction = sys_->wall_reactions();
-  const std::vector<PlaneWall>& planes = sys_->planes();
-  const std::size_t n = sys_->particle_count(), np = planes.size();
-  if (reaction.size() != n * np)
+void Subdomain::check_reactions() const {
+  if (!sys_->planes().empty() && !sys_->wall_reactions_recorded())
     throw Error("subdomain " + std::to_string(rank_) +
                 ": the planes' reactions are not recorded (System::set_wall_reactions(true) "
                 "before the first force pass)");
-  for (std::size_t i = 0; i < n; ++i) {
+}
+
+void Subdomain::add_wall_forces(ExactSum* sums) const {
+  check_reactions();
+  const std::vector<PlaneWall>& planes = sys_->planes();
+  for (std::size_t i = 0; i < sys_->particle_count(); ++i) {
     if (is_ghost(i)) continue;
-    for (std::size_t k = 0; k < np; ++k)
-      for (int c = 0; c < 3; ++c)
-        sums[3 * planes[k].wall + c].add(reaction[i * np + k][c]);
+    sys_->for_each_wall_reaction(i, [&](std::size_t k, const Eigen::Vector3d& f) {
+      for (int c = 0; c < 3; ++c) sums[3 * planes[k].wall + c].add(f[c]);
+    });
   }
 }
 
@@ -487,16 +489,12 @@ void Subdomain::add_contacts(ExactSum& sum) const {
 }
 
 void Subdomain::add_plane_forces(ExactSum* sums) const {
-  const std::vector<Eigen::Vector3d>& reaction = sys_->wall_reactions();
-  const std::size_t n = sys_->particle_count(), np = sys_->planes().size();
-  if (reaction.size() != n * np)
-    throw Error("subdomain " + std::to_string(rank_) +
-                ": the planes' reactions are not recorded (System::set_wall_reactions(true) "
-                "before the first force pass)");
-  for (std::size_t i = 0; i < n; ++i) {
+  check_reactions();
+  for (std::size_t i = 0; i < sys_->particle_count(); ++i) {
     if (is_ghost(i)) continue;
-    for (std::size_t k = 0; k < np; ++k)
-      for (int c = 0; c < 3; ++c) sums[3 * k + c].add(reaction[i * np + k][c]);
+    sys_->for_each_wall_reaction(i, [&](std::size_t k, const Eigen::Vector3d& f) {
+      for (int c = 0; c < 3; ++c) sums[3 * k + c].add(f[c]);
+    });
   }
 }
 
@@ -517,10 +515,8 @@ void Subdomain::add_step_energies(double dt, ExactSum* sums) const {
   const std::size_t n = sys_->particle_count();
   if (n == 0) return;
   const std::vector<System::ParticleEnergy>& e = sys_->particle_energies();
-  const std::vector<Eigen::Vector3d>& reaction = sys_->wall_reactions();
   const std::vector<PlaneWall>& planes = sys_->planes();
-  const std::size_t np = planes.size();
-  if (e.size() != n || reaction.size() != n * np)
+  if (e.size() != n || (!planes.empty() && !sys_->wall_reactions_recorded()))
     throw Error("subdomain " + std::to_string(rank_) +
                 ": the particles' energies or the planes' reactions are not recorded "
                 "(System::set_energy_terms(true) and set_wall_reactions(true) before the step)");
@@ -530,9 +526,10 @@ void Subdomain::add_step_energies(double dt, ExactSum* sums) const {
     sums[1].add(e[i].friction);
     sums[2].add(e[i].gravity);
     sums[3].add(e[i].stiffening);
-    for (std::size_t k = 0; k < np; ++k)
+    sys_->for_each_wall_reaction(i, [&](std::size_t k, const Eigen::Vector3d& f) {
       if (planes[k].velocity != Eigen::Vector3d::Zero())
-        sums[4 + planes[k].wall].add(-reaction[i * np + k].dot(planes[k].velocity) * dt);
+        sums[4 + planes[k].wall].add(-f.dot(planes[k].velocity) * dt);
+    });
   }
   const std::size_t walls = static_cast<std::size_t>(sys_->wall_count());
   sys_->mesh_contacts().for_each_contact(

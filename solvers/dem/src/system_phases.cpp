@@ -24,6 +24,7 @@
 
 #include "partita/dem/error.hpp"
 #include "partita/dem/exact_sum.hpp"
+#include "motion_bound.hpp"
 #include "parallel_pass.hpp"
 
 #include <algorithm>
@@ -113,12 +114,7 @@ bool System::phase_fusable(double dt, double& bound) const {
   if (!verlet_.has_motion() || !verlet_.loaded() ||
       neighbors_.position_at_build_.size() != store_.size())
     return false;
-  // (as step(): the first half moves a particle by at most dt (speed + dt/2 accel); rounding
-  // relative in the sums, absolute in x += dt v and x - x_build)
-  const VelocityVerlet::Motion& mo = verlet_.motion();
-  const double drift = dt * (mo.speed + 0.5 * dt * mo.accel);
-  const double eps = std::numeric_limits<double>::epsilon();
-  bound = (mo.moved + drift) * (1.0 + 1e-12) + 8.0 * eps * (mo.extent + drift);
+  bound = detail::motion_bound(verlet_.motion(), dt);  // (as step())
   return !neighbors_.needs_rebuild(bound * bound, walls_.planes(), meshes_);
 }
 
@@ -287,12 +283,10 @@ void System::add_half_step_term(const std::vector<char>& skip, double dt, ExactS
   const Particles& p = store_.core();
   const std::size_t n = p.size();
   const std::vector<PlaneWall>& planes = walls_.planes();
-  const std::size_t np = planes.size();
-  const std::vector<Eigen::Vector3d>& reaction = walls_.reactions();
   if (skip.size() != n)
     throw Error("add_half_step_term: needs one flag per particle (" + std::to_string(n) +
                 "), got " + std::to_string(skip.size()));
-  if (n > 0 && np > 0 && reaction.size() != n * np)
+  if (n > 0 && !planes.empty() && !wall_reactions_recorded())
     throw Error(
         "add_half_step_term: the planes' reactions are not recorded (set_wall_reactions(true) "
         "before the force pass)");
@@ -302,9 +296,10 @@ void System::add_half_step_term(const std::vector<char>& skip, double dt, ExactS
     const Eigen::Vector3d &f = p.force[i], &t = p.torque[i];
     sum.add(h * (f.dot(p.velocity[i]) + t.dot(p.angular_velocity[i])) +
             h2 * (f.squaredNorm() / p.mass[i] + t.squaredNorm() / p.inertia[i]));
-    for (std::size_t k = 0; k < np; ++k)  // the planes' motion: -F_plane . v_plane over dt/2
-      if (planes[k].velocity != Eigen::Vector3d::Zero())
-        sum.add(-h * reaction[i * np + k].dot(planes[k].velocity));
+    for_each_wall_reaction(i, [&](std::size_t k, const Eigen::Vector3d& r) {
+      if (planes[k].velocity != Eigen::Vector3d::Zero())  // the planes' motion: -F . v over dt/2
+        sum.add(-h * r.dot(planes[k].velocity));
+    });
   }
   mesh_contacts_.for_each_contact([&](int i, const MeshContactRecord& rec, const Eigen::Vector3d&) {
     if (skip[i]) return;

@@ -5,6 +5,7 @@
 #include "partita/dem/error.hpp"
 #include "partita/dem/mesh_contacts.hpp"
 #include "partita/dem/parallel.hpp"
+#include "motion_bound.hpp"
 #include "parallel_pass.hpp"
 
 #include <algorithm>
@@ -110,11 +111,7 @@ void System::step(double dt) {
   bool fused = false;
   double bound = 0.0;  // fused: no particle is further than this from its position at the build
   if (have_build && verlet_.has_motion()) {
-    const VelocityVerlet::Motion& mo = verlet_.motion();
-    const double drift = dt * (mo.speed + half * mo.accel);
-    // (rounding: relative in the sums, absolute in x += dt v and x - x_build)
-    const double eps = std::numeric_limits<double>::epsilon();
-    bound = (mo.moved + drift) * (1.0 + 1e-12) + 8.0 * eps * (mo.extent + drift);
+    bound = detail::motion_bound(verlet_.motion(), dt);
     fused = !neighbors_.needs_rebuild(bound * bound, walls_.planes(), meshes_);
   }
   if (fused) {

@@ -259,6 +259,8 @@ class Subdomain {
 
  private:
   std::vector<int>& owner_array() { return sys_->store().array<int>(h_owner_); }
+  // throws where the System has planes and does not record their reactions
+  void check_reactions() const;
 
   System* sys_;
   int rank_ = 0;

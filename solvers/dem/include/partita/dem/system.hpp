@@ -63,6 +63,7 @@
 #include "partita/dem/velocity_verlet.hpp"
 #include "partita/dem/wall_contacts.hpp"
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
@@ -331,15 +332,37 @@ class System {
   /// Error without the lists of the current particles (before the first step, after a change of
   /// the particle set) or with another number of flags.
   void add_elastic_energy(const std::vector<char>& skip, ExactSum& sum) const;
-  /// Records in every force pass each particle's reaction on each plane (off by default):
-  /// wall_reactions()[i * planes().size() + k], the force particle i exerted on plane k in the
-  /// last pass (zero without contact; wall_force() sums them per block), for sums in an order of
-  /// the caller's (a split bed's wall totals, SubdomainStepper::wall_force()).
+  /// Records in every force pass each particle's reaction on the planes near it (off by
+  /// default), for sums in an order of the caller's (a split bed's wall totals,
+  /// SubdomainStepper::wall_force()); for_each_wall_reaction() reads them.
   void set_wall_reactions(bool on) {
     walls_.set_recording(on);
     prepared_ = false;  // (sizes them)
   }
-  const std::vector<Eigen::Vector3d>& wall_reactions() const { return walls_.reactions(); }
+  /// Whether the reactions are recorded for the current particles (set_wall_reactions(true) and
+  /// a prepare since: the first step or phase_build()).
+  bool wall_reactions_recorded() const {
+    return walls_.recording() && walls_.reactions().size() == store_.size() * walls_.planes().size();
+  }
+  /// Calls visit(k, f) for each plane k near particle i at the last list build (the neighbour
+  /// list's plane mask; every plane where there are more than 64): f, the force particle i
+  /// exerted on plane k in the last force pass (zero without contact; the terms wall_force()
+  /// sums per block). A plane not visited has no contact with i. Nothing is visited without
+  /// wall_reactions_recorded() or without the lists of the current particles (zero forces).
+  template <class Visit>
+  void for_each_wall_reaction(std::size_t i, Visit&& visit) const {
+    const std::vector<Eigen::Vector3d>& r = walls_.reactions();
+    const std::size_t np = walls_.planes().size();
+    if (np == 0 || !wall_reactions_recorded() || i >= store_.size()) return;
+    const Eigen::Vector3d* const row = r.data() + i * np;
+    if (np > 64) {
+      for (std::size_t k = 0; k < np; ++k) visit(k, row[k]);
+      return;
+    }
+    if (neighbors_.plane_mask_.size() != store_.size()) return;
+    for (std::uint64_t m = neighbors_.plane_mask_[i]; m != 0; m &= m - 1)
+      visit(static_cast<std::size_t>(std::countr_zero(m)), row[std::countr_zero(m)]);
+  }
 
   // ---- access and monitors ------------------------------------------------------------------
   const Particles& particles() const {

@@ -118,10 +118,14 @@ class WallContacts {
                 record_ && reaction_.size() == store.size() * planes_.size() ? reaction_.data()
                                                                             : nullptr};
   }
-  /// Whether each force pass records every particle's reaction on every plane (off by default):
-  /// reactions()[i * planes + k], the force particle i exerted on plane k (zero without
-  /// contact), the terms of the plane's total, for sums in an order of one's own (a split bed's,
-  /// SubdomainStepper::wall_force()). Sized by resize() (a pass before it records nothing).
+  /// Whether each force pass records each particle's reaction on the planes near it (off by
+  /// default): reactions()[i * planes + k], the force particle i exerted on plane k (zero
+  /// without contact), the terms of the plane's total, for sums in an order of one's own (a split
+  /// bed's, SubdomainStepper::wall_force()). A pass writes the entries of the planes in the
+  /// particle's plane mask (NeighborList::plane_mask(); every plane where there are more than
+  /// 64), the only ones that can hold a force; the others keep what an earlier pass left there
+  /// (System::for_each_wall_reaction() visits the written ones). Sized, and zeroed, by resize()
+  /// (a pass before it records nothing).
   void set_recording(bool on) { record_ = on; }
   bool recording() const { return record_; }
   const std::vector<Eigen::Vector3d>& reactions() const { return reaction_; }
@@ -150,9 +154,9 @@ PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(
     Eigen::Vector3d& t, double& load, Eigen::Vector3d* block, DissipationSums* sums,
     WallDissipation* wd) const {
   const double ri = qi.r;
+  // (recording: only the planes near i are written, those a reader visits; zeroing every
+  // plane's entry of every particle would stream N x planes x 24 bytes through each pass)
   Eigen::Vector3d* const react = reaction ? reaction + static_cast<std::size_t>(i) * np : nullptr;
-  if (react)
-    for (int k = 0; k < np; ++k) react[k].setZero();
   for (int k = 0; k < np; ++k) {
     if (np <= 64) {  // jump to the next plane near i
       if (mask == 0) break;
@@ -164,6 +168,7 @@ PARTITA_DEM_INLINE void WallContacts::Pass::add_forces(
     const double delta = ri - (qi.x - w.point).dot(w.normal);
     if (delta <= 0.0) {
       sh.setZero();
+      if (react) react[k].setZero();
       continue;
     }
     const PairParameters& pp = model.pair(material_i, w.material);
