@@ -46,9 +46,9 @@
 //
 // Sums over the split, and what is not handled yet:
 //  - Wall forces: SubdomainStepper::wall_force() is the same on any split (each owned particle's
-//    reaction on each plane, System::set_wall_reactions(), in an exact sum); it may differ from
-//    System::wall_force()'s block sums in the last bits; plane_forces() gives each plane's (a box
-//    wall's faces) the same way. (A ghost has no plane or mesh contacts: each System's own
+//    reaction on each plane near it, System::for_each_wall_reaction(), in an exact sum); it may
+//    differ from System::wall_force()'s block sums in the last bits; plane_forces() gives each
+//    plane's (a box wall's faces) the same way. (A ghost has no plane or mesh contacts: each System's own
 //    wall_force(), mesh_force() and triangle_forces() are its owned particles', rounded in
 //    another order.)
 //  - Triangle meshes (STL walls, the coupling's FE surfaces): every subdomain holds every mesh
