@@ -242,8 +242,16 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     // triangle_fresh()); the force acts on the overlap beyond it
     // (fresh: also where the contact took over the history of a neighbouring feature's, as a
     // particle in a hole touching its walls does when the face under it is exposed)
+    // A centre behind a one-sided face found without history (no contact of the last pass at
+    // this point) was inside the body before this contact held it: deeper than r (no contact
+    // there) or held by a face that has gone. No motion of this step made that overlap (up to
+    // 2 r), so it is a pre-overlap, as under a face that enters the contacts: pushed out with it,
+    // the particle would take up to 8/15 E* sqrt(r) (2 r)^(5/2) that nothing worked for. Not at
+    // the first pass of a run (q.first_pass), whose contacts, found without history, hold the
+    // initial elastic energy.
+    const bool found_inside = k.behind && from_old[a] < 0 && !q.first_pass;
     float pre = 0.0f;
-    if (m.triangle_fresh(k.triangle))
+    if (m.triangle_fresh(k.triangle) || found_inside)
       pre = static_cast<float>(k.delta);
     else if (from_old[a] >= 0 && old_pre[from_old[a]] > 0.0f)
       pre = std::min(old_pre[from_old[a]], static_cast<float>(k.delta));

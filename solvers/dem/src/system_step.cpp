@@ -585,7 +585,8 @@ void System::evaluate_forces_impl(double dt, bool update_history, double kick) {
           Eigen::Vector3d fm = Eigen::Vector3d::Zero(), tm = Eigen::Vector3d::Zero();
           const double yield_pressure =
               yield_pressure_of != nullptr && 2.0 * qi.r < yield_.below_diameter ? yield_pressure_of[i] : 0.0;
-          const MeshContacts::Particle q{qi.x, qi.r, qi.v, mass[i], qi.w, material[i], yield_pressure};
+          const MeshContacts::Particle q{qi.x,      qi.r,        qi.v,          mass[i],
+                                         qi.w,      material[i], yield_pressure, steps_ == 0};
           MeshContacts::evaluate<Load, Energy>(i, q, nl, meshes_, model_, mesh.row(mesh_row++),
                                                dt, update_history, fm, tm, load_i, &di, &wd);
           f += fm;

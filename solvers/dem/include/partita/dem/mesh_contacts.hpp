@@ -46,6 +46,9 @@ class MeshContacts {
     int material;
     /// > 0: the particle yields at this mean contact pressure [Pa] (StepHook::contact_yield())
     double yield_pressure = 0.0;
+    /// true: the System's first force pass (every contact found without history, none made by
+    /// motion): a centre found inside a one-sided body is pushed out with its whole overlap
+    bool first_pass = false;
   };
   /// One particle's row: its contacts of the last pass (count), their feature keys, tangential
   /// histories and records, room for `capacity`.
@@ -123,7 +126,7 @@ class MeshContacts {
       Eigen::Vector3d shear[max_contacts];
       MeshContactRecord records[max_contacts];
       const Row row{count, max_contacts, key, shear, records};
-      const Particle q{p.position[i], p.radius[i], zero, p.mass[i], zero, p.material[i]};
+      const Particle q{p.position[i], p.radius[i], zero, p.mass[i], zero, p.material[i], 0.0, true};
       Eigen::Vector3d f = Eigen::Vector3d::Zero(), t = Eigen::Vector3d::Zero();
       double load = 0.0;
       evaluate<false>(i, q, lists, meshes, model, row, 0.0, false, f, t, load);
