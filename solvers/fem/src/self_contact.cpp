@@ -113,6 +113,10 @@ SelfContact::SelfContact(std::string name, const Model& model, const std::vector
   pre_.assign(nodes_.size(), 0.0);
   pre_trial_ = pre_;
   face_active_committed_.assign(faces_.size(), 0);  // at the start every face is new
+  held_.assign(nodes_.size(), 0);
+  held_trial_ = held_;
+  x_committed_.assign(nodes_.size(), Vec3::Zero());
+  x_trial_ = x_committed_;
   update_active();
 }
 
@@ -251,11 +255,13 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
   energy_ = force_sum_ = 0.0;
   active_ = 0;
   std::fill(pre_trial_.begin(), pre_trial_.end(), 0.0);
+  std::fill(held_trial_.begin(), held_trial_.end(), 0);
+  for (std::size_t j = 0; j < nodes_.size(); ++j) x_trial_[j] = position(u, nodes_[j]);
   double round_off2 = 0.0;
   for (std::size_t j = 0; j < nodes_.size(); ++j) {
     if (start_[j] == start_[j + 1]) continue;
     const std::size_t node = nodes_[j];
-    const Vec3 x = position(u, node);
+    const Vec3& x = x_trial_[j];
     // each candidate's plane: normal, signed distance, barycentric coordinates of the projection
     // and how far outside the triangle that lies (0 inside; in units of its size)
     const std::size_t count = start_[j + 1] - start_[j];
@@ -310,8 +316,19 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
     // is and pushes only beyond that depth; the depth is followed down as the node comes out
     const double depth = -pr.gap;
     const bool fresh = refreshed && !face_active_committed_[tri.face];
-    const double pre = fresh ? std::max(pre_[j], depth) : std::min(pre_[j], depth);
+    double pre = fresh ? std::max(pre_[j], depth) : std::min(pre_[j], depth);
+    if (!fresh && !held_[j]) {
+      // a contact not there at the last committed configuration: the depth the node had behind
+      // this face's plane then (the face's and the node's committed positions) is not made by
+      // this step's approach
+      const Vec3& a0 = x_committed_[node_slot_[tri.nodes[0]]];
+      const Vec3 n0 = (x_committed_[node_slot_[tri.nodes[1]]] - a0)
+                          .cross(x_committed_[node_slot_[tri.nodes[2]]] - a0);
+      const double area0 = n0.norm();
+      if (area0 > 0.0) pre = std::clamp(-n0.dot(x_committed_[j] - a0) / area0, 0.0, depth);
+    }
     pre_trial_[j] = pre;
+    held_trial_[j] = 1;
     const double overlap = depth - pre;
     if (!(overlap > 0.0)) continue;
     ++active_;
@@ -334,26 +351,42 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
   if (refreshed) {  // at the committed configuration: its depths and faces are the committed ones
     pre_ = pre_trial_;
     face_active_committed_ = face_active_;
+    held_ = held_trial_;
+    x_committed_ = x_trial_;
   }
 }
 
-void SelfContact::commit() { pre_.swap(pre_trial_); }
+void SelfContact::commit() {
+  pre_.swap(pre_trial_);
+  held_.swap(held_trial_);
+  x_committed_.swap(x_trial_);
+}
 
+// [pre-penetration per node][face took part per face][in contact per node][position per node, x y z]
 const std::vector<double>& SelfContact::committed_state() const {
   state_.assign(pre_.begin(), pre_.end());
   for (const char a : face_active_committed_) state_.push_back(a ? 1.0 : 0.0);
+  for (const char h : held_) state_.push_back(h ? 1.0 : 0.0);
+  for (const Vec3& x : x_committed_) state_.insert(state_.end(), {x.x(), x.y(), x.z()});
   return state_;
 }
 
 void SelfContact::set_committed_state(const std::vector<double>& state) {
-  const std::size_t expected = nodes_.size() + faces_.size();
+  const std::size_t n = nodes_.size(), expected = 5 * n + faces_.size();
   if (state.size() != expected)
     throw Error("self contact '" + name_ + "': a state of " + std::to_string(state.size()) +
                 " values was given, it keeps " + std::to_string(expected));
-  std::copy(state.begin(), state.begin() + static_cast<std::ptrdiff_t>(nodes_.size()), pre_.begin());
+  std::copy(state.begin(), state.begin() + static_cast<std::ptrdiff_t>(n), pre_.begin());
   for (std::size_t f = 0; f < faces_.size(); ++f)
-    face_active_committed_[f] = state[nodes_.size() + f] != 0.0 ? 1 : 0;
+    face_active_committed_[f] = state[n + f] != 0.0 ? 1 : 0;
+  const std::size_t held_at = n + faces_.size(), x_at = held_at + n;
+  for (std::size_t j = 0; j < n; ++j) {
+    held_[j] = state[held_at + j] != 0.0 ? 1 : 0;
+    x_committed_[j] = Vec3(state[x_at + 3 * j], state[x_at + 3 * j + 1], state[x_at + 3 * j + 2]);
+  }
   pre_trial_ = pre_;
+  held_trial_ = held_;
+  x_trial_ = x_committed_;
   refresh_ = true;
 }
 

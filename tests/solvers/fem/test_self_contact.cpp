@@ -306,3 +306,64 @@ TEST_CASE("self contact: bad options and faces are named", "[fem][contact][self]
   CHECK_THROWS_WITH(SelfContact("s", model, {"zmax"}, {0.1, 1.0}), Catch::Contains("0 < depth < 1"));
   CHECK_THROWS_WITH(SelfContact("s", model, {"zmax"}, {-1.0, 0.5}), Catch::Contains("penalty factor"));
 }
+
+TEST_CASE("self contact: a node that comes back within the caught depth from deeper is not pushed "
+          "out with a depth it did not make",
+          "[fem][contact][self][rupture]") {
+  // the column, its middle element eroded before the start (the two faces 10 mm apart), caught
+  // to 0.4 h = 4 mm; the top cube passes 4.5 mm through the bottom one in a step (beyond the
+  // catch, and 5.5 mm from the far faces: no contact), then comes back to 3.5 mm through: its
+  // nodes meet the face 3.5 mm behind it, a depth their motion made away from it. The contact
+  // holds it as a pre-penetration (1/2 k g^2 of 3.5 mm pushed out would be 8 x 322 J); going
+  // back in to 3.9 mm, the springs hold the 0.4 mm. An approach from in front is pushed with its
+  // whole depth, as before.
+  const double e = 210e9, h = Column::h, factor = 0.1, mm = 1e-3;
+  const Column col;
+  const Model& model = col.model;
+  const BlockAssembler& assembler = col.assembler;
+  const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
+  const auto top_down = [&](double by) { return col.top_down(by); };
+  const double k = factor * e * (h * h / 4) / h;
+  SelfContact c("self", model, {"zmin", "zmax", "between"}, {factor, 0.4});
+  c.set_eroded([&](std::size_t el) { return col.middle(el); });
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  c.set_time(0.0, 0.0);
+  c.add(top_down(0.0), f, nullptr, assembler);
+  CHECK(c.active_nodes() == 0);
+  c.set_time(1e-6, 1.0);
+  c.add(top_down(h + 4.5 * mm), f, nullptr, assembler);
+  c.commit();
+  CHECK(c.active_nodes() == 0);  // deeper than 0.4 h
+  f.setZero();
+  c.add(top_down(h + 3.5 * mm), f, nullptr, assembler);
+  c.commit();
+  INFO("energy at 3.5 mm on the way out " << c.stored_energy() << " J (1/2 k g^2 x 8 = "
+                                          << 8 * 0.5 * k * 3.5 * mm * 3.5 * mm << " J)");
+  CHECK(c.active_nodes() == 0);
+  CHECK(c.stored_energy() == 0.0);
+  CHECK(f.norm() == 0.0);
+  f.setZero();
+  c.add(top_down(h + 3.9 * mm), f, nullptr, assembler);
+  CHECK(c.active_nodes() == 8);
+  CHECK(c.stored_energy() == Approx(8 * 0.5 * k * 0.4 * mm * 0.4 * mm).epsilon(1e-6));
+  // the state committed at 3.5 mm restored: the same pre-penetration, the same springs
+  const std::vector<double> state = c.committed_state();
+  SelfContact again("self", model, {"zmin", "zmax", "between"}, {factor, 0.4});
+  again.set_eroded([&](std::size_t el) { return col.middle(el); });
+  again.set_committed_state(state);
+  again.add(top_down(h + 3.5 * mm), f, nullptr, assembler);
+  CHECK(again.stored_energy() == 0.0);
+  again.set_time(2e-6, 1.0);
+  again.add(top_down(h + 3.9 * mm), f, nullptr, assembler);
+  CHECK(again.stored_energy() == Approx(c.stored_energy()).epsilon(1e-12));
+
+  // from in front: 1 mm through in one step is its own approach, pushed with 1 mm
+  SelfContact front("self", model, {"zmin", "zmax", "between"}, {factor, 0.4});
+  front.set_eroded([&](std::size_t el) { return col.middle(el); });
+  front.set_time(0.0, 0.0);
+  front.add(top_down(0.0), f, nullptr, assembler);
+  front.set_time(1e-6, 1.0);
+  front.add(top_down(h + 1 * mm), f, nullptr, assembler);
+  CHECK(front.active_nodes() == 8);
+  CHECK(front.stored_energy() == Approx(8 * 0.5 * k * mm * mm));
+}
