@@ -113,7 +113,7 @@ SelfContact::SelfContact(std::string name, const Model& model, const std::vector
   pre_.assign(nodes_.size(), 0.0);
   pre_trial_ = pre_;
   face_active_committed_.assign(faces_.size(), 0);  // at the start every face is new
-  held_.assign(nodes_.size(), 0);
+  held_.assign(nodes_.size(), triangles_.size());
   held_trial_ = held_;
   x_committed_.assign(nodes_.size(), Vec3::Zero());
   x_trial_ = x_committed_;
@@ -255,7 +255,7 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
   energy_ = force_sum_ = 0.0;
   active_ = 0;
   std::fill(pre_trial_.begin(), pre_trial_.end(), 0.0);
-  std::fill(held_trial_.begin(), held_trial_.end(), 0);
+  std::fill(held_trial_.begin(), held_trial_.end(), triangles_.size());
   for (std::size_t j = 0; j < nodes_.size(); ++j) x_trial_[j] = position(u, nodes_[j]);
   double round_off2 = 0.0;
   for (std::size_t j = 0; j < nodes_.size(); ++j) {
@@ -317,18 +317,23 @@ void SelfContact::add(const Eigen::VectorXd& u, Eigen::VectorXd& f, SparseMatrix
     const double depth = -pr.gap;
     const bool fresh = refreshed && !face_active_committed_[tri.face];
     double pre = fresh ? std::max(pre_[j], depth) : std::min(pre_[j], depth);
-    if (!fresh && !held_[j]) {
-      // a contact not there at the last committed configuration: the depth the node had behind
-      // this face's plane then (the face's and the node's committed positions) is not made by
-      // this step's approach
-      const Vec3& a0 = x_committed_[node_slot_[tri.nodes[0]]];
-      const Vec3 n0 = (x_committed_[node_slot_[tri.nodes[1]]] - a0)
-                          .cross(x_committed_[node_slot_[tri.nodes[2]]] - a0);
-      const double area0 = n0.norm();
-      if (area0 > 0.0) pre = std::clamp(-n0.dot(x_committed_[j] - a0) / area0, 0.0, depth);
+    const std::size_t t = candidates_[start_[j] + best];
+    if (!fresh && held_[j] != t) {
+      // a triangle it did not touch at the last committed configuration: the overlap then
+      // (with the triangle it touched, or none) plus its approach to this one since
+      const auto depth_then = [&](const Triangle& s) {
+        const Vec3& a0 = x_committed_[node_slot_[s.nodes[0]]];
+        const Vec3 n0 = (x_committed_[node_slot_[s.nodes[1]]] - a0)
+                            .cross(x_committed_[node_slot_[s.nodes[2]]] - a0);
+        const double area0 = n0.norm();
+        return area0 > 0.0 ? -n0.dot(x_committed_[j] - a0) / area0 : 0.0;
+      };
+      const double overlap_then =
+          held_[j] < triangles_.size() ? std::max(depth_then(triangles_[held_[j]]) - pre_[j], 0.0) : 0.0;
+      pre = std::clamp(depth_then(tri) - overlap_then, 0.0, depth);
     }
     pre_trial_[j] = pre;
-    held_trial_[j] = 1;
+    held_trial_[j] = t;
     const double overlap = depth - pre;
     if (!(overlap > 0.0)) continue;
     ++active_;
@@ -362,11 +367,12 @@ void SelfContact::commit() {
   x_committed_.swap(x_trial_);
 }
 
-// [pre-penetration per node][face took part per face][in contact per node][position per node, x y z]
+// [pre-penetration per node][face took part per face][triangle touched per node (the count of
+// triangles: none)][position per node, x y z]
 const std::vector<double>& SelfContact::committed_state() const {
   state_.assign(pre_.begin(), pre_.end());
   for (const char a : face_active_committed_) state_.push_back(a ? 1.0 : 0.0);
-  for (const char h : held_) state_.push_back(h ? 1.0 : 0.0);
+  for (const std::size_t t : held_) state_.push_back(static_cast<double>(t));
   for (const Vec3& x : x_committed_) state_.insert(state_.end(), {x.x(), x.y(), x.z()});
   return state_;
 }
@@ -381,7 +387,11 @@ void SelfContact::set_committed_state(const std::vector<double>& state) {
     face_active_committed_[f] = state[n + f] != 0.0 ? 1 : 0;
   const std::size_t held_at = n + faces_.size(), x_at = held_at + n;
   for (std::size_t j = 0; j < n; ++j) {
-    held_[j] = state[held_at + j] != 0.0 ? 1 : 0;
+    const double t = state[held_at + j];
+    if (!(t >= 0.0 && t <= static_cast<double>(triangles_.size())))
+      throw Error("self contact '" + name_ + "': the state names triangle " + std::to_string(t) +
+                  " of " + std::to_string(triangles_.size()));
+    held_[j] = static_cast<std::size_t>(t);
     x_committed_[j] = Vec3(state[x_at + 3 * j], state[x_at + 3 * j + 1], state[x_at + 3 * j + 2]);
   }
   pre_trial_ = pre_;

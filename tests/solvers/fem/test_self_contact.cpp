@@ -367,3 +367,48 @@ TEST_CASE("self contact: a node that comes back within the caught depth from dee
   CHECK(front.active_nodes() == 8);
   CHECK(front.stored_energy() == Approx(8 * 0.5 * k * mm * mm));
 }
+
+TEST_CASE("self contact: a node passed on to a deeper face keeps its spring's overlap",
+          "[fem][contact][self][rupture]") {
+  // three 10 mm blocks of one mesh: b1 below z = 0, b2 in the same place raised 2 mm, t (2 mm
+  // across) above them. t comes down 2 mm in a step, from 1 mm above to 1 mm into b1's top face
+  // (it is 3 mm behind b2's, which b1's lies in front of: b1's face is the nearest): its four
+  // bottom nodes' springs hold 1 mm, and its four top nodes', 1 mm into b2's top face, too. Then
+  // b1 erodes: the bottom nodes pass on to b2's top face, 3 mm deep. The springs keep their 1 mm
+  // (pushed with 3 mm the bottom ones would store 9 times the energy).
+  const double h = 0.01, mm = 1e-3;
+  Mesh mesh;
+  BoxSpec b;
+  b.origin = Vec3(0, 0, -h);
+  b.size = Vec3(h, h, h);
+  append_box(mesh, b, "b1");
+  b.origin = Vec3(0, 0, -h + 2 * mm);
+  append_box(mesh, b, "b2");
+  b.origin = Vec3(4 * mm, 4 * mm, 1 * mm);
+  b.size = Vec3(2 * mm, 2 * mm, 2 * mm);
+  append_box(mesh, b, "t");
+  const Model model(mesh, Material{210e9, 0.3, 7850});
+  const BlockAssembler assembler(model.mesh());
+  const auto n = static_cast<Eigen::Index>(3 * model.mesh().num_nodes());
+  const std::vector<std::size_t> t_nodes = model.mesh().node_set("t");
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(n), f = Eigen::VectorXd::Zero(n);
+  SelfContact c("self", model, {"surface"});
+  c.set_time(0.0, 0.0);
+  c.add(u, f, nullptr, assembler);
+  c.commit();
+  for (auto node : t_nodes) u[3 * static_cast<Eigen::Index>(node) + 2] = -2 * mm;
+  c.set_time(1e-6, 1.0);
+  c.add(u, f, nullptr, assembler);
+  c.commit();
+  const double held = c.stored_energy();
+  CHECK(c.active_nodes() == 8);
+  CHECK(held > 0.0);
+  c.set_eroded([](std::size_t el) { return el == 0; });  // b1
+  c.set_time(1e-6, 0.0);
+  f.setZero();
+  c.add(u, f, nullptr, assembler);
+  INFO("springs' energy with b1's face " << held << " J, passed on to b2's " << c.stored_energy()
+                                         << " J");
+  CHECK(c.active_nodes() == 8);
+  CHECK(c.stored_energy() == Approx(held).epsilon(1e-9));
+}

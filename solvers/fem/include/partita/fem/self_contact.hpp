@@ -63,12 +63,14 @@ struct SelfContactOptions {
 // energy 1/2 k g^2 of that depth from nowhere. Such a contact keeps the depth it was found at
 // as a pre-penetration and pushes only beyond it (p = k (|g| - pre) n, W = 1/2 k (|g| - pre)^2),
 // the pre-penetration followed down as the node comes out (as the DEM's mesh contacts do with a
-// face exposed under a particle). Likewise a contact that was not there at the last committed
-// configuration can be deeper only by the node's approach to the face since then: where the node
-// already lay behind the face's plane (deeper than the depth that catches it, coming back out, or
-// beside the face, sliding under it) the depth it had is a pre-penetration (up to the present
-// one), else 1/2 k g^2 of a depth no motion made would push it. Committed state: per contact node
-// the pre-penetration, whether it was in contact and its position; which faces took part.
+// face exposed under a particle). Likewise a contact with a triangle the node did not touch at
+// the last committed configuration (a new contact, or one passed on from another triangle) can
+// have grown only by the node's approach to that triangle since then: the spring takes up the
+// overlap it had (with the other triangle, or none) plus that approach, and the rest of the depth
+// is a pre-penetration. Else a node coming back within the caught depth from deeper, sliding
+// under a face from beside it, or passed on to a deeper face would be pushed with 1/2 k g^2 of a
+// depth no motion made. Committed state: per contact node the pre-penetration, the triangle it
+// touched and its position; which faces took part.
 //
 // Explicit (central difference) analyses only: it offers no tangent. Stable step:
 // max_frequency_squared() estimates M^-1 K_c's largest eigenvalue for a node in one pair whose
@@ -148,9 +150,9 @@ class SelfContact final : public OperatorContribution {
   // whether it took part at the last committed configuration (a face not there then is new)
   std::vector<double> pre_, pre_trial_;
   std::vector<char> face_active_committed_;
-  // per contact node, at the last committed configuration and at the last add(): in contact (a
-  // face found behind which it lies, pushing or not), its position
-  std::vector<char> held_, held_trial_;
+  // per contact node, at the last committed configuration and at the last add(): the triangle
+  // it touched (behind which it lay, pushing or not; none: triangles_.size()), its position
+  std::vector<std::size_t> held_, held_trial_;
   std::vector<Vec3> x_committed_, x_trial_;
   mutable std::vector<double> state_;
   double energy_ = 0.0, round_off_ = 0.0, force_sum_ = 0.0;
