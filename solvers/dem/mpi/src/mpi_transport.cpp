@@ -69,12 +69,19 @@ void MpiSubdomainTransport::post(Kind kind, int peer, MPI_Request request) {
 }
 
 void MpiSubdomainTransport::wait_all(const char* what) {
+  wait_first(requests_.size(), what);
+  requests_.clear();
+  kind_.clear();
+  peer_.clear();
+}
+
+void MpiSubdomainTransport::wait_first(std::size_t count, const char* what) {
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
   auto nap = std::chrono::microseconds(0);
   for (;;) {
     int done = 0;
-    MPI_Testall(static_cast<int>(requests_.size()), requests_.data(), &done, MPI_STATUSES_IGNORE);
+    MPI_Testall(static_cast<int>(count), requests_.data(), &done, MPI_STATUSES_IGNORE);
     if (done) break;
     const double waited = std::chrono::duration<double>(clock::now() - start).count();
     if (waited > deadline_) {
@@ -84,7 +91,7 @@ void MpiSubdomainTransport::wait_all(const char* what) {
           << std::setprecision(3) << waited << " s (deadline " << deadline_ << " s) in call "
           << calls_ << " for " << what << "; still awaited:";
       std::vector<int> silent;
-      for (std::size_t k = 0; k < requests_.size(); ++k) {
+      for (std::size_t k = 0; k < count; ++k) {
         int flag = 0;
         if (requests_[k] != MPI_REQUEST_NULL) MPI_Test(&requests_[k], &flag, MPI_STATUS_IGNORE);
         else flag = 1;
@@ -112,9 +119,6 @@ void MpiSubdomainTransport::wait_all(const char* what) {
       std::this_thread::sleep_for(nap);
     }
   }
-  requests_.clear();
-  kind_.clear();
-  peer_.clear();
 }
 
 void MpiSubdomainTransport::exchange(std::vector<SubdomainMail>& out,
@@ -129,7 +133,8 @@ void MpiSubdomainTransport::exchange(std::vector<SubdomainMail>& out,
   in[0].resize(p);
   SubdomainMail& o = out[0];
   SubdomainMail& i = in[0];
-  // the sizes
+  // the sizes, and this rank's buffers sent at once behind them (a receiver matches them once it
+  // knows their sizes): one wait for the others instead of two
   for (std::size_t r = 0; r < p; ++r) {
     if (r == me) continue;
     send_size_[r] = o[r].size();
@@ -139,7 +144,17 @@ void MpiSubdomainTransport::exchange(std::vector<SubdomainMail>& out,
     MPI_Isend(&send_size_[r], 1, MPI_UINT64_T, static_cast<int>(r), kSizeTag, comm_, &q);
     post(Kind::size_sent, static_cast<int>(r), q);
   }
-  wait_all("the sizes of the messages of an exchange");
+  for (std::size_t r = 0; r < p; ++r) {
+    if (r == me) continue;
+    const std::uint64_t n = o[r].size();
+    for (std::uint64_t at = 0; at < n; at += piece_) {
+      MPI_Request q;
+      MPI_Isend(o[r].data() + at, static_cast<int>(std::min(piece_, n - at)), MPI_BYTE,
+                static_cast<int>(r), kDataTag, comm_, &q);
+      post(Kind::data_sent, static_cast<int>(r), q);
+    }
+  }
+  wait_first(2 * (p - 1), "the sizes of the messages of an exchange");
   // the non-empty buffers, in pieces
   for (std::size_t r = 0; r < p; ++r) {
     if (r == me) continue;
@@ -154,16 +169,6 @@ void MpiSubdomainTransport::exchange(std::vector<SubdomainMail>& out,
       MPI_Irecv(b.data() + at, static_cast<int>(std::min(piece_, n - at)), MPI_BYTE,
                 static_cast<int>(r), kDataTag, comm_, &q);
       post(Kind::data_received, static_cast<int>(r), q);
-    }
-  }
-  for (std::size_t r = 0; r < p; ++r) {
-    if (r == me) continue;
-    const std::uint64_t n = o[r].size();
-    for (std::uint64_t at = 0; at < n; at += piece_) {
-      MPI_Request q;
-      MPI_Isend(o[r].data() + at, static_cast<int>(std::min(piece_, n - at)), MPI_BYTE,
-                static_cast<int>(r), kDataTag, comm_, &q);
-      post(Kind::data_sent, static_cast<int>(r), q);
     }
   }
   i[me].swap(o[me]);

@@ -3,9 +3,11 @@
 // subdomain r (one local subdomain a rank). Library partita::dem_mpi, built where CMake finds
 // MPI; the DEM core (partita::dem) stays free of MPI.
 //
-// exchange(): the sizes first (one u64 from every rank to every other, non-blocking point to
-// point), then the non-empty buffers only, each to its rank, in pieces of at most 1 GiB (MPI
-// counts are int); the buffer a rank sends itself is swapped, not sent. The receive buffers are
+// exchange(): the sizes (one u64 from every rank to every other, non-blocking point to point)
+// and, posted with them, the non-empty buffers, each to its rank, in pieces of at most 1 GiB (MPI
+// counts are int); a rank posts its receives once it has the sizes, so an exchange waits for the
+// others once, not twice (a rank that shares its core answers a step sooner). The buffer a rank
+// sends itself is swapped, not sent. The receive buffers are
 // the caller's `in`, resized: no allocation once they have grown. max(): every rank's number to
 // every other (8 bytes each), the largest taken in rank order on every rank.
 //
@@ -69,8 +71,11 @@ class MpiSubdomainTransport final : public SubdomainTransport {
   // what a request waits for, for the message past the deadline
   enum class Kind { size_sent, size_received, data_sent, data_received, value_sent, value_received };
   void post(Kind kind, int peer, MPI_Request request);
-  // polls requests_ until all complete; PeerTimeout past the deadline naming what is pending
+  // polls requests_ until all complete, then forgets them; PeerTimeout past the deadline naming
+  // what is pending
   void wait_all(const char* what);
+  // the same for the first `count` requests, which it keeps (completed: MPI_REQUEST_NULL)
+  void wait_first(std::size_t count, const char* what);
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   int rank_ = 0, size_ = 1;
