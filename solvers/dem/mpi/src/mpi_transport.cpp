@@ -155,7 +155,7 @@ void MpiSubdomainTransport::exchange(std::vector<SubdomainMail>& out,
     }
   }
   wait_first(2 * (p - 1), "the sizes of the messages of an exchange");
-  // the non-empty buffers, in pieces
+  // the receives of the non-empty buffers, in pieces, now that their sizes are in
   for (std::size_t r = 0; r < p; ++r) {
     if (r == me) continue;
     std::vector<std::byte>& b = i[r];
