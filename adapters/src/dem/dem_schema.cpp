@@ -165,7 +165,9 @@ std::shared_ptr<Spec> make_spec() {
                "with other particles: the contact's mean pressure is held at its strength, the "
                "overlap beyond becomes permanent and its work joins damping_work; a fragment "
                "pinched between two closing faces or by its neighbours is flattened instead of "
-               "storing the elastic energy of an overlap of its own size; planes stay elastic)",
+               "storing the elastic energy of an overlap of its own size; against a mesh it "
+               "yields until its centre reaches the face and is elastic beyond, so it is not "
+               "pressed through the surface; planes stay elastic)",
                {"unbreakable", "powder", "yield"})
       .def("unbreakable");
   breakage

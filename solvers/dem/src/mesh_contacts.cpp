@@ -270,8 +270,14 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     const bool found_deep =
         Energy && from_old[a] < 0 && !m.triangle_fresh(k.triangle) && k.delta > reach;
     double work = 0.0;
+    // A particle flattened until its centre reaches the surface (a permanent overlap of its
+    // radius) yields no further: it is as compact as it gets there, and beyond it the contact is
+    // elastic (Hertz on delta - r), so a fragment pressed against the steel harder than its
+    // yield force stays at the face. (Without the bound a centre would sink through the surface
+    // under any force above F_y; deeper than r behind it no face touches it, and it would fly on
+    // inside the structure and out through the far side.)
     const double delta = yield_overlap(k.delta, r, pp.e_star, q.yield_pressure, pre,
-                                       Energy && !found_deep ? &work : nullptr);
+                                       Energy && !found_deep ? &work : nullptr, r);
     if constexpr (Energy) {
       const double growth = static_cast<double>(pre) - static_cast<double>(pre_before);
       wd->plastic += growth > reach ? work * (reach / growth) : work;

@@ -269,6 +269,82 @@ TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh yields 
   CHECK(elastic.elastic > 50.0 * yielding.elastic);
 }
 
+TEST_CASE("dem: a yielding granule pressed into a thick steel block harder than it yields is "
+          "flattened to its centre and then held elastically, in front of the block",
+          "[dem][breakage][energy]") {
+  // A granule below the comminution limit (below_limit yield) on the top face of a closed
+  // one-sided block 4 d thick, pressed by a body force of 10 f_y (gravity). Its mesh contact
+  // yields at f_y until its permanent overlap is the granule's radius (the centre on the face),
+  // then carries the rest elastically: it comes to rest with the Hertz overlap of 10 f_y beyond
+  // that, its centre that little behind the face, the block carrying its weight. A permanent
+  // overlap without bound would let it sink at f_y through the face, lose the contact deeper
+  // than r and fall through the block.
+  BreakageParameters b = parameters(3.0);
+  const double d = 2.0e-3, r = 0.5 * d;
+  b.comminution_limit = 2.5e-3;
+  b.yield = true;
+  const double e_eff = 1.0 / ((1.0 - NU * NU) / E + (1.0 - NU_P * NU_P) / E_P);
+  const double f_y = eq2_force(d, b);
+  const double delta_y = std::pow(3.0 * f_y / (4.0 * e_eff * std::sqrt(r)), 2.0 / 3.0);
+  const double mass = test::sphere_mass(r, RHO), weight = 10.0 * f_y;
+  // the Hertz overlap (R = r) that carries the weight
+  const double delta_w = std::pow(3.0 * weight / (4.0 * e_eff * std::sqrt(r)), 2.0 / 3.0);
+  System sys;
+  const int g = sys.add_material({E, NU, RHO});
+  const int s = sys.add_material({E_P, NU_P, 7850.0});
+  sys.add_interaction(g, g, {0.3, 0.5, 0.0});
+  sys.add_interaction(g, s, {0.3, 0.5, 0.0});
+  sys.add_particle({0.1 * d, 0.2 * d, r}, r, g);  // touching the top face z = 0
+  // the block [-4d, 4d]^2 x [-4d, 0]: 8 corners, 12 triangles counter-clockwise from outside
+  const double a = 4.0 * d;
+  Eigen::MatrixX3d x(8, 3);
+  for (int c = 0; c < 8; ++c)
+    x.row(c) << ((c & 1) ? a : -a), ((c & 2) ? a : -a), ((c & 4) ? 0.0 : -a);
+  const int quads[6][4] = {{4, 5, 7, 6}, {0, 2, 3, 1}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  TriangleMesh::Triangles t(12, 3);
+  for (int f = 0; f < 6; ++f) {
+    t.row(2 * f) << quads[f][0], quads[f][1], quads[f][2];
+    t.row(2 * f + 1) << quads[f][0], quads[f][2], quads[f][3];
+  }
+  const int block = sys.add_mesh(x, t, s);
+  sys.set_mesh_one_sided(block, true);
+  for (int k = 0; k < 12; ++k) {  // (the orientation: every normal points away from the centre)
+    const Eigen::Vector3d c = (x.row(t(k, 0)) + x.row(t(k, 1)) + x.row(t(k, 2))).transpose() / 3.0;
+    REQUIRE(sys.mesh(block).normal(k).dot(c - Eigen::Vector3d(0, 0, -0.5 * a)) > 0.0);
+  }
+  sys.set_gravity({0.0, 0.0, -weight / mass});
+  sys.add_hook(std::make_unique<Breakage>(b));
+  sys.set_energy_tracking(true);
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  // falling freely through the block's 4 d would take sqrt(2 * 5 d / g), under 0.3 ms: 3 ms
+  double z_min = 1.0;
+  const auto steps = static_cast<long>(3.0e-3 / dt);
+  for (long k = 0; k < steps; ++k) {
+    sys.step(dt);
+    z_min = std::min(z_min, sys.particles().position[0].z());
+  }
+  const double z = sys.particles().position[0].z();
+  const double force = sys.mesh_force(block).z();
+  INFO("f_y " << f_y << " N, weight " << weight << " N; centre at " << z << " m (lowest " << z_min
+              << " m, expected " << -delta_w << " m); block's force " << force
+              << " N; yield and damping work " << sys.energies().damping << " J (f_y r "
+              << f_y * r << " J); balance error " << sys.energy_balance_error());
+  REQUIRE(sys.particle_count() == 1);
+  // at rest on the block: flattened by r, then the elastic overlap of its weight
+  CHECK(z == Approx(-delta_w).epsilon(0.02));
+  // the arrest overshoots (the kinetic energy of the sinking, at most (weight - f_y) r, taken up
+  // by the Hertz contact: 0.13 r here), never near r behind the face, where none would touch it
+  const double overshoot = std::pow(15.0 * (weight - f_y) * r / (8.0 * e_eff * std::sqrt(r)), 0.4);
+  CHECK(z_min > -1.1 * overshoot);
+  CHECK(overshoot < 0.25 * r);
+  CHECK(-force == Approx(weight).epsilon(0.01));
+  CHECK(sys.particles().velocity[0].norm() < 1e-3);
+  // the yield work: f_y times the permanent overlap r (and the damping's share of the rest)
+  CHECK(sys.energies().damping > f_y * (r - delta_y));
+  CHECK(std::abs(sys.energy_balance_error()) < 2e-3);
+}
+
 namespace {
 
 // A yielding granule (below the comminution limit) on a floor, squeezed by a tenth of its

@@ -29,7 +29,10 @@ struct BreakageParameters {
   /// elastic-perfectly plastic contact, Thornton 1997 with the yield pressure p_y = sigma;
   /// yield_overlap()) and its work is dissipated (booked with the damping). A fragment that two
   /// closing faces or its neighbours pinch is flattened instead of storing the Hertz energy of an
-  /// overlap of its own size; its mass stays in the bed. Planes stay elastic.
+  /// overlap of its own size; its mass stays in the bed. A mesh contact yields until its
+  /// permanent overlap is the particle's radius (the centre at the face) and is elastic beyond,
+  /// so that a fragment pressed harder than it yields is not pushed through the surface.
+  /// Planes stay elastic.
   bool yield = false;
   FragmentPattern::Kind pattern = FragmentPattern::Kind::apollonian_14;
   /// false: the mass the inscribed fragments cannot hold is lost (counted); true: it is restored

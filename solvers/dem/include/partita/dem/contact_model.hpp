@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -238,22 +239,30 @@ inline double pair_yield_pressure(double pi, double pj) {
 /// pressure 4 E* sqrt(delta) / (3 pi sqrt(r_eff)) reaches p_y); beyond it the permanent overlap
 /// grows to delta - delta_y and the elastic force F_y = 4/3 E* sqrt(r_eff) delta_y^(3/2) does the
 /// work F_y x its growth (added to *work). Returns the elastic overlap (>= 0); p_y <= 0: no
-/// yield (the permanent overlap only followed down). The permanent overlap is a float (a pair's
-/// or a mesh contact's 4 bytes); the work is taken on the stored values.
+/// yield (the permanent overlap only followed down). The permanent overlap grows by yielding
+/// to at most max_plastic (a larger one carried in, such as a pre-overlap, is kept): beyond it
+/// the contact is elastic again, its Hertz force growing with delta - max_plastic. The
+/// permanent overlap is a float (a pair's or a mesh contact's 4 bytes); the work is taken on the
+/// stored values.
 inline double yield_overlap(double delta, double r_eff, double e_star, double p_y, float& plastic,
-                            double* work) {
+                            double* work,
+                            double max_plastic = std::numeric_limits<double>::infinity()) {
   float pl = std::min(plastic, static_cast<float>(delta));
   double elastic = pl > 0.0f ? std::max(0.0, delta - static_cast<double>(pl)) : delta;
   if (p_y > 0.0) {
     const double root = 0.75 * std::numbers::pi * p_y / e_star;
     const double delta_y = r_eff * root * root;
     if (elastic > delta_y) {
-      const float yielded = static_cast<float>(delta - delta_y);
-      if (work != nullptr)
-        *work += (4.0 / 3.0) * e_star * std::sqrt(r_eff) * delta_y * std::sqrt(delta_y) *
-                 (static_cast<double>(yielded) - static_cast<double>(pl));
-      pl = yielded;
-      elastic = std::max(0.0, delta - static_cast<double>(pl));
+      float yielded = static_cast<float>(delta - delta_y);
+      const bool capped = static_cast<double>(yielded) > max_plastic;
+      if (capped) yielded = std::max(pl, static_cast<float>(max_plastic));
+      if (!capped || yielded > pl) {
+        if (work != nullptr)
+          *work += (4.0 / 3.0) * e_star * std::sqrt(r_eff) * delta_y * std::sqrt(delta_y) *
+                   (static_cast<double>(yielded) - static_cast<double>(pl));
+        pl = yielded;
+        elastic = std::max(0.0, delta - static_cast<double>(pl));
+      }
     }
   }
   plastic = pl;
