@@ -108,3 +108,45 @@ TEST_CASE("dem: a partial Velocities section is refused with the file, line and 
   REQUIRE(rest.size() == 3);
   for (std::size_t i = 0; i < 3; ++i) CHECK(rest.velocity[i].norm() == 0.0);
 }
+
+TEST_CASE("dem: a particle file's numbers are read whole and finite, with a trailing comment",
+          "[dem][io][errors]") {
+  const auto dir = std::filesystem::path(PARTITA_BINARY_DIR) / "test_output" / "dem";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "fields.data").string();
+  auto write = [&](const std::string& atom, const std::string& velocity) {
+    std::ofstream f(path);
+    f << "one atom\n\n1 atoms\n1 atom types\n\nAtoms # sphere\n\n" << atom
+      << "\n\nVelocities\n\n" << velocity << "\n";
+  };
+  // as LAMMPS writes them: exponents, a '+' sign, tabs, a comment after the values
+  write("7 1 2.5e-3 +400 -1.5E-2\t0 0.01  # a comment", "7 0 0 -1e+0 0 0 0.5");
+  const LammpsData d = LammpsData::read(path);
+  REQUIRE(d.size() == 1);
+  CHECK(d.id[0] == 7);
+  CHECK(d.diameter[0] == 2.5e-3);
+  CHECK(d.density[0] == 400.0);
+  CHECK(d.position[0].x() == -1.5e-2);
+  CHECK(d.position[0].z() == 0.01);
+  CHECK(d.velocity[0].z() == -1.0);
+  CHECK(d.angular_velocity[0].z() == 0.5);
+  // a number run into letters, an infinite or missing one: refused with the file and line
+  const auto refused = [&](const std::string& atom, const std::string& velocity,
+                           const std::string& what) {
+    write(atom, velocity);
+    try {
+      (void)LammpsData::read(path);
+      FAIL("accepted: '" << atom << "' / '" << velocity << "'");
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      INFO(m);
+      CHECK(m.find(path + ":") != std::string::npos);
+      CHECK(m.find(what) != std::string::npos);
+    }
+  };
+  refused("7 1 2.5e-3 400 0 0 0.01abc", "7 0 0 0 0 0 0", "expected 'id type diameter density x y z'");
+  refused("7 1 2.5e-3 400 inf 0 0.01", "7 0 0 0 0 0 0", "finite numbers");
+  refused("7 1 2.5e-3 400 0 0", "7 0 0 0 0 0 0", "expected 'id type diameter density x y z'");
+  refused("7.5 1 2.5e-3 400 0 0 0.01", "7 0 0 0 0 0 0", "expected 'id type");
+  refused("7 1 2.5e-3 400 0 0 0.01", "7 0 0 nan 0 0 0", "expected 'id vx vy vz wx wy wz'");
+}
