@@ -48,7 +48,13 @@ void add_yield(Contacts& c, std::mt19937_64& rng) {
   for (const PairTask& t : c.tasks) {
     const double overlap = c.packed[t.i].r + c.packed[t.j].r - (c.packed[t.i].x - c.packed[t.j].x).norm();
     const int kind = t.s % 4;
-    c.plastic.push_back(kind == 0 ? 0.0f : static_cast<float>(overlap * (kind == 1 ? 0.3 : kind == 2 ? 0.999 : 1.5)));
+    // (a pair of which neither particle is below the size never yields, so it has no
+    // permanent overlap: PairYield)
+    const bool can_yield = 2.0 * c.packed[t.i].r < c.below_diameter ||
+                           2.0 * c.packed[t.j].r < c.below_diameter;
+    c.plastic.push_back(kind == 0 || !can_yield
+                            ? 0.0f
+                            : static_cast<float>(overlap * (kind == 1 ? 0.3 : kind == 2 ? 0.999 : 1.5)));
   }
 }
 

@@ -224,6 +224,8 @@ struct PairYield {
   const double* pressure;  ///< per particle: the yield pressure [Pa] (<= 0: none)
   double below_diameter;   ///< it applies to particles with 2 r below this [m]
   float* plastic;          ///< per pair slot: the permanent overlap [m]
+  // A pair of which neither particle is below below_diameter never yields, so its permanent
+  // overlap is 0 (a new pair's slot starts at 0): the kernels skip such pairs' slots.
 };
 
 /// The yield pressure of a pair whose particles yield at pi and pj (<= 0: that one does not):
