@@ -166,8 +166,10 @@ std::shared_ptr<Spec> make_spec() {
                "overlap beyond becomes permanent and its work joins damping_work; a fragment "
                "pinched between two closing faces or by its neighbours is flattened instead of "
                "storing the elastic energy of an overlap of its own size; against a mesh it "
-               "yields until its centre reaches the face and is elastic beyond, so it is not "
-               "pressed through the surface; planes stay elastic)",
+               "yields until its centre reaches the face and is elastic beyond, and where a "
+               "contact's pressure reaches 1.5 times its strength (pressed on there, against a "
+               "plane, which stays elastic, or in a hard impact) it is crushed to powder, counted "
+               "as above: it is not pressed through the surface)",
                {"unbreakable", "powder", "yield"})
       .def("unbreakable");
   breakage

@@ -64,10 +64,15 @@ void Breakage::attach(System& system) {
 void Breakage::set_limit(System& system, std::size_t i, double strength) const {
   ParticleStore& store = system.store_unsynced();
   const double pi3 = std::numbers::pi * std::numbers::pi * std::numbers::pi;
+  const double limit = 9.0 / 16.0 * pi3 * strength * strength * strength;
+  // below the limit, yielding: a yielding contact holds its mean pressure at the strength (its
+  // load at the limit); one pressed to 1.5 times that (a mesh contact flattened to the centre and
+  // pressed on elastically, a plane, a hard impact) crushes the particle to powder
+  constexpr double squeezed = 1.5 * 1.5 * 1.5;
   store.array<double>(h_limit_)[i] =
       parameters_.powder || 2.0 * store.core().radius[i] >= parameters_.comminution_limit
-          ? 9.0 / 16.0 * pi3 * strength * strength * strength
-          : std::numeric_limits<double>::infinity();
+          ? limit
+          : parameters_.yield ? squeezed * limit : std::numeric_limits<double>::infinity();
 }
 
 double Breakage::characteristic_strength(double diameter) const {
@@ -100,7 +105,8 @@ void Breakage::end_of_step(System& system, double /*dt*/) {
   if (load.size() != n) return;  // no force pass since the set changed
   if (!system.contact_load_reached()) return;  // (every load below its limit)
   // break when F (E'/r')^2 >= (9/16) pi^3 sigma^3 (eq. 2, see the class comment): into
-  // fragments for d >= d_min, to powder below it (the limit is infinite there without powder)
+  // fragments for d >= d_min, to powder below it (the limit is infinite there when the particle
+  // is unbreakable, 1.5^3 times eq. 2's when it yields: set_limit())
   const std::vector<double>& limit = store.array<double>(h_limit_);
   broken_.clear();
   powder_.clear();

@@ -269,26 +269,29 @@ TEST_CASE("dem: below the comminution limit a granule squeezed by a mesh yields 
   CHECK(elastic.elastic > 50.0 * yielding.elastic);
 }
 
-TEST_CASE("dem: a yielding granule pressed into a thick steel block harder than it yields is "
-          "flattened to its centre and then held elastically, in front of the block",
-          "[dem][breakage][energy]") {
+TEST_CASE("dem: a yielding granule pressed into a thick steel block is flattened to its centre, "
+          "then held elastically, then crushed to powder at 1.5 times its strength, never "
+          "pushed into the block", "[dem][breakage][energy]") {
   // A granule below the comminution limit (below_limit yield) on the top face of a closed
-  // one-sided block 4 d thick, pressed by a body force of 10 f_y (gravity). Its mesh contact
-  // yields at f_y until its permanent overlap is the granule's radius (the centre on the face),
-  // then carries the rest elastically: it comes to rest with the Hertz overlap of 10 f_y beyond
-  // that, its centre that little behind the face, the block carrying its weight. A permanent
-  // overlap without bound would let it sink at f_y through the face, lose the contact deeper
-  // than r and fall through the block.
+  // one-sided block 4 d thick, pressed by a plane (elastic, as planes are) coming down slowly.
+  // The block's contact yields at f_y until its permanent overlap is the granule's radius (the
+  // centre on the face: the plane has come down by r plus the two contacts' elastic overlaps at
+  // f_y), then both contacts are elastic (Hertz, R = r) and the force rises; at 1.5^3 f_y (the
+  // mean contact pressure 1.5 sigma) the granule is crushed to powder, its mass counted. Its
+  // centre is never deeper behind the face than the Hertz overlap of that force. (A permanent
+  // overlap without bound would let it sink at f_y through the face; deeper than r no face
+  // touches it.)
   BreakageParameters b = parameters(3.0);
-  const double d = 2.0e-3, r = 0.5 * d;
+  const double d = 2.0e-3, r = 0.5 * d, speed = 0.005;
   b.comminution_limit = 2.5e-3;
   b.yield = true;
   const double e_eff = 1.0 / ((1.0 - NU * NU) / E + (1.0 - NU_P * NU_P) / E_P);
-  const double f_y = eq2_force(d, b);
-  const double delta_y = std::pow(3.0 * f_y / (4.0 * e_eff * std::sqrt(r)), 2.0 / 3.0);
-  const double mass = test::sphere_mass(r, RHO), weight = 10.0 * f_y;
-  // the Hertz overlap (R = r) that carries the weight
-  const double delta_w = std::pow(3.0 * weight / (4.0 * e_eff * std::sqrt(r)), 2.0 / 3.0);
+  const double f_y = eq2_force(d, b), f_crush = 1.5 * 1.5 * 1.5 * f_y;
+  const auto hertz_overlap = [&](double f) {  // R = r
+    return std::pow(3.0 * f / (4.0 * e_eff * std::sqrt(r)), 2.0 / 3.0);
+  };
+  const double delta_y = hertz_overlap(f_y), delta_c = hertz_overlap(f_crush);
+  const double mass = test::sphere_mass(r, RHO);
   System sys;
   const int g = sys.add_material({E, NU, RHO});
   const int s = sys.add_material({E_P, NU_P, 7850.0});
@@ -313,35 +316,48 @@ TEST_CASE("dem: a yielding granule pressed into a thick steel block harder than 
     const Eigen::Vector3d c = (x.row(t(k, 0)) + x.row(t(k, 1)) + x.row(t(k, 2))).transpose() / 3.0;
     REQUIRE(sys.mesh(block).normal(k).dot(c - Eigen::Vector3d(0, 0, -0.5 * a)) > 0.0);
   }
-  sys.set_gravity({0.0, 0.0, -weight / mass});
+  sys.add_plane({0, 0, d}, {0, 0, -1}, s, {0, 0, -speed});  // touching the granule's top
   sys.add_hook(std::make_unique<Breakage>(b));
   sys.set_energy_tracking(true);
   const double dt = 0.2 * sys.rayleigh_time_step();
-  // falling freely through the block's 4 d would take sqrt(2 * 5 d / g), under 0.3 ms: 3 ms
-  double z_min = 1.0;
-  const auto steps = static_cast<long>(3.0e-3 / dt);
-  for (long k = 0; k < steps; ++k) {
+  // the plane's travel to the crushing: r + the two elastic overlaps at f_y (yield) + twice
+  // the Hertz overlap of f_crush beyond them; 10 % more
+  const double travel = r + 2.0 * delta_c;
+  const auto steps = static_cast<long>(1.1 * travel / (speed * dt));
+  double z_min = 1.0, f_max = 0.0, f_at_r = 0.0;
+  long crushed_at = -1;
+  for (long k = 0; k < steps && crushed_at < 0; ++k) {
     sys.step(dt);
-    z_min = std::min(z_min, sys.particles().position[0].z());
+    if (sys.particle_count() == 0) {
+      crushed_at = k;
+      break;
+    }
+    const double z = sys.particles().position[0].z();
+    z_min = std::min(z_min, z);
+    const double f = -sys.mesh_force(block).z();
+    f_max = std::max(f_max, f);
+    // the plane's travel at r + 2 delta_y less a tenth of r: still yielding at f_y
+    if (std::abs(speed * dt * static_cast<double>(k + 1) - (0.9 * r + 2.0 * delta_y)) < 0.5 * speed * dt)
+      f_at_r = f;
   }
-  const double z = sys.particles().position[0].z();
-  const double force = sys.mesh_force(block).z();
-  INFO("f_y " << f_y << " N, weight " << weight << " N; centre at " << z << " m (lowest " << z_min
-              << " m, expected " << -delta_w << " m); block's force " << force
-              << " N; yield and damping work " << sys.energies().damping << " J (f_y r "
-              << f_y * r << " J); balance error " << sys.energy_balance_error());
-  REQUIRE(sys.particle_count() == 1);
-  // at rest on the block: flattened by r, then the elastic overlap of its weight
-  CHECK(z == Approx(-delta_w).epsilon(0.02));
-  // the arrest overshoots (the kinetic energy of the sinking, at most (weight - f_y) r, taken up
-  // by the Hertz contact: 0.13 r here), never near r behind the face, where none would touch it
-  const double overshoot = std::pow(15.0 * (weight - f_y) * r / (8.0 * e_eff * std::sqrt(r)), 0.4);
-  CHECK(z_min > -1.1 * overshoot);
-  CHECK(overshoot < 0.25 * r);
-  CHECK(-force == Approx(weight).epsilon(0.01));
-  CHECK(sys.particles().velocity[0].norm() < 1e-3);
-  // the yield work: f_y times the permanent overlap r (and the damping's share of the rest)
-  CHECK(sys.energies().damping > f_y * (r - delta_y));
+  const BreakageCounters& n = breakage_of(sys).counters();
+  INFO("f_y " << f_y << " N, crushing force " << f_crush << " N; the block's force at 0.9 r "
+              << f_at_r << " N, largest " << f_max << " N; lowest centre " << z_min
+              << " m (Hertz overlap of the crushing force " << delta_c << " m); crushed after "
+              << crushed_at << " of " << steps << " steps; powder " << n.powder_events << ", "
+              << n.powder_mass << " kg; yield and damping work " << sys.energies().damping
+              << " J (f_y r " << f_y * r << " J); balance error " << sys.energy_balance_error());
+  // yielding at f_y while it flattens
+  CHECK(f_at_r == Approx(f_y).epsilon(0.01));
+  // crushed once the force reached 1.5^3 f_y, its mass counted, never deep in the block
+  REQUIRE(crushed_at > 0);
+  CHECK(f_max == Approx(f_crush).epsilon(0.01));
+  CHECK(n.powder_events == 1);
+  CHECK(n.powder_mass == Approx(mass).epsilon(1e-12));
+  CHECK(z_min > -1.01 * delta_c);
+  CHECK(delta_c < 0.1 * r);
+  // the yield work: f_y times the permanent overlap r
+  CHECK(sys.energies().damping == Approx(f_y * r).epsilon(0.02));
   CHECK(std::abs(sys.energy_balance_error()) < 2e-3);
 }
 

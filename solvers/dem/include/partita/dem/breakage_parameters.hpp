@@ -30,9 +30,10 @@ struct BreakageParameters {
   /// yield_overlap()) and its work is dissipated (booked with the damping). A fragment that two
   /// closing faces or its neighbours pinch is flattened instead of storing the Hertz energy of an
   /// overlap of its own size; its mass stays in the bed. A mesh contact yields until its
-  /// permanent overlap is the particle's radius (the centre at the face) and is elastic beyond,
-  /// so that a fragment pressed harder than it yields is not pushed through the surface.
-  /// Planes stay elastic.
+  /// permanent overlap is the particle's radius (the centre at the face) and is elastic beyond;
+  /// a particle whose contact pressure reaches 1.5 times its strength there (or against a plane,
+  /// which stays elastic, or in a hard impact) is crushed to powder as with `powder`, so that a
+  /// fragment pressed into the structure is dust at its face, not pushed through it.
   bool yield = false;
   FragmentPattern::Kind pattern = FragmentPattern::Kind::apollonian_14;
   /// false: the mass the inscribed fragments cannot hold is lost (counted); true: it is restored
