@@ -451,6 +451,12 @@ void Breakage::write_state(BinaryWriter& out) const {
   out.value(counters_);
 }
 
+void Breakage::restored(System& system) {
+  const std::vector<double>& strength = system.store_unsynced().array<double>(h_strength_);
+  for (std::size_t i = 0; i < strength.size(); ++i)
+    if (strength[i] >= 0.0) set_limit(system, i, strength[i]);
+}
+
 void Breakage::read_state(BinaryReader& in) {
   in.expect(parameters_.seed, "the breakage seed");
   in.value(counters_, "the breakage counters");

@@ -190,6 +190,7 @@ void System::read_body(BinaryReader& r, std::uint32_t version) {
   r.array(e.wall_work, "the wall work");
   r.array(e.mesh_work, "the mesh work");
   r.expect(end_tag, "the end tag");
+  for (int k = 0; k < hooks_.size(); ++k) hooks_[k].restored(*this);
 }
 
 }  // namespace partita::dem

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <functional>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -1076,4 +1077,41 @@ TEST_CASE("dem: removing a particle high above the origin leaves the energy book
     const double v = 0.3 - 9.81 * 0.05 - 9.81 * 0.5 * dt;
     CHECK(sys.energies().breakage == Approx(0.5 * mass * v * v).epsilon(1e-9));
   }
+}
+
+TEST_CASE("dem: a read state's load limits follow the breakage rule of the reader, not the stored "
+          "ones", "[dem][breakage][restart]") {
+  // The limits are derived from the strengths drawn (Breakage::restored()): a state whose
+  // stored limits follow another rule (here: every one made infinite before writing, as an
+  // unbreakable fine's) resumes with eq. 2's for a breakable granule and 1.5^3 times eq. 2's
+  // for a yielding one, and then with the same limits as the system that wrote it.
+  BreakageParameters b = parameters(3.0);
+  b.comminution_limit = 2.5e-3;
+  b.yield = true;
+  System sys;
+  granule_on_floor(sys, 2.0e-3);                                      // below the limit: yields
+  sys.add_particle({0.01, 0, 1.5e-3}, 1.5e-3, 0);                     // 3 mm: breakable
+  sys.add_hook(std::make_unique<Breakage>(b));
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  sys.run(5, dt);  // (strengths drawn at the first pass)
+  const int h = sys.store().find("breakage_load_limit");
+  const int hs = sys.store().find("breakage_strength");
+  REQUIRE(h >= 0);
+  REQUIRE(hs >= 0);
+  const std::vector<double> limits = sys.store().array<double>(h);
+  const std::vector<double> strength = sys.store().array<double>(hs);
+  const double pi3 = std::numbers::pi * std::numbers::pi * std::numbers::pi;
+  const auto eq2 = [&](std::size_t i) { return 9.0 / 16.0 * pi3 * std::pow(strength[i], 3); };
+  REQUIRE(limits.size() == 2);
+  CHECK(limits[0] == Approx(3.375 * eq2(0)).epsilon(1e-12));
+  CHECK(limits[1] == Approx(eq2(1)).epsilon(1e-12));
+  for (double& l : sys.store_unsynced().array<double>(h)) l = std::numeric_limits<double>::infinity();
+  std::stringstream state;
+  sys.write_state(state);
+  System copy;
+  granule_on_floor(copy, 2.0e-3);
+  copy.add_particle({0.01, 0, 1.5e-3}, 1.5e-3, 0);
+  copy.add_hook(std::make_unique<Breakage>(b));
+  copy.read_state(state);
+  CHECK(copy.store().array<double>(h) == limits);
 }

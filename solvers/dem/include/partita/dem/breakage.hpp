@@ -68,6 +68,9 @@ class Breakage final : public StepHook {
   void end_of_step(System& system, double dt) override;
   void write_state(BinaryWriter& out) const override;
   void read_state(BinaryReader& in) override;
+  /// The load limits again from the strengths drawn (the state's limits may follow another
+  /// version's rule for the particles below the comminution limit).
+  void restored(System& system) override;
 
   // on a split bed (StepHook's protocol): the particles a subdomain owns break there, their
   // fragments numbered by the stepper; the fragments' contact energy (energy_released) is taken

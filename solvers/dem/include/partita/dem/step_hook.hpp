@@ -65,6 +65,9 @@ class StepHook {
   virtual void end_of_step(System& /*system*/, double /*dt*/) {}
   virtual void write_state(BinaryWriter& /*out*/) const {}
   virtual void read_state(BinaryReader& /*in*/) {}
+  /// After a state was read or restored (System::read_state(), restore_state()): the particles
+  /// and their arrays are the state's; a hook derives again what follows from them.
+  virtual void restored(System& /*system*/) {}
 
   // ---- a hook that replaces particles, on a bed split into subdomains ------------------------
   // On a split bed (SubdomainStepper, subdomain.hpp) the subdomains must agree on every change of
