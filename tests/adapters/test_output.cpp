@@ -242,6 +242,12 @@ TEST_CASE("dem adapter: particle and mesh files in every format, forces summing 
     for (std::size_t v = 0; v < 25; ++v) point_z += m.point.at("force").values[3 * v + 2];
     CHECK(cell_z == Approx(fz).epsilon(1e-9));
     CHECK(point_z == Approx(fz).epsilon(1e-9));
+    // every triangle takes part in contacts (none taken out): active 1
+    REQUIRE(m.cell.count("active") == 1);
+    const auto& act = m.cell.at("active");
+    CHECK(act.ints.size() + act.values.size() == 32);
+    for (const auto a : act.ints) CHECK(a == 1);
+    for (const double a : act.values) CHECK(a == 1.0);
     // the plate moved with the displacement it was given
     for (std::size_t v = 0; v < 25; ++v)
       CHECK(m.xyz[3 * v + 2] == Approx(0.0102 + d(0, 2)).epsilon(1e-12));

@@ -51,7 +51,13 @@ void write_mesh_vtp(const dem::System& system, int mesh, const std::filesystem::
                                     m.triangles().size(), 3);
   piece.point_data = {xyz("velocity", m.velocities()),
                       vtk::DataArray::rows("force", vertex_forces)};
-  piece.cell_data = {vtk::DataArray::rows("force", triangle_forces)};
+  // active: 1 where the triangle takes part in contacts, 0 where its surface has gone (the face
+  // of an eroded element, TriangleMesh::triangle_active())
+  std::vector<std::uint8_t> active(m.triangles().size());
+  for (std::size_t t = 0; t < active.size(); ++t)
+    active[t] = m.triangle_active(static_cast<int>(t)) ? 1 : 0;
+  piece.cell_data = {vtk::DataArray::rows("force", triangle_forces),
+                     vtk::DataArray::own("active", std::move(active))};
   vtk::write(path, piece, options);
 }
 
