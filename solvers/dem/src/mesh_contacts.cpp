@@ -7,6 +7,7 @@
 #include <numbers>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <string>
 
 namespace partita::dem {
@@ -59,6 +60,11 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
   int nc = 0;
   int worst = -1;  // index of the least preferred kept candidate once the array is full
   bool any_behind = false;
+  // A yielding particle pinched between two faces closer than its diameter less its radius
+  // (opposite contacts whose overlaps add to more than r, or a face it has passed facing one it
+  // is in front of) is crushed: its load is reported as unbounded (Breakage turns it to powder).
+  // Flattened from both sides it is dust; as a sphere it would be pushed into one of the parts.
+  bool pinched = false;
   const Eigen::Vector3d& x = q.x;
   const double r = q.r;
   for (int k = nl.mesh_offsets_[i]; k < nl.mesh_offsets_[i + 1]; ++k) {
@@ -138,6 +144,11 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
         if (o == c || cand[o].mesh != cand[c].mesh) continue;
         drop[c] = !cand[o].behind || cand[o].delta < cand[c].delta ||
                   (cand[o].delta == cand[c].delta && o < c);
+        // (a face whose point lies in front of the front feature faces it across a gap
+        // narrower than the sphere: two parts closing on it, not the far side of a plate)
+        if (drop[c] && !cand[o].behind &&
+            (cand[c].cp.point - cand[o].cp.point).dot(cand[o].normal) > 0.0)
+          pinched = true;
       }
     }
     int kept = 0;
@@ -316,6 +327,17 @@ void MeshContacts::evaluate(int i, const Particle& q, const NeighborList& nl,
     rec.pre_overlap = pre;
   }
   row.count = na;
+  if constexpr (Load) {
+    if (q.yield_pressure > 0.0) {
+      for (int a = 0; a < na && !pinched; ++a)
+        for (int b = a + 1; b < na && !pinched; ++b) {
+          const Candidate& ka = cand[accepted[a]];
+          const Candidate& kb = cand[accepted[b]];
+          pinched = ka.normal.dot(kb.normal) < -0.5 && ka.delta + kb.delta > r;
+        }
+      if (pinched) load = std::numeric_limits<double>::infinity();
+    }
+  }
 }
 
 template void MeshContacts::evaluate<false, false>(int, const Particle&, const NeighborList&,

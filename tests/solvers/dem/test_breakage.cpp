@@ -1115,3 +1115,71 @@ TEST_CASE("dem: a read state's load limits follow the breakage rule of the reade
   copy.read_state(state);
   CHECK(copy.store().array<double>(h) == limits);
 }
+
+TEST_CASE("dem: a yielding granule pinched between two parts of one one-sided mesh closing on it "
+          "is crushed to powder between them, never pushed into either", "[dem][breakage]") {
+  // Two steel blocks of one one-sided mesh (as the faces of a slot in a web collapsing on a
+  // fragment): the lower one fixed, the upper one coming down slowly onto a granule below the
+  // comminution limit resting on the lower one. Both contacts yield at f_y; once their overlaps
+  // add up to more than the radius (the faces closer than the radius) the granule is crushed to
+  // powder, its centre between the faces all along. (Without the rule it was held at f_y until
+  // the gap closed, flattened to nothing, and as a sphere could be pushed into either part.)
+  BreakageParameters b = parameters(3.0);
+  const double d = 2.0e-3, r = 0.5 * d, speed = 0.005;
+  b.comminution_limit = 2.5e-3;
+  b.yield = true;
+  const double f_y = eq2_force(d, b);
+  System sys;
+  const int g = sys.add_material({E, NU, RHO});
+  const int s = sys.add_material({E_P, NU_P, 7850.0});
+  sys.add_interaction(g, g, {0.3, 0.5, 0.0});
+  sys.add_interaction(g, s, {0.3, 0.5, 0.0});
+  sys.add_particle({0.1 * d, 0.2 * d, r}, r, g);
+  const double a = 4.0 * d;
+  const auto block = [&](Eigen::MatrixX3d& x, TriangleMesh::Triangles& t, int k, double z0) {
+    const int quads[6][4] = {{4, 5, 7, 6}, {0, 2, 3, 1}, {0, 1, 5, 4},
+                             {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (int c = 0; c < 8; ++c)
+      x.row(8 * k + c) << ((c & 1) ? a : -a), ((c & 2) ? a : -a), z0 + ((c & 4) ? a : 0.0);
+    for (int f = 0; f < 6; ++f) {
+      t.row(12 * k + 2 * f) << 8 * k + quads[f][0], 8 * k + quads[f][1], 8 * k + quads[f][2];
+      t.row(12 * k + 2 * f + 1) << 8 * k + quads[f][0], 8 * k + quads[f][2], 8 * k + quads[f][3];
+    }
+  };
+  Eigen::MatrixX3d x0(16, 3);
+  TriangleMesh::Triangles t(24, 3);
+  block(x0, t, 0, -a);  // lower: top face z = 0
+  block(x0, t, 1, d);   // upper: bottom face z = d, touching the granule's top
+  const int mesh = sys.add_mesh(x0, t, s);
+  sys.set_mesh_one_sided(mesh, true);
+  sys.add_hook(std::make_unique<Breakage>(b));
+  const double dt = 0.2 * sys.rayleigh_time_step();
+  const auto steps = static_cast<long>(0.95 * d / (speed * dt));  // to a gap of 0.05 d
+  Eigen::MatrixX3d y = x0;
+  double gap_at_crush = -1.0, z_min = 1.0, behind = -1.0;
+  for (long k = 0; k < steps; ++k) {
+    const double gap = d - speed * dt * static_cast<double>(k + 1);
+    for (int c = 8; c < 16; ++c) y(c, 2) = x0(c, 2) - (d - gap);
+    sys.set_vertex_positions(mesh, y);
+    sys.step(dt);
+    if (sys.particle_count() == 0) {
+      gap_at_crush = gap;
+      break;
+    }
+    const double z = sys.particles().position[0].z();
+    z_min = std::min(z_min, z);
+    behind = std::max(behind, z - gap);
+  }
+  const BreakageCounters& n = breakage_of(sys).counters();
+  INFO("f_y " << f_y << " N; crushed at a gap of " << gap_at_crush << " m (diameter " << d
+              << " m); the centre " << z_min << " m above the lower face at least, " << behind
+              << " m from the upper one at most; powder " << n.powder_events);
+  REQUIRE(gap_at_crush > 0.0);
+  CHECK(n.powder_events == 1);
+  CHECK(n.powder_mass == Approx(test::sphere_mass(r, RHO)).epsilon(1e-12));
+  // crushed once the overlaps add to r: the gap d - r, less the elastic overlaps at f_y
+  CHECK(gap_at_crush < r);
+  CHECK(gap_at_crush > 0.9 * r);
+  CHECK(z_min > 0.0);
+  CHECK(behind < 0.0);
+}
