@@ -168,8 +168,9 @@ std::shared_ptr<Spec> make_spec() {
                "storing the elastic energy of an overlap of its own size; against a mesh it "
                "yields until its centre reaches the face and is elastic beyond, and where a "
                "contact's pressure reaches 1.5 times its strength (pressed on there, against a "
-               "plane, which stays elastic, or in a hard impact) it is crushed to powder, counted "
-               "as above: it is not pressed through the surface)",
+               "plane, which stays elastic, or in a hard impact) or where two faces closer than "
+               "its radius pinch it, it is crushed to powder, counted as above: it is not "
+               "pressed through the surface)",
                {"unbreakable", "powder", "yield"})
       .def("unbreakable");
   breakage

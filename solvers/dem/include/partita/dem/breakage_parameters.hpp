@@ -32,8 +32,9 @@ struct BreakageParameters {
   /// overlap of its own size; its mass stays in the bed. A mesh contact yields until its
   /// permanent overlap is the particle's radius (the centre at the face) and is elastic beyond;
   /// a particle whose contact pressure reaches 1.5 times its strength there (or against a plane,
-  /// which stays elastic, or in a hard impact) is crushed to powder as with `powder`, so that a
-  /// fragment pressed into the structure is dust at its face, not pushed through it.
+  /// which stays elastic, or in a hard impact) is crushed to powder as with `powder`, and so is one
+  /// pinched between two faces closer than its radius (MeshContacts), so that a fragment pressed
+  /// into the structure or caught in a closing gap is dust there, not pushed through a face.
   bool yield = false;
   FragmentPattern::Kind pattern = FragmentPattern::Kind::apollonian_14;
   /// false: the mass the inscribed fragments cannot hold is lost (counted); true: it is restored
